@@ -1,0 +1,42 @@
+# Every target CI uses is here; .ci/run calls `make test`.
+PY ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed-stamp
+SPEC ?= specs/my_robot.yaml
+
+.PHONY: install sysdeps demo test lint bench fuzz clean
+
+$(STAMP): pyproject.toml
+	$(PY) -m venv $(VENV)
+	$(BIN)/python -m pip install -q --upgrade pip
+	$(BIN)/python -m pip install -q -e '.[dev]'
+	touch $(STAMP)
+
+install: $(STAMP)
+
+# Debian tools some tests use (check_urdf, headless Chromium). Tests skip with a
+# reason where these cannot be installed (no apt, not root).
+sysdeps:
+	@bash scripts/sysdeps.sh
+
+demo: install
+	$(BIN)/armcli build $(SPEC)
+	@echo "demo: build done"
+
+lint: install
+	$(BIN)/ruff check src tests bench
+	$(BIN)/ruff format --check src tests bench
+
+test: install sysdeps lint
+	$(BIN)/armcli build --check $(SPEC)
+	$(BIN)/python -m pytest -q
+
+bench: install
+	@echo "no benchmarks yet"
+
+fuzz: install
+	HYPOTHESIS_PROFILE=fuzz $(BIN)/python -m pytest -q tests -k fuzz
+
+clean:
+	rm -rf $(VENV) build dist .pytest_cache .ruff_cache .mypy_cache

@@ -1,0 +1,34 @@
+"""`armcli build`: compile a spec into the xacro set and expanded URDFs."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import typer
+
+from armcli.spec import DEFAULT_SPEC
+
+
+def build_cmd(
+    spec: Path = typer.Argument(DEFAULT_SPEC, help="Robot spec YAML."),
+    out: Path = typer.Option(Path("urdf"), "-o", "--out", help="Output directory."),
+    check: bool = typer.Option(
+        False, "--check", help="Do not write; exit 1 listing files that differ from a fresh build."
+    ),
+) -> None:
+    """Compile SPEC into the course's xacro set and the expanded URDFs."""
+    from armcli.build import build, check_fresh
+
+    if check:
+        check_fresh(spec, out)
+        sys.stdout.write(f"{out}: up to date with {spec}\n")
+        return
+    result = build(spec, out)
+    sys.stdout.write(f"built {len(result.files)} files from {spec} into {out}/\n")
+    for f in result.files:
+        sys.stdout.write(f"  {f}\n")
+
+
+def register(app: typer.Typer) -> None:
+    app.command("build")(build_cmd)

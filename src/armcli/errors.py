@@ -1,0 +1,138 @@
+"""One exception hierarchy; the CLI maps `exit_code` to the process exit status.
+
+Exit codes: 2 = the input cannot be used (bad file, refused xacro, bad option),
+1 = the run worked but its verdict is negative (error findings, stale build,
+diverged simulation). Library code raises these and never prints or exits.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+EXIT_OK = 0
+EXIT_FAILED = 1
+EXIT_UNUSABLE = 2
+
+
+def _where(file: str | Path | None, line: int | None) -> str:
+    if file is None:
+        return ""
+    return f"{file}:{line}" if line else f"{file}"
+
+
+class ArmcliError(Exception):
+    """Base of every error armcli raises on purpose."""
+
+    exit_code: int = EXIT_UNUSABLE
+
+    def lines(self) -> list[str]:
+        """The one-line-per-problem rendering the CLI prints."""
+        return [str(self)]
+
+
+class InputError(ArmcliError):
+    """A file or value the user gave cannot be used."""
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        file: str | Path | None = None,
+        line: int | None = None,
+        field: str | None = None,
+    ) -> None:
+        self.message = message
+        self.file = str(file) if file is not None else None
+        self.line = line
+        self.field = field
+        where = _where(file, line)
+        prefix = " ".join(p for p in (where, field) if p)
+        super().__init__(f"{prefix}: {message}" if prefix else message)
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One validation problem: where it is and what is wrong."""
+
+    field: str
+    message: str
+    line: int | None = None
+
+
+class SpecError(InputError):
+    """A spec (or other structured YAML input) failed validation; one line per problem."""
+
+    def __init__(self, file: str | Path, problems: Sequence[Problem]) -> None:
+        self.problems = list(problems)
+        first = self.problems[0] if self.problems else Problem("", "invalid")
+        super().__init__(first.message, file=file, line=first.line, field=first.field or None)
+
+    def lines(self) -> list[str]:
+        out = []
+        for p in self.problems:
+            where = _where(self.file, p.line)
+            head = " ".join(x for x in (where, p.field) if x)
+            out.append(f"{head}: {p.message}" if head else p.message)
+        return out
+
+
+class XacroRefusedError(InputError):
+    """A foreign xacro file would run code from the file; refused without --trust-xacro."""
+
+
+class BuildError(ArmcliError):
+    """Generating or expanding robot description files failed."""
+
+
+class StaleBuildError(ArmcliError):
+    """`build --check`: committed outputs differ from a fresh build."""
+
+    exit_code = EXIT_FAILED
+
+    def __init__(self, stale: Sequence[str]) -> None:
+        self.stale = list(stale)
+        super().__init__("stale generated files: " + ", ".join(self.stale))
+
+    def lines(self) -> list[str]:
+        return [f"stale: {s}" for s in self.stale] + [
+            f"{len(self.stale)} generated file(s) differ from a fresh build; run `armcli build`"
+        ]
+
+
+class FindingsError(ArmcliError):
+    """`check` found problems of error severity."""
+
+    exit_code = EXIT_FAILED
+
+
+class SimulationError(ArmcliError):
+    """A simulation became non-finite or unphysical; carries the evidence."""
+
+    exit_code = EXIT_FAILED
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        time: float | None = None,
+        step: int | None = None,
+        joint: str | None = None,
+        cause: str | None = None,
+    ) -> None:
+        self.time = time
+        self.step = step
+        self.joint = joint
+        self.cause = cause
+        parts = [message]
+        if time is not None:
+            parts.append(f"at t = {time:.4f} s")
+        if step is not None:
+            parts.append(f"(step {step})")
+        if joint is not None:
+            parts.append(f"joint {joint}")
+        text = " ".join(parts)
+        if cause:
+            text += f"; likely cause: {cause}"
+        super().__init__(text)
