@@ -44,7 +44,9 @@ _register()
 
 
 def _err(line: str) -> None:
-    sys.stderr.write(f"error: {line}\n" if not line.startswith(("stale:", "error")) else line + "\n")
+    sys.stderr.write(
+        f"error: {line}\n" if not line.startswith(("stale:", "error")) else line + "\n"
+    )
 
 
 def main(argv: list[str] | None = None) -> None:

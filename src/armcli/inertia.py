@@ -58,48 +58,48 @@ def rpy_matrix(rpy: Sequence[float]) -> Matrix:
     )
 
 
-def rotate(I: Matrix, R: Matrix) -> Matrix:
-    """Express a tensor given in frame B in frame A, where R = R_A_B: R I R^T."""
-    return R @ I @ R.T
+def rotate(J: Matrix, R: Matrix) -> Matrix:
+    """Express a tensor given in frame B in frame A, where R = R_A_B: R J R^T."""
+    return R @ J @ R.T
 
 
-def parallel_axis(I_c: Matrix, m: float, d: Sequence[float]) -> Matrix:
+def parallel_axis(J_c: Matrix, m: float, d: Sequence[float]) -> Matrix:
     """Move a centroidal tensor to a point displaced by d [m] from the centroid (Steiner)."""
     dv = np.asarray(d, dtype=float)
-    return I_c + m * (float(dv @ dv) * np.eye(3) - np.outer(dv, dv))
+    return J_c + m * (float(dv @ dv) * np.eye(3) - np.outer(dv, dv))
 
 
-def is_symmetric(I: Matrix, rtol: float = 1e-9) -> bool:
-    """True when I equals its transpose up to rtol of its largest entry."""
-    scale = max(float(np.max(np.abs(I))), np.finfo(float).tiny)
-    return bool(np.max(np.abs(I - I.T)) <= rtol * scale)
+def is_symmetric(J: Matrix, rtol: float = 1e-9) -> bool:
+    """True when J equals its transpose up to rtol of its largest entry."""
+    scale = max(float(np.max(np.abs(J))), np.finfo(float).tiny)
+    return bool(np.max(np.abs(J - J.T)) <= rtol * scale)
 
 
-def principal_moments(I: Matrix) -> NDArray[np.float64]:
-    """Eigenvalues of the symmetric part of I, ascending [kg·m²]."""
-    return np.linalg.eigvalsh(0.5 * (I + I.T))
+def principal_moments(J: Matrix) -> NDArray[np.float64]:
+    """Eigenvalues of the symmetric part of J, ascending [kg·m²]."""
+    return np.linalg.eigvalsh(0.5 * (J + J.T))
 
 
-def is_positive_definite(I: Matrix) -> bool:
+def is_positive_definite(J: Matrix) -> bool:
     """True when every principal moment is strictly positive."""
-    return bool(np.all(np.isfinite(I)) and principal_moments(I)[0] > 0.0)
+    return bool(np.all(np.isfinite(J)) and principal_moments(J)[0] > 0.0)
 
 
-def triangle_violation(I: Matrix) -> float:
+def triangle_violation(J: Matrix) -> float:
     """How far the largest principal moment exceeds the sum of the other two, relative.
 
     A physical body satisfies I3 <= I1 + I2 (equality for a flat plate); the
     result is (I3 - I1 - I2) / I3, so <= 0 is fine and > TRIANGLE_RTOL is not.
     """
-    a, b, c = principal_moments(I)
+    a, b, c = principal_moments(J)
     if c <= 0.0:
         return 0.0
     return float((c - a - b) / c)
 
 
-def satisfies_triangle(I: Matrix, rtol: float = TRIANGLE_RTOL) -> bool:
+def satisfies_triangle(J: Matrix, rtol: float = TRIANGLE_RTOL) -> bool:
     """True when the principal moments obey the triangle inequality within rtol."""
-    return triangle_violation(I) <= rtol
+    return triangle_violation(J) <= rtol
 
 
 def relative_difference(A: Matrix, B: Matrix) -> float:

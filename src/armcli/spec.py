@@ -345,8 +345,11 @@ def _semantic_problems(spec: RobotSpec) -> list[Problem]:
             j = spec.arm.joints.get(jname)
             if j is None or (arm_movable and jname not in arm_movable):
                 add(("poses", pname, jname), f"unknown arm joint; known: {_names(spec.arm.joints)}")
-            elif j.limit is not None and j.type != "continuous" and not (
-                j.limit.lower - 1e-12 <= value <= j.limit.upper + 1e-12
+            elif (
+                j.limit is not None
+                and j.type != "continuous"
+                and j.limit.lower <= j.limit.upper
+                and not (j.limit.lower - 1e-12 <= value <= j.limit.upper + 1e-12)
             ):
                 add(
                     ("poses", pname, jname),
@@ -362,7 +365,10 @@ def _tree_problems(part: str, links: dict[str, Link], joints: dict[str, Joint], 
             if getattr(j, role) not in links:
                 add((part, "joints", jname, role), f"unknown link; known: {_names(links)}")
         if j.child in children:
-            add((part, "joints", jname, "child"), f"link already has parent joint {children[j.child]}")
+            add(
+                (part, "joints", jname, "child"),
+                f"link already has parent joint {children[j.child]}",
+            )
         children[j.child] = jname
         if j.parent == j.child:
             add((part, "joints", jname, "child"), "a joint cannot connect a link to itself")
@@ -399,7 +405,10 @@ def _plugin_problems(spec: RobotSpec, all_joints: dict[str, Joint], add: Any) ->
         for role in ("left_joint", "right_joint"):
             jn = getattr(dd, role)
             if jn not in all_joints:
-                add(("mobile_base", "diff_drive", role), f"unknown joint; known: {_names(all_joints)}")
+                add(
+                    ("mobile_base", "diff_drive", role),
+                    f"unknown joint; known: {_names(all_joints)}",
+                )
         links = spec.all_links()
         if dd.robot_base_frame not in links:
             add(("mobile_base", "diff_drive", "robot_base_frame"), "unknown link")
@@ -459,4 +468,4 @@ def loads_spec(text: str, source: str = "<string>") -> RobotSpec:
     return spec_from_doc(loads_yaml(text, source))
 
 
-DEFAULT_SPEC = Path("specs/my_robot.yaml")
+from armcli.defaults import DEFAULT_SPEC  # noqa: E402, F401  (re-export)

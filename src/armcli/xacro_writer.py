@@ -250,7 +250,10 @@ def arm_gazebo(spec: RobotSpec) -> etree._Element:
         params = [("update_rate", fmt(jsp.update_rate))]
         params += [("joint_name", j) for j in jsp.joints]
         _plugin(
-            root, "joint_state_publisher_controller", "libgazebo_ros_joint_state_publisher.so", params
+            root,
+            "joint_state_publisher_controller",
+            "libgazebo_ros_joint_state_publisher.so",
+            params,
         )
     jpt = spec.arm.joint_pose_trajectory
     if jpt is not None:

@@ -95,9 +95,14 @@ def _build(
             _build(child, loader, (*path, i), doc, flow_sets) for i, child in enumerate(node.value)
         ]
     if isinstance(node, yaml.MappingNode):
-        if flow_sets and node.flow_style and node.value and all(
-            isinstance(v, yaml.ScalarNode) and v.tag.endswith(":null") and v.value in ("", "~")
-            for _, v in node.value
+        if (
+            flow_sets
+            and node.flow_style
+            and node.value
+            and all(
+                isinstance(v, yaml.ScalarNode) and v.tag.endswith(":null") and v.value in ("", "~")
+                for _, v in node.value
+            )
         ):
             # ROS tolerates `{0.0, 0.0}` (a flow mapping of null values) as a list.
             return [
@@ -167,7 +172,9 @@ def read_text(path: str | Path, *, max_bytes: int = MAX_YAML_BYTES, what: str = 
     try:
         size = p.stat().st_size
         if size > max_bytes:
-            raise InputError(f"{what} is {size} bytes, larger than the {max_bytes}-byte cap", file=p)
+            raise InputError(
+                f"{what} is {size} bytes, larger than the {max_bytes}-byte cap", file=p
+            )
         raw = p.read_bytes()
     except OSError as exc:
         raise InputError(f"cannot read {what}: {exc.strerror}", file=p) from None

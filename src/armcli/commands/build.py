@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from armcli.spec import DEFAULT_SPEC
+from armcli.defaults import DEFAULT_SPEC
 
 
 def build_cmd(

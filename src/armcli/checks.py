@@ -1,0 +1,185 @@
+"""`check` rules -> list[Finding]: the rule table, the Finding type and the runner.
+
+Each rule has a stable id (used by `--ignore`, the JSON schema and CI
+annotations), one severity and a one-line fix hint. The rules themselves live
+in `checks_*.py` by topic; this module only defines the vocabulary and runs
+them in order. Nothing here prints or exits.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from armcli.checks_model import Summary
+    from armcli.spec import RobotSpec
+    from armcli.urdfxml import Urdf
+
+ERROR = "error"
+WARNING = "warning"
+
+Value = float | int | str | list[float] | None
+
+
+@dataclass(frozen=True)
+class Rule:
+    id: str
+    severity: str
+    title: str
+    hint: str
+
+
+_RULES = [
+    # structure
+    Rule("duplicate-name", ERROR, "link, joint or material name used twice", "rename one of them"),
+    Rule("unknown-link", ERROR, "joint parent/child is not a link", "fix the link name"),
+    Rule("multiple-parents", ERROR, "link is the child of several joints", "a link has one parent"),
+    Rule("root-count", ERROR, "the tree must have exactly one root", "connect the extra roots"),
+    Rule("disconnected", ERROR, "links not reachable from the root", "add the missing joints"),
+    Rule("joint-type", ERROR, "unknown joint type", "use revolute, continuous, prismatic, fixed"),
+    Rule("missing-limit", ERROR, "revolute/prismatic joint without full <limit>",
+         "give lower, upper, effort and velocity"),  # fmt: skip
+    Rule("mimic-target", ERROR, "mimic refers to an unknown joint", "fix the mimic joint name"),
+    Rule("material-conflict", WARNING, "material redefined with another colour",
+         "define each material once at top level"),  # fmt: skip
+    # numbers
+    Rule("number-syntax", ERROR, "number missing or not parsable", "write plain decimal numbers"),
+    Rule("non-finite", ERROR, "NaN or infinite number", "replace it with a finite value"),
+    Rule("vector-length", ERROR, "vector with the wrong number of values", "give 3 (rgba: 4)"),
+    Rule("geometry-size", ERROR, "geometry size not > 0", "give positive sizes"),
+    Rule("geometry-kind", ERROR, "geometry empty or of an unknown kind",
+         "use box, cylinder, sphere or mesh"),  # fmt: skip
+    Rule("rgba-range", ERROR, "colour component outside [0, 1]", "scale colours to [0, 1]"),
+    # inertia
+    Rule("mass-nonpositive", ERROR, "mass <= 0 on a moving link (or negative)",
+         "give the link its real mass"),  # fmt: skip
+    Rule("inertia-not-pd", ERROR, "inertia not positive definite",
+         "use the solid-body formula for the link's shape"),  # fmt: skip
+    Rule("inertia-triangle", ERROR, "principal moments violate I1 + I2 >= I3",
+         "a real body has I1 + I2 >= I3; recompute the inertia"),  # fmt: skip
+    Rule("tiny-mass", WARNING, "mass tiny compared with the robot",
+         "simulators become stiff with mass ratios above 1e4; use a realistic mass"),  # fmt: skip
+    Rule("missing-inertial", WARNING, "moving link with geometry but no <inertial>",
+         "add an <inertial>; Gazebo drops links without one"),  # fmt: skip
+    Rule("root-inertia", WARNING, "root link has an inertia (KDL ignores it)",
+         "add a massless dummy root link, e.g. base_footprint"),  # fmt: skip
+    Rule("inertia-geometry", WARNING, "inertia differs from the solid-body formula of the geometry",
+         "compute it from the shape (armcli's box/cylinder/sphere formulas)"),  # fmt: skip
+    Rule("com-geometry", WARNING, "inertial origin is not at the geometry centre",
+         "put the inertial origin at the shape's centre"),  # fmt: skip
+    # joints
+    Rule("limit-order", ERROR, "lower limit not below upper limit", "swap or fix the limits"),
+    Rule("limit-effort-velocity", ERROR, "effort or velocity limit <= 0",
+         "give the actuator's real effort and velocity limits"),  # fmt: skip
+    Rule("axis", ERROR, "joint axis zero", "give a unit axis such as 0 0 1"),
+    Rule("axis-unit", WARNING, "joint axis not unit length", "normalise the axis"),
+    Rule("limit-degrees", WARNING, "revolute limit beyond 2*pi: degrees instead of radians?",
+         "URDF angles are radians"),  # fmt: skip
+    Rule("spec-limits", ERROR, "joint limits differ from the spec", "rebuild from the spec"),
+    # model and dynamics
+    Rule("parser-message", WARNING, "the URDF parser printed a message", "read the message"),
+    Rule("model-load", ERROR, "Pinocchio cannot build a model", "fix the errors above"),
+    Rule("gravity-effort", ERROR, "gravity torque exceeds the effort limit",
+         "raise the effort limit or lighten the links"),  # fmt: skip
+    Rule("pd-unstable", ERROR, "PD loop unstable at dt even with implicit damping",
+         "lower Kp or dt"),  # fmt: skip
+    Rule("pd-explicit-unstable", WARNING, "PD loop unstable at dt with explicit damping",
+         "lower Kd or dt, or treat damping implicitly"),  # fmt: skip
+    # collision and meshes
+    Rule("visual-no-collision", WARNING, "moving link with visual but no collision geometry",
+         "add a <collision> (a primitive is enough)"),  # fmt: skip
+    Rule("self-collision", ERROR, "links collide at a named pose",
+         "change the pose or the geometry"),  # fmt: skip
+    Rule("mesh-missing", ERROR, "mesh file not found", "fix the path or pass --package-dir"),
+]
+RULES: dict[str, Rule] = {r.id: r for r in _RULES}
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One problem: which rule, where, what the numbers are, and how to fix it."""
+
+    rule: str
+    severity: str
+    file: str
+    line: int | None
+    message: str
+    values: Mapping[str, Value] = field(default_factory=dict)
+    hint: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "rule": self.rule,
+            "severity": self.severity,
+            "file": self.file,
+            "line": self.line,
+            "message": self.message,
+            "values": dict(self.values),
+            "hint": self.hint,
+        }
+
+
+class Collector:
+    """Builds findings for one file, filling severity and hint from the rule table."""
+
+    def __init__(self, file: str) -> None:
+        self.file = file
+        self.findings: list[Finding] = []
+
+    def add(self, rule: str, line: int | None, message: str, **values: Value) -> None:
+        r = RULES[rule]
+        self.findings.append(Finding(rule, r.severity, self.file, line, message, values, r.hint))
+
+    def has_errors(self, rules: Iterable[str] | None = None) -> bool:
+        wanted = set(rules) if rules is not None else None
+        return any(
+            f.severity == ERROR and (wanted is None or f.rule in wanted) for f in self.findings
+        )
+
+
+@dataclass(frozen=True)
+class CheckOptions:
+    """What the rules may use beyond the URDF itself."""
+
+    spec: RobotSpec | None = None
+    package_dirs: Mapping[str, Path] = field(default_factory=dict)
+    search_paths: tuple[Path, ...] = ()
+
+
+@dataclass(frozen=True)
+class CheckResult:
+    file: str
+    findings: tuple[Finding, ...]
+    summary: Summary | None
+
+
+def check_urdf(urdf: Urdf, options: CheckOptions | None = None) -> CheckResult:
+    """Run every rule on one parsed URDF."""
+    from armcli import checks_inertia, checks_joints, checks_meshes, checks_model, checks_structure
+
+    opts = options or CheckOptions()
+    out = Collector(urdf.source)
+    tree = checks_structure.check(urdf, out)
+    checks_inertia.check(urdf, tree, out)
+    checks_joints.check(urdf, opts.spec, out)
+    checks_meshes.check(urdf, opts, out)
+    summary = checks_model.check(urdf, tree, opts, out)
+    return CheckResult(urdf.source, tuple(out.findings), summary)
+
+
+def apply_policy(
+    findings: Iterable[Finding], *, ignore: Iterable[str] = (), strict: bool = False
+) -> list[Finding]:
+    """Drop ignored rules; with strict, every warning becomes an error."""
+    skip = set(ignore)
+    out = []
+    for f in findings:
+        if f.rule in skip:
+            continue
+        if strict and f.severity == WARNING:
+            f = Finding(f.rule, ERROR, f.file, f.line, f.message, f.values, f.hint)
+        out.append(f)
+    return out
