@@ -1,0 +1,82 @@
+"""Mesh references: resolve package://, file:// and relative paths; report missing files.
+
+Package lookup order: `--package-dir NAME=PATH`, then ROS_PACKAGE_PATH-style
+search paths (each entry is a package or holds packages as subdirectories),
+then an ancestor directory of the URDF named NAME (the usual
+`NAME/urdf/robot.urdf` layout).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from urllib.parse import unquote, urlparse
+
+from armcli.checks import CheckOptions, Collector
+from armcli.urdfxml import Urdf
+
+
+def ros_package_path() -> tuple[Path, ...]:
+    """The directories listed in $ROS_PACKAGE_PATH (empty when unset)."""
+    raw = os.environ.get("ROS_PACKAGE_PATH", "")
+    return tuple(Path(p) for p in raw.split(os.pathsep) if p)
+
+
+def package_root(name: str, urdf_path: Path, opts: CheckOptions) -> Path | None:
+    """Where package `name` lives, or None."""
+    if name in opts.package_dirs:
+        return Path(opts.package_dirs[name])
+    for base in (*opts.search_paths, *ros_package_path()):
+        if base.name == name and base.is_dir():
+            return base
+        if (base / name).is_dir():
+            return base / name
+    for parent in urdf_path.resolve().parents:
+        if parent.name == name:
+            return parent
+    return None
+
+
+def resolve(uri: str, urdf_path: Path, opts: CheckOptions) -> Path | None:
+    """The local file a mesh URI points to (None if the package is unknown)."""
+    parsed = urlparse(uri)
+    if parsed.scheme == "package":
+        root = package_root(parsed.netloc, urdf_path, opts)
+        return root / unquote(parsed.path).lstrip("/") if root is not None else None
+    if parsed.scheme == "file":
+        return Path(unquote(parsed.path))
+    if parsed.scheme:
+        return None
+    p = Path(uri)
+    return p if p.is_absolute() else urdf_path.resolve().parent / p
+
+
+def mesh_paths(urdf: Urdf, opts: CheckOptions) -> dict[str, Path | None]:
+    """Every mesh URI in the file -> its resolved path (None if unresolvable)."""
+    src = Path(urdf.source)
+    out: dict[str, Path | None] = {}
+    for link in urdf.links:
+        for s in (*link.visuals, *link.collisions):
+            g = s.geometry
+            if g is not None and g.kind == "mesh" and g.filename and g.filename not in out:
+                out[g.filename] = resolve(g.filename, src, opts)
+    return out
+
+
+def check(urdf: Urdf, opts: CheckOptions, out: Collector) -> None:
+    src = Path(urdf.source)
+    reported: set[str] = set()
+    for link in urdf.links:
+        for s in (*link.visuals, *link.collisions):
+            g = s.geometry
+            if g is None or g.kind != "mesh" or g.filename in reported:
+                continue
+            if not g.filename:
+                out.add("mesh-missing", g.line, f"link {link.name!r}: mesh without a filename")
+                continue
+            path = resolve(g.filename, src, opts)
+            if path is None or not path.is_file():
+                reported.add(g.filename)
+                why = "unknown package" if path is None else f"no file {path}"
+                out.add("mesh-missing", g.line, f"link {link.name!r}: mesh {g.filename!r}: {why}",
+                        uri=g.filename)  # fmt: skip
