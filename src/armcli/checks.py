@@ -40,59 +40,125 @@ _RULES = [
     Rule("root-count", ERROR, "the tree must have exactly one root", "connect the extra roots"),
     Rule("disconnected", ERROR, "links not reachable from the root", "add the missing joints"),
     Rule("joint-type", ERROR, "unknown joint type", "use revolute, continuous, prismatic, fixed"),
-    Rule("missing-limit", ERROR, "revolute/prismatic joint without full <limit>",
-         "give lower, upper, effort and velocity"),  # fmt: skip
+    Rule(
+        "missing-limit",
+        ERROR,
+        "revolute/prismatic joint without full <limit>",
+        "give lower, upper, effort and velocity",
+    ),
     Rule("mimic-target", ERROR, "mimic refers to an unknown joint", "fix the mimic joint name"),
-    Rule("material-conflict", WARNING, "material redefined with another colour",
-         "define each material once at top level"),  # fmt: skip
+    Rule(
+        "material-conflict",
+        WARNING,
+        "material redefined with another colour",
+        "define each material once at top level",
+    ),
     # numbers
     Rule("number-syntax", ERROR, "number missing or not parsable", "write plain decimal numbers"),
     Rule("non-finite", ERROR, "NaN or infinite number", "replace it with a finite value"),
     Rule("vector-length", ERROR, "vector with the wrong number of values", "give 3 (rgba: 4)"),
     Rule("geometry-size", ERROR, "geometry size not > 0", "give positive sizes"),
-    Rule("geometry-kind", ERROR, "geometry empty or of an unknown kind",
-         "use box, cylinder, sphere or mesh"),  # fmt: skip
+    Rule(
+        "geometry-kind",
+        ERROR,
+        "geometry empty or of an unknown kind",
+        "use box, cylinder, sphere or mesh",
+    ),
     Rule("rgba-range", ERROR, "colour component outside [0, 1]", "scale colours to [0, 1]"),
     # inertia
-    Rule("mass-nonpositive", ERROR, "mass <= 0 on a moving link (or negative)",
-         "give the link its real mass"),  # fmt: skip
-    Rule("inertia-not-pd", ERROR, "inertia not positive definite",
-         "use the solid-body formula for the link's shape"),  # fmt: skip
-    Rule("inertia-triangle", ERROR, "principal moments violate I1 + I2 >= I3",
-         "a real body has I1 + I2 >= I3; recompute the inertia"),  # fmt: skip
-    Rule("tiny-mass", WARNING, "mass tiny compared with the robot",
-         "simulators become stiff with mass ratios above 1e4; use a realistic mass"),  # fmt: skip
-    Rule("missing-inertial", WARNING, "moving link with geometry but no <inertial>",
-         "add an <inertial>; Gazebo drops links without one"),  # fmt: skip
-    Rule("root-inertia", WARNING, "root link has an inertia (KDL ignores it)",
-         "add a massless dummy root link, e.g. base_footprint"),  # fmt: skip
-    Rule("inertia-geometry", WARNING, "inertia differs from the solid-body formula of the geometry",
-         "compute it from the shape (armcli's box/cylinder/sphere formulas)"),  # fmt: skip
-    Rule("com-geometry", WARNING, "inertial origin is not at the geometry centre",
-         "put the inertial origin at the shape's centre"),  # fmt: skip
+    Rule(
+        "mass-nonpositive",
+        ERROR,
+        "mass <= 0 on a moving link (or negative)",
+        "give the link its real mass",
+    ),
+    Rule(
+        "inertia-not-pd",
+        ERROR,
+        "inertia not positive definite",
+        "use the solid-body formula for the link's shape",
+    ),
+    Rule(
+        "inertia-triangle",
+        ERROR,
+        "principal moments violate I1 + I2 >= I3",
+        "a real body has I1 + I2 >= I3; recompute the inertia",
+    ),
+    Rule(
+        "tiny-mass",
+        WARNING,
+        "mass tiny compared with the robot",
+        "simulators become stiff with mass ratios above 1e4; use a realistic mass",
+    ),
+    Rule(
+        "missing-inertial",
+        WARNING,
+        "moving link with geometry but no <inertial>",
+        "add an <inertial>; Gazebo drops links without one",
+    ),
+    Rule(
+        "root-inertia",
+        WARNING,
+        "root link has an inertia (KDL ignores it)",
+        "add a massless dummy root link, e.g. base_footprint",
+    ),
+    Rule(
+        "inertia-geometry",
+        WARNING,
+        "inertia differs from the solid-body formula of the geometry",
+        "compute it from the shape (armcli's box/cylinder/sphere formulas)",
+    ),
+    Rule(
+        "com-geometry",
+        WARNING,
+        "inertial origin is not at the geometry centre",
+        "put the inertial origin at the shape's centre",
+    ),
     # joints
     Rule("limit-order", ERROR, "lower limit not below upper limit", "swap or fix the limits"),
-    Rule("limit-effort-velocity", ERROR, "effort or velocity limit <= 0",
-         "give the actuator's real effort and velocity limits"),  # fmt: skip
+    Rule(
+        "limit-effort-velocity",
+        ERROR,
+        "effort or velocity limit <= 0",
+        "give the actuator's real effort and velocity limits",
+    ),
     Rule("axis", ERROR, "joint axis zero", "give a unit axis such as 0 0 1"),
     Rule("axis-unit", WARNING, "joint axis not unit length", "normalise the axis"),
-    Rule("limit-degrees", WARNING, "revolute limit beyond 2*pi: degrees instead of radians?",
-         "URDF angles are radians"),  # fmt: skip
+    Rule(
+        "limit-degrees",
+        WARNING,
+        "revolute limit beyond 2*pi: degrees instead of radians?",
+        "URDF angles are radians",
+    ),
     Rule("spec-limits", ERROR, "joint limits differ from the spec", "rebuild from the spec"),
     # model and dynamics
     Rule("parser-message", WARNING, "the URDF parser printed a message", "read the message"),
     Rule("model-load", ERROR, "Pinocchio cannot build a model", "fix the errors above"),
-    Rule("gravity-effort", ERROR, "gravity torque exceeds the effort limit",
-         "raise the effort limit or lighten the links"),  # fmt: skip
-    Rule("pd-unstable", ERROR, "PD loop unstable at dt even with implicit damping",
-         "lower Kp or dt"),  # fmt: skip
-    Rule("pd-explicit-unstable", WARNING, "PD loop unstable at dt with explicit damping",
-         "lower Kd or dt, or treat damping implicitly"),  # fmt: skip
+    Rule(
+        "gravity-effort",
+        ERROR,
+        "gravity torque exceeds the effort limit",
+        "raise the effort limit or lighten the links",
+    ),
+    Rule(
+        "pd-unstable", ERROR, "PD loop unstable at dt even with implicit damping", "lower Kp or dt"
+    ),
+    Rule(
+        "pd-explicit-unstable",
+        WARNING,
+        "PD loop unstable at dt with explicit damping",
+        "lower Kd or dt, or treat damping implicitly",
+    ),
     # collision and meshes
-    Rule("visual-no-collision", WARNING, "moving link with visual but no collision geometry",
-         "add a <collision> (a primitive is enough)"),  # fmt: skip
-    Rule("self-collision", ERROR, "links collide at a named pose",
-         "change the pose or the geometry"),  # fmt: skip
+    Rule(
+        "visual-no-collision",
+        WARNING,
+        "moving link with visual but no collision geometry",
+        "add a <collision> (a primitive is enough)",
+    ),
+    Rule(
+        "self-collision", ERROR, "links collide at a named pose", "change the pose or the geometry"
+    ),
     Rule("mesh-missing", ERROR, "mesh file not found", "fix the path or pass --package-dir"),
 ]
 RULES: dict[str, Rule] = {r.id: r for r in _RULES}

@@ -34,12 +34,21 @@ def check(urdf: Urdf, tree: Tree, out: Collector) -> None:
         ine = link.inertial
         if ine is None:
             if moving and (link.visuals or link.collisions):
-                out.add("missing-inertial", link.line, f"moving link {link.name!r} has geometry "
-                        "but no <inertial> (massless)", link=link.name)  # fmt: skip
+                out.add(
+                    "missing-inertial",
+                    link.line,
+                    f"moving link {link.name!r} has geometry but no <inertial> (massless)",
+                    link=link.name,
+                )
             continue
         if link.name == tree.root and finite(ine.mass) and ine.mass > 0:  # type: ignore[operator]
-            out.add("root-inertia", ine.line, f"root link {link.name!r} has mass {ine.mass:g} kg; "
-                    "KDL (robot_state_publisher) ignores root inertia", mass=ine.mass)  # fmt: skip
+            out.add(
+                "root-inertia",
+                ine.line,
+                f"root link {link.name!r} has mass {ine.mass:g} kg; "
+                "KDL (robot_state_publisher) ignores root inertia",
+                mass=ine.mass,
+            )
         if _mass_ok(link, ine, moving, total, out):
             J = _tensor_ok(link, ine, out)
             if J is not None:
@@ -51,13 +60,23 @@ def _mass_ok(link: Link, ine: Inertial, moving: bool, total: float, out: Collect
     if m is None or not finite(m):
         return False
     if m < 0 or (m == 0 and moving):
-        out.add("mass-nonpositive", ine.mass_line, f"link {link.name!r}: mass {m:g} kg"
-                + (" on a moving link" if m == 0 else ""), link=link.name, mass=m)  # fmt: skip
+        out.add(
+            "mass-nonpositive",
+            ine.mass_line,
+            f"link {link.name!r}: mass {m:g} kg" + (" on a moving link" if m == 0 else ""),
+            link=link.name,
+            mass=m,
+        )
         return False
     if moving and 0 < m < TINY_MASS_RATIO * total:
-        out.add("tiny-mass", ine.mass_line, f"link {link.name!r}: mass {m:g} kg is "
-                f"{m / total:.1e} of the robot's {total:g} kg", link=link.name, mass=m,
-                robot_mass=total)  # fmt: skip
+        out.add(
+            "tiny-mass",
+            ine.mass_line,
+            f"link {link.name!r}: mass {m:g} kg is {m / total:.1e} of the robot's {total:g} kg",
+            link=link.name,
+            mass=m,
+            robot_mass=total,
+        )
     return m > 0
 
 
@@ -68,16 +87,27 @@ def _tensor_ok(link: Link, ine: Inertial, out: Collector) -> np.ndarray | None:
     moments = inr.principal_moments(J)
     vals = dict(zip(("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), ine.inertia, strict=True))
     if not inr.is_positive_definite(J):
-        out.add("inertia-not-pd", ine.inertia_line, f"link {link.name!r}: inertia not positive "
-                f"definite, principal moments {_fmt(moments)}", link=link.name,
-                principal=[float(x) for x in moments], **vals)  # fmt: skip
+        out.add(
+            "inertia-not-pd",
+            ine.inertia_line,
+            f"link {link.name!r}: inertia not positive definite, principal moments {_fmt(moments)}",
+            link=link.name,
+            principal=[float(x) for x in moments],
+            **vals,
+        )
         return None
     excess = inr.triangle_violation(J)
     if excess > inr.TRIANGLE_RTOL:
         a, b, c = moments
-        out.add("inertia-triangle", ine.inertia_line, f"link {link.name!r}: principal moments "
-                f"{_fmt(moments)}: {c:.4g} > {a:.4g} + {b:.4g} (by {excess:.1%})",
-                link=link.name, principal=[float(x) for x in moments], excess=excess)  # fmt: skip
+        out.add(
+            "inertia-triangle",
+            ine.inertia_line,
+            f"link {link.name!r}: principal moments "
+            f"{_fmt(moments)}: {c:.4g} > {a:.4g} + {b:.4g} (by {excess:.1%})",
+            link=link.name,
+            principal=[float(x) for x in moments],
+            excess=excess,
+        )
         return None
     return J
 
@@ -116,17 +146,29 @@ def _versus_geometry(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -
     dims = "x".join(f"{x:g}" for x in g.dims or ())
     if diff > INERTIA_GEOMETRY_RTOL:
         got, want = np.diag(actual), np.diag(expected)
-        out.add("inertia-geometry", ine.inertia_line, f"link {link.name!r}: inertia diag "
-                f"{_fmt(got)} (geometry frame) vs solid {g.kind} {dims} m, {m:g} kg: "
-                f"{_fmt(want)}{_diagnosis(got, want)}", link=link.name, actual=_list(got),
-                expected=_list(want), relative_difference=diff)  # fmt: skip
+        out.add(
+            "inertia-geometry",
+            ine.inertia_line,
+            f"link {link.name!r}: inertia diag "
+            f"{_fmt(got)} (geometry frame) vs solid {g.kind} {dims} m, {m:g} kg: "
+            f"{_fmt(want)}{_diagnosis(got, want)}",
+            link=link.name,
+            actual=_list(got),
+            expected=_list(want),
+            relative_difference=diff,
+        )
     offset = np.subtract(ine.origin.xyz, shape.origin.xyz)
     tol = COM_ATOL + COM_RTOL * max(g.dims or (0.0,))
     if float(np.linalg.norm(offset)) > tol:
-        out.add("com-geometry", ine.origin.line or ine.line, f"link {link.name!r}: inertial "
-                f"origin {list(ine.origin.xyz)} is {np.linalg.norm(offset):.4g} m from the "
-                f"{g.kind} centre {list(shape.origin.xyz)}", link=link.name,
-                offset=_list(offset))  # fmt: skip
+        out.add(
+            "com-geometry",
+            ine.origin.line or ine.line,
+            f"link {link.name!r}: inertial "
+            f"origin {list(ine.origin.xyz)} is {np.linalg.norm(offset):.4g} m from the "
+            f"{g.kind} centre {list(shape.origin.xyz)}",
+            link=link.name,
+            offset=_list(offset),
+        )
 
 
 def _diagnosis(got: np.ndarray, want: np.ndarray) -> str:
@@ -139,7 +181,9 @@ def _diagnosis(got: np.ndarray, want: np.ndarray) -> str:
             if perm != (0, 1, 2):
                 parts.append("axes permuted")
             if abs(scale - 1.0) > INERTIA_GEOMETRY_RTOL:
-                parts.append(f"{scale:.3g}x too large" if scale > 1 else f"{1 / scale:.3g}x too small")
+                parts.append(
+                    f"{scale:.3g}x too large" if scale > 1 else f"{1 / scale:.3g}x too small"
+                )
             return " (" + ", ".join(parts) + ")" if parts else ""
     return ""
 

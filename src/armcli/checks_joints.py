@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 from armcli.checks import Collector
 from armcli.checks_structure import finite
-from armcli.spec import RobotSpec
 from armcli.urdfxml import Joint, Urdf
+
+if TYPE_CHECKING:
+    from armcli.spec import RobotSpec
 
 AXIS_UNIT_TOL = 1e-6
 # |limit| beyond one turn plus a margin is almost surely degrees typed as radians.
@@ -32,8 +35,13 @@ def _axis(j: Joint, out: Collector) -> None:
     if norm == 0.0:
         out.add("axis", j.axis_line, f"joint {j.name!r}: axis is zero", joint=j.name)
     elif abs(norm - 1.0) > AXIS_UNIT_TOL:
-        out.add("axis-unit", j.axis_line, f"joint {j.name!r}: axis {list(j.axis)} has length "
-                f"{norm:.6g}", joint=j.name, norm=norm)  # fmt: skip
+        out.add(
+            "axis-unit",
+            j.axis_line,
+            f"joint {j.name!r}: axis {list(j.axis)} has length {norm:.6g}",
+            joint=j.name,
+            norm=norm,
+        )
 
 
 def _limits(j: Joint, out: Collector) -> None:
@@ -43,17 +51,34 @@ def _limits(j: Joint, out: Collector) -> None:
     if finite(lo, hi):
         assert lo is not None and hi is not None
         if lo >= hi:
-            out.add("limit-order", lim.line, f"joint {j.name!r}: lower {lo:g} is not below upper "
-                    f"{hi:g}", joint=j.name, lower=lo, upper=hi)  # fmt: skip
+            out.add(
+                "limit-order",
+                lim.line,
+                f"joint {j.name!r}: lower {lo:g} is not below upper {hi:g}",
+                joint=j.name,
+                lower=lo,
+                upper=hi,
+            )
         if j.type == "revolute" and max(abs(lo), abs(hi)) > DEGREES_SUSPECT:
-            out.add("limit-degrees", lim.line, f"joint {j.name!r}: limits [{lo:g}, {hi:g}] rad "
-                    f"= [{math.degrees(lo):.0f}, {math.degrees(hi):.0f}] deg", joint=j.name,
-                    lower=lo, upper=hi)  # fmt: skip
+            out.add(
+                "limit-degrees",
+                lim.line,
+                f"joint {j.name!r}: limits [{lo:g}, {hi:g}] rad "
+                f"= [{math.degrees(lo):.0f}, {math.degrees(hi):.0f}] deg",
+                joint=j.name,
+                lower=lo,
+                upper=hi,
+            )
     for attr in ("effort", "velocity"):
         v = getattr(lim, attr)
         if v is not None and finite(v) and v <= 0:
-            out.add("limit-effort-velocity", lim.line, f"joint {j.name!r}: {attr} limit {v:g} "
-                    "must be > 0", joint=j.name, **{attr: v})  # fmt: skip
+            out.add(
+                "limit-effort-velocity",
+                lim.line,
+                f"joint {j.name!r}: {attr} limit {v:g} must be > 0",
+                joint=j.name,
+                **{attr: v},
+            )
 
 
 def _spec_limits(urdf: Urdf, spec: RobotSpec, out: Collector) -> None:
@@ -64,14 +89,23 @@ def _spec_limits(urdf: Urdf, spec: RobotSpec, out: Collector) -> None:
             continue
         uj = by_name[name]
         ul = uj.limit
-        want = {"lower": sj.limit.lower, "upper": sj.limit.upper,
-                "effort": sj.limit.effort, "velocity": sj.limit.velocity}  # fmt: skip
+        want = {
+            "lower": sj.limit.lower,
+            "upper": sj.limit.upper,
+            "effort": sj.limit.effort,
+            "velocity": sj.limit.velocity,
+        }
         got = {k: (getattr(ul, k) if ul is not None else None) for k in want}
         bad = [k for k in want if got[k] is None or abs(got[k] - want[k]) > SPEC_LIMIT_TOL]
         if bad:
             detail = ", ".join(f"{k} {_g(got[k])} (spec {want[k]:g})" for k in bad)
-            out.add("spec-limits", ul.line if ul else uj.line, f"joint {name!r}: {detail}",
-                    joint=name, **{f"spec_{k}": want[k] for k in bad})  # fmt: skip
+            out.add(
+                "spec-limits",
+                ul.line if ul else uj.line,
+                f"joint {name!r}: {detail}",
+                joint=name,
+                **{f"spec_{k}": want[k] for k in bad},
+            )
 
 
 def _g(v: float | None) -> str:

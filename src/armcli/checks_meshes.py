@@ -78,5 +78,9 @@ def check(urdf: Urdf, opts: CheckOptions, out: Collector) -> None:
             if path is None or not path.is_file():
                 reported.add(g.filename)
                 why = "unknown package" if path is None else f"no file {path}"
-                out.add("mesh-missing", g.line, f"link {link.name!r}: mesh {g.filename!r}: {why}",
-                        uri=g.filename)  # fmt: skip
+                out.add(
+                    "mesh-missing",
+                    g.line,
+                    f"link {link.name!r}: mesh {g.filename!r}: {why}",
+                    uri=g.filename,
+                )

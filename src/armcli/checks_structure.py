@@ -14,8 +14,12 @@ from armcli.checks import Collector
 from armcli.urdfxml import Joint, Link, Urdf
 
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
-NUMBER_RULES = {"missing": "number-syntax", "not-a-number": "number-syntax",
-                "non-finite": "non-finite", "length": "vector-length"}  # fmt: skip
+NUMBER_RULES = {
+    "missing": "number-syntax",
+    "not-a-number": "number-syntax",
+    "non-finite": "non-finite",
+    "length": "vector-length",
+}
 
 
 @dataclass(frozen=True)
@@ -33,8 +37,12 @@ class Tree:
 def check(urdf: Urdf, out: Collector) -> Tree:
     """Run the structure and number rules and return the tree."""
     for p in urdf.problems:
-        what = {"missing": "missing", "not-a-number": "not a number",
-                "non-finite": "not finite", "length": "wrong number of values"}[p.kind]  # fmt: skip
+        what = {
+            "missing": "missing",
+            "not-a-number": "not a number",
+            "non-finite": "not finite",
+            "length": "wrong number of values",
+        }[p.kind]
         out.add(NUMBER_RULES[p.kind], p.line, f"{p.where}: {what}: {p.text!r}", text=p.text)
     _names(urdf, out)
     _materials(urdf, out)
@@ -54,15 +62,23 @@ def _names(urdf: Urdf, out: Collector) -> None:
             if not it.name:
                 out.add("duplicate-name", it.line, f"{kind} without a name")
             elif counts[it.name] > 1 and it.name in seen:
-                out.add("duplicate-name", it.line, f"{kind} {it.name!r} defined {counts[it.name]}x",
-                        name=it.name)  # fmt: skip
+                out.add(
+                    "duplicate-name",
+                    it.line,
+                    f"{kind} {it.name!r} defined {counts[it.name]}x",
+                    name=it.name,
+                )
             seen.add(it.name)
     top = Counter(m.name for m in urdf.materials if m.top_level)
     seen = set()
     for m in urdf.materials:
         if m.top_level and top[m.name] > 1 and m.name in seen:
-            out.add("duplicate-name", m.line, f"material {m.name!r} defined {top[m.name]}x at top "
-                    "level", name=m.name)  # fmt: skip
+            out.add(
+                "duplicate-name",
+                m.line,
+                f"material {m.name!r} defined {top[m.name]}x at top level",
+                name=m.name,
+            )
         seen.add(m.name)
 
 
@@ -73,12 +89,21 @@ def _materials(urdf: Urdf, out: Collector) -> None:
             continue
         bad = [c for c in m.rgba if not 0.0 <= c <= 1.0]
         if bad:
-            out.add("rgba-range", m.line, f"material {m.name!r}: rgba {list(m.rgba)} outside [0, 1]",
-                    rgba=list(m.rgba))  # fmt: skip
+            out.add(
+                "rgba-range",
+                m.line,
+                f"material {m.name!r}: rgba {list(m.rgba)} outside [0, 1]",
+                rgba=list(m.rgba),
+            )
         prev = first.setdefault(m.name, m.rgba)
         if prev != m.rgba:
-            out.add("material-conflict", m.line, f"material {m.name!r} redefined: rgba "
-                    f"{list(m.rgba)} vs {list(prev)}", rgba=list(m.rgba), first=list(prev))  # fmt: skip
+            out.add(
+                "material-conflict",
+                m.line,
+                f"material {m.name!r} redefined: rgba {list(m.rgba)} vs {list(prev)}",
+                rgba=list(m.rgba),
+                first=list(prev),
+            )
 
 
 def _geometry_sizes(link: Link, out: Collector) -> None:
@@ -86,35 +111,58 @@ def _geometry_sizes(link: Link, out: Collector) -> None:
         for s in shapes:
             g = s.geometry
             if g is None or not g.kind:
-                out.add("geometry-kind", s.line, f"link {link.name!r}: {tag} without a geometry shape")
+                out.add(
+                    "geometry-kind", s.line, f"link {link.name!r}: {tag} without a geometry shape"
+                )
             elif g.kind not in ("box", "cylinder", "sphere", "mesh"):
                 out.add("geometry-kind", g.line, f"link {link.name!r}: unknown geometry <{g.kind}>")
             elif g.dims is not None and not all(d > 0 for d in g.dims):
-                out.add("geometry-size", g.line, f"link {link.name!r}: {tag} {g.kind} sizes "
-                        f"{list(g.dims)} must be > 0", dims=list(g.dims))  # fmt: skip
+                out.add(
+                    "geometry-size",
+                    g.line,
+                    f"link {link.name!r}: {tag} {g.kind} sizes {list(g.dims)} must be > 0",
+                    dims=list(g.dims),
+                )
             elif g.kind == "mesh" and not all(c != 0 for c in g.scale):
-                out.add("geometry-size", g.line, f"link {link.name!r}: mesh scale "
-                        f"{list(g.scale)} has a zero", scale=list(g.scale))  # fmt: skip
+                out.add(
+                    "geometry-size",
+                    g.line,
+                    f"link {link.name!r}: mesh scale {list(g.scale)} has a zero",
+                    scale=list(g.scale),
+                )
 
 
 def _joint_shape(j: Joint, links: set[str], joints: set[str], out: Collector) -> None:
     for role, name in (("parent", j.parent), ("child", j.child)):
         if name not in links:
-            out.add("unknown-link", j.line, f"joint {j.name!r}: {role} link {name!r} does not exist",
-                    link=name)  # fmt: skip
+            out.add(
+                "unknown-link",
+                j.line,
+                f"joint {j.name!r}: {role} link {name!r} does not exist",
+                link=name,
+            )
     if j.type not in JOINT_TYPES:
         out.add("joint-type", j.line, f"joint {j.name!r}: unknown type {j.type!r}", type=j.type)
     if j.type in ("revolute", "prismatic"):
         lim = j.limit
-        missing = ["limit"] if lim is None else [
-            a for a in ("effort", "velocity") if getattr(lim, a) is None
-        ]  # fmt: skip
+        missing = (
+            ["limit"]
+            if lim is None
+            else [a for a in ("effort", "velocity") if getattr(lim, a) is None]
+        )
         if missing:
-            out.add("missing-limit", (lim.line if lim else j.line),
-                    f"{j.type} joint {j.name!r} lacks {', '.join(missing)}")  # fmt: skip
+            out.add(
+                "missing-limit",
+                (lim.line if lim else j.line),
+                f"{j.type} joint {j.name!r} lacks {', '.join(missing)}",
+            )
     if j.mimic is not None and j.mimic not in joints:
-        out.add("mimic-target", j.mimic_line, f"joint {j.name!r} mimics unknown joint {j.mimic!r}",
-                target=j.mimic)  # fmt: skip
+        out.add(
+            "mimic-target",
+            j.mimic_line,
+            f"joint {j.name!r} mimics unknown joint {j.mimic!r}",
+            target=j.mimic,
+        )
 
 
 def _tree(urdf: Urdf, links: set[str], out: Collector) -> Tree:
@@ -123,22 +171,34 @@ def _tree(urdf: Urdf, links: set[str], out: Collector) -> Tree:
         if j.child is None or j.child not in links or j.parent not in links:
             continue
         if j.child in parent_joint:
-            out.add("multiple-parents", j.line, f"link {j.child!r} is the child of "
-                    f"{parent_joint[j.child].name!r} and {j.name!r}", link=j.child)  # fmt: skip
+            out.add(
+                "multiple-parents",
+                j.line,
+                f"link {j.child!r} is the child of {parent_joint[j.child].name!r} and {j.name!r}",
+                link=j.child,
+            )
             continue
         parent_joint[j.child] = j
     roots = sorted(lk for lk in links if lk not in parent_joint)
     if len(roots) != 1:
         line = urdf.links[0].line if urdf.links else None
-        out.add("root-count", line, f"expected one root link, found {len(roots)}: {roots}",
-                roots=", ".join(roots))  # fmt: skip
+        out.add(
+            "root-count",
+            line,
+            f"expected one root link, found {len(roots)}: {roots}",
+            roots=", ".join(roots),
+        )
         return Tree(roots[0] if roots else None, parent_joint, frozenset())
     moving, reached = _reach(roots[0], parent_joint)
     orphans = sorted(links - reached)
     if orphans:
         line = next((lk.line for lk in urdf.links if lk.name == orphans[0]), None)
-        out.add("disconnected", line, f"links not connected to root {roots[0]!r} (cycle?): "
-                f"{orphans}", links=", ".join(orphans))  # fmt: skip
+        out.add(
+            "disconnected",
+            line,
+            f"links not connected to root {roots[0]!r} (cycle?): {orphans}",
+            links=", ".join(orphans),
+        )
     return Tree(roots[0], parent_joint, frozenset(moving))
 
 

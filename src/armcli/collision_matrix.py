@@ -54,6 +54,7 @@ class CollisionMatrix:
     enabled: tuple[EnabledPair, ...]
     samples: int
     seed: int
+    pose_collisions: tuple[tuple[str, str, str], ...] = ()  # (pose, link1, link2) still checked
 
     def reason(self, a: str, b: str) -> str | None:
         """Why the pair (a, b) is disabled, or None if MoveIt keeps checking it."""
@@ -109,6 +110,15 @@ class _Sampler:
         """MoveIt's default state: 0 where the limits allow it, else the middle of the range."""
         return self._q(0.0 if lo <= 0.0 <= hi else 0.5 * (lo + hi) for _, _, lo, hi in self.joints)
 
+    def named(self, values: dict[str, float]) -> np.ndarray:
+        """The default state with the named joints set (revolute/prismatic only)."""
+        q = self.default()
+        for name, x in values.items():
+            jm = self.model.joints[self.model.getJointId(name)]
+            if jm.nq == 1:
+                q[jm.idx_q] = x
+        return q
+
     def random(self, rng: np.random.Generator) -> np.ndarray:
         return self._q(rng.uniform(lo, hi) for _, _, lo, hi in self.joints)
 
@@ -150,8 +160,13 @@ def compute_collision_matrix(
     samples: int = DEFAULT_SAMPLES,
     seed: int = DEFAULT_SEED,
     source: str = "<urdf>",
+    poses: dict[str, dict[str, float]] | None = None,
 ) -> CollisionMatrix:
-    """The Setup-Assistant-style collision matrix of a URDF (see the module docstring)."""
+    """The Setup-Assistant-style collision matrix of a URDF (see the module docstring).
+
+    `poses` (name -> joint values) are checked against the pairs left enabled,
+    i.e. what MoveIt would report if asked to plan to that named state.
+    """
     if samples < 1:
         raise InputError("must be at least 1", field="samples")
     data = urdf_xml.encode("utf-8") if isinstance(urdf_xml, str) else urdf_xml
@@ -182,10 +197,17 @@ def compute_collision_matrix(
         for a, b in candidates
         if (a, b) not in default_hits and counts[(a, b)] > 0
     ]
+    still_checked = [k for k in active if counts[checker.pair_links[k]] > 0]
+    in_collision = [
+        (name, a, b)
+        for name, values in (poses or {}).items()
+        for a, b in sorted(checker.colliding(sampler.named(values), still_checked))
+    ]
     return CollisionMatrix(
         links=links,
         disabled=tuple(sorted(disabled, key=lambda d: (d.link1, d.link2))),
         enabled=tuple(enabled),
         samples=samples,
         seed=seed,
+        pose_collisions=tuple(in_collision),
     )

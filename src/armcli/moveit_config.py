@@ -112,9 +112,7 @@ def ros2_controllers(spec: RobotSpec, source: str | None = None) -> dict[str, An
             "ros__parameters": {
                 "update_rate": controller_update_rate(spec, source),
                 ARM_CONTROLLER: {"type": "joint_trajectory_controller/JointTrajectoryController"},
-                JOINT_STATE_BROADCASTER: {
-                    "type": "joint_state_broadcaster/JointStateBroadcaster"
-                },
+                JOINT_STATE_BROADCASTER: {"type": "joint_state_broadcaster/JointStateBroadcaster"},
             }
         },
         ARM_CONTROLLER: {"ros__parameters": arm},
@@ -164,11 +162,15 @@ def pilz_cartesian_limits() -> dict[str, Any]:
     }
 
 
-def setup_assistant(spec: RobotSpec, description_pkg: str, srdf_path: str) -> dict[str, Any]:
-    """`.setup_assistant`: lets MoveItConfigsBuilder and the Setup Assistant find URDF and SRDF."""
+def setup_assistant(urdf_package: str, urdf_path: str, srdf_path: str) -> dict[str, Any]:
+    """`.setup_assistant`: lets MoveItConfigsBuilder and the Setup Assistant find URDF and SRDF.
+
+    The URDF named is the MoveIt package's own `config/<name>.urdf.xacro` (the
+    description plus ros2_control), which every MoveItConfigsBuilder version loads.
+    """
     return {
         "moveit_setup_assistant_config": {
-            "URDF": {"package": description_pkg, "relative_path": f"urdf/{spec.name}.urdf.xacro"},
+            "URDF": {"package": urdf_package, "relative_path": urdf_path},
             "SRDF": {"relative_path": srdf_path},
             "CONFIG": {"author_name": "armcli", "generated_timestamp": 0},
         }

@@ -51,9 +51,16 @@ class RenderResult:
 
 
 def load_urdf(xml: str, source: str = "<urdf>", mesh_dir: str | Path | None = None) -> Any:
-    """URDF text -> yourdfpy.URDF with its visual scene (meshes resolved under `mesh_dir`)."""
+    """URDF text -> yourdfpy.URDF with its visual scene (meshes resolved under `mesh_dir`).
+
+    The text first passes urdfxml's safe parser (no DTDs or entities, bounded size and
+    depth), since yourdfpy's own lxml parser would resolve entities.
+    """
     import yourdfpy
 
+    from armcli.urdfxml import parse_root
+
+    parse_root(xml.encode("utf-8"), source)
     try:
         return yourdfpy.URDF.load(
             io.BytesIO(xml.encode("utf-8")),
@@ -76,14 +83,19 @@ def joint_limits(urdf: Any) -> dict[str, tuple[float, float] | None]:
 
 
 def full_configuration(
-    urdf: Any, q: Mapping[str, float], source: str = "<urdf>"
+    urdf: Any, q: Mapping[str, float], source: str | None = None, field: str | None = None
 ) -> dict[str, float]:
-    """Every movable joint's value (0 where `q` is silent); unknown or out-of-limit -> InputError."""
+    """Every movable joint's value (0 where `q` is silent).
+
+    Unknown joints and values outside the limits raise InputError naming `field`.
+    """
     limits = joint_limits(urdf)
     for name, value in q.items():
         if name not in limits:
             known = ", ".join(limits) or "(none)"
-            raise InputError(f"unknown movable joint {name!r}; known: {known}", file=source)
+            raise InputError(
+                f"unknown movable joint {name!r}; known: {known}", file=source, field=field
+            )
         lim = limits[name]
         if not np.isfinite(value) or (lim and not lim[0] - 1e-9 <= value <= lim[1] + 1e-9):
             raise InputError(
@@ -91,6 +103,7 @@ def full_configuration(
                 if lim
                 else f"joint {name!r}: {value!r} is not a finite number",
                 file=source,
+                field=field,
             )
     return {name: float(q.get(name, 0.0)) for name in limits}
 
@@ -125,9 +138,7 @@ def posed_triangles(urdf: Any, q: Mapping[str, float]) -> tuple[np.ndarray, np.n
 def _draw_view(ax: Any, tris: np.ndarray, cols: np.ndarray, tip: np.ndarray | None) -> None:
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    ax.add_collection3d(
-        Poly3DCollection(tris, facecolors=cols, edgecolors=cols, linewidths=0.3)
-    )
+    ax.add_collection3d(Poly3DCollection(tris, facecolors=cols, edgecolors=cols, linewidths=0.3))
     pts = tris.reshape(-1, 3) if len(tris) else np.zeros((1, 3))
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     centre, half = (lo + hi) / 2, max(float((hi - lo).max()) / 2, 0.05) * 1.05
@@ -193,10 +204,13 @@ def render_png(
     tool: Tool | None = None,
     name: str = "robot",
     size: Sequence[int] = DEFAULT_SIZE,
-    source: str = "<urdf>",
+    field: str | None = None,
 ) -> RenderResult:
-    """Draw the robot at `q` (validated against the limits) and write a PNG atomically."""
-    full = full_configuration(urdf, q, source)
+    """Draw the robot at `q` (validated against the limits) and write a PNG atomically.
+
+    `field` names the user option `q` came from, for error messages.
+    """
+    full = full_configuration(urdf, q, field=field)
     fig = render_figure(urdf, full, tool=tool, name=name, size=size)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=DPI, metadata={"Software": None})

@@ -93,28 +93,32 @@ class _Stepper:
         p, dt, n = self.p, self.dt, self.n
         self.hi = np.where(qp > p[:, UPPER], vs + (p[:, UPPER] - qp) / dt, np.inf)
         self.lo = np.where(qp < p[:, LOWER], vs + (p[:, LOWER] - qp) / dt, -np.inf)
-        if not (np.any(p[:, FRICTION] > 0) or np.isfinite(self.hi).any() or np.isfinite(self.lo).any()):
+        if not (
+            np.any(p[:, FRICTION] > 0) or np.isfinite(self.hi).any() or np.isfinite(self.lo).any()
+        ):
             return vs.copy(), qp.copy()
         A = self.pin.computeMinverse(self.model, self.data, q)
-        A = np.triu(A) + np.triu(A, 1).T
+        Al = (np.triu(A) + np.triu(A, 1).T).tolist()
+        vl, lo, hi, fr = vs.tolist(), self.lo.tolist(), self.hi.tolist(), p[:, FRICTION].tolist()
         lam = [0.0] * n
         for _ in range(PGS_MAX_ITERS):
             change = scale = 0.0
             for i in range(n):
-                w = float(vs[i])
+                Ai = Al[i]
+                w = vl[i]
                 for j in range(n):
-                    w += A[i, j] * lam[j]
-                w -= A[i, i] * lam[i]
-                thr = A[i, i] * dt * p[i, FRICTION]
+                    w += Ai[j] * lam[j]
+                w -= Ai[i] * lam[i]
+                thr = Ai[i] * dt * fr[i]
                 u = w - thr if w > thr else (w + thr if w < -thr else 0.0)
-                u = min(max(u, self.lo[i]), self.hi[i])
-                li = (u - w) / A[i, i]
+                u = min(max(u, lo[i]), hi[i])
+                li = (u - w) / Ai[i]
                 change = max(change, abs(li - lam[i]))
                 lam[i] = li
                 scale = max(scale, abs(li))
             if change <= PGS_TOL * (1.0 + scale):
                 break
-        dv = np.array([sum(A[i, j] * lam[j] for j in range(n)) for i in range(n)])
+        dv = np.array([_dot(Al[i], lam) for i in range(n)])
         return vs + dv, qp + dt * dv
 
     def clamp(self, q: np.ndarray) -> np.ndarray:
@@ -195,3 +199,11 @@ def _check(q: np.ndarray, v: np.ndarray, vabort: np.ndarray) -> tuple[int, int]:
         if abs(v[i]) > vabort[i]:
             return FAIL_VELOCITY, i
     return FAIL_NONE, -1
+
+
+def _dot(a: list[float], b: list[float]) -> float:
+    """Left-to-right sum, the same rounding as the C++ loop."""
+    out = 0.0
+    for x, y in zip(a, b, strict=True):
+        out += x * y
+    return out

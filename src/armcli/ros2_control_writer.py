@@ -36,7 +36,7 @@ def ros2_control_xacro(robot: str, joints: list[str], header: str | None = None)
         macro,
         X + "property",
         name="initial_positions",
-        value="${load_yaml(initial_positions_file)['initial_positions']}",
+        value="${xacro.load_yaml(initial_positions_file)['initial_positions']}",
     )
     rc = etree.SubElement(macro, "ros2_control", name="${name}", type="system")
     hw = etree.SubElement(rc, "hardware")
@@ -56,12 +56,8 @@ def moveit_urdf_xacro(
 ) -> bytes:
     """`config/<robot>.urdf.xacro`: the course description plus the ros2_control macro call."""
     root = _robot(robot)
-    etree.SubElement(
-        root, X + "arg", name="initial_positions_file", default=INITIAL_POSITIONS_FILE
-    )
-    etree.SubElement(
-        root, X + "include", filename=f"$(find {description_pkg})/urdf/{top_xacro}"
-    )
+    etree.SubElement(root, X + "arg", name="initial_positions_file", default=INITIAL_POSITIONS_FILE)
+    etree.SubElement(root, X + "include", filename=f"$(find {description_pkg})/urdf/{top_xacro}")
     etree.SubElement(root, X + "include", filename=f"{robot}.ros2_control.xacro")
     etree.SubElement(
         root,

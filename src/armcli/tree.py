@@ -8,14 +8,12 @@ in joint-name order) so the same tooling can read it.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
-from lxml import etree
-
 from armcli.errors import InputError
+from armcli.urdfxml import Joint, Urdf, parse_urdf
 
 MOVABLE = ("revolute", "continuous", "prismatic", "floating", "planar")
 _TYPES = ("fixed", *MOVABLE)
@@ -64,84 +62,68 @@ class KinematicTree:
         return [j for _, j in self.walk() if j.type in MOVABLE]
 
 
-def _floats(text: str | None, n: int, default: tuple[float, ...], where: str) -> Any:
-    if text is None:
-        return default
-    try:
-        vals = tuple(float(x) for x in text.split())
-    except ValueError:
-        vals = ()
-    if len(vals) != n or not all(math.isfinite(v) for v in vals):
-        raise InputError(f"{where}: expected {n} finite numbers, got {text!r}")
-    return vals
-
-
-def _attr_float(el: Any, name: str, where: str) -> float | None:
-    if el is None or el.get(name) is None:
-        return None
-    return float(_floats(el.get(name), 1, (0.0,), f"{where} {name}")[0])
-
-
-def _joint(el: Any, source: str) -> JointInfo:
-    name = el.get("name") or ""
-    jtype = el.get("type") or ""
-    where = f"joint {name!r}"
-    if jtype not in _TYPES:
-        raise InputError(f"{where}: unknown type {jtype!r}; known: {', '.join(_TYPES)}", file=source)
-    parent, child, origin = el.find("parent"), el.find("child"), el.find("origin")
-    if parent is None or child is None or not parent.get("link") or not child.get("link"):
-        raise InputError(f"{where}: needs <parent link=...> and <child link=...>", file=source)
-    lim = el.find("limit")
-    try:
-        return JointInfo(
-            name=name,
-            type=jtype,
-            parent=parent.get("link"),
-            child=child.get("link"),
-            xyz=_floats(origin.get("xyz") if origin is not None else None, 3, (0.0,) * 3, where),
-            rpy=_floats(origin.get("rpy") if origin is not None else None, 3, (0.0,) * 3, where),
-            axis=_floats(
-                el.find("axis").get("xyz") if el.find("axis") is not None else None,
-                3,
-                (1.0, 0.0, 0.0),
-                where,
-            ),
-            lower=_attr_float(lim, "lower", where),
-            upper=_attr_float(lim, "upper", where),
-            effort=_attr_float(lim, "effort", where),
-            velocity=_attr_float(lim, "velocity", where),
+def _joint(j: Joint, source: str) -> JointInfo:
+    if j.type not in _TYPES:
+        raise InputError(
+            f"joint {j.name!r}: unknown type {j.type!r}; known: {', '.join(_TYPES)}",
+            file=source,
+            line=j.line,
         )
-    except InputError as exc:
-        raise InputError(exc.message, file=source) from None
+    if not j.parent or not j.child:
+        raise InputError(
+            f"joint {j.name!r}: needs <parent link=...> and <child link=...>",
+            file=source,
+            line=j.line,
+        )
+    lim = j.limit
+    return JointInfo(
+        name=j.name,
+        type=j.type,
+        parent=j.parent,
+        child=j.child,
+        xyz=j.origin.xyz,
+        rpy=j.origin.rpy,
+        axis=j.axis or (1.0, 0.0, 0.0),
+        lower=lim.lower if lim else None,
+        upper=lim.upper if lim else None,
+        effort=lim.effort if lim else None,
+        velocity=lim.velocity if lim else None,
+    )
 
 
-def parse_tree(xml: str, source: str = "<urdf>") -> KinematicTree:
-    """Parse URDF text into a KinematicTree; exactly one root and no cycles, or InputError."""
-    parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=False)
-    try:
-        root_el = etree.fromstring(xml.encode("utf-8"), parser)
-    except etree.XMLSyntaxError as exc:
-        raise InputError(f"not well-formed XML: {exc}", file=source) from None
-    if root_el.tag != "robot":
-        raise InputError(f"expected a <robot> URDF, found <{root_el.tag}>", file=source)
-    links = tuple(el.get("name") or "" for el in root_el.findall("link"))
-    joints = tuple(_joint(el, source) for el in root_el.findall("joint"))
+def tree_from_urdf(urdf: Urdf) -> KinematicTree:
+    """The tree of a parsed URDF: exactly one root, no cycles, sound numbers, or InputError."""
+    source = urdf.source
+    if urdf.problems:
+        p = urdf.problems[0]
+        raise InputError(f"{p.where}: {p.kind} number {p.text!r}", file=source, line=p.line)
+    links = tuple(lk.name for lk in urdf.links)
+    joints = tuple(_joint(j, source) for j in urdf.joints)
+    by_name = {j.name: j for j in urdf.joints}
     known = set(links)
     for j in joints:
         for role in ("parent", "child"):
             if getattr(j, role) not in known:
                 raise InputError(
-                    f"joint {j.name!r}: unknown {role} link {getattr(j, role)!r}", file=source
+                    f"joint {j.name!r}: unknown {role} link {getattr(j, role)!r}",
+                    file=source,
+                    line=by_name[j.name].line,
                 )
     children = [j.child for j in joints]
     roots = [n for n in links if n not in children]
     if len(roots) != 1:
         raise InputError(f"expected exactly one root link, found {roots}", file=source)
-    tree = KinematicTree(root_el.get("name") or "", roots[0], links, joints)
+    tree = KinematicTree(urdf.name, roots[0], links, joints)
     reached = {tree.root} | {j.child for _, j in tree.walk()}
     if len(reached) != len(known) or len(set(children)) != len(children):
         raise InputError("links are not one tree (a link has two parents, or a cycle)", file=source)
     return tree
+
+
+def parse_tree(xml: str | bytes, source: str = "<urdf>") -> KinematicTree:
+    """Parse URDF text safely (see urdfxml) into its KinematicTree."""
+    data = xml.encode("utf-8") if isinstance(xml, str) else xml
+    return tree_from_urdf(parse_urdf(data, source))
 
 
 def _num(x: float) -> str:

@@ -142,8 +142,14 @@ class _Numbers:
     def __init__(self) -> None:
         self.problems: list[NumberProblem] = []
 
-    def vec(self, el: etree._Element | None, attr: str, n: int, where: str,
-            default: tuple[float, ...] | None = None) -> tuple[float, ...] | None:  # fmt: skip
+    def vec(
+        self,
+        el: etree._Element | None,
+        attr: str,
+        n: int,
+        where: str,
+        default: tuple[float, ...] | None = None,
+    ) -> tuple[float, ...] | None:
         text = el.get(attr) if el is not None else None
         line = el.sourceline if el is not None else None
         if text is None:
@@ -162,8 +168,9 @@ class _Numbers:
             self.problems.append(NumberProblem("non-finite", f"{where}@{attr}", text, line))
         return values
 
-    def one(self, el: etree._Element | None, attr: str, where: str,
-            default: float | None = None) -> float | None:  # fmt: skip
+    def one(
+        self, el: etree._Element | None, attr: str, where: str, default: float | None = None
+    ) -> float | None:
         v = self.vec(el, attr, 1, where, None if default is None else (default,))
         return None if v is None else v[0]
 
@@ -225,8 +232,10 @@ def _inertial(num: _Numbers, el: etree._Element | None, where: str) -> Inertial 
     mass = num.one(mass_el, "value", f"{where}inertial/mass")
     inertia = None
     if inertia_el is not None:
-        values = [num.one(inertia_el, a, f"{where}inertial/inertia") for a in
-                  ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")]  # fmt: skip
+        values = [
+            num.one(inertia_el, a, f"{where}inertial/inertia")
+            for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+        ]
         if all(v is not None for v in values):
             inertia = tuple(values)
     else:
@@ -312,8 +321,9 @@ def _check_depth(root: etree._Element, source: str) -> None:
     while stack:
         el, depth = stack.pop()
         if depth > MAX_URDF_DEPTH:
-            raise InputError(f"XML nested deeper than {MAX_URDF_DEPTH} levels", file=source,
-                             line=el.sourceline)  # fmt: skip
+            raise InputError(
+                f"XML nested deeper than {MAX_URDF_DEPTH} levels", file=source, line=el.sourceline
+            )
         stack.extend((c, depth + 1) for c in el)
 
 
@@ -327,18 +337,30 @@ def parse_root(data: bytes, source: str) -> etree._Element:
     if len(data) > MAX_URDF_BYTES:
         raise InputError(f"file is larger than {MAX_URDF_BYTES} bytes", file=source)
     if b"<!DOCTYPE" in data or b"<!ENTITY" in data:
-        raise InputError("DOCTYPE/entity declarations are not allowed in URDF input", file=source,
-                         line=_line_of(data, b"<!"))  # fmt: skip
-    parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False,
-                             huge_tree=False, remove_comments=True, remove_pis=True)  # fmt: skip
+        raise InputError(
+            "DOCTYPE/entity declarations are not allowed in URDF input",
+            file=source,
+            line=_line_of(data, b"<!"),
+        )
+    parser = etree.XMLParser(
+        resolve_entities=False,
+        no_network=True,
+        load_dtd=False,
+        huge_tree=False,
+        remove_comments=True,
+        remove_pis=True,
+    )
     try:
         root = etree.fromstring(data, parser)
     except etree.XMLSyntaxError as exc:
         raise InputError(f"not well-formed XML: {exc.msg}", file=source, line=exc.lineno) from None
     _check_depth(root, source)
     if root.tag != "robot":
-        raise InputError(f"not a URDF: root element is <{root.tag}>, expected <robot>", file=source,
-                         line=root.sourceline)  # fmt: skip
+        raise InputError(
+            f"not a URDF: root element is <{root.tag}>, expected <robot>",
+            file=source,
+            line=root.sourceline,
+        )
     if any(isinstance(el.tag, str) and el.tag.startswith(f"{{{XACRO_NS}}}") for el in root.iter()):
         raise XacroRefusedError(
             "this file uses xacro elements; expanding xacro runs code from the file, "

@@ -68,7 +68,9 @@ def _parse_cell(text: str, col: str, line: int, source: str, blank_ok: bool) -> 
     except ValueError:
         value = math.nan
     if not math.isfinite(value):
-        raise InputError(f"expected a finite number, got {text!r}", file=source, line=line, field=col)
+        raise InputError(
+            f"expected a finite number, got {text!r}", file=source, line=line, field=col
+        )
     return value
 
 
@@ -80,7 +82,9 @@ def load_replay(path: str | Path, joints: Sequence[str]) -> Replay:
         raise InputError("first column must be 'time'", file=source, line=1)
     header = [h.strip() for h in rows[0]]
     pos_cols = {h[: -len(".position")]: i for i, h in enumerate(header) if h.endswith(".position")}
-    ref_cols = {h[: -len(".reference")]: i for i, h in enumerate(header) if h.endswith(".reference")}
+    ref_cols = {
+        h[: -len(".reference")]: i for i, h in enumerate(header) if h.endswith(".reference")
+    }
     for name in [*pos_cols, *ref_cols]:
         if name not in joints:
             known = ", ".join(joints) or "(none)"
@@ -154,7 +158,9 @@ class Viewer:
         self._playing = False
         check_port_free(host, port)
         with contextlib.redirect_stdout(io.StringIO()):  # viser prints a banner; the CLI prints
-            self.server = viser.ViserServer(host=host, port=port, label=f"armcli: {name}")
+            self.server = viser.ViserServer(
+                host=host, port=port, label=f"armcli: {name}", verbose=False
+            )
         if port and self.server.get_port() != port:  # lost a race for the port
             self._stop_server()
             check_port_free(host, port)
@@ -189,8 +195,8 @@ class Viewer:
             return {n: float(s.value) for n, s in self._sliders.items()}
 
     def set_configuration(self, q: Mapping[str, float]) -> None:
-        """Move the named joints (others keep their value); unknown or out of limits -> InputError."""
-        full_configuration(self._urdf, q, self._source)
+        """Move the named joints (others keep theirs); unknown or out of limits: InputError."""
+        full_configuration(self._urdf, q, field="q")
         with self._lock:
             self._batch = True
             try:
@@ -266,7 +272,7 @@ class Viewer:
         lo, hi = np.asarray(self._urdf.scene.bounds)
         centre, size = (lo + hi) / 2, float(np.linalg.norm(hi - lo))
         self.server.initial_camera.look_at = tuple(centre)
-        self.server.initial_camera.position = tuple(centre + size * np.array([0.9, -1.1, 0.6]))
+        self.server.initial_camera.position = tuple(centre + size * np.array([0.55, -0.75, 0.45]))
         self._frames = {
             link: scene.add_frame(
                 f"/frames/{link}", axes_length=FRAME_AXES, axes_radius=0.003, visible=False
@@ -308,7 +314,10 @@ class Viewer:
             self._speed = gui.add_slider("Speed", min=0.1, max=4.0, step=0.1, initial_value=1.0)
             self._loop = gui.add_checkbox("Loop", initial_value=True)
             self._time_slider = gui.add_slider(
-                "Time [s]", min=0.0, max=max(self._replay.duration, 1e-3), step=1e-3,
+                "Time [s]",
+                min=0.0,
+                max=max(self._replay.duration, 1e-3),
+                step=1e-3,
                 initial_value=0.0,
             )
             self._time_slider.on_update(lambda _e: self._show_time(self._time_slider.value))

@@ -20,6 +20,9 @@ MAX_YAML_BYTES = 1_000_000
 MAX_YAML_DEPTH = 64
 
 Path_ = tuple[str | int, ...]
+_PLAIN_TAGS = {
+    f"tag:yaml.org,2002:{t}" for t in ("str", "int", "float", "bool", "null", "map", "seq")
+}
 
 
 @dataclass
@@ -84,6 +87,10 @@ def _build(
     flow_sets: bool,
 ) -> Any:
     doc.lines.setdefault(path, node.start_mark.line + 1)
+    if node.tag not in _PLAIN_TAGS:
+        raise InputError(
+            f"unsupported YAML tag {node.tag!r}", file=doc.source, line=node.start_mark.line + 1
+        )
     if isinstance(node, yaml.ScalarNode):
         value = loader.construct_object(node, deep=True)
         if isinstance(value, str | int | float | bool) or value is None:

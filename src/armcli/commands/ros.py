@@ -1,9 +1,60 @@
-"""`armcli ros`: placeholder until implemented."""
+"""`armcli ros-package`: write the description, bringup and MoveIt config packages."""
 
 from __future__ import annotations
 
+import contextlib
+import sys
+from pathlib import Path
+
 import typer
+
+from armcli.defaults import DEFAULT_SPEC
+
+DEFAULT_SAMPLES = 10_000  # keep equal to armcli.collision_matrix.DEFAULT_SAMPLES (lazy import)
+
+
+def _label(spec: Path) -> str:
+    """How generated files name their spec: as `build` does, relative to the cwd if possible."""
+    with contextlib.suppress(ValueError):
+        return spec.resolve().relative_to(Path.cwd().resolve()).as_posix()
+    return spec.name
+
+
+def ros_package_cmd(
+    spec: Path = typer.Argument(DEFAULT_SPEC, help="Robot spec YAML."),
+    out: Path = typer.Option(Path("ros"), "-o", "--out", help="Output directory."),
+    samples: int = typer.Option(
+        DEFAULT_SAMPLES, "--samples", min=1, help="Random states for the collision matrix."
+    ),
+    seed: int = typer.Option(0, "--seed", help="Seed of the collision-matrix sampling."),
+    maintainer: str = typer.Option("armcli", "--maintainer", help="package.xml maintainer."),
+    email: str = typer.Option("armcli@example.com", "--email", help="Maintainer e-mail."),
+    license_: str = typer.Option("TODO", "--license", help="package.xml license."),
+) -> None:
+    """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
+    from armcli.ros_package import PackageInfo, write_ros_packages
+
+    info = PackageInfo(maintainer=maintainer, email=email, license=license_)
+    pkgs, written = write_ros_packages(
+        spec, out, label=_label(spec), samples=samples, seed=seed, info=info
+    )
+    n, m = pkgs.names, pkgs.matrix
+    counts = {r: sum(d.reason == r for d in m.disabled) for r in ("Adjacent", "Default", "Never")}
+    w = sys.stdout.write
+    w(f"wrote {len(written)} files into {out}/: {n.description}, {n.bringup}, {n.moveit}\n")
+    w(
+        f"collision matrix ({m.samples} samples, seed {m.seed}): {len(m.links)} links, "
+        f"disabled {counts['Adjacent']} Adjacent, {counts['Default']} Default, "
+        f"{counts['Never']} Never; {len(m.enabled)} pair(s) still checked\n"
+    )
+    for p in m.enabled:
+        w(f"  checked: {p.link1} / {p.link2} (in collision in {p.collisions} of {m.samples})\n")
+    for pose, a, b in m.pose_collisions:
+        sys.stderr.write(
+            f"warning: named pose {pose!r} puts {a} and {b} in contact; "
+            "MoveIt will report that state as in collision\n"
+        )
 
 
 def register(app: typer.Typer) -> None:
-    """Add this module's command(s) to the app (none yet)."""
+    app.command("ros-package")(ros_package_cmd)
