@@ -69,13 +69,13 @@ _RULES = [
     Rule(
         "mass-nonpositive",
         ERROR,
-        "mass <= 0 on a moving link (or negative)",
+        "negative mass, or a moving body without mass",
         "give the link its real mass",
     ),
     Rule(
         "inertia-not-pd",
         ERROR,
-        "inertia not positive definite",
+        "negative principal moment, or a moving body with singular inertia",
         "use the solid-body formula for the link's shape",
     ),
     Rule(
@@ -132,6 +132,7 @@ _RULES = [
     ),
     Rule("spec-limits", ERROR, "joint limits differ from the spec", "rebuild from the spec"),
     # model and dynamics
+    Rule("parser-error", ERROR, "the URDF parser reported an error", "read the message"),
     Rule("parser-message", WARNING, "the URDF parser printed a message", "read the message"),
     Rule("model-load", ERROR, "Pinocchio cannot build a model", "fix the errors above"),
     Rule(
@@ -224,12 +225,20 @@ class CheckResult:
 
 def check_urdf(urdf: Urdf, options: CheckOptions | None = None) -> CheckResult:
     """Run every rule on one parsed URDF."""
-    from armcli import checks_inertia, checks_joints, checks_meshes, checks_model, checks_structure
+    from armcli import (
+        checks_bodies,
+        checks_inertia,
+        checks_joints,
+        checks_meshes,
+        checks_model,
+        checks_structure,
+    )
 
     opts = options or CheckOptions()
     out = Collector(urdf.source)
     tree = checks_structure.check(urdf, out)
     checks_inertia.check(urdf, tree, out)
+    checks_bodies.check(urdf, tree, out)
     checks_joints.check(urdf, opts.spec, out)
     checks_meshes.check(urdf, opts, out)
     summary = checks_model.check(urdf, tree, opts, out)

@@ -19,21 +19,18 @@ INERTIA_GEOMETRY_RTOL = 0.05
 # Centre of mass within 1 mm + 1 % of the shape's largest size of its centre.
 COM_ATOL = 1e-3
 COM_RTOL = 0.01
-# A moving link lighter than this fraction of the robot makes the mass matrix stiff.
-TINY_MASS_RATIO = 1e-4
+# A link with mass needs principal moments above this [kg·m²] (MuJoCo's mjMINVAL):
+# zero is a point mass or an infinitely thin rod, and rounding noise on an
+# all-zero tensor (1e-20) must not pass as "positive".
+MIN_MOMENT = 1e-15
 
 
 def check(urdf: Urdf, tree: Tree, out: Collector) -> None:
-    total = sum(
-        lk.inertial.mass
-        for lk in urdf.links
-        if lk.inertial is not None and finite(lk.inertial.mass) and lk.inertial.mass > 0  # type: ignore[operator]
-    )
+    """Per-link rules; the bodies the joints move are checked in checks_bodies."""
     for link in urdf.links:
-        moving = tree.is_moving(link.name)
         ine = link.inertial
         if ine is None:
-            if moving and (link.visuals or link.collisions):
+            if tree.is_moving(link.name) and (link.visuals or link.collisions):
                 out.add(
                     "missing-inertial",
                     link.line,
@@ -49,48 +46,43 @@ def check(urdf: Urdf, tree: Tree, out: Collector) -> None:
                 "KDL (robot_state_publisher) ignores root inertia",
                 mass=ine.mass,
             )
-        if _mass_ok(link, ine, moving, total, out):
+        if _mass_ok(link, ine, out):
             J = _tensor_ok(link, ine, out)
             if J is not None:
                 _versus_geometry(link, ine, J, out)
 
 
-def _mass_ok(link: Link, ine: Inertial, moving: bool, total: float, out: Collector) -> bool:
+def _mass_ok(link: Link, ine: Inertial, out: Collector) -> bool:
     m = ine.mass
     if m is None or not finite(m):
         return False
-    if m < 0 or (m == 0 and moving):
+    if m < 0:
         out.add(
             "mass-nonpositive",
             ine.mass_line,
-            f"link {link.name!r}: mass {m:g} kg" + (" on a moving link" if m == 0 else ""),
+            f"link {link.name!r}: negative mass {m:g} kg",
             link=link.name,
             mass=m,
         )
         return False
-    if moving and 0 < m < TINY_MASS_RATIO * total:
-        out.add(
-            "tiny-mass",
-            ine.mass_line,
-            f"link {link.name!r}: mass {m:g} kg is {m / total:.1e} of the robot's {total:g} kg",
-            link=link.name,
-            mass=m,
-            robot_mass=total,
-        )
     return m > 0
 
 
 def _tensor_ok(link: Link, ine: Inertial, out: Collector) -> np.ndarray | None:
+    """The link's tensor if it is positive definite and obeys the triangle inequality."""
     if ine.inertia is None or not finite(*ine.inertia):
         return None
     J = inr.tensor(*ine.inertia)
     moments = inr.principal_moments(J)
     vals = dict(zip(("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), ine.inertia, strict=True))
-    if not inr.is_positive_definite(J):
+    if abs(moments[0]) <= MIN_MOMENT and abs(moments[-1]) <= MIN_MOMENT:
+        return None  # a point mass: fine on its own; checks_bodies checks what joints move
+    if moments[0] <= MIN_MOMENT:
         out.add(
             "inertia-not-pd",
             ine.inertia_line,
-            f"link {link.name!r}: inertia not positive definite, principal moments {_fmt(moments)}",
+            f"link {link.name!r}: inertia not positive definite, principal moments "
+            f"{_fmt(moments)} for mass {ine.mass:g} kg",
             link=link.name,
             principal=[float(x) for x in moments],
             **vals,
@@ -102,8 +94,8 @@ def _tensor_ok(link: Link, ine: Inertial, out: Collector) -> np.ndarray | None:
         out.add(
             "inertia-triangle",
             ine.inertia_line,
-            f"link {link.name!r}: principal moments "
-            f"{_fmt(moments)}: {c:.4g} > {a:.4g} + {b:.4g} (by {excess:.1%})",
+            f"link {link.name!r}: principal moments {_fmt(moments)}: "
+            f"{c:.4g} > {a:.4g} + {b:.4g} (by {excess:.1%})",
             link=link.name,
             principal=[float(x) for x in moments],
             excess=excess,
@@ -113,13 +105,28 @@ def _tensor_ok(link: Link, ine: Inertial, out: Collector) -> np.ndarray | None:
 
 
 def primitive_shape(link: Link) -> Shape | None:
-    """The link's single box/cylinder/sphere: collision first, visual if no collision."""
-    shapes = link.collisions or link.visuals
-    if len(shapes) != 1:
+    """The one box/cylinder/sphere the link is made of, or None.
+
+    Every visual and collision element must be that same primitive at the same
+    origin: a primitive collision next to a mesh visual is only an approximation
+    of the body, and its formula says nothing about the real inertia.
+    """
+    shapes = (*link.collisions, *link.visuals)
+    if not shapes:
         return None
-    g = shapes[0].geometry
-    ok = g is not None and g.kind in ("box", "cylinder", "sphere") and g.dims is not None
-    return shapes[0] if ok and all(d > 0 for d in g.dims) else None  # type: ignore[union-attr]
+    first = shapes[0]
+    g = first.geometry
+    if g is None or g.kind not in ("box", "cylinder", "sphere") or g.dims is None:
+        return None
+    if not all(d > 0 for d in g.dims):
+        return None
+    same = all(
+        s.geometry is not None
+        and (s.geometry.kind, s.geometry.dims) == (g.kind, g.dims)
+        and (s.origin.xyz, s.origin.rpy) == (first.origin.xyz, first.origin.rpy)
+        for s in shapes
+    )
+    return first if same else None
 
 
 def solid_inertia(g: Geometry, m: float) -> np.ndarray:

@@ -13,8 +13,12 @@ if TYPE_CHECKING:
     from armcli.spec import RobotSpec
 
 AXIS_UNIT_TOL = 1e-6
-# |limit| beyond one turn plus a margin is almost surely degrees typed as radians.
-DEGREES_SUSPECT = 2.0 * math.pi + 1e-6
+# A revolute limit beyond one turn that is a whole multiple of 5 (45, 90, 180, 360...)
+# is almost surely degrees typed as radians; larger values are "unlimited" sentinels
+# and non-round ones (3*pi, 10) are deliberate multi-turn ranges.
+DEGREES_SUSPECT = 2.0 * math.pi
+DEGREES_MAX = 720.0
+DEGREES_STEP = 5.0
 SPEC_LIMIT_TOL = 1e-9
 
 
@@ -59,7 +63,7 @@ def _limits(j: Joint, out: Collector) -> None:
                 lower=lo,
                 upper=hi,
             )
-        if j.type == "revolute" and max(abs(lo), abs(hi)) > DEGREES_SUSPECT:
+        if j.type == "revolute" and any(_looks_like_degrees(x) for x in (lo, hi)):
             out.add(
                 "limit-degrees",
                 lim.line,
@@ -79,6 +83,14 @@ def _limits(j: Joint, out: Collector) -> None:
                 joint=j.name,
                 **{attr: v},
             )
+
+
+def _looks_like_degrees(x: float) -> bool:
+    a = abs(x)
+    return (
+        DEGREES_SUSPECT < a <= DEGREES_MAX
+        and abs(a / DEGREES_STEP - round(a / DEGREES_STEP)) < 1e-9
+    )
 
 
 def _spec_limits(urdf: Urdf, spec: RobotSpec, out: Collector) -> None:

@@ -41,8 +41,11 @@ def resolve(uri: str, urdf_path: Path, opts: CheckOptions) -> Path | None:
     """The local file a mesh URI points to (None if the package is unknown)."""
     parsed = urlparse(uri)
     if parsed.scheme == "package":
-        root = package_root(parsed.netloc, urdf_path, opts)
-        return root / unquote(parsed.path).lstrip("/") if root is not None else None
+        name, rel = parsed.netloc, unquote(parsed.path).lstrip("/")
+        if not name:  # package:///name/path, seen in the wild and accepted by Pinocchio
+            name, _, rel = rel.partition("/")
+        root = package_root(name, urdf_path, opts)
+        return root / rel if root is not None else None
     if parsed.scheme == "file":
         return Path(unquote(parsed.path))
     if parsed.scheme:

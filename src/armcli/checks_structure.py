@@ -168,7 +168,7 @@ def _joint_shape(j: Joint, links: set[str], joints: set[str], out: Collector) ->
 def _tree(urdf: Urdf, links: set[str], out: Collector) -> Tree:
     parent_joint: dict[str, Joint] = {}
     for j in urdf.joints:
-        if j.child is None or j.child not in links or j.parent not in links:
+        if j.child is None or j.child not in links:
             continue
         if j.child in parent_joint:
             out.add(
@@ -185,12 +185,15 @@ def _tree(urdf: Urdf, links: set[str], out: Collector) -> Tree:
         out.add(
             "root-count",
             line,
-            f"expected one root link, found {len(roots)}: {roots}",
+            f"expected one root link, found {len(roots)}: {roots}" if links else "no <link>",
             roots=", ".join(roots),
         )
         return Tree(roots[0] if roots else None, parent_joint, frozenset())
     moving, reached = _reach(roots[0], parent_joint)
-    orphans = sorted(links - reached)
+    # Links hanging from a joint whose parent is unknown were reported as unknown-link.
+    dangling = {c for c, j in parent_joint.items() if j.parent not in links}
+    _, below = _reach_all(dangling, parent_joint)
+    orphans = sorted(links - reached - below)
     if orphans:
         line = next((lk.line for lk in urdf.links if lk.name == orphans[0]), None)
         out.add(
@@ -200,6 +203,16 @@ def _tree(urdf: Urdf, links: set[str], out: Collector) -> Tree:
             links=", ".join(orphans),
         )
     return Tree(roots[0], parent_joint, frozenset(moving))
+
+
+def _reach_all(starts: set[str], parent_joint: dict[str, Joint]) -> tuple[set[str], set[str]]:
+    moving: set[str] = set()
+    reached: set[str] = set()
+    for s in starts:
+        m, r = _reach(s, parent_joint)
+        moving |= m
+        reached |= r
+    return moving, reached
 
 
 def _reach(root: str, parent_joint: dict[str, Joint]) -> tuple[set[str], set[str]]:

@@ -40,7 +40,7 @@ class DisabledPair:
 
 @dataclass(frozen=True)
 class EnabledPair:
-    """A pair that stays checked, with in how many of the sampled states it collided."""
+    """A pair that stays checked, with in how many of the random states it collided."""
 
     link1: str
     link2: str
@@ -54,7 +54,7 @@ class CollisionMatrix:
     enabled: tuple[EnabledPair, ...]
     samples: int
     seed: int
-    pose_collisions: tuple[tuple[str, str, str], ...] = ()  # (pose, link1, link2) still checked
+    pose_collisions: tuple[tuple[str, str, str], ...] = ()  # (pose, link1, link2) in contact
 
     def reason(self, a: str, b: str) -> str | None:
         """Why the pair (a, b) is disabled, or None if MoveIt keeps checking it."""
@@ -154,6 +154,26 @@ class _Checker:
         return hits
 
 
+def _classify(
+    candidates: list[tuple[str, str]],
+    adjacent: set[tuple[str, str]],
+    default_hits: set[tuple[str, str]],
+    seen: set[tuple[str, str]],
+    counts: dict[tuple[str, str], int],
+) -> tuple[tuple[DisabledPair, ...], tuple[EnabledPair, ...]]:
+    """Sort every pair into Adjacent / Default / Never (disabled) or still checked."""
+    disabled = [DisabledPair(a, b, "Adjacent") for a, b in adjacent]
+    enabled = []
+    for a, b in candidates:
+        if (a, b) in default_hits:
+            disabled.append(DisabledPair(a, b, "Default"))
+        elif (a, b) in seen:
+            enabled.append(EnabledPair(a, b, counts[(a, b)]))
+        else:
+            disabled.append(DisabledPair(a, b, "Never"))
+    return tuple(sorted(disabled, key=lambda d: (d.link1, d.link2))), tuple(enabled)
+
+
 def compute_collision_matrix(
     urdf_xml: str | bytes,
     *,
@@ -164,8 +184,9 @@ def compute_collision_matrix(
 ) -> CollisionMatrix:
     """The Setup-Assistant-style collision matrix of a URDF (see the module docstring).
 
-    `poses` (name -> joint values) are checked against the pairs left enabled,
-    i.e. what MoveIt would report if asked to plan to that named state.
+    `poses` (name -> joint values) are extra, deterministic samples: a pair in
+    contact at a named pose is never marked `Never`, however rarely the random
+    states hit it, and the contacts are returned in `pose_collisions`.
     """
     if samples < 1:
         raise InputError("must be at least 1", field="samples")
@@ -179,35 +200,24 @@ def compute_collision_matrix(
     all_k = range(len(checker.pair_links))
     default_hits = checker.colliding(sampler.default(), all_k)
 
-    counts = dict.fromkeys(candidates, 0)
     active = [k for k in all_k if checker.pair_links[k] not in default_hits]
+    in_pose = [
+        (name, a, b)
+        for name, values in (poses or {}).items()
+        for a, b in sorted(checker.colliding(sampler.named(values), active))
+    ]
+    counts = dict.fromkeys(candidates, 0)
     rng = np.random.default_rng(seed)
     for _ in range(samples):
         for key in checker.colliding(sampler.random(rng), active):
             counts[key] += 1
-    disabled = [DisabledPair(a, b, "Adjacent") for a, b in adjacent]
-    disabled += [DisabledPair(a, b, "Default") for a, b in candidates if (a, b) in default_hits]
-    disabled += [
-        DisabledPair(a, b, "Never")
-        for a, b in candidates
-        if (a, b) not in default_hits and counts[(a, b)] == 0
-    ]
-    enabled = [
-        EnabledPair(a, b, counts[(a, b)])
-        for a, b in candidates
-        if (a, b) not in default_hits and counts[(a, b)] > 0
-    ]
-    still_checked = [k for k in active if counts[checker.pair_links[k]] > 0]
-    in_collision = [
-        (name, a, b)
-        for name, values in (poses or {}).items()
-        for a, b in sorted(checker.colliding(sampler.named(values), still_checked))
-    ]
+    seen = {key for key, c in counts.items() if c > 0} | {(a, b) for _, a, b in in_pose}
+    disabled, enabled = _classify(candidates, adjacent, default_hits, seen, counts)
     return CollisionMatrix(
         links=links,
-        disabled=tuple(sorted(disabled, key=lambda d: (d.link1, d.link2))),
-        enabled=tuple(enabled),
+        disabled=disabled,
+        enabled=enabled,
         samples=samples,
         seed=seed,
-        pose_collisions=tuple(in_collision),
+        pose_collisions=tuple(in_pose),
     )

@@ -36,7 +36,9 @@ def eval_expr(text: str) -> float:
 
 def _eval(node: ast.AST, text: str) -> float:
     if isinstance(node, ast.Constant) and type(node.value) in (int, float):
-        return float(node.value)
+        value = node.value
+        assert isinstance(value, int | float)
+        return float(value)
     if isinstance(node, ast.Name) and node.id in _NAMES:
         return _NAMES[node.id]
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):

@@ -28,18 +28,46 @@ class LoadedModel:
 
 
 def _capture_stderr(fn: Any) -> tuple[Any, list[str]]:
-    """Run fn() with the process-level stderr (fd 2) redirected to a temp file."""
+    """Run fn() with the process-level stderr (fd 2) redirected to a temp file.
+
+    If fn raises, the exception gets the captured lines as `parser_messages`.
+    """
     with tempfile.TemporaryFile(mode="w+b") as tmp:
         saved = os.dup(2)
+        error: BaseException | None = None
         try:
             os.dup2(tmp.fileno(), 2)
             result = fn()
+        except BaseException as exc:
+            error = exc
         finally:
             os.dup2(saved, 2)
             os.close(saved)
         tmp.seek(0)
         text = tmp.read().decode("utf-8", "replace")
-    return result, [ln for ln in text.splitlines() if ln.strip()]
+    lines = [ln for ln in text.splitlines() if ln.strip()]
+    if error is not None:
+        error.parser_messages = lines  # type: ignore[attr-defined]
+        raise error
+    return result, lines
+
+
+def parser_problems(lines: list[str]) -> list[str]:
+    """urdfdom's messages, one per problem: continuation lines (the C++ source location) dropped."""
+    out: list[str] = []
+    for ln in lines:
+        if ln[:1].isspace():
+            continue
+        out.append(" ".join(ln.split()))
+    return out
+
+
+class ModelLoadError(InputError):
+    """Pinocchio refused the URDF; carries what its parser printed."""
+
+    def __init__(self, message: str, *, file: str, parser_messages: list[str]) -> None:
+        self.parser_messages = parser_messages
+        super().__init__(message, file=file)
 
 
 def load_model(path: str | Path, *, xml: str | None = None) -> LoadedModel:
@@ -51,7 +79,11 @@ def load_model(path: str | Path, *, xml: str | None = None) -> LoadedModel:
     try:
         model, messages = _capture_stderr(lambda: pin.buildModelFromXML(text))
     except (RuntimeError, ValueError) as exc:
-        raise InputError(f"Pinocchio cannot load this URDF: {exc}", file=source) from None
+        said = parser_problems(getattr(exc, "parser_messages", []))
+        detail = f" ({'; '.join(said)})" if said else ""
+        raise ModelLoadError(
+            f"Pinocchio cannot load this URDF: {exc}{detail}", file=source, parser_messages=said
+        ) from None
     return LoadedModel(model=model, source=source, parser_messages=messages)
 
 

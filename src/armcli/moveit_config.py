@@ -137,16 +137,27 @@ def moveit_controllers(spec: RobotSpec) -> dict[str, Any]:
     }
 
 
+def passive_joints(spec: RobotSpec) -> list[str]:
+    """Movable joints outside the planning chain (the wheels): state only, never commanded.
+
+    They still go to ros2_control so that joint_state_broadcaster publishes them;
+    otherwise robot_state_publisher has no TF for the wheels and MoveIt waits for
+    "the complete state of the robot".
+    """
+    chain = set(chain_joints(spec))
+    return [n for n, j in spec.all_joints().items() if j.type != "fixed" and n not in chain]
+
+
 def initial_positions(spec: RobotSpec) -> dict[str, Any]:
     """Start of the mock hardware: the `home` pose if the spec has one, else the limit-clamped 0."""
     values = spec.pose("home") if "home" in spec.poses else {}
+    joints = spec.all_joints()
     out = {}
-    for j in chain_joints(spec):
-        lim = spec.arm.joints[j].limit
-        v = values.get(j, 0.0)
-        if lim is not None and spec.arm.joints[j].type != "continuous":
+    for name in [*chain_joints(spec), *passive_joints(spec)]:
+        lim, v = joints[name].limit, values.get(name, 0.0)
+        if lim is not None and joints[name].type != "continuous":
             v = min(max(v, lim.lower), lim.upper)
-        out[j] = float(v)
+        out[name] = float(v)
     return {"initial_positions": out}
 
 

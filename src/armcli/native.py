@@ -25,6 +25,7 @@ import numpy as np
 
 from armcli import rollout as ro
 from armcli.errors import BuildError
+from armcli.fsio import write_file_atomic
 
 SOURCE = Path(__file__).parent / "_native" / "rollout.cpp"
 ABI_VERSION = 1
@@ -91,7 +92,7 @@ def build(force: bool = False) -> Path:
         if proc.returncode != 0:
             tail = "\n".join(proc.stderr.strip().splitlines()[-15:])
             raise BuildError(f"compiling {SOURCE.name} failed:\n{tail}")
-        os.replace(out, path)  # atomic: a concurrent loader sees no half-written library
+        write_file_atomic(path, out.read_bytes())  # a concurrent loader never sees half a file
     _cache.clear()
     return path
 

@@ -130,18 +130,36 @@ def _summary(r: CheckResult) -> list[Any]:
         Text(f"robot {s.robot!r}: root {s.root}, total mass {s.total_mass:.4g} kg, {s.dof} DoF")
     ]
     if s.joints:
-        t = Table(title="joints", title_justify="left", header_style="bold")
-        for col in ("joint", "type", "lower", "upper", "effort", "velocity", "damping",
-                    "friction", "max |gravity torque|"):  # fmt: skip
+        out.append(Text("joints"))
+        t = Table(header_style="bold")
+        for col in (
+            "joint",
+            "type",
+            "lower",
+            "upper",
+            "effort",
+            "velocity",
+            "damping",
+            "friction",
+            "max |gravity torque|",
+        ):
             t.add_column(col, justify="left" if col in ("joint", "type") else "right")
         for j in s.joints:
-            t.add_row(j.name, j.type, _num(j.lower), _num(j.upper), _num(j.effort),
-                      _num(j.velocity), _num(j.damping), _num(j.friction),
-                      _num(j.gravity_max))  # fmt: skip
+            t.add_row(
+                j.name,
+                j.type,
+                _num(j.lower),
+                _num(j.upper),
+                _num(j.effort),
+                _num(j.velocity),
+                _num(j.damping),
+                _num(j.friction),
+                _num(j.gravity_max),
+            )
         out.append(t)
     if s.poses:
-        t = Table(title=f"end effector {s.end_effector} in {s.root} [m]", title_justify="left",
-                  header_style="bold")  # fmt: skip
+        out.append(Text(f"end effector {s.end_effector} in {s.root} [m]"))
+        t = Table(header_style="bold")
         for col in ("pose", "x", "y", "z"):
             t.add_column(col, justify="left" if col == "pose" else "right")
         for p in s.poses:

@@ -98,7 +98,10 @@ class _Stepper:
         ):
             return vs.copy(), qp.copy()
         A = self.pin.computeMinverse(self.model, self.data, q)
-        Al = (np.triu(A) + np.triu(A, 1).T).tolist()
+        Al = A.tolist()
+        for i in range(n):  # only the upper triangle is guaranteed
+            for j in range(i):
+                Al[i][j] = Al[j][i]
         vl, lo, hi, fr = vs.tolist(), self.lo.tolist(), self.hi.tolist(), p[:, FRICTION].tolist()
         lam = [0.0] * n
         for _ in range(PGS_MAX_ITERS):

@@ -26,8 +26,13 @@ def macro_name(robot: str) -> str:
     return f"{robot}_ros2_control"
 
 
-def ros2_control_xacro(robot: str, joints: list[str], header: str | None = None) -> bytes:
-    """A xacro macro emitting the `<ros2_control>` block for `joints` (position command)."""
+def ros2_control_xacro(
+    robot: str, commanded: list[str], passive: list[str], header: str | None = None
+) -> bytes:
+    """A xacro macro emitting the `<ros2_control>` block.
+
+    `commanded` joints take position commands; `passive` ones only report state.
+    """
     root = _robot()
     macro = etree.SubElement(
         root, X + "macro", name=macro_name(robot), params="name initial_positions_file"
@@ -41,9 +46,10 @@ def ros2_control_xacro(robot: str, joints: list[str], header: str | None = None)
     rc = etree.SubElement(macro, "ros2_control", name="${name}", type="system")
     hw = etree.SubElement(rc, "hardware")
     etree.SubElement(hw, "plugin").text = MOCK_PLUGIN
-    for j in joints:
+    for j in [*commanded, *passive]:
         el = etree.SubElement(rc, "joint", name=j)
-        etree.SubElement(el, "command_interface", name="position")
+        if j in commanded:
+            etree.SubElement(el, "command_interface", name="position")
         pos = etree.SubElement(el, "state_interface", name="position")
         param = etree.SubElement(pos, "param", name="initial_value")
         param.text = "${initial_positions['" + j + "']}"

@@ -10,27 +10,43 @@ written with one atomic tree swap, so a failure leaves no partial packages.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from lxml import etree
 
 from armcli import moveit_config as mc
 from armcli.build import expand_urdfs
-from armcli.collision_matrix import DEFAULT_SAMPLES, DEFAULT_SEED, CollisionMatrix
-from armcli.collision_matrix import compute_collision_matrix
+from armcli.collision_matrix import (
+    DEFAULT_SAMPLES,
+    DEFAULT_SEED,
+    CollisionMatrix,
+    compute_collision_matrix,
+)
+from armcli.errors import InputError
 from armcli.fsio import write_tree_atomic
 from armcli.launch_writer import render
 from armcli.ros2_control_writer import moveit_urdf_xacro, ros2_control_xacro
 from armcli.rviz_config import display_rviz, moveit_rviz
 from armcli.spec import RobotSpec, load_spec
 from armcli.srdf_writer import chain_joints, srdf_bytes
-from armcli.xacro_writer import GENERATED, STANDALONE_ARM, top_level_files, xacro_files
 from armcli.urdfxml import parse_urdf
+from armcli.xacro_writer import GENERATED, STANDALONE_ARM, top_level_files, xacro_files
 
 FORMAT3_SCHEMA = "http://download.ros.org/schema/package_format3.xsd"
 DISPLAY_RVIZ = "display.rviz"
+PACKAGE_NAME = re.compile(r"^[a-z][a-z0-9_]*$")  # REP 144
+DESCRIPTION_DEPENDS = [
+    "ament_index_python", "joint_state_publisher_gui", "launch", "launch_ros",
+    "robot_state_publisher", "rviz2", "urdf", "xacro",
+]  # fmt: skip
+BRINGUP_DEPENDS = [
+    "ament_index_python", "gazebo_plugins", "gazebo_ros", "launch", "launch_ros",
+    "robot_state_publisher", "rviz2", "xacro",
+]  # fmt: skip
 MOVEIT_DEPENDS = [
     "controller_manager", "hardware_interface", "joint_state_broadcaster",
     "joint_trajectory_controller", "moveit_configs_utils", "moveit_kinematics",
@@ -72,7 +88,13 @@ class Names:
     srdf: str
 
     @staticmethod
-    def of(spec: RobotSpec) -> Names:
+    def of(spec: RobotSpec, source: str | None = None) -> Names:
+        if not PACKAGE_NAME.match(spec.name):
+            raise InputError(
+                f"{spec.name!r}: ROS package names need lower case letters, digits and _",
+                file=source,
+                field="name",
+            )
         whole = top_level_files(spec).get(f"{spec.name}.urdf", STANDALONE_ARM)
         root = spec.arm_root()
         if spec.mobile_base is not None and whole != STANDALONE_ARM:
@@ -174,54 +196,51 @@ def description_files(spec: RobotSpec, n: Names, label: str, info: PackageInfo) 
     files["launch/display.launch.py"] = render("display.launch.py.tmpl", _launch_values(n), note)
     files[f"rviz/{DISPLAY_RVIZ}"] = mc.dump_yaml(display_rviz(n.robot_root), note)
     about = f"Robot description (xacro, URDF, RViz) of {n.robot}. {note}"
-    depends = [
-        "ament_index_python", "joint_state_publisher_gui", "launch", "launch_ros",
-        "robot_state_publisher", "rviz2", "urdf", "xacro",
-    ]  # fmt: skip
-    return _package(n.description, about, depends, files, info)
+    return _package(n.description, about, DESCRIPTION_DEPENDS, files, info)
 
 
-def bringup_files(n: Names, label: str, info: PackageInfo) -> dict[str, bytes]:
-    note = GENERATED.format(spec=label)
+def bringup_files(n: Names, note: str, info: PackageInfo) -> dict[str, bytes]:
     launch = render("gazebo.launch.py.tmpl", _launch_values(n), note)
     about = f"Gazebo bringup of {n.robot}. {note}"
-    depends = [
-        n.description, "ament_index_python", "gazebo_plugins", "gazebo_ros", "launch",
-        "launch_ros", "robot_state_publisher", "rviz2", "xacro",
-    ]  # fmt: skip
+    depends = [n.description, *BRINGUP_DEPENDS]
     return _package(n.bringup, about, depends, {f"launch/{n.gazebo_launch}": launch}, info)
 
 
-def moveit_files(
-    spec: RobotSpec, n: Names, urdf_xml: bytes, matrix: CollisionMatrix, label: str,
-    info: PackageInfo, source: str | None = None,
-) -> dict[str, bytes]:  # fmt: skip
-    note = GENERATED.format(spec=label)
-    urdf = parse_urdf(urdf_xml, f"{n.robot}.urdf")
-    joints = chain_joints(spec)
-    yamls = {
+def _moveit_yaml(spec: RobotSpec, urdf_xml: bytes) -> dict[str, dict[str, Any]]:
+    urdf = parse_urdf(urdf_xml, f"{spec.name}.urdf")
+    return {
         "kinematics.yaml": mc.kinematics(spec),
-        "joint_limits.yaml": mc.joint_limits(urdf, joints),
-        "ros2_controllers.yaml": mc.ros2_controllers(spec, source),
+        "joint_limits.yaml": mc.joint_limits(urdf, chain_joints(spec)),
+        "ros2_controllers.yaml": mc.ros2_controllers(spec),
         "moveit_controllers.yaml": mc.moveit_controllers(spec),
         "initial_positions.yaml": mc.initial_positions(spec),
         "pilz_cartesian_limits.yaml": mc.pilz_cartesian_limits(),
     }
+
+
+def moveit_files(
+    spec: RobotSpec,
+    n: Names,
+    urdf_xml: bytes,
+    matrix: CollisionMatrix,
+    note: str,
+    info: PackageInfo,
+) -> dict[str, bytes]:
+    yamls = _moveit_yaml(spec, urdf_xml)
     files = {f"config/{name}": mc.dump_yaml(data, note) for name, data in yamls.items()}
+    urdf_xacro = f"config/{n.robot}.urdf.xacro"
     files[n.srdf] = srdf_bytes(spec, matrix, note)
-    files[f"config/{n.robot}.urdf.xacro"] = moveit_urdf_xacro(
-        n.robot, n.description, n.robot_xacro, note
+    files[urdf_xacro] = moveit_urdf_xacro(n.robot, n.description, n.robot_xacro, note)
+    files[f"config/{n.robot}.ros2_control.xacro"] = ros2_control_xacro(
+        n.robot, chain_joints(spec), mc.passive_joints(spec), note
     )
-    files[f"config/{n.robot}.ros2_control.xacro"] = ros2_control_xacro(n.robot, joints, note)
     files["config/moveit.rviz"] = mc.dump_yaml(moveit_rviz(n.robot_root), note)
-    files[".setup_assistant"] = mc.dump_yaml(
-        mc.setup_assistant(n.moveit, f"config/{n.robot}.urdf.xacro", n.srdf), note
-    )
+    files[".setup_assistant"] = mc.dump_yaml(mc.setup_assistant(n.moveit, urdf_xacro, n.srdf), note)
     for launch, (generator, what) in MOVEIT_LAUNCHES.items():
         values = {"robot": n.robot, "moveit_pkg": n.moveit, "generator": generator}
         files[f"launch/{launch}"] = render("moveit.launch.py.tmpl", values, f"{what}\n\n{note}")
     about = f"MoveIt 2 configuration of {n.robot}. {note}"
-    return _package(n.moveit, about, MOVEIT_DEPENDS + [n.description], files, info)
+    return _package(n.moveit, about, [n.description, *MOVEIT_DEPENDS], files, info)
 
 
 def ros_packages(
@@ -233,18 +252,23 @@ def ros_packages(
     info: PackageInfo = PackageInfo(),
     source: str | None = None,
 ) -> RosPackages:
-    """All files of the three packages, in memory; deterministic for fixed samples and seed."""
-    n = Names.of(spec)
+    """All files of the three packages, in memory; deterministic for fixed samples and seed.
+
+    `source` (the spec file) is only used to point at it in input errors.
+    """
+    n = Names.of(spec, source)
+    mc.controller_update_rate(spec, source)  # refuse bad input before the slow sampling
     urdfs = expand_urdfs(spec)
     urdf_xml = urdfs.get(f"{n.robot}.urdf", urdfs["standalone_arm.urdf"])
     poses = {name: spec.pose(name) for name in spec.poses}
     matrix = compute_collision_matrix(
         urdf_xml, samples=samples, seed=seed, source=n.robot_xacro, poses=poses
     )
+    note = GENERATED.format(spec=label)
     files = {
         **description_files(spec, n, label, info),
-        **bringup_files(n, label, info),
-        **moveit_files(spec, n, urdf_xml, matrix, label, info, source),
+        **bringup_files(n, note, info),
+        **moveit_files(spec, n, urdf_xml, matrix, note, info),
     }
     return RosPackages(files=dict(sorted(files.items())), names=n, matrix=matrix)
 

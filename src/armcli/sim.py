@@ -27,7 +27,7 @@ from armcli.errors import InputError, SimulationError
 VEL_ABORT_FACTOR = 10.0  # divergence when |v| exceeds this times the URDF velocity limit
 DEFAULT_VABORT = 1000.0  # [rad/s or m/s] when the URDF gives no velocity limit
 RHO_TOL = 1e-9  # slack on the spectral radius (undamped symplectic Euler sits at 1)
-CHUNK_STEPS = 20_000  # steps per rollout call, so a progress bar can advance
+CHUNK_STEPS = {"native": 20_000, "python": 500}  # steps per call, for the progress bar
 _JOINT_TYPES = {
     "JointModelRX": 0,
     "JointModelRY": 1,
@@ -136,7 +136,9 @@ def step_radius(M: np.ndarray, K: np.ndarray, B: np.ndarray, dt: float, integrat
         Minv = np.linalg.inv(M)
         A = np.block([[np.zeros((n, n)), eye], [-Minv @ np.diag(K), -Minv @ np.diag(B)]])
         hA = dt * A
-        R = np.eye(2 * n) + hA @ (np.eye(2 * n) + hA / 2 @ (np.eye(2 * n) + hA / 3 @ (np.eye(2 * n) + hA / 4)))
+        R = np.eye(2 * n) + hA @ (
+            np.eye(2 * n) + hA / 2 @ (np.eye(2 * n) + hA / 3 @ (np.eye(2 * n) + hA / 4))
+        )
     else:
         W = np.linalg.inv(M + dt * np.diag(B))
         Av = eye - dt * W @ np.diag(B)
@@ -158,13 +160,16 @@ def check_stability(arm: Arm, cfg: SimConfig, configurations: np.ndarray) -> Non
         if rho <= 1.0 + RHO_TOL:
             continue
         dt_ok = _bisect(lambda h: step_radius(M, K, B, h, cfg.integrator) <= 1 + RHO_TOL, cfg.dt)
-        scale = _bisect(lambda s: step_radius(M, s * K, s * B, cfg.dt, cfg.integrator) <= 1 + RHO_TOL, 1.0)
+        scale = _bisect(
+            lambda s: step_radius(M, s * K, s * B, cfg.dt, cfg.integrator) <= 1 + RHO_TOL, 1.0
+        )
         what = "Kd + damping" if cfg.integrator == "rk4" else "Kp"
         raise InputError(
             f"the {cfg.integrator} integrator is unstable with these gains at dt = {cfg.dt:g} s "
             f"(closed-loop step spectral radius {rho:.3f} > 1 at q = {np.round(q, 3).tolist()}); "
             f"{what} is too stiff for this inertia: use --dt <= {dt_ok:.3g} or gains scaled by "
-            f"<= {scale:.3g}" + (" or the default euler integrator" if cfg.integrator == "rk4" else ""),
+            f"<= {scale:.3g}"
+            + (" or the default euler integrator" if cfg.integrator == "rk4" else ""),
             field="--dt",
         )
 
@@ -190,20 +195,25 @@ def simulate(
 
     steps = max(1, round(duration / cfg.dt))
     params = params_of(arm, cfg)
-    plant = ro.Plant(arm.model, params, cfg.gravity_comp, cfg.dt, cfg.integrator, _energy_max(arm, q0, params))
+    plant = ro.Plant(
+        arm.model, params, cfg.gravity_comp, cfg.dt, cfg.integrator, _energy_max(arm, q0, params)
+    )
     sub = 2 if cfg.integrator == "rk4" else 1
     t_ref = np.arange(sub * steps + 1) * (cfg.dt / sub)
     q_ref, v_ref = reference.sample(t_ref)
     ref = np.ascontiguousarray(np.hstack([q_ref, v_ref]))
     lib = native.load() if cfg.backend in ("auto", "native") else None
     if cfg.backend == "native" and lib is None:
-        raise InputError(f"the compiled simulator is not built ({native.why_missing()}); run `make native`")
+        raise InputError(
+            f"the compiled simulator is not built ({native.why_missing()}); run `make native`"
+        )
     run = (lambda *a: native.rollout(lib, *a)) if lib is not None else ro.rollout_python
     parts: list[ro.Rollout] = []
     q, v = np.array(q0, dtype=float), np.zeros(len(q0))
     start = time.perf_counter()
-    for k0 in range(0, steps, CHUNK_STEPS):
-        k1 = min(steps, k0 + CHUNK_STEPS)
+    chunk = CHUNK_STEPS["native" if lib is not None else "python"]
+    for k0 in range(0, steps, chunk):
+        k1 = min(steps, k0 + chunk)
         r = run(plant, q, v, ref[sub * k0 : sub * k1 + 1])
         parts.append(r)
         if r.fail_step >= 0:
@@ -241,7 +251,10 @@ def _raise(arm: Arm, params: np.ndarray, plant: ro.Plant, r: ro.Rollout, k0: int
     step = k0 + r.fail_step
     joint = arm.joint_names[r.fail_joint] if r.fail_joint >= 0 else None
     if r.fail_code == ro.FAIL_NONFINITE:
-        msg, cause = "the state became non-finite", "dt too large for the gains or a near-zero inertia"
+        msg, cause = (
+            "the state became non-finite",
+            "dt too large for the gains or a near-zero inertia",
+        )
     elif r.fail_code == ro.FAIL_VELOCITY:
         lim = params[r.fail_joint, ro.VABORT]
         msg = f"velocity exceeded {lim:g} (x{VEL_ABORT_FACTOR:g} the URDF velocity limit)"
@@ -249,4 +262,6 @@ def _raise(arm: Arm, params: np.ndarray, plant: ro.Plant, r: ro.Rollout, k0: int
     else:
         msg = f"kinetic energy exceeded {plant.energy_max:.3g} J"
         cause = "energy injected by the controller: gains too high for dt, try a smaller --dt"
-    raise SimulationError(f"simulation diverged: {msg}", time=step * plant.dt, step=step, joint=joint, cause=cause)
+    raise SimulationError(
+        f"simulation diverged: {msg}", time=step * plant.dt, step=step, joint=joint, cause=cause
+    )

@@ -19,7 +19,6 @@ from armcli.errors import InputError, XacroRefusedError
 
 MAX_URDF_BYTES = 10_000_000
 MAX_URDF_DEPTH = 32
-XACRO_NS = "http://www.ros.org/wiki/xacro"
 
 Vec3 = tuple[float, float, float]
 ZERO3: Vec3 = (0.0, 0.0, 0.0)
@@ -332,6 +331,11 @@ def _line_of(data: bytes, needle: bytes) -> int | None:
     return data.count(b"\n", 0, i) + 1 if i >= 0 else None
 
 
+def _is_xacro(el: etree._Element) -> bool:
+    """Elements in a xacro namespace (www.ros.org/wiki/xacro and wiki.ros.org/xacro both occur)."""
+    return isinstance(el.tag, str) and el.tag.startswith("{") and "xacro" in el.tag.split("}")[0]
+
+
 def parse_root(data: bytes, source: str) -> etree._Element:
     """Parse XML bytes safely and return the <robot> element (InputError otherwise)."""
     if len(data) > MAX_URDF_BYTES:
@@ -361,7 +365,7 @@ def parse_root(data: bytes, source: str) -> etree._Element:
             file=source,
             line=root.sourceline,
         )
-    if any(isinstance(el.tag, str) and el.tag.startswith(f"{{{XACRO_NS}}}") for el in root.iter()):
+    if any(_is_xacro(el) for el in root.iter()):
         raise XacroRefusedError(
             "this file uses xacro elements; expanding xacro runs code from the file, "
             "so pass --trust-xacro to expand it (in a sandbox)",

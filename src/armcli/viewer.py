@@ -16,7 +16,7 @@ import math
 import socket
 import threading
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -31,7 +31,7 @@ MAX_REPLAY_BYTES = 200_000_000
 GHOST_RGBA = (0.35, 0.65, 1.0, 0.35)  # translucent blue for the reference pose
 FRAME_RATE = 30.0  # [Hz] replay updates sent to the browser
 SLIDER_STEP = 1e-3  # [rad] or [m]
-FRAME_AXES = 0.08  # [m] length of link-frame axes
+FRAME_AXES = 0.12  # [m] length of link-frame axes
 
 
 @dataclass(frozen=True)
@@ -130,6 +130,29 @@ def check_port_free(host: str, port: int) -> None:
             ) from None
 
 
+def moving_parts(urdf_xml: str, joints: Collection[str], source: str = "<urdf>") -> str:
+    """The URDF with visuals kept only on links that `joints` move (for the reference ghost).
+
+    A whole-robot ghost would tint the base, which never differs from the reference.
+    """
+    from lxml import etree
+
+    from armcli.tree import parse_tree
+    from armcli.urdfxml import parse_root
+
+    tree = parse_tree(urdf_xml, source)
+    moving: set[str] = set()
+    for _, j in tree.walk():  # parents come before children
+        if j.name in joints or j.parent in moving:
+            moving.add(j.child)
+    root = parse_root(urdf_xml.encode("utf-8"), source)
+    for link in root.findall("link"):
+        if link.get("name") not in moving:
+            for visual in link.findall("visual"):
+                link.remove(visual)
+    return etree.tostring(root, encoding="unicode")
+
+
 class Viewer:
     """A running viser server showing one robot; thread-safe setters for the tests and the GUI."""
 
@@ -168,7 +191,8 @@ class Viewer:
         self._robot = ViserUrdf(self.server, self._urdf, root_node_name="/robot")
         self._ghost = None
         if replay is not None and replay.reference:
-            ghost_urdf = load_urdf(urdf_xml, source, mesh_dir)
+            ghost_xml = moving_parts(urdf_xml, replay.reference, source)
+            ghost_urdf = load_urdf(ghost_xml, source, mesh_dir)
             self._ghost = ViserUrdf(
                 self.server, ghost_urdf, root_node_name="/ghost", mesh_color_override=GHOST_RGBA
             )

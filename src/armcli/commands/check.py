@@ -1,9 +1,163 @@
-"""`armcli check`: placeholder until implemented."""
+"""`armcli check`: lint URDFs (or specs, built in memory) for physical sanity."""
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
 import typer
+
+from armcli.defaults import DEFAULT_SPEC
+from armcli.errors import EXIT_UNUSABLE, ArmcliError
+
+if TYPE_CHECKING:
+    from armcli.checks import CheckOptions, CheckResult
+    from armcli.urdfxml import Urdf
+
+FORMATS = ("table", "json", "github")
+SPEC_SUFFIXES = (".yaml", ".yml")
+REPORT_WIDTH = 140  # columns when stdout is not a terminal (CI logs, pipes)
+
+
+def _package_dirs(values: list[str]) -> dict[str, Path]:
+    from armcli.errors import InputError
+
+    out = {}
+    for v in values:
+        name, sep, path = v.partition("=")
+        if not sep or not name or not path:
+            raise InputError(f"expected NAME=PATH, got {v!r}", field="--package-dir")
+        out[name] = Path(path)
+    return out
+
+
+def _documents(path: Path, trust_xacro: bool) -> list[tuple[Urdf, Any]]:
+    """The URDF documents a PATH stands for, each with the spec it came from (or None)."""
+    from armcli.errors import InputError, XacroRefusedError
+    from armcli.urdfxml import parse_urdf, read_urdf
+
+    if path.is_dir():
+        files = sorted(p for p in path.rglob("*.urdf") if p.is_file())
+        if not files:
+            raise InputError("no *.urdf files under this directory", file=path)
+        return [(read_urdf(p), None) for p in files]
+    if path.suffix in SPEC_SUFFIXES:
+        from armcli.build import expand_urdfs
+        from armcli.spec import load_spec
+
+        spec = load_spec(path)
+        return [
+            (parse_urdf(data, f"{path}#{name}"), spec)
+            for name, data in sorted(expand_urdfs(spec).items())
+        ]
+    if path.suffix == ".xacro":
+        if not trust_xacro:
+            raise XacroRefusedError(
+                "refusing to expand a xacro file armcli did not generate: xacro runs Python "
+                "from the file ($(eval ...) can run shell commands); pass --trust-xacro if you "
+                "trust it, or check the expanded .urdf or the spec instead",
+                file=path,
+            )
+        from armcli.xacro_sandbox import expand_untrusted
+
+        return [(parse_urdf(expand_untrusted(path), f"{path}#expanded"), None)]
+    return [(read_urdf(path), None)]
+
+
+def _run(
+    paths: list[Path], base: CheckOptions, trust_xacro: bool
+) -> tuple[list[CheckResult], list[ArmcliError]]:
+    from dataclasses import replace
+
+    from armcli.checks import check_urdf
+    from armcli.errors import InputError
+
+    results: list[CheckResult] = []
+    errors: list[ArmcliError] = []
+    for path in paths:
+        try:
+            docs = _documents(path, trust_xacro)
+        except InputError as exc:
+            errors.append(exc)
+            continue
+        for urdf, spec in docs:
+            opts = replace(base, spec=spec) if spec is not None else base
+            results.append(check_urdf(urdf, opts))
+    return results, errors
+
+
+def check_cmd(
+    paths: list[Path] = typer.Argument(
+        None, help="URDF files, spec YAMLs (built in memory) or directories (every *.urdf)."
+    ),
+    spec: Path | None = typer.Option(
+        None, "--spec", help="Spec to compare limits with; also gives gains, dt, poses, tool."
+    ),
+    fmt: str = typer.Option("table", "--format", help="table, json or github."),
+    strict: bool = typer.Option(False, "--strict", help="Treat warnings as errors."),
+    ignore: list[str] = typer.Option([], "--ignore", help="Silence a rule id (repeatable)."),
+    package_dir: list[str] = typer.Option(
+        [], "--package-dir", help="NAME=PATH for package://NAME/ mesh URIs (repeatable)."
+    ),
+    trust_xacro: bool = typer.Option(
+        False, "--trust-xacro", help="Expand foreign .xacro files (runs code from them)."
+    ),
+) -> None:
+    """Check robot descriptions for physical sanity; exit 1 on error findings."""
+    from armcli.checks import RULES, CheckOptions, apply_policy
+    from armcli.errors import FindingsError, InputError
+    from armcli.report import counts
+
+    if fmt not in FORMATS:
+        raise InputError(f"unknown format {fmt!r}; known: {', '.join(FORMATS)}", field="--format")
+    unknown = sorted(set(ignore) - set(RULES))
+    if unknown:
+        raise InputError(f"unknown rule(s) {unknown}; known: {', '.join(RULES)}", field="--ignore")
+    base = CheckOptions(package_dirs=_package_dirs(package_dir))
+    if spec is not None:
+        from armcli.spec import load_spec
+
+        base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs)
+    results, errors = _run(list(paths or [DEFAULT_SPEC]), base, trust_xacro)
+    findings = apply_policy((f for r in results for f in r.findings), ignore=ignore, strict=strict)
+    n_err = counts(findings)["error"]
+    code = 2 if errors else (1 if n_err else 0)
+    _print(results, findings, fmt, code)
+    if errors:
+        raise _UnusableInputsError(errors)
+    if n_err:
+        raise FindingsError(f"{n_err} error finding(s) in {len(results)} file(s)")
+
+
+def _print(results: list[CheckResult], findings: list[Any], fmt: str, code: int) -> None:
+    from armcli import report
+
+    if fmt == "json":
+        sys.stdout.write(report.to_json(results, findings, code))
+    elif fmt == "github":
+        sys.stdout.write(report.to_github(findings))
+    elif results:
+        from rich.console import Console
+
+        width = None if sys.stdout.isatty() else REPORT_WIDTH
+        console = Console(file=sys.stdout, highlight=False, soft_wrap=False, width=width)
+        for item in report.to_rich(results, findings):
+            console.print(item)
+
+
+class _UnusableInputsError(ArmcliError):
+    """One or more inputs could not be used: one line each, exit 2, after the others' report."""
+
+    exit_code = EXIT_UNUSABLE
+
+    def __init__(self, errors: list[ArmcliError]) -> None:
+        self.errors = errors
+        super().__init__(str(errors[0]))
+
+    def lines(self) -> list[str]:
+        return [line for e in self.errors for line in e.lines()]
 
 
 def register(app: typer.Typer) -> None:
-    """Add this module's command(s) to the app (none yet)."""
+    app.command("check")(check_cmd)

@@ -1,9 +1,139 @@
-"""`armcli simulate`: placeholder until implemented."""
+"""`armcli simulate`: run the arm along a JointTrajectory under PD control."""
 
 from __future__ import annotations
 
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
 import typer
+
+from armcli.defaults import DEFAULT_SPEC
+
+PROGRESS_AFTER_S = 1.0  # show a progress bar when the run is projected to take longer
+
+
+def _floats(text: str | None, option: str) -> list[float] | None:
+    from armcli.errors import InputError
+
+    if text is None:
+        return None
+    try:
+        return [float(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise InputError(f"expected comma-separated numbers, got {text!r}", field=option) from None
+
+
+def simulate_cmd(
+    spec: Path = typer.Argument(None, help=f"Robot spec YAML [default: {DEFAULT_SPEC}]."),
+    trajectory: Path = typer.Option(None, "--trajectory", "-t", help="JointTrajectory YAML file."),
+    message: str = typer.Option(None, "--message", "-m", help="JointTrajectory as YAML text."),
+    urdf: Path = typer.Option(None, "--urdf", help="Simulate this URDF instead of the spec's arm."),
+    joints: str = typer.Option(
+        None, "--joints", help="Comma-separated joints to move; others are locked."
+    ),
+    kp: str = typer.Option(None, "--kp", help="P gain(s): one value or one per joint [N·m/rad]."),
+    kd: str = typer.Option(None, "--kd", help="D gain(s): one value or one per joint [N·m·s/rad]."),
+    gravity_comp: bool = typer.Option(
+        None, "--gravity-comp/--no-gravity-comp", help="Add g(q) to the PD torque."
+    ),
+    dt: float = typer.Option(None, "--dt", help="Time step [s] (default: the spec's control.dt)."),
+    integrator: str = typer.Option("euler", "--integrator", help="euler (semi-implicit) or rk4."),
+    duration: float = typer.Option(
+        None, "--duration", help="Simulated time [s] (default: last point + 2 s)."
+    ),
+    clamp: bool = typer.Option(
+        False, "--clamp", help="Clamp positions outside the limits (with a warning)."
+    ),
+    output: Path = typer.Option(
+        None, "--output", "-o", help="Joint states at --rate: .csv or .json."
+    ),
+    plot: Path = typer.Option(None, "--plot", help="Write a tracking plot PNG."),
+    rate: float = typer.Option(
+        None, "--rate", help="Output rate [Hz] (default: joint_state_publisher's)."
+    ),
+    engine: str = typer.Option("auto", "--engine", help="auto, native (compiled) or python."),
+) -> None:
+    """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
+    from rich.console import Console
+
+    from armcli import simjob, simreport
+    from armcli.errors import InputError
+    from armcli.spec import load_spec
+
+    if engine not in ("auto", "native", "python"):
+        raise InputError(
+            f"unknown engine {engine!r}; valid: auto, native, python", field="--engine"
+        )
+    if output is not None:
+        simreport.output_format(output)
+    spec_obj = load_spec(spec or DEFAULT_SPEC) if (spec is not None or urdf is None) else None
+    job = simjob.prepare(
+        spec=spec_obj,
+        urdf=urdf,
+        joints=[j.strip() for j in joints.split(",") if j.strip()] if joints else None,
+        trajectory=trajectory,
+        message=message,
+        kp=_floats(kp, "--kp"),
+        kd=_floats(kd, "--kd"),
+        gravity_comp=gravity_comp,
+        dt=dt,
+        integrator=integrator,
+        duration=duration,
+        clamp=clamp,
+        rate=rate,
+        backend=engine,
+    )
+    err = Console(stderr=True)
+    for w in job.trajectory.warnings:
+        err.print(f"warning: {w}", markup=False, highlight=False)
+    with _LazyProgress(err) as progress:
+        res = simjob.run(job, progress)
+    metrics = simreport.joint_metrics(res, job.trajectory.duration)
+    ee = simjob.tool_position(job, res.q[-1])
+    if output is not None:
+        simreport.write_states(output, res, job.rate)
+    if plot is not None:
+        from armcli.plot import write_tracking_plot
+
+        write_tracking_plot(plot, res, job.arm.effort)
+    out = Console(file=sys.stdout)
+    if not out.is_terminal:
+        out = Console(file=sys.stdout, width=110)
+    out.print(simreport.summary_table(metrics, ee, job.tool_label, res))
+    for path in (output, plot):
+        if path is not None:
+            out.print(f"wrote {path}", markup=False, highlight=False)
+
+
+class _LazyProgress:
+    """A rich progress bar that appears only when the run will take over ~1 s."""
+
+    def __init__(self, console: Any) -> None:
+        self.console = console
+        self.bar: Any = None
+        self.task: Any = None
+        self.start = time.perf_counter()
+
+    def __enter__(self) -> _LazyProgress:
+        return self
+
+    def __call__(self, done: int, total: int) -> None:
+        elapsed = time.perf_counter() - self.start
+        if self.bar is None and done < total and elapsed / done * total > PROGRESS_AFTER_S:
+            from rich.progress import Progress
+
+            self.bar = Progress(console=self.console, transient=True)
+            self.bar.start()
+            self.task = self.bar.add_task("simulating", total=total)
+        if self.bar is not None:
+            self.bar.update(self.task, completed=done)
+
+    def __exit__(self, *exc: object) -> None:
+        if self.bar is not None:
+            self.bar.stop()
 
 
 def register(app: typer.Typer) -> None:
-    """Add this module's command(s) to the app (none yet)."""
+    app.command("simulate")(simulate_cmd)

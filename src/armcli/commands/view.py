@@ -139,11 +139,18 @@ def render_cmd(
     width, height = _size(size)
     urdf = load_urdf(src.xml, src.source, src.mesh_dir)
     res = render_png(
-        urdf, values, out, tool=src.tool, name=src.name, size=(width, height),
+        urdf,
+        values,
+        out,
+        tool=src.tool,
+        name=src.name,
+        size=(width, height),
         field="--pose" if pose else "--q",
     )
-    tip = "" if res.tool_position is None else " tool at ({:.3f}, {:.3f}, {:.3f}) m".format(
-        *res.tool_position
+    tip = (
+        ""
+        if res.tool_position is None
+        else " tool at ({:.3f}, {:.3f}, {:.3f}) m".format(*res.tool_position)
     )
     sys.stdout.write(f"wrote {res.path} ({res.width}x{res.height} px){tip}\n")
 
@@ -212,14 +219,16 @@ def view_cmd(
         host=host,
         port=port,
     )
-    if pose:
-        viewer.apply_pose(pose)
-    sys.stdout.write(f"armcli view: {src.name} at {viewer.url}  (Ctrl-C to stop)\n")
-    sys.stdout.flush()
-    try:
+    try:  # entered before the URL is printed, so an early Ctrl-C still stops cleanly
+        if pose:
+            viewer.apply_pose(pose)
+        sys.stdout.write(f"armcli view: {src.name} at {viewer.url}  (Ctrl-C to stop)\n")
+        sys.stdout.flush()
         viewer.serve_forever()
     except KeyboardInterrupt:
         sys.stdout.write("viewer stopped\n")
+    finally:
+        viewer.close()
 
 
 def register(app: typer.Typer) -> None:

@@ -1,0 +1,135 @@
+"""Rules on the rigid bodies the joints move: each movable joint's child link plus
+everything fixed to it, lumped as simulators do (Pinocchio, MuJoCo's fusestatic,
+Gazebo's fixed-joint reduction).
+
+A zero-mass frame link fixed to a heavy link is fine; what breaks the mass
+matrix is a moving *body* with no mass or a singular inertia (a lone point
+mass). This is also the condition MuJoCo's compiler enforces ("mass and inertia
+of moving bodies must be larger than mjMINVAL"), which the corpus test uses as
+an oracle.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from armcli import inertia as inr
+from armcli.checks import Collector
+from armcli.checks_inertia import MIN_MOMENT
+from armcli.checks_structure import Tree, finite
+from armcli.urdfxml import Joint, Link, Urdf
+
+# A moving body lighter than this fraction of the robot makes the dynamics stiff.
+TINY_MASS_RATIO = 1e-4
+
+
+@dataclass(frozen=True)
+class Body:
+    """A lumped rigid body in the frame of the link its joint moves."""
+
+    joint: str
+    link: str
+    links: tuple[str, ...]
+    mass: float  # [kg]
+    com: np.ndarray  # [m], in the joint child link's frame
+    inertia: np.ndarray  # [kg·m²] about com, in the same frame
+
+
+def _transform(j: Joint) -> tuple[np.ndarray, np.ndarray]:
+    return inr.rpy_matrix(j.origin.rpy), np.asarray(j.origin.xyz, dtype=float)
+
+
+def lump(urdf: Urdf, tree: Tree, joint: Joint) -> Body:
+    """Lump `joint`'s child link with every link fixed to it (directly or in a chain)."""
+    links = {lk.name: lk for lk in urdf.links}
+    child = str(joint.child)
+    parts: list[tuple[Link, np.ndarray, np.ndarray]] = [(links[child], np.eye(3), np.zeros(3))]
+    frontier = [parts[0]]
+    while frontier:
+        link, R, p = frontier.pop()
+        for j in tree.parent_joint.values():
+            if j.parent == link.name and j.type == "fixed" and j.child in links:
+                Rj, pj = _transform(j)
+                item = (links[str(j.child)], R @ Rj, p + R @ pj)
+                parts.append(item)
+                frontier.append(item)
+    masses, coms, tensors = [], [], []
+    for link, R, p in parts:
+        ine = link.inertial
+        if ine is None or not finite(ine.mass) or ine.inertia is None or not finite(*ine.inertia):
+            continue
+        Ri = R @ inr.rpy_matrix(ine.origin.rpy)
+        masses.append(max(float(ine.mass or 0.0), 0.0))
+        coms.append(p + R @ np.asarray(ine.origin.xyz, dtype=float))
+        tensors.append(inr.rotate(inr.tensor(*ine.inertia), Ri))
+    total = float(sum(masses))
+    com = (
+        sum((m * c for m, c in zip(masses, coms, strict=True)), np.zeros(3)) / total
+        if total > 0
+        else np.zeros(3)
+    )
+    J = np.zeros((3, 3))
+    for m, c, Jc in zip(masses, coms, tensors, strict=True):
+        J += inr.parallel_axis(Jc, m, c - com)
+    return Body(joint.name, child, tuple(lk.name for lk, _, _ in parts), total, com, J)
+
+
+def moving_bodies(urdf: Urdf, tree: Tree) -> list[Body]:
+    """One lumped body per movable joint whose child link exists, in document order."""
+    names = {lk.name for lk in urdf.links}
+    return [
+        lump(urdf, tree, j)
+        for j in urdf.joints
+        if j.type != "fixed" and j.child in names and tree.parent_joint.get(str(j.child)) is j
+    ]
+
+
+def check(urdf: Urdf, tree: Tree, out: Collector) -> None:
+    total = _robot_mass(urdf)
+    lines = {lk.name: lk.line for lk in urdf.links}
+    for b in moving_bodies(urdf, tree):
+        where = f"the body moved by {b.joint!r} ({', '.join(b.links)})"
+        if b.mass <= 0.0:
+            out.add(
+                "mass-nonpositive",
+                lines.get(b.link),
+                f"{where} has no mass: MuJoCo rejects it, Gazebo drops or destabilises it",
+                joint=b.joint,
+                link=b.link,
+                mass=b.mass,
+            )
+            continue
+        moments = inr.principal_moments(b.inertia)
+        if moments[0] <= MIN_MOMENT:
+            out.add(
+                "inertia-not-pd",
+                lines.get(b.link),
+                f"{where} has a singular inertia, principal moments "
+                f"{[float(f'{x:.4g}') for x in moments]} (e.g. a lone point mass)",
+                joint=b.joint,
+                link=b.link,
+                principal=[float(x) for x in moments],
+            )
+        if total > 0 and b.mass < TINY_MASS_RATIO * total:
+            out.add(
+                "tiny-mass",
+                lines.get(b.link),
+                f"{where}: mass {b.mass:.3g} kg is "
+                f"{b.mass / total:.1e} of the robot's {total:.4g} kg",
+                joint=b.joint,
+                link=b.link,
+                mass=b.mass,
+                robot_mass=total,
+            )
+
+
+def _robot_mass(urdf: Urdf) -> float:
+    return float(
+        sum(
+            lk.inertial.mass
+            for lk in urdf.links
+            if lk.inertial is not None and finite(lk.inertial.mass) and lk.inertial.mass > 0  # type: ignore[operator]
+        )
+    )

@@ -1,0 +1,164 @@
+"""Put a simulation together from user inputs: spec or URDF, joints, gains, trajectory.
+
+The CLI only parses options and prints; everything that decides what is simulated
+(model, start state, gains, reference, duration, tool point) is here so tests can run it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from armcli.errors import InputError
+from armcli.interpolation import Reference, build_reference
+from armcli.sim import Arm, SimConfig, SimResult, arm_from_model, check_stability, simulate
+from armcli.trajectory import Trajectory, load_trajectory, loads_trajectory
+
+SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
+ARM_URDF = "standalone_arm.urdf"
+
+
+@dataclass(frozen=True)
+class SimJob:
+    arm: Arm
+    trajectory: Trajectory
+    reference: Reference
+    q0: np.ndarray
+    duration: float
+    config: SimConfig
+    tool_frame: int  # pinocchio frame id of the end-effector link
+    tool_offset: np.ndarray  # [m] point in that frame
+    tool_label: str
+    rate: float  # [Hz] joint_state_publisher rate
+
+
+def load_arm(spec: Any | None, urdf: Path | None, joints: Sequence[str] | None) -> Arm:
+    """The simulated arm: the spec's standalone arm built in memory, or a given URDF."""
+    from armcli.model import load_model
+
+    if urdf is not None:
+        return arm_from_model(load_model(urdf).model, joints)
+    from armcli.build import expand_urdfs
+
+    xml = expand_urdfs(spec)[ARM_URDF].decode("utf-8")
+    return arm_from_model(load_model(ARM_URDF, xml=xml).model, joints)
+
+
+def _gains(arm: Arm, spec: Any | None, override: Sequence[float] | None, which: str) -> np.ndarray:
+    n = len(arm.joint_names)
+    if override:
+        if len(override) not in (1, n):
+            raise InputError(f"give 1 or {n} value(s), got {len(override)}", field=f"--{which}")
+        vals = np.array(override * (n if len(override) == 1 else 1), dtype=float)
+        if not np.all(np.isfinite(vals)) or np.any(vals < 0):
+            raise InputError("gains must be finite and >= 0", field=f"--{which}")
+        return vals
+    gains = spec.control.gains if spec is not None else {}
+    missing = [j for j in arm.joint_names if j not in gains]
+    if missing:
+        raise InputError(
+            f"no {which} for {', '.join(missing)} in the spec; give --{which}", field=f"--{which}"
+        )
+    return np.array([getattr(gains[j], which) for j in arm.joint_names], dtype=float)
+
+
+def _tool(arm: Arm, spec: Any | None) -> tuple[int, np.ndarray, str]:
+    model = arm.model
+    if spec is not None and spec.arm.tool is not None and model.existFrame(spec.arm.tool.link):
+        off = np.array(spec.arm.tool.xyz, dtype=float)
+        return model.getFrameId(spec.arm.tool.link), off, f"{spec.arm.tool.link}+{_fmt(off)}"
+    last = model.njoints - 1
+    bodies = [i for i, f in enumerate(model.frames) if f.parentJoint == last]
+    fid = bodies[-1]
+    return fid, np.zeros(3), model.frames[fid].name
+
+
+def _fmt(v: np.ndarray) -> str:
+    return "(" + ",".join(f"{x:g}" for x in v) + ")"
+
+
+def start_state(arm: Arm, spec: Any | None) -> np.ndarray:
+    """The spec's `home` pose if it has one, else zero clamped into the joint limits."""
+    q = np.zeros(len(arm.joint_names))
+    if spec is not None and "home" in spec.poses:
+        home = spec.pose("home")
+        q = np.array([home.get(j, 0.0) for j in arm.joint_names], dtype=float)
+    return np.clip(q, arm.lower, arm.upper)
+
+
+def prepare(
+    *,
+    spec: Any | None,
+    urdf: Path | None = None,
+    joints: Sequence[str] | None = None,
+    trajectory: Path | None = None,
+    message: str | None = None,
+    kp: Sequence[float] | None = None,
+    kd: Sequence[float] | None = None,
+    gravity_comp: bool | None = None,
+    dt: float | None = None,
+    integrator: str = "euler",
+    duration: float | None = None,
+    clamp: bool = False,
+    rate: float | None = None,
+    backend: str = "auto",
+) -> SimJob:
+    """Validate every input and assemble the run; raises InputError on bad input."""
+    if (trajectory is None) == (message is None):
+        raise InputError(
+            "give exactly one of --trajectory FILE or --message '...'", field="--trajectory"
+        )
+    if integrator not in ("euler", "rk4"):
+        raise InputError(
+            f"unknown integrator {integrator!r}; valid: euler, rk4", field="--integrator"
+        )
+    dt = dt if dt is not None else (spec.control.dt if spec is not None else 0.001)
+    if not (np.isfinite(dt) and 0 < dt <= 0.1):
+        raise InputError(f"must be in (0, 0.1] s, got {dt:g}", field="--dt")
+    arm = load_arm(spec, urdf, joints)
+    limits = {
+        n: (float(lo), float(hi))
+        for n, lo, hi in zip(arm.joint_names, arm.lower, arm.upper, strict=True)
+    }
+    if trajectory is not None:
+        traj = load_trajectory(trajectory, limits, clamp=clamp)
+    else:
+        traj = loads_trajectory(str(message), limits, clamp=clamp)
+    q0 = start_state(arm, spec)
+    ref = build_reference(traj, arm.joint_names, q0)
+    gc = (
+        gravity_comp
+        if gravity_comp is not None
+        else bool(spec and spec.control.gravity_compensation)
+    )
+    cfg = SimConfig(
+        _gains(arm, spec, kp, "kp"), _gains(arm, spec, kd, "kd"), dt, integrator, gc, backend
+    )
+    configs = np.vstack([q0[None, :], ref.sample(traj.times)[0]])
+    check_stability(arm, cfg, configs)
+    total = duration if duration is not None else traj.duration + SETTLE_EXTRA_S
+    if not (np.isfinite(total) and 0 < total <= 3600):
+        raise InputError(f"must be in (0, 3600] s, got {total:g}", field="--duration")
+    jsp = spec.arm.joint_state_publisher if spec is not None else None
+    rate = rate if rate is not None else (jsp.update_rate if jsp is not None else 10.0)
+    if not (np.isfinite(rate) and rate > 0):
+        raise InputError(f"must be > 0 Hz, got {rate:g}", field="--rate")
+    fid, off, label = _tool(arm, spec)
+    return SimJob(arm, traj, ref, q0, total, cfg, fid, off, label, float(rate))
+
+
+def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
+    """End-effector point in the model's root frame at configuration q [m]."""
+    import pinocchio as pin
+
+    data = job.arm.model.createData()
+    pin.framesForwardKinematics(job.arm.model, data, q)
+    return np.asarray(data.oMf[job.tool_frame].act(job.tool_offset), dtype=float)
+
+
+def run(job: SimJob, progress: Callable[[int, int], None] | None = None) -> SimResult:
+    return simulate(job.arm, job.reference, job.q0, job.duration, job.config, progress)
