@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 SPEC ?= specs/my_robot.yaml
 
-.PHONY: install sysdeps demo test lint bench fuzz clean
+.PHONY: install sysdeps demo test lint bench native fuzz clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -32,8 +32,13 @@ test: install sysdeps lint
 	$(BIN)/armcli build --check $(SPEC)
 	$(BIN)/python -m pytest -q
 
-bench: install
-	@echo "no benchmarks yet"
+# Compiled simulator rollout (optional: armcli falls back to its Python loop). Cached under
+# ~/.cache/armcli/native keyed by source + pin version; ~2-4 min the first time.
+native: install
+	$(BIN)/python -m armcli.native
+
+bench: install native
+	$(BIN)/python bench/bench_sim.py
 
 fuzz: install
 	HYPOTHESIS_PROFILE=fuzz $(BIN)/python -m pytest -q tests -k fuzz

@@ -145,3 +145,19 @@ def test_cli_render_q_and_errors(root: Path, tmp_path: Path) -> None:
     assert count.returncode == 2
     assert "expected 2 values, for: arm_base_forearm_joint, forearm_hand_joint" in count.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.png"]
+
+
+def test_mesh_geometry_is_drawn_and_a_missing_mesh_is_an_error(tmp_path: Path) -> None:
+    import trimesh
+
+    trimesh.creation.icosphere(radius=0.2).export(tmp_path / "ball.stl")
+    link = (
+        '<link name="a"><visual><geometry><mesh filename="{}"/></geometry>'
+        '<material name="red"><color rgba="1 0 0 1"/></material></visual></link>'
+    )
+    ok = f'<robot name="r">{link.format("ball.stl")}</robot>'
+    res = render_png(load_urdf(ok, "m.urdf", tmp_path), {}, tmp_path / "m.png")
+    assert shade_mask(pixels(res.path), (1.0, 0.0, 0.0)).sum() > 10 * MIN_PIXELS
+    bad = f'<robot name="r">{link.format("package://nope/cube.stl")}</robot>'
+    with pytest.raises(InputError, match=r"mesh file not found: package://nope/cube\.stl"):
+        load_urdf(bad, "bad.urdf", tmp_path)

@@ -25,7 +25,7 @@ mujoco = pytest.importorskip("mujoco")
 DT = 5e-4  # [s] the comparison step
 KP, KD = 50.0, 5.0  # the spec's gains
 AGREE = 3e-4  # [rad] required agreement with friction off (the bound)
-FRICTION_DIFF = 1e-2  # [rad] loose bound with friction on: MuJoCo's friction is a soft constraint
+FRICTION_DIFF = 2e-3  # [rad] with friction on (measured 7.9e-4): MuJoCo friction is soft
 MULTI = (
     "joint_names: [arm_base_forearm_joint, forearm_hand_joint]\npoints:\n"
     " - {positions: [0.6, 0.4], time_from_start: 1.0}\n"
@@ -77,7 +77,9 @@ def _both(arm: Arm, built_dir: Path, friction: bool) -> tuple[np.ndarray, np.nda
     cfg = SimConfig(np.full(2, KP), np.full(2, KD), dt=DT)
     res = simulate(plant, ref, Q0, DURATION, cfg)
     assert not res.stop_active.any() and not res.saturated.any()  # same physics on both sides
-    q_mj = mujoco_run(mujoco_model(built_dir / "standalone_arm.urdf", friction), res.q_ref, res.v_ref)
+    q_mj = mujoco_run(
+        mujoco_model(built_dir / "standalone_arm.urdf", friction), res.q_ref, res.v_ref
+    )
     return res.q, q_mj
 
 

@@ -7,11 +7,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
+from hypothesis import given
 from scipy.interpolate import BPoly, CubicHermiteSpline
 
-from armcli.errors import SpecError
+from armcli.errors import ArmcliError, SpecError
 from armcli.interpolation import build_reference, segment_coeffs
 from armcli.trajectory import DEFAULT_SEGMENT_S, load_trajectory, loads_trajectory
+from fuzz_helpers import mutated
 
 J1, J2 = "arm_base_forearm_joint", "forearm_hand_joint"
 LIMITS = {J1: (0.0, math.pi / 2), J2: (0.0, math.pi / 2)}  # the seed's joint limits
@@ -61,17 +64,33 @@ def test_time_forms_sec_nanosec_and_seconds() -> None:
     ("text", "field", "needle"),
     [
         ("joint_names: [elbow]\npoints: [{positions: [0]}]", "joint_names[0]", J1),
-        ("joint_names: [%s, %s]\npoints: [{positions: [0.1]}]" % (J1, J2), "points[0].positions", "has 1"),
         (
-            "joint_names: [%s]\npoints:\n - {positions: [0.1], time_from_start: 2}\n"
-            " - {positions: [0.2], time_from_start: 1}" % J1,
+            f"joint_names: [{J1}, {J2}]\npoints: [{{positions: [0.1]}}]",
+            "points[0].positions",
+            "has 1",
+        ),
+        (
+            f"joint_names: [{J1}]\npoints:\n - {{positions: [0.1], time_from_start: 2}}\n"
+            " - {positions: [0.2], time_from_start: 1}",
             "points[1].time_from_start",
             "increase",
         ),
-        ("joint_names: [%s]\npoints: [{positions: [.nan]}]" % J1, "points[0].positions[0]", "finite"),
-        ("joint_names: [%s]\npoints: [{positions: [2.0]}]" % J1, "points[0].positions[0]", "limits"),
-        ("joint_names: [%s]\npoints: [{positions: [0.1], speed: 1}]" % J1, "points[0].speed", "unknown"),
-        ("joint_names: [%s]\npoints: []" % J1, "points", "non-empty"),
+        (
+            f"joint_names: [{J1}]\npoints: [{{positions: [.nan]}}]",
+            "points[0].positions[0]",
+            "finite",
+        ),
+        (
+            f"joint_names: [{J1}]\npoints: [{{positions: [2.0]}}]",
+            "points[0].positions[0]",
+            "limits",
+        ),
+        (
+            f"joint_names: [{J1}]\npoints: [{{positions: [0.1], speed: 1}}]",
+            "points[0].speed",
+            "unknown",
+        ),
+        (f"joint_names: [{J1}]\npoints: []", "points", "non-empty"),
     ],
 )
 def test_invalid_trajectories_name_file_field_and_line(text: str, field: str, needle: str) -> None:
@@ -83,7 +102,7 @@ def test_invalid_trajectories_name_file_field_and_line(text: str, field: str, ne
 
 
 def test_clamp_turns_limit_error_into_warning() -> None:
-    text = "joint_names: [%s]\npoints: [{positions: [2.0]}]" % J1
+    text = f"joint_names: [{J1}]\npoints: [{{positions: [2.0]}}]"
     tr = loads_trajectory(text, LIMITS, clamp=True)
     assert tr.positions[0, 0] == pytest.approx(math.pi / 2)
     assert len(tr.warnings) == 1 and "clamped" in tr.warnings[0]
@@ -91,8 +110,8 @@ def test_clamp_turns_limit_error_into_warning() -> None:
 
 def test_linear_segments_hit_points_and_hold_after_end() -> None:
     text = (
-        "joint_names: [%s, %s]\npoints:\n - {positions: [0.4, 0.2], time_from_start: 1}\n"
-        " - {positions: [0.8, 1.0], time_from_start: 3}" % (J1, J2)
+        f"joint_names: [{J1}, {J2}]\npoints:\n - {{positions: [0.4, 0.2], time_from_start: 1}}\n"
+        " - {positions: [0.8, 1.0], time_from_start: 3}"
     )
     tr = loads_trajectory(text, LIMITS)
     q0 = np.array([0.1, 0.0])
@@ -111,7 +130,7 @@ def test_linear_segments_hit_points_and_hold_after_end() -> None:
 
 def test_first_point_at_time_zero_is_the_reference_from_the_start() -> None:
     tr = loads_trajectory(
-        "joint_names: [%s]\npoints: [{positions: [0.5], time_from_start: 0}]" % J1, LIMITS
+        f"joint_names: [{J1}]\npoints: [{{positions: [0.5], time_from_start: 0}}]", LIMITS
     )
     ref = build_reference(tr, (J1, J2), np.zeros(2))
     q, _ = _sample1(ref, 0.0)
@@ -149,3 +168,26 @@ def test_cubic_reference_velocities_at_knots() -> None:
     q, v = ref.sample(tr.times)
     np.testing.assert_allclose(q, tr.positions, atol=1e-12)
     np.testing.assert_allclose(v, tr.velocities, atol=1e-12)
+
+
+WAVE = yaml.safe_load((ROOT / "specs" / "trajectories" / "wave.yaml").read_text())
+
+
+@given(mutated(WAVE))
+def test_fuzz_trajectory_structured(doc: object) -> None:
+    try:
+        text = yaml.safe_dump(doc, allow_unicode=True)
+    except yaml.YAMLError:
+        return
+    try:
+        tr = loads_trajectory(text, LIMITS, source="fuzz.yaml")
+    except ArmcliError as exc:
+        assert all(ln.startswith("fuzz.yaml") for ln in exc.lines()), exc.lines()
+        return
+    # accepted: times increase, positions finite and within limits, reference finite
+    assert np.all(np.diff(tr.times) > 0) and tr.times[0] >= 0
+    assert np.all(np.isfinite(tr.positions))
+    assert np.all(tr.positions >= -1e-9) and np.all(tr.positions <= math.pi / 2 + 1e-9)
+    ref = build_reference(tr, (J1, J2), np.zeros(2))
+    q, v = ref.sample(np.linspace(0, tr.duration + 1, 50))
+    assert np.all(np.isfinite(q)) and np.all(np.isfinite(v))

@@ -8,6 +8,7 @@ robot's colours and for the forearm moving when a joint is set through the API.
 from __future__ import annotations
 
 import base64
+import contextlib
 import io
 import json
 import math
@@ -30,7 +31,7 @@ from PIL import Image
 
 from armcli.commands.view import load_robot
 from armcli.errors import InputError
-from armcli.viewer import Viewer, load_replay
+from armcli.viewer import Viewer, load_replay, moving_parts
 
 TIP_TOL = 1e-6  # [m] forward kinematics vs closed form
 INTERP_TOL = 1e-12  # [rad] linear interpolation of a linear record is exact
@@ -128,12 +129,15 @@ def test_replay_file_is_read_and_interpolated(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("edit", "message"),
     [
-        (lambda t: t.replace("forearm_hand_joint.position", "elbow.position"),
-         r"states.csv:1: unknown joint 'elbow'; known: .*forearm_hand_joint"),
-        (lambda t: t.replace("0.300,", "0.100,", 1),
-         r"states.csv:5 time: time must increase"),
-        (lambda t: t.replace("0.100000", "abc", 1),
-         r"states.csv:4 arm_base_forearm_joint.position: expected a finite number, got 'abc'"),
+        (
+            lambda t: t.replace("forearm_hand_joint.position", "elbow.position"),
+            r"states.csv:1: unknown joint 'elbow'; known: .*forearm_hand_joint",
+        ),
+        (lambda t: t.replace("0.300,", "0.100,", 1), r"states.csv:5 time: time must increase"),
+        (
+            lambda t: t.replace("0.100000", "abc", 1),
+            r"states.csv:4 arm_base_forearm_joint.position: expected a finite number, got 'abc'",
+        ),
         (lambda t: t.replace("time,", "t,", 1), r"states.csv:1: first column must be 'time'"),
     ],
 )
@@ -161,6 +165,33 @@ def test_replay_seek_play_and_ghost(robot, tmp_path: Path) -> None:  # type: ign
         v.play(False)
         moved = v.configuration()[ARM[0]]
         assert 0.0 < moved <= 0.5 * 2.0
+
+
+def test_ghost_shows_only_the_links_the_references_move(robot) -> None:  # type: ignore[no-untyped-def]
+    from armcli.urdfxml import parse_urdf
+
+    ghost = parse_urdf(moving_parts(robot.xml, ARM).encode(), "ghost")
+    # The seed's arm joints move forearm_link and, below it, hand_link; nothing else.
+    assert {lk.name for lk in ghost.links if lk.visuals} == {"forearm_link", "hand_link"}
+    assert len(ghost.links) == len(parse_urdf(robot.xml.encode(), "full").links)
+
+
+def test_cli_view_port_taken_exits_2(root: Path) -> None:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        port = s.getsockname()[1]
+        proc = subprocess.run(
+            [sys.executable, "-m", "armcli.cli", "view", "--port", str(port)],
+            cwd=root,
+            capture_output=True,
+            text=True,
+            timeout=120,
+            check=False,
+        )
+    assert proc.returncode == 2
+    assert proc.stderr.startswith(f"error: --port: cannot listen on 127.0.0.1:{port}: ")
+    assert proc.stdout == ""
 
 
 def test_cli_view_stops_cleanly_on_ctrl_c(root: Path) -> None:
@@ -222,7 +253,9 @@ def browser() -> Iterator[Any]:
     """Headless Chromium with a fresh profile; yields a function opening a URL in a page."""
     exe = shutil.which("chromium") or shutil.which("chromium-browser")
     if exe is None:
-        pytest.skip("chromium not installed (Debian packages chromium, chromium-driver; make sysdeps)")
+        pytest.skip(
+            "chromium not installed (Debian packages chromium, chromium-driver; make sysdeps)"
+        )
     profile = Path(tempfile.mkdtemp(prefix="armcli-chromium-"))
     proc = subprocess.Popen(
         [exe, *CHROMIUM_FLAGS, f"--user-data-dir={profile}", "about:blank"],
@@ -270,10 +303,8 @@ def wait_for(dev: DevTools, test: Any, timeout: float) -> np.ndarray:
     deadline = time.monotonic() + timeout
     img = np.zeros((1, 1, 3), dtype=int)
     while True:
-        try:
+        with contextlib.suppress(RuntimeError):  # the page may still be attaching
             img = dev.screenshot()
-        except RuntimeError:  # the page is still being attached after navigation
-            pass
         if test(img) or time.monotonic() > deadline:
             return img
         time.sleep(0.5)

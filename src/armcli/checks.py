@@ -75,7 +75,7 @@ _RULES = [
     Rule(
         "inertia-not-pd",
         ERROR,
-        "negative principal moment, or a moving body with singular inertia",
+        "inertia of a link with mass not positive definite, or a moving body's singular",
         "use the solid-body formula for the link's shape",
     ),
     Rule(
@@ -127,7 +127,7 @@ _RULES = [
     Rule(
         "limit-degrees",
         WARNING,
-        "revolute limit beyond 2*pi: degrees instead of radians?",
+        "revolute limit a round number beyond 2*pi: degrees, not radians?",
         "URDF angles are radians",
     ),
     Rule("spec-limits", ERROR, "joint limits differ from the spec", "rebuild from the spec"),

@@ -35,6 +35,7 @@ class Body:
     mass: float  # [kg]
     com: np.ndarray  # [m], in the joint child link's frame
     inertia: np.ndarray  # [kg·m²] about com, in the same frame
+    unknown: bool = False  # some part has unusable numbers (already reported)
 
 
 def _transform(j: Joint) -> tuple[np.ndarray, np.ndarray]:
@@ -43,7 +44,9 @@ def _transform(j: Joint) -> tuple[np.ndarray, np.ndarray]:
 
 def lump(urdf: Urdf, tree: Tree, joint: Joint) -> Body:
     """Lump `joint`'s child link with every link fixed to it (directly or in a chain)."""
-    links = {lk.name: lk for lk in urdf.links}
+    links: dict[str, Link] = {}
+    for lk in urdf.links:
+        links.setdefault(lk.name, lk)  # a duplicate name is reported; the first one counts
     child = str(joint.child)
     parts: list[tuple[Link, np.ndarray, np.ndarray]] = [(links[child], np.eye(3), np.zeros(3))]
     frontier = [parts[0]]
@@ -56,10 +59,15 @@ def lump(urdf: Urdf, tree: Tree, joint: Joint) -> Body:
                 parts.append(item)
                 frontier.append(item)
     masses, coms, tensors = [], [], []
+    unknown = False
     for link, R, p in parts:
         ine = link.inertial
-        if ine is None or not finite(ine.mass) or ine.inertia is None or not finite(*ine.inertia):
+        if ine is None:
             continue
+        if not _finite_inertial(link) or not np.all(np.isfinite(p)) or not np.all(np.isfinite(R)):
+            unknown = True  # reported by the number rules; the body cannot be judged
+            continue
+        assert ine.inertia is not None  # _finite_inertial
         Ri = R @ inr.rpy_matrix(ine.origin.rpy)
         masses.append(max(float(ine.mass or 0.0), 0.0))
         coms.append(p + R @ np.asarray(ine.origin.xyz, dtype=float))
@@ -73,7 +81,17 @@ def lump(urdf: Urdf, tree: Tree, joint: Joint) -> Body:
     J = np.zeros((3, 3))
     for m, c, Jc in zip(masses, coms, tensors, strict=True):
         J += inr.parallel_axis(Jc, m, c - com)
-    return Body(joint.name, child, tuple(lk.name for lk, _, _ in parts), total, com, J)
+    return Body(joint.name, child, tuple(lk.name for lk, _, _ in parts), total, com, J, unknown)
+
+
+def _finite_inertial(link: Link) -> bool:
+    ine = link.inertial
+    return (
+        ine is not None
+        and finite(ine.mass)
+        and ine.inertia is not None
+        and finite(*ine.inertia, *ine.origin.xyz, *ine.origin.rpy)
+    )
 
 
 def moving_bodies(urdf: Urdf, tree: Tree) -> list[Body]:
@@ -90,6 +108,8 @@ def check(urdf: Urdf, tree: Tree, out: Collector) -> None:
     total = _robot_mass(urdf)
     lines = {lk.name: lk.line for lk in urdf.links}
     for b in moving_bodies(urdf, tree):
+        if b.unknown:
+            continue
         where = f"the body moved by {b.joint!r} ({', '.join(b.links)})"
         if b.mass <= 0.0:
             out.add(
@@ -126,10 +146,9 @@ def check(urdf: Urdf, tree: Tree, out: Collector) -> None:
 
 
 def _robot_mass(urdf: Urdf) -> float:
-    return float(
-        sum(
-            lk.inertial.mass
-            for lk in urdf.links
-            if lk.inertial is not None and finite(lk.inertial.mass) and lk.inertial.mass > 0  # type: ignore[operator]
-        )
-    )
+    total = 0.0
+    for lk in urdf.links:
+        m = lk.inertial.mass if lk.inertial is not None else None
+        if m is not None and finite(m) and m > 0:
+            total += m
+    return total

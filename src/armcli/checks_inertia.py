@@ -143,6 +143,9 @@ def _versus_geometry(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -
     shape = primitive_shape(link)
     if shape is None or shape.geometry is None:
         return
+    poses = (*ine.origin.xyz, *ine.origin.rpy, *shape.origin.xyz, *shape.origin.rpy)
+    if not finite(*poses):
+        return  # reported by the number rules
     g, m = shape.geometry, float(ine.mass or 0.0)
     R_link_geom = inr.rpy_matrix(shape.origin.rpy)
     R_link_inertial = inr.rpy_matrix(ine.origin.rpy)

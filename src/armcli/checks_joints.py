@@ -108,7 +108,7 @@ def _spec_limits(urdf: Urdf, spec: RobotSpec, out: Collector) -> None:
             "velocity": sj.limit.velocity,
         }
         got = {k: (getattr(ul, k) if ul is not None else None) for k in want}
-        bad = [k for k in want if got[k] is None or abs(got[k] - want[k]) > SPEC_LIMIT_TOL]
+        bad = [k for k in want if (g := got[k]) is None or abs(g - want[k]) > SPEC_LIMIT_TOL]
         if bad:
             detail = ", ".join(f"{k} {_g(got[k])} (spec {want[k]:g})" for k in bad)
             out.add(

@@ -51,7 +51,17 @@ def check(urdf: Urdf, out: Collector) -> Tree:
     links = {lk.name for lk in urdf.links}
     for j in urdf.joints:
         _joint_shape(j, links, {jj.name for jj in urdf.joints}, out)
-    return _tree(urdf, links, out)
+    tree = _tree(urdf, links, out)
+    for link in urdf.links:
+        if tree.is_moving(link.name) and link.visuals and not link.collisions:
+            out.add(
+                "visual-no-collision",
+                link.line,
+                f"moving link {link.name!r} is visible but has no <collision>: it passes "
+                "through everything in simulation",
+                link=link.name,
+            )
+    return tree
 
 
 def _names(urdf: Urdf, out: Collector) -> None:

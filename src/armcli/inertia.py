@@ -83,7 +83,7 @@ def is_symmetric(J: Matrix, rtol: float = 1e-9) -> bool:
 
 def principal_moments(J: Matrix) -> NDArray[np.float64]:
     """Eigenvalues of the symmetric part of J, ascending [kg·m²]."""
-    return np.linalg.eigvalsh(0.5 * (J + J.T))
+    return np.asarray(np.linalg.eigvalsh(0.5 * (J + J.T)), dtype=np.float64)
 
 
 def is_positive_definite(J: Matrix) -> bool:

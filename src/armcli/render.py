@@ -22,7 +22,7 @@ from armcli.fsio import write_file_atomic
 
 MAX_EDGE = 0.04  # [m] faces are split to this edge length so depth sorting works
 LIGHT = np.array([0.35, -0.55, 0.76])  # direction towards the light, world frame
-AMBIENT = 0.45  # share of colour that does not depend on the light
+AMBIENT = 0.3  # share of colour that does not depend on the light
 VIEWS = (  # (title, elevation [deg], azimuth [deg])
     ("3-D view", 22.0, -58.0),
     ("side view (x-z plane)", 0.0, -90.0),
@@ -54,22 +54,42 @@ def load_urdf(xml: str, source: str = "<urdf>", mesh_dir: str | Path | None = No
     """URDF text -> yourdfpy.URDF with its visual scene (meshes resolved under `mesh_dir`).
 
     The text first passes urdfxml's safe parser (no DTDs or entities, bounded size and
-    depth), since yourdfpy's own lxml parser would resolve entities.
+    depth), since yourdfpy's own lxml parser would resolve entities. A mesh file that
+    cannot be found is an InputError, where yourdfpy would log and draw nothing.
     """
+    import logging
+
     import yourdfpy
 
     from armcli.urdfxml import parse_root
 
     parse_root(xml.encode("utf-8"), source)
+    missing: list[str] = []
+
+    def resolve(fname: str) -> str:
+        found = str(yourdfpy.filename_handler_magic(fname, dir=str(mesh_dir or ".")))
+        if not Path(found).is_file():
+            missing.append(fname)
+        return found
+
+    log = logging.getLogger("yourdfpy")
+    level, log.level = log.level, logging.CRITICAL  # its warnings become our error below
     try:
-        return yourdfpy.URDF.load(
+        urdf = yourdfpy.URDF.load(
             io.BytesIO(xml.encode("utf-8")),
             build_collision_scene_graph=False,
             load_collision_meshes=False,
-            mesh_dir=str(mesh_dir or ""),
+            filename_handler=resolve,
         )
     except Exception as exc:  # yourdfpy raises assorted types for bad URDFs
         raise InputError(f"cannot load this URDF: {exc}", file=source) from None
+    finally:
+        log.level = level
+    if missing:
+        raise InputError(
+            f"mesh file not found: {missing[0]} (searched from {mesh_dir or '.'})", file=source
+        )
+    return urdf
 
 
 def joint_limits(urdf: Any) -> dict[str, tuple[float, float] | None]:
@@ -85,7 +105,7 @@ def joint_limits(urdf: Any) -> dict[str, tuple[float, float] | None]:
 def full_configuration(
     urdf: Any, q: Mapping[str, float], source: str | None = None, field: str | None = None
 ) -> dict[str, float]:
-    """Every movable joint's value (0 where `q` is silent).
+    """Every movable joint's value (`neutral` where `q` is silent).
 
     Unknown joints and values outside the limits raise InputError naming `field`.
     """
@@ -105,7 +125,12 @@ def full_configuration(
                 file=source,
                 field=field,
             )
-    return {name: float(q.get(name, 0.0)) for name in limits}
+    return {name: float(q.get(name, neutral(limits[name]))) for name in limits}
+
+
+def neutral(limit: tuple[float, float] | None) -> float:
+    """The value a joint takes when nobody sets it: 0, or the nearest limit if 0 is outside."""
+    return 0.0 if limit is None else float(np.clip(0.0, limit[0], limit[1]))
 
 
 def tool_position(urdf: Any, tool: Tool | None) -> np.ndarray | None:

@@ -103,9 +103,7 @@ def arm_from_model(model: Any, joints: Sequence[str] | None = None) -> Arm:
                 "revolute and prismatic joints are supported (lock it with --joints)",
                 field="--joints",
             )
-    order = list(model.names)[1:]
-    if order != chosen and joints:
-        chosen = order  # simulate in model order; names keep their meaning
+    order = list(model.names)[1:]  # simulated in model (tree) order whatever --joints says
     effort = np.array(model.effortLimit, dtype=float)
     effort = np.where((effort > 0) & np.isfinite(effort), effort, np.inf)
     return Arm(
@@ -159,19 +157,26 @@ def check_stability(arm: Arm, cfg: SimConfig, configurations: np.ndarray) -> Non
         rho = step_radius(M, K, B, cfg.dt, cfg.integrator)
         if rho <= 1.0 + RHO_TOL:
             continue
-        dt_ok = _bisect(lambda h: step_radius(M, K, B, h, cfg.integrator) <= 1 + RHO_TOL, cfg.dt)
-        scale = _bisect(
-            lambda s: step_radius(M, s * K, s * B, cfg.dt, cfg.integrator) <= 1 + RHO_TOL, 1.0
-        )
-        what = "Kd + damping" if cfg.integrator == "rk4" else "Kp"
-        raise InputError(
-            f"the {cfg.integrator} integrator is unstable with these gains at dt = {cfg.dt:g} s "
-            f"(closed-loop step spectral radius {rho:.3f} > 1 at q = {np.round(q, 3).tolist()}); "
-            f"{what} is too stiff for this inertia: use --dt <= {dt_ok:.3g} or gains scaled by "
-            f"<= {scale:.3g}"
-            + (" or the default euler integrator" if cfg.integrator == "rk4" else ""),
-            field="--dt",
-        )
+        _refuse(M, K, B, cfg, rho, q)
+
+
+def _refuse(
+    M: np.ndarray, K: np.ndarray, B: np.ndarray, cfg: SimConfig, rho: float, q: Any
+) -> None:
+    def stable(h: float, s: float) -> bool:
+        return step_radius(M, s * K, s * B, h, cfg.integrator) <= 1 + RHO_TOL
+
+    dt_ok = _bisect(lambda h: stable(h, 1.0), cfg.dt)
+    scale = _bisect(lambda s: stable(cfg.dt, s), 1.0)
+    what = "Kd + damping" if cfg.integrator == "rk4" else "Kp"
+    hint = " or the default euler integrator" if cfg.integrator == "rk4" else ""
+    raise InputError(
+        f"the {cfg.integrator} integrator is unstable with these gains at dt = {cfg.dt:g} s "
+        f"(closed-loop step spectral radius {rho:.3f} > 1 at q = {np.round(q, 3).tolist()}); "
+        f"{what} is too stiff for this inertia: use --dt <= {dt_ok:.3g} or gains scaled by "
+        f"<= {scale:.3g}{hint}",
+        field="--dt",
+    )
 
 
 def _bisect(ok: Callable[[float], bool], hi: float) -> float:
@@ -222,19 +227,34 @@ def simulate(
         if progress is not None:
             progress(k1, steps)
     wall = time.perf_counter() - start
+    backend = "native" if lib is not None else "python"
+    return _result(arm, cfg, parts, q_ref[::sub], v_ref[::sub], backend, wall)
+
+
+def _result(
+    arm: Arm,
+    cfg: SimConfig,
+    parts: list[ro.Rollout],
+    q_ref: np.ndarray,
+    v_ref: np.ndarray,
+    backend: str,
+    wall: float,
+) -> SimResult:
+    """Stitch the chunks (each repeats the previous chunk's last state as its first row)."""
+    flags = np.vstack([p.flags for p in parts])
     return SimResult(
         joint_names=arm.joint_names,
-        t=np.arange(steps + 1) * cfg.dt,
+        t=np.arange(q_ref.shape[0]) * cfg.dt,
         q=np.vstack([parts[0].q[:1]] + [p.q[1:] for p in parts]),
         v=np.vstack([parts[0].v[:1]] + [p.v[1:] for p in parts]),
-        q_ref=q_ref[::sub],
-        v_ref=v_ref[::sub],
+        q_ref=q_ref,
+        v_ref=v_ref,
         tau=np.vstack([p.tau for p in parts]),
-        saturated=np.vstack([p.flags for p in parts]) & ro.FLAG_SATURATED > 0,
-        stop_active=np.vstack([p.flags for p in parts]) & ro.FLAG_STOP > 0,
+        saturated=(flags & ro.FLAG_SATURATED) > 0,
+        stop_active=(flags & ro.FLAG_STOP) > 0,
         dt=cfg.dt,
         integrator=cfg.integrator,
-        backend="native" if lib is not None else "python",
+        backend=backend,
         wall_time=wall,
     )
 

@@ -17,9 +17,12 @@ from armcli.errors import InputError
 from armcli.interpolation import Reference, build_reference
 from armcli.sim import Arm, SimConfig, SimResult, arm_from_model, check_stability, simulate
 from armcli.trajectory import Trajectory, load_trajectory, loads_trajectory
+from armcli.yamlio import read_text
 
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
 ARM_URDF = "standalone_arm.urdf"
+MAX_URDF_BYTES = 50_000_000
+MAX_STEPS = 2_000_000  # ~200 MB of recorded states for a 2-joint arm
 
 
 @dataclass(frozen=True)
@@ -41,9 +44,12 @@ def load_arm(spec: Any | None, urdf: Path | None, joints: Sequence[str] | None) 
     from armcli.model import load_model
 
     if urdf is not None:
-        return arm_from_model(load_model(urdf).model, joints)
+        text = read_text(urdf, max_bytes=MAX_URDF_BYTES, what="URDF file")
+        return arm_from_model(load_model(urdf, xml=text).model, joints)
     from armcli.build import expand_urdfs
 
+    if spec is None:
+        raise InputError("give a spec or --urdf", field="--urdf")
     xml = expand_urdfs(spec)[ARM_URDF].decode("utf-8")
     return arm_from_model(load_model(ARM_URDF, xml=xml).model, joints)
 
@@ -53,8 +59,8 @@ def _gains(arm: Arm, spec: Any | None, override: Sequence[float] | None, which: 
     if override:
         if len(override) not in (1, n):
             raise InputError(f"give 1 or {n} value(s), got {len(override)}", field=f"--{which}")
-        vals = np.array(override * (n if len(override) == 1 else 1), dtype=float)
-        if not np.all(np.isfinite(vals)) or np.any(vals < 0):
+        vals = np.array(list(override) * (n if len(override) == 1 else 1), dtype=np.float64)
+        if not np.all(np.isfinite(vals)) or np.any(vals < 0.0):
             raise InputError("gains must be finite and >= 0", field=f"--{which}")
         return vals
     gains = spec.control.gains if spec is not None else {}
@@ -143,6 +149,12 @@ def prepare(
     total = duration if duration is not None else traj.duration + SETTLE_EXTRA_S
     if not (np.isfinite(total) and 0 < total <= 3600):
         raise InputError(f"must be in (0, 3600] s, got {total:g}", field="--duration")
+    if total / dt > MAX_STEPS:
+        raise InputError(
+            f"{total:g} s at dt = {dt:g} s is {total / dt:.3g} steps, more than {MAX_STEPS:,}; "
+            "shorten --duration or raise --dt",
+            field="--duration",
+        )
     jsp = spec.arm.joint_state_publisher if spec is not None else None
     rate = rate if rate is not None else (jsp.update_rate if jsp is not None else 10.0)
     if not (np.isfinite(rate) and rate > 0):

@@ -135,6 +135,12 @@ class Urdf:
         return next((lk for lk in self.links if lk.name == name), None)
 
 
+def _ln(el: etree._Element) -> int | None:
+    """The element's 1-based source line (lxml's stubs type it loosely)."""
+    line = el.sourceline
+    return line if isinstance(line, int) else None
+
+
 class _Numbers:
     """Parses numeric attributes, collecting problems instead of raising."""
 
@@ -150,7 +156,7 @@ class _Numbers:
         default: tuple[float, ...] | None = None,
     ) -> tuple[float, ...] | None:
         text = el.get(attr) if el is not None else None
-        line = el.sourceline if el is not None else None
+        line = _ln(el) if el is not None else None
         if text is None:
             if default is None:
                 self.problems.append(NumberProblem("missing", f"{where}@{attr}", "", line))
@@ -178,7 +184,7 @@ class _Numbers:
             return Pose()
         xyz = self.vec(el, "xyz", 3, f"{where}origin", ZERO3) or ZERO3
         rpy = self.vec(el, "rpy", 3, f"{where}origin", ZERO3) or ZERO3
-        return Pose(xyz=xyz, rpy=rpy, line=el.sourceline)  # type: ignore[arg-type]
+        return Pose(xyz=xyz, rpy=rpy, line=_ln(el))  # type: ignore[arg-type]
 
 
 _DIMS = {
@@ -193,20 +199,20 @@ def _geometry(num: _Numbers, el: etree._Element | None, where: str) -> Geometry 
         return None
     shape = next((c for c in el if isinstance(c.tag, str)), None)
     if shape is None:
-        return Geometry(kind="", dims=None, line=el.sourceline)
+        return Geometry(kind="", dims=None, line=_ln(el))
     kind = str(shape.tag)
     if kind == "mesh":
         scale = num.vec(shape, "scale", 3, f"{where}mesh", (1.0, 1.0, 1.0)) or (1.0, 1.0, 1.0)
-        return Geometry("mesh", None, shape.sourceline, shape.get("filename"), scale)  # type: ignore[arg-type]
+        return Geometry("mesh", None, _ln(shape), shape.get("filename"), scale)  # type: ignore[arg-type]
     if kind not in _DIMS:
-        return Geometry(kind=kind, dims=None, line=shape.sourceline)
+        return Geometry(kind=kind, dims=None, line=_ln(shape))
     dims: list[float] = []
     for attr, n in _DIMS[kind]:
         v = num.vec(shape, attr, n, f"{where}{kind}")
         if v is None:
-            return Geometry(kind=kind, dims=None, line=shape.sourceline)
+            return Geometry(kind=kind, dims=None, line=_ln(shape))
         dims.extend(v)
-    return Geometry(kind=kind, dims=tuple(dims), line=shape.sourceline)
+    return Geometry(kind=kind, dims=tuple(dims), line=_ln(shape))
 
 
 def _shapes(num: _Numbers, link: etree._Element, tag: str, where: str) -> tuple[Shape, ...]:
@@ -217,7 +223,7 @@ def _shapes(num: _Numbers, link: etree._Element, tag: str, where: str) -> tuple[
             Shape(
                 origin=num.pose(el.find("origin"), f"{where}{tag}/"),
                 geometry=_geometry(num, el.find("geometry"), f"{where}{tag}/"),
-                line=el.sourceline,
+                line=_ln(el),
                 material=mat.get("name") if mat is not None else None,
             )
         )
@@ -238,14 +244,14 @@ def _inertial(num: _Numbers, el: etree._Element | None, where: str) -> Inertial 
         if all(v is not None for v in values):
             inertia = tuple(values)
     else:
-        num.problems.append(NumberProblem("missing", f"{where}inertial/inertia", "", el.sourceline))
+        num.problems.append(NumberProblem("missing", f"{where}inertial/inertia", "", _ln(el)))
     return Inertial(
         origin=num.pose(el.find("origin"), f"{where}inertial/"),
         mass=mass,
         inertia=inertia,  # type: ignore[arg-type]
-        line=el.sourceline,
-        mass_line=mass_el.sourceline if mass_el is not None else el.sourceline,
-        inertia_line=inertia_el.sourceline if inertia_el is not None else el.sourceline,
+        line=_ln(el),
+        mass_line=_ln(mass_el) if mass_el is not None else _ln(el),
+        inertia_line=_ln(inertia_el) if inertia_el is not None else _ln(el),
     )
 
 
@@ -254,7 +260,7 @@ def _link(num: _Numbers, el: etree._Element) -> Link:
     where = f"link {name}: "
     return Link(
         name=name,
-        line=el.sourceline,
+        line=_ln(el),
         inertial=_inertial(num, el.find("inertial"), where),
         visuals=_shapes(num, el, "visual", where),
         collisions=_shapes(num, el, "collision", where),
@@ -280,23 +286,23 @@ def _joint(num: _Numbers, el: etree._Element) -> Joint:
             upper=num.one(limit_el, "upper", f"{where}limit", 0.0),
             effort=_optional(num, limit_el, "effort", where),
             velocity=_optional(num, limit_el, "velocity", where),
-            line=limit_el.sourceline,
+            line=_ln(limit_el),
         )
     parent, child = el.find("parent"), el.find("child")
     return Joint(
         name=name,
         type=jtype,
-        line=el.sourceline,
+        line=_ln(el),
         parent=parent.get("link") if parent is not None else None,
         child=child.get("link") if child is not None else None,
         origin=num.pose(el.find("origin"), f"{where}"),
         axis=axis,  # type: ignore[arg-type]
-        axis_line=axis_el.sourceline if axis_el is not None else el.sourceline,
+        axis_line=_ln(axis_el) if axis_el is not None else _ln(el),
         limit=limit,
         damping=num.one(dyn_el, "damping", f"{where}dynamics", 0.0) or 0.0,
         friction=num.one(dyn_el, "friction", f"{where}dynamics", 0.0) or 0.0,
         mimic=mimic_el.get("joint") if mimic_el is not None else None,
-        mimic_line=mimic_el.sourceline if mimic_el is not None else None,
+        mimic_line=_ln(mimic_el) if mimic_el is not None else None,
     )
 
 
@@ -311,7 +317,7 @@ def _materials(num: _Numbers, root: etree._Element) -> tuple[Material, ...]:
         name = el.get("name", "")
         color = el.find("color")
         rgba = num.vec(color, "rgba", 4, f"material {name}: color") if color is not None else None
-        out.append(Material(name, rgba, el.sourceline, el.getparent() is root))
+        out.append(Material(name, rgba, _ln(el), el.getparent() is root))
     return tuple(out)
 
 
@@ -321,7 +327,7 @@ def _check_depth(root: etree._Element, source: str) -> None:
         el, depth = stack.pop()
         if depth > MAX_URDF_DEPTH:
             raise InputError(
-                f"XML nested deeper than {MAX_URDF_DEPTH} levels", file=source, line=el.sourceline
+                f"XML nested deeper than {MAX_URDF_DEPTH} levels", file=source, line=_ln(el)
             )
         stack.extend((c, depth + 1) for c in el)
 
@@ -363,7 +369,7 @@ def parse_root(data: bytes, source: str) -> etree._Element:
         raise InputError(
             f"not a URDF: root element is <{root.tag}>, expected <robot>",
             file=source,
-            line=root.sourceline,
+            line=_ln(root),
         )
     if any(_is_xacro(el) for el in root.iter()):
         raise XacroRefusedError(

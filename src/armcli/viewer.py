@@ -24,7 +24,14 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import InputError
-from armcli.render import Tool, full_configuration, joint_limits, load_urdf, tool_position
+from armcli.render import (
+    Tool,
+    full_configuration,
+    joint_limits,
+    load_urdf,
+    neutral,
+    tool_position,
+)
 from armcli.yamlio import read_text
 
 MAX_REPLAY_BYTES = 200_000_000
@@ -188,18 +195,25 @@ class Viewer:
             self._stop_server()
             check_port_free(host, port)
         self.host, self.port = host, int(self.server.get_port())
-        self._robot = ViserUrdf(self.server, self._urdf, root_node_name="/robot")
-        self._ghost = None
-        if replay is not None and replay.reference:
-            ghost_xml = moving_parts(urdf_xml, replay.reference, source)
-            ghost_urdf = load_urdf(ghost_xml, source, mesh_dir)
-            self._ghost = ViserUrdf(
-                self.server, ghost_urdf, root_node_name="/ghost", mesh_color_override=GHOST_RGBA
-            )
-        self._build_scene()
-        self._build_gui(name)
-        self._apply()
         self._player: threading.Thread | None = None
+        try:
+            self._robot = ViserUrdf(self.server, self._urdf, root_node_name="/robot")
+            self._ghost = None
+            if replay is not None and replay.reference:
+                ghost_xml = moving_parts(urdf_xml, replay.reference, source)
+                self._ghost = ViserUrdf(
+                    self.server,
+                    load_urdf(ghost_xml, source, mesh_dir),
+                    root_node_name="/ghost",
+                    mesh_color_override=GHOST_RGBA,
+                )
+            self._build_scene()
+            self._build_gui(name)
+            self._apply()
+        except BaseException:
+            self._stop.set()
+            self._stop_server()
+            raise
         if replay is not None:
             self._player = threading.Thread(target=self._play_loop, daemon=True)
             self._player.start()
@@ -231,11 +245,12 @@ class Viewer:
             self._apply()
 
     def apply_pose(self, name: str) -> None:
-        """Move to a named pose of the spec (joints it does not name go to 0)."""
+        """Move to a named pose of the spec (joints it does not name go to `neutral`)."""
         if name not in self._poses:
             known = ", ".join(self._poses) or "(none)"
             raise InputError(f"unknown pose {name!r}; known: {known}", field="pose")
-        self.set_configuration({j: self._poses[name].get(j, 0.0) for j in self._limits})
+        pose = self._poses[name]
+        self.set_configuration({j: pose.get(j, neutral(lim)) for j, lim in self._limits.items()})
 
     def tool_position(self) -> np.ndarray | None:
         """The end-effector point in the root-link frame [m], or None without a tool."""
@@ -315,17 +330,18 @@ class Viewer:
         with gui.add_folder("Joints"):
             for joint, lim in self._limits.items():
                 lo, hi = lim if lim is not None else (-math.pi, math.pi)
-                s = gui.add_slider(joint, min=lo, max=hi, step=SLIDER_STEP, initial_value=0.0)
+                s = gui.add_slider(
+                    joint, min=lo, max=hi, step=SLIDER_STEP, initial_value=neutral(lim)
+                )
                 s.on_update(lambda _e: None if self._batch else self._apply())
                 self._sliders[joint] = s
         if self._poses:
             with gui.add_folder("Poses"):
                 for pose in self._poses:
-                    b = gui.add_button(pose)
-                    b.on_click(lambda _e, p=pose: self.apply_pose(p))
-        self._frames_box = gui.add_checkbox("Show link frames", initial_value=False)
+                    gui.add_button(pose).on_click(self._pose_button(pose))
+        self._frames_box: Any = gui.add_checkbox("Show link frames", initial_value=False)
         self._frames_box.on_update(lambda _e: self._update_frames())
-        self._tool_text = gui.add_text("Tool position [m]", initial_value="", disabled=True)
+        self._tool_text: Any = gui.add_text("Tool position [m]", initial_value="", disabled=True)
         if self._replay is not None:
             self._build_replay_gui()
 
@@ -335,9 +351,11 @@ class Viewer:
         with gui.add_folder("Replay"):
             play = gui.add_button("Play / pause")
             play.on_click(lambda _e: self.play(not self._playing))
-            self._speed = gui.add_slider("Speed", min=0.1, max=4.0, step=0.1, initial_value=1.0)
-            self._loop = gui.add_checkbox("Loop", initial_value=True)
-            self._time_slider = gui.add_slider(
+            self._speed: Any = gui.add_slider(
+                "Speed", min=0.1, max=4.0, step=0.1, initial_value=1.0
+            )
+            self._loop: Any = gui.add_checkbox("Loop", initial_value=True)
+            self._time_slider: Any = gui.add_slider(
                 "Time [s]",
                 min=0.0,
                 max=max(self._replay.duration, 1e-3),
@@ -350,6 +368,12 @@ class Viewer:
                 box.on_update(lambda _e: self._show_time(self._time_slider.value))
                 self._ghost_box = box
         self._show_time(0.0)
+
+    def _pose_button(self, pose: str) -> Any:
+        def on_click(_event: Any) -> None:
+            self.apply_pose(pose)
+
+        return on_click
 
     def _show_time(self, t: float) -> None:
         assert self._replay is not None

@@ -25,11 +25,22 @@ XACRO_MEMORY_BYTES = 1 << 30
 XACRO_MAX_OUTPUT = 10_000_000  # same cap as urdfxml.MAX_URDF_BYTES
 XACRO_MAX_FILES = 64
 
-_SCRIPT = (
-    "import sys, xacro\n"
-    "doc = xacro.process_file(sys.argv[1], mappings=dict(a.split(':=', 1) for a in sys.argv[2:]))\n"
-    "sys.stdout.buffer.write(doc.toprettyxml(indent='  ', encoding='utf-8'))\n"
-)
+_SCRIPT = """
+import sys, xacro
+try:
+    args = dict(a.split(":=", 1) for a in sys.argv[2:])
+    doc = xacro.process_file(sys.argv[1], mappings=args)
+except BaseException as exc:
+    inner = exc
+    while getattr(inner, "exc", None) is not None:
+        inner = inner.exc
+    text = f"{type(inner).__name__}: {' '.join(str(inner).split())}"
+    if inner is not exc:
+        text += " (" + str(exc).strip().splitlines()[-1] + ")"
+    sys.stderr.write(text.strip()[:400] + "\\n")
+    sys.exit(1)
+sys.stdout.buffer.write(doc.toprettyxml(indent="  ", encoding="utf-8"))
+"""
 
 
 def _limit_child() -> None:  # runs in the child between fork and exec

@@ -1,6 +1,6 @@
-// Compiled rollout of armcli's simulator: the same step as armcli.rollout.step_python.
+// Compiled rollout of armcli's simulator: the same step as armcli.rollout._Stepper.
 //
-// Why: a Python step loop pays ~30 us of interpreter overhead per step around a ~1 us
+// Why: a Python step loop pays ~100 us of interpreter overhead per step around a ~1 us
 // Pinocchio ABA call; running the whole loop here removes it. The algorithm must stay
 // identical to the Python reference (tests compare both to ~1e-12), so any change to
 // one is made to the other.

@@ -46,7 +46,7 @@ def load_robot(path: Path) -> RobotSource:
         spec = load_spec(path)
         urdfs = expand_urdfs(spec)
         xml = urdfs.get(f"{spec.name}.urdf", urdfs["standalone_arm.urdf"]).decode("utf-8")
-        tool = Tool(spec.arm.tool.link, tuple(spec.arm.tool.xyz)) if spec.arm.tool else None
+        tool = Tool(spec.arm.tool.link, spec.arm.tool.xyz) if spec.arm.tool else None
         return RobotSource(
             xml=xml,
             source=str(path),
@@ -126,10 +126,12 @@ def render_cmd(
     robot: Path = typer.Argument(DEFAULT_SPEC, help=ROBOT_HELP),
     pose: str = typer.Option(None, "--pose", help="A named pose of the spec."),
     q: str = typer.Option(
-        None, "--q", help="Joint values [rad|m]: '0.3,pi/4' in arm order, or 'joint=0.3,...'."
+        None,
+        "--q",
+        help="Joint values in rad (m if prismatic): '0.3,pi/4' in arm order, or 'joint=0.3,...'.",
     ),
     out: Path = typer.Option(Path("robot.png"), "-o", "--out", help="PNG to write."),
-    size: str = typer.Option("1200x600", "--size", help="Image size WIDTHxHEIGHT [px]."),
+    size: str = typer.Option("1200x600", "--size", help="Image size WIDTHxHEIGHT in pixels."),
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
     from armcli.render import load_urdf, render_png
