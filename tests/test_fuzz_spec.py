@@ -6,12 +6,12 @@ from pathlib import Path
 from typing import Any
 
 import yaml
-from fuzz_helpers import mutated
 from hypothesis import given
 from hypothesis import strategies as st
 
 from armcli.errors import ArmcliError
 from armcli.spec import RobotSpec, loads_spec
+from fuzz_helpers import mutated
 
 BASE = yaml.safe_load((Path(__file__).parents[1] / "specs" / "my_robot.yaml").read_text())
 

@@ -42,6 +42,10 @@ def test_seed_message(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, err = run(["--message", SEED], capsys)
     assert code == 0, err
     assert J1 in out and J2 in out and "end effector" in out
+    # The seed holds q = 0: tip in base_footprint at (base_length/4, 0, 0.1 + 0.2 + 0.02 + 0.6),
+    # the same frame and numbers `check` and `view` report.
+    assert "in base_footprint" in out
+    assert "(0.1500, 0.0000, 0.9200) m" in out
 
 
 @pytest.mark.parametrize("name", sorted(p.name for p in TRAJ.glob("*.yaml")))

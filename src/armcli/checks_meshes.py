@@ -55,15 +55,32 @@ def resolve(uri: str, urdf_path: Path, opts: CheckOptions) -> Path | None:
 
 
 def mesh_paths(urdf: Urdf, opts: CheckOptions) -> dict[str, Path | None]:
-    """Every mesh URI in the file -> its resolved path (None if unresolvable)."""
+    """Every mesh URI in the file -> its resolved path (None if unresolvable or outside
+    the allowed roots, so that nothing outside them is ever loaded)."""
     src = Path(urdf.source)
     out: dict[str, Path | None] = {}
     for link in urdf.links:
         for s in (*link.visuals, *link.collisions):
             g = s.geometry
             if g is not None and g.kind == "mesh" and g.filename and g.filename not in out:
-                out[g.filename] = resolve(g.filename, src, opts)
+                path = resolve(g.filename, src, opts)
+                ok = path is not None and confined(g.filename, path, src, opts)
+                out[g.filename] = path if ok else None
     return out
+
+
+def confined(uri: str, path: Path, urdf_path: Path, opts: CheckOptions) -> bool:
+    """Whether a resolved mesh path lies inside the allowed roots (robot_source.allowed_roots,
+    --package-dir, the search paths, and for package:// the package it names)."""
+    from armcli.robot_source import allowed_roots, inside_roots
+
+    extra = [*map(Path, opts.package_dirs.values()), *opts.search_paths]
+    parsed = urlparse(uri)
+    if parsed.scheme == "package":
+        name = parsed.netloc or unquote(parsed.path).lstrip("/").partition("/")[0]
+        root = package_root(name, urdf_path, opts)
+        extra += [root] if root is not None else []
+    return inside_roots(path, allowed_roots(urdf_path.parent, extra))
 
 
 def check(urdf: Urdf, opts: CheckOptions, out: Collector) -> None:
@@ -78,6 +95,17 @@ def check(urdf: Urdf, opts: CheckOptions, out: Collector) -> None:
                 out.add("mesh-missing", g.line, f"link {link.name!r}: mesh without a filename")
                 continue
             path = resolve(g.filename, src, opts)
+            if path is not None and not confined(g.filename, path, src, opts):  # not stat'ed
+                reported.add(g.filename)
+                out.add(
+                    "mesh-missing",
+                    g.line,
+                    f"link {link.name!r}: mesh {g.filename!r} resolves to {path}, outside the "
+                    "allowed directories (the URDF's directory and ROS package, --package-dir, "
+                    "ROS_PACKAGE_PATH); not read",
+                    uri=g.filename,
+                )
+                continue
             if path is None or not path.is_file():
                 reported.add(g.filename)
                 why = "unknown package" if path is None else f"no file {path}"

@@ -61,15 +61,23 @@ def load_urdf(xml: str, source: str = "<urdf>", mesh_dir: str | Path | None = No
 
     import yourdfpy
 
+    from armcli.robot_source import allowed_roots, inside_roots
     from armcli.urdfxml import parse_root
 
     parse_root(xml.encode("utf-8"), source)
     missing: list[str] = []
+    roots = allowed_roots(Path(mesh_dir or "."))
 
     def resolve(fname: str) -> str:
         found = str(yourdfpy.filename_handler_magic(fname, dir=str(mesh_dir or ".")))
         if not Path(found).is_file():
             missing.append(fname)
+        elif not inside_roots(Path(found), roots):  # never read files outside the roots
+            raise InputError(
+                f"mesh {fname!r} resolves to {found}, outside the allowed directories "
+                "(the URDF's directory, its ROS package, ROS_PACKAGE_PATH)",
+                file=source,
+            )
         return found
 
     log = logging.getLogger("yourdfpy")
@@ -81,6 +89,8 @@ def load_urdf(xml: str, source: str = "<urdf>", mesh_dir: str | Path | None = No
             load_collision_meshes=False,
             filename_handler=resolve,
         )
+    except InputError:
+        raise
     except Exception as exc:  # yourdfpy raises assorted types for bad URDFs
         raise InputError(f"cannot load this URDF: {exc}", file=source) from None
     finally:

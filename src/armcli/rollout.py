@@ -69,6 +69,7 @@ class _Stepper:
 
         self.pin = pin
         self.model = plant.model.copy()
+        self.model.armature = np.zeros(self.model.nv)  # URDF has no rotor inertia; C++ too
         self.data = self.model.createData()
         self.p = plant.params
         self.n = self.model.nv

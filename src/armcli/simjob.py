@@ -37,6 +37,7 @@ class SimJob:
     tool_offset: np.ndarray  # [m] point in that frame
     tool_label: str
     rate: float  # [Hz] joint_state_publisher rate
+    T_frame_root: np.ndarray  # 4x4 pose of the arm's root link in the reporting frame
 
 
 def load_arm(spec: Any | None, urdf: Path | None, joints: Sequence[str] | None) -> Arm:
@@ -81,6 +82,30 @@ def _tool(arm: Arm, spec: Any | None) -> tuple[int, np.ndarray, str]:
     bodies = [i for i, f in enumerate(model.frames) if f.parentJoint == last]
     fid = bodies[-1]
     return fid, np.zeros(3), model.frames[fid].name
+
+
+def _report_frame(arm: Arm, spec: Any | None) -> tuple[str, np.ndarray]:
+    """Frame the tool point is reported in, and the arm root's pose in it.
+
+    With a spec that mounts the arm on a mobile base, that is the base's root link
+    (base_footprint), composed from the fixed joint origins (moving joints at 0),
+    so the numbers match `check` and `view`; otherwise the arm's own root link.
+    """
+    import pinocchio as pin
+
+    model = arm.model
+    root = next(f.name for f in model.frames if f.parentJoint == 0 and f.name != "universe")
+    T = pin.SE3.Identity()
+    if spec is None or spec.mobile_base is None or spec.mount is None:
+        return root, T.homogeneous
+    by_child = {j.child: j for j in spec.all_joints().values()}
+    link = spec.arm_root()
+    while link in by_child:
+        joint = by_child[link]
+        rot = pin.rpy.rpyToMatrix(*joint.origin.rpy)
+        T = pin.SE3(rot, np.array(joint.origin.xyz, dtype=float)) * T
+        link = joint.parent
+    return link, T.homogeneous
 
 
 def _fmt(v: np.ndarray) -> str:
@@ -160,16 +185,19 @@ def prepare(
     if not (np.isfinite(rate) and rate > 0):
         raise InputError(f"must be > 0 Hz, got {rate:g}", field="--rate")
     fid, off, label = _tool(arm, spec)
-    return SimJob(arm, traj, ref, q0, total, cfg, fid, off, label, float(rate))
+    frame, T_frame_root = _report_frame(arm, spec)
+    label = f"{label} in {frame}"
+    return SimJob(arm, traj, ref, q0, total, cfg, fid, off, label, float(rate), T_frame_root)
 
 
 def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
-    """End-effector point in the model's root frame at configuration q [m]."""
+    """End-effector point in the reporting frame (see `_report_frame`) at configuration q [m]."""
     import pinocchio as pin
 
     data = job.arm.model.createData()
     pin.framesForwardKinematics(job.arm.model, data, q)
-    return np.asarray(data.oMf[job.tool_frame].act(job.tool_offset), dtype=float)
+    p_root = np.asarray(data.oMf[job.tool_frame].act(job.tool_offset), dtype=float)
+    return job.T_frame_root[:3, :3] @ p_root + job.T_frame_root[:3, 3]
 
 
 def run(job: SimJob, progress: Callable[[int, int], None] | None = None) -> SimResult:

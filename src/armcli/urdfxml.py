@@ -337,6 +337,10 @@ def _line_of(data: bytes, needle: bytes) -> int | None:
     return data.count(b"\n", 0, i) + 1 if i >= 0 else None
 
 
+def _line_at(data: bytes, offset: int) -> int:
+    return data.count(b"\n", 0, offset) + 1
+
+
 def _is_xacro(el: etree._Element) -> bool:
     """Elements in a xacro namespace (www.ros.org/wiki/xacro and wiki.ros.org/xacro both occur)."""
     return isinstance(el.tag, str) and el.tag.startswith("{") and "xacro" in el.tag.split("}")[0]
@@ -346,6 +350,12 @@ def parse_root(data: bytes, source: str) -> etree._Element:
     """Parse XML bytes safely and return the <robot> element (InputError otherwise)."""
     if len(data) > MAX_URDF_BYTES:
         raise InputError(f"file is larger than {MAX_URDF_BYTES} bytes", file=source)
+    try:  # first: in UTF-16 the DOCTYPE test below would not see "<!DOCTYPE"
+        data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(
+            "not UTF-8 text (URDF files are UTF-8)", file=source, line=_line_at(data, exc.start)
+        ) from None
     if b"<!DOCTYPE" in data or b"<!ENTITY" in data:
         raise InputError(
             "DOCTYPE/entity declarations are not allowed in URDF input",
@@ -363,6 +373,10 @@ def parse_root(data: bytes, source: str) -> etree._Element:
     try:
         root = etree.fromstring(data, parser)
     except etree.XMLSyntaxError as exc:
+        if "Excessive depth" in str(exc.msg):  # libxml2's own cap (256) hit before ours
+            raise InputError(
+                f"XML nested deeper than {MAX_URDF_DEPTH} levels", file=source, line=exc.lineno
+            ) from None
         raise InputError(f"not well-formed XML: {exc.msg}", file=source, line=exc.lineno) from None
     _check_depth(root, source)
     if root.tag != "robot":

@@ -10,13 +10,13 @@ import typer
 
 from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import EXIT_UNUSABLE, ArmcliError
+from armcli.robot_source import TRUST_XACRO_HELP
 
 if TYPE_CHECKING:
     from armcli.checks import CheckOptions, CheckResult
     from armcli.urdfxml import Urdf
 
 FORMATS = ("table", "json", "github")
-SPEC_SUFFIXES = (".yaml", ".yml")
 REPORT_WIDTH = 140  # columns when stdout is not a terminal (CI logs, pipes)
 
 
@@ -34,35 +34,17 @@ def _package_dirs(values: list[str]) -> dict[str, Path]:
 
 def _documents(path: Path, trust_xacro: bool) -> list[tuple[Urdf, Any]]:
     """The URDF documents a PATH stands for, each with the spec it came from (or None)."""
-    from armcli.errors import InputError, XacroRefusedError
-    from armcli.urdfxml import parse_urdf, read_urdf
+    from armcli.errors import InputError
+    from armcli.robot_source import read_robot
+    from armcli.urdfxml import read_urdf
 
     if path.is_dir():
         files = sorted(p for p in path.rglob("*.urdf") if p.is_file())
         if not files:
             raise InputError("no *.urdf files under this directory", file=path)
         return [(read_urdf(p), None) for p in files]
-    if path.suffix in SPEC_SUFFIXES:
-        from armcli.build import expand_urdfs
-        from armcli.spec import load_spec
-
-        spec = load_spec(path)
-        return [
-            (parse_urdf(data, f"{path}#{name}"), spec)
-            for name, data in sorted(expand_urdfs(spec).items())
-        ]
-    if path.suffix == ".xacro":
-        if not trust_xacro:
-            raise XacroRefusedError(
-                "refusing to expand a xacro file armcli did not generate: xacro runs Python "
-                "from the file ($(eval ...) can run shell commands); pass --trust-xacro if you "
-                "trust it, or check the expanded .urdf or the spec instead",
-                file=path,
-            )
-        from armcli.xacro_sandbox import expand_untrusted
-
-        return [(parse_urdf(expand_untrusted(path), f"{path}#expanded"), None)]
-    return [(read_urdf(path), None)]
+    robot = read_robot(path, trust_xacro=trust_xacro)
+    return [(urdf, robot.spec) for urdf in robot.urdfs]
 
 
 def _run(
@@ -100,9 +82,7 @@ def check_cmd(
     package_dir: list[str] = typer.Option(
         [], "--package-dir", help="NAME=PATH for package://NAME/ mesh URIs (repeatable)."
     ),
-    trust_xacro: bool = typer.Option(
-        False, "--trust-xacro", help="Expand foreign .xacro files (runs code from them)."
-    ),
+    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Check robot descriptions for physical sanity; exit 1 on error findings."""
     from armcli.checks import RULES, CheckOptions, apply_policy

@@ -31,7 +31,7 @@ def simulate_cmd(
         None,
         "--trajectory",
         "-t",
-        help="JointTrajectory YAML file (a point without time_from_start comes 1 s after the previous).",
+        help="JointTrajectory YAML (a point without time_from_start: previous + 1 s).",
     ),
     message: str = typer.Option(None, "--message", "-m", help="JointTrajectory as YAML text."),
     urdf: Path = typer.Option(None, "--urdf", help="Simulate this URDF instead of the spec's arm."),

@@ -1,7 +1,8 @@
 """`armcli view`, `armcli render`, `armcli tree`: see the robot from a spec or a URDF.
 
 A spec is built in memory (xacro expansion, nothing written); a URDF is read
-as is. Heavy libraries (viser, yourdfpy, matplotlib) load inside the commands.
+strictly; a foreign xacro file only with --trust-xacro (see robot_source).
+Heavy libraries (viser, yourdfpy, matplotlib) load inside the commands.
 """
 
 from __future__ import annotations
@@ -15,11 +16,12 @@ import typer
 
 from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import InputError
+from armcli.robot_source import TRUST_XACRO_HELP
 
 if TYPE_CHECKING:
     from armcli.render import Tool
 
-ROBOT_HELP = "Robot spec YAML, or a URDF file."
+ROBOT_HELP = "Robot spec YAML, URDF file, or xacro file (with --trust-xacro)."
 
 
 @dataclass(frozen=True)
@@ -35,20 +37,20 @@ class RobotSource:
     tool: Tool | None = None
 
 
-def load_robot(path: Path) -> RobotSource:
-    """Spec YAML (built in memory) or URDF file -> RobotSource; xacro files are refused."""
+def load_robot(path: Path, trust_xacro: bool = False) -> RobotSource:
+    """Spec YAML (built in memory), URDF or trusted xacro file -> RobotSource.
+
+    Mesh URIs must resolve inside robot_source.allowed_roots.
+    """
     from armcli.render import Tool
+    from armcli.robot_source import read_robot, urdf_text
 
-    if path.suffix in (".yaml", ".yml"):
-        from armcli.build import expand_urdfs
-        from armcli.spec import load_spec
-
-        spec = load_spec(path)
-        urdfs = expand_urdfs(spec)
-        xml = urdfs.get(f"{spec.name}.urdf", urdfs["standalone_arm.urdf"]).decode("utf-8")
+    robot = read_robot(path, trust_xacro=trust_xacro)
+    spec = robot.spec
+    if spec is not None:
         tool = Tool(spec.arm.tool.link, spec.arm.tool.xyz) if spec.arm.tool else None
         return RobotSource(
-            xml=xml,
+            xml=urdf_text(robot.robot),
             source=str(path),
             name=spec.name,
             mesh_dir=None,
@@ -56,21 +58,14 @@ def load_robot(path: Path) -> RobotSource:
             poses={p: spec.pose(p) for p in spec.poses},
             tool=tool,
         )
-    if path.suffix == ".xacro":
-        raise InputError("give the spec or an expanded URDF, not a xacro file", file=path)
     from armcli.tree import tree_from_urdf
-    from armcli.urdfxml import read_urdf
 
-    urdf = read_urdf(path)
+    urdf = robot.robot
     tree = tree_from_urdf(urdf)
-    try:
-        xml = urdf.text.decode("utf-8")
-    except UnicodeDecodeError:
-        raise InputError("URDF is not UTF-8 text", file=path) from None
     movable = tree.movable()
     tip = max((d, j.child) for d, j in tree.walk())[1] if tree.joints else tree.root
     return RobotSource(
-        xml=xml,
+        xml=urdf_text(urdf),
         source=str(path),
         name=tree.robot or path.stem,
         mesh_dir=path.parent,
@@ -132,11 +127,12 @@ def render_cmd(
     ),
     out: Path = typer.Option(Path("robot.png"), "-o", "--out", help="PNG to write."),
     size: str = typer.Option("1200x600", "--size", help="Image size WIDTHxHEIGHT in pixels."),
+    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
     from armcli.render import load_urdf, render_png
 
-    src = load_robot(robot)
+    src = load_robot(robot, trust_xacro)
     values = _pose_q(src, pose, q)
     width, height = _size(size)
     urdf = load_urdf(src.xml, src.source, src.mesh_dir)
@@ -161,13 +157,14 @@ def tree_cmd(
     robot: Path = typer.Argument(DEFAULT_SPEC, help=ROBOT_HELP),
     fmt: str = typer.Option("text", "--format", help="text (a tree) or dot (Graphviz)."),
     out: Path = typer.Option(None, "-o", "--out", help="Write to this file instead of stdout."),
+    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Print the kinematic tree: links, and joints with their types and limits."""
     from armcli.tree import parse_tree, to_dot, to_rich
 
     if fmt not in ("text", "dot"):
         raise InputError(f"unknown format {fmt!r}; known: text, dot", field="--format")
-    src = load_robot(robot)
+    src = load_robot(robot, trust_xacro)
     tree = parse_tree(src.xml, src.source)
     if fmt == "dot":
         text = to_dot(tree)
@@ -197,12 +194,13 @@ def view_cmd(
     pose: str = typer.Option(None, "--pose", help="Start at this named pose."),
     host: str = typer.Option("127.0.0.1", "--host", help="Address to listen on."),
     port: int = typer.Option(8080, "--port", help="Port to listen on (0: any free port)."),
+    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Open a browser 3-D viewer with joint sliders, named poses and simulation replay."""
     from armcli.render import joint_limits, load_urdf
     from armcli.viewer import Viewer, load_replay
 
-    src = load_robot(robot)
+    src = load_robot(robot, trust_xacro)
     _pose_q(src, pose, None)  # validate before starting the server
     if not 0 <= port <= 65535:
         raise InputError(f"{port} is not a port number", field="--port")
