@@ -36,6 +36,7 @@ demo: install
 lint: install
 	$(BIN)/ruff check src tests bench
 	$(BIN)/ruff format --check src tests bench
+	$(BIN)/mypy src
 
 test: install sysdeps lint native-or-skip
 	$(BIN)/armcli build --check $(SPEC)

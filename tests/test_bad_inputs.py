@@ -2,10 +2,14 @@
 
 The corpus lives in tests/bad_inputs/ with its expectations in cases.yaml; a few
 cases that would be wasteful to commit (huge files, a directory) are made here.
+`check` reports findings on stdout (exit 1), so for those cases the runner also
+asserts, from `--format json`, that an error finding of the expected rule names
+the problem.
 """
 
 from __future__ import annotations
 
+import json
 import re
 import subprocess
 import sys
@@ -18,6 +22,12 @@ HERE = Path(__file__).parent / "bad_inputs"
 CASES = yaml.safe_load((HERE / "cases.yaml").read_text())
 TIME_LIMIT_S = 60.0  # generous bound on one CLI run on a loaded 2-core machine
 PWNED = Path("/tmp/armcli-pwned")  # the hostile files try to create this
+# A valid trajectory for the standalone arm's first joint, so that `simulate --urdf`
+# fails on the URDF and not on the trajectory ({{ }}: str.format escapes).
+TRAJECTORY_FOR_URDF = (
+    "{{joint_names: [arm_base_forearm_joint], "
+    "points: [{{positions: [0.1], time_from_start: {{sec: 1}}}}]}}"
+)
 
 COMMANDS = {
     "build": ["build", "{file}", "-o", "{out}/urdf"],
@@ -37,14 +47,21 @@ COMMANDS = {
         "simulate",
         "--urdf",
         "{file}",
-        "--joints",
-        "a,b",
+        "--message",
+        TRAJECTORY_FOR_URDF,
+        "--kp",
+        "10",
+        "--kd",
+        "1",
         "--output",
         "{out}/states.csv",
     ],
     "ros-package": ["ros-package", "{file}", "-o", "{out}/ros"],
     "render": ["render", "{file}", "-o", "{out}/robot.png"],
-    "tree": ["tree", "{file}"],
+    "tree": ["tree", "{file}", "-o", "{out}/tree.txt"],
+    "check-trusted": ["check", "--trust-xacro", "{file}"],
+    "tree-trusted": ["tree", "--trust-xacro", "{file}", "-o", "{out}/tree.txt"],
+    "render-trusted": ["render", "--trust-xacro", "{file}", "-o", "{out}/robot.png"],
 }
 
 
@@ -71,18 +88,39 @@ def assert_clean_failure(
     assert not PWNED.exists(), "hostile input executed code"
 
 
-@pytest.mark.parametrize("case", CASES, ids=[c["file"] for c in CASES])
+def assert_finding(stdout: str, rule: str, finding: str) -> None:
+    """`check --format json` (exit 1) reported an error finding of `rule` matching `finding`."""
+    doc = json.loads(stdout)
+    messages = [
+        f["message"]
+        for file in doc["files"]
+        for f in file["findings"]
+        if f["rule"] == rule and f["severity"] == "error"
+    ]
+    assert any(re.search(finding, m) for m in messages), (rule, finding, messages)
+
+
+def _param(case: dict) -> object:
+    marks = [pytest.mark.xfail(reason=case["xfail"], strict=True)] if "xfail" in case else []
+    return pytest.param(case, id=f"{case['file']}:{case['command']}", marks=marks)
+
+
+@pytest.mark.parametrize("case", [_param(c) for c in CASES])
 def test_corpus_case(case: dict, tmp_path: Path, root: Path) -> None:
     out = tmp_path / "out"
     out.mkdir()
     path = HERE / case["file"]
     text = path.read_text(errors="replace") if case["command"] == "simulate-message" else ""
     args = [a.format(file=path, out=out, text=text) for a in COMMANDS[case["command"]]]
-    assert_clean_failure(run_cli(args, root), case["exit"], case["message"], out)
+    proc = run_cli(args, root)
+    assert_clean_failure(proc, case["exit"], case["message"], out)
+    if "rule" in case:  # findings go to stdout; the stderr line only counts them
+        assert_finding(proc.stdout, case["rule"], case.get("finding", ""))
 
 
 def test_corpus_is_large_enough() -> None:
-    assert len(CASES) >= 40 or len(CASES) >= 30  # grows as commands land; see cases.yaml
+    assert len(CASES) >= 40
+    assert {c["file"].split("/")[0] for c in CASES} >= {"spec", "urdf", "xacro"}
 
 
 def test_huge_spec(tmp_path: Path, root: Path) -> None:
@@ -106,3 +144,25 @@ def test_missing_spec(tmp_path: Path, root: Path) -> None:
     out.mkdir()
     proc = run_cli(["build", str(tmp_path / "nope.yaml"), "-o", str(out / "urdf")], root)
     assert_clean_failure(proc, 2, r"nope\.yaml: YAML file not found", out)
+
+
+def test_huge_urdf(tmp_path: Path, root: Path) -> None:
+    from armcli.urdfxml import MAX_URDF_BYTES
+
+    out = tmp_path / "out"
+    out.mkdir()
+    huge = tmp_path / "huge.urdf"
+    huge.write_bytes(b'<robot name="x">' + b" " * MAX_URDF_BYTES + b"</robot>")
+    for command in ("check", "tree", "render"):
+        args = [a.format(file=huge, out=out) for a in COMMANDS[command]]
+        assert_clean_failure(run_cli(args, root), 2, r"huge\.urdf: .*larger than", out)
+
+
+def test_directory_instead_of_urdf(tmp_path: Path, root: Path) -> None:
+    out = tmp_path / "out"
+    out.mkdir()
+    robot = tmp_path / "robot.urdf"
+    robot.mkdir()
+    for command in ("tree", "render"):
+        args = [a.format(file=robot, out=out) for a in COMMANDS[command]]
+        assert_clean_failure(run_cli(args, root), 2, r"robot\.urdf: is a directory", out)

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 from armcli.errors import InputError, XacroRefusedError
 
 if TYPE_CHECKING:
+    from armcli.model import LoadedModel
     from armcli.spec import RobotSpec
     from armcli.urdfxml import Urdf
 
@@ -31,6 +32,13 @@ XACRO_REFUSED = (
     "file ($(eval ...) can run shell commands); pass --trust-xacro if you trust it, or give "
     "the spec or the expanded .urdf instead"
 )
+
+_PROBLEM = {
+    "missing": "missing number",
+    "not-a-number": "not a number:",
+    "non-finite": "non-finite number",
+    "length": "wrong number of values:",
+}
 
 
 @dataclass(frozen=True)
@@ -83,6 +91,26 @@ def read_urdf_file(path: Path, *, trust_xacro: bool = False) -> Urdf:
     from armcli.xacro_sandbox import expand_untrusted
 
     return parse_urdf(expand_untrusted(path), f"{path}#expanded")
+
+
+def load_checked_model(path: Path, *, trust_xacro: bool = False) -> LoadedModel:
+    """A URDF/xacro file -> Pinocchio model, refusing what Pinocchio would silently accept.
+
+    For commands that compute with the model (simulate --urdf): a malformed or
+    non-finite number (Pinocchio turns mass="nan" into 0) or any error the URDF
+    parser prints is an InputError naming the file and line, not a wrong result.
+    """
+    from armcli.model import load_model, parser_problems
+
+    urdf = read_urdf_file(path, trust_xacro=trust_xacro)
+    if urdf.problems:
+        p = urdf.problems[0]
+        raise InputError(f"{p.where}: {_PROBLEM[p.kind]} {p.text!r}", file=urdf.source, line=p.line)
+    loaded = load_model(urdf.source, xml=urdf_text(urdf))
+    said = [m for m in parser_problems(loaded.parser_messages) if "error" in m.lower()]
+    if said:
+        raise InputError(f"the URDF parser reported: {said[0]}", file=urdf.source)
+    return loaded
 
 
 def urdf_text(urdf: Urdf) -> str:
