@@ -38,19 +38,19 @@ def simulate_cmd(
     joints: str = typer.Option(
         None, "--joints", help="Comma-separated joints to move; others are locked."
     ),
-    kp: str = typer.Option(None, "--kp", help="P gain(s): one value or one per joint \\[N·m/rad]."),
+    kp: str = typer.Option(None, "--kp", help="P gain(s): one value or one per joint [N·m/rad]."),
     kd: str = typer.Option(
-        None, "--kd", help="D gain(s): one value or one per joint \\[N·m·s/rad]."
+        None, "--kd", help="D gain(s): one value or one per joint [N·m·s/rad]."
     ),
     gravity_comp: bool = typer.Option(
         None, "--gravity-comp/--no-gravity-comp", help="Add g(q) to the PD torque."
     ),
     dt: float = typer.Option(
-        None, "--dt", help="Time step \\[s] (default: the spec's control.dt)."
+        None, "--dt", help="Time step [s] (default: the spec's control.dt)."
     ),
     integrator: str = typer.Option("euler", "--integrator", help="euler (semi-implicit) or rk4."),
     duration: float = typer.Option(
-        None, "--duration", help="Simulated time \\[s] (default: last point + 2 s)."
+        None, "--duration", help="Simulated time [s] (default: last point + 2 s)."
     ),
     clamp: bool = typer.Option(
         False, "--clamp", help="Clamp positions outside the limits (with a warning)."
@@ -60,7 +60,7 @@ def simulate_cmd(
     ),
     plot: Path = typer.Option(None, "--plot", help="Write a tracking plot PNG."),
     rate: float = typer.Option(
-        None, "--rate", help="Output rate \\[Hz] (default: joint_state_publisher's)."
+        None, "--rate", help="Output rate [Hz] (default: joint_state_publisher's)."
     ),
     engine: str = typer.Option("auto", "--engine", help="auto, native (compiled) or python."),
 ) -> None:
