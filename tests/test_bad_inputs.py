@@ -166,3 +166,15 @@ def test_directory_instead_of_urdf(tmp_path: Path, root: Path) -> None:
     for command in ("tree", "render"):
         args = [a.format(file=robot, out=out) for a in COMMANDS[command]]
         assert_clean_failure(run_cli(args, root), 2, r"robot\.urdf: is a directory", out)
+
+
+@pytest.mark.parametrize(
+    ("command", "message"),
+    [("check", "larger than 10000000 bytes"), ("tree", "larger than"), ("build", "larger than")],
+)
+def test_endless_device(command: str, message: str, tmp_path: Path, root: Path) -> None:
+    """/dev/zero reports size 0 and never ends: reads are capped, not trusted to stat."""
+    out = tmp_path / "out"
+    out.mkdir()
+    args = [a.format(file="/dev/zero", out=out) for a in COMMANDS[command]]
+    assert_clean_failure(run_cli(args, root), 2, rf"/dev/zero: .*{message}", out)

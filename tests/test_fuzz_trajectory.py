@@ -33,12 +33,16 @@ PAYLOAD = (
     "forearm_hand_joint], points: [{positions: {0.0, 0.0}}]}"
 )  # the course's `ros2 topic pub` payload, with ROS's flow-set quirk
 SOURCE = "fuzz.yaml"
+TINY_S = 1e-6  # [s] below this a time is left to test_tiny_first_segment_is_an_input_error
 # Numbers where times and positions go: edges of float, integers, values near the limits.
-# Integers beyond float range are left out: see test_huge_integer_is_an_input_error.
+# Integers beyond float range and tiny positive times are left out until trajectory.py
+# refuses them (the xfail tests at the end; reported to the simulate owner).
 HOSTILE_NUMBERS = st.one_of(
-    st.floats(allow_nan=True, allow_infinity=True),
+    st.floats(min_value=TINY_S),
+    st.floats(max_value=-TINY_S),
+    st.sampled_from([math.nan, math.inf, -math.inf, 0.0]),
     st.integers(min_value=-(10**300), max_value=10**300),
-    st.sampled_from([0, -0.0, 1e-300, 5e-324, 1e300, math.pi / 2, math.pi / 2 + 1e-10, 2**63]),
+    st.sampled_from([0, -0.0, 1e-3, 1e300, math.pi / 2, math.pi / 2 + 1e-10, 2**63]),
 )
 
 
@@ -132,3 +136,19 @@ def test_fuzz_trajectory_file_bytes(tmp_path_factory: pytest.TempPathFactory, da
 def test_huge_integer_is_an_input_error(text: str) -> None:
     with pytest.raises(ArmcliError, match="points"):
         loads_trajectory(text, LIMITS)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="trajectory.py accepts a 5e-324 s first segment; the linear reference is then "
+    "inf/NaN and simulate blames dt or the inertia (found by this fuzzer, fuzz profile)",
+)
+def test_tiny_first_segment_is_an_input_error() -> None:
+    text = (
+        "{joint_names: [arm_base_forearm_joint, forearm_hand_joint], points: ["
+        "{positions: [0.6, 0.4], time_from_start: 5.0e-324}, "
+        "{positions: [0.9, 1.2], time_from_start: {sec: 2, nanosec: 0}}]}"
+    )
+    tr = _accepted(text, clamp=False)
+    if tr is not None:
+        _assert_usable(tr)

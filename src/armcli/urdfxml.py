@@ -411,7 +411,8 @@ def read_urdf(path: str | Path) -> Urdf:
         size = p.stat().st_size
         if size > MAX_URDF_BYTES:
             raise InputError(f"file is larger than {MAX_URDF_BYTES} bytes", file=p)
-        data = p.read_bytes()
+        with p.open("rb") as fh:  # capped: /dev/zero or a pipe report no size
+            data = fh.read(MAX_URDF_BYTES + 1)
     except OSError as exc:
         raise InputError(f"cannot read: {exc.strerror}", file=p) from None
     return parse_urdf(data, str(p))

@@ -182,7 +182,10 @@ def read_text(path: str | Path, *, max_bytes: int = MAX_YAML_BYTES, what: str = 
             raise InputError(
                 f"{what} is {size} bytes, larger than the {max_bytes}-byte cap", file=p
             )
-        raw = p.read_bytes()
+        with p.open("rb") as fh:  # capped: /dev/zero or a pipe report no size
+            raw = fh.read(max_bytes + 1)
+        if len(raw) > max_bytes:
+            raise InputError(f"{what} is larger than the {max_bytes}-byte cap", file=p)
     except OSError as exc:
         raise InputError(f"cannot read {what}: {exc.strerror}", file=p) from None
     try:
