@@ -149,3 +149,13 @@ def test_fuzz_urdf_text_edits(data: st.DataObject) -> None:
     urdf = _parse(BASE[:pos] + insert + BASE[pos + cut :])
     if urdf is not None:
         _check(urdf)
+
+
+def test_absurd_mass_is_checked_without_overflow() -> None:
+    """Found by the fuzz profile: a mass of 6.48e156 kg overflowed the inertia comparison's norm
+    (a RuntimeWarning, an error under pytest); inertia.relative_difference now rescales."""
+    data = BASE.replace(b'<mass value="0.5"/>', b'<mass value="1e300"/>', 1)
+    assert data != BASE
+    urdf = _parse(data)
+    assert urdf is not None
+    _check(urdf)

@@ -93,3 +93,23 @@ def test_ros_package_path_entries_are_roots(
     shared.mkdir()
     monkeypatch.setenv("ROS_PACKAGE_PATH", os.pathsep.join([str(shared), ""]))
     assert inside_roots(shared / "pkg" / "mesh.stl", allowed_roots(tmp_path / "robot"))
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        "check",
+        "view",
+        "render",
+        "tree",
+        "simulate",
+    ],
+)
+def test_every_robot_file_command_offers_trust_xacro(command: str) -> None:
+    from typer.testing import CliRunner
+
+    from armcli.cli import app
+
+    result = CliRunner().invoke(app, [command, "--help"])
+    assert result.exit_code == 0, result.output
+    assert "--trust-xacro" in result.output

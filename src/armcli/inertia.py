@@ -110,5 +110,8 @@ def satisfies_triangle(J: Matrix, rtol: float = TRIANGLE_RTOL) -> bool:
 
 def relative_difference(A: Matrix, B: Matrix) -> float:
     """Frobenius-norm difference of two tensors relative to the larger one."""
-    scale = max(float(np.linalg.norm(A)), float(np.linalg.norm(B)), np.finfo(float).tiny)
+    tiny = np.finfo(float).tiny
+    unit = max(float(np.max(np.abs(A))), float(np.max(np.abs(B))), tiny)
+    A, B = np.asarray(A) / unit, np.asarray(B) / unit  # no overflow for absurd masses
+    scale = max(float(np.linalg.norm(A)), float(np.linalg.norm(B)), tiny)
     return float(np.linalg.norm(A - B) / scale)

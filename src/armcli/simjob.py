@@ -17,7 +17,6 @@ from armcli.errors import InputError
 from armcli.interpolation import Reference, build_reference
 from armcli.sim import Arm, SimConfig, SimResult, arm_from_model, check_stability, simulate
 from armcli.trajectory import Trajectory, load_trajectory, loads_trajectory
-from armcli.yamlio import read_text
 
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
 ARM_URDF = "standalone_arm.urdf"
@@ -40,13 +39,25 @@ class SimJob:
     T_frame_root: np.ndarray  # 4x4 pose of the arm's root link in the reporting frame
 
 
-def load_arm(spec: Any | None, urdf: Path | None, joints: Sequence[str] | None) -> Arm:
-    """The simulated arm: the spec's standalone arm built in memory, or a given URDF."""
+def load_arm(
+    spec: Any | None,
+    urdf: Path | None,
+    joints: Sequence[str] | None,
+    *,
+    trust_xacro: bool = False,
+) -> Arm:
+    """The simulated arm: the spec's standalone arm built in memory, or a given URDF.
+
+    A given URDF goes through the same strict reader as `check` (no DOCTYPE, finite
+    numbers, no foreign xacro without trust), since Pinocchio alone would simulate
+    mass="nan" as 0 kg.
+    """
     from armcli.model import load_model
 
     if urdf is not None:
-        text = read_text(urdf, max_bytes=MAX_URDF_BYTES, what="URDF file")
-        return arm_from_model(load_model(urdf, xml=text).model, joints)
+        from armcli.robot_source import load_checked_model
+
+        return arm_from_model(load_checked_model(urdf, trust_xacro=trust_xacro).model, joints)
     from armcli.build import expand_urdfs
 
     if spec is None:
@@ -137,6 +148,7 @@ def prepare(
     clamp: bool = False,
     rate: float | None = None,
     backend: str = "auto",
+    trust_xacro: bool = False,
 ) -> SimJob:
     """Validate every input and assemble the run; raises InputError on bad input."""
     if (trajectory is None) == (message is None):
@@ -150,7 +162,7 @@ def prepare(
     dt = dt if dt is not None else (spec.control.dt if spec is not None else 0.001)
     if not (np.isfinite(dt) and 0 < dt <= 0.1):
         raise InputError(f"must be in (0, 0.1] s, got {dt:g}", field="--dt")
-    arm = load_arm(spec, urdf, joints)
+    arm = load_arm(spec, urdf, joints, trust_xacro=trust_xacro)
     limits = {
         n: (float(lo), float(hi))
         for n, lo, hi in zip(arm.joint_names, arm.lower, arm.upper, strict=True)

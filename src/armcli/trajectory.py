@@ -30,6 +30,8 @@ from armcli.errors import Problem, SpecError
 from armcli.yamlio import YamlDoc, dotted, load_yaml, loads_yaml
 
 DEFAULT_SEGMENT_S = 1.0  # [s] time given to a point without time_from_start
+MIN_SEGMENT_S = 1e-6  # [s] shorter segments make the interpolated reference overflow
+MAX_TIME_S = 1e6  # [s] ~11.6 days: far beyond any simulation worth running step by step
 LIMIT_TOL = 1e-9  # [rad] slack when comparing positions with joint limits
 _TOP_KEYS = {"header", "joint_names", "points"}
 _POINT_KEYS = {"positions", "velocities", "accelerations", "effort", "time_from_start"}
@@ -186,11 +188,28 @@ def _vector(
         return None
     out = []
     for i, x in enumerate(raw):
-        if isinstance(x, bool) or not isinstance(x, int | float) or not math.isfinite(x):
-            c.add((*path, i), f"must be a finite number, got {x!r}")
+        value = _finite(x)
+        if value is None:
+            c.add((*path, i), f"must be a finite number, got {_short(x)}")
             return None
-        out.append(float(x))
+        out.append(value)
     return out
+
+
+def _finite(x: Any) -> float | None:
+    """`x` as a finite float, or None (bools, strings, NaN/inf, ints beyond float range)."""
+    if isinstance(x, bool) or not isinstance(x, int | float):
+        return None
+    try:
+        value = float(x)
+    except OverflowError:
+        return None
+    return value if math.isfinite(value) else None
+
+
+def _short(x: Any) -> str:
+    text = repr(x)
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def _time(point: dict[str, Any], previous: Sequence[float], k: int, c: _Collector) -> float:
@@ -208,16 +227,28 @@ def _time(point: dict[str, Any], previous: Sequence[float], k: int, c: _Collecto
         if not 0 <= nsec < 1_000_000_000:
             c.add((*path, "nanosec"), "must be in [0, 1e9)")
             return last
-        t = sec + nsec * 1e-9
-    elif isinstance(raw, int | float) and not isinstance(raw, bool) and math.isfinite(raw):
+        seconds = _finite(sec)
+        if seconds is None:
+            c.add((*path, "sec"), f"must be a finite number of seconds, got {_short(sec)}")
+            return last
+        t = seconds + nsec * 1e-9
+    elif _finite(raw) is not None:
         t = float(raw)
     else:
-        c.add(path, f"must be seconds or {{sec, nanosec}}, got {raw!r}")
+        c.add(path, f"must be seconds or {{sec, nanosec}}, got {_short(raw)}")
         return last
     if t < 0:
         c.add(path, f"must be >= 0, got {t:g}")
+    elif t > MAX_TIME_S:
+        c.add(path, f"must be <= {MAX_TIME_S:g} s, got {t:g}")
     elif previous and t <= last:
         c.add(path, f"times must increase: {t:g} s is not after point {k - 1} at {last:g} s")
+    elif 0 < t - last < MIN_SEGMENT_S:
+        c.add(
+            path,
+            f"{t - last:g} s after the previous point: segments must last at least "
+            f"{MIN_SEGMENT_S:g} s",
+        )
     return t
 
 

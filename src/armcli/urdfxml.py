@@ -19,6 +19,13 @@ from armcli.errors import InputError, XacroRefusedError
 
 MAX_URDF_BYTES = 10_000_000
 MAX_URDF_DEPTH = 32
+# Bounds on time and memory, measured on a chain robot: yourdfpy's render takes ~5 s at
+# 256 links and ~20 s at 500; Pinocchio's Data grows ~cubically with the DoF (19 MB at
+# 63, 136 MB at 127, 24 GB RSS for `check` at 1000). The largest robot in
+# example-robot-data has 130 links and 101 DoF (tiago_dual).
+MAX_URDF_LINKS = 300
+MAX_URDF_DOF = 128
+_DOF = {"revolute": 1, "continuous": 1, "prismatic": 1, "planar": 3, "floating": 6}
 
 Vec3 = tuple[float, float, float]
 ZERO3: Vec3 = (0.0, 0.0, 0.0)
@@ -391,7 +398,24 @@ def parse_root(data: bytes, source: str) -> etree._Element:
             "so pass --trust-xacro to expand it (in a sandbox)",
             file=source,
         )
+    _check_size(root, source)
     return root
+
+
+def _check_size(root: etree._Element, source: str) -> None:
+    links = root.findall("link")
+    if len(links) > MAX_URDF_LINKS:
+        raise InputError(
+            f"more than {MAX_URDF_LINKS} links ({len(links)}); armcli's bound on robot size",
+            file=source,
+            line=_ln(links[MAX_URDF_LINKS]),
+        )
+    dof = sum(_DOF.get(str(j.get("type")), 0) for j in root.findall("joint"))
+    if dof > MAX_URDF_DOF:
+        raise InputError(
+            f"more than {MAX_URDF_DOF} degrees of freedom ({dof}); armcli's bound on robot size",
+            file=source,
+        )
 
 
 def parse_urdf(data: bytes, source: str) -> Urdf:

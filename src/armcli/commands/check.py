@@ -35,14 +35,13 @@ def _package_dirs(values: list[str]) -> dict[str, Path]:
 def _documents(path: Path, trust_xacro: bool) -> list[tuple[Urdf, Any]]:
     """The URDF documents a PATH stands for, each with the spec it came from (or None)."""
     from armcli.errors import InputError
-    from armcli.robot_source import read_robot
-    from armcli.urdfxml import read_urdf
+    from armcli.robot_source import read_robot, read_urdf_file
 
     if path.is_dir():
         files = sorted(p for p in path.rglob("*.urdf") if p.is_file())
         if not files:
             raise InputError("no *.urdf files under this directory", file=path)
-        return [(read_urdf(p), None) for p in files]
+        return [(read_urdf_file(p, trust_xacro=trust_xacro), None) for p in files]
     robot = read_robot(path, trust_xacro=trust_xacro)
     return [(urdf, robot.spec) for urdf in robot.urdfs]
 

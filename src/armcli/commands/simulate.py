@@ -10,6 +10,7 @@ from typing import Any
 import typer
 
 from armcli.defaults import DEFAULT_SPEC
+from armcli.robot_source import TRUST_XACRO_HELP
 
 PROGRESS_AFTER_S = 1.0  # show a progress bar when the run is projected to take longer
 
@@ -39,15 +40,11 @@ def simulate_cmd(
         None, "--joints", help="Comma-separated joints to move; others are locked."
     ),
     kp: str = typer.Option(None, "--kp", help="P gain(s): one value or one per joint [N·m/rad]."),
-    kd: str = typer.Option(
-        None, "--kd", help="D gain(s): one value or one per joint [N·m·s/rad]."
-    ),
+    kd: str = typer.Option(None, "--kd", help="D gain(s): one value or one per joint [N·m·s/rad]."),
     gravity_comp: bool = typer.Option(
         None, "--gravity-comp/--no-gravity-comp", help="Add g(q) to the PD torque."
     ),
-    dt: float = typer.Option(
-        None, "--dt", help="Time step [s] (default: the spec's control.dt)."
-    ),
+    dt: float = typer.Option(None, "--dt", help="Time step [s] (default: the spec's control.dt)."),
     integrator: str = typer.Option("euler", "--integrator", help="euler (semi-implicit) or rk4."),
     duration: float = typer.Option(
         None, "--duration", help="Simulated time [s] (default: last point + 2 s)."
@@ -63,6 +60,7 @@ def simulate_cmd(
         None, "--rate", help="Output rate [Hz] (default: joint_state_publisher's)."
     ),
     engine: str = typer.Option("auto", "--engine", help="auto, native (compiled) or python."),
+    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
     from rich.console import Console
@@ -93,6 +91,7 @@ def simulate_cmd(
         clamp=clamp,
         rate=rate,
         backend=engine,
+        trust_xacro=trust_xacro,
     )
     err = Console(stderr=True)
     for w in job.trajectory.warnings:
