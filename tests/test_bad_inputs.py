@@ -178,3 +178,46 @@ def test_endless_device(command: str, message: str, tmp_path: Path, root: Path) 
     out.mkdir()
     args = [a.format(file="/dev/zero", out=out) for a in COMMANDS[command]]
     assert_clean_failure(run_cli(args, root), 2, rf"/dev/zero: .*{message}", out)
+
+
+def test_diverging_simulation_exits_1_without_output(tmp_path: Path, root: Path) -> None:
+    # A URDF whose velocity limit (0.01 rad/s) the PD loop exceeds tenfold in one step:
+    # the run must stop with the evidence, not write a misleading CSV or plot.
+    slow = tmp_path / "slow.urdf"
+    slow.write_text(
+        (root / "urdf" / "standalone_arm.urdf")
+        .read_text()
+        .replace('velocity="100"', 'velocity="0.01"')
+    )
+    out = tmp_path / "out"
+    out.mkdir()
+    message = (
+        "{joint_names: [arm_base_forearm_joint, forearm_hand_joint], "
+        "points: [{positions: [1.0, 1.0], time_from_start: 0.5}]}"
+    )
+    proc = run_cli(
+        [
+            "simulate",
+            "--urdf",
+            str(slow),
+            "--joints",
+            "arm_base_forearm_joint,forearm_hand_joint",
+            "--kp",
+            "50",
+            "--kd",
+            "5",
+            "--message",
+            message,
+            "--output",
+            str(out / "s.csv"),
+            "--plot",
+            str(out / "p.png"),
+        ],
+        root,
+    )
+    assert_clean_failure(
+        proc,
+        1,
+        r"simulation diverged: velocity exceeded .* at t = [0-9.]+ s \(step \d+\) joint ",
+        out,
+    )

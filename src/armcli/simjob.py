@@ -20,7 +20,6 @@ from armcli.trajectory import Trajectory, load_trajectory, loads_trajectory
 
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
 ARM_URDF = "standalone_arm.urdf"
-MAX_URDF_BYTES = 50_000_000
 MAX_STEPS = 2_000_000  # ~200 MB of recorded states for a 2-joint arm
 
 
