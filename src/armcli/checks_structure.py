@@ -144,7 +144,9 @@ def _geometry_sizes(link: Link, out: Collector) -> None:
 
 def _joint_shape(j: Joint, links: set[str], joints: set[str], out: Collector) -> None:
     for role, name in (("parent", j.parent), ("child", j.child)):
-        if name not in links:
+        if name is None:
+            out.add("unknown-link", j.line, f"joint {j.name!r}: no <{role} link=...>", link="")
+        elif name not in links:
             out.add(
                 "unknown-link",
                 j.line,
@@ -195,7 +197,7 @@ def _tree(urdf: Urdf, links: set[str], out: Collector) -> Tree:
         out.add(
             "root-count",
             line,
-            f"expected one root link, found {len(roots)}: {roots}" if links else "no <link>",
+            _root_message(roots, bool(links)),
             roots=", ".join(roots),
         )
         return Tree(roots[0] if roots else None, parent_joint, frozenset())
@@ -248,3 +250,11 @@ def _reach(root: str, parent_joint: dict[str, Joint]) -> tuple[set[str], set[str
 def finite(*values: float | None) -> bool:
     """True when every value is present and finite."""
     return all(v is not None and math.isfinite(v) for v in values)
+
+
+def _root_message(roots: list[str], has_links: bool) -> str:
+    if not has_links:
+        return "no <link>"
+    if not roots:
+        return "no root link: every link has a parent joint, so the joints form a cycle"
+    return f"expected one root link, found {len(roots)}: {', '.join(roots)}"

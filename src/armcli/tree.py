@@ -112,7 +112,8 @@ def tree_from_urdf(urdf: Urdf) -> KinematicTree:
     children = [j.child for j in joints]
     roots = [n for n in links if n not in children]
     if len(roots) != 1:
-        raise InputError(f"expected exactly one root link, found {roots}", file=source)
+        found = ", ".join(roots) if roots else "none: the joints form a cycle"
+        raise InputError(f"expected exactly one root link, found {found}", file=source)
     tree = KinematicTree(urdf.name, roots[0], links, joints)
     reached = {tree.root} | {j.child for _, j in tree.walk()}
     if len(reached) != len(known) or len(set(children)) != len(children):
