@@ -31,7 +31,8 @@ from PIL import Image
 
 from armcli.commands.view import load_robot
 from armcli.errors import InputError
-from armcli.viewer import Viewer, load_replay, moving_parts
+from armcli.replay import load_replay
+from armcli.viewer import Viewer, moving_parts
 
 TIP_TOL = 1e-6  # [m] forward kinematics vs closed form
 INTERP_TOL = 1e-12  # [rad] linear interpolation of a linear record is exact

@@ -198,7 +198,8 @@ def view_cmd(
 ) -> None:
     """Open a browser 3-D viewer with joint sliders, named poses and simulation replay."""
     from armcli.render import joint_limits, load_urdf
-    from armcli.viewer import Viewer, load_replay
+    from armcli.replay import load_replay
+    from armcli.viewer import Viewer
 
     src = load_robot(robot, trust_xacro)
     _pose_q(src, pose, None)  # validate before starting the server
