@@ -161,3 +161,22 @@ def test_mesh_geometry_is_drawn_and_a_missing_mesh_is_an_error(tmp_path: Path) -
     bad = f'<robot name="r">{link.format("package://nope/cube.stl")}</robot>'
     with pytest.raises(InputError, match=r"mesh file not found: package://nope/cube\.stl"):
         load_urdf(bad, "bad.urdf", tmp_path)
+
+
+def test_foreign_textured_meshes(root: Path, tmp_path: Path) -> None:
+    """A URDF nobody here wrote, with COLLADA meshes whose colour comes from a texture
+    material (trimesh TextureVisuals, which has no face_colors): it used to crash."""
+    import sysconfig
+
+    share = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix" / "share"
+    urdf = share / "example-robot-data/robots/ur_description/urdf/ur5_robot.urdf"
+    if not urdf.is_file():
+        pytest.skip("example-robot-data (dev dependency) not installed")
+    out = tmp_path / "ur5.png"
+    proc = _cli("render", str(urdf), "--q", "0,-1.2,1.5,0,0,0", "-o", str(out), cwd=root)
+    assert proc.returncode == 0, proc.stderr
+    img = pixels(out)
+    assert img.shape[:2] == (600, 1200)
+    # The UR5's dark grey links cover a good part of the 3-D view (left half).
+    dark = (img[:, :600].max(axis=-1) < 0.35).sum()
+    assert dark > MIN_PIXELS

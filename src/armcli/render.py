@@ -10,6 +10,7 @@ matplotlib's per-face depth sort (a painter's algorithm) stays right.
 from __future__ import annotations
 
 import io
+import textwrap
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -48,6 +49,10 @@ class RenderResult:
     height: int
     q: dict[str, float]
     tool_position: tuple[float, float, float] | None
+
+
+FALLBACK_RGBA = (0.6, 0.6, 0.6, 1.0)  # meshes whose colour cannot be read
+TITLE_WIDTH = 110  # [characters] per title line, so many joints do not run off the figure
 
 
 def load_urdf(xml: str, source: str = "<urdf>", mesh_dir: str | Path | None = None) -> Any:
@@ -151,12 +156,24 @@ def tool_position(urdf: Any, tool: Tool | None) -> np.ndarray | None:
     return np.asarray(T[:3, :3] @ np.asarray(tool.xyz) + T[:3, 3])
 
 
+def _mesh_rgba(mesh: Any) -> np.ndarray:
+    """One RGBA row in [0, 1] for a mesh: its colour, a texture's main colour, or grey."""
+    visual = mesh.visual
+    try:
+        if getattr(visual, "kind", None) == "texture" or not hasattr(visual, "face_colors"):
+            main = visual.material.main_color  # textured meshes (e.g. COLLADA with images)
+            return np.asarray(main, dtype=float).reshape(1, -1)[:, :4] / 255.0
+        return np.asarray(visual.face_colors, dtype=float)[:1] / 255.0
+    except (AttributeError, TypeError, ValueError, IndexError):
+        return np.array([FALLBACK_RGBA])
+
+
 def posed_triangles(urdf: Any, q: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
     """World-frame triangles (n, 3, 3) [m] and their shaded RGBA colours (n, 4) at pose q."""
     urdf.update_cfg(dict(q))
     tris, cols = [], []
     for mesh in urdf.scene.dump():
-        rgba = np.asarray(mesh.visual.face_colors, dtype=float)[:1] / 255.0
+        rgba = _mesh_rgba(mesh)
         if mesh.extents.max() > MAX_EDGE:
             mesh = mesh.subdivide_to_size(MAX_EDGE, max_iter=8)
         normals = np.asarray(mesh.face_normals)
@@ -198,7 +215,7 @@ def _title(name: str, q: Mapping[str, float], urdf: Any, tip: np.ndarray | None)
     shown = {j: v for j, v in q.items() if v != 0.0 or limits.get(j) is not None} or q
     unit = {j: "m" if urdf.joint_map[j].type == "prismatic" else "rad" for j in shown}
     joints = ", ".join(f"{j} = {v:.3f} {unit[j]}" for j, v in shown.items())
-    text = f"{name}: {joints or 'no movable joints'}"
+    text = textwrap.fill(f"{name}: {joints or 'no movable joints'}", TITLE_WIDTH)
     if tip is not None:
         text += "\ntool at ({:.3f}, {:.3f}, {:.3f}) m".format(*tip)
     return text
