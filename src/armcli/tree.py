@@ -111,6 +111,8 @@ def tree_from_urdf(urdf: Urdf) -> KinematicTree:
                 )
     children = [j.child for j in joints]
     roots = [n for n in links if n not in children]
+    if not links:
+        raise InputError("no <link> elements: not a robot description", file=source)
     if len(roots) != 1:
         found = ", ".join(roots) if roots else "none: the joints form a cycle"
         raise InputError(f"expected exactly one root link, found {found}", file=source)
