@@ -21,7 +21,8 @@ from armcli.checks import RULES, check_urdf
 from armcli.errors import ArmcliError
 from armcli.report import to_json
 from armcli.tree import tree_from_urdf
-from armcli.urdfxml import Urdf, parse_urdf
+from armcli.urdfdoc import Urdf
+from armcli.urdfxml import parse_urdf
 
 SOURCE = "fuzz.urdf"
 BASE = (Path(__file__).parents[1] / "urdf" / "my_robot.urdf").read_bytes()

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from armcli.checks_model import Summary
     from armcli.spec import RobotSpec
-    from armcli.urdfxml import Urdf
+    from armcli.urdfdoc import Urdf
 
 ERROR = "error"
 WARNING = "warning"

@@ -19,7 +19,7 @@ from armcli import inertia as inr
 from armcli.checks import Collector
 from armcli.checks_inertia import MIN_MOMENT
 from armcli.checks_structure import Tree, finite
-from armcli.urdfxml import Joint, Link, Urdf
+from armcli.urdfdoc import Joint, Link, Urdf
 
 # A moving body lighter than this fraction of the robot makes the dynamics stiff.
 TINY_MASS_RATIO = 1e-4

@@ -18,7 +18,7 @@ from armcli.checks import CheckOptions, Collector
 from armcli.checks_structure import finite
 from armcli.errors import InputError
 from armcli.stability import StabilityReport
-from armcli.urdfxml import Urdf
+from armcli.urdfdoc import Urdf
 
 if TYPE_CHECKING:
     from armcli.checks_model import JointRow

@@ -11,7 +11,7 @@ import numpy as np
 from armcli import inertia as inr
 from armcli.checks import Collector
 from armcli.checks_structure import Tree, finite
-from armcli.urdfxml import Geometry, Inertial, Link, Shape, Urdf
+from armcli.urdfdoc import Geometry, Inertial, Link, Shape, Urdf
 
 # Inertia within 5 % (Frobenius, relative) of the solid-body formula counts as
 # "from the geometry"; real macro bugs (permuted axes, 4x) are off by >= 50 %.

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 from armcli.checks import Collector
 from armcli.checks_structure import finite
-from armcli.urdfxml import Joint, Urdf
+from armcli.urdfdoc import Joint, Urdf
 
 if TYPE_CHECKING:
     from armcli.spec import RobotSpec

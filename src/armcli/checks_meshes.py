@@ -13,7 +13,7 @@ from pathlib import Path
 from urllib.parse import unquote, urlparse
 
 from armcli.checks import CheckOptions, Collector
-from armcli.urdfxml import Urdf
+from armcli.urdfdoc import Urdf
 
 
 def ros_package_path() -> tuple[Path, ...]:

@@ -15,7 +15,7 @@ from armcli import checks_dynamics as dyn
 from armcli.checks import CheckOptions, Collector
 from armcli.checks_structure import Tree, finite
 from armcli.stability import StabilityReport
-from armcli.urdfxml import Urdf
+from armcli.urdfdoc import Urdf
 
 _STRUCTURE_ERRORS = (
     "duplicate-name",

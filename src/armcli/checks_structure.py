@@ -11,7 +11,7 @@ from collections import Counter
 from dataclasses import dataclass
 
 from armcli.checks import Collector
-from armcli.urdfxml import Joint, Link, Urdf
+from armcli.urdfdoc import Joint, Link, Urdf
 
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 NUMBER_RULES = {

@@ -22,7 +22,8 @@ import numpy as np
 
 from armcli.errors import BuildError, InputError
 from armcli.model import load_model
-from armcli.urdfxml import Urdf, parse_urdf
+from armcli.urdfdoc import Urdf
+from armcli.urdfxml import parse_urdf
 
 DEFAULT_SAMPLES = 10_000  # the Setup Assistant's default "sampling density"
 DEFAULT_SEED = 0

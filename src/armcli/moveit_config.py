@@ -16,7 +16,7 @@ import yaml
 from armcli.errors import InputError
 from armcli.spec import RobotSpec
 from armcli.srdf_writer import ARM_GROUP, chain_joints
-from armcli.urdfxml import Urdf
+from armcli.urdfdoc import Urdf
 
 ARM_CONTROLLER = "arm_controller"
 JOINT_STATE_BROADCASTER = "joint_state_broadcaster"

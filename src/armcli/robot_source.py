@@ -22,7 +22,7 @@ from armcli.errors import InputError, XacroRefusedError
 if TYPE_CHECKING:
     from armcli.model import LoadedModel
     from armcli.spec import RobotSpec
-    from armcli.urdfxml import Urdf
+    from armcli.urdfdoc import Urdf
 
 SPEC_SUFFIXES = (".yaml", ".yml")
 XACRO_SUFFIX = ".xacro"

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from armcli.errors import InputError
-from armcli.urdfxml import Joint, Urdf, parse_urdf
+from armcli.urdfdoc import Joint, Urdf
+from armcli.urdfxml import parse_urdf
 
 MOVABLE = ("revolute", "continuous", "prismatic", "floating", "planar")
 _TYPES = ("fixed", *MOVABLE)

@@ -10,12 +10,24 @@ report every one of them instead of stopping at the first.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from lxml import etree
 
 from armcli.errors import InputError, XacroRefusedError
+from armcli.urdfdoc import (
+    ZERO3,
+    Geometry,
+    Inertial,
+    Joint,
+    Limit,
+    Link,
+    Material,
+    NumberProblem,
+    Pose,
+    Shape,
+    Urdf,
+)
 
 MAX_URDF_BYTES = 10_000_000
 MAX_URDF_DEPTH = 32
@@ -26,120 +38,6 @@ MAX_URDF_DEPTH = 32
 MAX_URDF_LINKS = 300
 MAX_URDF_DOF = 128
 _DOF = {"revolute": 1, "continuous": 1, "prismatic": 1, "planar": 3, "floating": 6}
-
-Vec3 = tuple[float, float, float]
-ZERO3: Vec3 = (0.0, 0.0, 0.0)
-
-
-@dataclass(frozen=True)
-class NumberProblem:
-    """A numeric attribute that is missing, unparsable, non-finite or of the wrong length."""
-
-    kind: str  # "missing" | "not-a-number" | "non-finite" | "length"
-    where: str  # e.g. "link base_link: inertial/mass@value"
-    text: str
-    line: int | None
-
-
-@dataclass(frozen=True)
-class Pose:
-    xyz: Vec3 = ZERO3
-    rpy: Vec3 = ZERO3
-    line: int | None = None
-
-
-@dataclass(frozen=True)
-class Geometry:
-    """kind is box/cylinder/sphere/mesh (or the unknown tag); dims [m] as URDF orders them."""
-
-    kind: str
-    dims: tuple[float, ...] | None  # box (x, y, z); cylinder (radius, length); sphere (radius,)
-    line: int | None
-    filename: str | None = None
-    scale: Vec3 = (1.0, 1.0, 1.0)
-
-
-@dataclass(frozen=True)
-class Shape:
-    """A <visual> or <collision> element."""
-
-    origin: Pose
-    geometry: Geometry | None
-    line: int | None
-    material: str | None = None
-
-
-@dataclass(frozen=True)
-class Inertial:
-    origin: Pose
-    mass: float | None
-    inertia: tuple[float, float, float, float, float, float] | None  # ixx ixy ixz iyy iyz izz
-    line: int | None
-    mass_line: int | None
-    inertia_line: int | None
-
-
-@dataclass(frozen=True)
-class Link:
-    name: str
-    line: int | None
-    inertial: Inertial | None
-    visuals: tuple[Shape, ...]
-    collisions: tuple[Shape, ...]
-
-
-@dataclass(frozen=True)
-class Limit:
-    lower: float | None
-    upper: float | None
-    effort: float | None
-    velocity: float | None
-    line: int | None
-
-
-@dataclass(frozen=True)
-class Joint:
-    name: str
-    type: str
-    line: int | None
-    parent: str | None
-    child: str | None
-    origin: Pose
-    axis: Vec3 | None
-    axis_line: int | None
-    limit: Limit | None
-    damping: float
-    friction: float
-    mimic: str | None = None
-    mimic_line: int | None = None
-
-    @property
-    def movable(self) -> bool:
-        return self.type not in ("fixed", "floating", "planar")
-
-
-@dataclass(frozen=True)
-class Material:
-    name: str
-    rgba: tuple[float, ...] | None
-    line: int | None
-    top_level: bool
-
-
-@dataclass(frozen=True)
-class Urdf:
-    """What `check` needs from one URDF document."""
-
-    name: str
-    source: str
-    text: bytes
-    links: tuple[Link, ...]
-    joints: tuple[Joint, ...]
-    materials: tuple[Material, ...]
-    problems: tuple[NumberProblem, ...] = field(default=())
-
-    def link(self, name: str) -> Link | None:
-        return next((lk for lk in self.links if lk.name == name), None)
 
 
 def _ln(el: etree._Element) -> int | None:

@@ -14,7 +14,7 @@ from armcli.robot_source import TRUST_XACRO_HELP
 
 if TYPE_CHECKING:
     from armcli.checks import CheckOptions, CheckResult
-    from armcli.urdfxml import Urdf
+    from armcli.urdfdoc import Urdf
 
 FORMATS = ("table", "json", "github")
 REPORT_WIDTH = 140  # columns when stdout is not a terminal (CI logs, pipes)
