@@ -67,7 +67,7 @@ def build_files(spec: RobotSpec, spec_label: str) -> dict[str, bytes]:
     return {**xfiles, **expand_urdfs(spec, xfiles)}
 
 
-def _label(spec_path: Path) -> str:
+def spec_label(spec_path: Path) -> str:
     """How generated files name their spec: relative to the cwd when possible."""
     with contextlib.suppress(ValueError):
         return spec_path.resolve().relative_to(Path.cwd().resolve()).as_posix()
@@ -78,7 +78,7 @@ def build(spec_path: str | Path, out_dir: str | Path) -> BuildResult:
     """Build the spec into `out_dir` all-or-nothing."""
     path = Path(spec_path)
     spec = load_spec(path)
-    files = build_files(spec, _label(path))
+    files = build_files(spec, spec_label(path))
     written = write_tree_atomic(out_dir, files)
     return BuildResult(spec=spec, out_dir=Path(out_dir), files=tuple(written))
 
@@ -86,7 +86,7 @@ def build(spec_path: str | Path, out_dir: str | Path) -> BuildResult:
 def stale_files(spec_path: str | Path, out_dir: str | Path) -> list[str]:
     """Generated files in `out_dir` that are missing or differ from a fresh build."""
     path = Path(spec_path)
-    files = build_files(load_spec(path), _label(path))
+    files = build_files(load_spec(path), spec_label(path))
     out = Path(out_dir)
     return [
         str(out / name)

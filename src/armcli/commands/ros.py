@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import contextlib
 import sys
 from pathlib import Path
 
@@ -11,13 +10,6 @@ import typer
 from armcli.defaults import DEFAULT_SPEC
 
 DEFAULT_SAMPLES = 10_000  # keep equal to armcli.collision_matrix.DEFAULT_SAMPLES (lazy import)
-
-
-def _label(spec: Path) -> str:
-    """How generated files name their spec: as `build` does, relative to the cwd if possible."""
-    with contextlib.suppress(ValueError):
-        return spec.resolve().relative_to(Path.cwd().resolve()).as_posix()
-    return spec.name
 
 
 def ros_package_cmd(
@@ -32,11 +24,12 @@ def ros_package_cmd(
     license_: str = typer.Option("TODO", "--license", help="package.xml license."),
 ) -> None:
     """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
+    from armcli.build import spec_label
     from armcli.ros_package import PackageInfo, write_ros_packages
 
     info = PackageInfo(maintainer=maintainer, email=email, license=license_)
     pkgs, written = write_ros_packages(
-        spec, out, label=_label(spec), samples=samples, seed=seed, info=info
+        spec, out, label=spec_label(spec), samples=samples, seed=seed, info=info
     )
     n, m = pkgs.names, pkgs.matrix
     counts = {r: sum(d.reason == r for d in m.disabled) for r in ("Adjacent", "Default", "Never")}
