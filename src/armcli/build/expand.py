@@ -49,7 +49,7 @@ def expand(xacro_dir: Path, xacro_name: str) -> bytes:
             + (f" ({detail[-1]})" if detail else "")
         ) from None
     _banner_fix(doc, xacro_name)
-    return doc.toprettyxml(indent="  ", encoding="utf-8")
+    return bytes(doc.toprettyxml(indent="  ", encoding="utf-8"))
 
 
 def expand_urdfs(spec: RobotSpec, files: dict[str, bytes] | None = None) -> dict[str, bytes]:

@@ -47,7 +47,7 @@ class YamlDoc:
 _Base: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml when PyYAML has it
 
 
-class _Loader(_Base):  # type: ignore[misc, valid-type]
+class _Loader(_Base):  # type: ignore[misc]
     """The safe loader (C-accelerated where available); anchors are refused before use."""
 
 

@@ -206,7 +206,8 @@ def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
     data = job.arm.model.createData()
     pin.framesForwardKinematics(job.arm.model, data, q)
     p_root = np.asarray(data.oMf[job.tool_frame].act(job.tool_offset), dtype=float)
-    return job.T_frame_root[:3, :3] @ p_root + job.T_frame_root[:3, 3]
+    out: np.ndarray = job.T_frame_root[:3, :3] @ p_root + job.T_frame_root[:3, 3]
+    return out
 
 
 def run(job: SimJob, progress: Callable[[int, int], None] | None = None) -> SimResult:

@@ -173,7 +173,10 @@ def rollout_batch(
     fs = np.zeros(batch, dtype=np.int64)
     fj = np.zeros(batch, dtype=np.int32)
     fc = np.zeros(batch, dtype=np.int32)
-    c = lambda a: np.ascontiguousarray(a, dtype=float)  # noqa: E731
+
+    def c(a: Any) -> np.ndarray:
+        return np.ascontiguousarray(a, dtype=float)
+
     grav = c(np.array(plant.model.gravity.linear))
     params, q0c, v0c, refc = c(plant.params), c(q0), c(v0), c(ref)
     dbl, i32 = ctypes.c_double, ctypes.c_int
