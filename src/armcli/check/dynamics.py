@@ -34,7 +34,8 @@ PENETRATION_TOL = 1e-4  # [m]
 
 def samples(model: Any, ranges: list[Any]) -> list[tuple[dict[str, float], Any]]:
     """Joint-space sample: a full grid for few joints; else every corner of the range box
-    (where gravity torques peak for serial arms) when there are few, plus seeded draws."""
+    (where gravity torques peak for serial arms) when there are few, plus seeded draws.
+    """
     n = len(ranges)
     names = [jr.name for jr in ranges]
     if n and GRID_POINTS**n <= MAX_GRID:

@@ -57,7 +57,8 @@ def resolve(uri: str, urdf_path: Path, opts: CheckOptions) -> Path | None:
 
 def mesh_paths(urdf: Urdf, opts: CheckOptions) -> dict[str, Path | None]:
     """Every mesh URI in the file -> its resolved path (None if unresolvable or outside
-    the allowed roots, so that nothing outside them is ever loaded)."""
+    the allowed roots, so that nothing outside them is ever loaded).
+    """
     src = Path(urdf.source)
     out: dict[str, Path | None] = {}
     for link in urdf.links:
@@ -72,7 +73,8 @@ def mesh_paths(urdf: Urdf, opts: CheckOptions) -> dict[str, Path | None]:
 
 def confined(uri: str, path: Path, urdf_path: Path, opts: CheckOptions) -> bool:
     """Whether a resolved mesh path lies inside the allowed roots (robot_source.allowed_roots,
-    --package-dir, the search paths, and for package:// the package it names)."""
+    --package-dir, the search paths, and for package:// the package it names).
+    """
     extra = [*map(Path, opts.package_dirs.values()), *opts.search_paths]
     parsed = urlparse(uri)
     if parsed.scheme == "package":
