@@ -114,8 +114,11 @@ def urdf_text(urdf: Urdf) -> str:
 
 
 def allowed_roots(urdf_dir: Path, extra: Iterable[Path] = ()) -> tuple[Path, ...]:
-    """Directories mesh files may come from: the URDF's directory, the ROS package it sits
-    in (nearest ancestor with a package.xml), `extra` (--package-dir) and ROS_PACKAGE_PATH."""
+    """Directories mesh files may come from.
+
+    The URDF's directory, the ROS package it sits in (nearest ancestor with a package.xml),
+    `extra` (--package-dir) and ROS_PACKAGE_PATH.
+    """
     here = urdf_dir.resolve()
     roots = [here, *extra]
     roots += [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
