@@ -34,4 +34,5 @@ def build_cmd(
 
 
 def register(app: typer.Typer) -> None:
+    """Add the `build` command to the typer app."""
     app.command("build")(build_cmd)

@@ -119,4 +119,5 @@ def _print(results: list[CheckResult], findings: list[Any], fmt: str, code: int)
 
 
 def register(app: typer.Typer) -> None:
+    """Add the `check` command to the typer app."""
     app.command("check")(check_cmd)

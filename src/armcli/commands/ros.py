@@ -71,4 +71,5 @@ def ros_package_cmd(
 
 
 def register(app: typer.Typer) -> None:
+    """Add the `ros-package` command to the typer app."""
     app.command("ros-package")(ros_package_cmd)
