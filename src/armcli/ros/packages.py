@@ -34,6 +34,7 @@ from armcli.ros.launch import render
 from armcli.ros.ros2_control import moveit_urdf_xacro, ros2_control_xacro
 from armcli.ros.rviz import display_rviz, moveit_rviz
 from armcli.ros.srdf import chain_joints, srdf_bytes
+from armcli.spec.graph import root_links
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
 from armcli.urdf.read import parse_urdf
@@ -105,8 +106,8 @@ class Names:
         whole = top_level_files(spec).get(f"{spec.name}.urdf", STANDALONE_ARM)
         root = spec.arm_root()
         if spec.mobile_base is not None and whole != STANDALONE_ARM:
-            children = {j.child for j in spec.mobile_base.joints.values()}
-            root = next(n for n in spec.mobile_base.links if n not in children)
+            base = spec.mobile_base
+            root = root_links(base.links, (j.child for j in base.joints.values()))[0]
         return Names(
             robot=spec.name,
             description=f"{spec.name}_description",

@@ -24,6 +24,7 @@ from pydantic import (
 
 from armcli.defaults import DEFAULT_DT
 from armcli.spec.expr import eval_expr
+from armcli.spec.graph import root_links
 
 
 def _number(v: Any) -> Any:
@@ -290,9 +291,7 @@ class RobotSpec(_Model):
 
     def arm_root(self) -> str:
         """The arm link that is no arm joint's child (a valid spec has exactly one)."""
-        children = {j.child for j in self.arm.joints.values()}
-        roots = [name for name in self.arm.links if name not in children]
-        return roots[0]
+        return root_links(self.arm.links, (j.child for j in self.arm.joints.values()))[0]
 
     def mount_joint(self) -> Joint:
         """The mount as the fixed `Joint` from the base to the arm root; needs a mount."""
