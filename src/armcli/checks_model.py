@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from armcli import checks_dynamics as dyn
+from armcli import checks_interface
 from armcli.checks import CheckOptions, Collector
 from armcli.checks_structure import Tree, finite
 from armcli.stability import StabilityReport
@@ -130,7 +131,10 @@ def _with_model(
     else:
         samples = dyn.samples(model, ranges)
         rows = dyn.gravity(urdf, model, data, samples, rows, out)
-        report = dyn.stability(urdf, opts, model, data, samples, ranges, out, notes)
+        servo = checks_interface.check(urdf.text, opts, out, notes)
+        gained = set(opts.spec.control.gains) if opts.spec is not None else set()
+        if not (servo and gained <= servo):  # a position servo is not a PD loop
+            report = dyn.stability(urdf, opts, model, data, samples, ranges, out, notes)
     if opts.spec is not None and opts.spec.poses:
         dyn.self_collision(urdf, opts, model, poses, out, notes)
     return Summary(

@@ -22,6 +22,12 @@ def ros_package_cmd(
     maintainer: str = typer.Option("armcli", "--maintainer", help="package.xml maintainer."),
     email: str = typer.Option("armcli@example.com", "--email", help="Maintainer e-mail."),
     license_: str = typer.Option("TODO", "--license", help="package.xml license."),
+    target: str = typer.Option(
+        "humble-classic",
+        "--target",
+        help="humble-classic: the course's ROS 2 Humble + Gazebo classic; "
+        "jazzy: ROS 2 Jazzy + Gazebo Harmonic with ros2_control (effort, the spec's gains).",
+    ),
 ) -> None:
     """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
     from armcli.build import spec_label
@@ -29,7 +35,7 @@ def ros_package_cmd(
 
     info = PackageInfo(maintainer=maintainer, email=email, license=license_)
     pkgs, written = write_ros_packages(
-        spec, out, label=spec_label(spec), samples=samples, seed=seed, info=info
+        spec, out, label=spec_label(spec), samples=samples, seed=seed, info=info, target=target
     )
     n, m = pkgs.names, pkgs.matrix
     counts = {r: sum(d.reason == r for d in m.disabled) for r in ("Adjacent", "Default", "Never")}
