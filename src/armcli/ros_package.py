@@ -254,7 +254,8 @@ def moveit_files(
         values = {"robot": n.robot, "moveit_pkg": n.moveit, "generator": generator}
         files[f"launch/{launch}"] = render("moveit.launch.py.tmpl", values, f"{what}\n\n{note}")
     if target == "jazzy":
-        files[f"launch/{jazzy.MOVE_GROUP_LAUNCH}"] = jazzy.move_group_launch(n.robot, n.moveit, note)
+        gz_launch = jazzy.move_group_launch(n.robot, n.moveit, note)
+        files[f"launch/{jazzy.MOVE_GROUP_LAUNCH}"] = gz_launch
     about = f"MoveIt 2 configuration of {n.robot}. {note}"
     depends = sorted({*MOVEIT_DEPENDS, *(jazzy.MOVEIT_DEPENDS if target == "jazzy" else ())})
     return _package(n.moveit, about, [n.description, *depends], files, info)
