@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 from lxml import etree
 
-from armcli.checks import CheckOptions, Collector
+from armcli.checks import CheckOptions, Collector, Value
 
 GZ_SYSTEMS = ("gz_ros2_control/GazeboSimSystem", "ign_ros2_control/IgnitionSystem")
 GZ_PLUGIN_FILES = ("gz_ros2_control-system", "ign_ros2_control-system")
@@ -73,7 +73,7 @@ def read_interfaces(text: bytes) -> Interfaces | None:
             names = tuple(c.get("name", "") for c in j.findall("command_interface"))
             command[j.get("name", "")] = names
     line = blocks[0].sourceline
-    return Interfaces(hardware, command, _gain(root), int(line) if line is not None else None)
+    return Interfaces(hardware, command, _gain(root), line if isinstance(line, int) else None)
 
 
 def check(text: bytes, opts: CheckOptions, out: Collector, notes: list[str]) -> set[str]:
@@ -90,7 +90,7 @@ def check(text: bytes, opts: CheckOptions, out: Collector, notes: list[str]) -> 
     g = ifaces.gain
     rate = opts.spec.control.controller_update_rate if opts.spec is not None else None
     per_s = f"{g * rate:.4g}/s" if rate is not None else "gain x update_rate"
-    values = dict(gain=g, factor=1.0 - g, joints=", ".join(joints))
+    values: dict[str, Value] = {"gain": g, "factor": 1.0 - g, "joints": ", ".join(joints)}
     where = f"gz_ros2_control position interface on {', '.join(joints)}"
     if not 0.0 < g < STABLE_BELOW:
         out.add(
