@@ -35,9 +35,9 @@ def _root(
 
 
 def _register() -> None:
-    from armcli.commands import build, check, ros, simulate, view
+    from armcli.commands import build, check, export, ros, simulate, view
 
-    for module in (build, check, simulate, ros, view):
+    for module in (build, check, simulate, ros, view, export):
         module.register(app)
 
 

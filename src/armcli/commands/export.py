@@ -1,0 +1,57 @@
+"""`armcli export mjcf`: the robot as a MuJoCo model (plus scene.xml, meshes/)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import typer
+
+from armcli.defaults import DEFAULT_SPEC
+from armcli.robot_source import TRUST_XACRO_HELP
+
+export_app = typer.Typer(
+    help="Export the robot to other simulators' formats.", no_args_is_help=True
+)
+
+
+@export_app.command("mjcf")
+def mjcf_cmd(
+    robot: Path = typer.Argument(DEFAULT_SPEC, help="Robot spec YAML, URDF or xacro file."),
+    out: Path = typer.Option(Path("robot.xml"), "-o", "--out", help="MJCF model file."),
+    base: str = typer.Option(
+        "fixed", "--base", help="fixed: the root link is welded to the world; free: a free joint."
+    ),
+    whole_robot: bool = typer.Option(
+        False, "--whole-robot", help="For a spec: the whole robot instead of the arm alone."
+    ),
+    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
+) -> None:
+    """Write a MuJoCo MJCF model of ROBOT to OUT, with scene.xml (floor, light) beside it.
+
+    Joints with spec gains get `position` actuators (kp = Kp, kv = Kd, force range =
+    the effort limit); the report lists what MuJoCo cannot represent.
+    """
+    from armcli.build import spec_label
+    from armcli.export.mjcf_files import export_mjcf
+
+    res = export_mjcf(
+        robot,
+        out,
+        base=base,
+        whole_robot=whole_robot,
+        trust_xacro=trust_xacro,
+        label=spec_label(robot),
+    )
+    exp = res.export
+    w = sys.stdout.write
+    w(f"wrote {len(res.files)} files beside {out} from {res.robot}\n")
+    w(
+        f"{len(exp.joints)} joints, {len(exp.actuators)} actuators, "
+        f"keyframes: {', '.join(exp.keyframes)}\n"
+    )
+    w(res.report)
+
+
+def register(app: typer.Typer) -> None:
+    app.add_typer(export_app, name="export")
