@@ -267,9 +267,10 @@ def build_mjcf(
     _header(root, name, spec)
     b.assets(root, meshes or {})
     _worldbody(etree.SubElement(root, "worldbody"), b, name, base == "free")
+    parts.excludes(root, urdf, {str(el.get("name")) for el in root.iter("body")})
+    parts.equalities(root, b.extras, {j.name for j in b.joints})
     actuators = parts.actuators(root, b.joints, spec, b.extras, b.notes)
     keys = parts.keyframes(root, b.joints, actuators, spec, base == "free")
-    parts.equalities(root, b.extras, {j.name for j in b.joints})
     b.notes[:0] = parts.notes(urdf, b.joints, b.extras, spec, b.skipped_meshes)
     if header is not None:  # the report travels with the model
         header = f"{header}\n\n{text(b.notes)}".replace("--", "- -")

@@ -102,6 +102,21 @@ def keyframes(
     return tuple(poses)
 
 
+def excludes(root: etree._Element, urdf: Urdf, bodies: set[str]) -> None:
+    """No contact between the two links of a URDF joint, as in Gazebo and MoveIt.
+
+    MuJoCo's own parent/child filter does not apply to a body welded to the world
+    (the fixed base), whose children would otherwise touch it by construction.
+    """
+    pairs = [(str(j.parent), str(j.child)) for j in urdf.joints]
+    pairs = [(a, b) for a, b in pairs if a in bodies and b in bodies]
+    if not pairs:
+        return
+    contact = etree.SubElement(root, "contact")
+    for a, b in pairs:
+        etree.SubElement(contact, "exclude", body1=a, body2=b)
+
+
 def equalities(root: etree._Element, extras: Extras, joints: set[str]) -> None:
     """Mimic joints as joint equality constraints: q1 = offset + multiplier * q2."""
     pairs = [(f, m) for f, m in sorted(extras.mimic.items()) if f in joints and m.joint in joints]
