@@ -145,6 +145,7 @@ def tool_without_inertial(r: Any) -> None:
 
 SAFE_SPEC = with_gains(50.0, 2.0)  # Kd = 2 keeps even the explicit loop stable at 1 ms
 
+
 # (edit of urdf/my_robot.urdf, spec or None, the exact set of rules expected)
 def gz_position_servo(gain: float) -> Callable[[Any], None]:
     """A gz_ros2_control block commanding forearm_hand_joint by position at `gain`."""
