@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 
 from armcli.defaults import DEFAULT_SPEC
-from armcli.robot_source import TRUST_XACRO_HELP
+from armcli.urdf.source import TRUST_XACRO_HELP
 
 export_app = typer.Typer(
     help="Export the robot to other simulators' formats.", no_args_is_help=True
@@ -32,7 +32,7 @@ def mjcf_cmd(
     Joints with spec gains get `position` actuators (kp = Kp, kv = Kd, force range =
     the effort limit); the report lists what MuJoCo cannot represent.
     """
-    from armcli.build import spec_label
+    from armcli.build.expand import spec_label
     from armcli.export.mjcf_files import export_mjcf
 
     res = export_mjcf(
@@ -54,4 +54,5 @@ def mjcf_cmd(
 
 
 def register(app: typer.Typer) -> None:
+    """Add `armcli export ...` as a sub-app (one subcommand per format)."""
     app.add_typer(export_app, name="export")

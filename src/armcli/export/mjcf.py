@@ -25,13 +25,13 @@ from pathlib import Path, PurePosixPath
 import numpy as np
 from lxml import etree
 
+from armcli.build.xmlfmt import fmt, to_bytes, vec
 from armcli.errors import InputError
 from armcli.export import mjcf_parts as parts
 from armcli.export.mjcf_report import Extras, Note, scan, text
-from armcli.spec import RobotSpec
-from armcli.urdfdoc import Joint, Link, Pose, Shape, Urdf
-from armcli.urdfxml import parse_root
-from armcli.xmlfmt import fmt, to_bytes, vec
+from armcli.spec.model import RobotSpec
+from armcli.urdf.doc import Joint, Link, Pose, Shape, Urdf
+from armcli.urdf.read import parse_root
 
 BASES = ("fixed", "free")
 MESH_SUFFIXES = (".stl", ".obj", ".msh")  # what MuJoCo loads
@@ -74,11 +74,13 @@ def quat(rpy: tuple[float, float, float]) -> tuple[float, float, float, float]:
 
 
 def rotation(rpy: tuple[float, float, float]) -> np.ndarray:
+    """The 3x3 matrix of URDF's roll-pitch-yaw (to rotate inertias into the body frame)."""
     r, p, y = rpy
     Rx = np.array([[1, 0, 0], [0, math.cos(r), -math.sin(r)], [0, math.sin(r), math.cos(r)]])
     Ry = np.array([[math.cos(p), 0, math.sin(p)], [0, 1, 0], [-math.sin(p), 0, math.cos(p)]])
     Rz = np.array([[math.cos(y), -math.sin(y), 0], [math.sin(y), math.cos(y), 0], [0, 0, 1]])
-    return Rz @ Ry @ Rx
+    out: np.ndarray = Rz @ Ry @ Rx
+    return out
 
 
 def _place(attrs: dict[str, str], pose: Pose) -> dict[str, str]:

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 from lxml import etree
 
+from armcli.build.xmlfmt import fmt, vec
 from armcli.export.mjcf_report import EXTRA_TAGS, Extras, Note
-from armcli.spec import RobotSpec
-from armcli.urdfdoc import Joint, Urdf
-from armcli.xmlfmt import fmt, vec
+from armcli.spec.model import RobotSpec
+from armcli.urdf.doc import Joint, Urdf
 
 HOME = "home"
 FREE_QPOS = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)  # origin, identity quaternion (w x y z)
@@ -90,6 +90,7 @@ def keyframes(
     spec: RobotSpec | None,
     free: bool,
 ) -> tuple[str, ...]:
+    """`<keyframe>`: one key per pose (qpos in MuJoCo order, ctrl holding the pose)."""
     key_el = etree.SubElement(root, "keyframe")
     poses = _poses(joints, spec)
     for name, values in poses.items():

@@ -8,12 +8,13 @@ from __future__ import annotations
 
 from lxml import etree
 
-from armcli.xmlfmt import to_bytes
+from armcli.build.xmlfmt import to_bytes
 
 SCENE = "scene.xml"
 
 
 def scene_xml(model_file: str, model_name: str, header: str | None = None) -> bytes:
+    """The scene file: includes `model_file` (relative) and adds floor, light and sky."""
     root = etree.Element("mujoco", model=f"{model_name} scene")
     etree.SubElement(root, "include", file=model_file)
     visual = etree.SubElement(root, "visual")
