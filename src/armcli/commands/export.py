@@ -5,9 +5,13 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+import click
 import typer
 
+from armcli.build.expand import spec_label
 from armcli.defaults import DEFAULT_SPEC
+from armcli.export.mjcf import BASES
+from armcli.export.mjcf_files import export_mjcf
 from armcli.urdf.source import TRUST_XACRO_HELP
 
 export_app = typer.Typer(
@@ -17,10 +21,24 @@ export_app = typer.Typer(
 
 @export_app.command("mjcf")
 def mjcf_cmd(
-    robot: Path = typer.Argument(DEFAULT_SPEC, help="Robot spec YAML, URDF or xacro file."),
-    out: Path = typer.Option(Path("robot.xml"), "-o", "--out", help="MJCF model file."),
+    robot: Path = typer.Argument(
+        DEFAULT_SPEC,
+        show_default=False,
+        help=f"Robot spec YAML, URDF or xacro file (default: {DEFAULT_SPEC}).",
+    ),
+    out: Path = typer.Option(
+        Path("robot.xml"),
+        "-o",
+        "--out",
+        show_default=False,
+        help="MJCF model file (default: robot.xml).",
+    ),
     base: str = typer.Option(
-        "fixed", "--base", help="fixed: the root link is welded to the world; free: a free joint."
+        "fixed",
+        "--base",
+        click_type=click.Choice(BASES),
+        show_default=False,
+        help="fixed (default): the root link is welded to the world; free: on a free joint.",
     ),
     whole_robot: bool = typer.Option(
         False, "--whole-robot", help="For a spec: the whole robot instead of the arm alone."
@@ -32,9 +50,6 @@ def mjcf_cmd(
     Joints with spec gains get `position` actuators (kp = Kp, kv = Kd, force range =
     the effort limit); the report lists what MuJoCo cannot represent.
     """
-    from armcli.build.expand import spec_label
-    from armcli.export.mjcf_files import export_mjcf
-
     res = export_mjcf(
         robot,
         out,

@@ -20,6 +20,7 @@ from lxml import etree
 
 from armcli.build.expand import expand_urdfs
 from armcli.build.xacro_writer import GENERATED, STANDALONE_ARM, top_level_files, xacro_files
+from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.io.files import write_tree_atomic
 from armcli.ros import jazzy
@@ -94,6 +95,11 @@ class Names:
 
     @staticmethod
     def of(spec: RobotSpec, source: str | None = None) -> Names:
+        """Every package, file and frame name, derived from the spec's name.
+
+        Raises:
+            InputError: the spec name is not a valid ROS package name.
+        """
         if not PACKAGE_NAME.match(spec.name):
             raise InputError(
                 f"{spec.name!r}: ROS package names need lower case letters, digits and _",
@@ -120,6 +126,8 @@ class Names:
 
 @dataclass(frozen=True)
 class RosPackages:
+    """The three packages in memory, before the one atomic write, with their names and matrix."""
+
     files: Mapping[str, bytes]  # path relative to the output directory -> content
     names: Names
     matrix: CollisionMatrix
@@ -202,6 +210,10 @@ def description_files(
     info: PackageInfo,
     extra: Mapping[str, bytes] | None = None,
 ) -> dict[str, bytes]:
+    """The `<name>_description` files: the `build` xacro set, a display launch and RViz config.
+
+    `extra` adds xacro files under `urdf/` (the Jazzy top levels).
+    """
     note = GENERATED.format(spec=label)
     xacros = {**xacro_files(spec, label), **(extra or {})}
     files = {f"urdf/{name}": data for name, data in xacros.items()}
@@ -212,6 +224,7 @@ def description_files(
 
 
 def bringup_files(n: Names, note: str, info: PackageInfo) -> dict[str, bytes]:
+    """The `<name>_bringup` files: a launch file that starts Gazebo with the robot."""
     launch = render("gazebo.launch.py.tmpl", _launch_values(n), note)
     about = f"Gazebo bringup of {n.robot}. {note}"
     depends = [n.description, *BRINGUP_DEPENDS]
@@ -239,6 +252,7 @@ def moveit_files(
     info: PackageInfo,
     target: str = DEFAULT_TARGET,
 ) -> dict[str, bytes]:
+    """The `<name>_moveit_config` files: SRDF, config YAML, ros2_control xacro, RViz, launches."""
     yamls = _moveit_yaml(spec, urdf_xml)
     if target == "jazzy":
         yamls["moveit_controllers.yaml"] = jazzy.moveit_controllers(spec)
@@ -284,7 +298,7 @@ def ros_packages(
     if target == "jazzy":
         jazzy.required_gains(spec, source)
     urdfs = expand_urdfs(spec)
-    urdf_xml = urdfs.get(f"{n.robot}.urdf", urdfs["standalone_arm.urdf"])
+    urdf_xml = urdfs.get(f"{n.robot}.urdf", urdfs[STANDALONE_ARM_URDF])
     poses = {name: spec.pose(name) for name in spec.poses}
     matrix = compute_collision_matrix(
         urdf_xml, samples=samples, seed=seed, source=n.robot_xacro, poses=poses

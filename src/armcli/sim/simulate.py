@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from armcli.defaults import DEFAULT_DT
 from armcli.errors import InputError, SimulationError
 from armcli.sim import native
 from armcli.sim import rollout as ro
@@ -47,9 +48,11 @@ class Arm:
 
 @dataclass(frozen=True)
 class SimConfig:
+    """Controller and integrator settings: PD gains [N·m/rad, N·m·s/rad] and time step [s]."""
+
     kp: np.ndarray
     kd: np.ndarray
-    dt: float = 0.001  # [s]
+    dt: float = DEFAULT_DT  # [s]
     integrator: str = "euler"
     gravity_comp: bool = False
     backend: str = "auto"  # "auto" | "native" | "python"
@@ -57,6 +60,8 @@ class SimConfig:
 
 @dataclass(frozen=True)
 class SimResult:
+    """One rollout: time [s], states, references and motor torques [N·m] at every step."""
+
     joint_names: tuple[str, ...]
     t: np.ndarray  # (N + 1,) [s]
     q: np.ndarray  # (N + 1, n)
