@@ -322,3 +322,29 @@ def test_jazzy_urdf_has_the_course_dynamics_in_pinocchio(
         M_ours = pin.crba(ours, ours.createData(), q)
         M_course = pin.crba(course, course.createData(), q)
         assert np.max(np.abs(M_ours - M_course)) < RIGID_TOL
+
+
+def test_cli_target_choice_and_one_line_error(tmp_path: Path) -> None:
+    import sys
+
+    spec = str(ROOT / LABEL)
+    r = subprocess.run(
+        [sys.executable, "-m", "armcli.cli", "ros-package", spec, "-o", str(tmp_path / "a"),
+         "--samples", "10", "--target", "noetic"],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert r.returncode == 2 and "humble-classic" in r.stderr and "jazzy" in r.stderr
+    assert not (tmp_path / "a").exists()
+    bad = tmp_path / "no_gains.yaml"
+    bad.write_text(
+        (ROOT / LABEL).read_text().replace("    forearm_hand_joint: {kp: 50, kd: 5}\n", "")
+    )
+    r = subprocess.run(
+        [sys.executable, "-m", "armcli.cli", "ros-package", str(bad), "-o", str(tmp_path / "b"),
+         "--samples", "10", "--target", "jazzy"],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert r.returncode == 2, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1
+    assert "no_gains.yaml" in r.stderr and "control.gains" in r.stderr
+    assert not (tmp_path / "b").exists()
