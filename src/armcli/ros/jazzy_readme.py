@@ -44,29 +44,10 @@ def _gains_table(spec: RobotSpec) -> list[str]:
     return rows
 
 
-def readme(spec: RobotSpec, bringup: str, launch: str, moveit: str, note: str) -> bytes:
-    """The whole README text, deterministic for a given spec."""
+def _moving(spec: RobotSpec) -> list[str]:
     pose, _ = _example_pose(spec)
     ctl = f"/{ARM_CONTROLLER}"
-    tol = spec.control.tolerances
-    lines = [
-        f"# {bringup}: {spec.name} in Gazebo Harmonic with ros2_control (ROS 2 Jazzy)",
-        "",
-        note,
-        "",
-        "## Run",
-        "",
-        "```sh",
-        f"ros2 launch {bringup} {launch}                   # whole robot",
-        f"ros2 launch {bringup} {launch} standalone:=true  # the arm alone",
-        f"ros2 launch {moveit} gz_move_group.launch.py     # optional: MoveIt on top",
-        "```",
-        "",
-        "The launch starts `gz_sim.launch.py` (ros_gz_sim) with an empty world, "
-        "robot_state_publisher on the xacro, `ros_gz_sim create -topic robot_description`, "
-        "the `/clock` bridge, then spawns `joint_state_broadcaster` once the robot exists "
-        f"and `{ARM_CONTROLLER}` once that is active.",
-        "",
+    return [
         "## Moving the arm (the course's `/set_joint_trajectory`)",
         "",
         "The course teleported the joints through `/set_joint_trajectory`. Here the "
@@ -85,6 +66,12 @@ def readme(spec: RobotSpec, bringup: str, launch: str, moveit: str, note: str) -
         f'"{_trajectory(spec)}"',
         "```",
         "",
+    ]
+
+
+def _control(spec: RobotSpec) -> list[str]:
+    tol = spec.control.tolerances
+    return [
         "## Control",
         "",
         f"`config/{controllers_file(spec.name)}`: controller_manager at "
@@ -104,15 +91,45 @@ def readme(spec: RobotSpec, bringup: str, launch: str, moveit: str, note: str) -
         "`mock_components/GenericSystem` to test the wiring without Gazebo; mock hardware "
         "only mirrors commands, so an effort command does not move the joints there.",
         "",
-        "## What was not run",
+    ]
+
+
+NOT_RUN = [
+    "## What was not run",
+    "",
+    "armcli generated these files without a ROS installation. Checked by its tests: "
+    "the launch files compile and name only packages in package.xml; every YAML parses "
+    "and names only joints of the URDF; the expanded xacro passes `check_urdf`, "
+    "`armcli check` and Pinocchio; package.xml validates with catkin_pkg. **Not run**: "
+    "a real ROS 2 Jazzy + Gazebo Harmonic install, i.e. `colcon build`, the launch "
+    f"itself, {GZ_PLUGIN_NAME} loading the controllers, and the tracking in Gazebo "
+    "(Gazebo's physics differs from armcli's simulator: contacts, its own integrator).",
+    "",
+]
+
+
+def readme(spec: RobotSpec, bringup: str, launch: str, moveit: str, note: str) -> bytes:
+    """The whole README text, deterministic for a given spec."""
+    lines = [
+        f"# {bringup}: {spec.name} in Gazebo Harmonic with ros2_control (ROS 2 Jazzy)",
         "",
-        "armcli generated these files without a ROS installation. Checked by its tests: "
-        "the launch files compile and name only packages in package.xml; every YAML parses "
-        "and names only joints of the URDF; the expanded xacro passes `check_urdf`, "
-        "`armcli check` and Pinocchio; package.xml validates with catkin_pkg. **Not run**: "
-        f"a real ROS 2 Jazzy + Gazebo Harmonic install, i.e. `colcon build`, the launch "
-        f"itself, {GZ_PLUGIN_NAME} loading the controllers, and the tracking in Gazebo "
-        "(Gazebo's physics differs from armcli's simulator: contacts, its own integrator).",
+        note,
         "",
+        "## Run",
+        "",
+        "```sh",
+        f"ros2 launch {bringup} {launch}                   # whole robot",
+        f"ros2 launch {bringup} {launch} standalone:=true  # the arm alone",
+        f"ros2 launch {moveit} gz_move_group.launch.py     # optional: MoveIt on top",
+        "```",
+        "",
+        "The launch starts `gz_sim.launch.py` (ros_gz_sim) with an empty world, "
+        "robot_state_publisher on the xacro, `ros_gz_sim create -topic robot_description`, "
+        "the `/clock` bridge, then spawns `joint_state_broadcaster` once the robot exists "
+        f"and `{ARM_CONTROLLER}` once that is active.",
+        "",
+        *_moving(spec),
+        *_control(spec),
+        *NOT_RUN,
     ]
     return "\n".join(lines).encode("utf-8")
