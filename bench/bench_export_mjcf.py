@@ -51,7 +51,7 @@ def main() -> None:
                 def peer(text: str = text, out: str = out) -> None:
                     mujoco.mj_saveLastXML(out, mujoco.MjModel.from_xml_string(text))
 
-                ours = median_ms(lambda u=urdf: build_mjcf(u, spec), repeats)
+                ours = median_ms(lambda u=urdf, s=spec: build_mjcf(u, s), repeats)
                 theirs = median_ms(peer, repeats)
             name = f"{spec_path.stem} / {urdf.source.split('#')[-1]}"
             print(f"{name:40} {ours:12.2f} {theirs:12.2f} {ours / theirs:7.2f}")
