@@ -296,32 +296,48 @@ def test_jazzy_urdf_passes_check_urdf(files: Mapping[str, bytes], tmp_path: Path
         assert "Successfully Parsed XML" in r.stdout
 
 
+TOPS = [
+    ("my_robot_gz.urdf.xacro", "my_robot.urdf"),
+    ("standalone_arm_gz.urdf.xacro", "standalone_arm.urdf"),
+]
+
+
+@pytest.mark.parametrize(("top", "course"), TOPS)
 def test_jazzy_urdf_passes_armcli_check_with_the_pd_bound(
-    files: Mapping[str, bytes], spec: RobotSpec, tmp_path: Path
+    files: Mapping[str, bytes], spec: RobotSpec, tmp_path: Path, top: str, course: str
 ) -> None:
-    urdf = parse_urdf(expand(files, "my_robot_gz.urdf.xacro", tmp_path), "my_robot_gz.urdf")
+    urdf = parse_urdf(expand(files, top, tmp_path), top)
     res = check_urdf(urdf, CheckOptions(spec=spec))
     assert [f for f in res.findings if f.severity == "error"] == []
     # effort interface: the PD torque loop, bounded as for the course URDF (docs/check.md:
-    # Kp 50, Kd 5 at 1 ms is explicitly unstable, implicitly stable)
+    # Kp 50, Kd 5 at 1 ms is explicitly unstable, implicitly stable). The standalone arm
+    # hangs from a massless `world` link, so KDL's root-inertia warning is gone too.
     assert res.summary is not None and res.summary.stability is not None
     assert {f.rule for f in res.findings} == {"pd-explicit-unstable"}
 
 
+@pytest.mark.parametrize(("top", "course"), TOPS)
 def test_jazzy_urdf_has_the_course_dynamics_in_pinocchio(
-    files: Mapping[str, bytes], built_dir: Path, tmp_path: Path
+    files: Mapping[str, bytes], built_dir: Path, tmp_path: Path, top: str, course: str
 ) -> None:
     import pinocchio as pin
 
-    ours = pin.buildModelFromXML(expand(files, "my_robot_gz.urdf.xacro", tmp_path).decode())
-    course = pin.buildModelFromUrdf(str(built_dir / "my_robot.urdf"))
-    assert list(ours.names) == list(course.names)
+    ours = pin.buildModelFromXML(expand(files, top, tmp_path).decode())
+    ref = pin.buildModelFromUrdf(str(built_dir / course))
+    assert list(ours.names) == list(ref.names)
     pin.seed(0)
     for _ in range(10):
-        q = pin.randomConfiguration(course)
+        q = pin.randomConfiguration(ref)
         M_ours = pin.crba(ours, ours.createData(), q)
-        M_course = pin.crba(course, course.createData(), q)
-        assert np.max(np.abs(M_ours - M_course)) < RIGID_TOL
+        M_ref = pin.crba(ref, ref.createData(), q)
+        assert np.max(np.abs(M_ours - M_ref)) < RIGID_TOL
+
+
+def test_standalone_arm_is_welded_to_the_world(files: Mapping[str, bytes], tmp_path: Path) -> None:
+    urdf = parse_urdf(expand(files, "standalone_arm_gz.urdf.xacro", tmp_path), "arm")
+    anchor = next(j for j in urdf.joints if j.name == jazzy.WORLD_JOINT)
+    assert (anchor.type, anchor.parent, anchor.child) == ("fixed", "world", "arm_base_link")
+    assert urdf.link("world") is not None and urdf.link("world").inertial is None  # type: ignore[union-attr]
 
 
 def test_cli_target_choice_and_one_line_error(tmp_path: Path) -> None:

@@ -24,7 +24,7 @@ from armcli.errors import InputError
 from armcli.ros import moveit as mc
 from armcli.ros.launch import render
 from armcli.ros.srdf import chain_joints
-from armcli.spec.model import RobotSpec
+from armcli.spec.model import Joint, RobotSpec
 
 X = f"{{{XACRO_NS}}}"
 GZ_SYSTEM = "gz_ros2_control/GazeboSimSystem"
@@ -41,6 +41,8 @@ TOP = "{name}_gz.urdf.xacro"
 STANDALONE = "standalone_arm_gz.urdf.xacro"
 GZ_LAUNCH = "{name}_gz.launch.py"
 MOVE_GROUP_LAUNCH = "gz_move_group.launch.py"
+WORLD = "world"  # gz-sim welds a link of this name to the world
+WORLD_JOINT = "world_joint"
 # Everything the Jazzy bringup launch starts or loads, for its package.xml.
 BRINGUP_DEPENDS = [
     "ament_index_python", "control_msgs", "controller_manager", "gz_ros2_control",
@@ -154,7 +156,12 @@ def _friction(parent: etree._Element, spec: RobotSpec, whole: bool) -> None:
 
 
 def top_xacro(spec: RobotSpec, bringup_pkg: str, *, whole: bool, header: str) -> bytes:
-    """A Jazzy top-level xacro: the course parts plus ros2_control and gz-sim plugins."""
+    """A Jazzy top-level xacro: the course parts plus ros2_control and gz-sim plugins.
+
+    The arm alone is welded to a `world` link (gz-sim fixes a model to the world
+    through a link of that name); otherwise its torque-driven links would topple
+    the light arm base over in Gazebo.
+    """
     root = _robot(spec.name if whole else "standalone_arm")
     _sub(root, X + "arg", name=MOCK_ARG, default="false")
     default = f"$(find {bringup_pkg})/config/{controllers_file(spec.name)}"
@@ -164,6 +171,10 @@ def top_xacro(spec: RobotSpec, bringup_pkg: str, *, whole: bool, header: str) ->
         _sub(root, X + "include", filename=inc)
     if whole and spec.mount is not None:
         joint_element(root, spec.mount.joint, spec.mount_joint())
+    if not whole:
+        _sub(root, "link", name=WORLD)
+        anchor = Joint(type="fixed", parent=WORLD, child=spec.arm_root())
+        joint_element(root, WORLD_JOINT, anchor)
     _friction(root, spec, whole)
     ros2_control_block(root, spec, mc.passive_joints(spec) if whole else [])
     _gz_plugins(root, spec, whole)
