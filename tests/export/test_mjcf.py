@@ -385,3 +385,23 @@ def test_offscreen_render_shows_the_arm(tmp_path: Path) -> None:
     if r.returncode != 0:
         pytest.skip(f"no offscreen OpenGL here: {r.stderr.strip().splitlines()[-1:]}")
     assert int(r.stdout.strip()) > MIN_ARM_PIXELS
+
+
+def test_package_uri_meshes_resolve_through_package_dir(tmp_path: Path) -> None:
+    from armcli.urdf.meshes import MeshSearch
+
+    pkg = tmp_path / "elsewhere" / "my_meshes"
+    (pkg / "meshes").mkdir(parents=True)
+    _binary_stl(pkg / "meshes" / "tet.stl")
+    src = tmp_path / "robot"
+    src.mkdir()
+    text = URDF_WITH_EXTRAS.replace("parts/tet.stl", "package://my_meshes/meshes/tet.stl")
+    (src / "gripper.urdf").write_text(text)
+    out = tmp_path / "out" / "gripper.xml"
+    without = export_mjcf(src / "gripper.urdf", out)  # unknown package: left out, reported
+    assert "package://my_meshes/meshes/tet.stl" in without.report
+    found = export_mjcf(src / "gripper.urdf", out, search=MeshSearch({"my_meshes": pkg}))
+    assert (out.parent / "meshes" / "tet.stl").is_file()
+    skipped = next(n.what for n in found.export.notes if n.topic == "meshes")
+    assert "tet.stl" not in skipped and "shell.dae" in skipped
+    assert mujoco.MjModel.from_xml_path(str(out)).nmesh == 1

@@ -12,6 +12,7 @@ from armcli.build.expand import spec_label
 from armcli.defaults import DEFAULT_SPEC
 from armcli.export.mjcf import BASES
 from armcli.export.mjcf_files import export_mjcf
+from armcli.urdf.meshes import MeshSearch, parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP
 
 export_app = typer.Typer(
@@ -44,6 +45,9 @@ def mjcf_cmd(
         False, "--whole-robot", help="For a spec: the whole robot instead of the arm alone."
     ),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
+    package_dir: list[str] = typer.Option(
+        [], "--package-dir", help="NAME=PATH: where package://NAME/ meshes live (repeatable)."
+    ),
 ) -> None:
     """Write a MuJoCo MJCF model of ROBOT to OUT, with scene.xml (floor, light) beside it.
 
@@ -56,6 +60,7 @@ def mjcf_cmd(
         base=base,
         whole_robot=whole_robot,
         trust_xacro=trust_xacro,
+        search=MeshSearch(parse_package_dirs(package_dir)),
         label=spec_label(robot),
     )
     exp = res.export
