@@ -35,9 +35,9 @@ def _root(
 
 
 def _register() -> None:
-    from armcli.commands import build, check, ros, simulate, view
+    from armcli.commands import build, check, ros, simulate, tune, view
 
-    for module in (build, check, simulate, ros, view):
+    for module in (build, check, simulate, tune, ros, view):
         module.register(app)
 
 
