@@ -126,11 +126,14 @@ class DaskEngine:
             raise InputError(f"needs dask.distributed: {DASK_HINT}", field="--scheduler") from None
         self.address = address
         try:
+            _probe(address, timeout)
             self.client: Any = Client(address, timeout=f"{timeout}s", set_as_default=False)
-        except (OSError, TimeoutError, ValueError) as exc:
+        except ValueError as exc:
+            raise InputError(f"not a Dask address: {exc}", field="--scheduler") from None
+        except (OSError, TimeoutError) as exc:
             raise InputError(
                 f"cannot reach the Dask scheduler at {address} within {timeout:g} s "
-                f"({type(exc).__name__}: {exc}); start one with `dask scheduler` and "
+                f"({str(exc) or 'no answer'}); start one with `dask scheduler` and "
                 "`dask worker ADDRESS`",
                 field="--scheduler",
             ) from None
@@ -151,6 +154,20 @@ class DaskEngine:
 
     def close(self) -> None:
         self.client.close()
+
+
+def _probe(address: str, timeout: float) -> None:
+    """Connect and handshake with a hard deadline: `Client` alone can wait forever on a
+    port that accepts TCP but never speaks the Dask protocol."""
+    import asyncio
+
+    from distributed.comm import connect
+
+    async def once() -> None:
+        comm = await asyncio.wait_for(connect(address, timeout=timeout), timeout)
+        await comm.close()
+
+    asyncio.run(once())
 
 
 def make_engine(jobs: int, scheduler: str | None) -> Engine:
