@@ -13,6 +13,7 @@ from __future__ import annotations
 import io
 import os
 import re
+import stat
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -26,10 +27,13 @@ _SCALAR = re.compile(r"[^\s,}\]#]+")
 
 
 def check_writable(path: Path) -> None:
-    """InputError unless `path` is an existing file we may overwrite."""
+    """InputError unless `path` is an existing file we may overwrite. A file without any
+    write permission bit counts as read-only even for root, who could write it anyway:
+    `chmod a-w` says the user does not want it changed."""
     if not path.is_file():
         raise InputError("spec file not found", file=path, field="--write")
-    if not os.access(path, os.W_OK) or not os.access(path.parent, os.W_OK):
+    no_write_bit = not path.stat().st_mode & (stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH)
+    if no_write_bit or not os.access(path, os.W_OK) or not os.access(path.parent, os.W_OK):
         raise InputError("spec file is read-only; nothing written", file=path, field="--write")
 
 
