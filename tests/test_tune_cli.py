@@ -115,8 +115,9 @@ def test_read_only_spec_with_write(spec_copy: Path, capsys: pytest.CaptureFixtur
     assert spec_copy.read_bytes() == before
 
 
-def test_named_poses_as_steps_without_trajectories(tmp_path: Path,
-                                                   capsys: pytest.CaptureFixture[str]) -> None:  # fmt: skip
+def test_named_poses_as_steps_without_trajectories(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     path = tmp_path / "robot.yaml"  # no trajectories/ next to it
     shutil.copy(SPEC, path)
     out_json = tmp_path / "t.json"

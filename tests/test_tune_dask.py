@@ -17,11 +17,11 @@ import pytest
 
 pytest.importorskip("distributed")
 
-from armcli.spec import load_spec  # noqa: E402
-from armcli.tune import job as tjob  # noqa: E402
-from armcli.tune import session  # noqa: E402
-from armcli.tune.engine import DaskEngine, LocalEngine  # noqa: E402
-from armcli.tune.search import SearchOptions  # noqa: E402
+from armcli.spec import load_spec
+from armcli.tune import job as tjob
+from armcli.tune import session
+from armcli.tune.engine import DaskEngine, LocalEngine
+from armcli.tune.search import SearchOptions
 
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "specs" / "my_robot.yaml"
@@ -71,13 +71,31 @@ def scheduler_address(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]
     cwd = tmp_path_factory.mktemp("dask")
     env = {**os.environ, "DASK_DISTRIBUTED__WORKER__DAEMON": "False"}
     common = {"cwd": cwd, "env": env, "stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
-    procs = [subprocess.Popen([exe, "scheduler", "--host", "127.0.0.1", "--port", str(port),
-                               "--no-dashboard"], **common)]  # type: ignore[call-overload]
+    procs = [
+        subprocess.Popen(
+            [exe, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
+            **common,
+        )
+    ]  # type: ignore[call-overload]
     try:
         for _ in range(2):
-            procs.append(subprocess.Popen([exe, "worker", address, "--host", "127.0.0.1",
-                                           "--nthreads", "1", "--nworkers", "1",
-                                           "--no-dashboard"], **common))  # type: ignore[call-overload]
+            procs.append(
+                subprocess.Popen(
+                    [
+                        exe,
+                        "worker",
+                        address,
+                        "--host",
+                        "127.0.0.1",
+                        "--nthreads",
+                        "1",
+                        "--nworkers",
+                        "1",
+                        "--no-dashboard",
+                    ],
+                    **common,
+                )
+            )  # type: ignore[call-overload]
         from distributed import Client
 
         with Client(address, timeout=f"{START_TIMEOUT_S}s") as client:

@@ -70,8 +70,9 @@ def test_same_result_with_two_threads(job: tjob.TuneJob, outcome: session.Outcom
     assert [r.cost for r in again.result.history] == [r.cost for r in outcome.result.history]
 
 
-def test_robust_worst_case_no_worse_than_nominal_tuning(job: tjob.TuneJob,
-                                                        outcome: session.Outcome) -> None:
+def test_robust_worst_case_no_worse_than_nominal_tuning(
+    job: tjob.TuneJob, outcome: session.Outcome
+) -> None:
     settings = tjob.TuneSettings(settle=SETTLE, robust=3, mass_scale=(0.7, 1.3),
                                  friction_scale=(0.5, 2.0), seed=1)  # fmt: skip
     robust_job = tjob.prepare(load_spec(SPEC), SPEC, [], settings)

@@ -33,13 +33,22 @@ def test_only_the_values_change(tmp_path: Path) -> None:
 
 
 def test_block_style_entries_and_a_new_joint(tmp_path: Path) -> None:
-    text = SPEC.read_text(encoding="utf-8").replace(
-        "    arm_base_forearm_joint: {kp: 50, kd: 5}\n",
-        "    arm_base_forearm_joint:\n      kp: 50   # hand-tuned\n      kd: 5\n",
-    ).replace("    forearm_hand_joint: {kp: 50, kd: 5}\n", "")
-    new = updated_text(text, tmp_path / "x.yaml",
-                       {"arm_base_forearm_joint": (70, 7), "forearm_hand_joint": (30, 3)})
-    assert "      kp: 70   # hand-tuned\n      kd: 7\n    forearm_hand_joint: {kp: 30, kd: 3}\n" in new
+    text = (
+        SPEC.read_text(encoding="utf-8")
+        .replace(
+            "    arm_base_forearm_joint: {kp: 50, kd: 5}\n",
+            "    arm_base_forearm_joint:\n      kp: 50   # hand-tuned\n      kd: 5\n",
+        )
+        .replace("    forearm_hand_joint: {kp: 50, kd: 5}\n", "")
+    )
+    new = updated_text(
+        text,
+        tmp_path / "x.yaml",
+        {"arm_base_forearm_joint": (70, 7), "forearm_hand_joint": (30, 3)},
+    )
+    assert (
+        "      kp: 70   # hand-tuned\n      kd: 7\n    forearm_hand_joint: {kp: 30, kd: 3}\n" in new
+    )
 
 
 def test_no_exponent_form() -> None:

@@ -24,16 +24,19 @@ def _pair(text: str, option: str) -> tuple[float, float]:
 def tune_cmd(
     spec: Path = typer.Argument(None, help=f"Robot spec YAML (default: {DEFAULT_SPEC})."),
     trajectory: list[Path] = typer.Option(
-        None, "--trajectory", "-t",
+        None,
+        "--trajectory",
+        "-t",
         help="JointTrajectory YAML (repeatable; default: trajectories/*.yaml next to the spec, "
         "else the named poses as steps).",
-    ),  # fmt: skip
+    ),
     joints: str = typer.Option(None, "--joints", help="Comma-separated joints; others locked."),
     loop: str = typer.Option(
-        "implicit", "--loop",
+        "implicit",
+        "--loop",
         help="Stability bound: implicit (armcli's simulator) or explicit (a torque loop "
         "stepped explicitly, e.g. Gazebo's effort controller).",
-    ),  # fmt: skip
+    ),
     zeta: float = typer.Option(1.0, "--zeta", help="Damping ratio of the start gains."),
     wn: float = typer.Option(
         None, "--wn", help="Target natural frequency [rad/s] (default: 2π·update rate / 10)."
@@ -50,7 +53,9 @@ def tune_cmd(
     quantile: float = typer.Option(0.9, "--quantile", help="Quantile for --robust-mode quantile."),
     jobs: int = typer.Option(1, "--jobs", "-j", help="Local threads scoring candidates."),
     scheduler: str = typer.Option(
-        None, "--scheduler", help="Dask scheduler address, e.g. tcp://HOST:8786 (needs armcli[dask])."
+        None,
+        "--scheduler",
+        help="Dask scheduler address, e.g. tcp://HOST:8786 (needs armcli[dask]).",
     ),
     output: Path = typer.Option(None, "--output", "-o", help="Write the results as JSON."),
     plot: Path = typer.Option(None, "--plot", help="Write history + before/after tracking PNG."),
@@ -73,9 +78,15 @@ def tune_cmd(
         check_writable(spec_path)
     settings = tjob.TuneSettings(
         tuple(j.strip() for j in joints.split(",") if j.strip()) if joints else None,
-        loop, zeta, wn, settle, robust, _pair(mass_scale, "--mass-scale"),
-        _pair(friction_scale, "--friction-scale"), seed,
-    )  # fmt: skip
+        loop,
+        zeta,
+        wn,
+        settle,
+        robust,
+        _pair(mass_scale, "--mass-scale"),
+        _pair(friction_scale, "--friction-scale"),
+        seed,
+    )
     job = tjob.prepare(load_spec(spec_path), spec_path, trajectory or [], settings)
     engine = make_engine(jobs, scheduler)
     try:
@@ -84,8 +95,15 @@ def tune_cmd(
         engine.close()
 
 
-def _run(job: Any, engine: Any, opts: Any, output: Path | None, plot: Path | None,
-         write: bool, spec_path: Path) -> None:  # fmt: skip
+def _run(
+    job: Any,
+    engine: Any,
+    opts: Any,
+    output: Path | None,
+    plot: Path | None,
+    write: bool,
+    spec_path: Path,
+) -> None:
     from rich.console import Console
     from rich.progress import Progress
 
@@ -102,9 +120,12 @@ def _run(job: Any, engine: Any, opts: Any, output: Path | None, plot: Path | Non
     if output is not None:
         from armcli.fsio import write_file_atomic
 
-        write_file_atomic(output, report.to_json(job.problem, job.start, outcome.rows,
-                                                 outcome.result, opts, engine.name,
-                                                 arm_damping))  # fmt: skip
+        write_file_atomic(
+            output,
+            report.to_json(
+                job.problem, job.start, outcome.rows, outcome.result, opts, engine.name, arm_damping
+            ),
+        )
     if plot is not None:
         from armcli.tune.plot import write_tune_plot
 
@@ -116,8 +137,10 @@ def _run(job: Any, engine: Any, opts: Any, output: Path | None, plot: Path | Non
 
         n = len(job.problem.joints)
         best = outcome.result.best
-        write_gains(spec_path, {j: (float(best[i]), float(best[n + i]))
-                                for i, j in enumerate(job.problem.joints)})  # fmt: skip
+        write_gains(
+            spec_path,
+            {j: (float(best[i]), float(best[n + i])) for i, j in enumerate(job.problem.joints)},
+        )
     for path in (output, plot, spec_path if write else None):
         if path is not None:
             out.print(f"wrote {path}", markup=False, highlight=False)

@@ -180,4 +180,3 @@ def make_engine(jobs: int, scheduler: str | None) -> Engine:
 def keyed(problem: TuneProblem) -> TuneProblem:
     """`problem` with its content key set (required before shipping it to workers)."""
     return problem if problem.key else problem.with_key()
-

@@ -126,7 +126,11 @@ def prepare(spec: Any, spec_path: Path, trajectories: Sequence[Path], s: TuneSet
             "the spec or named poses other than the start",
             field="--trajectory",
         )
-    wn = s.wn if s.wn is not None else 2 * math.pi * spec.control.controller_update_rate / TARGET_RATIO
+    wn = (
+        s.wn
+        if s.wn is not None
+        else 2 * math.pi * spec.control.controller_update_rate / TARGET_RATIO
+    )
     start = start_gains(arm, dt=spec.control.dt, loop=s.loop, zeta=s.zeta, wn_target=wn,
                         steps=largest_steps(cases, len(joints)))  # fmt: skip
     from armcli.tune.model_gains import STABILITY_MARGIN

@@ -162,11 +162,11 @@ def start_gains(
         caps = {"target": wn_target, "stability": wn_s, "effort": wn_e}
         binding = min(caps, key=lambda k: caps[k])
         wn = caps[binding]
-        kp, kd = m_max * wn * wn, 2.0 * zeta * wn * m_max
+        kp_j, kd_j = m_max * wn * wn, 2.0 * zeta * wn * m_max
         rows.append(
             JointReasoning(
                 name, float(diag[:, j].min()), m_max, float(g[j]), float(steps[j]),
-                wn_target, wn_s, wn_e, wn, zeta, kp, kd, binding,
+                wn_target, wn_s, wn_e, wn, zeta, kp_j, kd_j, binding,
             )
         )  # fmt: skip
     kp = np.array([r.kp for r in rows])
@@ -223,4 +223,6 @@ def _coupled_scale(
 def _scaled(r: JointReasoning, s: float) -> JointReasoning:
     from dataclasses import replace
 
-    return replace(r, kp=r.kp * s, kd=r.kd * math.sqrt(s), wn=r.wn * math.sqrt(s), binding="stability")
+    return replace(
+        r, kp=r.kp * s, kd=r.kd * math.sqrt(s), wn=r.wn * math.sqrt(s), binding="stability"
+    )

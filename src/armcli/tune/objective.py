@@ -44,7 +44,7 @@ class Weights:
 def overshoot(res: SimResult, t_end: float) -> np.ndarray:
     """Per joint: how far q went past the final reference, as a fraction of the gap left
     at the last point [-]. Zero when the joint was already within SETTLE_TOL there."""
-    k = min(int(round(t_end / res.dt)), res.q.shape[0] - 1)
+    k = min(round(t_end / res.dt), res.q.shape[0] - 1)
     q_f = res.q_ref[-1]
     gap = q_f - res.q[k]
     past = np.sign(gap) * (res.q[k:] - q_f)  # > 0 beyond the target, in the approach direction
@@ -60,9 +60,7 @@ def run_metrics(res: SimResult, t_end: float) -> np.ndarray:
     rows = []
     for m, os in zip(joint_metrics(res, t_end), overshoot(res, t_end), strict=True):
         settle = m.settle_time if m.settle_time is not None else window
-        rows.append(
-            [m.rms_error, m.max_error, m.final_error, settle, m.saturated_pct / 100.0, os]
-        )
+        rows.append([m.rms_error, m.max_error, m.final_error, settle, m.saturated_pct / 100.0, os])
     return np.array(rows, dtype=float)
 
 

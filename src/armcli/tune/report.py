@@ -60,27 +60,55 @@ def reasoning_table(start: StartGains) -> Any:
     from rich.table import Table
 
     t = Table(title=f"model-based start ({start.loop} loop, dt = {start.dt:g} s)")
-    for col in ("joint", "M_ii [kg·m²]", "|g| max", "step", "wn target/stab/effort",
-                "wn", "zeta", "kp", "kd", "binding"):  # fmt: skip
+    for col in (
+        "joint",
+        "M_ii [kg·m²]",
+        "|g| max",
+        "step",
+        "wn target/stab/effort",
+        "wn",
+        "zeta",
+        "kp",
+        "kd",
+        "binding",
+    ):
         t.add_column(col, justify="left" if col in ("joint", "binding") else "right")
     for r in start.rows:
         t.add_row(
-            r.name, f"{r.m_min:.4g}..{r.m_max:.4g}", f"{r.gravity_max:.3g}", f"{r.step:.3g}",
-            f"{r.wn_target:.3g} / {r.wn_stability:.3g} / {r.wn_effort:.3g}", f"{r.wn:.4g}",
-            f"{r.zeta:g}", f"{r.kp:.4g}", f"{r.kd:.4g}", r.binding,
-        )  # fmt: skip
+            r.name,
+            f"{r.m_min:.4g}..{r.m_max:.4g}",
+            f"{r.gravity_max:.3g}",
+            f"{r.step:.3g}",
+            f"{r.wn_target:.3g} / {r.wn_stability:.3g} / {r.wn_effort:.3g}",
+            f"{r.wn:.4g}",
+            f"{r.zeta:g}",
+            f"{r.kp:.4g}",
+            f"{r.kd:.4g}",
+            r.binding,
+        )
     return t
 
 
-def comparison_table(problem: TuneProblem, start: StartGains, rows: Sequence[Row],
-                     damping: np.ndarray) -> Any:  # fmt: skip
+def comparison_table(
+    problem: TuneProblem, start: StartGains, rows: Sequence[Row], damping: np.ndarray
+) -> Any:
     """A rich Table: per joint and gain set, gains, errors, settle, saturation, margin."""
     from rich.table import Table
 
     n = len(problem.joints)
     t = Table(title="before / after (nominal model, all trajectories)")
-    for col in ("joint", "gains", "kp", "kd", "RMS [rad]", "max", "|final|", "settle [s]",
-                "saturated", "margin"):  # fmt: skip
+    for col in (
+        "joint",
+        "gains",
+        "kp",
+        "kd",
+        "RMS [rad]",
+        "max",
+        "|final|",
+        "settle [s]",
+        "saturated",
+        "margin",
+    ):
         t.add_column(col, justify="left" if col in ("joint", "gains") else "right")
     for j, name in enumerate(problem.joints):
         for row in rows:
@@ -88,8 +116,15 @@ def comparison_table(problem: TuneProblem, start: StartGains, rows: Sequence[Row
             kp, kd = float(row.gains[j]), float(row.gains[n + j])
             cells = [_f(s[k]) for k in ("rms", "max", "final", "settle")]
             sat = "-" if s["saturated_pct"] is None else f"{s['saturated_pct']:.1f} %"
-            t.add_row(name, row.label, f"{kp:.4g}", f"{kd:.4g}", *cells, sat,
-                      f"{margin(start, kp, kd, float(damping[j])):.3g}x")  # fmt: skip
+            t.add_row(
+                name,
+                row.label,
+                f"{kp:.4g}",
+                f"{kd:.4g}",
+                *cells,
+                sat,
+                f"{margin(start, kp, kd, float(damping[j])):.3g}x",
+            )
         if j < n - 1:
             t.add_section()
     return t
@@ -99,18 +134,30 @@ def _f(x: float | None) -> str:
     return "-" if x is None else f"{x:.4g}"
 
 
-def to_json(problem: TuneProblem, start: StartGains, rows: Sequence[Row], result: SearchResult,
-            opts: SearchOptions, engine: str, damping: np.ndarray) -> str:  # fmt: skip
+def to_json(
+    problem: TuneProblem,
+    start: StartGains,
+    rows: Sequence[Row],
+    result: SearchResult,
+    opts: SearchOptions,
+    engine: str,
+    damping: np.ndarray,
+) -> str:
     """The output document (stable key order, floats as JSON numbers, no timestamps)."""
     n = len(problem.joints)
     doc = {
         "schema_version": SCHEMA_VERSION,
         "problem": describe(problem),
         "search": {
-            "trials": opts.trials, "batch": opts.batch, "seed": opts.seed, "span": opts.span,
-            "robust": opts.robust, "quantile": opts.quantile, "engine": engine,
+            "trials": opts.trials,
+            "batch": opts.batch,
+            "seed": opts.seed,
+            "span": opts.span,
+            "robust": opts.robust,
+            "quantile": opts.quantile,
+            "engine": engine,
             "weights": vars(opts.weights),
-        },  # fmt: skip
+        },
         "start": [vars(r) for r in start.rows],
         "results": {
             row.label: {
@@ -118,22 +165,36 @@ def to_json(problem: TuneProblem, start: StartGains, rows: Sequence[Row], result
                 "feasible": row.nominal.feasible,
                 "joints": {
                     name: {
-                        "kp": float(row.gains[j]), "kd": float(row.gains[n + j]),
-                        "stability_margin": _num(margin(start, float(row.gains[j]),
-                                                        float(row.gains[n + j]),
-                                                        float(damping[j]))),
+                        "kp": float(row.gains[j]),
+                        "kd": float(row.gains[n + j]),
+                        "stability_margin": _num(
+                            margin(
+                                start,
+                                float(row.gains[j]),
+                                float(row.gains[n + j]),
+                                float(damping[j]),
+                            )
+                        ),
                         **{k: _num(v) for k, v in joint_summary(row.nominal, j).items()},
-                    }  # fmt: skip
+                    }
                     for j, name in enumerate(problem.joints)
                 },
             }
             for row in rows
         },
-        "best": {"cost": _num(result.best_cost), "kp": result.best[:n].tolist(),
-                 "kd": result.best[n:].tolist()},  # fmt: skip
+        "best": {
+            "cost": _num(result.best_cost),
+            "kp": result.best[:n].tolist(),
+            "kd": result.best[n:].tolist(),
+        },
         "history": [
-            {"trial": r.number, "cost": _num(r.cost), "feasible": r.feasible,
-             "reason": r.reason, "gains": r.gains.tolist()}  # fmt: skip
+            {
+                "trial": r.number,
+                "cost": _num(r.cost),
+                "feasible": r.feasible,
+                "reason": r.reason,
+                "gains": r.gains.tolist(),
+            }
             for r in result.history
         ],
     }

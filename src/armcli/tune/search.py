@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -35,7 +35,7 @@ class SearchOptions:
     span: float = 4.0
     robust: str = "worst"
     quantile: float = 0.9
-    weights: Weights = Weights()
+    weights: Weights = field(default_factory=Weights)
 
 
 @dataclass(frozen=True, eq=False)
@@ -98,7 +98,7 @@ def search(
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     names = _param_names(problem.joints)
     lo, hi = start / opts.span, start * opts.span
-    dists = {
+    dists: dict[str, optuna.distributions.BaseDistribution] = {
         nm: optuna.distributions.FloatDistribution(float(a), float(b), log=True)
         for nm, a, b in zip(names, lo, hi, strict=True)
     }

@@ -13,9 +13,9 @@ import numpy as np
 from armcli.sim import SimConfig, SimResult, simulate
 from armcli.tune.engine import Engine
 from armcli.tune.job import TuneJob
+from armcli.tune.problem import nominal_arm
 from armcli.tune.report import Row
 from armcli.tune.search import SearchOptions, SearchResult, cost_of, nominal, search
-from armcli.tune.problem import nominal_arm
 
 
 @dataclass(frozen=True, eq=False)
@@ -79,4 +79,3 @@ def tracking_runs(job: TuneJob, outcome: Outcome, case: int) -> list[tuple[str, 
         cfg = SimConfig(row.gains[:n], row.gains[n:], p.dt, p.integrator, p.gravity_comp)
         out.append((row.label, simulate(arm, c.reference, c.q0, c.duration, cfg)))
     return out
-
