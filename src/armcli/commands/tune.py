@@ -9,10 +9,19 @@ from typing import Any
 import typer
 
 from armcli.defaults import DEFAULT_SPEC
+from armcli.errors import InputError
+from armcli.io.files import write_file_atomic
+from armcli.spec.load import load_spec
+from armcli.tune import job as tjob
+from armcli.tune import report, session
+from armcli.tune.engine import make_engine
+from armcli.tune.plot import write_tune_plot
+from armcli.tune.problem import nominal_arm
+from armcli.tune.search import SearchOptions, validate
+from armcli.tune.write import check_writable, write_gains
 
 
 def _pair(text: str, option: str) -> tuple[float, float]:
-    from armcli.errors import InputError
 
     try:
         a, b = (float(x) for x in text.split(","))
@@ -62,13 +71,6 @@ def tune_cmd(
     write: bool = typer.Option(False, "--write", help="Update control.gains in the spec in place."),
 ) -> None:
     """Tune PD gains: model-based start, then a seeded search over simulated rollouts."""
-    from armcli.errors import InputError
-    from armcli.spec import load_spec
-    from armcli.tune import job as tjob
-    from armcli.tune.engine import make_engine
-    from armcli.tune.search import SearchOptions, validate
-    from armcli.tune.write import check_writable
-
     spec_path = spec or DEFAULT_SPEC
     opts = SearchOptions(trials, batch, seed, span, robust_mode, quantile)
     validate(opts)
@@ -107,19 +109,15 @@ def _run(
     from rich.console import Console
     from rich.progress import Progress
 
-    from armcli.tune import report, session
-
     out = Console(file=sys.stdout) if sys.stdout.isatty() else Console(file=sys.stdout, width=130)
     out.print(report.reasoning_table(job.start))
-    arm_damping = session.nominal_arm(job.problem).damping
+    arm_damping = nominal_arm(job.problem).damping
     with Progress(console=Console(stderr=True), transient=True) as bar:
         task = bar.add_task(f"tuning on {engine.name}", total=opts.trials)
         outcome = session.run(job, engine, opts, lambda d, t: bar.update(task, completed=d))
     out.print(report.comparison_table(job.problem, job.start, outcome.rows, arm_damping))
     _summary(out, outcome)
     if output is not None:
-        from armcli.fsio import write_file_atomic
-
         write_file_atomic(
             output,
             report.to_json(
@@ -127,14 +125,10 @@ def _run(
             ),
         )
     if plot is not None:
-        from armcli.tune.plot import write_tune_plot
-
         case = session.showcase_case(job, outcome)
         runs = session.tracking_runs(job, outcome, case)
         write_tune_plot(plot, outcome.result.history, runs, job.problem.cases[case].label)
     if write:
-        from armcli.tune.write import write_gains
-
         n = len(job.problem.joints)
         best = outcome.result.best
         write_gains(
@@ -147,7 +141,6 @@ def _run(
 
 
 def _summary(out: Any, outcome: Any) -> None:
-    from armcli.tune import session
 
     tuned = outcome.row("tuned")
     parts = []
@@ -163,4 +156,5 @@ def _summary(out: Any, outcome: Any) -> None:
 
 
 def register(app: typer.Typer) -> None:
+    """Add `tune` to the app."""
     app.command("tune")(tune_cmd)

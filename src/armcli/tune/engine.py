@@ -25,7 +25,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from armcli.errors import InputError, SimulationError
-from armcli.sim import Arm, SimConfig, SimResult, simulate
+from armcli.sim.simulate import Arm, SimConfig, SimResult, simulate
 from armcli.tune.model_gains import loop_stable
 from armcli.tune.objective import METRIC_FIELDS, Weights, run_cost, run_metrics
 from armcli.tune.problem import Case, TuneProblem, scored_models
@@ -89,9 +89,13 @@ class Engine(Protocol):
 
     def evaluate(
         self, problem: TuneProblem, batch: Sequence[np.ndarray], weights: Weights
-    ) -> list[CandidateEval]: ...
+    ) -> list[CandidateEval]:
+        """Score every candidate of `batch` on `problem`, in order."""
+        ...
 
-    def close(self) -> None: ...
+    def close(self) -> None:
+        """Release threads or the cluster connection."""
+        ...
 
 
 class LocalEngine:
@@ -107,11 +111,13 @@ class LocalEngine:
     def evaluate(
         self, problem: TuneProblem, batch: Sequence[np.ndarray], weights: Weights
     ) -> list[CandidateEval]:
+        """Score `batch` on the threads, results in batch order."""
         if self._pool is None:
             return [evaluate_candidate(problem, g, weights) for g in batch]
         return list(self._pool.map(lambda g: evaluate_candidate(problem, g, weights), batch))
 
     def close(self) -> None:
+        """Stop the threads."""
         if self._pool is not None:
             self._pool.shutdown()
 
@@ -127,7 +133,9 @@ class DaskEngine:
         self.address = address
         try:
             _probe(address, timeout)
-            self.client: Any = Client(address, timeout=f"{timeout}s", set_as_default=False)
+            self.client: Any = Client(  # type: ignore[no-untyped-call]
+                address, timeout=f"{timeout}s", set_as_default=False
+            )
         except ValueError as exc:
             raise InputError(f"not a Dask address: {exc}", field="--scheduler") from None
         except (OSError, TimeoutError) as exc:
@@ -144,6 +152,7 @@ class DaskEngine:
     def evaluate(
         self, problem: TuneProblem, batch: Sequence[np.ndarray], weights: Weights
     ) -> list[CandidateEval]:
+        """Score `batch` as one task per candidate, results in batch order."""
         if problem.key not in self._shipped:
             self._shipped[problem.key] = self.client.scatter(problem, broadcast=True, hash=False)
         shipped = self._shipped[problem.key]
@@ -153,18 +162,21 @@ class DaskEngine:
         return list(self.client.gather(futures))
 
     def close(self) -> None:
+        """Disconnect from the scheduler (the cluster keeps running)."""
         self.client.close()
 
 
 def _probe(address: str, timeout: float) -> None:
-    """Connect and handshake with a hard deadline: `Client` alone can wait forever on a
-    port that accepts TCP but never speaks the Dask protocol."""
+    """Connect and handshake with a hard deadline.
+
+    `Client` alone can wait forever on a port that accepts TCP but never speaks Dask.
+    """
     import asyncio
 
-    from distributed.comm import connect
+    from distributed.comm.core import connect
 
     async def once() -> None:
-        comm = await asyncio.wait_for(connect(address, timeout=timeout), timeout)
+        comm = await asyncio.wait_for(connect(address, timeout=timeout), timeout)  # type: ignore[no-untyped-call]
         await comm.close()
 
     asyncio.run(once())

@@ -15,11 +15,18 @@ from typing import Any
 
 import numpy as np
 
+from armcli.build.expand import expand_urdfs
 from armcli.errors import InputError
-from armcli.interpolation import Reference, build_reference
-from armcli.simjob import ARM_URDF, SETTLE_EXTRA_S, start_state
-from armcli.trajectory import Trajectory, load_trajectory
-from armcli.tune.model_gains import LOOPS, StartGains, start_gains
+from armcli.sim.job import ARM_URDF, SETTLE_EXTRA_S, start_state
+from armcli.sim.reference import Reference, build_reference
+from armcli.sim.trajectory import Trajectory, load_trajectory
+from armcli.tune.model_gains import (
+    LOOPS,
+    STABILITY_MARGIN,
+    TARGET_RATIO,
+    StartGains,
+    start_gains,
+)
 from armcli.tune.problem import Case, TuneProblem, draw_variants, nominal_arm
 
 DEFAULT_ZETA = 1.0  # critically damped
@@ -57,8 +64,6 @@ def default_trajectories(spec_path: Path) -> list[Path]:
 
 
 def _validate(s: TuneSettings) -> None:
-    from armcli.tune.model_gains import TARGET_RATIO  # noqa: F401  (documented default)
-
     if s.loop not in LOOPS:
         raise InputError(f"unknown loop {s.loop!r}; valid: {', '.join(LOOPS)}", field="--loop")
     if not (math.isfinite(s.zeta) and s.zeta > 0):
@@ -104,9 +109,6 @@ def largest_steps(cases: Sequence[Case], n: int) -> np.ndarray:
 
 def prepare(spec: Any, spec_path: Path, trajectories: Sequence[Path], s: TuneSettings) -> TuneJob:
     """Validate every input and build the job; raises InputError/SpecError on bad input."""
-    from armcli.build import expand_urdfs
-    from armcli.tune.model_gains import TARGET_RATIO
-
     _validate(s)
     xml = expand_urdfs(spec)[ARM_URDF].decode("utf-8")
     base = TuneProblem(xml, ARM_URDF, tuple(s.joints or ()), spec.control.dt, "euler",
@@ -133,8 +135,6 @@ def prepare(spec: Any, spec_path: Path, trajectories: Sequence[Path], s: TuneSet
     )
     start = start_gains(arm, dt=spec.control.dt, loop=s.loop, zeta=s.zeta, wn_target=wn,
                         steps=largest_steps(cases, len(joints)))  # fmt: skip
-    from armcli.tune.model_gains import STABILITY_MARGIN
-
     variants = draw_variants(arm, s.robust, s.mass_scale, s.friction_scale, s.seed)
     problem = TuneProblem(xml, ARM_URDF, joints, spec.control.dt, "euler", base.gravity_comp,
                           s.loop, STABILITY_MARGIN, tuple(cases), variants).with_key()  # fmt: skip

@@ -27,9 +27,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from armcli import stability as stab
 from armcli.errors import InputError
-from armcli.sim import Arm
+from armcli.sim import stability as stab
+from armcli.sim.simulate import Arm
 
 TARGET_RATIO = 10.0  # wn <= 2 pi f_c / TARGET_RATIO for a loop closed at f_c [Hz]
 STABILITY_MARGIN = 2.0  # gains must be stable at this multiple of dt
@@ -97,7 +97,7 @@ def mass_matrices(arm: Arm, qs: np.ndarray) -> list[np.ndarray]:
 
 
 def gravity_max(arm: Arm, qs: np.ndarray) -> np.ndarray:
-    """max |g(q)| per joint over the sample [N·m or N]."""
+    """Max |g(q)| per joint over the sample [N·m or N]."""
     import pinocchio as pin
 
     data = arm.model.createData()
@@ -115,7 +115,7 @@ def lambda_max(Ms: Sequence[np.ndarray]) -> float:
 def dt_max(loop: str, kp: float, d: float, lam: float) -> float:
     """Largest stable dt for one mode, from `armcli.stability` [s]."""
     bound = stab.implicit_dt_max if loop == "implicit" else stab.explicit_dt_max
-    return bound(kp, d, lam)
+    return float(bound(kp, d, lam))
 
 
 def _largest(ok: Callable[[float], bool], lo: float, hi: float) -> float:
@@ -147,8 +147,10 @@ def start_gains(
     wn_target: float,
     steps: np.ndarray,
 ) -> StartGains:
-    """Model-based kp, kd per joint (see the module docstring); InputError when the effort
-    limit cannot even hold the arm against gravity."""
+    """Model-based kp, kd per joint (see the module docstring).
+
+    Raises InputError when the effort limit cannot even hold the arm against gravity.
+    """
     qs = sample_configurations(arm)
     Ms = mass_matrices(arm, qs)
     lam = lambda_max(Ms)
@@ -203,15 +205,17 @@ def loop_stable(
         arm.damping.tolist(), dt,
     )  # fmt: skip
     verdict = rep.implicit if loop == "implicit" else rep.explicit
-    return verdict.stable
+    return bool(verdict.stable)
 
 
 def _coupled_scale(
     arm: Arm, Ms: Sequence[np.ndarray], qs: np.ndarray, kp: np.ndarray, kd: np.ndarray,
     loop: str, dt: float,
 ) -> float:  # fmt: skip
-    """1, or the largest kp scale s (kd scaled by sqrt(s): same zeta) the coupled loop is
-    stable with at margin * dt."""
+    """Common kp scale keeping the coupled loop stable at margin * dt (1 when it is).
+
+    kd is scaled by sqrt(s), which keeps zeta.
+    """
     h = STABILITY_MARGIN * dt
     if loop_stable(arm, Ms, qs, kp, kd, loop, h):
         return 1.0

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from armcli.sim import SimResult
-from armcli.simreport import SETTLE_TOL, joint_metrics
+from armcli.sim.report import SETTLE_TOL, joint_metrics
+from armcli.sim.simulate import SimResult
 
 W_SATURATION = 0.1  # [rad] cost of saturating during the whole run
 W_OVERSHOOT = 0.1  # [rad] per unit of overshoot fraction beyond the bound
@@ -42,8 +42,10 @@ class Weights:
 
 
 def overshoot(res: SimResult, t_end: float) -> np.ndarray:
-    """Per joint: how far q went past the final reference, as a fraction of the gap left
-    at the last point [-]. Zero when the joint was already within SETTLE_TOL there."""
+    """Per joint: how far q went past the final reference [fraction of the step].
+
+    The step is the gap left at the last point; zero when it is within SETTLE_TOL.
+    """
     k = min(round(t_end / res.dt), res.q.shape[0] - 1)
     q_f = res.q_ref[-1]
     gap = q_f - res.q[k]
@@ -54,8 +56,10 @@ def overshoot(res: SimResult, t_end: float) -> np.ndarray:
 
 
 def run_metrics(res: SimResult, t_end: float) -> np.ndarray:
-    """(n_joints, len(METRIC_FIELDS)) metrics of one run; settle is the whole window when
-    the joint never settles."""
+    """The (n_joints, len(METRIC_FIELDS)) metrics of one run.
+
+    Settle is the whole window after the last point when the joint never settles.
+    """
     window = float(res.t[-1]) - t_end
     rows = []
     for m, os in zip(joint_metrics(res, t_end), overshoot(res, t_end), strict=True):
@@ -75,8 +79,10 @@ def run_cost(metrics: np.ndarray, w: Weights) -> float:
 
 
 def aggregate(costs: np.ndarray, feasible: bool, robust: str, quantile: float) -> float:
-    """Candidate cost from per-(model, trajectory) costs: mean over trajectories, then the
-    worst model (`robust="worst"`) or the given quantile over models."""
+    """Candidate cost from its per-(model, trajectory) costs.
+
+    Mean over trajectories, then the worst model (`robust="worst"`) or the quantile.
+    """
     if not feasible or not np.all(np.isfinite(costs)):
         return INFEASIBLE_COST
     per_model = np.mean(costs, axis=1)

@@ -11,16 +11,18 @@ from pathlib import Path
 
 import numpy as np
 
-from armcli.fsio import write_file_atomic
-from armcli.sim import SimResult
+from armcli.io.files import write_file_atomic
+from armcli.sim.simulate import SimResult
 from armcli.tune.objective import INFEASIBLE_COST
 from armcli.tune.search import TrialRecord
 
 
 def tune_png(history: Sequence[TrialRecord], runs: Sequence[tuple[str, SimResult]],
              case_label: str) -> bytes:  # fmt: skip
-    """PNG bytes: history on top (cost per trial, best so far), below one tracking-error
-    panel per joint with every gain set (errors, not positions: the curves would overlap)."""
+    """PNG bytes: the history on top, one tracking-error panel per joint below.
+
+    Errors rather than positions: at this scale the position curves would overlap.
+    """
     import matplotlib
 
     matplotlib.use("Agg")

@@ -15,9 +15,10 @@ from typing import Any
 
 import numpy as np
 
-from armcli.interpolation import Reference
-from armcli.sim import Arm, arm_from_model
+from armcli.sim.reference import Reference
+from armcli.sim.simulate import Arm, arm_from_model
 from armcli.tune.model_gains import mass_matrices, sample_configurations
+from armcli.urdf.pinocchio import load_model
 
 _CACHE: dict[str, tuple[Scored, ...]] = {}
 _LOCK = threading.Lock()
@@ -75,8 +76,6 @@ class TuneProblem:
 
 def nominal_arm(problem: TuneProblem) -> Arm:
     """The unperturbed arm of `problem`."""
-    from armcli.model import load_model
-
     model = load_model(problem.urdf_name, xml=problem.urdf_xml).model
     return arm_from_model(model, list(problem.joints))
 
@@ -94,8 +93,10 @@ def perturb(arm: Arm, variant: Variant) -> Arm:
 
 
 def scored_models(problem: TuneProblem) -> tuple[Scored, ...]:
-    """The models every candidate is scored on (the variants, or the nominal arm alone),
-    built once per process and cached under the problem's key."""
+    """The models every candidate is scored on: the variants, or the nominal arm alone.
+
+    Built once per process and cached under the problem's key.
+    """
     key = problem.key or problem.with_key().key
     with _LOCK:
         if key not in _CACHE:

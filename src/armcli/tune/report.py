@@ -1,5 +1,6 @@
-"""Tuning results for people and programs: the reasoning and before/after tables, and
-the JSON document (schema in docs/tune.md, `SCHEMA_VERSION` bumps on breaking changes).
+"""Tuning results for people and programs: tables and the JSON document.
+
+The JSON schema is in docs/tune.md; `SCHEMA_VERSION` changes on breaking changes.
 
 Per-joint figures come from the nominal model and aggregate the trajectories: RMS is the
 mean over trajectories, max and |final| the largest, settle the longest, saturated the

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from armcli.sim import SimConfig, SimResult, simulate
+from armcli.sim.simulate import SimConfig, SimResult, simulate
 from armcli.tune.engine import Engine
 from armcli.tune.job import TuneJob
 from armcli.tune.problem import nominal_arm
@@ -26,6 +26,7 @@ class Outcome:
     rows: tuple[Row, ...]  # "spec" (when the spec has gains for every joint), "start", "tuned"
 
     def row(self, label: str) -> Row:
+        """The row labelled `label`."""
         return next(r for r in self.rows if r.label == label)
 
 

@@ -19,17 +19,19 @@ from pathlib import Path
 from typing import Any
 
 from armcli.errors import InputError
-from armcli.fsio import write_file_atomic
-from armcli.spec import loads_spec
-from armcli.yamlio import read_text
+from armcli.io.files import write_file_atomic
+from armcli.io.yaml import read_text
+from armcli.spec.load import loads_spec
 
 _SCALAR = re.compile(r"[^\s,}\]#]+")
 
 
 def check_writable(path: Path) -> None:
-    """InputError unless `path` is an existing file we may overwrite. A file without any
-    write permission bit counts as read-only even for root, who could write it anyway:
-    `chmod a-w` says the user does not want it changed."""
+    """Raise InputError unless `path` is an existing file we may overwrite.
+
+    A file without any write permission bit counts as read-only even for root, who could
+    write it anyway: `chmod a-w` says the user does not want it changed.
+    """
     if not path.is_file():
         raise InputError("spec file not found", file=path, field="--write")
     no_write_bit = not path.stat().st_mode & (stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH)
@@ -38,8 +40,10 @@ def check_writable(path: Path) -> None:
 
 
 def fmt_gain(x: float) -> str:
-    """The text a gain is written as: 4 significant digits, as reported, and never in
-    exponent form (PyYAML reads `1e+04` as a string)."""
+    """The text a gain is written as: 4 significant digits, as reported.
+
+    Never in exponent form: PyYAML reads `1e+04` as a string.
+    """
     import numpy as np
 
     return str(np.format_float_positional(float(f"{x:.4g}"), trim="-"))
