@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from armcli.cli import main
+from armcli.spec.load import load_spec
 from tests.helpers import ROOT
 
 SPEC = ROOT / "specs" / "my_robot.yaml"
@@ -52,7 +53,7 @@ def test_outputs_and_write(spec_copy: Path, tmp_path: Path,
     assert set(doc["results"]) == {"spec", "start", "tuned"}
     assert len(doc["history"]) == 4
     best = doc["best"]
-    gains = __import__("armcli.spec", fromlist=["load_spec"]).load_spec(spec_copy).control.gains
+    gains = load_spec(spec_copy).control.gains
     # --write stores the reported (rounded) best gains.
     assert [gains[j].kp for j in doc["problem"]["joints"]] == best["kp"]
     assert [gains[j].kd for j in doc["problem"]["joints"]] == best["kd"]

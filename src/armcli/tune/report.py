@@ -159,7 +159,10 @@ def to_json(
             "engine": engine,
             "weights": vars(opts.weights),
         },
-        "start": [vars(r) for r in start.rows],
+        "start": [
+            {k: _num(v) if isinstance(v, float) else v for k, v in vars(r).items()}
+            for r in start.rows
+        ],
         "results": {
             row.label: {
                 "robust_cost": _num(row.robust_cost),
