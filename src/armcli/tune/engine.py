@@ -70,7 +70,7 @@ def evaluate_candidate(problem: TuneProblem, gains: np.ndarray, weights: Weights
     cfg = SimConfig(kp, kd, problem.dt, problem.integrator, problem.gravity_comp, "auto")
     h = problem.stability_margin * problem.dt
     for v, sm in enumerate(models):
-        if not loop_stable(sm.arm, sm.Ms, sm.qs, kp, kd, problem.loop, h):
+        if not loop_stable(sm.arm, sm.Ms, kp, kd, problem.loop, h):
             why = f"{problem.loop} loop unstable at {problem.stability_margin:g} x dt"
             return CandidateEval(False, f"model {v}: {why}", costs, metrics)
         for c, res in enumerate(rollout_cases(sm.arm, problem.cases, cfg)):

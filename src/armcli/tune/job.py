@@ -143,6 +143,6 @@ def prepare(spec: Any, spec_path: Path, trajectories: Sequence[Path], s: TuneSet
 
 def _spec_gains(spec: Any, joints: Sequence[str]) -> np.ndarray | None:
     gains = spec.control.gains
-    if not all(j in gains for j in joints):
-        return None
+    if not all(j in gains and gains[j].ki == 0.0 for j in joints):
+        return None  # missing, or PID: the PD simulator cannot reproduce it
     return np.array([gains[j].kp for j in joints] + [gains[j].kd for j in joints], dtype=float)

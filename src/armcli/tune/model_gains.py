@@ -15,7 +15,8 @@ zeta. wn_j is the smallest of three caps, and the binding one is reported:
   controller) with lambda_max(M^-1) over the sample;
 - `effort`: kp_j * (largest step of joint j) + max |g_j(q)| stays within the effort limit.
 
-The full gain vector is then verified with `stability.analyse` on every sampled M.
+The full gain vector is then verified on every sampled M with the verdict of
+`armcli.sim.stability` (spectral radius of the real step maps, `worst_radius`).
 """
 
 from __future__ import annotations
@@ -173,7 +174,7 @@ def start_gains(
         )  # fmt: skip
     kp = np.array([r.kp for r in rows])
     kd = np.array([r.kd for r in rows])
-    scale = _coupled_scale(arm, Ms, qs, kp, kd, loop, dt)
+    scale = _coupled_scale(arm, Ms, kp, kd, loop, dt)
     if scale < 1.0:
         kp, kd = kp * scale, kd * math.sqrt(scale)
         rows = [_scaled(r, scale) for r in rows]
@@ -196,32 +197,27 @@ def _effort_cap(name: str, effort: float, g: float, step: float, m: float) -> fl
 
 
 def loop_stable(
-    arm: Arm, Ms: Sequence[np.ndarray], qs: np.ndarray, kp: np.ndarray, kd: np.ndarray,
-    loop: str, dt: float,
-) -> bool:  # fmt: skip
-    """The full-matrix verdict of `stability.analyse` for the chosen loop at dt."""
-    rep = stab.analyse(
-        list(Ms), qs.tolist(), list(range(len(kp))), kp.tolist(), kd.tolist(),
-        arm.damping.tolist(), dt,
-    )  # fmt: skip
-    verdict = rep.implicit if loop == "implicit" else rep.explicit
-    return bool(verdict.stable)
+    arm: Arm, Ms: Sequence[np.ndarray], kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
+) -> bool:
+    """The verdict of `armcli.sim.stability` on the full step maps, for `loop` at dt."""
+    idx = list(range(len(kp)))
+    D = np.asarray(kd, dtype=float) + arm.damping
+    scheme: stab.Scheme = "implicit" if loop == "implicit" else "explicit"
+    radius, _ = stab.worst_radius(Ms, idx, np.asarray(kp, dtype=float), D, dt, scheme)
+    return stab.is_stable(radius)
 
 
 def _coupled_scale(
-    arm: Arm, Ms: Sequence[np.ndarray], qs: np.ndarray, kp: np.ndarray, kd: np.ndarray,
-    loop: str, dt: float,
-) -> float:  # fmt: skip
+    arm: Arm, Ms: Sequence[np.ndarray], kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
+) -> float:
     """Common kp scale keeping the coupled loop stable at margin * dt (1 when it is).
 
     kd is scaled by sqrt(s), which keeps zeta.
     """
     h = STABILITY_MARGIN * dt
-    if loop_stable(arm, Ms, qs, kp, kd, loop, h):
+    if loop_stable(arm, Ms, kp, kd, loop, h):
         return 1.0
-    return _largest(
-        lambda s: loop_stable(arm, Ms, qs, s * kp, math.sqrt(s) * kd, loop, h), 1e-9, 1.0
-    )
+    return _largest(lambda s: loop_stable(arm, Ms, s * kp, math.sqrt(s) * kd, loop, h), 1e-9, 1.0)
 
 
 def _scaled(r: JointReasoning, s: float) -> JointReasoning:
