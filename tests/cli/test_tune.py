@@ -6,6 +6,7 @@ import json
 import shutil
 import socket
 import stat
+import sys
 import time
 from pathlib import Path
 
@@ -58,6 +59,11 @@ def test_outputs_and_write(spec_copy: Path, tmp_path: Path,
     assert [gains[j].kp for j in doc["problem"]["joints"]] == best["kp"]
     assert [gains[j].kd for j in doc["problem"]["joints"]] == best["kd"]
     assert out_png.read_bytes().startswith(PNG_MAGIC)
+    documented = (ROOT / "docs" / "tune.md").read_text(encoding="utf-8")
+    joint_doc = doc["results"]["tuned"]["joints"][doc["problem"]["joints"][0]]
+    keys = [*doc, *doc["problem"], *doc["search"], *doc["search"]["weights"], *doc["start"][0],
+            *doc["results"]["tuned"], *joint_doc, *doc["best"], *doc["history"][0]]  # fmt: skip
+    assert [k for k in keys if k not in documented] == []  # docs/tune.md lists every key
 
 
 @pytest.mark.parametrize(
@@ -70,6 +76,10 @@ def test_outputs_and_write(spec_copy: Path, tmp_path: Path,
         (["--mass-scale", "1.2,0.8"], "--mass-scale: need 0 < a <= b"),
         (["--output", "x.csv"], "must end in .json"),
         (["--scheduler", "nonsense://x"], "not a Dask address"),
+        (
+            ["--trajectory", str(ROOT / "tests" / "fixtures" / "tune" / "unknown_joint.yaml")],
+            "unknown joint 'wrist_joint'",
+        ),
     ],
 )
 def test_bad_options(args: list[str], message: str, spec_copy: Path,
@@ -88,6 +98,26 @@ def test_trajectory_outside_limits(spec_copy: Path, tmp_path: Path,
     code, _, err = run([str(spec_copy), "--trajectory", str(bad)], capsys)
     assert code == 2
     assert str(bad) in err and "outside" in err
+
+
+def test_scheduler_without_dask_says_what_to_install(
+    spec_copy: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
+    code, _, err = run([str(spec_copy), *QUICK, "--scheduler", "tcp://127.0.0.1:8786"], capsys)
+    assert code == 2
+    assert "pip install 'armcli[dask]'" in err
+
+
+def test_shared_trajectory_folder_other_spec(capsys: pytest.CaptureFixture[str],
+                                             tmp_path: Path) -> None:  # fmt: skip
+    # specs/trajectories/ holds my_robot's examples: the tabletop arm falls back to its poses.
+    out_json = tmp_path / "t.json"
+    spec = ROOT / "specs" / "tabletop_arm.yaml"
+    code, _, err = run([str(spec), "--trials", "2", "--settle", "0.3", "-o", str(out_json)], capsys)
+    assert code == 0, err
+    labels = [c["label"] for c in json.loads(out_json.read_text())["problem"]["cases"]]
+    assert labels and all(label.startswith("pose ") for label in labels)
 
 
 def test_unreachable_scheduler_fails_fast(spec_copy: Path,

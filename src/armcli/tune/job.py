@@ -17,6 +17,7 @@ import numpy as np
 
 from armcli.build.expand import expand_urdfs
 from armcli.errors import InputError
+from armcli.io.yaml import load_yaml
 from armcli.sim.job import ARM_URDF, SETTLE_EXTRA_S, start_state
 from armcli.sim.reference import Reference, build_reference
 from armcli.sim.trajectory import Trajectory, load_trajectory
@@ -57,10 +58,23 @@ class TuneJob:
     spec_gains: np.ndarray | None  # [kp..., kd...] from control.gains, when all are given
 
 
-def default_trajectories(spec_path: Path) -> list[Path]:
-    """The spec's example trajectories: `trajectories/*.yaml` next to the spec, sorted."""
+def default_trajectories(spec_path: Path, joints: Sequence[str]) -> list[Path]:
+    """The spec's example trajectories: `trajectories/*.yaml` next to the spec, sorted.
+
+    A folder shared by several specs holds other arms' examples too: only files whose
+    `joint_names` are all joints of this arm count (an explicit --trajectory is always
+    validated in full).
+    """
     folder = spec_path.parent / "trajectories"
-    return sorted(folder.glob("*.yaml")) if folder.is_dir() else []
+    if not folder.is_dir():
+        return []
+    out = []
+    for path in sorted(folder.glob("*.yaml")):
+        data = load_yaml(path, flow_sets=True).data
+        names = data.get("joint_names") if isinstance(data, dict) else None
+        if isinstance(names, list) and names and set(map(str, names)) <= set(joints):
+            out.append(path)
+    return out
 
 
 def _validate(s: TuneSettings) -> None:
@@ -118,7 +132,7 @@ def prepare(spec: Any, spec_path: Path, trajectories: Sequence[Path], s: TuneSet
     limits = {n: (float(lo), float(hi)) for n, lo, hi in zip(joints, arm.lower, arm.upper,
                                                               strict=True)}  # fmt: skip
     q0 = start_state(arm, spec)
-    paths = list(trajectories) or default_trajectories(spec_path)
+    paths = list(trajectories) or default_trajectories(spec_path, joints)
     cases = [_traj_case(load_trajectory(p, limits), p.stem, joints, q0, s.settle) for p in paths]
     if not cases:
         cases = _pose_cases(spec, joints, q0, s.settle)

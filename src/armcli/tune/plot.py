@@ -8,6 +8,7 @@ from __future__ import annotations
 import io
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -31,21 +32,7 @@ def tune_png(history: Sequence[TrialRecord], runs: Sequence[tuple[str, SimResult
     names = runs[0][1].joint_names
     fig = plt.figure(figsize=(5.0 * max(2, len(names)), 8.0))
     grid = fig.add_gridspec(2, len(names))
-    ax = fig.add_subplot(grid[0, :])
-    cost = np.array([r.cost for r in history])
-    ok = cost < INFEASIBLE_COST
-    x = np.arange(1, len(cost) + 1)
-    ax.semilogy(x[ok], cost[ok], "o", ms=4, color="C0", label="trial")
-    if (~ok).any():
-        top = cost[ok].max() if ok.any() else 1.0
-        ax.plot(x[~ok], np.full((~ok).sum(), top), "x", color="C3", label="infeasible")
-    best = np.minimum.accumulate(np.where(ok, cost, np.inf))
-    ax.step(x, best, where="post", color="C1", lw=1.5, label="best so far")
-    ax.set_xlabel("trial")
-    ax.set_ylabel("objective [rad]")
-    ax.set_title("optimisation history")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(loc="upper right", fontsize=8)
+    _history(fig.add_subplot(grid[0, :]), history)
     for i, name in enumerate(names):
         axj = fig.add_subplot(grid[1, i])
         axj.axhline(0.0, color="0.4", lw=1.0, ls="--")
@@ -62,6 +49,24 @@ def tune_png(history: Sequence[TrialRecord], runs: Sequence[tuple[str, SimResult
     fig.savefig(buf, format="png", dpi=100, metadata={"Software": None})
     plt.close(fig)
     return buf.getvalue()
+
+
+def _history(ax: Any, history: Sequence[TrialRecord]) -> None:
+    """Cost per trial (log scale), best so far, infeasible trials as crosses on top."""
+    cost = np.array([r.cost for r in history])
+    ok = cost < INFEASIBLE_COST
+    x = np.arange(1, len(cost) + 1)
+    ax.semilogy(x[ok], cost[ok], "o", ms=4, color="C0", label="trial")
+    if (~ok).any():
+        top = cost[ok].max() if ok.any() else 1.0
+        ax.plot(x[~ok], np.full((~ok).sum(), top), "x", color="C3", label="infeasible")
+    best = np.minimum.accumulate(np.where(ok, cost, np.inf))
+    ax.step(x, best, where="post", color="C1", lw=1.5, label="best so far")
+    ax.set_xlabel("trial")
+    ax.set_ylabel("objective [rad]")
+    ax.set_title("optimisation history")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(loc="upper right", fontsize=8)
 
 
 def write_tune_plot(path: Path, history: Sequence[TrialRecord],

@@ -22,7 +22,7 @@ from armcli.tune.engine import CandidateEval
 from armcli.tune.model_gains import StartGains, dt_max
 from armcli.tune.objective import FINAL, MAX, RMS, SATURATED, SETTLE
 from armcli.tune.problem import TuneProblem, describe
-from armcli.tune.search import SearchOptions, SearchResult
+from armcli.tune.search import SearchOptions, SearchResult, TrialRecord
 
 SCHEMA_VERSION = 1
 
@@ -144,17 +144,14 @@ def to_json(
     engine: str,
     damping: np.ndarray,
 ) -> str:
-    """The output document (stable key order, floats as JSON numbers, no timestamps)."""
+    """The output document (schema in docs/tune.md; stable key order, no timestamps)."""
     n = len(problem.joints)
+    search = {k: getattr(opts, k) for k in ("trials", "batch", "seed", "span", "robust")}
     doc = {
         "schema_version": SCHEMA_VERSION,
         "problem": describe(problem),
         "search": {
-            "trials": opts.trials,
-            "batch": opts.batch,
-            "seed": opts.seed,
-            "span": opts.span,
-            "robust": opts.robust,
+            **search,
             "quantile": opts.quantile,
             "engine": engine,
             "weights": vars(opts.weights),
@@ -163,46 +160,39 @@ def to_json(
             {k: _num(v) if isinstance(v, float) else v for k, v in vars(r).items()}
             for r in start.rows
         ],
-        "results": {
-            row.label: {
-                "robust_cost": _num(row.robust_cost),
-                "feasible": row.nominal.feasible,
-                "joints": {
-                    name: {
-                        "kp": float(row.gains[j]),
-                        "kd": float(row.gains[n + j]),
-                        "stability_margin": _num(
-                            margin(
-                                start,
-                                float(row.gains[j]),
-                                float(row.gains[n + j]),
-                                float(damping[j]),
-                            )
-                        ),
-                        **{k: _num(v) for k, v in joint_summary(row.nominal, j).items()},
-                    }
-                    for j, name in enumerate(problem.joints)
-                },
-            }
-            for row in rows
-        },
+        "results": {row.label: _row_doc(problem, start, row, damping) for row in rows},
         "best": {
             "cost": _num(result.best_cost),
             "kp": result.best[:n].tolist(),
             "kd": result.best[n:].tolist(),
         },
-        "history": [
-            {
-                "trial": r.number,
-                "cost": _num(r.cost),
-                "feasible": r.feasible,
-                "reason": r.reason,
-                "gains": r.gains.tolist(),
-            }
-            for r in result.history
-        ],
+        "history": [_trial_doc(r) for r in result.history],
     }
     return json.dumps(doc, indent=2, allow_nan=False) + "\n"
+
+
+def _row_doc(problem: TuneProblem, start: StartGains, row: Row, damping: np.ndarray
+             ) -> dict[str, Any]:  # fmt: skip
+    n = len(problem.joints)
+    return {
+        "robust_cost": _num(row.robust_cost),
+        "feasible": row.nominal.feasible,
+        "joints": {
+            name: _joint_doc(start, row, j, n, float(damping[j]))
+            for j, name in enumerate(problem.joints)
+        },
+    }
+
+
+def _trial_doc(r: TrialRecord) -> dict[str, Any]:
+    return {"trial": r.number, "cost": _num(r.cost), "feasible": r.feasible,
+            "reason": r.reason, "gains": r.gains.tolist()}  # fmt: skip
+
+
+def _joint_doc(start: StartGains, row: Row, j: int, n: int, damping: float) -> dict[str, Any]:
+    kp, kd = float(row.gains[j]), float(row.gains[n + j])
+    summary = {k: _num(v) for k, v in joint_summary(row.nominal, j).items()}
+    return {"kp": kp, "kd": kd, "stability_margin": _num(margin(start, kp, kd, damping)), **summary}
 
 
 def _num(x: float | None) -> float | None:

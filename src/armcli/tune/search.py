@@ -4,9 +4,9 @@ Candidates are asked in fixed-size batches, scored through an `Engine`, and told
 batch order, so for a given seed and batch size the sampler sees the same history
 whichever backend scored them: the result is identical on threads or on Dask.
 
-The search box is [start / span, start * span] per gain. The first trial is the
-model-based start; the spec's current gains are the second when they lie in the box, so
-the result is never worse (by the objective) than either.
+The search box is [start / span, start * span] per gain, widened to hold the spec's
+current gains. The first trial is the model-based start and the second the spec's gains
+(when all are > 0), so the result is never worse (by the objective) than either.
 """
 
 from __future__ import annotations
@@ -98,6 +98,9 @@ def search(
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     names = _param_names(problem.joints)
     lo, hi = start / opts.span, start * opts.span
+    for g in also_try:  # widen the box to hold the user's gains (when all are > 0)
+        if np.all(g > 0):
+            lo, hi = np.minimum(lo, g), np.maximum(hi, g)
     dists: dict[str, optuna.distributions.BaseDistribution] = {
         nm: optuna.distributions.FloatDistribution(float(a), float(b), log=True)
         for nm, a, b in zip(names, lo, hi, strict=True)
