@@ -3,7 +3,9 @@ robust tuning no worse in the worst case, and results independent of the thread 
 
 from __future__ import annotations
 
+import shutil
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,6 +16,7 @@ from armcli.tune import job as tjob
 from armcli.tune import session
 from armcli.tune.engine import LocalEngine
 from armcli.tune.model_gains import mass_matrices, sample_configurations
+from armcli.tune.objective import INFEASIBLE_COST
 from armcli.tune.problem import nominal_arm
 from armcli.tune.search import SearchOptions, cost_of
 from tests.helpers import ROOT
@@ -25,6 +28,7 @@ SETTLE = 1.0  # [s] short settle windows keep the test quick
 # The tuned gains must cut the mean RMS error on the example trajectories by at least
 # this much versus the spec's kp = 50, kd = 5 (measured: about 75 % with 16 trials).
 MIN_RMS_REDUCTION = 0.5
+ROBUST_TRIALS = 24
 
 
 @pytest.fixture(scope="module")
@@ -69,19 +73,27 @@ def test_same_result_with_two_threads(job: tjob.TuneJob, outcome: session.Outcom
     assert [r.cost for r in again.result.history] == [r.cost for r in outcome.result.history]
 
 
-def test_robust_worst_case_no_worse_than_nominal_tuning(
-    job: tjob.TuneJob, outcome: session.Outcome
-) -> None:
-    settings = tjob.TuneSettings(settle=SETTLE, robust=3, mass_scale=(0.7, 1.3),
-                                 friction_scale=(0.5, 2.0), seed=1)  # fmt: skip
-    robust_job = tjob.prepare(load_spec(SPEC), SPEC, [], settings)
-    opts = SearchOptions(trials=TRIALS, batch=BATCH, robust="worst")
+def test_robust_worst_case_no_worse_than_nominal_tuning(tmp_path: Path) -> None:
+    # Where robustness matters: the seed arm stepped at dt = 5 ms under the explicit
+    # (Gazebo effort-controller) bound, with links up to 40 % lighter than modelled, which
+    # moves the stability limit. Measured: worst case 0.0115 rad (robust tuning) against
+    # 0.0286 rad for the nominal tuning's gains on the same perturbed models.
+    shutil.copytree(SPEC.parent / "trajectories", tmp_path / "trajectories")
+    spec_path = tmp_path / "robot.yaml"
+    spec_path.write_text(SPEC.read_text(encoding="utf-8").replace("  dt: 0.001", "  dt: 0.005"))
+    spec = load_spec(spec_path)
+    base = tjob.TuneSettings(settle=SETTLE, loop="explicit")
+    opts = SearchOptions(trials=ROBUST_TRIALS, batch=BATCH, robust="worst")
+    nominal = session.run(tjob.prepare(spec, spec_path, [], base), LocalEngine(1), opts)
+    robust_job = tjob.prepare(spec, spec_path, [], replace(base, robust=3, mass_scale=(0.6, 1.0),
+                                                            seed=1))  # fmt: skip
     robust = session.run(robust_job, LocalEngine(1), opts)
     engine = LocalEngine(1)
-    nominal_best = outcome.result.best
-    worst_nominal = cost_of(engine.evaluate(robust_job.problem, [nominal_best], opts.weights)[0],
-                            opts)  # fmt: skip
-    assert robust.result.best_cost <= worst_nominal
+    nominal_worst = cost_of(
+        engine.evaluate(robust_job.problem, [nominal.result.best], opts.weights)[0], opts
+    )
+    assert robust.result.best_cost < INFEASIBLE_COST
+    assert robust.result.best_cost <= nominal_worst
 
 
 def test_trials_zero_is_refused(job: tjob.TuneJob) -> None:

@@ -9,10 +9,10 @@ zeta. wn_j is the smallest of three caps, and the binding one is reported:
 
 - `target`: the requested wn, by default a decade under the controller's update rate
   (2 pi f_c / TARGET_RATIO), the usual rule for a sampled loop;
-- `stability`: the loop chosen by `--loop` stays stable at STABILITY_MARGIN * dt, using
-  the one bound in `armcli.stability` (`implicit_dt_max` for armcli's simulator,
+- `stability`: the loop chosen by `--loop` stays stable at STABILITY_MARGIN * dt, by the
+  scalar-mode bound of `armcli.sim.stability` (`implicit_dt_max` for armcli's simulator,
   `explicit_dt_max` for an explicitly stepped torque loop such as Gazebo's effort
-  controller) with lambda_max(M^-1) over the sample;
+  controller) with lambda_j = max (M^-1)_jj over the sample, the joint's own mode;
 - `effort`: kp_j * (largest step of joint j) + max |g_j(q)| stays within the effort limit.
 
 The full gain vector is then verified on every sampled M with the verdict of
@@ -51,6 +51,7 @@ class JointReasoning:
     m_max: float  # max M_jj (the inertia the gains are sized for)
     gravity_max: float  # max |g_j(q)| over the sample [N·m or N]
     step: float  # largest step in the trajectories [rad or m]
+    lambda_j: float  # max (M^-1)_jj over the sample, the joint's mode [1/(kg·m²)]
     wn_target: float  # [rad/s]
     wn_stability: float  # [rad/s]
     wn_effort: float  # [rad/s] (inf without an effort limit)
@@ -69,6 +70,7 @@ class StartGains:
     kd: np.ndarray
     rows: tuple[JointReasoning, ...]
     lambda_max: float  # max lambda_max(M^-1) over the sample [1/(kg·m²)]
+    lambda_joint: np.ndarray  # per joint, max (M^-1)_jj over the sample [1/(kg·m²)]
     loop: str
     dt: float  # [s]
 
@@ -155,12 +157,13 @@ def start_gains(
     qs = sample_configurations(arm)
     Ms = mass_matrices(arm, qs)
     lam = lambda_max(Ms)
+    lam_j = np.max([np.diag(np.linalg.inv(M)) for M in Ms], axis=0)
     g = gravity_max(arm, qs)
     diag = np.array([np.diag(M) for M in Ms])
     rows = []
     for j, name in enumerate(arm.joint_names):
         m_max = float(diag[:, j].max())
-        wn_s = stability_cap(loop, m_max, zeta, float(arm.damping[j]), lam, dt)
+        wn_s = stability_cap(loop, m_max, zeta, float(arm.damping[j]), float(lam_j[j]), dt)
         wn_e = _effort_cap(name, float(arm.effort[j]), float(g[j]), float(steps[j]), m_max)
         caps = {"target": wn_target, "stability": wn_s, "effort": wn_e}
         binding = min(caps, key=lambda k: caps[k])
@@ -168,7 +171,7 @@ def start_gains(
         kp_j, kd_j = m_max * wn * wn, 2.0 * zeta * wn * m_max
         rows.append(
             JointReasoning(
-                name, float(diag[:, j].min()), m_max, float(g[j]), float(steps[j]),
+                name, float(diag[:, j].min()), m_max, float(g[j]), float(steps[j]), float(lam_j[j]),
                 wn_target, wn_s, wn_e, wn, zeta, kp_j, kd_j, binding,
             )
         )  # fmt: skip
@@ -178,7 +181,7 @@ def start_gains(
     if scale < 1.0:
         kp, kd = kp * scale, kd * math.sqrt(scale)
         rows = [_scaled(r, scale) for r in rows]
-    return StartGains(kp, kd, tuple(rows), lam, loop, dt)
+    return StartGains(kp, kd, tuple(rows), lam, lam_j, loop, dt)
 
 
 def _effort_cap(name: str, effort: float, g: float, step: float, m: float) -> float:

@@ -10,7 +10,9 @@ Cost of one run (one trajectory on one model), in radians (metres for prismatic 
 A candidate's cost on one model is the mean of J over the trajectories; over perturbed
 models it is the worst case (default) or a quantile. A run that diverges, or gains that
 violate the stability bound of the chosen loop, make the candidate infeasible: its cost
-is INFEASIBLE_COST, far above any feasible cost, so the sampler learns to avoid it.
+is INFEASIBLE_COST, far above any feasible cost, so the sampler learns to avoid it. The
+nominal model must be stable at STABILITY_MARGIN * dt; with `--robust` each perturbed
+model must be stable at dt (the perturbations take the place of the margin).
 """
 
 from __future__ import annotations

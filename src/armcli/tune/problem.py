@@ -63,7 +63,7 @@ class TuneProblem:
     integrator: str
     gravity_comp: bool
     loop: str  # "implicit" | "explicit": which stability bound makes a candidate infeasible
-    stability_margin: float  # the loop must be stable at stability_margin * dt
+    stability_margin: float  # nominal model: stable at stability_margin * dt; variants: at dt
     cases: tuple[Case, ...]
     variants: tuple[Variant, ...]  # empty: the nominal model only
     key: str = field(default="", compare=False)

@@ -5,7 +5,7 @@ The JSON schema is in docs/tune.md; `SCHEMA_VERSION` changes on breaking changes
 Per-joint figures come from the nominal model and aggregate the trajectories: RMS is the
 mean over trajectories, max and |final| the largest, settle the longest, saturated the
 mean share of steps. The stability margin is dt_max / dt for the chosen loop
-(`armcli.stability` bound with lambda_max(M^-1) over the sampled range).
+(scalar-mode bound of `armcli.sim.stability` with the joint's lambda_j = max (M^-1)_jj).
 """
 
 from __future__ import annotations
@@ -51,9 +51,9 @@ def joint_summary(ev: CandidateEval, j: int) -> dict[str, float | None]:
     }
 
 
-def margin(start: StartGains, kp: float, kd: float, damping: float) -> float:
-    """dt_max / dt of one joint's gains for the chosen loop [-]."""
-    return dt_max(start.loop, kp, kd + damping, start.lambda_max) / start.dt
+def margin(start: StartGains, j: int, kp: float, kd: float, damping: float) -> float:
+    """dt_max / dt of joint j's gains for the chosen loop [-]."""
+    return dt_max(start.loop, kp, kd + damping, float(start.lambda_joint[j])) / start.dt
 
 
 def reasoning_table(start: StartGains) -> Any:
@@ -124,7 +124,7 @@ def comparison_table(
                 f"{kd:.4g}",
                 *cells,
                 sat,
-                f"{margin(start, kp, kd, float(damping[j])):.3g}x",
+                f"{margin(start, j, kp, kd, float(damping[j])):.3g}x",
             )
         if j < n - 1:
             t.add_section()
@@ -192,7 +192,12 @@ def _trial_doc(r: TrialRecord) -> dict[str, Any]:
 def _joint_doc(start: StartGains, row: Row, j: int, n: int, damping: float) -> dict[str, Any]:
     kp, kd = float(row.gains[j]), float(row.gains[n + j])
     summary = {k: _num(v) for k, v in joint_summary(row.nominal, j).items()}
-    return {"kp": kp, "kd": kd, "stability_margin": _num(margin(start, kp, kd, damping)), **summary}
+    return {
+        "kp": kp,
+        "kd": kd,
+        "stability_margin": _num(margin(start, j, kp, kd, damping)),
+        **summary,
+    }
 
 
 def _num(x: float | None) -> float | None:
