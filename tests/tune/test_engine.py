@@ -1,6 +1,7 @@
-"""The Dask backend for real: `dask scheduler` + two `dask worker` processes on 127.0.0.1,
-and a `distributed.LocalCluster` with worker processes. Both must give the local run's
-result bit for bit (same seed, same batch size)."""
+"""The engine: infeasible candidates, metrics equal to a plain `simulate` run, and the Dask
+backend for real (`dask scheduler` + two `dask worker` processes on 127.0.0.1, and a
+`distributed.LocalCluster` with worker processes), which must give the local run's result
+bit for bit (same seed, same batch size)."""
 
 from __future__ import annotations
 
@@ -15,13 +16,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytest.importorskip("distributed")
-
+from armcli.sim.report import joint_metrics
+from armcli.sim.simulate import SimConfig, simulate
 from armcli.spec.load import load_spec
 from armcli.tune import job as tjob
 from armcli.tune import session
 from armcli.tune.engine import DaskEngine, LocalEngine
-from armcli.tune.search import SearchOptions
+from armcli.tune.objective import INFEASIBLE_COST, RMS, Weights
+from armcli.tune.problem import nominal_arm
+from armcli.tune.search import SearchOptions, cost_of, nominal
 from tests.helpers import ROOT
 
 SPEC = ROOT / "specs" / "my_robot.yaml"
@@ -41,6 +44,30 @@ def job() -> tjob.TuneJob:
 @pytest.fixture(scope="module")
 def local(job: tjob.TuneJob) -> session.Outcome:
     return session.run(job, LocalEngine(1), OPTS)
+
+
+def test_unstable_candidate_is_infeasible(job: tjob.TuneJob) -> None:
+    # kp = 1e7 N·m/rad on ~0.01-0.07 kg·m² at dt = 1 ms: wn·dt ~ 12-33, far beyond the
+    # implicit-Euler bound (wn·dt < 2 + 2 sqrt(2) even with critical damping).
+    n = len(job.problem.joints)
+    gains = np.array([1e7] * n + [1.0] * n)
+    ev = LocalEngine(1).evaluate(job.problem, [gains], Weights())[0]
+    assert not ev.feasible
+    assert "loop unstable" in ev.reason
+    assert cost_of(ev, OPTS) == INFEASIBLE_COST
+
+
+def test_metrics_match_a_plain_simulate_run(job: tjob.TuneJob) -> None:
+    # The engine's RMS for the nominal model equals sim.report's on a direct simulate call.
+    p = nominal(job.problem)
+    n = len(p.joints)
+    gains = np.concatenate([job.start.kp, job.start.kd])
+    ev = LocalEngine(1).evaluate(p, [gains], Weights())[0]
+    case = p.cases[0]
+    cfg = SimConfig(job.start.kp, job.start.kd, p.dt, p.integrator, p.gravity_comp)
+    res = simulate(nominal_arm(p), case.reference, case.q0, case.duration, cfg)
+    expected = [m.rms_error for m in joint_metrics(res, case.t_end)]
+    assert ev.metrics[0, 0, :n, RMS].tolist() == expected
 
 
 def _free_port() -> int:
@@ -63,6 +90,7 @@ def _stop(procs: list[subprocess.Popen[bytes]]) -> None:
 
 @pytest.fixture(scope="module")
 def scheduler_address(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+    pytest.importorskip("distributed")
     if not DASK.exists() and shutil.which("dask") is None:
         pytest.skip("the `dask` command is not installed (pip install 'armcli[dask]')")
     exe = str(DASK) if DASK.exists() else "dask"
@@ -125,7 +153,8 @@ def test_dask_scheduler_and_two_workers(job: tjob.TuneJob, local: session.Outcom
 
 
 def test_local_cluster_with_processes(job: tjob.TuneJob, local: session.Outcome) -> None:
-    from distributed import LocalCluster
+    distributed = pytest.importorskip("distributed")
+    LocalCluster = distributed.LocalCluster
 
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                       dashboard_address=":0", host="127.0.0.1") as cluster:  # fmt: skip
