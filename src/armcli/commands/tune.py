@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import click
 import typer
 
 from armcli.defaults import DEFAULT_SPEC
@@ -15,9 +16,10 @@ from armcli.spec.load import load_spec
 from armcli.tune import job as tjob
 from armcli.tune import report, session
 from armcli.tune.engine import make_engine
+from armcli.tune.model_gains import LOOPS
 from armcli.tune.plot import write_tune_plot
 from armcli.tune.problem import nominal_arm
-from armcli.tune.search import SearchOptions, validate
+from armcli.tune.search import ROBUST_MODES, SearchOptions, validate
 from armcli.tune.write import check_writable, write_gains
 
 
@@ -43,8 +45,10 @@ def tune_cmd(
     loop: str = typer.Option(
         "implicit",
         "--loop",
-        help="Stability bound: implicit (armcli's simulator) or explicit (a torque loop "
-        "stepped explicitly, e.g. Gazebo's effort controller).",
+        click_type=click.Choice(LOOPS),
+        show_default=False,
+        help="Stability bound: implicit (default: armcli's simulator) or explicit (a torque "
+        "loop stepped explicitly, e.g. Gazebo's effort controller).",
     ),
     zeta: float = typer.Option(1.0, "--zeta", help="Damping ratio of the start gains."),
     wn: float = typer.Option(
@@ -58,7 +62,13 @@ def tune_cmd(
     robust: int = typer.Option(0, "--robust", help="Score every candidate on N perturbed models."),
     mass_scale: str = typer.Option("0.8,1.2", "--mass-scale", help="Mass/inertia scale range."),
     friction_scale: str = typer.Option("0.5,2", "--friction-scale", help="Friction scale range."),
-    robust_mode: str = typer.Option("worst", "--robust-mode", help="worst or quantile."),
+    robust_mode: str = typer.Option(
+        "worst",
+        "--robust-mode",
+        click_type=click.Choice(ROBUST_MODES),
+        show_default=False,
+        help="Aggregate over the perturbed models: worst (default) or quantile.",
+    ),
     quantile: float = typer.Option(0.9, "--quantile", help="Quantile for --robust-mode quantile."),
     jobs: int = typer.Option(1, "--jobs", "-j", help="Local threads scoring candidates."),
     scheduler: str = typer.Option(

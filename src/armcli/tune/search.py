@@ -23,6 +23,7 @@ from armcli.tune.objective import Weights, aggregate
 from armcli.tune.problem import TuneProblem
 
 ROUND_DIGITS = 4  # significant digits of the reported (and written) gains
+ROBUST_MODES = ("worst", "quantile")
 
 
 @dataclass(frozen=True)
@@ -66,7 +67,7 @@ def validate(opts: SearchOptions) -> None:
         raise InputError(f"must be >= 1, got {opts.batch}", field="--batch")
     if not (math.isfinite(opts.span) and opts.span > 1.0):
         raise InputError(f"must be > 1, got {opts.span:g}", field="--span")
-    if opts.robust not in ("worst", "quantile"):
+    if opts.robust not in ROBUST_MODES:
         raise InputError(f"unknown {opts.robust!r}; valid: worst, quantile", field="--robust-mode")
     if not 0.0 <= opts.quantile <= 1.0:
         raise InputError(f"must be in [0, 1], got {opts.quantile:g}", field="--quantile")
