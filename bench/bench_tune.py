@@ -14,6 +14,7 @@ on the machine and its load.
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import sys
 import time
