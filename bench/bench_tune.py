@@ -83,6 +83,7 @@ def main() -> None:
     job = tjob.prepare(load_spec(SPEC), SPEC, [], tjob.TuneSettings())
     batch = candidates(job, count)
     steps = sum(round(c.duration / job.problem.dt) for c in job.problem.cases)
+    print(f"load average before the run: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print(f"seed arm, {len(job.problem.cases)} trajectories, {steps} steps per candidate, "
           f"{count} candidates x {repeats} repeats")  # fmt: skip
     rows = []
