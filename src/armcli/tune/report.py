@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from armcli.tune.engine import CandidateEval
+from armcli.tune.evaluate import CandidateEval
 from armcli.tune.model_gains import StartGains, dt_max
 from armcli.tune.objective import FINAL, MAX, RMS, SATURATED, SETTLE
 from armcli.tune.problem import TuneProblem, describe

@@ -18,7 +18,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from armcli.errors import InputError
-from armcli.tune.engine import CandidateEval, Engine
+from armcli.tune.engine import Engine
+from armcli.tune.evaluate import CandidateEval
 from armcli.tune.objective import Weights, aggregate
 from armcli.tune.problem import TuneProblem
 
