@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from armcli.spec.model import RobotSpec
+from armcli.urdf.meshes import MeshSearch
 
 ERROR = "error"
 WARNING = "warning"
@@ -231,6 +232,10 @@ class CheckOptions:
     spec: RobotSpec | None = None
     package_dirs: Mapping[str, Path] = field(default_factory=dict)
     search_paths: tuple[Path, ...] = ()
+
+    def mesh_search(self) -> MeshSearch:
+        """The mesh-resolver view of these options (shared with view and render)."""
+        return MeshSearch(self.package_dirs, self.search_paths)
 
 
 def apply_policy(

@@ -20,6 +20,7 @@ from armcli.errors import ModelLoadError
 from armcli.sim.stability import StabilityReport
 from armcli.urdf.doc import Urdf
 from armcli.urdf.pinocchio import configuration, joint_ranges, load_model, parser_problems
+from armcli.urdf.tool import tool_point
 
 _STRUCTURE_ERRORS = (
     "duplicate-name",
@@ -113,7 +114,7 @@ def _with_model(
     data = model.createData()
     ranges = joint_ranges(model)
     notes: list[str] = []
-    ee_label, ee_frame, ee_offset = _end_effector(urdf, tree, opts, model)
+    ee_label, ee_frame, ee_offset = _end_effector(urdf, opts, model)
     poses = _poses(urdf, opts, ranges)
     pose_rows = []
     for name, values in poses:
@@ -167,25 +168,15 @@ def _joint_rows(urdf: Urdf) -> tuple[JointRow, ...]:
 
 
 def _end_effector(
-    urdf: Urdf, tree: Tree, opts: CheckOptions, model: Any
+    urdf: Urdf, opts: CheckOptions, model: Any
 ) -> tuple[str, int, tuple[float, float, float]]:
-    """The spec's tool point, else the origin of the deepest link (most movable joints above)."""
-    spec = opts.spec
-    if spec is not None and spec.arm.tool is not None and model.existFrame(spec.arm.tool.link):
-        t = spec.arm.tool
-        return (f"{t.link} + {tuple(t.xyz)}", model.getFrameId(t.link), tuple(t.xyz))  # type: ignore[return-value]
-
-    def depth(link: str) -> int:
-        n, cur = 0, link
-        while cur in tree.parent_joint:
-            j = tree.parent_joint[cur]
-            n += j.type != "fixed"
-            cur = str(j.parent)
-        return n
-
-    names = [lk.name for lk in urdf.links if model.existFrame(lk.name)]
-    best = max(names, key=depth) if names else str(model.frames[0].name)
-    return best, model.getFrameId(best), (0.0, 0.0, 0.0)
+    """The tool point (armcli.urdf.tool) as (label, Pinocchio frame id, offset [m])."""
+    tool = tool_point(urdf, opts.spec)
+    if tool is None or not model.existFrame(tool.link):
+        name = str(model.frames[0].name)
+        return name, model.getFrameId(name), (0.0, 0.0, 0.0)
+    label = f"{tool.link} + {tool.xyz}" if tool.xyz != (0.0, 0.0, 0.0) else tool.link
+    return label, model.getFrameId(tool.link), tool.xyz
 
 
 def _poses(urdf: Urdf, opts: CheckOptions, ranges: list[Any]) -> list[tuple[str, dict[str, float]]]:

@@ -7,7 +7,6 @@ import time
 from pathlib import Path
 from typing import Any, cast
 
-import click
 import typer
 
 from armcli.defaults import DEFAULT_SPEC
@@ -53,7 +52,7 @@ def simulate_cmd(
     integrator: str = typer.Option(
         "euler",
         "--integrator",
-        click_type=click.Choice(INTEGRATORS),
+        metavar="[" + "|".join(INTEGRATORS) + "]",
         show_default=False,
         help="Semi-implicit Euler (default) or RK4.",
     ),
@@ -73,7 +72,7 @@ def simulate_cmd(
     engine: str = typer.Option(
         "auto",
         "--engine",
-        click_type=click.Choice(ENGINES),
+        metavar="[" + "|".join(ENGINES) + "]",
         show_default=False,
         help="auto (default: compiled when available), native (compiled) or python.",
     ),
