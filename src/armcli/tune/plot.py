@@ -66,7 +66,7 @@ def _history(ax: Any, history: Sequence[TrialRecord]) -> None:
     ax.set_ylabel("objective [rad]")
     ax.set_title("optimisation history")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(loc="upper right", fontsize=8)
+    ax.legend(loc="best", fontsize=8)
 
 
 def write_tune_plot(path: Path, history: Sequence[TrialRecord],
