@@ -7,6 +7,7 @@ exercised by the whole tool chain without writing a test for it.
 from __future__ import annotations
 
 import csv
+import json
 import math
 from pathlib import Path
 
@@ -98,3 +99,16 @@ def test_ros_package(built: tuple[Path, RobotSpec, Path], tmp_path: Path) -> Non
     assert info.value.code in (0, None)
     srdf = tmp_path / f"{spec.name}_moveit_config" / "config" / f"{spec.name}.srdf"
     assert srdf.is_file()
+
+
+def test_tune(built: tuple[Path, RobotSpec, Path], tmp_path: Path) -> None:
+    path, spec, _ = built
+    out = tmp_path / "tune.json"
+    with pytest.raises(SystemExit) as info:
+        main(
+            ["tune", str(path), "--trials", "3", "--batch", "3", "--settle", "0.5", "-o", str(out)]
+        )
+    assert info.value.code in (0, None)
+    doc = json.loads(out.read_text(encoding="utf-8"))
+    assert doc["problem"]["joints"] == spec.movable_arm_joints()
+    assert doc["results"]["tuned"]["feasible"]
