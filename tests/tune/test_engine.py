@@ -5,6 +5,7 @@ bit for bit (same seed, same batch size)."""
 
 from __future__ import annotations
 
+import json
 import shutil
 import socket
 import subprocess
@@ -15,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from armcli.cli import main
 from armcli.sim.report import joint_metrics
 from armcli.sim.simulate import SimConfig, simulate
 from armcli.spec.load import load_spec
@@ -162,3 +164,19 @@ def test_local_cluster_with_processes(job: tjob.TuneJob, local: session.Outcome)
         finally:
             engine.close()
     _same(local, remote)
+
+
+def test_cli_scheduler_option_gives_the_local_result(scheduler_address: str,
+                                                      tmp_path: Path) -> None:  # fmt: skip
+    args = ["tune", str(SPEC), "-t", str(PICK), "--trials", "6", "--batch", "3",
+            "--settle", "0.5"]  # fmt: skip
+    docs = []
+    for extra in ([], ["--scheduler", scheduler_address]):
+        out = tmp_path / f"{len(extra)}.json"
+        with pytest.raises(SystemExit) as info:
+            main([*args, *extra, "-o", str(out)])
+        assert info.value.code in (0, None)
+        docs.append(json.loads(out.read_text(encoding="utf-8")))
+    assert "dask" in docs[1]["search"]["engine"]
+    assert docs[0]["best"] == docs[1]["best"]
+    assert docs[0]["history"] == docs[1]["history"]
