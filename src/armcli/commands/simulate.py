@@ -13,6 +13,7 @@ from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import InputError
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
+from armcli.sim import states
 from armcli.sim.options import ENGINES, INTEGRATORS, Engine, Integrator, SimOptions
 from armcli.sim.plot import write_tracking_plot
 from armcli.spec.load import load_spec
@@ -82,7 +83,7 @@ def simulate_cmd(
     from rich.console import Console
 
     if output is not None:
-        simreport.output_format(output)
+        states.output_format(output)
     spec_obj = load_spec(spec or DEFAULT_SPEC) if (spec is not None or urdf is None) else None
     kp_values, kd_values = _floats(kp, "--kp"), _floats(kd, "--kd")
     opts = SimOptions(
@@ -110,7 +111,7 @@ def simulate_cmd(
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
     if output is not None:
-        simreport.write_states(output, res, job.rate)
+        states.write_states(output, res, job.rate)
     if plot is not None:
         write_tracking_plot(plot, res, job.arm.effort)
     out = Console(file=sys.stdout)
