@@ -15,7 +15,7 @@ from armcli.io.files import write_file_atomic
 from armcli.spec.load import load_spec
 from armcli.tune import job as tjob
 from armcli.tune import report, session
-from armcli.tune.engine import make_engine
+from armcli.tune.engine import Engine, make_engine
 from armcli.tune.model_gains import LOOPS
 from armcli.tune.plot import write_tune_plot
 from armcli.tune.problem import nominal_arm
@@ -108,9 +108,9 @@ def tune_cmd(
 
 
 def _run(
-    job: Any,
-    engine: Any,
-    opts: Any,
+    job: tjob.TuneJob,
+    engine: Engine,
+    opts: SearchOptions,
     output: Path | None,
     plot: Path | None,
     write: bool,
@@ -150,7 +150,7 @@ def _run(
             out.print(f"wrote {path}", markup=False, highlight=False)
 
 
-def _summary(out: Any, outcome: Any) -> None:
+def _summary(out: Any, outcome: session.Outcome) -> None:
 
     tuned = outcome.row("tuned")
     parts = []

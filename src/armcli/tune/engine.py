@@ -134,8 +134,3 @@ def make_engine(jobs: int, scheduler: str | None) -> Engine:
     if scheduler:
         return DaskEngine(scheduler)
     return LocalEngine(jobs)
-
-
-def keyed(problem: TuneProblem) -> TuneProblem:
-    """`problem` with its content key set (required before shipping it to workers)."""
-    return problem if problem.key else problem.with_key()

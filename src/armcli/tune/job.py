@@ -11,7 +11,6 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -21,6 +20,7 @@ from armcli.io.yaml import load_yaml
 from armcli.sim.job import ARM_URDF, SETTLE_EXTRA_S, start_state
 from armcli.sim.reference import Reference, build_reference
 from armcli.sim.trajectory import Trajectory, load_trajectory
+from armcli.spec.model import RobotSpec
 from armcli.tune.model_gains import (
     LOOPS,
     STABILITY_MARGIN,
@@ -93,7 +93,9 @@ def _validate(s: TuneSettings) -> None:
             raise InputError(f"need 0 < a <= b, got {a:g},{b:g}", field=field)
 
 
-def _pose_cases(spec: Any, joints: Sequence[str], q0: np.ndarray, settle: float) -> list[Case]:
+def _pose_cases(
+    spec: RobotSpec, joints: Sequence[str], q0: np.ndarray, settle: float
+) -> list[Case]:
     """Each named pose that differs from the start, as a step at t = 0."""
     cases = []
     for name in sorted(spec.poses):
@@ -121,7 +123,9 @@ def largest_steps(cases: Sequence[Case], n: int) -> np.ndarray:
     return out
 
 
-def prepare(spec: Any, spec_path: Path, trajectories: Sequence[Path], s: TuneSettings) -> TuneJob:
+def prepare(
+    spec: RobotSpec, spec_path: Path, trajectories: Sequence[Path], s: TuneSettings
+) -> TuneJob:
     """Validate every input and build the job; raises InputError/SpecError on bad input."""
     _validate(s)
     xml = expand_urdfs(spec)[ARM_URDF].decode("utf-8")
@@ -155,7 +159,7 @@ def prepare(spec: Any, spec_path: Path, trajectories: Sequence[Path], s: TuneSet
     return TuneJob(problem, start, _spec_gains(spec, joints))
 
 
-def _spec_gains(spec: Any, joints: Sequence[str]) -> np.ndarray | None:
+def _spec_gains(spec: RobotSpec, joints: Sequence[str]) -> np.ndarray | None:
     gains = spec.control.gains
     if not all(j in gains and gains[j].ki == 0.0 for j in joints):
         return None  # missing, or PID: the PD simulator cannot reproduce it
