@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -70,7 +71,13 @@ def tune_cmd(
         help="Aggregate over the perturbed models: worst (default) or quantile.",
     ),
     quantile: float = typer.Option(0.9, "--quantile", help="Quantile for --robust-mode quantile."),
-    jobs: int = typer.Option(1, "--jobs", "-j", help="Local threads scoring candidates."),
+    jobs: int = typer.Option(
+        None,
+        "--jobs",
+        "-j",
+        show_default=False,
+        help="Local threads scoring candidates (default: every core).",
+    ),
     scheduler: str = typer.Option(
         None,
         "--scheduler",
@@ -100,7 +107,7 @@ def tune_cmd(
         seed,
     )
     job = tjob.prepare(load_spec(spec_path), spec_path, trajectory or [], settings)
-    engine = make_engine(jobs, scheduler)
+    engine = make_engine(jobs if jobs is not None else (os.cpu_count() or 1), scheduler)
     try:
         _run(job, engine, opts, output, plot, write, spec_path)
     finally:
