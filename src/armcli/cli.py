@@ -25,9 +25,24 @@ app = typer.Typer(
 )
 
 
+def _version(value: bool) -> None:
+    if value:
+        from armcli.about import version_lines
+
+        sys.stdout.write("".join(f"{line}\n" for line in version_lines()))
+        raise typer.Exit()
+
+
 @app.callback()
 def _root(
     debug: bool = typer.Option(False, "--debug", help="Show Python tracebacks for errors."),
+    version: bool = typer.Option(
+        False,
+        "--version",
+        is_eager=True,
+        callback=_version,
+        help="Show the version, the simulator engine (compiled or Python), pin and xacro.",
+    ),
 ) -> None:
     """armcli: robot descriptions without ROS."""
     if debug:
@@ -35,9 +50,9 @@ def _root(
 
 
 def _register() -> None:
-    from armcli.commands import build, check, ros, simulate, view
+    from armcli.commands import build, check, init, ros, simulate, view
 
-    for module in (build, check, simulate, ros, view):
+    for module in (init, build, check, simulate, ros, view):
         module.register(app)
 
 

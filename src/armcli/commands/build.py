@@ -7,11 +7,12 @@ from pathlib import Path
 
 import typer
 
-from armcli.defaults import DEFAULT_SPEC
+from armcli.defaults import SPEC_HELP
+from armcli.spec_discovery import find_spec
 
 
 def build_cmd(
-    spec: Path = typer.Argument(DEFAULT_SPEC, help="Robot spec YAML."),
+    spec: Path | None = typer.Argument(None, help=SPEC_HELP, show_default=False),
     out: Path = typer.Option(Path("urdf"), "-o", "--out", help="Output directory."),
     check: bool = typer.Option(
         False, "--check", help="Do not write; exit 1 listing files that differ from a fresh build."
@@ -20,6 +21,7 @@ def build_cmd(
     """Compile SPEC into the course's xacro set and the expanded URDFs."""
     from armcli.build import build, check_fresh
 
+    spec = find_spec(spec)
     if check:
         check_fresh(spec, out)
         sys.stdout.write(f"{out}: up to date with {spec}\n")

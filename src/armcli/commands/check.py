@@ -8,9 +8,9 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import EXIT_UNUSABLE, ArmcliError
 from armcli.robot_source import TRUST_XACRO_HELP
+from armcli.spec_discovery import find_spec
 
 if TYPE_CHECKING:
     from armcli.checks import CheckOptions, CheckResult
@@ -98,7 +98,7 @@ def check_cmd(
         from armcli.spec import load_spec
 
         base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs)
-    results, errors = _run(list(paths or [DEFAULT_SPEC]), base, trust_xacro)
+    results, errors = _run(list(paths or [find_spec(None)]), base, trust_xacro)
     findings = apply_policy((f for r in results for f in r.findings), ignore=ignore, strict=strict)
     n_err = counts(findings)["error"]
     code = 2 if errors else (1 if n_err else 0)

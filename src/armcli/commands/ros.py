@@ -7,13 +7,14 @@ from pathlib import Path
 
 import typer
 
-from armcli.defaults import DEFAULT_SPEC
+from armcli.defaults import SPEC_HELP
+from armcli.spec_discovery import find_spec
 
 DEFAULT_SAMPLES = 10_000  # keep equal to armcli.collision_matrix.DEFAULT_SAMPLES (lazy import)
 
 
 def ros_package_cmd(
-    spec: Path = typer.Argument(DEFAULT_SPEC, help="Robot spec YAML."),
+    spec: Path | None = typer.Argument(None, help=SPEC_HELP, show_default=False),
     out: Path = typer.Option(Path("ros"), "-o", "--out", help="Output directory."),
     samples: int = typer.Option(
         DEFAULT_SAMPLES, "--samples", min=1, help="Random states for the collision matrix."
@@ -27,6 +28,7 @@ def ros_package_cmd(
     from armcli.build import spec_label
     from armcli.ros_package import PackageInfo, write_ros_packages
 
+    spec = find_spec(spec)
     info = PackageInfo(maintainer=maintainer, email=email, license=license_)
     pkgs, written = write_ros_packages(
         spec, out, label=spec_label(spec), samples=samples, seed=seed, info=info

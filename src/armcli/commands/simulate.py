@@ -9,8 +9,9 @@ from typing import Any
 
 import typer
 
-from armcli.defaults import DEFAULT_SPEC
+from armcli.defaults import SPEC_HELP
 from armcli.robot_source import TRUST_XACRO_HELP
+from armcli.spec_discovery import find_spec
 
 PROGRESS_AFTER_S = 1.0  # show a progress bar when the run is projected to take longer
 
@@ -27,7 +28,7 @@ def _floats(text: str | None, option: str) -> list[float] | None:
 
 
 def simulate_cmd(
-    spec: Path = typer.Argument(None, help=f"Robot spec YAML (default: {DEFAULT_SPEC})."),
+    spec: Path = typer.Argument(None, help=SPEC_HELP, show_default=False),
     trajectory: Path = typer.Option(
         None,
         "--trajectory",
@@ -75,7 +76,7 @@ def simulate_cmd(
         )
     if output is not None:
         simreport.output_format(output)
-    spec_obj = load_spec(spec or DEFAULT_SPEC) if (spec is not None or urdf is None) else None
+    spec_obj = load_spec(find_spec(spec)) if (spec is not None or urdf is None) else None
     job = simjob.prepare(
         spec=spec_obj,
         urdf=urdf,

@@ -14,14 +14,17 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import InputError
 from armcli.robot_source import TRUST_XACRO_HELP
+from armcli.spec_discovery import find_spec
 
 if TYPE_CHECKING:
     from armcli.render import Tool
 
-ROBOT_HELP = "Robot spec YAML, URDF file, or xacro file (with --trust-xacro)."
+ROBOT_HELP = (
+    "Robot spec YAML, URDF file, or xacro file (with --trust-xacro); "
+    "default: ./armcli.yaml, else the spec in specs/."
+)
 
 
 @dataclass(frozen=True)
@@ -37,14 +40,15 @@ class RobotSource:
     tool: Tool | None = None
 
 
-def load_robot(path: Path, trust_xacro: bool = False) -> RobotSource:
+def load_robot(path: Path | None, trust_xacro: bool = False) -> RobotSource:
     """Spec YAML (built in memory), URDF or trusted xacro file -> RobotSource.
 
-    Mesh URIs must resolve inside robot_source.allowed_roots.
+    Mesh URIs must resolve inside robot_source.allowed_roots; no path: `find_spec`'s.
     """
     from armcli.render import Tool
     from armcli.robot_source import read_robot, urdf_text
 
+    path = find_spec(path)
     robot = read_robot(path, trust_xacro=trust_xacro)
     spec = robot.spec
     if spec is not None:
@@ -118,7 +122,7 @@ def _size(text: str) -> tuple[int, int]:
 
 
 def render_cmd(
-    robot: Path = typer.Argument(DEFAULT_SPEC, help=ROBOT_HELP),
+    robot: Path | None = typer.Argument(None, help=ROBOT_HELP, show_default=False),
     pose: str = typer.Option(None, "--pose", help="A named pose of the spec."),
     q: str = typer.Option(
         None,
@@ -154,7 +158,7 @@ def render_cmd(
 
 
 def tree_cmd(
-    robot: Path = typer.Argument(DEFAULT_SPEC, help=ROBOT_HELP),
+    robot: Path | None = typer.Argument(None, help=ROBOT_HELP, show_default=False),
     fmt: str = typer.Option("text", "--format", help="text (a tree) or dot (Graphviz)."),
     out: Path = typer.Option(None, "-o", "--out", help="Write to this file instead of stdout."),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
@@ -189,7 +193,7 @@ def tree_cmd(
 
 
 def view_cmd(
-    robot: Path = typer.Argument(DEFAULT_SPEC, help=ROBOT_HELP),
+    robot: Path | None = typer.Argument(None, help=ROBOT_HELP, show_default=False),
     replay: Path = typer.Option(None, "--replay", help="A CSV written by `armcli simulate`."),
     pose: str = typer.Option(None, "--pose", help="Start at this named pose."),
     host: str = typer.Option("127.0.0.1", "--host", help="Address to listen on."),

@@ -1,0 +1,39 @@
+"""`armcli init`: start a project outside the repository from a shipped example."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import typer
+
+from armcli.defaults import SPEC_FILE, TRAJECTORY_DIR
+
+
+def init_cmd(
+    directory: Path = typer.Argument(
+        Path("."), help="Where to write (created if missing; default: here)."
+    ),
+    template: str = typer.Option(
+        "course", "--template", help="course (2-axis arm on a mobile base) or tabletop (3-axis)."
+    ),
+) -> None:
+    """Write an example spec (armcli.yaml), its trajectories and a README; never overwrites."""
+    from armcli.scaffold import init_project
+
+    written = init_project(directory, template)
+    where = "." if directory == Path(".") else str(directory)
+    sys.stdout.write(f"wrote {len(written)} files into {where}{os.sep}\n")
+    for path in written:
+        sys.stdout.write(f"  {path}\n")
+    cd = "" if where == "." else f"cd {where} && "
+    pick = (TRAJECTORY_DIR / "pick.yaml").as_posix()
+    sys.stdout.write(
+        f"next: {cd}armcli build && armcli check && armcli simulate --trajectory {pick}"
+        f"  (commands read ./{SPEC_FILE} when no spec is given)\n"
+    )
+
+
+def register(app: typer.Typer) -> None:
+    app.command("init")(init_cmd)
