@@ -1,20 +1,15 @@
-"""armcli: typed robot-arm specs compiled to ROS-ready xacro/URDF, checked and simulated."""
+"""armcli: typed robot-arm specs -> ROS-ready URDF, physical checks and simulation, without ROS."""
 
 from __future__ import annotations
 
-from typing import Any
 
+def __getattr__(name: str) -> str:
+    """`armcli.__version__`, read lazily: importlib.metadata costs ~50 ms at start-up."""
+    if name != "__version__":
+        raise AttributeError(name)
+    from importlib.metadata import PackageNotFoundError, version
 
-def __getattr__(name: str) -> Any:
-    """`armcli.__version__`, read from the installed metadata (pyproject.toml is the source).
-
-    Lazy, so `import armcli` does not pay for importlib.metadata on every command.
-    """
-    if name == "__version__":
-        from importlib import metadata
-
-        try:
-            return metadata.version("armcli")
-        except metadata.PackageNotFoundError:  # a bare source tree on sys.path
-            return "0+unknown"
-    raise AttributeError(f"module 'armcli' has no attribute {name!r}")
+    try:  # the one source of the version is pyproject.toml, via the installed metadata
+        return version("armcli")
+    except PackageNotFoundError:  # a source tree that was never installed
+        return "0+unknown"

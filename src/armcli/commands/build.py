@@ -7,8 +7,9 @@ from pathlib import Path
 
 import typer
 
+from armcli.build.expand import build, check_fresh
 from armcli.defaults import SPEC_HELP
-from armcli.spec_discovery import find_spec
+from armcli.spec.discover import find_spec
 
 
 def build_cmd(
@@ -19,8 +20,6 @@ def build_cmd(
     ),
 ) -> None:
     """Compile SPEC into the course's xacro set and the expanded URDFs."""
-    from armcli.build import build, check_fresh
-
     spec = find_spec(spec)
     if check:
         check_fresh(spec, out)

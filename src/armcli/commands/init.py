@@ -9,6 +9,7 @@ from pathlib import Path
 import typer
 
 from armcli.defaults import SPEC_FILE, TRAJECTORY_DIR
+from armcli.spec.scaffold import init_project
 
 
 def init_cmd(
@@ -20,8 +21,6 @@ def init_cmd(
     ),
 ) -> None:
     """Write an example spec (armcli.yaml), its trajectories and a README; never overwrites."""
-    from armcli.scaffold import init_project
-
     written = init_project(directory, template)
     where = "." if directory == Path(".") else str(directory)
     sys.stdout.write(f"wrote {len(written)} files into {where}{os.sep}\n")
@@ -36,4 +35,5 @@ def init_cmd(
 
 
 def register(app: typer.Typer) -> None:
+    """Add `init` to the app."""
     app.command("init")(init_cmd)
