@@ -26,10 +26,8 @@ from packaging.utils import canonicalize_name
 
 ROOT = Path(__file__).resolve().parents[1]
 # Not part of a source distribution: local state, caches and outputs of the checkout.
-NOT_SOURCE = shutil.ignore_patterns(
-    ".git", ".venv", "build", "dist", "out", "ros", "__pycache__", "*.egg-info", ".*_cache",
-    ".hypothesis", "MUJOCO_LOG.TXT",
-)  # fmt: skip
+TOP_LEVEL_LOCAL = {".git", ".venv", "build", "dist", "out", "ros", ".hypothesis", "MUJOCO_LOG.TXT"}
+ANYWHERE_LOCAL = shutil.ignore_patterns("__pycache__", "*.egg-info", ".*_cache")
 PIP_TIMEOUT_S = 600
 
 
@@ -89,10 +87,21 @@ def wheelhouse() -> Path:
     return path
 
 
+def _not_source(directory: str, names: list[str]) -> set[str]:
+    """Names copytree skips: checkout-local state at the top, caches anywhere.
+
+    Only at the top: `src/armcli/build/` is a package, not a build directory.
+    """
+    skip = set(ANYWHERE_LOCAL(directory, names))
+    if Path(directory) == ROOT:
+        skip |= TOP_LEVEL_LOCAL & set(names)
+    return skip
+
+
 def build_wheel(out: Path, house: Path) -> Path:
     """`pip wheel --no-deps` of a clean copy of the checkout (no stale build/ reused)."""
     src = out / "src-copy"
-    shutil.copytree(ROOT, src, symlinks=True, ignore=NOT_SOURCE)
+    shutil.copytree(ROOT, src, symlinks=True, ignore=_not_source)
     dist = out / "dist"
     _pip("wheel", "-q", "--no-deps", "--no-index", "--find-links", house, "-w", dist, src)
     (wheel,) = dist.glob("armcli-*.whl")
