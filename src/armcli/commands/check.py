@@ -64,7 +64,9 @@ def _run(
 
 def check_cmd(
     paths: list[Path] = typer.Argument(
-        None, help="URDF files, spec YAMLs (built in memory) or directories (every *.urdf)."
+        None,
+        help="URDF files, spec YAMLs (built in memory) or directories (every *.urdf); "
+        "default: ./armcli.yaml, else the spec in specs/.",
     ),
     spec: Path | None = typer.Option(
         None, "--spec", help="Spec to compare limits with; also gives gains, dt, poses, tool."
