@@ -13,8 +13,10 @@ from armcli.spec.discover import find_spec
 
 
 def build_cmd(
-    spec: Path | None = typer.Argument(None, help=SPEC_HELP, show_default=False),
-    out: Path = typer.Option(Path("urdf"), "-o", "--out", help="Output directory."),
+    spec: Path | None = typer.Argument(None, show_default=False, help=SPEC_HELP),
+    out: Path = typer.Option(
+        Path("urdf"), "-o", "--out", show_default=False, help="Output directory (default: urdf)."
+    ),
     check: bool = typer.Option(
         False, "--check", help="Do not write; exit 1 listing files that differ from a fresh build."
     ),
@@ -32,4 +34,5 @@ def build_cmd(
 
 
 def register(app: typer.Typer) -> None:
+    """Add the `build` command to the typer app."""
     app.command("build")(build_cmd)

@@ -61,6 +61,7 @@ def _command(out: Path) -> list[str]:
 
 
 def cache_dir() -> Path:
+    """Where compiled libraries go: $ARMCLI_CACHE_DIR, else the XDG cache, plus `native`."""
     base = os.environ.get("ARMCLI_CACHE_DIR") or os.path.join(
         os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "armcli"
     )
@@ -100,6 +101,7 @@ def build(force: bool = False) -> Path:
 
 
 def why_missing() -> str:
+    """Why `load()` gave None, for the fallback message: not built, or failed to load."""
     if not SOURCE.is_file():  # a wheel install ships no C++ source
         return f"this installation has no {SOURCE.name}"
     path = library_path()

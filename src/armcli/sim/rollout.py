@@ -180,8 +180,11 @@ class _Stepper:
 
 
 def rollout_python(plant: Plant, q0: np.ndarray, v0: np.ndarray, ref: np.ndarray) -> Rollout:
-    """Reference implementation. `ref` rows are [q_ref, v_ref] at t = k dt (Euler,
-    steps + 1 rows) or k dt/2 (RK4, 2 steps + 1 rows)."""
+    """Reference implementation of the rollout; the compiled `_native` one does the same.
+
+    `ref` rows are [q_ref, v_ref] at t = k dt (Euler, steps + 1 rows) or k dt/2 (RK4,
+    2 steps + 1 rows).
+    """
     s = _Stepper(plant)
     n = s.n
     steps = (ref.shape[0] - 1) // (2 if plant.integrator == "rk4" else 1)
