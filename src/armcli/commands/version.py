@@ -27,10 +27,16 @@ def _dist_version(name: str) -> str:
 
 
 def engine() -> str:
-    """`compiled` or `Python`, with where the library is or why it is missing."""
-    if native.load() is not None:
-        return f"compiled ({native.library_path()})"
-    return f"Python (no compiled rollout: {native.why_missing()})"
+    """`compiled` or `Python`: what `simulate --engine auto` runs, and where or why not.
+
+    Asks `native.load()`, the same check the simulator makes, so the answer cannot differ
+    from what `simulate` does.
+    """
+    lib = native.load()
+    if lib is None:
+        return f"Python (no compiled rollout: {native.why_missing()})"
+    where = getattr(lib, "__file__", None) or getattr(lib, "_name", "")  # module or CDLL
+    return f"compiled ({where})"
 
 
 def version_lines() -> list[str]:
