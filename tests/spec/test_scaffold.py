@@ -8,7 +8,8 @@ import pytest
 import yaml
 
 from armcli.cli import main
-from armcli.spec.scaffold import TEMPLATES, template_files
+from armcli.errors import InputError
+from armcli.spec.scaffold import TEMPLATES, init_project, template_files
 from tests.helpers import ROOT
 
 EXAMPLES = ROOT / "src" / "armcli" / "examples"
@@ -97,8 +98,8 @@ def test_init_into_a_file_is_refused(tmp_path: Path, capsys: pytest.CaptureFixtu
 
 
 def test_unknown_template(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert _main(["init", str(tmp_path), "--template", "ur5"]) == 2
-    assert capsys.readouterr().err == (
-        "error: --template: unknown template 'ur5'; known: course, tabletop\n"
-    )
+    assert _main(["init", str(tmp_path), "--template", "ur5"]) == 2  # a usage error
+    assert "'ur5' is not one of 'course', 'tabletop'" in capsys.readouterr().err
+    with pytest.raises(InputError, match="unknown template 'ur5'; known: course, tabletop"):
+        init_project(tmp_path, "ur5")  # the library call says the same
     assert list(tmp_path.iterdir()) == []

@@ -6,18 +6,23 @@ import os
 import sys
 from pathlib import Path
 
+import click
 import typer
 
 from armcli.defaults import SPEC_FILE, TRAJECTORY_DIR
-from armcli.spec.scaffold import init_project
+from armcli.spec.scaffold import DEFAULT_TEMPLATE, TEMPLATES, init_project
 
 
 def init_cmd(
     directory: Path = typer.Argument(
-        Path("."), help="Where to write (created if missing; default: here)."
+        Path("."), show_default=False, help="Where to write (created if missing; default: here)."
     ),
     template: str = typer.Option(
-        "course", "--template", help="course (2-axis arm on a mobile base) or tabletop (3-axis)."
+        DEFAULT_TEMPLATE,
+        "--template",
+        click_type=click.Choice(tuple(TEMPLATES)),
+        show_default=False,
+        help="course (default: a 2-axis arm on a mobile base) or tabletop (a 3-axis arm).",
     ),
 ) -> None:
     """Write an example spec (armcli.yaml), its trajectories and a README; never overwrites."""
