@@ -13,7 +13,7 @@ import sys
 import typer
 import typer.core
 
-from armcli.commands import build, check, init, render, ros, simulate, tree, view
+from armcli.commands import build, check, export, init, render, ros, simulate, tree, view
 from armcli.commands.version import version_lines
 from armcli.errors import EXIT_FAILED, ArmcliError
 
@@ -52,7 +52,7 @@ def _root(
     """armcli: robot descriptions without ROS."""
 
 
-for _module in (init, build, check, simulate, ros, view, render, tree):
+for _module in (init, build, check, simulate, ros, view, render, tree, export):
     _module.register(app)
 
 

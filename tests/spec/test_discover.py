@@ -61,10 +61,12 @@ def test_nothing_here_says_to_run_init() -> None:
         find_spec(None)
 
 
-@pytest.mark.parametrize("command", ["build", "check", "simulate", "ros-package", "render", "tree"])
+@pytest.mark.parametrize(
+    "command", ["build", "check", "simulate", "ros-package", "render", "tree", "export mjcf"]
+)
 def test_commands_say_to_run_init(command: str, capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as info:
-        main([command])
+        main(command.split())
     err = capsys.readouterr().err
     assert info.value.code == 2
     assert err.count("\n") == 1 and "no ./armcli.yaml or specs/*.yaml here" in err
