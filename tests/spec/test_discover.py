@@ -62,7 +62,8 @@ def test_nothing_here_says_to_run_init() -> None:
 
 
 @pytest.mark.parametrize(
-    "command", ["build", "check", "simulate", "ros-package", "render", "tree", "export mjcf"]
+    "command",
+    ["build", "check", "simulate", "tune", "ros-package", "render", "tree", "export mjcf"],
 )
 def test_commands_say_to_run_init(command: str, capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as info:
