@@ -34,7 +34,7 @@ def run() -> dict[str, object]:
     keys: list[str] = []
     files = corpus()
     for path in files:
-        name = path.as_posix().split("/robots/")[1]
+        name = path.as_posix().split("/robots/", 1)[1]
         try:
             result = check_urdf(read_urdf(path), CheckOptions())
         except ArmcliError:

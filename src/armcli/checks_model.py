@@ -17,9 +17,13 @@ from armcli.checks_structure import Tree, finite
 from armcli.stability import StabilityReport
 from armcli.urdfdoc import Urdf
 
+# Skip the model after these: urdfdom would only repeat them (a NaN mass came back as
+# two parser errors; a nameless <robot> as model-load).
 _STRUCTURE_ERRORS = (
+    "robot-name",
     "duplicate-name",
     "number-syntax",
+    "non-finite",
     "vector-length",
     "unknown-link",
     "multiple-parents",

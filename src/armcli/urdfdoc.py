@@ -76,6 +76,7 @@ class Limit:
     effort: float | None
     velocity: float | None
     line: int | None
+    missing_bounds: tuple[str, ...] = ()  # "lower"/"upper" absent (URDF reads them as 0)
 
 
 @dataclass(frozen=True)
@@ -105,6 +106,7 @@ class Material:
     rgba: tuple[float, ...] | None
     line: int | None
     top_level: bool
+    texture: str | None = None  # <texture filename=...>
 
 
 @dataclass(frozen=True)
@@ -118,6 +120,7 @@ class Urdf:
     joints: tuple[Joint, ...]
     materials: tuple[Material, ...]
     problems: tuple[NumberProblem, ...] = field(default=())
+    line: int | None = None  # the <robot> element's
 
     def link(self, name: str) -> Link | None:
         return next((lk for lk in self.links if lk.name == name), None)
