@@ -97,9 +97,9 @@ def test_foreign_xacro_is_refused_without_running_it(tmp_path: Path) -> None:
 
 def test_trusted_xacro_is_expanded_in_a_sandbox() -> None:
     r = armcli("check", "--trust-xacro", FIXTURES / "course_macros.urdf.xacro", "--format", "json")
-    assert r.returncode == 0, r.stderr  # the macro bugs are warnings
+    assert r.returncode == 1, r.stderr  # the 4x inertias are impossible for their shapes
     (f,) = json.loads(r.stdout)["files"]
-    assert {x["rule"] for x in f["findings"]} == {"inertia-geometry"}
+    assert {x["rule"] for x in f["findings"]} == {"inertia-geometry", "inertia-exceeds-geometry"}
 
 
 @pytest.mark.parametrize(

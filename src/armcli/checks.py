@@ -226,6 +226,7 @@ class Collector:
         line: int | None,
         message: str,
         fix: Mapping[str, Value] | None = None,
+        /,
         **values: Value,
     ) -> None:
         """Record a finding; `fix` holds the numeric remedy (e.g. the inertia that would pass)."""

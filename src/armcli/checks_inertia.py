@@ -93,7 +93,7 @@ def _tensor_ok(link: Link, ine: Inertial, out: Collector) -> np.ndarray | None:
             f"all within {noise:.3g} kg m² of zero for mass {ine.mass:g} kg; MuJoCo rejects a "
             "non-zero tensor without positive eigenvalues: write the part's inertia"
             + _fix_suffix(fix := _solid_fix(link, ine)),
-            fix=fix,
+            fix,
             link=link.name,
             principal=[float(x) for x in moments],
             **vals,
@@ -105,7 +105,7 @@ def _tensor_ok(link: Link, ine: Inertial, out: Collector) -> np.ndarray | None:
             ine.inertia_line,
             f"link {link.name!r}: inertia not positive definite, principal moments "
             f"{_fmt(moments)} for mass {ine.mass:g} kg" + _fix_suffix(fix := _solid_fix(link, ine)),
-            fix=fix,
+            fix,
             link=link.name,
             principal=[float(x) for x in moments],
             **vals,
@@ -120,7 +120,7 @@ def _tensor_ok(link: Link, ine: Inertial, out: Collector) -> np.ndarray | None:
             f"link {link.name!r}: principal moments {_fmt(moments)}: "
             f"{c:.4g} > {a:.4g} + {b:.4g} (by {excess:.1%})"
             + _fix_suffix(fix := _solid_fix(link, ine)),
-            fix=fix,
+            fix,
             link=link.name,
             principal=[float(x) for x in moments],
             excess=excess,
@@ -211,7 +211,7 @@ def _versus_geometry(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -
             f"link {link.name!r}: inertia diag "
             f"{_fmt(got)} (geometry frame) vs solid {g.kind} {dims} m, {m:g} kg: "
             f"{_fmt(want)}{_diagnosis(got, want)}{_fix_suffix(fix)}",
-            fix=fix,
+            fix,
             link=link.name,
             actual=_list(got),
             expected=_list(want),
@@ -265,7 +265,7 @@ def _exceeds(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -> bool:
         f"solid {g.kind}: {_fmt(solid)} "
         f"(geometry frame){_diagnosis(np.diag(inr.rotate(J, R_geom_inertial)), solid)}"
         f"{_fix_suffix(fix)}",
-        fix=fix,
+        fix,
         link=link.name,
         axes=", ".join(ex.axes),
         about_centre=list(ex.centre),

@@ -86,7 +86,7 @@ def excess(J_geom: Matrix, m: float, com_offset: NDArray[np.float64], g: Geometr
         com_offset: centre of mass minus shape centre [m], in the geometry frame.
         g: the primitive.
     """
-    about_centre = np.diag(inr.parallel_axis(J_geom, m, com_offset))
+    about_centre = np.diag(inr.parallel_axis(J_geom, m, [float(x) for x in com_offset]))
     bound = extreme_bound(g, m)
     over = tuple(
         a for a, i, b in zip(AXES, about_centre, bound, strict=True) if i > b * (1 + EXCEEDS_RTOL)

@@ -13,10 +13,9 @@ from armcli.errors import EXIT_UNUSABLE, ArmcliError
 from armcli.robot_source import TRUST_XACRO_HELP
 
 if TYPE_CHECKING:
-    from armcli.checks import CheckOptions, CheckResult
-    from armcli.urdfdoc import Urdf
+    from armcli.check_inputs import CheckRun
 
-FORMATS = ("table", "json", "github")
+FORMATS = ("table", "json", "github", "sarif")
 REPORT_WIDTH = 140  # columns when stdout is not a terminal (CI logs, pipes)
 
 
@@ -32,42 +31,6 @@ def _package_dirs(values: list[str]) -> dict[str, Path]:
     return out
 
 
-def _documents(path: Path, trust_xacro: bool) -> list[tuple[Urdf, Any]]:
-    """The URDF documents a PATH stands for, each with the spec it came from (or None)."""
-    from armcli.errors import InputError
-    from armcli.robot_source import read_robot, read_urdf_file
-
-    if path.is_dir():
-        files = sorted(p for p in path.rglob("*.urdf") if p.is_file())
-        if not files:
-            raise InputError("no *.urdf files under this directory", file=path)
-        return [(read_urdf_file(p, trust_xacro=trust_xacro), None) for p in files]
-    robot = read_robot(path, trust_xacro=trust_xacro)
-    return [(urdf, robot.spec) for urdf in robot.urdfs]
-
-
-def _run(
-    paths: list[Path], base: CheckOptions, trust_xacro: bool
-) -> tuple[list[CheckResult], list[ArmcliError]]:
-    from dataclasses import replace
-
-    from armcli.checks import check_urdf
-    from armcli.errors import InputError
-
-    results: list[CheckResult] = []
-    errors: list[ArmcliError] = []
-    for path in paths:
-        try:
-            docs = _documents(path, trust_xacro)
-        except InputError as exc:
-            errors.append(exc)
-            continue
-        for urdf, spec in docs:
-            opts = replace(base, spec=spec) if spec is not None else base
-            results.append(check_urdf(urdf, opts))
-    return results, errors
-
-
 def check_cmd(
     paths: list[Path] = typer.Argument(
         None, help="URDF files, spec YAMLs (built in memory) or directories (every *.urdf)."
@@ -75,7 +38,9 @@ def check_cmd(
     spec: Path | None = typer.Option(
         None, "--spec", help="Spec to compare limits with; also gives gains, dt, poses, tool."
     ),
-    fmt: str = typer.Option("table", "--format", help="table, json or github."),
+    fmt: str = typer.Option(
+        "table", "--format", help="table, json, github (annotations) or sarif (SARIF 2.1.0)."
+    ),
     strict: bool = typer.Option(False, "--strict", help="Treat warnings as errors."),
     ignore: list[str] = typer.Option([], "--ignore", help="Silence a rule id (repeatable)."),
     package_dir: list[str] = typer.Option(
@@ -84,8 +49,9 @@ def check_cmd(
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Check robot descriptions for physical sanity; exit 1 on error findings."""
+    from armcli.check_inputs import run_check
     from armcli.checks import RULES, CheckOptions, apply_policy
-    from armcli.errors import FindingsError, InputError
+    from armcli.errors import EXIT_FAILED, EXIT_UNUSABLE, FindingsError, InputError
     from armcli.report import counts
 
     if fmt not in FORMATS:
@@ -98,30 +64,39 @@ def check_cmd(
         from armcli.spec import load_spec
 
         base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs)
-    results, errors = _run(list(paths or [DEFAULT_SPEC]), base, trust_xacro)
-    findings = apply_policy((f for r in results for f in r.findings), ignore=ignore, strict=strict)
-    n_err = counts(findings)["error"]
-    code = 2 if errors else (1 if n_err else 0)
-    _print(results, findings, fmt, code)
-    if errors:
-        raise _UnusableInputsError(errors)
-    if n_err:
-        raise FindingsError(f"{n_err} error finding(s) in {len(results)} file(s)")
+    run = run_check(list(paths or [DEFAULT_SPEC]), base, trust_xacro=trust_xacro)
+    everything = [f for r in run.results for f in r.findings]
+    everything += [u.finding() for u in run.unusable]
+    findings = apply_policy(everything, ignore=ignore, strict=strict)
+    code = run.exit_code(findings)
+    _print(run, findings, fmt, code)
+    if code == EXIT_UNUSABLE:
+        raise _UnusableInputsError([u.error for u in run.unusable])
+    if code == EXIT_FAILED:
+        n_err = counts(findings)["error"]
+        raise FindingsError(
+            f"{n_err} error finding(s) in {len(run.results) + len(run.unusable)} file(s)"
+        )
 
 
-def _print(results: list[CheckResult], findings: list[Any], fmt: str, code: int) -> None:
+def _print(run: CheckRun, findings: list[Any], fmt: str, code: int) -> None:
     from armcli import report
 
+    unusable = [(u.file, u.error.message) for u in run.unusable]
     if fmt == "json":
-        sys.stdout.write(report.to_json(results, findings, code))
+        sys.stdout.write(report.to_json(run.results, findings, code, unusable))
     elif fmt == "github":
         sys.stdout.write(report.to_github(findings))
-    elif results:
+    elif fmt == "sarif":
+        from armcli.sarif import to_sarif
+
+        sys.stdout.write(to_sarif(findings))
+    elif run.results or run.unusable:
         from rich.console import Console
 
         width = None if sys.stdout.isatty() else REPORT_WIDTH
         console = Console(file=sys.stdout, highlight=False, soft_wrap=False, width=width)
-        for item in report.to_rich(results, findings):
+        for item in report.to_rich(run.results, findings, [u for u, _ in unusable]):
             console.print(item)
 
 
