@@ -124,8 +124,11 @@ def test_good_and_bad_inputs_report_the_good_and_exit_2(tmp_path: Path) -> None:
     r = armcli("check", "urdf/my_robot.urdf", tmp_path / "missing.urdf", "--format", "json")
     assert r.returncode == 2
     doc = json.loads(r.stdout)
-    assert [f["file"] for f in doc["files"]] == ["urdf/my_robot.urdf"]
-    assert doc["exit_code"] == 2
+    good, bad = doc["files"]
+    assert good["file"] == "urdf/my_robot.urdf" and "error" not in good
+    assert bad["file"] == str(tmp_path / "missing.urdf") and "cannot read" in bad["error"]
+    assert [f["rule"] for f in bad["findings"]] == ["input-unusable"]
+    assert doc["exit_code"] == 2  # a file named on the command line is unusable
 
 
 def test_directory_and_spec_option(tmp_path: Path) -> None:
@@ -192,7 +195,10 @@ def test_sandbox_stops_runaway_xacro(tmp_path: Path) -> None:
 
 def test_docs_list_every_rule() -> None:
     from armcli.checks import RULES
+    from armcli.rule_docs import render
 
     doc = (ROOT / "docs" / "check.md").read_text()
     for rule in RULES.values():
         assert f"| `{rule.id}` | {rule.severity} |" in doc, rule.id
+    # The table is the registry's: `python -m armcli.rule_docs docs/check.md` regenerates it.
+    assert render(doc) == doc

@@ -91,7 +91,7 @@ def _print(run: CheckRun, findings: list[Any], fmt: str, code: int) -> None:
         from armcli.sarif import to_sarif
 
         sys.stdout.write(to_sarif(findings))
-    elif run.results or run.unusable:
+    elif run.results:  # nothing usable: the stderr lines say it all
         from rich.console import Console
 
         width = None if sys.stdout.isatty() else REPORT_WIDTH
