@@ -26,9 +26,15 @@ def corpus() -> list[Path]:
 def run() -> dict[str, object]:
     """Rule id -> number of findings (`(unusable)` counts exit-2 files), and every finding
     as "robot-path rule line" so that a diff names the findings that changed."""
-    from armcli.checks import CheckOptions, check_urdf
     from armcli.errors import ArmcliError
-    from armcli.urdfxml import read_urdf
+
+    try:  # the package layout since the subpackage refactor
+        from armcli.check.rules import CheckOptions
+        from armcli.check.run import check_urdf
+        from armcli.urdf.read import read_urdf
+    except ImportError:  # an older checkout's flat modules (for the "before" counts)
+        from armcli.checks import CheckOptions, check_urdf  # type: ignore[no-redef]
+        from armcli.urdfxml import read_urdf  # type: ignore[no-redef]
 
     totals: Counter[str] = Counter()
     keys: list[str] = []

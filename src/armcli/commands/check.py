@@ -4,24 +4,31 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import typer
 
+from armcli.check import report
+from armcli.check.inputs import CheckRun, run_check
+from armcli.check.report import counts
+from armcli.check.rules import RULES, CheckOptions, apply_policy
+from armcli.check.sarif import to_sarif
 from armcli.defaults import DEFAULT_SPEC
-from armcli.errors import EXIT_UNUSABLE, ArmcliError
-from armcli.robot_source import TRUST_XACRO_HELP
-
-if TYPE_CHECKING:
-    from armcli.check_inputs import CheckRun
+from armcli.errors import (
+    EXIT_FAILED,
+    EXIT_UNUSABLE,
+    FindingsError,
+    InputError,
+    UnusableInputsError,
+)
+from armcli.spec.load import load_spec
+from armcli.urdf.source import TRUST_XACRO_HELP
 
 FORMATS = ("table", "json", "github", "sarif")
 REPORT_WIDTH = 140  # columns when stdout is not a terminal (CI logs, pipes)
 
 
 def _package_dirs(values: list[str]) -> dict[str, Path]:
-    from armcli.errors import InputError
-
     out = {}
     for v in values:
         name, sep, path = v.partition("=")
@@ -49,11 +56,6 @@ def check_cmd(
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Check robot descriptions for physical sanity; exit 1 on error findings."""
-    from armcli.check_inputs import run_check
-    from armcli.checks import RULES, CheckOptions, apply_policy
-    from armcli.errors import EXIT_FAILED, EXIT_UNUSABLE, FindingsError, InputError
-    from armcli.report import counts
-
     if fmt not in FORMATS:
         raise InputError(f"unknown format {fmt!r}; known: {', '.join(FORMATS)}", field="--format")
     unknown = sorted(set(ignore) - set(RULES))
@@ -61,8 +63,6 @@ def check_cmd(
         raise InputError(f"unknown rule(s) {unknown}; known: {', '.join(RULES)}", field="--ignore")
     base = CheckOptions(package_dirs=_package_dirs(package_dir))
     if spec is not None:
-        from armcli.spec import load_spec
-
         base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs)
     run = run_check(list(paths or [DEFAULT_SPEC]), base, trust_xacro=trust_xacro)
     everything = [f for r in run.results for f in r.findings]
@@ -71,7 +71,7 @@ def check_cmd(
     code = run.exit_code(findings)
     _print(run, findings, fmt, code)
     if code == EXIT_UNUSABLE:
-        raise _UnusableInputsError([u.error for u in run.unusable])
+        raise UnusableInputsError([u.error for u in run.unusable])
     if code == EXIT_FAILED:
         n_err = counts(findings)["error"]
         raise FindingsError(
@@ -80,16 +80,12 @@ def check_cmd(
 
 
 def _print(run: CheckRun, findings: list[Any], fmt: str, code: int) -> None:
-    from armcli import report
-
     unusable = [(u.file, u.error.message) for u in run.unusable]
     if fmt == "json":
         sys.stdout.write(report.to_json(run.results, findings, code, unusable))
     elif fmt == "github":
         sys.stdout.write(report.to_github(findings))
     elif fmt == "sarif":
-        from armcli.sarif import to_sarif
-
         sys.stdout.write(to_sarif(findings))
     elif run.results:  # nothing usable: the stderr lines say it all
         from rich.console import Console
@@ -98,19 +94,6 @@ def _print(run: CheckRun, findings: list[Any], fmt: str, code: int) -> None:
         console = Console(file=sys.stdout, highlight=False, soft_wrap=False, width=width)
         for item in report.to_rich(run.results, findings, [u for u, _ in unusable]):
             console.print(item)
-
-
-class _UnusableInputsError(ArmcliError):
-    """One or more inputs could not be used: one line each, exit 2, after the others' report."""
-
-    exit_code = EXIT_UNUSABLE
-
-    def __init__(self, errors: list[ArmcliError]) -> None:
-        self.errors = errors
-        super().__init__(str(errors[0]))
-
-    def lines(self) -> list[str]:
-        return [line for e in self.errors for line in e.lines()]
 
 
 def register(app: typer.Typer) -> None:
