@@ -75,7 +75,8 @@ def check_cmd(
     if code == EXIT_FAILED:
         n_err = counts(findings)["error"]
         raise FindingsError(
-            f"{n_err} error finding(s) in {len(run.results) + len(run.unusable)} file(s)"
+            f"{n_err} error finding(s) in {len(run.results) + len(run.unusable)} file(s)",
+            [u.error for u in run.unusable],
         )
 
 
