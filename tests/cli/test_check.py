@@ -203,3 +203,15 @@ def test_docs_list_every_rule() -> None:
         assert f"| `{rule.id}` | {rule.severity} |" in doc, rule.id
     # The table is the registry's: `python -m armcli.check.rule_docs docs/check.md` regenerates it.
     assert render(doc) == doc
+
+
+@pytest.mark.parametrize(
+    "command", ["build", "check", "simulate", "ros-package", "view", "render", "tree"]
+)
+def test_help_lists_choices_and_prints_no_stray_escapes(command: str) -> None:
+    """Every --help renders plainly: no rich escape backslash before `[...]`."""
+    res = armcli(command, "--help")
+    assert res.returncode == 0 and "Usage:" in res.stdout
+    assert "\\" not in res.stdout
+    if command in ("check", "simulate"):
+        assert "[" in res.stdout and "|" in res.stdout  # a Choice lists its values

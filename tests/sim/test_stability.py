@@ -4,11 +4,18 @@ of a planar two-link arm, and brute-force iteration of the integrator itself."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
+from armcli.errors import InputError
 from armcli.sim import stability as stab
+from armcli.sim.job import load_arm
+from armcli.sim.simulate import Arm, SimConfig, check_stability
+from armcli.spec.load import load_spec
+from tests.helpers import DEFAULT_SPEC
 
 # The course arm (specs/my_robot.yaml): two solid cylinders r = 0.02 m, l = 0.3 m,
 # m = 0.3 kg, hinged at one end, both joints about y; gains Kp = 50, Kd = 5, joint
@@ -108,3 +115,65 @@ def test_pinocchio_crba_matches_the_textbook_matrix(root) -> None:
         M = pin.crba(model, data, q)
         M = np.triu(M) + np.triu(M, 1).T
         np.testing.assert_allclose(M, two_link_mass_matrix(q2), rtol=1e-9)
+
+
+# -- one bound for `check` and `simulate` ----------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def seed_arm() -> Arm:
+    return load_arm(load_spec(DEFAULT_SPEC), None, None)
+
+
+def _sweep() -> list[tuple[float, float, float, float]]:
+    """(Kp, Kd, damping, dt) around the seed arm's stability edge, undamped cases included."""
+    rng = np.random.default_rng(7)
+    cases = [(KP, 0.0, 0.0, DT), (4e5, 0.0, 0.0, DT), (KP, KD, DAMPING, DT), (1e3, 0.0, 0.0, 0.01)]
+    for _ in range(40):
+        kp = float(10 ** rng.uniform(0, 6))
+        kd = float(rng.choice([0.0, 10 ** rng.uniform(-2, 2)]))
+        d = float(rng.choice([0.0, 0.1]))
+        cases.append((kp, kd, d, float(10 ** rng.uniform(-4, -1.5))))
+    return cases
+
+
+@pytest.mark.parametrize(("kp", "kd", "damping", "dt"), _sweep())
+def test_check_verdict_equals_simulate_acceptance(
+    seed_arm: Arm, kp: float, kd: float, damping: float, dt: float
+) -> None:
+    """`check`'s implicit-loop verdict and `simulate`'s refusal come from one bound."""
+    arm = replace(seed_arm, damping=np.full(2, damping))
+    configs = np.array([[a, b] for a in (0.0, 0.8, 1.57) for b in (0.0, 0.8, 1.57)])
+    data = arm.model.createData()
+    Ms = []
+    for q in configs:
+        M = pin.crba(arm.model, data, q)
+        Ms.append(np.triu(M) + np.triu(M, 1).T)
+    rep = stab.analyse(Ms, configs.tolist(), [0, 1], [kp] * 2, [kd] * 2, [damping] * 2, dt)
+    cfg = SimConfig(kp=np.full(2, kp), kd=np.full(2, kd), dt=dt)
+    try:
+        check_stability(arm, cfg, configs)
+        accepted = True
+    except InputError:
+        accepted = False
+    assert rep.implicit.stable == accepted
+
+
+def test_undamped_loop_is_marginal_and_accepted() -> None:
+    """No damping: symplectic Euler keeps |eigenvalues| = 1 (a bounded oscillation) below the
+    Jury edge a < 4, so both commands accept it, and iterating it neither grows nor decays."""
+    M = two_link_mass_matrix(0.0)
+    rep = stab.analyse([M], [[0.0, 0.0]], [0, 1], [KP] * 2, [0.0] * 2, [0.0] * 2, DT)
+    assert rep.implicit.stable and rep.explicit.stable
+    assert rep.implicit.spectral_radius == pytest.approx(1.0, abs=stab.RADIUS_TOL)
+    assert simulate(M, KP, 0.0, DT, implicit=True) < 1.5  # bounded: no growth
+
+
+def test_largest_stable_dt_matches_the_closed_form() -> None:
+    """Bisection on the real step map equals the scalar Jury edge for equal gains."""
+    M = two_link_mass_matrix(0.0)
+    lam = float(np.linalg.eigvalsh(np.linalg.inv(M))[-1])
+    d = KD + DAMPING
+    kp_v, d_v = np.full(2, KP), np.full(2, d)
+    dt_exp = stab.largest_stable_dt([M], [0, 1], kp_v, d_v, "explicit", DT)
+    assert dt_exp == pytest.approx(stab.explicit_dt_max(KP, d, lam), rel=1e-9)

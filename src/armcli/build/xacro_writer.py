@@ -11,6 +11,8 @@ from __future__ import annotations
 from lxml import etree
 
 from armcli.build.xmlfmt import XACRO_NS, fmt, to_bytes, vec
+from armcli.defaults import STANDALONE_ARM as STANDALONE_ARM_NAME
+from armcli.defaults import STANDALONE_ARM_URDF, STANDALONE_ARM_XACRO
 from armcli.spec.model import Joint, Link, RobotSpec
 
 X = f"{{{XACRO_NS}}}"
@@ -21,7 +23,7 @@ MOBILE_BASE = "mobile_base.xacro"
 MOBILE_BASE_GAZEBO = "mobile_base_gazebo.xacro"
 ARM = "arm.xacro"
 ARM_GAZEBO = "arm_gazebo.xacro"
-STANDALONE_ARM = "standalone_arm.urdf.xacro"
+STANDALONE_ARM = STANDALONE_ARM_XACRO
 TOP = "{name}.urdf.xacro"
 
 # Solid-body inertia about the centroid, shape axes = inertial frame axes.
@@ -60,6 +62,11 @@ def _sub(parent: etree._Element, tag: str, **attrs: str) -> etree._Element:
 
 
 def common_properties(spec: RobotSpec) -> etree._Element:
+    """The common_properties.xacro tree: RViz materials and the inertia macros.
+
+    The box, cylinder and sphere macros give solid-body inertias [kg·m²] about the centroid,
+    so every link's inertia comes from one set of formulas.
+    """
     root = _robot()
     for name in sorted(spec.materials):
         mat = _sub(root, "material", name=name)
@@ -146,6 +153,11 @@ def _link(root: etree._Element, name: str, link: Link, refs: dict[str, str]) -> 
 
 
 def joint_element(parent: etree._Element, name: str, joint: Joint) -> etree._Element:
+    """Append the URDF `<joint>` of `joint` to `parent` and return it.
+
+    Fixed joints get no axis, limit or dynamics; continuous joints get only effort and
+    velocity limits. Values are written in SI units as the spec gives them.
+    """
     el = _sub(parent, "joint", name=name, type=joint.type)
     _sub(el, "parent", link=joint.parent)
     _sub(el, "child", link=joint.child)
@@ -215,6 +227,7 @@ def _flag(b: bool) -> str:
 
 
 def mobile_base_gazebo(spec: RobotSpec) -> etree._Element:
+    """The mobile_base_gazebo.xacro tree: base link materials and the diff-drive plugin."""
     root = _robot()
     assert spec.mobile_base is not None
     _gazebo_materials(root, spec, spec.mobile_base.links)
@@ -243,6 +256,7 @@ def mobile_base_gazebo(spec: RobotSpec) -> etree._Element:
 
 
 def arm_gazebo(spec: RobotSpec) -> etree._Element:
+    """The arm_gazebo.xacro tree: arm link materials and the joint state/trajectory plugins."""
     root = _robot()
     _gazebo_materials(root, spec, spec.arm.links)
     jsp = spec.arm.joint_state_publisher
@@ -281,7 +295,7 @@ def xacro_files(spec: RobotSpec, spec_label: str = "the armcli spec") -> dict[st
         COMMON: common_properties(spec),
         ARM: part(spec.arm.links, spec.arm.joints, prefixes),
         ARM_GAZEBO: arm_gazebo(spec),
-        STANDALONE_ARM: _top("standalone_arm", [COMMON, ARM, ARM_GAZEBO]),
+        STANDALONE_ARM: _top(STANDALONE_ARM_NAME, [COMMON, ARM, ARM_GAZEBO]),
     }
     if spec.mobile_base is not None and spec.mount is not None:
         trees[MOBILE_BASE] = part(spec.mobile_base.links, spec.mobile_base.joints, prefixes)
@@ -294,7 +308,7 @@ def xacro_files(spec: RobotSpec, spec_label: str = "the armcli spec") -> dict[st
 
 def top_level_files(spec: RobotSpec) -> dict[str, str]:
     """Expanded URDF name -> the top-level xacro file it comes from."""
-    out = {"standalone_arm.urdf": STANDALONE_ARM}
+    out = {STANDALONE_ARM_URDF: STANDALONE_ARM}
     if spec.mobile_base is not None and spec.mount is not None:
         out[f"{spec.name}.urdf"] = TOP.format(name=spec.name)
     return out

@@ -1,5 +1,7 @@
-"""Rules on the Pinocchio model: worst gravity torque over a sample of the joint range
-versus the effort limit, PD stability at the spec's time step (armcli.sim.stability), and
+"""Rules on the Pinocchio model: gravity versus effort, PD stability, self-collision.
+
+The worst gravity torque over a sample of the joint range is compared with the effort
+limit, PD stability is checked at the spec's time step (armcli.sim.stability), and
 self-collision at the spec's named poses (Pinocchio GeometryModel + coal).
 """
 
@@ -13,13 +15,13 @@ from typing import Any
 
 import numpy as np
 
-from armcli.check.meshes import mesh_paths
 from armcli.check.rules import CheckOptions, Collector, JointRow
 from armcli.check.structure import finite
 from armcli.errors import InputError
 from armcli.sim import stability as stab
 from armcli.sim.stability import StabilityReport
 from armcli.urdf.doc import Urdf
+from armcli.urdf.meshes import mesh_paths
 from armcli.urdf.pinocchio import collision_model, configuration
 
 GRID_POINTS = 5  # per joint, when the grid has at most MAX_GRID samples
@@ -39,7 +41,7 @@ REMEDY_DIGITS = 2
 
 
 def round_up(x: float, digits: int = REMEDY_DIGITS) -> float:
-    """x rounded up to `digits` significant digits (an effort that still covers x)."""
+    """X rounded up to `digits` significant digits (an effort that still covers x)."""
     if x <= 0 or not np.isfinite(x):
         return x
     step = 10.0 ** (np.floor(np.log10(x)) - digits + 1)
@@ -47,7 +49,7 @@ def round_up(x: float, digits: int = REMEDY_DIGITS) -> float:
 
 
 def round_down(x: float, digits: int = REMEDY_DIGITS) -> float:
-    """x rounded down to `digits` significant digits (a dt or gain still below a bound)."""
+    """X rounded down to `digits` significant digits (a dt or gain still below a bound)."""
     if x <= 0 or not np.isfinite(x):
         return x
     step = 10.0 ** (np.floor(np.log10(x)) - digits + 1)
@@ -55,8 +57,12 @@ def round_down(x: float, digits: int = REMEDY_DIGITS) -> float:
 
 
 def samples(model: Any, ranges: list[Any]) -> list[tuple[dict[str, float], Any]]:
-    """Joint-space sample: a full grid for few joints; else every corner of the range box
-    (where gravity torques peak for serial arms) when there are few, plus seeded draws."""
+    """Joint-space sample as (joint values by name, Pinocchio configuration) pairs.
+
+    A full grid for few joints; else the zero pose clamped into range, every corner of the
+    range box (where gravity torques peak for serial arms) when there are few, and seeded
+    draws, so the same URDF always gives the same sample.
+    """
     n = len(ranges)
     names = [jr.name for jr in ranges]
     if n and GRID_POINTS**n <= MAX_GRID:
@@ -80,6 +86,11 @@ def gravity(
     rows: tuple[JointRow, ...],
     out: Collector,
 ) -> tuple[JointRow, ...]:
+    """Rule `gravity-effort`: the worst gravity torque over `samples` versus each effort limit.
+
+    Returns:
+        `rows` with `gravity_max` [N·m or N] filled in (None for joints not in the model).
+    """
     import pinocchio as pin
 
     worst = np.zeros(model.nv)
@@ -121,6 +132,11 @@ def stability(
     out: Collector,
     notes: list[str],
 ) -> StabilityReport | None:
+    """Rules `pd-explicit-unstable` and `pd-unstable`: the spec's PD gains at its time step.
+
+    The mass matrix at every sample bounds the gains (armcli.sim.stability). Returns None
+    without a spec that has gains, and adds a note when no controlled joint is in the URDF.
+    """
     import pinocchio as pin
 
     spec = opts.spec
@@ -204,9 +220,14 @@ def self_collision(
     out: Collector,
     notes: list[str],
 ) -> None:
+    """Rule `self-collision`: link pairs that interpenetrate at the spec's named poses.
+
+    Adjacent (parent-child) links and overlaps below PENETRATION_TOL [m] do not count. Skipped
+    with a note when a mesh cannot be found or the collision model cannot be built.
+    """
     import pinocchio as pin
 
-    meshes = mesh_paths(urdf, opts)
+    meshes = mesh_paths(urdf, opts.mesh_search())
     if any(p is None or not p.is_file() for p in meshes.values()):
         notes.append("self-collision skipped: some meshes cannot be found")
         return

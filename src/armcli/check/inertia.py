@@ -1,5 +1,6 @@
-"""Inertia rules: mass sign, positive definiteness, triangle inequality, and inertia
-versus the link's own geometry (which catches permuted or scaled macro output).
+"""Inertia rules: mass sign, positive definiteness, triangle inequality, own geometry.
+
+Comparing the inertia with the link's own geometry catches permuted or scaled macro output.
 """
 
 from __future__ import annotations
@@ -155,8 +156,11 @@ def primitive_shape(link: Link) -> Shape | None:
 
 
 def _size(link: Link) -> float:
-    """The link's size L [m] for ZERO_RTOL: its largest primitive dimension (a diameter for
-    spheres and cylinders), else the distance of its centre of mass from the link origin."""
+    """The link's size L [m] for ZERO_RTOL.
+
+    Its largest primitive dimension (a diameter for spheres and cylinders), else the
+    distance of its centre of mass from the link origin.
+    """
     sizes = [
         max((2.0 * g.dims[0], *g.dims[1:])) if g.kind in ("sphere", "cylinder") else max(g.dims)
         for s in (*link.collisions, *link.visuals)

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from armcli.spec.model import RobotSpec
+from armcli.urdf.meshes import MeshSearch
 
 ERROR = "error"
 WARNING = "warning"
@@ -23,6 +24,8 @@ Value = float | int | str | list[float] | None
 
 @dataclass(frozen=True)
 class Rule:
+    """One check rule: stable id (for --ignore and JSON), severity, title and fix hint."""
+
     id: str
     severity: str
     title: str
@@ -162,6 +165,18 @@ _RULES = [
         "PD loop unstable at dt with explicit damping",
         "lower Kd or dt, or treat damping implicitly",
     ),
+    Rule(
+        "servo-unstable",
+        ERROR,
+        "gz_ros2_control position servo diverges: position_proportional_gain not in (0, 2)",
+        "set <position_proportional_gain> in the gz_ros2_control plugin below 1",
+    ),
+    Rule(
+        "servo-oscillates",
+        WARNING,
+        "gz_ros2_control position servo overshoots: position_proportional_gain in (1, 2)",
+        "set <position_proportional_gain> to at most 1",
+    ),
     # collision and meshes
     Rule(
         "visual-no-collision",
@@ -198,6 +213,7 @@ class Finding:
     fix: Mapping[str, Value] = field(default_factory=dict)  # the numbers that would pass
 
     def to_dict(self) -> dict[str, Any]:
+        """The finding as a JSON object in the stable schema of docs/check.md."""
         return {
             "rule": self.rule,
             "severity": self.severity,
@@ -226,7 +242,11 @@ class Collector:
         /,
         **values: Value,
     ) -> None:
-        """Record a finding; `fix` holds the numeric remedy (e.g. the inertia that would pass)."""
+        """Record a finding of `rule` at `line`.
+
+        `values` are the numbers behind the message, `fix` the numeric remedy (e.g. the
+        inertia that would pass); `fix` is positional-only so no value can shadow it.
+        """
         r = RULES[rule]
         self.findings.append(
             Finding(rule, r.severity, self.file, line, message, values, r.hint, dict(fix or {}))
@@ -241,6 +261,7 @@ class Collector:
         )
 
     def has_errors(self, rules: Iterable[str] | None = None) -> bool:
+        """Whether an error-severity finding was recorded, optionally only among `rules`."""
         wanted = set(rules) if rules is not None else None
         return any(
             f.severity == ERROR and (wanted is None or f.rule in wanted) for f in self.findings
@@ -269,6 +290,10 @@ class CheckOptions:
     spec: RobotSpec | None = None
     package_dirs: Mapping[str, Path] = field(default_factory=dict)
     search_paths: tuple[Path, ...] = ()
+
+    def mesh_search(self) -> MeshSearch:
+        """The mesh-resolver view of these options (shared with view and render)."""
+        return MeshSearch(self.package_dirs, self.search_paths)
 
 
 def apply_policy(

@@ -22,20 +22,11 @@ from armcli.errors import (
     UnusableInputsError,
 )
 from armcli.spec.load import load_spec
+from armcli.urdf.meshes import parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP
 
 FORMATS = ("table", "json", "github", "sarif")
 REPORT_WIDTH = 140  # columns when stdout is not a terminal (CI logs, pipes)
-
-
-def _package_dirs(values: list[str]) -> dict[str, Path]:
-    out = {}
-    for v in values:
-        name, sep, path = v.partition("=")
-        if not sep or not name or not path:
-            raise InputError(f"expected NAME=PATH, got {v!r}", field="--package-dir")
-        out[name] = Path(path)
-    return out
 
 
 def check_cmd(
@@ -46,7 +37,11 @@ def check_cmd(
         None, "--spec", help="Spec to compare limits with; also gives gains, dt, poses, tool."
     ),
     fmt: str = typer.Option(
-        "table", "--format", help="table, json, github (annotations) or sarif (SARIF 2.1.0)."
+        "table",
+        "--format",
+        metavar="[" + "|".join(FORMATS) + "]",
+        show_default=False,
+        help="Report format (default: table).",
     ),
     strict: bool = typer.Option(False, "--strict", help="Treat warnings as errors."),
     ignore: list[str] = typer.Option([], "--ignore", help="Silence a rule id (repeatable)."),
@@ -61,7 +56,7 @@ def check_cmd(
     unknown = sorted(set(ignore) - set(RULES))
     if unknown:
         raise InputError(f"unknown rule(s) {unknown}; known: {', '.join(RULES)}", field="--ignore")
-    base = CheckOptions(package_dirs=_package_dirs(package_dir))
+    base = CheckOptions(package_dirs=parse_package_dirs(package_dir))
     if spec is not None:
         base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs)
     run = run_check(list(paths or [DEFAULT_SPEC]), base, trust_xacro=trust_xacro)
@@ -98,4 +93,5 @@ def _print(run: CheckRun, findings: list[Any], fmt: str, code: int) -> None:
 
 
 def register(app: typer.Typer) -> None:
+    """Add the `check` command to the typer app."""
     app.command("check")(check_cmd)

@@ -9,6 +9,7 @@ import typer
 
 from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import InputError
+from armcli.urdf.meshes import MeshSearch, parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP
 from armcli.view.png import load_urdf, render_png
 from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
@@ -25,22 +26,36 @@ def _size(text: str) -> tuple[int, int]:
 
 
 def render_cmd(
-    robot: Path = typer.Argument(DEFAULT_SPEC, help=ROBOT_HELP),
+    robot: Path = typer.Argument(DEFAULT_SPEC, show_default=False, help=ROBOT_HELP),
     pose: str = typer.Option(None, "--pose", help="A named pose of the spec."),
     q: str = typer.Option(
         None,
         "--q",
         help="Joint values in rad (m if prismatic): '0.3,pi/4' in arm order, or 'joint=0.3,...'.",
     ),
-    out: Path = typer.Option(Path("robot.png"), "-o", "--out", help="PNG to write."),
-    size: str = typer.Option("1200x600", "--size", help="Image size WIDTHxHEIGHT in pixels."),
+    out: Path = typer.Option(
+        Path("robot.png"),
+        "-o",
+        "--out",
+        show_default=False,
+        help="PNG to write (default: robot.png).",
+    ),
+    size: str = typer.Option(
+        "1200x600",
+        "--size",
+        show_default=False,
+        help="Image size WIDTHxHEIGHT in pixels (default: 1200x600).",
+    ),
+    package_dir: list[str] = typer.Option(
+        [], "--package-dir", help="NAME=PATH for package://NAME/ mesh URIs (repeatable)."
+    ),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
-    src = load_robot(robot, trust_xacro)
+    src = load_robot(robot, trust_xacro, MeshSearch(parse_package_dirs(package_dir)))
     values = pose_q(src, pose, q)
     width, height = _size(size)
-    urdf = load_urdf(src.xml, src.source, src.mesh_dir)
+    urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search)
     res = render_png(
         urdf,
         values,

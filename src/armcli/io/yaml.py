@@ -47,7 +47,7 @@ class YamlDoc:
 _Base: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml when PyYAML has it
 
 
-class _Loader(_Base):  # type: ignore[misc, valid-type]
+class _Loader(_Base):  # type: ignore[misc]
     """The safe loader (C-accelerated where available); anchors are refused before use."""
 
 
@@ -204,4 +204,5 @@ def load_yaml(path: str | Path, *, flow_sets: bool = False) -> YamlDoc:
 
 
 def is_finite_number(x: object) -> bool:
+    """Whether `x` is a finite int or float; YAML booleans are not numbers here."""
     return isinstance(x, int | float) and not isinstance(x, bool) and math.isfinite(x)

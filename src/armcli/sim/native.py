@@ -61,6 +61,7 @@ def _command(out: Path) -> list[str]:
 
 
 def cache_dir() -> Path:
+    """Where compiled libraries go: $ARMCLI_CACHE_DIR, else the XDG cache, plus `native`."""
     base = os.environ.get("ARMCLI_CACHE_DIR") or os.path.join(
         os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "armcli"
     )
@@ -98,6 +99,7 @@ def build(force: bool = False) -> Path:
 
 
 def why_missing() -> str:
+    """Why `load()` gave None, for the fallback message: not built, or failed to load."""
     path = library_path()
     return f"{path} does not exist" if not path.exists() else "it failed to load"
 
@@ -173,7 +175,10 @@ def rollout_batch(
     fs = np.zeros(batch, dtype=np.int64)
     fj = np.zeros(batch, dtype=np.int32)
     fc = np.zeros(batch, dtype=np.int32)
-    c = lambda a: np.ascontiguousarray(a, dtype=float)  # noqa: E731
+
+    def c(a: Any) -> np.ndarray:
+        return np.ascontiguousarray(a, dtype=float)
+
     grav = c(np.array(plant.model.gravity.linear))
     params, q0c, v0c, refc = c(plant.params), c(q0), c(v0), c(ref)
     dbl, i32 = ctypes.c_double, ctypes.c_int

@@ -98,7 +98,8 @@ class _Stepper:
         if self.gc:
             t = t + self.pin.computeGeneralizedGravity(self.model, self.data, q)
         self.sat = np.abs(t) > p[:, EFFORT]
-        return np.where(self.sat, np.copysign(p[:, EFFORT], t), t)
+        out: np.ndarray = np.where(self.sat, np.copysign(p[:, EFFORT], t), t)
+        return out
 
     def project(
         self, q: np.ndarray, vs: np.ndarray, qp: np.ndarray
@@ -138,7 +139,8 @@ class _Stepper:
         return vs + dv, qp + dt * dv
 
     def clamp(self, q: np.ndarray) -> np.ndarray:
-        return np.minimum(np.maximum(q, self.p[:, LOWER]), self.p[:, UPPER])
+        out: np.ndarray = np.minimum(np.maximum(q, self.p[:, LOWER]), self.p[:, UPPER])
+        return out
 
     def euler(self, q: np.ndarray, v: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, ...]:
         p, dt, n = self.p, self.dt, self.n
@@ -178,8 +180,11 @@ class _Stepper:
 
 
 def rollout_python(plant: Plant, q0: np.ndarray, v0: np.ndarray, ref: np.ndarray) -> Rollout:
-    """Reference implementation. `ref` rows are [q_ref, v_ref] at t = k dt (Euler,
-    steps + 1 rows) or k dt/2 (RK4, 2 steps + 1 rows)."""
+    """Reference implementation of the rollout; the compiled `_native` one does the same.
+
+    `ref` rows are [q_ref, v_ref] at t = k dt (Euler, steps + 1 rows) or k dt/2 (RK4,
+    2 steps + 1 rows).
+    """
     s = _Stepper(plant)
     n = s.n
     steps = (ref.shape[0] - 1) // (2 if plant.integrator == "rk4" else 1)

@@ -21,13 +21,14 @@ from typing import Any
 
 import numpy as np
 
+from armcli.defaults import DEFAULT_DT
 from armcli.errors import InputError, SimulationError
 from armcli.sim import native
 from armcli.sim import rollout as ro
+from armcli.sim import stability as stab
 
 VEL_ABORT_FACTOR = 10.0  # divergence when |v| exceeds this times the URDF velocity limit
 DEFAULT_VABORT = 1000.0  # [rad/s or m/s] when the URDF gives no velocity limit
-RHO_TOL = 1e-9  # slack on the spectral radius (undamped symplectic Euler sits at 1)
 CHUNK_STEPS = {"native": 20_000, "python": 500}  # steps per call, for the progress bar
 
 
@@ -47,9 +48,11 @@ class Arm:
 
 @dataclass(frozen=True)
 class SimConfig:
+    """Controller and integrator settings: PD gains [N·m/rad, N·m·s/rad] and time step [s]."""
+
     kp: np.ndarray
     kd: np.ndarray
-    dt: float = 0.001  # [s]
+    dt: float = DEFAULT_DT  # [s]
     integrator: str = "euler"
     gravity_comp: bool = False
     backend: str = "auto"  # "auto" | "native" | "python"
@@ -57,6 +60,8 @@ class SimConfig:
 
 @dataclass(frozen=True)
 class SimResult:
+    """One rollout: time [s], states, references and motor torques [N·m] at every step."""
+
     joint_names: tuple[str, ...]
     t: np.ndarray  # (N + 1,) [s]
     q: np.ndarray  # (N + 1, n)
@@ -117,65 +122,36 @@ def params_of(arm: Arm, cfg: SimConfig) -> np.ndarray:
     return np.ascontiguousarray(np.column_stack(cols), dtype=float)
 
 
-def step_radius(M: np.ndarray, K: np.ndarray, B: np.ndarray, dt: float, integrator: str) -> float:
-    """Spectral radius of the linearised closed-loop step map (gravity gradient ignored)."""
-    n = M.shape[0]
-    eye = np.eye(n)
-    if integrator == "rk4":
-        Minv = np.linalg.inv(M)
-        A = np.block([[np.zeros((n, n)), eye], [-Minv @ np.diag(K), -Minv @ np.diag(B)]])
-        hA = dt * A
-        R = np.eye(2 * n) + hA @ (
-            np.eye(2 * n) + hA / 2 @ (np.eye(2 * n) + hA / 3 @ (np.eye(2 * n) + hA / 4))
-        )
-    else:
-        W = np.linalg.inv(M + dt * np.diag(B))
-        Av = eye - dt * W @ np.diag(B)
-        Aq = -dt * W @ np.diag(K)
-        R = np.block([[eye + dt * Aq, dt * Av], [Aq, Av]])
-    return float(np.max(np.abs(np.linalg.eigvals(R))))
-
-
 def check_stability(arm: Arm, cfg: SimConfig, configurations: np.ndarray) -> None:
-    """Refuse gains/dt the integrator cannot handle, saying what would work."""
+    """Refuse gains/dt the integrator cannot handle (the bound `check` reports), saying what would.
+
+    Euler steps damping implicitly, as `check`'s implicit loop; RK4 is explicit.
+    """
     import pinocchio as pin
 
     data = arm.model.createData()
-    K, B = cfg.kp, cfg.kd + arm.damping
+    K, B = np.asarray(cfg.kp, float), np.asarray(cfg.kd, float) + arm.damping
+    Ms = []
     for q in configurations:
         M = pin.crba(arm.model, data, q)
-        M = np.triu(M) + np.triu(M, 1).T
-        rho = step_radius(M, K, B, cfg.dt, cfg.integrator)
-        if rho <= 1.0 + RHO_TOL:
-            continue
-        _refuse(M, K, B, cfg, rho, q)
-
-
-def _refuse(
-    M: np.ndarray, K: np.ndarray, B: np.ndarray, cfg: SimConfig, rho: float, q: Any
-) -> None:
-    def stable(h: float, s: float) -> bool:
-        return step_radius(M, s * K, s * B, h, cfg.integrator) <= 1 + RHO_TOL
-
-    dt_ok = _bisect(lambda h: stable(h, 1.0), cfg.dt)
-    scale = _bisect(lambda s: stable(cfg.dt, s), 1.0)
+        Ms.append(np.triu(M) + np.triu(M, 1).T)
+    controlled = list(range(arm.model.nv))
+    scheme: stab.Scheme = "rk4" if cfg.integrator == "rk4" else "implicit"
+    rho, k = stab.worst_radius(Ms, controlled, K, B, cfg.dt, scheme)
+    if stab.is_stable(rho):
+        return
+    dt_ok = stab.largest_stable_dt([Ms[k]], controlled, K, B, scheme, cfg.dt)
+    scale = stab.largest_stable_scale([Ms[k]], controlled, K, B, cfg.dt, scheme)
     what = "Kd + damping" if cfg.integrator == "rk4" else "Kp"
     hint = " or the default euler integrator" if cfg.integrator == "rk4" else ""
     raise InputError(
         f"the {cfg.integrator} integrator is unstable with these gains at dt = {cfg.dt:g} s "
-        f"(closed-loop step spectral radius {rho:.3f} > 1 at q = {np.round(q, 3).tolist()}); "
+        f"(closed-loop step spectral radius {rho:.3f} > 1 at "
+        f"q = {np.round(configurations[k], 3).tolist()}); "
         f"{what} is too stiff for this inertia: use --dt <= {dt_ok:.3g} or gains scaled by "
         f"<= {scale:.3g}{hint}",
         field="--dt",
     )
-
-
-def _bisect(ok: Callable[[float], bool], hi: float) -> float:
-    lo = 0.0
-    for _ in range(50):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
-    return lo
 
 
 def simulate(

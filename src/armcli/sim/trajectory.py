@@ -53,6 +53,7 @@ class Trajectory:
 
     @property
     def duration(self) -> float:
+        """Time of the last point [s]."""
         return float(self.times[-1])
 
 
@@ -82,7 +83,9 @@ class _Collector:
     def add(self, path: tuple[str | int, ...], msg: str) -> None:
         self.problems.append(Problem(dotted(path), msg, self.doc.line_of(path)))
 
-    def unknown_keys(self, data: Mapping[str, Any], allowed: set[str], path: tuple) -> None:
+    def unknown_keys(
+        self, data: Mapping[str, Any], allowed: set[str], path: tuple[str | int, ...]
+    ) -> None:
         for key in data:
             if key not in allowed:
                 self.add((*path, key), f"unknown key; expected one of {', '.join(sorted(allowed))}")
@@ -249,7 +252,7 @@ def _time(point: dict[str, Any], previous: Sequence[float], k: int, c: _Collecto
             f"{t - last:g} s after the previous point: segments must last at least "
             f"{MIN_SEGMENT_S:g} s",
         )
-    return t
+    return float(t)
 
 
 def _consistent(fields: dict[str, list[list[float] | None]], c: _Collector) -> None:

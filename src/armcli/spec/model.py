@@ -22,7 +22,9 @@ from pydantic import (
     model_validator,
 )
 
+from armcli.defaults import DEFAULT_DT
 from armcli.spec.expr import eval_expr
+from armcli.spec.graph import root_links
 
 
 def _number(v: Any) -> Any:
@@ -60,20 +62,28 @@ class Material(_Model):
 
 
 class Origin(_Model):
+    """A frame offset: translation `xyz` [m] and roll-pitch-yaw `rpy` [rad], as URDF's <origin>."""
+
     xyz: Vec3 = (0.0, 0.0, 0.0)
     rpy: Vec3 = (0.0, 0.0, 0.0)
 
 
 class Box(_Model):
+    """A box with edge lengths `size` [m] along x, y and z."""
+
     size: tuple[Positive, Positive, Positive]
 
 
 class Cylinder(_Model):
+    """A cylinder of `radius` and `length` [m], its axis along z."""
+
     radius: Positive
     length: Positive
 
 
 class Sphere(_Model):
+    """A sphere of `radius` [m]."""
+
     radius: Positive
 
 
@@ -93,6 +103,7 @@ class Geometry(_Model):
 
     @property
     def kind(self) -> str:
+        """Which primitive is given: "box", "cylinder" or "sphere"."""
         return "box" if self.box else "cylinder" if self.cylinder else "sphere"
 
 
@@ -126,6 +137,8 @@ class Link(_Model):
 
 
 class Limit(_Model):
+    """Joint limits: `lower`/`upper` [rad or m], `effort` [N·m or N], `velocity` [rad/s or m/s]."""
+
     lower: Real
     upper: Real
     effort: Positive
@@ -133,6 +146,8 @@ class Limit(_Model):
 
 
 class Dynamics(_Model):
+    """Joint `friction` [N·m or N] and viscous `damping` [N·m·s/rad or N·s/m]."""
+
     friction: NonNeg = 0.0
     damping: NonNeg = 0.0
 
@@ -141,6 +156,12 @@ JointType = Literal["revolute", "continuous", "prismatic", "fixed"]
 
 
 class Joint(_Model):
+    """A URDF joint from `parent` to `child`; revolute and prismatic joints need a `limit`.
+
+    `origin` places the joint frame in the parent link's frame; `axis` is a non-zero vector
+    in the joint frame.
+    """
+
     type: JointType
     parent: Name
     child: Name
@@ -196,12 +217,16 @@ class Tool(_Model):
 
 
 class MobileBase(_Model):
+    """The mobile base: its links and joints (one tree) and an optional diff-drive plugin."""
+
     links: dict[Name, Link]
     joints: dict[Name, Joint] = {}
     diff_drive: DiffDrive | None = None
 
 
 class Arm(_Model):
+    """The arm: its links and joints (one tree), its Gazebo plugins and the tool point."""
+
     links: dict[Name, Link] = Field(min_length=1)
     joints: dict[Name, Joint] = {}
     joint_state_publisher: JointStatePublisher | None = None
@@ -225,11 +250,33 @@ class Gains(_Model):
     ki: NonNeg = 0.0
 
 
+class Tolerances(_Model):
+    """Trajectory-following limits for the Jazzy JointTrajectoryController (`constraints`).
+
+    Defaults: `stopped_velocity_tolerance` and `trajectory` are the controller's own
+    defaults (0.01 rad/s; 0 = not checked: a PD loop under gravity lags its reference);
+    `goal_time` is MoveIt's default goal-duration margin; `goal` is 0.05 rad because a
+    P(D) loop without integral action settles off the goal by gravity torque / Kp.
+    """
+
+    goal_time: NonNeg = 0.5  # [s] extra time allowed to reach the goal; 0 = unlimited
+    stopped_velocity_tolerance: NonNeg = 0.01  # [rad/s or m/s]
+    goal: NonNeg = 0.05  # [rad or m] position error allowed at the goal; 0 = not checked
+    trajectory: NonNeg = 0.0  # [rad or m] error allowed along the way; 0 = not checked
+
+
 class Control(_Model):
-    dt: Positive = 0.001
+    """How the arm is controlled and simulated.
+
+    `dt` is the simulation step [s], `gains` the PD gains per arm joint,
+    `controller_update_rate` the ros2_control rate [Hz].
+    """
+
+    dt: Positive = DEFAULT_DT
     gains: dict[Name, Gains] = {}
     controller_update_rate: Positive = 100.0
     gravity_compensation: bool = False
+    tolerances: Tolerances = Tolerances()
 
 
 class RobotSpec(_Model):
@@ -245,11 +292,13 @@ class RobotSpec(_Model):
 
     # -- derived views used by writers, checks and the simulator ----------------
     def all_links(self) -> dict[str, Link]:
+        """Links of the base and the arm by name (names are unique across parts)."""
         out = dict(self.mobile_base.links) if self.mobile_base else {}
         out.update(self.arm.links)
         return out
 
     def all_joints(self) -> dict[str, Joint]:
+        """Joints of the base and the arm by name, plus the mount joint with a base."""
         out = dict(self.mobile_base.joints) if self.mobile_base else {}
         out.update(self.arm.joints)
         if self.mount is not None and self.mobile_base is not None:
@@ -257,11 +306,11 @@ class RobotSpec(_Model):
         return out
 
     def arm_root(self) -> str:
-        children = {j.child for j in self.arm.joints.values()}
-        roots = [name for name in self.arm.links if name not in children]
-        return roots[0]
+        """The arm link that is no arm joint's child (a valid spec has exactly one)."""
+        return root_links(self.arm.links, (j.child for j in self.arm.joints.values()))[0]
 
     def mount_joint(self) -> Joint:
+        """The mount as the fixed `Joint` from the base to the arm root; needs a mount."""
         assert self.mount is not None
         return Joint(
             type="fixed", parent=self.mount.parent, child=self.arm_root(), origin=self.mount.origin

@@ -12,6 +12,20 @@ Vec3 = tuple[float, float, float]
 ZERO3: Vec3 = (0.0, 0.0, 0.0)
 
 
+# The one joint-type table: every URDF joint type and the degrees of freedom it adds.
+JOINT_DOF: dict[str, int] = {
+    "fixed": 0,
+    "revolute": 1,
+    "continuous": 1,
+    "prismatic": 1,
+    "floating": 6,
+    "planar": 3,
+}
+JOINT_TYPES: tuple[str, ...] = tuple(JOINT_DOF)
+MOVABLE_TYPES: tuple[str, ...] = tuple(k for k, n in JOINT_DOF.items() if n > 0)
+ONE_DOF_TYPES: tuple[str, ...] = tuple(k for k, n in JOINT_DOF.items() if n == 1)
+
+
 @dataclass(frozen=True)
 class NumberProblem:
     """A numeric attribute that is missing, unparsable, non-finite or of the wrong length."""
@@ -24,6 +38,8 @@ class NumberProblem:
 
 @dataclass(frozen=True)
 class Pose:
+    """An <origin>: `xyz` [m] and `rpy` [rad], with its source line."""
+
     xyz: Vec3 = ZERO3
     rpy: Vec3 = ZERO3
     line: int | None = None
@@ -52,6 +68,8 @@ class Shape:
 
 @dataclass(frozen=True)
 class Inertial:
+    """An <inertial>: mass [kg] and inertia [kg·m²], None where missing or unparsed."""
+
     origin: Pose
     mass: float | None
     inertia: tuple[float, float, float, float, float, float] | None  # ixx ixy ixz iyy iyz izz
@@ -62,6 +80,8 @@ class Inertial:
 
 @dataclass(frozen=True)
 class Link:
+    """A <link>: its inertial and its visual and collision shapes."""
+
     name: str
     line: int | None
     inertial: Inertial | None
@@ -71,6 +91,8 @@ class Link:
 
 @dataclass(frozen=True)
 class Limit:
+    """A <limit>: lower/upper [rad or m], effort [N·m or N], velocity [rad/s or m/s]."""
+
     lower: float | None
     upper: float | None
     effort: float | None
@@ -81,6 +103,8 @@ class Limit:
 
 @dataclass(frozen=True)
 class Joint:
+    """A <joint>: its links, origin, axis, limit, damping, friction and mimic, with lines."""
+
     name: str
     type: str
     line: int | None
@@ -97,11 +121,14 @@ class Joint:
 
     @property
     def movable(self) -> bool:
-        return self.type not in ("fixed", "floating", "planar")
+        """Whether the joint moves along one axis: any type but fixed, floating and planar."""
+        return JOINT_DOF.get(self.type, 1) == 1  # an unknown type is reported elsewhere
 
 
 @dataclass(frozen=True)
 class Material:
+    """A <material>: name, rgba colour, and whether it is declared at the robot's top level."""
+
     name: str
     rgba: tuple[float, ...] | None
     line: int | None
@@ -123,4 +150,5 @@ class Urdf:
     line: int | None = None  # the <robot> element's
 
     def link(self, name: str) -> Link | None:
+        """The link called `name`, or None."""
         return next((lk for lk in self.links if lk.name == name), None)

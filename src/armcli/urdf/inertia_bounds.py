@@ -1,5 +1,6 @@
-"""Upper bounds on the moments of inertia a mass inside a primitive shape can have, and the
-solid-body inertia to write instead: the numbers behind `inertia-exceeds-geometry`.
+"""Bounds on the moments of inertia a mass inside a primitive shape can have.
+
+The numbers behind `inertia-exceeds-geometry`, and the solid-body inertia to write instead.
 
 Why a bound and not a tolerance: a hollow part legitimately has more inertia than the
 solid formula (a tube, a shell), so "differs from the solid" is only a warning. But no

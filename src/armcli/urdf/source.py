@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from armcli.build.expand import expand_urdfs
+from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import InputError, XacroRefusedError
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
@@ -54,7 +55,7 @@ class RobotFile:
     def robot(self) -> Urdf:
         """The whole robot: the spec's `<name>.urdf`, else the only document."""
         if self.spec is not None:
-            for name in (f"{self.spec.name}.urdf", "standalone_arm.urdf"):
+            for name in (f"{self.spec.name}.urdf", STANDALONE_ARM_URDF):
                 found = next((u for u in self.urdfs if u.source.endswith(f"#{name}")), None)
                 if found is not None:
                     return found
@@ -94,7 +95,11 @@ def load_checked_model(path: Path, *, trust_xacro: bool = False) -> LoadedModel:
     non-finite number (Pinocchio turns mass="nan" into 0) or any error the URDF
     parser prints is an InputError naming the file and line, not a wrong result.
     """
-    urdf = read_urdf_file(path, trust_xacro=trust_xacro)
+    return checked_model(read_urdf_file(path, trust_xacro=trust_xacro))
+
+
+def checked_model(urdf: Urdf) -> LoadedModel:
+    """A parsed URDF -> Pinocchio model, refusing what Pinocchio would silently accept."""
     if urdf.problems:
         p = urdf.problems[0]
         raise InputError(f"{p.where}: {_PROBLEM[p.kind]} {p.text!r}", file=urdf.source, line=p.line)
@@ -114,8 +119,11 @@ def urdf_text(urdf: Urdf) -> str:
 
 
 def allowed_roots(urdf_dir: Path, extra: Iterable[Path] = ()) -> tuple[Path, ...]:
-    """Directories mesh files may come from: the URDF's directory, the ROS package it sits
-    in (nearest ancestor with a package.xml), `extra` (--package-dir) and ROS_PACKAGE_PATH."""
+    """Directories mesh files may come from.
+
+    The URDF's directory, the ROS package it sits in (nearest ancestor with a package.xml),
+    `extra` (--package-dir) and ROS_PACKAGE_PATH.
+    """
     here = urdf_dir.resolve()
     roots = [here, *extra]
     roots += [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]

@@ -22,17 +22,18 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import InputError
+from armcli.sim.states import Replay
+from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_root
+from armcli.urdf.tool import ToolPoint
 from armcli.urdf.tree import parse_tree
 from armcli.view.png import (
-    Tool,
     full_configuration,
     joint_limits,
     load_urdf,
     neutral,
     tool_position,
 )
-from armcli.view.replay import Replay
 
 GHOST_RGBA = (0.35, 0.65, 1.0, 0.35)  # translucent blue for the reference pose
 FRAME_RATE = 30.0  # [Hz] replay updates sent to the browser
@@ -86,8 +87,9 @@ class Viewer:
         name: str = "robot",
         source: str = "<urdf>",
         mesh_dir: str | Path | None = None,
+        search: MeshSearch | None = None,
         poses: Mapping[str, Mapping[str, float]] | None = None,
-        tool: Tool | None = None,
+        tool: ToolPoint | None = None,
         replay: Replay | None = None,
         host: str = "127.0.0.1",
         port: int = 8080,
@@ -97,7 +99,7 @@ class Viewer:
 
         self._source, self._tool, self._replay = source, tool, replay
         self._poses = {k: dict(v) for k, v in (poses or {}).items()}
-        self._urdf = load_urdf(urdf_xml, source, mesh_dir)
+        self._urdf = load_urdf(urdf_xml, source, mesh_dir, search)
         self._limits = joint_limits(self._urdf)
         self._lock = threading.RLock()
         self._stop = threading.Event()
@@ -119,7 +121,7 @@ class Viewer:
                 ghost_xml = moving_parts(urdf_xml, replay.reference, source)
                 self._ghost = ViserUrdf(
                     self.server,
-                    load_urdf(ghost_xml, source, mesh_dir),
+                    load_urdf(ghost_xml, source, mesh_dir, search),
                     root_node_name="/ghost",
                     mesh_color_override=GHOST_RGBA,
                 )
@@ -137,10 +139,12 @@ class Viewer:
     # -- public API ------------------------------------------------------------------
     @property
     def url(self) -> str:
+        """Address of the viewer page."""
         return f"http://{self.host}:{self.port}"
 
     @property
     def joint_names(self) -> tuple[str, ...]:
+        """The movable joints the sliders control, in yourdfpy's order."""
         return tuple(self._limits)
 
     def configuration(self) -> dict[str, float]:
@@ -174,6 +178,7 @@ class Viewer:
             return tool_position(self._urdf, self._tool)
 
     def show_frames(self, visible: bool) -> None:
+        """Show or hide the link frames, through the GUI checkbox so the page stays in sync."""
         self._frames_box.value = bool(visible)
 
     def seek(self, t: float) -> None:
@@ -183,13 +188,16 @@ class Viewer:
         self._time_slider.value = float(np.clip(t, 0.0, self._replay.duration))
 
     def play(self, playing: bool = True) -> None:
+        """Start or pause the replay; without a replay it stays paused."""
         self._playing = bool(playing) and self._replay is not None
 
     @property
     def playing(self) -> bool:
+        """Whether the replay is running."""
         return self._playing
 
     def ghost_visible(self) -> bool:
+        """Whether the reference ghost is drawn (only with a replay that has references)."""
         return self._ghost is not None and self._ghost.show_visual
 
     def serve_forever(self) -> None:
