@@ -134,3 +134,13 @@ def test_uris_are_encoded(tmp_path: Path, name: str) -> None:
     validate(doc)
     uri = doc["runs"][0]["results"][0]["locations"][0]["physicalLocation"]["artifactLocation"]
     assert " " not in uri["uri"] and uri["uri"].endswith(".urdf")
+
+
+def test_files_outside_the_root_get_absolute_file_uris(tmp_path: Path) -> None:
+    from armcli.check.sarif import artifact_uri
+
+    inside = tmp_path / "repo" / "robots" / "a b.urdf"
+    outside = tmp_path / "elsewhere" / "x.urdf"
+    assert artifact_uri(str(inside), tmp_path / "repo") == ("robots/a%20b.urdf", True)
+    uri, relative = artifact_uri(str(outside), tmp_path / "repo")
+    assert not relative and uri == outside.resolve().as_uri()
