@@ -11,11 +11,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 from armcli.check.rules import ERROR, RULES, CheckOptions, Finding
 from armcli.check.run import CheckResult, check_urdf
 from armcli.errors import EXIT_FAILED, EXIT_OK, EXIT_UNUSABLE, InputError
+from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
 from armcli.urdf.source import read_robot, read_urdf_file
 
@@ -56,7 +56,9 @@ class CheckRun:
         return EXIT_FAILED if any(f.severity == ERROR for f in findings) else EXIT_OK
 
 
-def _documents(path: Path, trust_xacro: bool) -> tuple[list[tuple[Urdf, Any]], list[Unusable]]:
+def _documents(
+    path: Path, trust_xacro: bool
+) -> tuple[list[tuple[Urdf, RobotSpec | None]], list[Unusable]]:
     """The URDF documents a PATH stands for, each with its spec (or None); the unusable files."""
     if not path.is_dir():
         robot = read_robot(path, trust_xacro=trust_xacro)
@@ -64,7 +66,7 @@ def _documents(path: Path, trust_xacro: bool) -> tuple[list[tuple[Urdf, Any]], l
     files = sorted(p for p in path.rglob(URDF_GLOB) if p.is_file())
     if not files:
         raise InputError(f"no {URDF_GLOB} files under this directory", file=path)
-    docs: list[tuple[Urdf, Any]] = []
+    docs: list[tuple[Urdf, RobotSpec | None]] = []
     bad: list[Unusable] = []
     for p in files:
         try:
