@@ -163,9 +163,17 @@ def stability(
         [joints[n].damping for n in names],
         spec.control.dt,
     )
+    line = next((j.line for j in urdf.joints if j.name == names[0]), None)
+    _report_stability(rep, names, line, out)
+    return rep
+
+
+def _report_stability(
+    rep: StabilityReport, names: list[str], line: int | None, out: Collector
+) -> None:
+    """The two PD findings, with the numbers that explain them and a remedy."""
     q_txt = ", ".join(f"{n} = {v:.3g}" for n, v in zip(names, rep.q_worst, strict=True))
     common = dict(lambda_max=rep.lambda_max, dt=rep.dt, kp=rep.kp, kd_plus_damping=rep.d)
-    line = next((j.line for j in urdf.joints if j.name == names[0]), None)
     if not rep.explicit.stable:
         e = rep.explicit
         fix = {
@@ -209,7 +217,6 @@ def stability(
             kp_max=rep.kp_max_implicit,
             dt_max=rep.implicit.dt_max,
         )
-    return rep
 
 
 def self_collision(
