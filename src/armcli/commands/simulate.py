@@ -98,6 +98,8 @@ def simulate_cmd(
         err.print(f"warning: {w}", markup=False, highlight=False)
     with _LazyProgress(err) as progress:
         res = simjob.run(job, progress)
+    if res.notice:
+        err.print(f"note: {res.notice}", markup=False, highlight=False)
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
     if output is not None:
