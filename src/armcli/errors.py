@@ -26,6 +26,8 @@ class ArmcliError(Exception):
     """Base of every error armcli raises on purpose."""
 
     exit_code: int = EXIT_UNUSABLE
+    #: What the CLI writes before each line; None when the lines carry their own label.
+    label: str | None = "error"
 
     def lines(self) -> list[str]:
         """The one-line-per-problem rendering the CLI prints."""
@@ -82,6 +84,27 @@ class XacroRefusedError(InputError):
     """A foreign xacro file would run code from the file; refused without --trust-xacro."""
 
 
+class ModelLoadError(InputError):
+    """Pinocchio refused the URDF; carries what its parser printed."""
+
+    def __init__(self, message: str, *, file: str, parser_messages: list[str]) -> None:
+        self.parser_messages = parser_messages
+        super().__init__(message, file=file)
+
+
+class UnusableInputsError(ArmcliError):
+    """One or more inputs could not be used: one line each, exit 2, after the others' report."""
+
+    exit_code = EXIT_UNUSABLE
+
+    def __init__(self, errors: Sequence[ArmcliError]) -> None:
+        self.errors = list(errors)
+        super().__init__(str(self.errors[0]))
+
+    def lines(self) -> list[str]:
+        return [line for e in self.errors for line in e.lines()]
+
+
 class BuildError(ArmcliError):
     """Generating or expanding robot description files failed."""
 
@@ -90,6 +113,7 @@ class StaleBuildError(ArmcliError):
     """`build --check`: committed outputs differ from a fresh build."""
 
     exit_code = EXIT_FAILED
+    label = None
 
     def __init__(self, stale: Sequence[str]) -> None:
         self.stale = list(stale)

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import typer
 
+from armcli.build.expand import build, check_fresh
 from armcli.defaults import DEFAULT_SPEC
 
 
@@ -18,8 +19,6 @@ def build_cmd(
     ),
 ) -> None:
     """Compile SPEC into the course's xacro set and the expanded URDFs."""
-    from armcli.build import build, check_fresh
-
     if check:
         check_fresh(spec, out)
         sys.stdout.write(f"{out}: up to date with {spec}\n")

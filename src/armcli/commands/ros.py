@@ -7,9 +7,11 @@ from pathlib import Path
 
 import typer
 
+from armcli.build.expand import spec_label
 from armcli.defaults import DEFAULT_SPEC
+from armcli.ros.packages import PackageInfo, write_ros_packages
 
-DEFAULT_SAMPLES = 10_000  # keep equal to armcli.collision_matrix.DEFAULT_SAMPLES (lazy import)
+DEFAULT_SAMPLES = 10_000  # keep equal to armcli.ros.collision_matrix.DEFAULT_SAMPLES (lazy import)
 
 
 def ros_package_cmd(
@@ -24,9 +26,6 @@ def ros_package_cmd(
     license_: str = typer.Option("TODO", "--license", help="package.xml license."),
 ) -> None:
     """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
-    from armcli.build import spec_label
-    from armcli.ros_package import PackageInfo, write_ros_packages
-
     info = PackageInfo(maintainer=maintainer, email=email, license=license_)
     pkgs, written = write_ros_packages(
         spec, out, label=spec_label(spec), samples=samples, seed=seed, info=info

@@ -10,14 +10,17 @@ from typing import Any
 import typer
 
 from armcli.defaults import DEFAULT_SPEC
-from armcli.robot_source import TRUST_XACRO_HELP
+from armcli.errors import InputError
+from armcli.sim import job as simjob
+from armcli.sim import report as simreport
+from armcli.sim.plot import write_tracking_plot
+from armcli.spec.load import load_spec
+from armcli.urdf.source import TRUST_XACRO_HELP
 
 PROGRESS_AFTER_S = 1.0  # show a progress bar when the run is projected to take longer
 
 
 def _floats(text: str | None, option: str) -> list[float] | None:
-    from armcli.errors import InputError
-
     if text is None:
         return None
     try:
@@ -65,10 +68,6 @@ def simulate_cmd(
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
     from rich.console import Console
 
-    from armcli import simjob, simreport
-    from armcli.errors import InputError
-    from armcli.spec import load_spec
-
     if engine not in ("auto", "native", "python"):
         raise InputError(
             f"unknown engine {engine!r}; valid: auto, native, python", field="--engine"
@@ -105,8 +104,6 @@ def simulate_cmd(
     if output is not None:
         simreport.write_states(output, res, job.rate)
     if plot is not None:
-        from armcli.plot import write_tracking_plot
-
         write_tracking_plot(plot, res, job.arm.effort)
     out = Console(file=sys.stdout)
     if not out.is_terminal:

@@ -1,0 +1,151 @@
+"""The simulator's rollout: PD motor, implicit damping, friction and joint stops.
+
+One step (semi-implicit Euler, the default) at state (q, v) and reference (q_ref, v_ref):
+
+1. motor torque tau = Kp (q_ref - q) + Kd (v_ref - v) [+ g(q)], saturated at the effort limit;
+2. velocity-proportional torques (Kd of unsaturated joints, viscous damping D) are implicit:
+   (M + dt B)(v* - v)/dt = tau_explicit - B v - nle, with B = diag(Kd + D). ABA adds
+   `model.armature` to the diagonal of M, so armature = dt B gives exactly this, and the
+   step is stable for any non-negative Kd and D;
+3. Coulomb friction and joint stops are solved at velocity level, like MuJoCo's
+   frictionloss and limit constraints: v' = argmin ½|v - v*|²_(M+dtB) + dt Σ F_i |v_i|
+   subject to the stop bounds, by projected Gauss-Seidel. A joint at rest with a small
+   torque stays exactly at rest (no chatter), and since v = 0 is feasible the projection
+   never adds kinetic energy;
+4. the motor torque over the whole step, tau - Kd (v' - v), must respect the effort limit
+   too: a joint whose implicit Kd would push it past the limit is saturated and the step
+   solved again, so the reported torque is the applied torque and never exceeds the limit;
+5. q' = q + dt v', clamped to the limits against round-off.
+
+RK4 integrates the smooth part (PD, gravity, damping) with the classic four stages, all
+explicit, on reference samples from one polynomial piece per step (so a knot between
+steps does not cost the method its order), then applies the same projection.
+
+`stepper.py` holds the step in plain Python floats (the reference and the fallback);
+`_native/rollout.cpp` runs the identical algorithm compiled (`native.py`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from armcli.sim.stepper import (  # noqa: F401  (re-exported: the parameter layout)
+    DAMPING,
+    EFFORT,
+    FRICTION,
+    KD,
+    KP,
+    LOWER,
+    PARAM_FIELDS,
+    UPPER,
+    VABORT,
+    Stepper,
+)
+
+# Pinocchio joint model -> the joint code both engines use (revolute 0-3, prismatic 4-7).
+JOINT_TYPES = {
+    "JointModelRX": 0,
+    "JointModelRY": 1,
+    "JointModelRZ": 2,
+    "JointModelRevoluteUnaligned": 3,
+    "JointModelPX": 4,
+    "JointModelPY": 5,
+    "JointModelPZ": 6,
+    "JointModelPrismaticUnaligned": 7,
+}
+FAIL_NONE, FAIL_NONFINITE, FAIL_VELOCITY, FAIL_ENERGY = range(4)
+FLAG_SATURATED = 1
+FLAG_STOP = 2
+ENERGY_EVERY = 100  # steps between kinetic-energy checks
+RK4_ROWS = 3  # reference rows per RK4 step: t, t + dt/2, t + dt (one polynomial piece)
+
+
+@dataclass(frozen=True)
+class Plant:
+    """Everything a rollout needs besides the initial state and the reference."""
+
+    model: Any  # pinocchio.Model, only nq == nv one-dof joints
+    params: np.ndarray  # (n, len(PARAM_FIELDS))
+    gravity_comp: bool
+    dt: float  # [s]
+    integrator: str  # "euler" | "rk4"
+    energy_max: float  # [J] kinetic energy treated as a blow-up
+
+
+@dataclass(frozen=True)
+class Rollout:
+    """States at every step; a failed run stops at `fail_step` (rows after it are unset)."""
+
+    q: np.ndarray  # (steps + 1, n) [rad or m]
+    v: np.ndarray  # (steps + 1, n)
+    tau: np.ndarray  # (steps, n) motor torque applied during each step [N·m or N]
+    flags: np.ndarray  # (steps, n) uint8: FLAG_SATURATED | FLAG_STOP
+    fail_step: int  # -1 when the run completed
+    fail_joint: int  # index, -1 when not joint-specific
+    fail_code: int
+
+
+def rows_per_step(integrator: str) -> int:
+    """Reference rows one step consumes: [q_ref, v_ref] at t (Euler) or at t, t + dt/2,
+    t + dt (RK4). A reference for N steps has N * rows + 1 rows (the last: t = N dt)."""
+    return RK4_ROWS if integrator == "rk4" else 1
+
+
+def steps_of(plant: Plant, ref: np.ndarray) -> int:
+    return (ref.shape[0] - 1) // rows_per_step(plant.integrator)
+
+
+def rollout_python(plant: Plant, q0: np.ndarray, v0: np.ndarray, ref: np.ndarray) -> Rollout:
+    """Reference implementation and fallback of `native.rollout` (same contract)."""
+    s = Stepper(plant.model, plant.params, plant.gravity_comp, plant.dt)
+    n, rk4 = s.n, plant.integrator == "rk4"
+    steps = steps_of(plant, ref)
+    R = np.asarray(ref, dtype=float).tolist()
+    q, v = [float(x) for x in q0], [float(x) for x in v0]
+    Qs, Vs, Ts, Fs = [q], [v], [], []
+    code, joint, fail = FAIL_NONE, -1, -1
+    for k in range(steps):
+        if rk4:
+            q, v = s.rk4(q, v, R[3 * k], R[3 * k + 1], R[3 * k + 2])
+        else:
+            q, v = s.euler(q, v, R[k][:n], R[k][n:])
+        Qs.append(q)
+        Vs.append(v)
+        Ts.append(s.tau)
+        Fs.append([FLAG_SATURATED * s.sat[i] | FLAG_STOP * s.stop[i] for i in range(n)])
+        code, joint = _check(q, v, s.vabort)
+        if code == FAIL_NONE and (k + 1) % ENERGY_EVERY == 0:
+            s.set_armature(None)  # the kinetic energy of the arm alone
+            s.qa[:], s.va[:] = q, v
+            if not s.pin.computeKineticEnergy(s.model, s.data, s.qa, s.va) <= plant.energy_max:
+                code = FAIL_ENERGY
+        if code != FAIL_NONE:
+            fail = k + 1
+            break
+    return _arrays(steps, n, Qs, Vs, Ts, Fs, fail, joint, code)
+
+
+def _arrays(
+    steps: int, n: int, Qs: list[Any], Vs: list[Any], Ts: list[Any], Fs: list[Any], *fail: int
+) -> Rollout:
+    Q = np.full((steps + 1, n), np.nan)
+    V = np.full((steps + 1, n), np.nan)
+    T = np.full((steps, n), np.nan)
+    F = np.zeros((steps, n), dtype=np.uint8)
+    Q[: len(Qs)], V[: len(Vs)] = Qs, Vs
+    if Ts:
+        T[: len(Ts)], F[: len(Fs)] = Ts, Fs
+    return Rollout(Q, V, T, F, *fail)
+
+
+def _check(q: list[float], v: list[float], vabort: list[float]) -> tuple[int, int]:
+    for i in range(len(q)):
+        if not (math.isfinite(q[i]) and math.isfinite(v[i])):
+            return FAIL_NONFINITE, i
+        if abs(v[i]) > vabort[i]:
+            return FAIL_VELOCITY, i
+    return FAIL_NONE, -1
