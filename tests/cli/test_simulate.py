@@ -5,6 +5,8 @@ from __future__ import annotations
 import csv
 import json
 import math
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -124,3 +126,28 @@ def test_bad_output_extension_fails_before_running(
     code, _, err = run(["--message", SEED, "-o", str(tmp_path / "s.txt")], capsys)
     assert code == 2 and "--output" in err
     assert not (tmp_path / "s.txt").exists()
+
+
+def test_integral_gain_is_refused_not_ignored(tmp_path: Path) -> None:
+    """The simulator is PD: a spec ki > 0 is an error naming the field, unless --kp/--kd given."""
+    text = (ROOT / "specs" / "my_robot.yaml").read_text()
+    assert "kd: 5" in text
+    spec = tmp_path / "ki.yaml"
+    spec.write_text(text.replace("kd: 5", "kd: 5, ki: 0.5", 1))
+    traj = str(ROOT / "specs" / "trajectories" / "pick.yaml")
+    res = subprocess.run(
+        [sys.executable, "-m", "armcli", "simulate", str(spec), "-t", traj, "--duration", "0.5"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert res.returncode == 2
+    assert "control.gains." in res.stderr and ".ki" in res.stderr and "PD" in res.stderr
+    ok = subprocess.run(
+        [sys.executable, "-m", "armcli", "simulate", str(spec), "-t", traj, "--duration", "0.5",
+         "--kp", "50", "--kd", "5"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )  # fmt: skip
+    assert ok.returncode == 0, ok.stderr

@@ -11,6 +11,8 @@ from __future__ import annotations
 from lxml import etree
 
 from armcli.build.xmlfmt import XACRO_NS, fmt, to_bytes, vec
+from armcli.defaults import STANDALONE_ARM as STANDALONE_ARM_NAME
+from armcli.defaults import STANDALONE_ARM_URDF, STANDALONE_ARM_XACRO
 from armcli.spec.model import Joint, Link, RobotSpec
 
 X = f"{{{XACRO_NS}}}"
@@ -21,7 +23,7 @@ MOBILE_BASE = "mobile_base.xacro"
 MOBILE_BASE_GAZEBO = "mobile_base_gazebo.xacro"
 ARM = "arm.xacro"
 ARM_GAZEBO = "arm_gazebo.xacro"
-STANDALONE_ARM = "standalone_arm.urdf.xacro"
+STANDALONE_ARM = STANDALONE_ARM_XACRO
 TOP = "{name}.urdf.xacro"
 
 # Solid-body inertia about the centroid, shape axes = inertial frame axes.
@@ -281,7 +283,7 @@ def xacro_files(spec: RobotSpec, spec_label: str = "the armcli spec") -> dict[st
         COMMON: common_properties(spec),
         ARM: part(spec.arm.links, spec.arm.joints, prefixes),
         ARM_GAZEBO: arm_gazebo(spec),
-        STANDALONE_ARM: _top("standalone_arm", [COMMON, ARM, ARM_GAZEBO]),
+        STANDALONE_ARM: _top(STANDALONE_ARM_NAME, [COMMON, ARM, ARM_GAZEBO]),
     }
     if spec.mobile_base is not None and spec.mount is not None:
         trees[MOBILE_BASE] = part(spec.mobile_base.links, spec.mobile_base.joints, prefixes)
@@ -294,7 +296,7 @@ def xacro_files(spec: RobotSpec, spec_label: str = "the armcli spec") -> dict[st
 
 def top_level_files(spec: RobotSpec) -> dict[str, str]:
     """Expanded URDF name -> the top-level xacro file it comes from."""
-    out = {"standalone_arm.urdf": STANDALONE_ARM}
+    out = {STANDALONE_ARM_URDF: STANDALONE_ARM}
     if spec.mobile_base is not None and spec.mount is not None:
         out[f"{spec.name}.urdf"] = TOP.format(name=spec.name)
     return out

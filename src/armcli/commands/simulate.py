@@ -5,14 +5,16 @@ from __future__ import annotations
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
+import click
 import typer
 
 from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import InputError
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
+from armcli.sim.options import ENGINES, INTEGRATORS, Engine, Integrator, SimOptions
 from armcli.sim.plot import write_tracking_plot
 from armcli.spec.load import load_spec
 from armcli.urdf.source import TRUST_XACRO_HELP
@@ -48,7 +50,13 @@ def simulate_cmd(
         None, "--gravity-comp/--no-gravity-comp", help="Add g(q) to the PD torque."
     ),
     dt: float = typer.Option(None, "--dt", help="Time step [s] (default: the spec's control.dt)."),
-    integrator: str = typer.Option("euler", "--integrator", help="euler (semi-implicit) or rk4."),
+    integrator: str = typer.Option(
+        "euler",
+        "--integrator",
+        click_type=click.Choice(INTEGRATORS),
+        show_default=False,
+        help="Semi-implicit Euler (default) or RK4.",
+    ),
     duration: float = typer.Option(
         None, "--duration", help="Simulated time [s] (default: last point + 2 s)."
     ),
@@ -62,36 +70,39 @@ def simulate_cmd(
     rate: float = typer.Option(
         None, "--rate", help="Output rate [Hz] (default: joint_state_publisher's)."
     ),
-    engine: str = typer.Option("auto", "--engine", help="auto, native (compiled) or python."),
+    engine: str = typer.Option(
+        "auto",
+        "--engine",
+        click_type=click.Choice(ENGINES),
+        show_default=False,
+        help="auto (default: compiled when available), native (compiled) or python.",
+    ),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
     from rich.console import Console
 
-    if engine not in ("auto", "native", "python"):
-        raise InputError(
-            f"unknown engine {engine!r}; valid: auto, native, python", field="--engine"
-        )
     if output is not None:
         simreport.output_format(output)
     spec_obj = load_spec(spec or DEFAULT_SPEC) if (spec is not None or urdf is None) else None
-    job = simjob.prepare(
-        spec=spec_obj,
-        urdf=urdf,
-        joints=[j.strip() for j in joints.split(",") if j.strip()] if joints else None,
+    kp_values, kd_values = _floats(kp, "--kp"), _floats(kd, "--kd")
+    opts = SimOptions(
         trajectory=trajectory,
         message=message,
-        kp=_floats(kp, "--kp"),
-        kd=_floats(kd, "--kd"),
+        urdf=urdf,
+        joints=tuple(j.strip() for j in joints.split(",") if j.strip()) if joints else None,
+        kp=tuple(kp_values) if kp_values is not None else None,
+        kd=tuple(kd_values) if kd_values is not None else None,
         gravity_comp=gravity_comp,
         dt=dt,
-        integrator=integrator,
+        integrator=cast(Integrator, integrator),
         duration=duration,
         clamp=clamp,
         rate=rate,
-        backend=engine,
+        engine=cast(Engine, engine),
         trust_xacro=trust_xacro,
     )
+    job = simjob.prepare(spec_obj, opts)
     err = Console(stderr=True)
     for w in job.trajectory.warnings:
         err.print(f"warning: {w}", markup=False, highlight=False)

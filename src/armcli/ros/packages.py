@@ -20,6 +20,7 @@ from lxml import etree
 
 from armcli.build.expand import expand_urdfs
 from armcli.build.xacro_writer import GENERATED, STANDALONE_ARM, top_level_files, xacro_files
+from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.io.files import write_tree_atomic
 from armcli.ros import moveit as mc
@@ -260,7 +261,7 @@ def ros_packages(
     n = Names.of(spec, source)
     mc.controller_update_rate(spec, source)  # refuse bad input before the slow sampling
     urdfs = expand_urdfs(spec)
-    urdf_xml = urdfs.get(f"{n.robot}.urdf", urdfs["standalone_arm.urdf"])
+    urdf_xml = urdfs.get(f"{n.robot}.urdf", urdfs[STANDALONE_ARM_URDF])
     poses = {name: spec.pose(name) for name in spec.poses}
     matrix = compute_collision_matrix(
         urdf_xml, samples=samples, seed=seed, source=n.robot_xacro, poses=poses

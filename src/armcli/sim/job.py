@@ -9,20 +9,22 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from armcli.build.expand import expand_urdfs
+from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_URDF
 from armcli.errors import InputError
+from armcli.sim.options import SimOptions
 from armcli.sim.reference import Reference, build_reference
 from armcli.sim.simulate import Arm, SimConfig, SimResult, arm_from_model, check_stability, simulate
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
+from armcli.spec.model import RobotSpec
 from armcli.urdf.pinocchio import load_model
 from armcli.urdf.source import load_checked_model
 
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
-ARM_URDF = "standalone_arm.urdf"
+ARM_URDF = STANDALONE_ARM_URDF
 MAX_STEPS = 2_000_000  # ~200 MB of recorded states for a 2-joint arm
 
 
@@ -42,7 +44,7 @@ class SimJob:
 
 
 def load_arm(
-    spec: Any | None,
+    spec: RobotSpec | None,
     urdf: Path | None,
     joints: Sequence[str] | None,
     *,
@@ -63,7 +65,9 @@ def load_arm(
     return arm_from_model(load_model(ARM_URDF, xml=xml).model, joints)
 
 
-def _gains(arm: Arm, spec: Any | None, override: Sequence[float] | None, which: str) -> np.ndarray:
+def _gains(
+    arm: Arm, spec: RobotSpec | None, override: Sequence[float] | None, which: str
+) -> np.ndarray:
     n = len(arm.joint_names)
     if override:
         if len(override) not in (1, n):
@@ -81,7 +85,19 @@ def _gains(arm: Arm, spec: Any | None, override: Sequence[float] | None, which: 
     return np.array([getattr(gains[j], which) for j in arm.joint_names], dtype=float)
 
 
-def _tool(arm: Arm, spec: Any | None) -> tuple[int, np.ndarray, str]:
+def _refuse_integral_gain(arm: Arm, spec: RobotSpec | None) -> None:
+    """The simulator runs PD: a spec ki would be silently dropped, so it is refused instead."""
+    gains = spec.control.gains if spec is not None else {}
+    for j in arm.joint_names:
+        if j in gains and gains[j].ki > 0.0:
+            raise InputError(
+                f"= {gains[j].ki:g}: armcli simulates PD control only (no integral term); "
+                "set ki to 0 to simulate this spec, or give --kp and --kd explicitly",
+                field=f"control.gains.{j}.ki",
+            )
+
+
+def _tool(arm: Arm, spec: RobotSpec | None) -> tuple[int, np.ndarray, str]:
     model = arm.model
     if spec is not None and spec.arm.tool is not None and model.existFrame(spec.arm.tool.link):
         off = np.array(spec.arm.tool.xyz, dtype=float)
@@ -92,7 +108,7 @@ def _tool(arm: Arm, spec: Any | None) -> tuple[int, np.ndarray, str]:
     return fid, np.zeros(3), model.frames[fid].name
 
 
-def _report_frame(arm: Arm, spec: Any | None) -> tuple[str, np.ndarray]:
+def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
     """Frame the tool point is reported in, and the arm root's pose in it.
 
     With a spec that mounts the arm on a mobile base, that is the base's root link
@@ -120,7 +136,7 @@ def _fmt(v: np.ndarray) -> str:
     return "(" + ",".join(f"{x:g}" for x in v) + ")"
 
 
-def start_state(arm: Arm, spec: Any | None) -> np.ndarray:
+def start_state(arm: Arm, spec: RobotSpec | None) -> np.ndarray:
     """The spec's `home` pose if it has one, else zero clamped into the joint limits."""
     q = np.zeros(len(arm.joint_names))
     if spec is not None and "home" in spec.poses:
@@ -129,58 +145,39 @@ def start_state(arm: Arm, spec: Any | None) -> np.ndarray:
     return np.clip(q, arm.lower, arm.upper)
 
 
-def prepare(
-    *,
-    spec: Any | None,
-    urdf: Path | None = None,
-    joints: Sequence[str] | None = None,
-    trajectory: Path | None = None,
-    message: str | None = None,
-    kp: Sequence[float] | None = None,
-    kd: Sequence[float] | None = None,
-    gravity_comp: bool | None = None,
-    dt: float | None = None,
-    integrator: str = "euler",
-    duration: float | None = None,
-    clamp: bool = False,
-    rate: float | None = None,
-    backend: str = "auto",
-    trust_xacro: bool = False,
-) -> SimJob:
+def prepare(spec: RobotSpec | None, opts: SimOptions) -> SimJob:
     """Validate every input and assemble the run; raises InputError on bad input."""
+    trajectory, message, dt, rate = opts.trajectory, opts.message, opts.dt, opts.rate
     if (trajectory is None) == (message is None):
         raise InputError(
             "give exactly one of --trajectory FILE or --message '...'", field="--trajectory"
         )
-    if integrator not in ("euler", "rk4"):
-        raise InputError(
-            f"unknown integrator {integrator!r}; valid: euler, rk4", field="--integrator"
-        )
-    dt = dt if dt is not None else (spec.control.dt if spec is not None else 0.001)
+    dt = dt if dt is not None else (spec.control.dt if spec is not None else DEFAULT_DT)
     if not (np.isfinite(dt) and 0 < dt <= 0.1):
         raise InputError(f"must be in (0, 0.1] s, got {dt:g}", field="--dt")
-    arm = load_arm(spec, urdf, joints, trust_xacro=trust_xacro)
+    arm = load_arm(spec, opts.urdf, opts.joints, trust_xacro=opts.trust_xacro)
     limits = {
         n: (float(lo), float(hi))
         for n, lo, hi in zip(arm.joint_names, arm.lower, arm.upper, strict=True)
     }
     if trajectory is not None:
-        traj = load_trajectory(trajectory, limits, clamp=clamp)
+        traj = load_trajectory(trajectory, limits, clamp=opts.clamp)
     else:
-        traj = loads_trajectory(str(message), limits, clamp=clamp)
+        traj = loads_trajectory(str(message), limits, clamp=opts.clamp)
     q0 = start_state(arm, spec)
     ref = build_reference(traj, arm.joint_names, q0)
     gc = (
-        gravity_comp
-        if gravity_comp is not None
+        opts.gravity_comp
+        if opts.gravity_comp is not None
         else bool(spec and spec.control.gravity_compensation)
     )
-    cfg = SimConfig(
-        _gains(arm, spec, kp, "kp"), _gains(arm, spec, kd, "kd"), dt, integrator, gc, backend
-    )
+    kp, kd = _gains(arm, spec, opts.kp, "kp"), _gains(arm, spec, opts.kd, "kd")
+    if opts.kp is None or opts.kd is None:
+        _refuse_integral_gain(arm, spec)
+    cfg = SimConfig(kp, kd, dt, opts.integrator, gc, opts.engine)
     configs = np.vstack([q0[None, :], ref.sample(traj.times)[0]])
     check_stability(arm, cfg, configs)
-    total = duration if duration is not None else traj.duration + SETTLE_EXTRA_S
+    total = opts.duration if opts.duration is not None else traj.duration + SETTLE_EXTRA_S
     if not (np.isfinite(total) and 0 < total <= 3600):
         raise InputError(f"must be in (0, 3600] s, got {total:g}", field="--duration")
     if total / dt > MAX_STEPS:
@@ -190,7 +187,11 @@ def prepare(
             field="--duration",
         )
     jsp = spec.arm.joint_state_publisher if spec is not None else None
-    rate = rate if rate is not None else (jsp.update_rate if jsp is not None else 10.0)
+    rate = (
+        rate
+        if rate is not None
+        else (jsp.update_rate if jsp is not None else DEFAULT_STATE_RATE_HZ)
+    )
     if not (np.isfinite(rate) and rate > 0):
         raise InputError(f"must be > 0 Hz, got {rate:g}", field="--rate")
     fid, off, label = _tool(arm, spec)

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from armcli.defaults import DEFAULT_DT
 from armcli.errors import InputError, SimulationError
 from armcli.sim import native
 from armcli.sim import rollout as ro
@@ -49,7 +50,7 @@ class Arm:
 class SimConfig:
     kp: np.ndarray
     kd: np.ndarray
-    dt: float = 0.001  # [s]
+    dt: float = DEFAULT_DT  # [s]
     integrator: str = "euler"
     gravity_comp: bool = False
     backend: str = "auto"  # "auto" | "native" | "python"

@@ -22,6 +22,7 @@ from pydantic import (
     model_validator,
 )
 
+from armcli.defaults import DEFAULT_DT
 from armcli.spec.expr import eval_expr
 
 
@@ -226,7 +227,7 @@ class Gains(_Model):
 
 
 class Control(_Model):
-    dt: Positive = 0.001
+    dt: Positive = DEFAULT_DT
     gains: dict[Name, Gains] = {}
     controller_update_rate: Positive = 100.0
     gravity_compensation: bool = False

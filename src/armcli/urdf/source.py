@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from armcli.build.expand import expand_urdfs
+from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import InputError, XacroRefusedError
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
@@ -54,7 +55,7 @@ class RobotFile:
     def robot(self) -> Urdf:
         """The whole robot: the spec's `<name>.urdf`, else the only document."""
         if self.spec is not None:
-            for name in (f"{self.spec.name}.urdf", "standalone_arm.urdf"):
+            for name in (f"{self.spec.name}.urdf", STANDALONE_ARM_URDF):
                 found = next((u for u in self.urdfs if u.source.endswith(f"#{name}")), None)
                 if found is not None:
                     return found
