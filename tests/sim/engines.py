@@ -24,7 +24,9 @@ def require_native() -> ModuleType:
     if mod is not None:
         return mod
     if has_compiler():
-        pytest.fail(f"compiled engine missing although a C++ compiler exists: {native.why_missing()}")
+        pytest.fail(
+            f"compiled engine missing although a C++ compiler exists: {native.why_missing()}"
+        )
     pytest.skip(f"no C++ compiler: {native.why_missing()}")
 
 

@@ -122,7 +122,7 @@ def test_every_example_robot_engines_agree() -> None:
         simulable = [
             model.names[j]
             for j in range(1, model.njoints)
-            if model.joints[j].shortname() in native.JOINT_TYPES and model.joints[j].nq == 1
+            if model.joints[j].shortname() in ro.JOINT_TYPES and model.joints[j].nq == 1
         ]
         if not simulable:
             continue

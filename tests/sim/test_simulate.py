@@ -127,7 +127,9 @@ def test_energy_conserved_without_damping(arm: Arm) -> None:
     free = _arm(arm.model)
     cfg = SimConfig(kp=np.zeros(2), kd=np.zeros(2), dt=2.5e-4, integrator="rk4")
     steps = 40_000  # 10 s
-    r = _run(FAST, _plant(free, cfg), [0.4, -0.3], [0.0, 0.0], _const_ref(2, steps, sub=ro.RK4_ROWS))
+    r = _run(
+        FAST, _plant(free, cfg), [0.4, -0.3], [0.0, 0.0], _const_ref(2, steps, sub=ro.RK4_ROWS)
+    )
     e0 = _energy(free.model, r.q[0], r.v[0])
     energies = [_energy(free.model, r.q[k], r.v[k]) for k in range(0, steps + 1, 1000)]
     # conservative double pendulum (chaotic, up to ~55 rad/s): total energy constant;

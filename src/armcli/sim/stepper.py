@@ -78,7 +78,9 @@ class Stepper:
         out: list[float] = self.pin.aba(self.model, self.data, qa, va, ta).tolist()
         return out
 
-    def motor(self, q: list[float], v: list[float], qr: list[float], vr: list[float]) -> list[float]:
+    def motor(
+        self, q: list[float], v: list[float], qr: list[float], vr: list[float]
+    ) -> list[float]:
         """PD(+gravity) torque before saturation."""
         kp, kd, n = self.kp, self.kd, self.n
         t = [kp[i] * (qr[i] - q[i]) + kd[i] * (vr[i] - v[i]) for i in range(n)]
@@ -107,7 +109,9 @@ class Stepper:
             vs = [v[i] + dt * a[i] for i in range(n)]
             qp = [q[i] + dt * vs[i] for i in range(n)]
             qn, vn = self.project(q, vs, qp, 1.0)
-            tau = [tau_pd[i] if self.sat[i] else tau_pd[i] - kd[i] * (vn[i] - v[i]) for i in range(n)]
+            tau = [
+                tau_pd[i] if self.sat[i] else tau_pd[i] - kd[i] * (vn[i] - v[i]) for i in range(n)
+            ]
             over = [i for i in range(n) if not self.sat[i] and abs(tau[i]) > e[i]]
             if not over:
                 break
@@ -117,7 +121,9 @@ class Stepper:
         self.tau = tau
         return self.clamp(qn), vn
 
-    def accel(self, q: list[float], v: list[float], qr: list[float], vr: list[float]) -> list[float]:
+    def accel(
+        self, q: list[float], v: list[float], qr: list[float], vr: list[float]
+    ) -> list[float]:
         """Explicit acceleration under the saturated motor torque (RK4 stages), with the
         joints in `self.locked` held (zero acceleration) by their stops."""
         d = self.damp
