@@ -11,10 +11,16 @@ from __future__ import annotations
 import sys
 
 import typer
+import typer.core
 
 import armcli
 from armcli.commands import build, check, render, ros, simulate, tree, view
 from armcli.errors import EXIT_FAILED, ArmcliError
+
+# Typer escapes "[" for rich's HTML export whenever rich is importable, even with
+# rich_markup_mode=None (plain click help), which prints "\\[default: ...]" in --help.
+# Plain click help needs no escaping, and nothing else of typer's rich path is used here.
+typer.core.HAS_RICH = False
 
 app = typer.Typer(
     name="armcli",

@@ -72,6 +72,7 @@ class SpecError(InputError):
         super().__init__(first.message, file=file, line=first.line, field=first.field or None)
 
     def lines(self) -> list[str]:
+        """One line per problem, each prefixed with its file:line and field path."""
         out = []
         for p in self.problems:
             where = _where(self.file, p.line)
@@ -102,6 +103,7 @@ class UnusableInputsError(ArmcliError):
         super().__init__(str(self.errors[0]))
 
     def lines(self) -> list[str]:
+        """The lines of every unusable input, in the order they failed."""
         return [line for e in self.errors for line in e.lines()]
 
 
@@ -120,6 +122,7 @@ class StaleBuildError(ArmcliError):
         super().__init__("stale generated files: " + ", ".join(self.stale))
 
     def lines(self) -> list[str]:
+        """One `stale:` line per file, then a count and how to fix it."""
         return [f"stale: {s}" for s in self.stale] + [
             f"{len(self.stale)} generated file(s) differ from a fresh build; run `armcli build`"
         ]

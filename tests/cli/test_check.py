@@ -197,3 +197,15 @@ def test_docs_list_every_rule() -> None:
     doc = (ROOT / "docs" / "check.md").read_text()
     for rule in RULES.values():
         assert f"| `{rule.id}` | {rule.severity} |" in doc, rule.id
+
+
+@pytest.mark.parametrize(
+    "command", ["build", "check", "simulate", "ros-package", "view", "render", "tree"]
+)
+def test_help_lists_choices_and_prints_no_stray_escapes(command: str) -> None:
+    """Every --help renders plainly: no rich escape backslash before `[...]`."""
+    res = armcli(command, "--help")
+    assert res.returncode == 0 and "Usage:" in res.stdout
+    assert "\\" not in res.stdout
+    if command in ("check", "simulate"):
+        assert "[" in res.stdout and "|" in res.stdout  # a Choice lists its values

@@ -62,6 +62,11 @@ def _sub(parent: etree._Element, tag: str, **attrs: str) -> etree._Element:
 
 
 def common_properties(spec: RobotSpec) -> etree._Element:
+    """The common_properties.xacro tree: RViz materials and the inertia macros.
+
+    The box, cylinder and sphere macros give solid-body inertias [kg·m²] about the centroid,
+    so every link's inertia comes from one set of formulas.
+    """
     root = _robot()
     for name in sorted(spec.materials):
         mat = _sub(root, "material", name=name)
@@ -148,6 +153,11 @@ def _link(root: etree._Element, name: str, link: Link, refs: dict[str, str]) -> 
 
 
 def joint_element(parent: etree._Element, name: str, joint: Joint) -> etree._Element:
+    """Append the URDF `<joint>` of `joint` to `parent` and return it.
+
+    Fixed joints get no axis, limit or dynamics; continuous joints get only effort and
+    velocity limits. Values are written in SI units as the spec gives them.
+    """
     el = _sub(parent, "joint", name=name, type=joint.type)
     _sub(el, "parent", link=joint.parent)
     _sub(el, "child", link=joint.child)
@@ -217,6 +227,7 @@ def _flag(b: bool) -> str:
 
 
 def mobile_base_gazebo(spec: RobotSpec) -> etree._Element:
+    """The mobile_base_gazebo.xacro tree: base link materials and the diff-drive plugin."""
     root = _robot()
     assert spec.mobile_base is not None
     _gazebo_materials(root, spec, spec.mobile_base.links)
@@ -245,6 +256,7 @@ def mobile_base_gazebo(spec: RobotSpec) -> etree._Element:
 
 
 def arm_gazebo(spec: RobotSpec) -> etree._Element:
+    """The arm_gazebo.xacro tree: arm link materials and the joint state/trajectory plugins."""
     root = _robot()
     _gazebo_materials(root, spec, spec.arm.links)
     jsp = spec.arm.joint_state_publisher

@@ -24,6 +24,7 @@ def fmt(x: float) -> str:
 
 
 def vec(values: Iterable[float]) -> str:
+    """Space-separated `fmt` of each value, as URDF writes vectors (xyz, rpy, rgba)."""
     return " ".join(fmt(v) for v in values)
 
 

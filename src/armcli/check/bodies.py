@@ -1,6 +1,7 @@
-"""Rules on the rigid bodies the joints move: each movable joint's child link plus
-everything fixed to it, lumped as simulators do (Pinocchio, MuJoCo's fusestatic,
-Gazebo's fixed-joint reduction).
+"""Rules on the rigid bodies the joints move, lumped as simulators lump them.
+
+A body is a movable joint's child link plus everything fixed to it (Pinocchio,
+MuJoCo's fusestatic, Gazebo's fixed-joint reduction).
 
 A zero-mass frame link fixed to a heavy link is fine; what breaks the mass
 matrix is a moving *body* with no mass or a singular inertia (a lone point
@@ -105,6 +106,10 @@ def moving_bodies(urdf: Urdf, tree: Tree) -> list[Body]:
 
 
 def check(urdf: Urdf, tree: Tree, out: Collector) -> None:
+    """Rules on moving bodies: no mass, a singular inertia, or a tiny share of the robot mass.
+
+    Bodies with unusable numbers are skipped: the number rules already reported them.
+    """
     total = _robot_mass(urdf)
     lines = {lk.name: lk.line for lk in urdf.links}
     for b in moving_bodies(urdf, tree):

@@ -1,5 +1,7 @@
-"""Rules on the Pinocchio model: worst gravity torque over a sample of the joint range
-versus the effort limit, PD stability at the spec's time step (armcli.sim.stability), and
+"""Rules on the Pinocchio model: gravity versus effort, PD stability, self-collision.
+
+The worst gravity torque over a sample of the joint range is compared with the effort
+limit, PD stability is checked at the spec's time step (armcli.sim.stability), and
 self-collision at the spec's named poses (Pinocchio GeometryModel + coal).
 """
 
@@ -33,8 +35,11 @@ PENETRATION_TOL = 1e-4  # [m]
 
 
 def samples(model: Any, ranges: list[Any]) -> list[tuple[dict[str, float], Any]]:
-    """Joint-space sample: a full grid for few joints; else every corner of the range box
-    (where gravity torques peak for serial arms) when there are few, plus seeded draws.
+    """Joint-space sample as (joint values by name, Pinocchio configuration) pairs.
+
+    A full grid for few joints; else the zero pose clamped into range, every corner of the
+    range box (where gravity torques peak for serial arms) when there are few, and seeded
+    draws, so the same URDF always gives the same sample.
     """
     n = len(ranges)
     names = [jr.name for jr in ranges]
@@ -59,6 +64,11 @@ def gravity(
     rows: tuple[JointRow, ...],
     out: Collector,
 ) -> tuple[JointRow, ...]:
+    """Rule `gravity-effort`: the worst gravity torque over `samples` versus each effort limit.
+
+    Returns:
+        `rows` with `gravity_max` [N·m or N] filled in (None for joints not in the model).
+    """
     import pinocchio as pin
 
     worst = np.zeros(model.nv)
@@ -97,6 +107,11 @@ def stability(
     out: Collector,
     notes: list[str],
 ) -> StabilityReport | None:
+    """Rules `pd-explicit-unstable` and `pd-unstable`: the spec's PD gains at its time step.
+
+    The mass matrix at every sample bounds the gains (armcli.sim.stability). Returns None
+    without a spec that has gains, and adds a note when no controlled joint is in the URDF.
+    """
     import pinocchio as pin
 
     spec = opts.spec
@@ -169,6 +184,11 @@ def self_collision(
     out: Collector,
     notes: list[str],
 ) -> None:
+    """Rule `self-collision`: link pairs that interpenetrate at the spec's named poses.
+
+    Adjacent (parent-child) links and overlaps below PENETRATION_TOL [m] do not count. Skipped
+    with a note when a mesh cannot be found or the collision model cannot be built.
+    """
     import pinocchio as pin
 
     meshes = mesh_paths(urdf, opts)

@@ -1,5 +1,6 @@
-"""Inertia rules: mass sign, positive definiteness, triangle inequality, and inertia
-versus the link's own geometry (which catches permuted or scaled macro output).
+"""Inertia rules: mass sign, positive definiteness, triangle inequality, own geometry.
+
+Comparing the inertia with the link's own geometry catches permuted or scaled macro output.
 """
 
 from __future__ import annotations

@@ -20,6 +20,7 @@ SPEC_LIMIT_TOL = 1e-9
 
 
 def check(urdf: Urdf, spec: RobotSpec | None, out: Collector) -> None:
+    """Joint rules: axis and limits of each moving joint, then the arm limits against the spec."""
     for j in urdf.joints:
         if j.type in ("revolute", "prismatic", "continuous"):
             _axis(j, out)

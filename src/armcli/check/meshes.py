@@ -56,8 +56,10 @@ def resolve(uri: str, urdf_path: Path, opts: CheckOptions) -> Path | None:
 
 
 def mesh_paths(urdf: Urdf, opts: CheckOptions) -> dict[str, Path | None]:
-    """Every mesh URI in the file -> its resolved path (None if unresolvable or outside
-    the allowed roots, so that nothing outside them is ever loaded).
+    """Every mesh URI in the file -> its resolved path.
+
+    None if unresolvable or outside the allowed roots, so that nothing outside them is
+    ever loaded.
     """
     src = Path(urdf.source)
     out: dict[str, Path | None] = {}
@@ -72,8 +74,10 @@ def mesh_paths(urdf: Urdf, opts: CheckOptions) -> dict[str, Path | None]:
 
 
 def confined(uri: str, path: Path, urdf_path: Path, opts: CheckOptions) -> bool:
-    """Whether a resolved mesh path lies inside the allowed roots (robot_source.allowed_roots,
-    --package-dir, the search paths, and for package:// the package it names).
+    """Whether a resolved mesh path lies inside the allowed roots.
+
+    The roots: robot_source.allowed_roots, --package-dir, the search paths, and for
+    package:// the package it names.
     """
     extra = [*map(Path, opts.package_dirs.values()), *opts.search_paths]
     parsed = urlparse(uri)
@@ -85,6 +89,10 @@ def confined(uri: str, path: Path, urdf_path: Path, opts: CheckOptions) -> bool:
 
 
 def check(urdf: Urdf, opts: CheckOptions, out: Collector) -> None:
+    """Rule `mesh-missing`: meshes without a filename, outside the allowed roots, or absent.
+
+    Each URI is reported once; a path outside the allowed roots is never stat'ed.
+    """
     src = Path(urdf.source)
     reported: set[str] = set()
     for link in urdf.links:

@@ -18,6 +18,7 @@ JSON_SCHEMA = "armcli.check/1"
 
 
 def counts(findings: Sequence[Finding]) -> dict[str, int]:
+    """Number of findings per severity (`error`, `warning`) for the summary and JSON."""
     return {
         ERROR: sum(f.severity == ERROR for f in findings),
         WARNING: sum(f.severity == WARNING for f in findings),

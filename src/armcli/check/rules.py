@@ -23,6 +23,8 @@ Value = float | int | str | list[float] | None
 
 @dataclass(frozen=True)
 class Rule:
+    """One check rule: stable id (for --ignore and JSON), severity, title and fix hint."""
+
     id: str
     severity: str
     title: str
@@ -175,6 +177,7 @@ class Finding:
     hint: str = ""
 
     def to_dict(self) -> dict[str, Any]:
+        """The finding as a JSON object in the stable schema of docs/check.md."""
         return {
             "rule": self.rule,
             "severity": self.severity,
@@ -194,10 +197,12 @@ class Collector:
         self.findings: list[Finding] = []
 
     def add(self, rule: str, line: int | None, message: str, **values: Value) -> None:
+        """Record a finding of `rule` at `line`; `values` are the numbers behind the message."""
         r = RULES[rule]
         self.findings.append(Finding(rule, r.severity, self.file, line, message, values, r.hint))
 
     def has_errors(self, rules: Iterable[str] | None = None) -> bool:
+        """Whether an error-severity finding was recorded, optionally only among `rules`."""
         wanted = set(rules) if rules is not None else None
         return any(
             f.severity == ERROR and (wanted is None or f.rule in wanted) for f in self.findings

@@ -12,6 +12,8 @@ from armcli.urdf.doc import Urdf
 
 @dataclass(frozen=True)
 class CheckResult:
+    """The `check` outcome for one file: its findings and the report's summary."""
+
     file: str
     findings: tuple[Finding, ...]
     summary: Summary | None

@@ -31,6 +31,7 @@ class Tree:
     moving: frozenset[str]  # links below at least one movable joint
 
     def is_moving(self, link: str) -> bool:
+        """Whether `link` is below at least one movable joint."""
         return link in self.moving
 
 

@@ -1,6 +1,8 @@
-"""Loading the Pinocchio model (parser messages become findings) and the report's
-summary: mass, DoF, joint table, end-effector forward kinematics at each pose.
-The model-based rules themselves are in checks_dynamics.
+"""Loading the Pinocchio model for `check`, and the report's summary.
+
+Parser messages become findings. The summary holds mass, DoF, the joint table and the
+end-effector forward kinematics at each pose. The model-based rules themselves are in
+`armcli.check.dynamics`.
 """
 
 from __future__ import annotations
@@ -45,6 +47,8 @@ _NUMBER_ERRORS = (
 
 @dataclass(frozen=True)
 class PoseRow:
+    """One pose in the summary: its joint values [rad or m] and the end-effector position."""
+
     name: str
     q: tuple[tuple[str, float], ...]
     xyz: tuple[float, float, float]  # end effector in the root link frame [m]
@@ -52,6 +56,8 @@ class PoseRow:
 
 @dataclass(frozen=True)
 class Summary:
+    """The report's summary of one URDF: mass, DoF, joint table, poses, PD stability, notes."""
+
     robot: str
     root: str | None
     total_mass: float  # [kg]
@@ -64,6 +70,11 @@ class Summary:
 
 
 def check(urdf: Urdf, tree: Tree, opts: CheckOptions, out: Collector) -> Summary:
+    """Load the Pinocchio model, run the model rules on it and build the summary.
+
+    Parser messages become `parser-error`/`parser-message` findings and a refused model a
+    `model-load` finding; the model is not loaded while structure errors remain.
+    """
     rows = _joint_rows(urdf)
     base: dict[str, Any] = {
         "robot": urdf.name,

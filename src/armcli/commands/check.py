@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import click
 import typer
 
 from armcli.check import report
@@ -69,7 +70,13 @@ def check_cmd(
     spec: Path | None = typer.Option(
         None, "--spec", help="Spec to compare limits with; also gives gains, dt, poses, tool."
     ),
-    fmt: str = typer.Option("table", "--format", help="table, json or github."),
+    fmt: str = typer.Option(
+        "table",
+        "--format",
+        click_type=click.Choice(FORMATS),
+        show_default=False,
+        help="Report format (default: table).",
+    ),
     strict: bool = typer.Option(False, "--strict", help="Treat warnings as errors."),
     ignore: list[str] = typer.Option([], "--ignore", help="Silence a rule id (repeatable)."),
     package_dir: list[str] = typer.Option(
@@ -112,4 +119,5 @@ def _print(results: list[CheckResult], findings: list[Any], fmt: str, code: int)
 
 
 def register(app: typer.Typer) -> None:
+    """Add the `check` command to the typer app."""
     app.command("check")(check_cmd)

@@ -25,15 +25,26 @@ def _size(text: str) -> tuple[int, int]:
 
 
 def render_cmd(
-    robot: Path = typer.Argument(DEFAULT_SPEC, help=ROBOT_HELP),
+    robot: Path = typer.Argument(DEFAULT_SPEC, show_default=False, help=ROBOT_HELP),
     pose: str = typer.Option(None, "--pose", help="A named pose of the spec."),
     q: str = typer.Option(
         None,
         "--q",
         help="Joint values in rad (m if prismatic): '0.3,pi/4' in arm order, or 'joint=0.3,...'.",
     ),
-    out: Path = typer.Option(Path("robot.png"), "-o", "--out", help="PNG to write."),
-    size: str = typer.Option("1200x600", "--size", help="Image size WIDTHxHEIGHT in pixels."),
+    out: Path = typer.Option(
+        Path("robot.png"),
+        "-o",
+        "--out",
+        show_default=False,
+        help="PNG to write (default: robot.png).",
+    ),
+    size: str = typer.Option(
+        "1200x600",
+        "--size",
+        show_default=False,
+        help="Image size WIDTHxHEIGHT in pixels (default: 1200x600).",
+    ),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""

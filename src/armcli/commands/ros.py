@@ -15,15 +15,37 @@ DEFAULT_SAMPLES = 10_000  # keep equal to armcli.ros.collision_matrix.DEFAULT_SA
 
 
 def ros_package_cmd(
-    spec: Path = typer.Argument(DEFAULT_SPEC, help="Robot spec YAML."),
-    out: Path = typer.Option(Path("ros"), "-o", "--out", help="Output directory."),
-    samples: int = typer.Option(
-        DEFAULT_SAMPLES, "--samples", min=1, help="Random states for the collision matrix."
+    spec: Path = typer.Argument(
+        DEFAULT_SPEC, show_default=False, help=f"Robot spec YAML (default: {DEFAULT_SPEC})."
     ),
-    seed: int = typer.Option(0, "--seed", help="Seed of the collision-matrix sampling."),
-    maintainer: str = typer.Option("armcli", "--maintainer", help="package.xml maintainer."),
-    email: str = typer.Option("armcli@example.com", "--email", help="Maintainer e-mail."),
-    license_: str = typer.Option("TODO", "--license", help="package.xml license."),
+    out: Path = typer.Option(
+        Path("ros"), "-o", "--out", show_default=False, help="Output directory (default: ros)."
+    ),
+    samples: int = typer.Option(
+        DEFAULT_SAMPLES,
+        "--samples",
+        min=1,
+        show_default=False,
+        help=f"Random states for the collision matrix (default: {DEFAULT_SAMPLES}).",
+    ),
+    seed: int = typer.Option(
+        0, "--seed", show_default=False, help="Seed of the collision-matrix sampling (default: 0)."
+    ),
+    maintainer: str = typer.Option(
+        "armcli",
+        "--maintainer",
+        show_default=False,
+        help="package.xml maintainer (default: armcli).",
+    ),
+    email: str = typer.Option(
+        "armcli@example.com",
+        "--email",
+        show_default=False,
+        help="Maintainer e-mail (default: armcli@example.com).",
+    ),
+    license_: str = typer.Option(
+        "TODO", "--license", show_default=False, help="package.xml license (default: TODO)."
+    ),
 ) -> None:
     """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
     info = PackageInfo(maintainer=maintainer, email=email, license=license_)
@@ -49,4 +71,5 @@ def ros_package_cmd(
 
 
 def register(app: typer.Typer) -> None:
+    """Add the `ros-package` command to the typer app."""
     app.command("ros-package")(ros_package_cmd)

@@ -154,4 +154,5 @@ class _LazyProgress:
 
 
 def register(app: typer.Typer) -> None:
+    """Add the `simulate` command to the typer app."""
     app.command("simulate")(simulate_cmd)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+import click
 import typer
 
 from armcli.defaults import DEFAULT_SPEC
@@ -14,10 +15,18 @@ from armcli.urdf.source import TRUST_XACRO_HELP
 from armcli.urdf.tree import parse_tree, to_dot, to_rich
 from armcli.view.scene import ROBOT_HELP, load_robot
 
+TREE_FORMATS = ("text", "dot")
+
 
 def tree_cmd(
-    robot: Path = typer.Argument(DEFAULT_SPEC, help=ROBOT_HELP),
-    fmt: str = typer.Option("text", "--format", help="text (a tree) or dot (Graphviz)."),
+    robot: Path = typer.Argument(DEFAULT_SPEC, show_default=False, help=ROBOT_HELP),
+    fmt: str = typer.Option(
+        "text",
+        "--format",
+        click_type=click.Choice(TREE_FORMATS),
+        show_default=False,
+        help="text (a tree, the default) or dot (Graphviz).",
+    ),
     out: Path = typer.Option(None, "-o", "--out", help="Write to this file instead of stdout."),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:

@@ -17,11 +17,18 @@ from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
 
 
 def view_cmd(
-    robot: Path = typer.Argument(DEFAULT_SPEC, help=ROBOT_HELP),
+    robot: Path = typer.Argument(DEFAULT_SPEC, show_default=False, help=ROBOT_HELP),
     replay: Path = typer.Option(None, "--replay", help="A CSV written by `armcli simulate`."),
     pose: str = typer.Option(None, "--pose", help="Start at this named pose."),
-    host: str = typer.Option("127.0.0.1", "--host", help="Address to listen on."),
-    port: int = typer.Option(8080, "--port", help="Port to listen on (0: any free port)."),
+    host: str = typer.Option(
+        "127.0.0.1", "--host", show_default=False, help="Address to listen on (default: 127.0.0.1)."
+    ),
+    port: int = typer.Option(
+        8080,
+        "--port",
+        show_default=False,
+        help="Port to listen on (default: 8080; 0: any free port).",
+    ),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Open a browser 3-D viewer with joint sliders, named poses and simulation replay."""

@@ -204,4 +204,5 @@ def load_yaml(path: str | Path, *, flow_sets: bool = False) -> YamlDoc:
 
 
 def is_finite_number(x: object) -> bool:
+    """Whether `x` is a finite int or float; YAML booleans are not numbers here."""
     return isinstance(x, int | float) and not isinstance(x, bool) and math.isfinite(x)

@@ -50,6 +50,12 @@ class EnabledPair:
 
 @dataclass(frozen=True)
 class CollisionMatrix:
+    """The pairs MoveIt may skip and the pairs it checks, with the sampling used.
+
+    `samples` and `seed` reproduce the matrix; `pose_collisions` lists pairs in contact at
+    the spec's named poses.
+    """
+
     links: tuple[str, ...]  # links with collision geometry, sorted
     disabled: tuple[DisabledPair, ...]  # sorted by (link1, link2)
     enabled: tuple[EnabledPair, ...]

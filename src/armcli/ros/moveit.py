@@ -41,6 +41,7 @@ def dump_yaml(data: dict[str, Any], header: str | None = None) -> bytes:
 
 
 def kinematics(spec: RobotSpec) -> dict[str, Any]:
+    """The kinematics.yaml of the arm group: KDL, position-only (2 axes cannot reach 6-D poses)."""
     return {
         ARM_GROUP: {
             "kinematics_solver": KDL_PLUGIN,

@@ -91,6 +91,11 @@ class Names:
 
     @staticmethod
     def of(spec: RobotSpec, source: str | None = None) -> Names:
+        """Every package, file and frame name, derived from the spec's name.
+
+        Raises:
+            InputError: the spec name is not a valid ROS package name.
+        """
         if not PACKAGE_NAME.match(spec.name):
             raise InputError(
                 f"{spec.name!r}: ROS package names need lower case letters, digits and _",
@@ -117,6 +122,8 @@ class Names:
 
 @dataclass(frozen=True)
 class RosPackages:
+    """The three packages in memory, before the one atomic write, with their names and matrix."""
+
     files: Mapping[str, bytes]  # path relative to the output directory -> content
     names: Names
     matrix: CollisionMatrix
@@ -193,6 +200,7 @@ def _launch_values(n: Names) -> dict[str, str]:
 
 
 def description_files(spec: RobotSpec, n: Names, label: str, info: PackageInfo) -> dict[str, bytes]:
+    """The `<name>_description` files: the `build` xacro set, a display launch and RViz config."""
     note = GENERATED.format(spec=label)
     files = {f"urdf/{name}": data for name, data in xacro_files(spec, label).items()}
     files["launch/display.launch.py"] = render("display.launch.py.tmpl", _launch_values(n), note)
@@ -202,6 +210,7 @@ def description_files(spec: RobotSpec, n: Names, label: str, info: PackageInfo) 
 
 
 def bringup_files(n: Names, note: str, info: PackageInfo) -> dict[str, bytes]:
+    """The `<name>_bringup` files: a launch file that starts Gazebo with the robot."""
     launch = render("gazebo.launch.py.tmpl", _launch_values(n), note)
     about = f"Gazebo bringup of {n.robot}. {note}"
     depends = [n.description, *BRINGUP_DEPENDS]
@@ -228,6 +237,7 @@ def moveit_files(
     note: str,
     info: PackageInfo,
 ) -> dict[str, bytes]:
+    """The `<name>_moveit_config` files: SRDF, config YAML, ros2_control xacro, RViz, launches."""
     yamls = _moveit_yaml(spec, urdf_xml)
     files = {f"config/{name}": mc.dump_yaml(data, note) for name, data in yamls.items()}
     urdf_xacro = f"config/{n.robot}.urdf.xacro"

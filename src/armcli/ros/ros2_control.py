@@ -23,6 +23,7 @@ def _robot(name: str | None = None) -> etree._Element:
 
 
 def macro_name(robot: str) -> str:
+    """Name of the xacro macro that emits the robot's `<ros2_control>` block."""
     return f"{robot}_ros2_control"
 
 

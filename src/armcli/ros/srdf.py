@@ -48,6 +48,7 @@ def chain_joints(spec: RobotSpec) -> list[str]:
 
 
 def srdf_tree(spec: RobotSpec, matrix: CollisionMatrix) -> etree._Element:
+    """The SRDF element tree: arm and hand groups, named poses, end effector, disabled pairs."""
     root = etree.Element("robot", name=spec.name)
     base, tip = arm_chain(spec)
     arm = etree.SubElement(root, "group", name=ARM_GROUP)

@@ -30,6 +30,8 @@ MAX_STEPS = 2_000_000  # ~200 MB of recorded states for a 2-joint arm
 
 @dataclass(frozen=True)
 class SimJob:
+    """Everything one simulation run needs, as `prepare` decided it from the user inputs."""
+
     arm: Arm
     trajectory: Trajectory
     reference: Reference
@@ -212,4 +214,5 @@ def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
 
 
 def run(job: SimJob, progress: Callable[[int, int], None] | None = None) -> SimResult:
+    """Run the job; `progress(steps_done, steps_total)` is called between chunks of steps."""
     return simulate(job.arm, job.reference, job.q0, job.duration, job.config, progress)

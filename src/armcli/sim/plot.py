@@ -57,4 +57,5 @@ def tracking_png(res: SimResult, effort_limits: np.ndarray | None = None) -> byt
 def write_tracking_plot(
     path: Path, res: SimResult, effort_limits: np.ndarray | None = None
 ) -> None:
+    """Write the tracking plot PNG atomically; `effort_limits` [N·m] mark saturation."""
     write_file_atomic(path, tracking_png(res, effort_limits))

@@ -62,8 +62,9 @@ def segment_coeffs(
     a0: np.ndarray | None = None,
     a1: np.ndarray | None = None,
 ) -> np.ndarray:
-    """(6, n) coefficients over [0, h]: linear, cubic (v0, v1) or quintic (also a0, a1),
-    the same closed forms as joint_trajectory_controller's interpolation.
+    """(6, n) coefficients over [0, h]: linear, cubic (v0, v1) or quintic (also a0, a1).
+
+    The same closed forms as joint_trajectory_controller's interpolation.
     """
     n = p0.shape[0]
     c = np.zeros((6, n))

@@ -25,6 +25,8 @@ FLOAT_FMT = "{:.9g}"
 
 @dataclass(frozen=True)
 class JointMetrics:
+    """How well one joint tracked its reference; errors in the joint's unit [rad or m]."""
+
     name: str
     rms_error: float  # over the whole run
     max_error: float
@@ -132,6 +134,11 @@ def states_bytes(cols: dict[str, np.ndarray], fmt: str) -> bytes:
 
 
 def output_format(path: Path) -> str:
+    """The joint-state file format named by the extension of `path`: "csv" or "json".
+
+    Raises:
+        InputError: any other extension.
+    """
     ext = path.suffix.lower()
     if ext not in (".csv", ".json"):
         raise InputError(
@@ -141,4 +148,5 @@ def output_format(path: Path) -> str:
 
 
 def write_states(path: Path, res: SimResult, rate: float) -> None:
+    """Write the joint states sampled at `rate` [Hz] atomically, as CSV or JSON by extension."""
     write_file_atomic(path, states_bytes(sample_states(res, rate), output_format(path)))

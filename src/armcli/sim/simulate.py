@@ -48,6 +48,8 @@ class Arm:
 
 @dataclass(frozen=True)
 class SimConfig:
+    """Controller and integrator settings: PD gains [N·m/rad, N·m·s/rad] and time step [s]."""
+
     kp: np.ndarray
     kd: np.ndarray
     dt: float = DEFAULT_DT  # [s]
@@ -58,6 +60,8 @@ class SimConfig:
 
 @dataclass(frozen=True)
 class SimResult:
+    """One rollout: time [s], states, references and motor torques [N·m] at every step."""
+
     joint_names: tuple[str, ...]
     t: np.ndarray  # (N + 1,) [s]
     q: np.ndarray  # (N + 1, n)

@@ -56,6 +56,8 @@ class LoopVerdict:
 
 @dataclass(frozen=True)
 class StabilityReport:
+    """PD stability at the worst sampled configuration, and the gain bounds at `dt`."""
+
     dt: float  # [s]
     lambda_max: float  # max over samples of lambda_max(M^-1) [1/(kg·m²)]
     q_worst: tuple[float, ...]  # controlled joints at that sample [rad or m]
@@ -98,7 +100,7 @@ def update_matrix(
 
 
 def spectral_radius(A: NDArray[np.float64]) -> float:
-    """Largest eigenvalue modulus: the step map's growth factor per step."""
+    """Largest eigenvalue modulus of A; the discrete loop is stable when it is <= 1."""
     return float(np.max(np.abs(np.linalg.eigvals(A))))
 
 

@@ -53,6 +53,7 @@ class Trajectory:
 
     @property
     def duration(self) -> float:
+        """Time of the last point [s]."""
         return float(self.times[-1])
 
 

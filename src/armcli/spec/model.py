@@ -61,20 +61,28 @@ class Material(_Model):
 
 
 class Origin(_Model):
+    """A frame offset: translation `xyz` [m] and roll-pitch-yaw `rpy` [rad], as URDF's <origin>."""
+
     xyz: Vec3 = (0.0, 0.0, 0.0)
     rpy: Vec3 = (0.0, 0.0, 0.0)
 
 
 class Box(_Model):
+    """A box with edge lengths `size` [m] along x, y and z."""
+
     size: tuple[Positive, Positive, Positive]
 
 
 class Cylinder(_Model):
+    """A cylinder of `radius` and `length` [m], its axis along z."""
+
     radius: Positive
     length: Positive
 
 
 class Sphere(_Model):
+    """A sphere of `radius` [m]."""
+
     radius: Positive
 
 
@@ -94,6 +102,7 @@ class Geometry(_Model):
 
     @property
     def kind(self) -> str:
+        """Which primitive is given: "box", "cylinder" or "sphere"."""
         return "box" if self.box else "cylinder" if self.cylinder else "sphere"
 
 
@@ -127,6 +136,8 @@ class Link(_Model):
 
 
 class Limit(_Model):
+    """Joint limits: `lower`/`upper` [rad or m], `effort` [N·m or N], `velocity` [rad/s or m/s]."""
+
     lower: Real
     upper: Real
     effort: Positive
@@ -134,6 +145,8 @@ class Limit(_Model):
 
 
 class Dynamics(_Model):
+    """Joint `friction` [N·m or N] and viscous `damping` [N·m·s/rad or N·s/m]."""
+
     friction: NonNeg = 0.0
     damping: NonNeg = 0.0
 
@@ -142,6 +155,12 @@ JointType = Literal["revolute", "continuous", "prismatic", "fixed"]
 
 
 class Joint(_Model):
+    """A URDF joint from `parent` to `child`; revolute and prismatic joints need a `limit`.
+
+    `origin` places the joint frame in the parent link's frame; `axis` is a non-zero vector
+    in the joint frame.
+    """
+
     type: JointType
     parent: Name
     child: Name
@@ -197,12 +216,16 @@ class Tool(_Model):
 
 
 class MobileBase(_Model):
+    """The mobile base: its links and joints (one tree) and an optional diff-drive plugin."""
+
     links: dict[Name, Link]
     joints: dict[Name, Joint] = {}
     diff_drive: DiffDrive | None = None
 
 
 class Arm(_Model):
+    """The arm: its links and joints (one tree), its Gazebo plugins and the tool point."""
+
     links: dict[Name, Link] = Field(min_length=1)
     joints: dict[Name, Joint] = {}
     joint_state_publisher: JointStatePublisher | None = None
@@ -227,6 +250,12 @@ class Gains(_Model):
 
 
 class Control(_Model):
+    """How the arm is controlled and simulated.
+
+    `dt` is the simulation step [s], `gains` the PD gains per arm joint,
+    `controller_update_rate` the ros2_control rate [Hz].
+    """
+
     dt: Positive = DEFAULT_DT
     gains: dict[Name, Gains] = {}
     controller_update_rate: Positive = 100.0
@@ -246,11 +275,13 @@ class RobotSpec(_Model):
 
     # -- derived views used by writers, checks and the simulator ----------------
     def all_links(self) -> dict[str, Link]:
+        """Links of the base and the arm by name (names are unique across parts)."""
         out = dict(self.mobile_base.links) if self.mobile_base else {}
         out.update(self.arm.links)
         return out
 
     def all_joints(self) -> dict[str, Joint]:
+        """Joints of the base and the arm by name, plus the mount joint with a base."""
         out = dict(self.mobile_base.joints) if self.mobile_base else {}
         out.update(self.arm.joints)
         if self.mount is not None and self.mobile_base is not None:
@@ -258,11 +289,13 @@ class RobotSpec(_Model):
         return out
 
     def arm_root(self) -> str:
+        """The arm link that is no arm joint's child (a valid spec has exactly one)."""
         children = {j.child for j in self.arm.joints.values()}
         roots = [name for name in self.arm.links if name not in children]
         return roots[0]
 
     def mount_joint(self) -> Joint:
+        """The mount as the fixed `Joint` from the base to the arm root; needs a mount."""
         assert self.mount is not None
         return Joint(
             type="fixed", parent=self.mount.parent, child=self.arm_root(), origin=self.mount.origin

@@ -15,6 +15,7 @@ from armcli.spec.model import Joint, Link, RobotSpec
 
 
 def semantic_problems(spec: RobotSpec) -> list[Problem]:
+    """Every cross-reference problem of `spec`, with dotted field paths; [] if none."""
     out: list[Problem] = []
 
     def add(path: tuple[str | int, ...], msg: str) -> None:

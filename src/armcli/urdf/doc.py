@@ -24,6 +24,8 @@ class NumberProblem:
 
 @dataclass(frozen=True)
 class Pose:
+    """An <origin>: `xyz` [m] and `rpy` [rad], with its source line."""
+
     xyz: Vec3 = ZERO3
     rpy: Vec3 = ZERO3
     line: int | None = None
@@ -52,6 +54,8 @@ class Shape:
 
 @dataclass(frozen=True)
 class Inertial:
+    """An <inertial>: mass [kg] and inertia [kg·m²], None where missing or unparsed."""
+
     origin: Pose
     mass: float | None
     inertia: tuple[float, float, float, float, float, float] | None  # ixx ixy ixz iyy iyz izz
@@ -62,6 +66,8 @@ class Inertial:
 
 @dataclass(frozen=True)
 class Link:
+    """A <link>: its inertial and its visual and collision shapes."""
+
     name: str
     line: int | None
     inertial: Inertial | None
@@ -71,6 +77,8 @@ class Link:
 
 @dataclass(frozen=True)
 class Limit:
+    """A <limit>: lower/upper [rad or m], effort [N·m or N], velocity [rad/s or m/s]."""
+
     lower: float | None
     upper: float | None
     effort: float | None
@@ -80,6 +88,8 @@ class Limit:
 
 @dataclass(frozen=True)
 class Joint:
+    """A <joint>: its links, origin, axis, limit, damping, friction and mimic, with lines."""
+
     name: str
     type: str
     line: int | None
@@ -96,11 +106,14 @@ class Joint:
 
     @property
     def movable(self) -> bool:
+        """Whether the joint moves along one axis: any type but fixed, floating and planar."""
         return self.type not in ("fixed", "floating", "planar")
 
 
 @dataclass(frozen=True)
 class Material:
+    """A <material>: name, rgba colour, and whether it is declared at the robot's top level."""
+
     name: str
     rgba: tuple[float, ...] | None
     line: int | None
@@ -120,4 +133,5 @@ class Urdf:
     problems: tuple[NumberProblem, ...] = field(default=())
 
     def link(self, name: str) -> Link | None:
+        """The link called `name`, or None."""
         return next((lk for lk in self.links if lk.name == name), None)

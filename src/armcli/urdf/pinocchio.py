@@ -53,7 +53,7 @@ def _capture_stderr(fn: Any) -> tuple[Any, list[str]]:
 
 
 def parser_problems(lines: list[str]) -> list[str]:
-    """Urdfdom's messages, one per problem: continuation lines (the C++ source location) dropped."""
+    """The urdfdom messages, one per problem: continuation lines (C++ source locations) dropped."""
     out: list[str] = []
     for ln in lines:
         if ln[:1].isspace():

@@ -115,8 +115,10 @@ def urdf_text(urdf: Urdf) -> str:
 
 
 def allowed_roots(urdf_dir: Path, extra: Iterable[Path] = ()) -> tuple[Path, ...]:
-    """Directories mesh files may come from: the URDF's directory, the ROS package it sits
-    in (nearest ancestor with a package.xml), `extra` (--package-dir) and ROS_PACKAGE_PATH.
+    """Directories mesh files may come from.
+
+    The URDF's directory, the ROS package it sits in (nearest ancestor with a package.xml),
+    `extra` (--package-dir) and ROS_PACKAGE_PATH.
     """
     here = urdf_dir.resolve()
     roots = [here, *extra]

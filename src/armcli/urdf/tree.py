@@ -172,7 +172,7 @@ def to_rich(tree: KinematicTree) -> Any:
 
 
 def _q(text: str) -> str:
-    """A DOT double-quoted string (text may hold DOT's own `\\n` line breaks)."""
+    r"""A DOT double-quoted string (text may hold DOT's own `\n` line breaks)."""
     return '"' + text.replace('"', '\\"') + '"'
 
 

@@ -137,10 +137,12 @@ class Viewer:
     # -- public API ------------------------------------------------------------------
     @property
     def url(self) -> str:
+        """Address of the viewer page."""
         return f"http://{self.host}:{self.port}"
 
     @property
     def joint_names(self) -> tuple[str, ...]:
+        """The movable joints the sliders control, in yourdfpy's order."""
         return tuple(self._limits)
 
     def configuration(self) -> dict[str, float]:
@@ -174,6 +176,7 @@ class Viewer:
             return tool_position(self._urdf, self._tool)
 
     def show_frames(self, visible: bool) -> None:
+        """Show or hide the link frames, through the GUI checkbox so the page stays in sync."""
         self._frames_box.value = bool(visible)
 
     def seek(self, t: float) -> None:
@@ -183,13 +186,16 @@ class Viewer:
         self._time_slider.value = float(np.clip(t, 0.0, self._replay.duration))
 
     def play(self, playing: bool = True) -> None:
+        """Start or pause the replay; without a replay it stays paused."""
         self._playing = bool(playing) and self._replay is not None
 
     @property
     def playing(self) -> bool:
+        """Whether the replay is running."""
         return self._playing
 
     def ghost_visible(self) -> bool:
+        """Whether the reference ghost is drawn (only with a replay that has references)."""
         return self._ghost is not None and self._ghost.show_visual
 
     def serve_forever(self) -> None:

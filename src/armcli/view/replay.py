@@ -33,6 +33,7 @@ class Replay:
 
     @property
     def duration(self) -> float:
+        """Length of the record [s]."""
         return float(self.time[-1] - self.time[0])
 
     def positions_at(self, t: float) -> dict[str, float]:

@@ -10,13 +10,16 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import InputError
 from armcli.spec.expr import eval_expr
 from armcli.urdf.source import read_robot, urdf_text
 from armcli.urdf.tree import tree_from_urdf
 from armcli.view.png import Tool
 
-ROBOT_HELP = "Robot spec YAML, URDF file, or xacro file (with --trust-xacro)."
+ROBOT_HELP = (
+    f"Robot spec YAML, URDF file, or xacro file (with --trust-xacro); default: {DEFAULT_SPEC}."
+)
 
 
 @dataclass(frozen=True)
