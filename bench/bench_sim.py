@@ -218,7 +218,10 @@ def batch_scaling(args, mod, plant, reference, m_c) -> None:
         ctrl = (q_r + KD / KP * v_r)[:-1][None]
         for t in threads:
             datas = [mujoco.MjData(m_c) for _ in range(t)]
-            secs = timed(lambda datas=datas: rollout_mj(m_c, datas, states, ctrl), 3)
+            secs = timed(
+                lambda datas=datas, states=states, ctrl=ctrl: rollout_mj(m_c, datas, states, ctrl),
+                3,
+            )
             cells.append(f"{secs / (batch * steps) * 1e6:.3f}")
         print(row(batch, *cells))
 

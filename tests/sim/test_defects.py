@@ -7,6 +7,7 @@ positions-only trajectories.
 
 from __future__ import annotations
 
+import itertools
 import math
 from pathlib import Path
 
@@ -220,7 +221,7 @@ def test_rk4_is_fourth_order_on_positions_only_trajectory(built_dir: Path) -> No
     # DOP853 restarted at each knot, so it never steps across a reference discontinuity
     y = np.concatenate([q0, np.zeros(2)])
     knots = [0.0, 0.5, 1.0, 1.5, t_end]
-    for t0, t1 in zip(knots[:-1], knots[1:], strict=True):
+    for t0, t1 in itertools.pairwise(knots):
         sol = solve_ivp(f, (t0, t1), y, "DOP853", rtol=1e-13, atol=1e-13, args=(0.5 * (t0 + t1),))
         y = sol.y[:, -1]
     errors = []

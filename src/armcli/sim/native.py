@@ -57,6 +57,7 @@ def why_missing() -> str:
 
 
 def engine_name(mod: ModuleType | None) -> str:
+    """The engine `load()`'s result runs: "native" (compiled) or "python"."""
     return "native" if mod is not None else "python"
 
 

@@ -77,7 +77,8 @@ def summary_table(
     from rich.text import Text
 
     caption = (
-        f"{res.integrator}, dt = {res.dt:g} s, {len(res.t) - 1} steps, {ENGINE_LABEL.get(res.backend, res.backend)} engine "
+        f"{res.integrator}, dt = {res.dt:g} s, {len(res.t) - 1} steps, "
+        f"{ENGINE_LABEL.get(res.backend, res.backend)} engine "
         f"({res.wall_time * 1e6 / max(1, len(res.t) - 1):.2f} µs/step)\n"
         f"errors q - q_ref [rad]; settle: time after the last point until |error| stays "
         f"< {SETTLE_TOL:g}"

@@ -33,18 +33,16 @@ from typing import Any
 
 import numpy as np
 
-from armcli.sim.stepper import (  # noqa: F401  (re-exported: the parameter layout)
-    DAMPING,
-    EFFORT,
-    FRICTION,
-    KD,
-    KP,
-    LOWER,
-    PARAM_FIELDS,
-    UPPER,
-    VABORT,
-    Stepper,
-)
+from armcli.sim.stepper import DAMPING as DAMPING
+from armcli.sim.stepper import EFFORT as EFFORT
+from armcli.sim.stepper import FRICTION as FRICTION
+from armcli.sim.stepper import KD as KD
+from armcli.sim.stepper import KP as KP
+from armcli.sim.stepper import LOWER as LOWER
+from armcli.sim.stepper import PARAM_FIELDS as PARAM_FIELDS
+from armcli.sim.stepper import UPPER as UPPER
+from armcli.sim.stepper import VABORT as VABORT
+from armcli.sim.stepper import Stepper
 
 # Pinocchio joint model -> the joint code both engines use (revolute 0-3, prismatic 4-7).
 JOINT_TYPES = {
@@ -90,13 +88,17 @@ class Rollout:
 
 
 def rows_per_step(integrator: str) -> int:
-    """Reference rows one step consumes: [q_ref, v_ref] at t (Euler) or at t, t + dt/2,
-    t + dt (RK4). A reference for N steps has N * rows + 1 rows (the last: t = N dt)."""
+    """Reference rows one step consumes.
+
+    [q_ref, v_ref] at t (Euler) or at t, t + dt/2, t + dt (RK4). A reference for N steps
+    has N * rows + 1 rows (the last: t = N dt).
+    """
     return RK4_ROWS if integrator == "rk4" else 1
 
 
 def steps_of(plant: Plant, ref: np.ndarray) -> int:
-    return (ref.shape[0] - 1) // rows_per_step(plant.integrator)
+    """How many steps the reference table `ref` drives."""
+    return int((ref.shape[0] - 1) // rows_per_step(plant.integrator))
 
 
 def rollout_python(plant: Plant, q0: np.ndarray, v0: np.ndarray, ref: np.ndarray) -> Rollout:

@@ -177,13 +177,12 @@ def simulate(
     notice = None
     if cfg.backend == "auto" and mod is None:
         notice = f"compiled engine unavailable ({native.why_missing()}); using the Python loop"
-    if mod is not None:
-        compiled = native.compiled_model(mod, arm.model)
+    compiled = native.compiled_model(mod, arm.model) if mod is not None else None
 
-        def run(p: ro.Plant, q: np.ndarray, v: np.ndarray, r: np.ndarray) -> ro.Rollout:
-            return native.rollout_batch(mod, [native.Job(p, q, v, r, compiled)])[0]
-    else:
-        run = ro.rollout_python
+    def run(p: ro.Plant, q: np.ndarray, v: np.ndarray, r: np.ndarray) -> ro.Rollout:
+        if mod is None:
+            return ro.rollout_python(p, q, v, r)
+        return native.rollout_batch(mod, [native.Job(p, q, v, r, compiled)])[0]
     parts: list[ro.Rollout] = []
     q, v = np.array(q0, dtype=float), np.zeros(len(q0))
     start = time.perf_counter()

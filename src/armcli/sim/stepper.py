@@ -91,6 +91,7 @@ class Stepper:
         return t
 
     def saturate(self, t: list[float]) -> list[float]:
+        """Clamp the torques `t` at the effort limits; sets `sat`."""
         e = self.effort
         self.sat = [abs(t[i]) > e[i] for i in range(self.n)]
         return [math.copysign(e[i], t[i]) if self.sat[i] else t[i] for i in range(self.n)]
@@ -98,9 +99,12 @@ class Stepper:
     def euler(
         self, q: list[float], v: list[float], qr: list[float], vr: list[float]
     ) -> tuple[list[float], list[float]]:
-        """Semi-implicit Euler, Kd and damping implicit; the motor torque of the whole
-        step (explicit part + implicit Kd) respects the effort limit: a joint whose total
-        would exceed it is saturated and the step solved again (at most n times)."""
+        """Semi-implicit Euler step, Kd and damping implicit.
+
+        The motor torque of the whole step (explicit part + implicit Kd) respects the
+        effort limit: a joint whose total would exceed it is saturated and the step solved
+        again (at most n times).
+        """
         n, dt, kd, d, e = self.n, self.dt, self.kd, self.damp, self.effort
         tau_pd = self.saturate(self.motor(q, v, qr, vr))
         while True:
@@ -124,16 +128,20 @@ class Stepper:
     def accel(
         self, q: list[float], v: list[float], qr: list[float], vr: list[float]
     ) -> list[float]:
-        """Explicit acceleration under the saturated motor torque (RK4 stages), with the
-        joints in `self.locked` held (zero acceleration) by their stops."""
+        """Explicit acceleration under the saturated motor torque (RK4 stages).
+
+        Joints in `self.locked` are held (zero acceleration) by their stops.
+        """
         d = self.damp
         self.tau = tau = self.saturate(self.motor(q, v, qr, vr))
         a = self._aba(q, v, [tau[i] - d[i] * v[i] for i in range(self.n)])
         return self.hold(q, a) if self.locked else a
 
     def hold(self, q: list[float], a: list[float]) -> list[float]:
-        """The acceleration with the locked joints' accelerations cancelled by stop forces:
-        a + A[:, S] x with A[S, S] x = -a[S] (A = M⁻¹), exactly the constrained dynamics."""
+        """The acceleration with the locked joints' accelerations cancelled by stop forces.
+
+        a + A[:, S] x with A[S, S] x = -a[S] (A = M⁻¹): exactly the constrained dynamics.
+        """
         S = self.locked
         self.qa[:] = q
         A = self.pin.computeMinverse(self.model, self.data, self.qa).tolist()
@@ -150,9 +158,11 @@ class Stepper:
         return out
 
     def resting(self, q: list[float], v: list[float], r: list[float]) -> list[int]:
-        """Joints resting on a stop and pressed into it: at the stop (to round-off), not
-        moving away, with the stop force pushing back (a locked set found by dropping any
-        joint whose force would pull it onto the stop)."""
+        """Joints resting on a stop and pressed into it; sets `locked`.
+
+        At the stop (to round-off), not moving away, with the stop force pushing back: the
+        set is found by dropping any joint whose force would pull it onto the stop.
+        """
         n, lo, hi = self.n, self.lower, self.upper
         side = [
             1.0 if q[i] >= hi[i] - REST_POS * (1.0 + abs(hi[i])) and v[i] >= -REST_VEL
@@ -176,8 +186,10 @@ class Stepper:
     def rk4(
         self, q: list[float], v: list[float], r0: list[float], r1: list[float], r2: list[float]
     ) -> tuple[list[float], list[float]]:
-        """Classic RK4 on the smooth dynamics; the reference rows r0, r1, r2 (at t, t + dt/2
-        and t + dt) come from one polynomial piece, so the stages see a smooth input.
+        """Classic RK4 step on the smooth dynamics, then the friction/stop projection.
+
+        The reference rows r0, r1, r2 (at t, t + dt/2 and t + dt) come from one polynomial
+        piece, so the stages see a smooth input.
 
         Joints resting on a stop are held by it through all four stages: integrating the
         free dynamics and projecting afterwards would leave a velocity of dt a / 2 on the
@@ -238,6 +250,7 @@ class Stepper:
         return qn, vn
 
     def clamp(self, q: list[float]) -> list[float]:
+        """Positions clamped to the limits (against round-off)."""
         lo, hi = self.lower, self.upper
         return [min(max(q[i], lo[i]), hi[i]) for i in range(self.n)]
 
@@ -245,8 +258,11 @@ class Stepper:
 def pgs(
     A: list[list[float]], vs: list[float], lo: list[float], hi: list[float], fdt: list[float]
 ) -> list[float]:
-    """Velocity change dv = A lam minimising ½|v' - vs|²_(A⁻¹) + Σ fdt_i |v'_i| with
-    lo <= v' <= hi, by projected Gauss-Seidel; v' = 0 is feasible, so no energy is added."""
+    """Velocity change of friction and stops, by projected Gauss-Seidel.
+
+    dv = A lam minimises ½|v' - vs|²_(A⁻¹) + Σ fdt_i |v'_i| with lo <= v' <= hi; v' = 0 is
+    feasible, so no energy is added.
+    """
     n = len(vs)
     lam = [0.0] * n
     for _ in range(PGS_MAX_ITERS):
@@ -276,8 +292,10 @@ def pgs(
 
 
 def solve_spd(A: list[list[float]], b: list[float]) -> list[float]:
-    """x with A x = b for a small symmetric positive definite A (Cholesky, in the same
-    operation order as the C++ engine)."""
+    """Solve A x = b for a small symmetric positive definite A.
+
+    Cholesky, in the same operation order as the C++ engine.
+    """
     n = len(b)
     L = [[0.0] * n for _ in range(n)]
     for i in range(n):
