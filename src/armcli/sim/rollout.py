@@ -42,7 +42,7 @@ from armcli.sim.stepper import LOWER as LOWER
 from armcli.sim.stepper import PARAM_FIELDS as PARAM_FIELDS
 from armcli.sim.stepper import UPPER as UPPER
 from armcli.sim.stepper import VABORT as VABORT
-from armcli.sim.stepper import Stepper
+from armcli.sim.stepper import FastEuler, Stepper
 
 # Pinocchio joint model -> the joint code both engines use (revolute 0-3, prismatic 4-7).
 JOINT_TYPES = {
@@ -102,24 +102,43 @@ def steps_of(plant: Plant, ref: np.ndarray) -> int:
 
 
 def rollout_python(plant: Plant, q0: np.ndarray, v0: np.ndarray, ref: np.ndarray) -> Rollout:
-    """Reference implementation and fallback of `native.rollout` (same contract)."""
+    """Reference implementation and fallback of `native.rollout` (same contract).
+
+    Euler steps go through `FastEuler` (the common step in a few C-level maps) and fall
+    back to the general `Stepper.euler` when saturation, a stop or friction is involved;
+    both compute the same operations, so the result does not depend on which ran.
+    """
     s = Stepper(plant.model, plant.params, plant.gravity_comp, plant.dt)
     n, rk4 = s.n, plant.integrator == "rk4"
     steps = steps_of(plant, ref)
-    R = np.asarray(ref, dtype=float).tolist()
+    table = np.asarray(ref, dtype=float)
+    R = table.tolist() if rk4 else []  # the reference, sampled once, as Python floats
+    Rq, Rv = table[:, :n].tolist(), table[:, n:].tolist()
     q, v = [float(x) for x in q0], [float(x) for x in v0]
-    Qs, Vs, Ts, Fs = [q], [v], [], []
+    Qs, Vs, Ts, flagged = list(q), list(v), [], []  # flat: one conversion at the end
     code, joint, fail = FAIL_NONE, -1, -1
+    vmin = min(s.vabort)
+    fast = FastEuler(s).step
     for k in range(steps):
-        if rk4:
-            q, v = s.rk4(q, v, R[3 * k], R[3 * k + 1], R[3 * k + 2])
+        r = None if rk4 else fast(q, v, Rq[k], Rv[k])
+        if r is not None:
+            q, v, tau = r
+            Ts.extend(tau)
         else:
-            q, v = s.euler(q, v, R[k][:n], R[k][n:])
-        Qs.append(q)
-        Vs.append(v)
-        Ts.append(s.tau)
-        Fs.append([FLAG_SATURATED * s.sat[i] | FLAG_STOP * s.stop[i] for i in range(n)])
-        code, joint = _check(q, v, s.vabort)
+            if rk4:
+                q, v = s.rk4(q, v, R[3 * k], R[3 * k + 1], R[3 * k + 2])
+            else:
+                q, v = s.euler(q, v, Rq[k], Rv[k])
+            Ts.extend(s.tau)
+            if True in s.sat or True in s.stop:
+                flags = [FLAG_SATURATED * a | FLAG_STOP * b for a, b in zip(s.sat, s.stop)]
+                flagged.append((k, flags))
+        Qs.extend(q)
+        Vs.extend(v)
+        # sum |v| <= min vabort implies every |v_i| <= its limit and finite v; q is finite
+        # unless q or v is (a step from a finite state moves q by dt v)
+        if not (sum(map(abs, v)) <= vmin and (r is not None or math.isfinite(sum(q)))):
+            code, joint = _check(q, v, s.vabort)  # the exact check, in joint order
         if code == FAIL_NONE and (k + 1) % ENERGY_EVERY == 0:
             s.set_armature(None)  # the kinetic energy of the arm alone
             s.qa[:], s.va[:] = q, v
@@ -128,20 +147,20 @@ def rollout_python(plant: Plant, q0: np.ndarray, v0: np.ndarray, ref: np.ndarray
         if code != FAIL_NONE:
             fail = k + 1
             break
-    return _arrays(steps, n, Qs, Vs, Ts, Fs, fail, joint, code)
+    F = np.zeros((steps, n), dtype=np.uint8)
+    for k, row in flagged:
+        F[k] = row
+    return _arrays(steps, n, Qs, Vs, Ts, F, fail, joint, code)
 
 
 def _arrays(
-    steps: int, n: int, Qs: list[Any], Vs: list[Any], Ts: list[Any], Fs: list[Any], *fail: int
+    steps: int, n: int, Qs: list[Any], Vs: list[Any], Ts: list[Any], F: np.ndarray, *fail: int
 ) -> Rollout:
-    Q = np.full((steps + 1, n), np.nan)
-    V = np.full((steps + 1, n), np.nan)
-    T = np.full((steps, n), np.nan)
-    F = np.zeros((steps, n), dtype=np.uint8)
-    Q[: len(Qs)], V[: len(Vs)] = Qs, Vs
-    if Ts:
-        T[: len(Ts)], F[: len(Fs)] = Ts, Fs
-    return Rollout(Q, V, T, F, *fail)
+    Q = np.full((steps + 1) * n, np.nan)
+    V = np.full((steps + 1) * n, np.nan)
+    T = np.full(steps * n, np.nan)
+    Q[: len(Qs)], V[: len(Vs)], T[: len(Ts)] = Qs, Vs, Ts
+    return Rollout(Q.reshape(-1, n), V.reshape(-1, n), T.reshape(-1, n), F, *fail)
 
 
 def _check(q: list[float], v: list[float], vabort: list[float]) -> tuple[int, int]:

@@ -183,6 +183,7 @@ def simulate(
         if mod is None:
             return ro.rollout_python(p, q, v, r)
         return native.rollout_batch(mod, [native.Job(p, q, v, r, compiled)])[0]
+
     parts: list[ro.Rollout] = []
     q, v = np.array(q0, dtype=float), np.zeros(len(q0))
     start = time.perf_counter()

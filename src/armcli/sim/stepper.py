@@ -13,6 +13,9 @@ two engines agree to round-off (the tests require 1e-12; in practice they are eq
 from __future__ import annotations
 
 import math
+import struct
+from operator import gt, lt
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -46,13 +49,17 @@ class Stepper:
         self.any_friction = any(f > 0.0 for f in self.fric)
         self.gc = gravity_comp
         self.dt = dt
-        self.qa, self.va, self.ta = np.zeros(n), np.zeros(n), np.zeros(n)
+        self.buf = np.zeros(3 * n)  # q, v, tau for Pinocchio, filled by one struct pack
+        self.qa, self.va, self.ta = self.buf[:n], self.buf[n : 2 * n], self.buf[2 * n :]
+        self.pack3 = struct.Struct(f"{3 * n}d").pack_into
         self.sat = [False] * n
         self.locked: list[int] = []  # RK4: joints held by their stops during the stages
         self.force: list[float] = []  # their stop forces (M⁻¹ units), for the sign test
         self.stop = [False] * n
         self.tau = [0.0] * n
         self._armature_key: tuple[bool, ...] | None = None  # () is the zero armature
+        self._armature_sat: list[bool] | None = None
+        self._no_stop = [False] * n
         self.set_armature(None)
 
     def set_armature(self, sat: list[bool] | None) -> None:
@@ -60,7 +67,10 @@ class Stepper:
 
         None: zero armature (RK4 and energy checks). Set only when it changes.
         """
+        if sat is not None and sat == self._armature_sat:  # the per-step case: one compare
+            return
         key = () if sat is None else tuple(sat)
+        self._armature_sat = None if sat is None else list(sat)
         if key == self._armature_key:
             return
         if sat is None:
@@ -82,19 +92,24 @@ class Stepper:
         self, q: list[float], v: list[float], qr: list[float], vr: list[float]
     ) -> list[float]:
         """PD(+gravity) torque before saturation."""
-        kp, kd, n = self.kp, self.kd, self.n
-        t = [kp[i] * (qr[i] - q[i]) + kd[i] * (vr[i] - v[i]) for i in range(n)]
+        t = [
+            kp * (a - b) + kd * (c - d)
+            for kp, a, b, kd, c, d in zip(self.kp, qr, q, self.kd, vr, v, strict=True)
+        ]
         if self.gc:
             self.qa[:] = q
             g = self.pin.computeGeneralizedGravity(self.model, self.data, self.qa).tolist()
-            t = [t[i] + g[i] for i in range(n)]
+            t = [x + y for x, y in zip(t, g, strict=True)]
         return t
 
     def saturate(self, t: list[float]) -> list[float]:
         """Clamp the torques `t` at the effort limits; sets `sat`."""
-        e = self.effort
-        self.sat = [abs(t[i]) > e[i] for i in range(self.n)]
-        return [math.copysign(e[i], t[i]) if self.sat[i] else t[i] for i in range(self.n)]
+        self.sat = sat = [abs(x) > e for x, e in zip(t, self.effort, strict=True)]
+        if True not in sat:
+            return t
+        return [
+            math.copysign(e, x) if s else x for x, e, s in zip(t, self.effort, sat, strict=True)
+        ]
 
     def euler(
         self, q: list[float], v: list[float], qr: list[float], vr: list[float]
@@ -108,15 +123,17 @@ class Stepper:
         n, dt, kd, d, e = self.n, self.dt, self.kd, self.damp, self.effort
         tau_pd = self.saturate(self.motor(q, v, qr, vr))
         while True:
-            self.set_armature(self.sat)
-            a = self._aba(q, v, [tau_pd[i] - d[i] * v[i] for i in range(n)])
-            vs = [v[i] + dt * a[i] for i in range(n)]
-            qp = [q[i] + dt * vs[i] for i in range(n)]
+            sat = self.sat
+            self.set_armature(sat)
+            a = self._aba(q, v, [t - c * x for t, c, x in zip(tau_pd, d, v, strict=True)])
+            vs = [x + dt * y for x, y in zip(v, a, strict=True)]
+            qp = [x + dt * y for x, y in zip(q, vs, strict=True)]
             qn, vn = self.project(q, vs, qp, 1.0)
             tau = [
-                tau_pd[i] if self.sat[i] else tau_pd[i] - kd[i] * (vn[i] - v[i]) for i in range(n)
+                t if s else t - c * (y - x)
+                for t, s, c, y, x in zip(tau_pd, sat, kd, vn, v, strict=True)
             ]
-            over = [i for i in range(n) if not self.sat[i] and abs(tau[i]) > e[i]]
+            over = [i for i in range(n) if not sat[i] and abs(tau[i]) > e[i]]
             if not over:
                 break
             for i in over:
@@ -211,8 +228,10 @@ class Stepper:
         qp = [q[i] + h6 * (v[i] + 2.0 * k2q[i] + 2.0 * k3q[i] + k4q[i]) for i in range(n)]
         self.sat, self.tau, self.locked = sat1, tau1, []
         qn, vn = self.project(q, vs, qp, 0.5)
-        for i in locked:
-            self.stop[i] = True
+        if locked:
+            self.stop = list(self.stop)
+            for i in locked:
+                self.stop[i] = True
         return self.clamp(qn), vn
 
     def project(
@@ -228,6 +247,11 @@ class Stepper:
         joint by dt² Δa / 2 = dt dv / 2).
         """
         n, dt = self.n, self.dt
+        if not self.any_friction and all(
+            lo <= x <= hi for x, lo, hi in zip(qp, self.lower, self.upper, strict=True)
+        ):  # the common step: nothing to solve
+            self.stop = self._no_stop
+            return qp, vs
         lo, hi = [-INF] * n, [INF] * n
         for i in range(n):
             if qp[i] > self.upper[i]:
@@ -317,3 +341,51 @@ def solve_spd(A: list[list[float]], b: list[float]) -> list[float]:
             s -= L[k][i] * x[k]
         x[i] = s / L[i][i]
     return x
+
+
+class FastEuler:
+    """The common Euler step (no saturation, no stop, no friction) in a few comprehensions.
+
+    `step(q, v, q_ref, v_ref)` computes exactly the operations of `Stepper.euler` in
+    that case (same expressions, same order) and returns (q', v', tau), or None as soon
+    as the step needs more, so the caller runs the general step instead. It is a closure
+    over the parameters: a per-step Python loop spends its time on name lookups.
+    """
+
+    def __init__(self, s: Stepper) -> None:
+        self.step = self._closure(s)
+
+    @staticmethod
+    def _closure(s: Stepper) -> Callable[..., tuple[list[float], ...] | None]:
+        kp, kd, d, effort, dt, lower, upper = s.kp, s.kd, s.damp, s.effort, s.dt, s.lower, s.upper
+        qa, va, ta, aba, gravity = s.qa, s.va, s.ta, s.pin.aba, s.pin.computeGeneralizedGravity
+        buf, pack3 = s.buf, s.pack3
+        model, data, gc, nosat = s.model, s.data, s.gc, [False] * s.n
+        usable = not s.any_friction
+
+        def step(
+            q: list[float], v: list[float], qr: list[float], vr: list[float]
+        ) -> tuple[list[float], ...] | None:
+            if not usable:
+                return None
+            t = [a * (b - c) + e * (f - g) for a, b, c, e, f, g in zip(kp, qr, q, kd, vr, v)]
+            if gc:
+                qa[:] = q
+                t = [x + y for x, y in zip(t, gravity(model, data, qa).tolist())]
+            if any(map(gt, map(abs, t), effort)):
+                return None
+            if s._armature_sat != nosat:
+                s.set_armature(nosat)
+            pack3(buf, 0, *q, *v, *[x - c * y for x, c, y in zip(t, d, v)])
+            a = aba(model, data, qa, va, ta).tolist()
+            vs = [x + dt * y for x, y in zip(v, a)]
+            qp = [x + dt * y for x, y in zip(q, vs)]
+            if any(map(gt, qp, upper)) or any(map(lt, qp, lower)):
+                return None
+            tau = [x - c * (y - z) for x, c, y, z in zip(t, kd, vs, v)]
+            if any(map(gt, map(abs, tau), effort)):
+                return None
+            s.sat = s.stop = nosat
+            return qp, vs, tau  # qp within the limits: the clamp would change nothing
+
+        return step
