@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from types import ModuleType
 from typing import Any
 
@@ -120,11 +120,19 @@ def rollout_batch(
 
     The extension releases the GIL, so the rollouts run in parallel.
     """
+    models: dict[int, Any] = {}  # each distinct pinocchio.Model is converted once
+    for j in jobs:
+        if j.compiled is None and id(j.plant.model) not in models:
+            models[id(j.plant.model)] = compiled_model(mod, j.plant.model)
+    ready = [
+        j if j.compiled is not None else replace(j, compiled=models[id(j.plant.model)])
+        for j in jobs
+    ]
     workers = max(1, min(threads or os.cpu_count() or 1, len(jobs)))
     if workers == 1:
-        return [_run(mod, j) for j in jobs]
+        return [_run(mod, j) for j in ready]
     with ThreadPoolExecutor(max_workers=workers) as pool:
-        return list(pool.map(lambda j: _run(mod, j), jobs))
+        return list(pool.map(lambda j: _run(mod, j), ready))
 
 
 def _run(mod: ModuleType, job: Job) -> ro.Rollout:

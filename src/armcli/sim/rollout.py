@@ -27,14 +27,21 @@ steps does not cost the method its order), then applies the same projection.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from armcli.sim.fastloop import euler_loop, rk4_loop
 from armcli.sim.stepper import DAMPING as DAMPING
 from armcli.sim.stepper import EFFORT as EFFORT
+from armcli.sim.stepper import ENERGY_EVERY as ENERGY_EVERY
+from armcli.sim.stepper import FAIL_ENERGY as FAIL_ENERGY
+from armcli.sim.stepper import FAIL_NONE as FAIL_NONE
+from armcli.sim.stepper import FAIL_NONFINITE as FAIL_NONFINITE
+from armcli.sim.stepper import FAIL_VELOCITY as FAIL_VELOCITY
+from armcli.sim.stepper import FLAG_SATURATED as FLAG_SATURATED
+from armcli.sim.stepper import FLAG_STOP as FLAG_STOP
 from armcli.sim.stepper import FRICTION as FRICTION
 from armcli.sim.stepper import KD as KD
 from armcli.sim.stepper import KP as KP
@@ -42,7 +49,7 @@ from armcli.sim.stepper import LOWER as LOWER
 from armcli.sim.stepper import PARAM_FIELDS as PARAM_FIELDS
 from armcli.sim.stepper import UPPER as UPPER
 from armcli.sim.stepper import VABORT as VABORT
-from armcli.sim.stepper import FastEuler, Stepper
+from armcli.sim.stepper import Stepper
 
 # Pinocchio joint model -> the joint code both engines use (revolute 0-3, prismatic 4-7).
 JOINT_TYPES = {
@@ -55,10 +62,6 @@ JOINT_TYPES = {
     "JointModelPZ": 6,
     "JointModelPrismaticUnaligned": 7,
 }
-FAIL_NONE, FAIL_NONFINITE, FAIL_VELOCITY, FAIL_ENERGY = range(4)
-FLAG_SATURATED = 1
-FLAG_STOP = 2
-ENERGY_EVERY = 100  # steps between kinetic-energy checks
 RK4_ROWS = 3  # reference rows per RK4 step: t, t + dt/2, t + dt (one polynomial piece)
 
 
@@ -102,71 +105,30 @@ def steps_of(plant: Plant, ref: np.ndarray) -> int:
 
 
 def rollout_python(plant: Plant, q0: np.ndarray, v0: np.ndarray, ref: np.ndarray) -> Rollout:
-    """Reference implementation and fallback of `native.rollout` (same contract).
-
-    Euler steps go through `FastEuler` (the common step in a few C-level maps) and fall
-    back to the general `Stepper.euler` when saturation, a stop or friction is involved;
-    both compute the same operations, so the result does not depend on which ran.
-    """
+    """Reference implementation and fallback of `native.rollout` (same contract)."""
     s = Stepper(plant.model, plant.params, plant.gravity_comp, plant.dt)
-    n, rk4 = s.n, plant.integrator == "rk4"
+    n = s.n
     steps = steps_of(plant, ref)
     table = np.asarray(ref, dtype=float)
-    R = table.tolist() if rk4 else []  # the reference, sampled once, as Python floats
-    Rq, Rv = table[:, :n].tolist(), table[:, n:].tolist()
     q, v = [float(x) for x in q0], [float(x) for x in v0]
-    Qs, Vs, Ts, flagged = list(q), list(v), [], []  # flat: one conversion at the end
-    code, joint, fail = FAIL_NONE, -1, -1
-    vmin = min(s.vabort)
-    fast = FastEuler(s).step
-    for k in range(steps):
-        r = None if rk4 else fast(q, v, Rq[k], Rv[k])
-        if r is not None:
-            q, v, tau = r
-            Ts.extend(tau)
-        else:
-            if rk4:
-                q, v = s.rk4(q, v, R[3 * k], R[3 * k + 1], R[3 * k + 2])
-            else:
-                q, v = s.euler(q, v, Rq[k], Rv[k])
-            Ts.extend(s.tau)
-            if True in s.sat or True in s.stop:
-                flags = [FLAG_SATURATED * a | FLAG_STOP * b for a, b in zip(s.sat, s.stop)]
-                flagged.append((k, flags))
-        Qs.extend(q)
-        Vs.extend(v)
-        # sum |v| <= min vabort implies every |v_i| <= its limit and finite v; q is finite
-        # unless q or v is (a step from a finite state moves q by dt v)
-        if not (sum(map(abs, v)) <= vmin and (r is not None or math.isfinite(sum(q)))):
-            code, joint = _check(q, v, s.vabort)  # the exact check, in joint order
-        if code == FAIL_NONE and (k + 1) % ENERGY_EVERY == 0:
-            s.set_armature(None)  # the kinetic energy of the arm alone
-            s.qa[:], s.va[:] = q, v
-            if not s.pin.computeKineticEnergy(s.model, s.data, s.qa, s.va) <= plant.energy_max:
-                code = FAIL_ENERGY
-        if code != FAIL_NONE:
-            fail = k + 1
-            break
+    if plant.integrator == "rk4":  # the reference, sampled once, as Python floats
+        rec = rk4_loop(s, q, v, table[: RK4_ROWS * steps].tolist(), plant.energy_max)
+    else:
+        Rq, Rv = table[:steps, :n].tolist(), table[:steps, n:].tolist()
+        rec = euler_loop(s, q, v, Rq, Rv, plant.energy_max)
     F = np.zeros((steps, n), dtype=np.uint8)
-    for k, row in flagged:
+    for k, row in rec.flagged:
         F[k] = row
-    return _arrays(steps, n, Qs, Vs, Ts, F, fail, joint, code)
-
-
-def _arrays(
-    steps: int, n: int, Qs: list[Any], Vs: list[Any], Ts: list[Any], F: np.ndarray, *fail: int
-) -> Rollout:
     Q = np.full((steps + 1) * n, np.nan)
     V = np.full((steps + 1) * n, np.nan)
     T = np.full(steps * n, np.nan)
-    Q[: len(Qs)], V[: len(Vs)], T[: len(Ts)] = Qs, Vs, Ts
-    return Rollout(Q.reshape(-1, n), V.reshape(-1, n), T.reshape(-1, n), F, *fail)
-
-
-def _check(q: list[float], v: list[float], vabort: list[float]) -> tuple[int, int]:
-    for i in range(len(q)):
-        if not (math.isfinite(q[i]) and math.isfinite(v[i])):
-            return FAIL_NONFINITE, i
-        if abs(v[i]) > vabort[i]:
-            return FAIL_VELOCITY, i
-    return FAIL_NONE, -1
+    Q[: len(rec.q)], V[: len(rec.v)], T[: len(rec.tau)] = rec.q, rec.v, rec.tau
+    return Rollout(
+        Q.reshape(-1, n),
+        V.reshape(-1, n),
+        T.reshape(-1, n),
+        F,
+        rec.fail_step,
+        rec.fail_joint,
+        rec.fail_code,
+    )

@@ -29,7 +29,7 @@ from armcli.sim import stability as stab
 
 VEL_ABORT_FACTOR = 10.0  # divergence when |v| exceeds this times the URDF velocity limit
 DEFAULT_VABORT = 1000.0  # [rad/s or m/s] when the URDF gives no velocity limit
-CHUNK_STEPS = {"native": 20_000, "python": 500}  # steps per call, for the progress bar
+CHUNK_STEPS = {"native": 20_000, "python": 5_000}  # steps per call, for the progress bar
 
 
 @dataclass(frozen=True)

@@ -14,14 +14,16 @@ from __future__ import annotations
 
 import math
 import struct
-from operator import gt, lt
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
 PARAM_FIELDS = ("kp", "kd", "damping", "friction", "lower", "upper", "effort", "vabort")
 KP, KD, DAMPING, FRICTION, LOWER, UPPER, EFFORT, VABORT = range(len(PARAM_FIELDS))
+FAIL_NONE, FAIL_NONFINITE, FAIL_VELOCITY, FAIL_ENERGY = range(4)
+FLAG_SATURATED = 1
+FLAG_STOP = 2
+ENERGY_EVERY = 100  # steps between kinetic-energy checks
 PGS_MAX_ITERS = 200
 PGS_TOL = 1e-14
 INF = math.inf
@@ -46,6 +48,7 @@ class Stepper:
         cols = np.asarray(params, dtype=float).T.tolist()
         self.kp, self.kd, self.damp, self.fric = cols[KP], cols[KD], cols[DAMPING], cols[FRICTION]
         self.lower, self.upper, self.effort, self.vabort = cols[LOWER:]
+        self.vmin = min(self.vabort)
         self.any_friction = any(f > 0.0 for f in self.fric)
         self.gc = gravity_comp
         self.dt = dt
@@ -341,51 +344,3 @@ def solve_spd(A: list[list[float]], b: list[float]) -> list[float]:
             s -= L[k][i] * x[k]
         x[i] = s / L[i][i]
     return x
-
-
-class FastEuler:
-    """The common Euler step (no saturation, no stop, no friction) in a few comprehensions.
-
-    `step(q, v, q_ref, v_ref)` computes exactly the operations of `Stepper.euler` in
-    that case (same expressions, same order) and returns (q', v', tau), or None as soon
-    as the step needs more, so the caller runs the general step instead. It is a closure
-    over the parameters: a per-step Python loop spends its time on name lookups.
-    """
-
-    def __init__(self, s: Stepper) -> None:
-        self.step = self._closure(s)
-
-    @staticmethod
-    def _closure(s: Stepper) -> Callable[..., tuple[list[float], ...] | None]:
-        kp, kd, d, effort, dt, lower, upper = s.kp, s.kd, s.damp, s.effort, s.dt, s.lower, s.upper
-        qa, va, ta, aba, gravity = s.qa, s.va, s.ta, s.pin.aba, s.pin.computeGeneralizedGravity
-        buf, pack3 = s.buf, s.pack3
-        model, data, gc, nosat = s.model, s.data, s.gc, [False] * s.n
-        usable = not s.any_friction
-
-        def step(
-            q: list[float], v: list[float], qr: list[float], vr: list[float]
-        ) -> tuple[list[float], ...] | None:
-            if not usable:
-                return None
-            t = [a * (b - c) + e * (f - g) for a, b, c, e, f, g in zip(kp, qr, q, kd, vr, v)]
-            if gc:
-                qa[:] = q
-                t = [x + y for x, y in zip(t, gravity(model, data, qa).tolist())]
-            if any(map(gt, map(abs, t), effort)):
-                return None
-            if s._armature_sat != nosat:
-                s.set_armature(nosat)
-            pack3(buf, 0, *q, *v, *[x - c * y for x, c, y in zip(t, d, v)])
-            a = aba(model, data, qa, va, ta).tolist()
-            vs = [x + dt * y for x, y in zip(v, a)]
-            qp = [x + dt * y for x, y in zip(q, vs)]
-            if any(map(gt, qp, upper)) or any(map(lt, qp, lower)):
-                return None
-            tau = [x - c * (y - z) for x, c, y, z in zip(t, kd, vs, v)]
-            if any(map(gt, map(abs, tau), effort)):
-                return None
-            s.sat = s.stop = nosat
-            return qp, vs, tau  # qp within the limits: the clamp would change nothing
-
-        return step
