@@ -143,9 +143,9 @@ def test_every_example_robot_engines_agree() -> None:
 
 @pytest.mark.parametrize("kd", [5.0, 50.0])
 def test_effort_limit_holds_for_the_applied_torque(kd: float) -> None:
-    """A weak motor (3 N·m) against gravity (up to 4.9 N·m): the implicit Kd must not
+    """A weak motor (4 N·m) against gravity (up to 4.9 N·m): the implicit Kd must not
     push the applied torque past the limit, and the reported torque is the applied one."""
-    effort, dt = 3.0, 1e-3
+    effort, dt = 4.0, 1e-3  # before the fix: 1.0035x (Kd 5), 1.031x (Kd 50) the limit
     arm = _arm(pendulum(), effort=effort, damping=0.05)
     cfg = SimConfig(np.array([50.0]), np.array([kd]), dt=dt)
     a, _ = _both(_plant(arm, cfg), np.array([math.pi / 2]), _hold(np.array([math.pi / 2]), 2000))
