@@ -14,7 +14,7 @@ import typer
 import typer.core
 
 import armcli
-from armcli.commands import build, check, render, ros, simulate, tree, view
+from armcli.commands import build, check, export, render, ros, simulate, tree, view
 from armcli.errors import EXIT_FAILED, ArmcliError
 
 # Typer escapes "[" for rich's HTML export whenever rich is importable, even with
@@ -48,7 +48,7 @@ def _root(
     """armcli: robot descriptions without ROS."""
 
 
-for _module in (build, check, simulate, ros, view, render, tree):
+for _module in (build, check, simulate, ros, view, render, tree, export):
     _module.register(app)
 
 

@@ -180,3 +180,33 @@ def test_foreign_textured_meshes(root: Path, tmp_path: Path) -> None:
     # The UR5's dark grey links cover a good part of the 3-D view (left half).
     dark = (img[:, :600].max(axis=-1) < 0.35).sum()
     assert dark > MIN_PIXELS
+
+
+def test_render_resolves_package_meshes_with_package_dir(tmp_path: Path) -> None:
+    """`render` uses check's mesh resolver: package://NAME needs --package-dir NAME=PATH."""
+    import trimesh
+
+    pkg = tmp_path / "meshes_pkg"
+    pkg.mkdir()
+    trimesh.creation.box(extents=(0.1, 0.1, 0.3)).export(pkg / "hand.stl")
+    urdf = tmp_path / "robot" / "arm.urdf"
+    urdf.parent.mkdir()
+    urdf.write_text(
+        '<robot name="meshy"><link name="base"/><link name="hand"><visual><geometry>'
+        '<mesh filename="package://my_meshes/hand.stl"/></geometry></visual></link>'
+        '<joint name="j" type="revolute"><parent link="base"/><child link="hand"/>'
+        '<axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+        "</robot>"
+    )
+    out = tmp_path / "meshy.png"
+    res = _cli("render", str(urdf), "-o", str(out), cwd=tmp_path)
+    assert (
+        res.returncode == 2 and "my_meshes/hand.stl" in res.stderr and "--package-dir" in res.stderr
+    )
+    assert not out.exists()
+    res = _cli(
+        "render", str(urdf), "-o", str(out), "--package-dir", f"my_meshes={pkg}", cwd=tmp_path
+    )
+    assert res.returncode == 0, res.stderr
+    with Image.open(out) as img:
+        assert img.size == (1200, 600)

@@ -15,13 +15,13 @@ from typing import Any
 
 import numpy as np
 
-from armcli.check.meshes import mesh_paths
 from armcli.check.rules import CheckOptions, Collector, JointRow
 from armcli.check.structure import finite
 from armcli.errors import InputError
 from armcli.sim import stability as stab
 from armcli.sim.stability import StabilityReport
 from armcli.urdf.doc import Urdf
+from armcli.urdf.meshes import mesh_paths
 from armcli.urdf.pinocchio import collision_model, configuration
 
 GRID_POINTS = 5  # per joint, when the grid has at most MAX_GRID samples
@@ -191,7 +191,7 @@ def self_collision(
     """
     import pinocchio as pin
 
-    meshes = mesh_paths(urdf, opts)
+    meshes = mesh_paths(urdf, opts.mesh_search())
     if any(p is None or not p.is_file() for p in meshes.values()):
         notes.append("self-collision skipped: some meshes cannot be found")
         return

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from armcli.spec.model import RobotSpec
+from armcli.urdf.meshes import MeshSearch
 
 ERROR = "error"
 WARNING = "warning"
@@ -149,6 +150,18 @@ _RULES = [
         "PD loop unstable at dt with explicit damping",
         "lower Kd or dt, or treat damping implicitly",
     ),
+    Rule(
+        "servo-unstable",
+        ERROR,
+        "gz_ros2_control position servo diverges: position_proportional_gain not in (0, 2)",
+        "set <position_proportional_gain> in the gz_ros2_control plugin below 1",
+    ),
+    Rule(
+        "servo-oscillates",
+        WARNING,
+        "gz_ros2_control position servo overshoots: position_proportional_gain in (1, 2)",
+        "set <position_proportional_gain> to at most 1",
+    ),
     # collision and meshes
     Rule(
         "visual-no-collision",
@@ -231,6 +244,10 @@ class CheckOptions:
     spec: RobotSpec | None = None
     package_dirs: Mapping[str, Path] = field(default_factory=dict)
     search_paths: tuple[Path, ...] = ()
+
+    def mesh_search(self) -> MeshSearch:
+        """The mesh-resolver view of these options (shared with view and render)."""
+        return MeshSearch(self.package_dirs, self.search_paths)
 
 
 def apply_policy(

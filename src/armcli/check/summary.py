@@ -14,12 +14,14 @@ from typing import Any
 import numpy as np
 
 from armcli.check import dynamics as dyn
+from armcli.check import interface
 from armcli.check.rules import CheckOptions, Collector, JointRow
 from armcli.check.structure import Tree, finite
 from armcli.errors import ModelLoadError
 from armcli.sim.stability import StabilityReport
 from armcli.urdf.doc import Urdf
 from armcli.urdf.pinocchio import configuration, joint_ranges, load_model, parser_problems
+from armcli.urdf.tool import tool_point
 
 _STRUCTURE_ERRORS = (
     "duplicate-name",
@@ -113,7 +115,7 @@ def _with_model(
     data = model.createData()
     ranges = joint_ranges(model)
     notes: list[str] = []
-    ee_label, ee_frame, ee_offset = _end_effector(urdf, tree, opts, model)
+    ee_label, ee_frame, ee_offset = _end_effector(urdf, opts, model)
     poses = _poses(urdf, opts, ranges)
     pose_rows = []
     for name, values in poses:
@@ -127,7 +129,10 @@ def _with_model(
     else:
         samples = dyn.samples(model, ranges)
         rows = dyn.gravity(urdf, model, data, samples, rows, out)
-        report = dyn.stability(urdf, opts, model, data, samples, ranges, out, notes)
+        servo = interface.check(urdf.text, opts, out, notes)
+        gained = set(opts.spec.control.gains) if opts.spec is not None else set()
+        if not (servo and gained <= servo):  # a position servo is not a PD loop
+            report = dyn.stability(urdf, opts, model, data, samples, ranges, out, notes)
     if opts.spec is not None and opts.spec.poses:
         dyn.self_collision(urdf, opts, model, poses, out, notes)
     return Summary(
@@ -167,25 +172,15 @@ def _joint_rows(urdf: Urdf) -> tuple[JointRow, ...]:
 
 
 def _end_effector(
-    urdf: Urdf, tree: Tree, opts: CheckOptions, model: Any
+    urdf: Urdf, opts: CheckOptions, model: Any
 ) -> tuple[str, int, tuple[float, float, float]]:
-    """The spec's tool point, else the origin of the deepest link (most movable joints above)."""
-    spec = opts.spec
-    if spec is not None and spec.arm.tool is not None and model.existFrame(spec.arm.tool.link):
-        t = spec.arm.tool
-        return (f"{t.link} + {tuple(t.xyz)}", model.getFrameId(t.link), tuple(t.xyz))  # type: ignore[return-value]
-
-    def depth(link: str) -> int:
-        n, cur = 0, link
-        while cur in tree.parent_joint:
-            j = tree.parent_joint[cur]
-            n += j.type != "fixed"
-            cur = str(j.parent)
-        return n
-
-    names = [lk.name for lk in urdf.links if model.existFrame(lk.name)]
-    best = max(names, key=depth) if names else str(model.frames[0].name)
-    return best, model.getFrameId(best), (0.0, 0.0, 0.0)
+    """The tool point (armcli.urdf.tool) as (label, Pinocchio frame id, offset [m])."""
+    tool = tool_point(urdf, opts.spec)
+    if tool is None or not model.existFrame(tool.link):
+        name = str(model.frames[0].name)
+        return name, model.getFrameId(name), (0.0, 0.0, 0.0)
+    label = f"{tool.link} + {tool.xyz}" if tool.xyz != (0.0, 0.0, 0.0) else tool.link
+    return label, model.getFrameId(tool.link), tool.xyz
 
 
 def _poses(urdf: Urdf, opts: CheckOptions, ranges: list[Any]) -> list[tuple[str, dict[str, float]]]:

@@ -6,7 +6,6 @@ import sys
 from pathlib import Path
 from typing import Any
 
-import click
 import typer
 
 from armcli.check import report
@@ -17,20 +16,11 @@ from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import ArmcliError, FindingsError, InputError, UnusableInputsError
 from armcli.spec.load import load_spec
 from armcli.urdf.doc import Urdf
+from armcli.urdf.meshes import parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP, read_robot, read_urdf_file
 
 FORMATS = ("table", "json", "github")
 REPORT_WIDTH = 140  # columns when stdout is not a terminal (CI logs, pipes)
-
-
-def _package_dirs(values: list[str]) -> dict[str, Path]:
-    out = {}
-    for v in values:
-        name, sep, path = v.partition("=")
-        if not sep or not name or not path:
-            raise InputError(f"expected NAME=PATH, got {v!r}", field="--package-dir")
-        out[name] = Path(path)
-    return out
 
 
 def _documents(path: Path, trust_xacro: bool) -> list[tuple[Urdf, Any]]:
@@ -73,7 +63,7 @@ def check_cmd(
     fmt: str = typer.Option(
         "table",
         "--format",
-        click_type=click.Choice(FORMATS),
+        metavar="[" + "|".join(FORMATS) + "]",
         show_default=False,
         help="Report format (default: table).",
     ),
@@ -90,7 +80,7 @@ def check_cmd(
     unknown = sorted(set(ignore) - set(RULES))
     if unknown:
         raise InputError(f"unknown rule(s) {unknown}; known: {', '.join(RULES)}", field="--ignore")
-    base = CheckOptions(package_dirs=_package_dirs(package_dir))
+    base = CheckOptions(package_dirs=parse_package_dirs(package_dir))
     if spec is not None:
         base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs)
     results, errors = _run(list(paths or [DEFAULT_SPEC]), base, trust_xacro)

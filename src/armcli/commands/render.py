@@ -9,6 +9,7 @@ import typer
 
 from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import InputError
+from armcli.urdf.meshes import MeshSearch, parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP
 from armcli.view.png import load_urdf, render_png
 from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
@@ -45,13 +46,16 @@ def render_cmd(
         show_default=False,
         help="Image size WIDTHxHEIGHT in pixels (default: 1200x600).",
     ),
+    package_dir: list[str] = typer.Option(
+        [], "--package-dir", help="NAME=PATH for package://NAME/ mesh URIs (repeatable)."
+    ),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
-    src = load_robot(robot, trust_xacro)
+    src = load_robot(robot, trust_xacro, MeshSearch(parse_package_dirs(package_dir)))
     values = pose_q(src, pose, q)
     width, height = _size(size)
-    urdf = load_urdf(src.xml, src.source, src.mesh_dir)
+    urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search)
     res = render_png(
         urdf,
         values,

@@ -5,7 +5,6 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import click
 import typer
 
 from armcli.defaults import DEFAULT_SPEC
@@ -23,7 +22,7 @@ def tree_cmd(
     fmt: str = typer.Option(
         "text",
         "--format",
-        click_type=click.Choice(TREE_FORMATS),
+        metavar="[" + "|".join(TREE_FORMATS) + "]",
         show_default=False,
         help="text (a tree, the default) or dot (Graphviz).",
     ),
@@ -31,7 +30,7 @@ def tree_cmd(
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Print the kinematic tree: links, and joints with their types and limits."""
-    if fmt not in ("text", "dot"):
+    if fmt not in TREE_FORMATS:
         raise InputError(f"unknown format {fmt!r}; known: text, dot", field="--format")
     src = load_robot(robot, trust_xacro)
     tree = parse_tree(src.xml, src.source)

@@ -9,10 +9,11 @@ import typer
 
 from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import InputError
+from armcli.sim.states import load_replay
+from armcli.urdf.meshes import MeshSearch, parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP
 from armcli.view.browser import Viewer
 from armcli.view.png import joint_limits, load_urdf
-from armcli.view.replay import load_replay
 from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
 
 
@@ -29,22 +30,26 @@ def view_cmd(
         show_default=False,
         help="Port to listen on (default: 8080; 0: any free port).",
     ),
+    package_dir: list[str] = typer.Option(
+        [], "--package-dir", help="NAME=PATH for package://NAME/ mesh URIs (repeatable)."
+    ),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Open a browser 3-D viewer with joint sliders, named poses and simulation replay."""
-    src = load_robot(robot, trust_xacro)
+    src = load_robot(robot, trust_xacro, MeshSearch(parse_package_dirs(package_dir)))
     pose_q(src, pose, None)  # validate before starting the server
     if not 0 <= port <= 65535:
         raise InputError(f"{port} is not a port number", field="--port")
     run = None
     if replay is not None:
-        names = list(joint_limits(load_urdf(src.xml, src.source, src.mesh_dir)))
+        names = list(joint_limits(load_urdf(src.xml, src.source, src.mesh_dir, src.search)))
         run = load_replay(replay, names)
     viewer = Viewer(
         src.xml,
         name=src.name,
         source=src.source,
         mesh_dir=src.mesh_dir,
+        search=src.search,
         poses=src.poses,
         tool=src.tool,
         replay=run,

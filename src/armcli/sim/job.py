@@ -20,8 +20,10 @@ from armcli.sim.reference import Reference, build_reference
 from armcli.sim.simulate import Arm, SimConfig, SimResult, arm_from_model, check_stability, simulate
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.spec.model import RobotSpec
-from armcli.urdf.pinocchio import load_model
-from armcli.urdf.source import load_checked_model
+from armcli.urdf.doc import Urdf
+from armcli.urdf.read import parse_urdf
+from armcli.urdf.source import checked_model, read_urdf_file
+from armcli.urdf.tool import tool_point
 
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
 ARM_URDF = STANDALONE_ARM_URDF
@@ -45,6 +47,18 @@ class SimJob:
     T_frame_root: np.ndarray  # 4x4 pose of the arm's root link in the reporting frame
 
 
+def arm_urdf(spec: RobotSpec | None, urdf: Path | None, *, trust_xacro: bool = False) -> Urdf:
+    """The URDF to simulate: a given file or the spec's standalone arm built in memory.
+
+    A given file goes through the strict reader (a foreign xacro only when trusted).
+    """
+    if urdf is not None:
+        return read_urdf_file(urdf, trust_xacro=trust_xacro)
+    if spec is None:
+        raise InputError("give a spec or --urdf", field="--urdf")
+    return parse_urdf(expand_urdfs(spec)[ARM_URDF], ARM_URDF)
+
+
 def load_arm(
     spec: RobotSpec | None,
     urdf: Path | None,
@@ -58,13 +72,9 @@ def load_arm(
     numbers, no foreign xacro without trust), since Pinocchio alone would simulate
     mass="nan" as 0 kg.
     """
-    if urdf is not None:
-        return arm_from_model(load_checked_model(urdf, trust_xacro=trust_xacro).model, joints)
-
-    if spec is None:
-        raise InputError("give a spec or --urdf", field="--urdf")
-    xml = expand_urdfs(spec)[ARM_URDF].decode("utf-8")
-    return arm_from_model(load_model(ARM_URDF, xml=xml).model, joints)
+    return arm_from_model(
+        checked_model(arm_urdf(spec, urdf, trust_xacro=trust_xacro)).model, joints
+    )
 
 
 def _gains(
@@ -99,15 +109,15 @@ def _refuse_integral_gain(arm: Arm, spec: RobotSpec | None) -> None:
             )
 
 
-def _tool(arm: Arm, spec: RobotSpec | None) -> tuple[int, np.ndarray, str]:
+def _tool(arm: Arm, doc: Urdf, spec: RobotSpec | None) -> tuple[int, np.ndarray, str]:
+    """The tool point (armcli.urdf.tool) as (Pinocchio frame id, offset [m], label)."""
     model = arm.model
-    if spec is not None and spec.arm.tool is not None and model.existFrame(spec.arm.tool.link):
-        off = np.array(spec.arm.tool.xyz, dtype=float)
-        return model.getFrameId(spec.arm.tool.link), off, f"{spec.arm.tool.link}+{_fmt(off)}"
-    last = model.njoints - 1
-    bodies = [i for i, f in enumerate(model.frames) if f.parentJoint == last]
-    fid = bodies[-1]
-    return fid, np.zeros(3), model.frames[fid].name
+    tool = tool_point(doc, spec)
+    if tool is None or not model.existFrame(tool.link):
+        raise InputError("this URDF has no link to report as the end effector", file=doc.source)
+    off = np.array(tool.xyz, dtype=float)
+    label = f"{tool.link}+{_fmt(off)}" if np.any(off) else tool.link
+    return model.getFrameId(tool.link), off, label
 
 
 def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
@@ -157,7 +167,8 @@ def prepare(spec: RobotSpec | None, opts: SimOptions) -> SimJob:
     dt = dt if dt is not None else (spec.control.dt if spec is not None else DEFAULT_DT)
     if not (np.isfinite(dt) and 0 < dt <= 0.1):
         raise InputError(f"must be in (0, 0.1] s, got {dt:g}", field="--dt")
-    arm = load_arm(spec, opts.urdf, opts.joints, trust_xacro=opts.trust_xacro)
+    doc = arm_urdf(spec, opts.urdf, trust_xacro=opts.trust_xacro)
+    arm = arm_from_model(checked_model(doc).model, opts.joints)
     limits = {
         n: (float(lo), float(hi))
         for n, lo, hi in zip(arm.joint_names, arm.lower, arm.upper, strict=True)
@@ -196,7 +207,7 @@ def prepare(spec: RobotSpec | None, opts: SimOptions) -> SimJob:
     )
     if not (np.isfinite(rate) and rate > 0):
         raise InputError(f"must be > 0 Hz, got {rate:g}", field="--rate")
-    fid, off, label = _tool(arm, spec)
+    fid, off, label = _tool(arm, doc, spec)
     frame, T_frame_root = _report_frame(arm, spec)
     label = f"{label} in {frame}"
     return SimJob(arm, traj, ref, q0, total, cfg, fid, off, label, float(rate), T_frame_root)

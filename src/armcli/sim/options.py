@@ -10,6 +10,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal, get_args
 
+from armcli.errors import InputError
+
 Integrator = Literal["euler", "rk4"]
 """euler: semi-implicit (symplectic) Euler with implicit damping; rk4: classic Runge-Kutta."""
 Engine = Literal["auto", "native", "python"]
@@ -54,3 +56,13 @@ class SimOptions:
     rate: float | None = None
     engine: Engine = "auto"
     trust_xacro: bool = False
+
+    def __post_init__(self) -> None:
+        for value, choices, option in (
+            (self.integrator, INTEGRATORS, "--integrator"),
+            (self.engine, ENGINES, "--engine"),
+        ):
+            if value not in choices:
+                raise InputError(
+                    f"unknown value {value!r}; valid: {', '.join(choices)}", field=option
+                )

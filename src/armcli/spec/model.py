@@ -24,6 +24,7 @@ from pydantic import (
 
 from armcli.defaults import DEFAULT_DT
 from armcli.spec.expr import eval_expr
+from armcli.spec.graph import root_links
 
 
 def _number(v: Any) -> Any:
@@ -249,6 +250,21 @@ class Gains(_Model):
     ki: NonNeg = 0.0
 
 
+class Tolerances(_Model):
+    """Trajectory-following limits for the Jazzy JointTrajectoryController (`constraints`).
+
+    Defaults: `stopped_velocity_tolerance` and `trajectory` are the controller's own
+    defaults (0.01 rad/s; 0 = not checked: a PD loop under gravity lags its reference);
+    `goal_time` is MoveIt's default goal-duration margin; `goal` is 0.05 rad because a
+    P(D) loop without integral action settles off the goal by gravity torque / Kp.
+    """
+
+    goal_time: NonNeg = 0.5  # [s] extra time allowed to reach the goal; 0 = unlimited
+    stopped_velocity_tolerance: NonNeg = 0.01  # [rad/s or m/s]
+    goal: NonNeg = 0.05  # [rad or m] position error allowed at the goal; 0 = not checked
+    trajectory: NonNeg = 0.0  # [rad or m] error allowed along the way; 0 = not checked
+
+
 class Control(_Model):
     """How the arm is controlled and simulated.
 
@@ -260,6 +276,7 @@ class Control(_Model):
     gains: dict[Name, Gains] = {}
     controller_update_rate: Positive = 100.0
     gravity_compensation: bool = False
+    tolerances: Tolerances = Tolerances()
 
 
 class RobotSpec(_Model):
@@ -290,9 +307,7 @@ class RobotSpec(_Model):
 
     def arm_root(self) -> str:
         """The arm link that is no arm joint's child (a valid spec has exactly one)."""
-        children = {j.child for j in self.arm.joints.values()}
-        roots = [name for name in self.arm.links if name not in children]
-        return roots[0]
+        return root_links(self.arm.links, (j.child for j in self.arm.joints.values()))[0]
 
     def mount_joint(self) -> Joint:
         """The mount as the fixed `Joint` from the base to the arm root; needs a mount."""

@@ -16,6 +16,7 @@ from lxml import etree
 
 from armcli.errors import InputError, XacroRefusedError
 from armcli.urdf.doc import (
+    JOINT_DOF,
     ZERO3,
     Geometry,
     Inertial,
@@ -37,7 +38,6 @@ MAX_URDF_DEPTH = 32
 # example-robot-data has 130 links and 101 DoF (tiago_dual).
 MAX_URDF_LINKS = 300
 MAX_URDF_DOF = 128
-_DOF = {"revolute": 1, "continuous": 1, "prismatic": 1, "planar": 3, "floating": 6}
 
 
 def _ln(el: etree._Element) -> int | None:
@@ -308,7 +308,7 @@ def _check_size(root: etree._Element, source: str) -> None:
             file=source,
             line=_ln(links[MAX_URDF_LINKS]),
         )
-    dof = sum(_DOF.get(str(j.get("type")), 0) for j in root.findall("joint"))
+    dof = sum(JOINT_DOF.get(str(j.get("type")), 0) for j in root.findall("joint"))
     if dof > MAX_URDF_DOF:
         raise InputError(
             f"more than {MAX_URDF_DOF} degrees of freedom ({dof}); armcli's bound on robot size",

@@ -95,7 +95,11 @@ def load_checked_model(path: Path, *, trust_xacro: bool = False) -> LoadedModel:
     non-finite number (Pinocchio turns mass="nan" into 0) or any error the URDF
     parser prints is an InputError naming the file and line, not a wrong result.
     """
-    urdf = read_urdf_file(path, trust_xacro=trust_xacro)
+    return checked_model(read_urdf_file(path, trust_xacro=trust_xacro))
+
+
+def checked_model(urdf: Urdf) -> LoadedModel:
+    """A parsed URDF -> Pinocchio model, refusing what Pinocchio would silently accept."""
     if urdf.problems:
         p = urdf.problems[0]
         raise InputError(f"{p.where}: {_PROBLEM[p.kind]} {p.text!r}", file=urdf.source, line=p.line)

@@ -22,17 +22,18 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import InputError
+from armcli.sim.states import Replay
+from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_root
+from armcli.urdf.tool import ToolPoint
 from armcli.urdf.tree import parse_tree
 from armcli.view.png import (
-    Tool,
     full_configuration,
     joint_limits,
     load_urdf,
     neutral,
     tool_position,
 )
-from armcli.view.replay import Replay
 
 GHOST_RGBA = (0.35, 0.65, 1.0, 0.35)  # translucent blue for the reference pose
 FRAME_RATE = 30.0  # [Hz] replay updates sent to the browser
@@ -86,8 +87,9 @@ class Viewer:
         name: str = "robot",
         source: str = "<urdf>",
         mesh_dir: str | Path | None = None,
+        search: MeshSearch | None = None,
         poses: Mapping[str, Mapping[str, float]] | None = None,
-        tool: Tool | None = None,
+        tool: ToolPoint | None = None,
         replay: Replay | None = None,
         host: str = "127.0.0.1",
         port: int = 8080,
@@ -97,7 +99,7 @@ class Viewer:
 
         self._source, self._tool, self._replay = source, tool, replay
         self._poses = {k: dict(v) for k, v in (poses or {}).items()}
-        self._urdf = load_urdf(urdf_xml, source, mesh_dir)
+        self._urdf = load_urdf(urdf_xml, source, mesh_dir, search)
         self._limits = joint_limits(self._urdf)
         self._lock = threading.RLock()
         self._stop = threading.Event()
@@ -119,7 +121,7 @@ class Viewer:
                 ghost_xml = moving_parts(urdf_xml, replay.reference, source)
                 self._ghost = ViserUrdf(
                     self.server,
-                    load_urdf(ghost_xml, source, mesh_dir),
+                    load_urdf(ghost_xml, source, mesh_dir, search),
                     root_node_name="/ghost",
                     mesh_color_override=GHOST_RGBA,
                 )

@@ -20,8 +20,9 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
+from armcli.urdf.meshes import MeshSearch, confined, resolve
 from armcli.urdf.read import parse_root
-from armcli.urdf.source import allowed_roots, inside_roots
+from armcli.urdf.tool import ToolPoint
 
 MAX_EDGE = 0.04  # [m] faces are split to this edge length so depth sorting works
 LIGHT = np.array([0.35, -0.55, 0.76])  # direction towards the light, world frame
@@ -32,14 +33,6 @@ VIEWS = (  # (title, elevation [deg], azimuth [deg])
 )
 DEFAULT_SIZE = (1200, 600)  # [px]
 DPI = 100
-
-
-@dataclass(frozen=True)
-class Tool:
-    """The end-effector point: `xyz` [m] fixed in `link`'s frame."""
-
-    link: str
-    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -57,12 +50,19 @@ FALLBACK_RGBA = (0.6, 0.6, 0.6, 1.0)  # meshes whose colour cannot be read
 TITLE_WIDTH = 110  # [characters] per title line, so many joints do not run off the figure
 
 
-def load_urdf(xml: str, source: str = "<urdf>", mesh_dir: str | Path | None = None) -> Any:
-    """URDF text -> yourdfpy.URDF with its visual scene (meshes resolved under `mesh_dir`).
+def load_urdf(
+    xml: str,
+    source: str = "<urdf>",
+    mesh_dir: str | Path | None = None,
+    search: MeshSearch | None = None,
+) -> Any:
+    """URDF text -> yourdfpy.URDF with its visual scene.
 
-    The text first passes urdfxml's safe parser (no DTDs or entities, bounded size and
-    depth), since yourdfpy's own lxml parser would resolve entities. A mesh file that
-    cannot be found is an InputError, where yourdfpy would log and draw nothing.
+    Meshes resolve with armcli.urdf.meshes from `mesh_dir` (the URDF's directory), as in
+    `check`, honouring `--package-dir` through `search`. The text first passes the strict
+    URDF reader (no DTDs or entities, bounded size and depth), since yourdfpy's own lxml
+    parser would resolve entities. A mesh file that cannot be found is an InputError,
+    where yourdfpy would log and draw nothing.
     """
     import logging
 
@@ -70,19 +70,21 @@ def load_urdf(xml: str, source: str = "<urdf>", mesh_dir: str | Path | None = No
 
     parse_root(xml.encode("utf-8"), source)
     missing: list[str] = []
-    roots = allowed_roots(Path(mesh_dir or "."))
+    base = Path(mesh_dir or ".")
+    where = search or MeshSearch()
 
-    def resolve(fname: str) -> str:
-        found = str(yourdfpy.filename_handler_magic(fname, dir=str(mesh_dir or ".")))
-        if not Path(found).is_file():
-            missing.append(fname)
-        elif not inside_roots(Path(found), roots):  # never read files outside the roots
-            raise InputError(
-                f"mesh {fname!r} resolves to {found}, outside the allowed directories "
-                "(the URDF's directory, its ROS package, ROS_PACKAGE_PATH)",
+    def resolve_mesh(fname: str) -> str:
+        path = resolve(fname, base, where)
+        if path is not None and not confined(fname, path, base, where):
+            raise InputError(  # never read files outside the roots
+                f"mesh {fname!r} resolves to {path}, outside the allowed directories "
+                "(the URDF's directory and ROS package, --package-dir, ROS_PACKAGE_PATH)",
                 file=source,
             )
-        return found
+        if path is None or not path.is_file():
+            missing.append(fname)
+            return fname
+        return str(path)
 
     log = logging.getLogger("yourdfpy")
     level, log.level = log.level, logging.CRITICAL  # its warnings become our error below
@@ -91,7 +93,7 @@ def load_urdf(xml: str, source: str = "<urdf>", mesh_dir: str | Path | None = No
             io.BytesIO(xml.encode("utf-8")),
             build_collision_scene_graph=False,
             load_collision_meshes=False,
-            filename_handler=resolve,
+            filename_handler=resolve_mesh,
         )
     except InputError:
         raise
@@ -101,7 +103,9 @@ def load_urdf(xml: str, source: str = "<urdf>", mesh_dir: str | Path | None = No
         log.level = level
     if missing:
         raise InputError(
-            f"mesh file not found: {missing[0]} (searched from {mesh_dir or '.'})", file=source
+            f"mesh file not found: {missing[0]} (searched from {base}; --package-dir "
+            "NAME=PATH points package://NAME at a folder)",
+            file=source,
         )
     return urdf
 
@@ -147,7 +151,7 @@ def neutral(limit: tuple[float, float] | None) -> float:
     return 0.0 if limit is None else float(np.clip(0.0, limit[0], limit[1]))
 
 
-def tool_position(urdf: Any, tool: Tool | None) -> np.ndarray | None:
+def tool_position(urdf: Any, tool: ToolPoint | None) -> np.ndarray | None:
     """The tool point in the root-link frame [m] at the URDF's current configuration."""
     if tool is None:
         return None
@@ -224,7 +228,7 @@ def render_figure(
     urdf: Any,
     q: Mapping[str, float],
     *,
-    tool: Tool | None = None,
+    tool: ToolPoint | None = None,
     name: str = "robot",
     size: Sequence[int] = DEFAULT_SIZE,
 ) -> Any:
@@ -252,7 +256,7 @@ def render_png(
     q: Mapping[str, float],
     out: str | Path,
     *,
-    tool: Tool | None = None,
+    tool: ToolPoint | None = None,
     name: str = "robot",
     size: Sequence[int] = DEFAULT_SIZE,
     field: str | None = None,

@@ -13,9 +13,10 @@ from pathlib import Path
 from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import InputError
 from armcli.spec.expr import eval_expr
+from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import read_robot, urdf_text
+from armcli.urdf.tool import ToolPoint, tool_point
 from armcli.urdf.tree import tree_from_urdf
-from armcli.view.png import Tool
 
 ROBOT_HELP = (
     f"Robot spec YAML, URDF file, or xacro file (with --trust-xacro); default: {DEFAULT_SPEC}."
@@ -32,18 +33,22 @@ class RobotSource:
     mesh_dir: Path | None
     joints: tuple[str, ...]  # the joints `--q a,b,...` assigns, in order
     poses: dict[str, dict[str, float]] = field(default_factory=dict)
-    tool: Tool | None = None
+    tool: ToolPoint | None = None
+    search: MeshSearch = field(default_factory=MeshSearch)  # --package-dir
 
 
-def load_robot(path: Path, trust_xacro: bool = False) -> RobotSource:
+def load_robot(
+    path: Path, trust_xacro: bool = False, search: MeshSearch | None = None
+) -> RobotSource:
     """Spec YAML (built in memory), URDF or trusted xacro file -> RobotSource.
 
-    Mesh URIs must resolve inside robot_source.allowed_roots.
+    Mesh URIs resolve with armcli.urdf.meshes (honouring `search`, the --package-dir
+    options) and must stay inside the allowed roots; the tool point is armcli.urdf.tool's.
     """
     robot = read_robot(path, trust_xacro=trust_xacro)
     spec = robot.spec
+    where = search or MeshSearch()
     if spec is not None:
-        tool = Tool(spec.arm.tool.link, spec.arm.tool.xyz) if spec.arm.tool else None
         return RobotSource(
             xml=urdf_text(robot.robot),
             source=str(path),
@@ -51,19 +56,19 @@ def load_robot(path: Path, trust_xacro: bool = False) -> RobotSource:
             mesh_dir=None,
             joints=tuple(spec.movable_arm_joints()),
             poses={p: spec.pose(p) for p in spec.poses},
-            tool=tool,
+            tool=tool_point(robot.robot, spec),
+            search=where,
         )
     urdf = robot.robot
     tree = tree_from_urdf(urdf)
-    movable = tree.movable()
-    tip = max((d, j.child) for d, j in tree.walk())[1] if tree.joints else tree.root
     return RobotSource(
         xml=urdf_text(urdf),
         source=str(path),
         name=tree.robot or path.stem,
         mesh_dir=path.parent,
-        joints=tuple(j.name for j in movable),
-        tool=Tool(tip),
+        joints=tuple(j.name for j in tree.movable()),
+        tool=tool_point(urdf),
+        search=where,
     )
 
 
