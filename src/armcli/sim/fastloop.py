@@ -25,6 +25,7 @@ from armcli.sim.stepper import (
     FLAG_SATURATED,
     FLAG_STOP,
     Stepper,
+    pgs,
 )
 
 
@@ -86,29 +87,43 @@ def euler_loop(
     qa, va, ta, aba, gravity = s.qa, s.va, s.ta, s.pin.aba, s.pin.computeGeneralizedGravity
     buf, pack3 = cast(Any, s.buf), s.pack3  # a numpy array is a writable buffer
     model, data, gc, nosat, vmin = s.model, s.data, s.gc, [False] * s.n, s.vmin
-    fast, armed, isfinite = not s.any_friction, False, math.isfinite
+    armed, isfinite, friction, minverse = (
+        False,
+        math.isfinite,
+        s.any_friction,
+        s.pin.computeMinverse,
+    )
+    free_lo, free_hi, fdt, n = [-math.inf] * s.n, [math.inf] * s.n, [dt * f for f in s.fric], s.n
     rec = Record(list(q), list(v), [], [])
     Qx, Vx, Tx = rec.q.extend, rec.v.extend, rec.tau.extend
     for k, (qr, vr) in enumerate(zip(Rq, Rv, strict=True)):
         done = False
-        if fast:
-            t = [a * (b - c) + e * (f - g) for a, b, c, e, f, g in zip(kp, qr, q, kd, vr, v)]  # noqa: B905
-            if gc:
-                qa[:] = q
-                t = [x + y for x, y in zip(t, gravity(model, data, qa).tolist())]  # noqa: B905
-            if not any(map(gt, map(abs, t), effort)):
-                if not armed:
-                    s.set_armature(nosat)
-                    armed = True
-                pack3(buf, 0, *q, *v, *[x - c * y for x, c, y in zip(t, d, v)])  # noqa: B905
-                a = aba(model, data, qa, va, ta).tolist()
-                vs = [x + dt * y for x, y in zip(v, a)]  # noqa: B905
-                qp = [x + dt * y for x, y in zip(q, vs)]  # noqa: B905
-                if not (any(map(gt, qp, upper)) or any(map(lt, qp, lower))):
-                    tau = [x - c * (y - z) for x, c, y, z in zip(t, kd, vs, v)]  # noqa: B905
-                    if not any(map(gt, map(abs, tau), effort)):
-                        q, v, done = qp, vs, True  # within the limits: the clamp is a no-op
-                        Tx(tau)
+        t = [a * (b - c) + e * (f - g) for a, b, c, e, f, g in zip(kp, qr, q, kd, vr, v)]  # noqa: B905
+        if gc:
+            qa[:] = q
+            t = [x + y for x, y in zip(t, gravity(model, data, qa).tolist())]  # noqa: B905
+        if not any(map(gt, map(abs, t), effort)):
+            if not armed:
+                s.set_armature(nosat)
+                armed = True
+            pack3(buf, 0, *q, *v, *[x - c * y for x, c, y in zip(t, d, v)])  # noqa: B905
+            a = aba(model, data, qa, va, ta).tolist()
+            vs = [x + dt * y for x, y in zip(v, a)]  # noqa: B905
+            qp = [x + dt * y for x, y in zip(q, vs)]  # noqa: B905
+            if not (any(map(gt, qp, upper)) or any(map(lt, qp, lower))):
+                if friction:  # Stepper.project without stops: friction alone
+                    A = minverse(model, data, qa).tolist()
+                    for i in range(n):  # only the upper triangle is guaranteed
+                        for j in range(i):
+                            A[i][j] = A[j][i]
+                    dv = pgs(A, vs, free_lo, free_hi, fdt, s.lam)
+                    qp = [x + dt * y for x, y in zip(qp, dv)]  # noqa: B905
+                    qp = [min(max(x, lo), hi) for x, lo, hi in zip(qp, lower, upper)]  # noqa: B905
+                    vs = [x + y for x, y in zip(vs, dv)]  # noqa: B905
+                tau = [x - c * (y - z) for x, c, y, z in zip(t, kd, vs, v)]  # noqa: B905
+                if not any(map(gt, map(abs, tau), effort)):
+                    q, v, done = qp, vs, True  # within the limits: the clamp is a no-op
+                    Tx(tau)
         if not done:
             q, v = s.euler(q, v, qr, vr)
             armed = False
