@@ -169,10 +169,33 @@ def per_step(args, mod, arm, reference, plant, m, m_c) -> float:
         ("armcli simulate() Python, all-in", t_sim_py),
     ]
     print(f"\nsame model (standalone arm), trajectory (5 points, {steps * DT:g} s), dt = {DT} s")
+    print("friction off (MuJoCo's frictionloss is a soft constraint; this is the like-for-like)")
     print(row("engine", "µs/step", "x MuJoCo loop"))
     for name, t in rows:
         print(row(name, f"{t * 1e6:.2f}", f"{t / t_mj:.3f}"))
     return t_mj
+
+
+def per_step_friction(args, mod, urdf: Path, reference) -> None:
+    """The seed arm as its URDF has it: Coulomb friction 0.05 N·m on both joints."""
+    reps = 3 if args.quick else 5
+    steps = 10_000
+    q_ref, v_ref, ref = refs(reference, steps)
+    arm_f, _ = setup(urdf, friction=True)
+    cfg = SimConfig(np.full(2, KP), np.full(2, KD), dt=DT)
+    plant = ro.Plant(arm_f.model, params_of(arm_f, cfg), False, DT, "euler", math.inf)
+    m_f = mujoco_model(urdf, friction=True)
+    t_mj = timed(lambda: mujoco_loop(m_f, q_ref, v_ref, Q0), reps) / steps
+    rows = [("MuJoCo mj_step, PD in Python", t_mj)]
+    if mod is not None:
+        t_nat = timed(lambda: native.rollout(mod, plant, Q0, np.zeros(2), ref), reps) / steps
+        rows.append(("armcli compiled rollout", t_nat))
+    t_py = timed(lambda: ro.rollout_python(plant, Q0, np.zeros(2), ref), 1 if args.quick else 3)
+    rows.append(("armcli Python loop (fallback)", t_py / steps))
+    print("\nfriction on (URDF: 0.05 N·m per joint; MuJoCo frictionloss)")
+    print(row("engine", "µs/step", "x MuJoCo loop"))
+    for name, t in rows:
+        print(row(name, f"{t * 1e6:.2f}", f"{t / t_mj:.3f}"))
 
 
 def agreement(arm, reference, urdf: Path, m, m_c) -> None:
@@ -258,6 +281,7 @@ def main() -> None:
     m = mujoco_model(urdf, friction=False)
     m_c = mujoco_actuated(urdf)
     per_step(args, mod, arm, reference, plant, m, m_c)
+    per_step_friction(args, mod, urdf, reference)
     agreement(arm, reference, urdf, m, m_c)
     batch_scaling(args, mod, plant, reference, m_c)
 
