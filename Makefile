@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 SPEC ?= specs/my_robot.yaml
 
-.PHONY: install sysdeps demo test lint bench native native-check fuzz clean
+.PHONY: spec-docs install sysdeps demo test lint bench native native-check fuzz clean
 
 # The install builds the compiled rollout (armcli.sim._rollout, CMakeLists.txt) too, so a
 # change to its C++ source or build files reinstalls.
@@ -60,9 +60,14 @@ native-check: install
 bench: install native-check
 	$(BIN)/python bench/bench_sim.py
 	$(BIN)/python bench/bench_process.py
+	$(BIN)/python bench/bench_tune.py
 
 fuzz: install
 	HYPOTHESIS_PROFILE=fuzz $(BIN)/python -m pytest -q tests -k fuzz
 
 clean:
 	rm -rf $(VENV) build dist out .pytest_cache .ruff_cache .mypy_cache
+
+# The spec reference is generated from the pydantic models (a test keeps it in sync).
+spec-docs: install
+	$(BIN)/python -m armcli.spec.reference > docs/spec.md
