@@ -5,56 +5,30 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import click
 import typer
 
 from armcli.build.expand import spec_label
-from armcli.defaults import DEFAULT_SPEC
+from armcli.commands.options import choice, option, out_option, spec_argument
 from armcli.ros.packages import DEFAULT_TARGET, TARGETS, PackageInfo, write_ros_packages
 
+TARGET_HELP = (
+    "humble-classic: the course's ROS 2 Humble + Gazebo classic (default); jazzy: ROS 2 Jazzy "
+    "+ Gazebo Harmonic with ros2_control (effort, the spec's gains)."
+)
 DEFAULT_SAMPLES = 10_000  # keep equal to armcli.ros.collision_matrix.DEFAULT_SAMPLES (lazy import)
 
 
 def ros_package_cmd(
-    spec: Path = typer.Argument(
-        DEFAULT_SPEC, show_default=False, help=f"Robot spec YAML (default: {DEFAULT_SPEC})."
+    spec: Path = spec_argument(),
+    out: Path = out_option(Path("ros"), "Output directory"),
+    samples: int = option(
+        DEFAULT_SAMPLES, "--samples", min=1, help="Random states for the collision matrix"
     ),
-    out: Path = typer.Option(
-        Path("ros"), "-o", "--out", show_default=False, help="Output directory (default: ros)."
-    ),
-    samples: int = typer.Option(
-        DEFAULT_SAMPLES,
-        "--samples",
-        min=1,
-        show_default=False,
-        help=f"Random states for the collision matrix (default: {DEFAULT_SAMPLES}).",
-    ),
-    seed: int = typer.Option(
-        0, "--seed", show_default=False, help="Seed of the collision-matrix sampling (default: 0)."
-    ),
-    maintainer: str = typer.Option(
-        "armcli",
-        "--maintainer",
-        show_default=False,
-        help="package.xml maintainer (default: armcli).",
-    ),
-    email: str = typer.Option(
-        "armcli@example.com",
-        "--email",
-        show_default=False,
-        help="Maintainer e-mail (default: armcli@example.com).",
-    ),
-    license_: str = typer.Option(
-        "TODO", "--license", show_default=False, help="package.xml license (default: TODO)."
-    ),
-    target: str = typer.Option(
-        DEFAULT_TARGET,
-        "--target",
-        click_type=click.Choice(TARGETS),
-        show_default=False,
-        help="humble-classic: the course's ROS 2 Humble + Gazebo classic (default); "
-        "jazzy: ROS 2 Jazzy + Gazebo Harmonic with ros2_control (effort, the spec's gains).",
-    ),
+    seed: int = option(0, "--seed", help="Seed of the collision-matrix sampling"),
+    maintainer: str = option("armcli", "--maintainer", help="package.xml maintainer"),
+    email: str = option("armcli@example.com", "--email", help="Maintainer e-mail"),
+    license_: str = option("TODO", "--license", help="package.xml license"),
+    target: str = choice(DEFAULT_TARGET, TARGETS, "--target", help=TARGET_HELP),
 ) -> None:
     """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
     info = PackageInfo(maintainer=maintainer, email=email, license=license_)
