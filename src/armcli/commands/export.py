@@ -9,9 +9,9 @@ import typer
 
 from armcli.build.expand import spec_label
 from armcli.commands.options import choice
-from armcli.defaults import DEFAULT_SPEC
 from armcli.export.mjcf import BASES
 from armcli.export.mjcf_files import export_mjcf
+from armcli.spec.discover import find_spec
 from armcli.urdf.meshes import MeshSearch, parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP
 
@@ -22,10 +22,11 @@ export_app = typer.Typer(
 
 @export_app.command("mjcf")
 def mjcf_cmd(
-    robot: Path = typer.Argument(
-        DEFAULT_SPEC,
+    robot: Path | None = typer.Argument(
+        None,
         show_default=False,
-        help=f"Robot spec YAML, URDF or xacro file (default: {DEFAULT_SPEC}).",
+        help="Robot spec YAML, URDF or xacro file (default: ./armcli.yaml, else the spec in "
+        "specs/).",
     ),
     out: Path = typer.Option(
         Path("robot.xml"),
@@ -53,6 +54,7 @@ def mjcf_cmd(
     Joints with spec gains get `position` actuators (kp = Kp, kv = Kd, force range =
     the effort limit); the report lists what MuJoCo cannot represent.
     """
+    robot = find_spec(robot)
     res = export_mjcf(
         robot,
         out,

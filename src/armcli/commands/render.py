@@ -7,8 +7,9 @@ from pathlib import Path
 
 import typer
 
-from armcli.defaults import DEFAULT_SPEC
+from armcli.commands.options import spec_argument
 from armcli.errors import InputError
+from armcli.spec.discover import find_spec
 from armcli.urdf.meshes import MeshSearch, parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP
 from armcli.view.png import load_urdf, render_png
@@ -26,7 +27,7 @@ def _size(text: str) -> tuple[int, int]:
 
 
 def render_cmd(
-    robot: Path = typer.Argument(DEFAULT_SPEC, show_default=False, help=ROBOT_HELP),
+    robot: Path | None = spec_argument(ROBOT_HELP),
     pose: str = typer.Option(None, "--pose", help="A named pose of the spec."),
     q: str = typer.Option(
         None,
@@ -52,7 +53,7 @@ def render_cmd(
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
-    src = load_robot(robot, trust_xacro, MeshSearch(parse_package_dirs(package_dir)))
+    src = load_robot(find_spec(robot), trust_xacro, MeshSearch(parse_package_dirs(package_dir)))
     values = pose_q(src, pose, q)
     width, height = _size(size)
     urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search)

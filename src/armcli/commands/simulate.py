@@ -9,14 +9,14 @@ from typing import Any, cast
 
 import typer
 
-from armcli.commands.options import choice, option
-from armcli.defaults import DEFAULT_SPEC
+from armcli.commands.options import choice, option, spec_argument
 from armcli.errors import InputError
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
 from armcli.sim import states
 from armcli.sim.options import ENGINES, INTEGRATORS, Engine, Integrator, SimOptions
 from armcli.sim.plot import write_tracking_plot
+from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
 from armcli.urdf.source import TRUST_XACRO_HELP
 
@@ -37,7 +37,7 @@ def _floats(text: str | None, option: str) -> list[float] | None:
 
 
 def simulate_cmd(
-    spec: Path = typer.Argument(None, help=f"Robot spec YAML (default: {DEFAULT_SPEC})."),
+    spec: Path | None = spec_argument(),
     trajectory: Path = option(None, "--trajectory", "-t", help=TRAJECTORY_HELP),
     message: str = option(None, "--message", "-m", help="JointTrajectory as YAML text."),
     urdf: Path = option(None, "--urdf", help="Simulate this URDF instead of the spec's arm."),
@@ -58,7 +58,7 @@ def simulate_cmd(
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
     if output is not None:
         states.output_format(output)
-    spec_obj = load_spec(spec or DEFAULT_SPEC) if (spec is not None or urdf is None) else None
+    spec_obj = load_spec(find_spec(spec)) if (spec is not None or urdf is None) else None
     kp_values, kd_values = _floats(kp, "--kp"), _floats(kd, "--kd")
     opts = SimOptions(
         trajectory=trajectory,

@@ -7,10 +7,10 @@ from pathlib import Path
 
 import typer
 
-from armcli.commands.options import choice
-from armcli.defaults import DEFAULT_SPEC
+from armcli.commands.options import choice, spec_argument
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
+from armcli.spec.discover import find_spec
 from armcli.urdf.source import TRUST_XACRO_HELP
 from armcli.urdf.tree import parse_tree, to_dot, to_rich
 from armcli.view.scene import ROBOT_HELP, load_robot
@@ -19,7 +19,7 @@ TREE_FORMATS = ("text", "dot")
 
 
 def tree_cmd(
-    robot: Path = typer.Argument(DEFAULT_SPEC, show_default=False, help=ROBOT_HELP),
+    robot: Path | None = spec_argument(ROBOT_HELP),
     fmt: str = choice(
         "text", TREE_FORMATS, "--format", help="text (a tree, the default) or dot (Graphviz)."
     ),
@@ -29,7 +29,7 @@ def tree_cmd(
     """Print the kinematic tree: links, and joints with their types and limits."""
     if fmt not in TREE_FORMATS:
         raise InputError(f"unknown format {fmt!r}; known: text, dot", field="--format")
-    src = load_robot(robot, trust_xacro)
+    src = load_robot(find_spec(robot), trust_xacro)
     tree = parse_tree(src.xml, src.source)
     if fmt == "dot":
         text = to_dot(tree)

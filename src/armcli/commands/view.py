@@ -7,9 +7,10 @@ from pathlib import Path
 
 import typer
 
-from armcli.defaults import DEFAULT_SPEC
+from armcli.commands.options import spec_argument
 from armcli.errors import InputError
 from armcli.sim.states import load_replay
+from armcli.spec.discover import find_spec
 from armcli.urdf.meshes import MeshSearch, parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP
 from armcli.view.browser import Viewer
@@ -18,7 +19,7 @@ from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
 
 
 def view_cmd(
-    robot: Path = typer.Argument(DEFAULT_SPEC, show_default=False, help=ROBOT_HELP),
+    robot: Path | None = spec_argument(ROBOT_HELP),
     replay: Path = typer.Option(None, "--replay", help="A CSV written by `armcli simulate`."),
     pose: str = typer.Option(None, "--pose", help="Start at this named pose."),
     host: str = typer.Option(
@@ -36,7 +37,7 @@ def view_cmd(
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Open a browser 3-D viewer with joint sliders, named poses and simulation replay."""
-    src = load_robot(robot, trust_xacro, MeshSearch(parse_package_dirs(package_dir)))
+    src = load_robot(find_spec(robot), trust_xacro, MeshSearch(parse_package_dirs(package_dir)))
     pose_q(src, pose, None)  # validate before starting the server
     if not 0 <= port <= 65535:
         raise InputError(f"{port} is not a port number", field="--port")
