@@ -5,9 +5,11 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 SPEC ?= specs/my_robot.yaml
 
-.PHONY: spec-docs install sysdeps demo test lint bench native native-or-skip fuzz clean
+.PHONY: spec-docs install sysdeps demo test lint bench native native-check fuzz clean
 
-$(STAMP): pyproject.toml
+# The install builds the compiled rollout (armcli.sim._rollout, CMakeLists.txt) too, so a
+# change to its C++ source or build files reinstalls.
+$(STAMP): pyproject.toml CMakeLists.txt src/armcli/sim/_native/rollout.cpp
 	$(PY) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
 	$(BIN)/python -m pip install -q -e '.[dev]'
@@ -38,22 +40,26 @@ lint: install
 	$(BIN)/ruff format --check src tests bench
 	$(BIN)/mypy src
 
-test: install sysdeps lint native-or-skip
+test: install sysdeps lint native-check
 	$(BIN)/armcli build --check $(SPEC)
 	$(BIN)/python -m pytest -q
 
-# Compiled simulator rollout (optional: armcli falls back to its Python loop). Cached under
-# ~/.cache/armcli/native keyed by source + pin version; ~2-4 min the first time.
+# Rebuild the compiled rollout after editing its C++ (the editable install does not rebuild
+# on import): incremental, in build/, with the build tools of the dev extra.
 native: install
+	$(BIN)/python -m pip install -q --no-build-isolation --no-deps -e .
 	$(BIN)/python -m armcli.sim.native
 
-# For the tests: build the compiled path when possible; its tests skip (with the reason)
-# where no compiler is available, and everything else uses the Python loop.
-native-or-skip: install
-	@$(BIN)/python -m armcli.sim.native || echo "native rollout not built; its tests will skip"
+# The compiled engine must be there wherever a C++ compiler exists: a failed build fails
+# `make test` instead of skipping its tests.
+native-check: install
+	@if command -v c++ >/dev/null 2>&1 || command -v g++ >/dev/null 2>&1; then \
+	  $(BIN)/python -m armcli.sim.native; \
+	else echo "no C++ compiler: armcli uses its Python engine; compiled-engine tests skip"; fi
 
-bench: install native
+bench: install native-check
 	$(BIN)/python bench/bench_sim.py
+	$(BIN)/python bench/bench_process.py
 	$(BIN)/python bench/bench_tune.py
 
 fuzz: install

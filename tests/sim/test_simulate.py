@@ -24,15 +24,10 @@ from armcli.sim.simulate import (
 )
 from armcli.sim.trajectory import loads_trajectory
 from armcli.urdf.pinocchio import load_model
+from tests.sim.engines import FAST, require_native  # FAST for long runs; equality is tested
 
 G = 9.81
-BACKENDS = [
-    "python",
-    pytest.param(
-        "native", marks=pytest.mark.skipif(native.load() is None, reason="run `make native`")
-    ),
-]
-FAST = "python" if native.load() is None else "native"  # for long runs; equality is tested
+BACKENDS = ["python", "native"]
 WIDE = 1e3  # [rad] limits far away: no stop contact
 ROUNDOFF = 1e-12
 ODE_TOL = 1e-6  # [rad] RK4 at dt = 0.5 ms vs DOP853 (the requirement)
@@ -85,7 +80,7 @@ def _plant(arm: Arm, cfg: SimConfig, energy_max: float = np.inf) -> ro.Plant:
 def _run(backend: str, plant: ro.Plant, q0, v0, ref: np.ndarray) -> ro.Rollout:
     q0, v0 = np.asarray(q0, dtype=float), np.asarray(v0, dtype=float)
     if backend == "native":
-        return native.rollout(native.load(), plant, q0, v0, ref)
+        return native.rollout(require_native(), plant, q0, v0, ref)
     return ro.rollout_python(plant, q0, v0, ref)
 
 
@@ -116,9 +111,8 @@ def test_pendulum_small_amplitude_period(integrator: str) -> None:
     arm = pendulum(m, length)
     cfg = SimConfig(kp=np.zeros(1), kd=np.zeros(1), dt=1e-3, integrator=integrator)
     steps = 10_000
-    sub = 2 if integrator == "rk4" else 1
-    r = _run("python" if native.load() is None else "native", _plant(arm, cfg), [0.01], [0.0],
-             _const_ref(1, steps, sub=sub))  # fmt: skip
+    sub = ro.rows_per_step(integrator)
+    r = _run(FAST, _plant(arm, cfg), [0.01], [0.0], _const_ref(1, steps, sub=sub))
     q, t = r.q[:, 0], np.arange(steps + 1) * 1e-3
     up = np.nonzero((q[:-1] < 0) & (q[1:] >= 0))[0]
     crossings = t[up] - q[up] * 1e-3 / (q[up + 1] - q[up])  # linear interpolation
@@ -133,7 +127,9 @@ def test_energy_conserved_without_damping(arm: Arm) -> None:
     free = _arm(arm.model)
     cfg = SimConfig(kp=np.zeros(2), kd=np.zeros(2), dt=2.5e-4, integrator="rk4")
     steps = 40_000  # 10 s
-    r = _run(FAST, _plant(free, cfg), [0.4, -0.3], [0.0, 0.0], _const_ref(2, steps, sub=2))
+    r = _run(
+        FAST, _plant(free, cfg), [0.4, -0.3], [0.0, 0.0], _const_ref(2, steps, sub=ro.RK4_ROWS)
+    )
     e0 = _energy(free.model, r.q[0], r.v[0])
     energies = [_energy(free.model, r.q[k], r.v[k]) for k in range(0, steps + 1, 1000)]
     # conservative double pendulum (chaotic, up to ~55 rad/s): total energy constant;
@@ -273,9 +269,9 @@ def test_divergence_is_reported_not_nan(arm: Arm, backend: str) -> None:
     assert err.cause and "nan" not in str(err).lower()
 
 
-@pytest.mark.skipif(native.load() is None, reason="run `make native`")
 @pytest.mark.parametrize("integrator", ["euler", "rk4"])
 def test_native_matches_python(arm: Arm, integrator: str) -> None:
+    require_native()
     text = (
         "joint_names: [arm_base_forearm_joint, forearm_hand_joint]\npoints:\n"
         " - {positions: [1.5707963267948966, 0.4], time_from_start: 0.5}\n"

@@ -88,6 +88,8 @@ def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
         err.print(f"warning: {w}", markup=False, highlight=False)
     with _LazyProgress(err) as progress:
         res = simjob.run(job, progress)
+    if res.notice:
+        err.print(f"note: {res.notice}", markup=False, highlight=False, soft_wrap=True)
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
     if output is not None:

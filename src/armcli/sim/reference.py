@@ -23,16 +23,24 @@ class Reference:
     coeffs: np.ndarray  # (S, 6, n) c0..c5 of q(tau) = sum c_k tau^k, tau = t - knots[s]
     final: np.ndarray  # (n,) position held after the last knot
 
-    def sample(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Reference positions and velocities at times `t`, each (len(t), n)."""
+    def sample(
+        self, t: np.ndarray, segment_time: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Reference positions and velocities at times `t`, each (len(t), n).
+
+        `segment_time` (same length) picks the polynomial piece evaluated at each `t`
+        (default: the piece holding `t`); a simulator step samples the piece of its
+        midpoint so that all its stages see one smooth function.
+        """
         t = np.asarray(t, dtype=float)
+        ts = t if segment_time is None else np.asarray(segment_time, dtype=float)
         n = self.final.shape[0]
         q = np.broadcast_to(self.final, (t.shape[0], n)).copy()
         v = np.zeros((t.shape[0], n))
         if self.coeffs.shape[0] == 0:
             return q, v
-        inside = t < self.knots[-1]
-        idx = np.clip(np.searchsorted(self.knots, t[inside], side="right") - 1, 0, None)
+        inside = ts < self.knots[-1]
+        idx = np.clip(np.searchsorted(self.knots, ts[inside], side="right") - 1, 0, None)
         tau = (t[inside] - self.knots[idx])[:, None]
         c = self.coeffs[idx]  # (T, 6, n)
         qi = c[:, 5]

@@ -57,6 +57,9 @@ def _settle(t: np.ndarray, e: np.ndarray, t_end: float, tol: float) -> float | N
     return max(0.0, float(start) - t_end)
 
 
+ENGINE_LABEL = {"native": "compiled (native)", "python": "Python"}
+
+
 def summary_table(
     metrics: Sequence[JointMetrics], ee: np.ndarray | None, ee_label: str, res: SimResult
 ) -> Any:
@@ -65,7 +68,8 @@ def summary_table(
     from rich.text import Text
 
     caption = (
-        f"{res.integrator}, dt = {res.dt:g} s, {len(res.t) - 1} steps, {res.backend} engine "
+        f"{res.integrator}, dt = {res.dt:g} s, {len(res.t) - 1} steps, "
+        f"{ENGINE_LABEL.get(res.backend, res.backend)} engine "
         f"({res.wall_time * 1e6 / max(1, len(res.t) - 1):.2f} µs/step)\n"
         f"errors q - q_ref [rad]; settle: time after the last point until |error| stays "
         f"< {SETTLE_TOL:g}"

@@ -1,4 +1,4 @@
-"""The simulator's step loop: PD motor, implicit damping, friction and joint stops.
+"""The simulator's rollout: PD motor, implicit damping, friction and joint stops.
 
 One step (semi-implicit Euler, the default) at state (q, v) and reference (q_ref, v_ref):
 
@@ -12,11 +12,17 @@ One step (semi-implicit Euler, the default) at state (q, v) and reference (q_ref
    subject to the stop bounds, by projected Gauss-Seidel. A joint at rest with a small
    torque stays exactly at rest (no chatter), and since v = 0 is feasible the projection
    never adds kinetic energy;
-4. q' = q + dt v', clamped to the limits against round-off.
+4. the motor torque over the whole step, tau - Kd (v' - v), must respect the effort limit
+   too: a joint whose implicit Kd would push it past the limit is saturated and the step
+   solved again, so the reported torque is the applied torque and never exceeds the limit;
+5. q' = q + dt v', clamped to the limits against round-off.
 
-RK4 integrates the smooth part (PD, gravity, damping) with the classic four stages, then
-applies the same projection. `native.py` runs the identical algorithm in C++; the Python
-loop here is the reference and the fallback.
+RK4 integrates the smooth part (PD, gravity, damping) with the classic four stages, all
+explicit, on reference samples from one polynomial piece per step (so a knot between
+steps does not cost the method its order), then applies the same projection.
+
+`stepper.py` holds the step in plain Python floats (the reference and the fallback);
+`_native/rollout.cpp` runs the identical algorithm compiled (`native.py`).
 """
 
 from __future__ import annotations
@@ -25,6 +31,25 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+
+from armcli.sim.fastloop import euler_loop, rk4_loop
+from armcli.sim.stepper import DAMPING as DAMPING
+from armcli.sim.stepper import EFFORT as EFFORT
+from armcli.sim.stepper import ENERGY_EVERY as ENERGY_EVERY
+from armcli.sim.stepper import FAIL_ENERGY as FAIL_ENERGY
+from armcli.sim.stepper import FAIL_NONE as FAIL_NONE
+from armcli.sim.stepper import FAIL_NONFINITE as FAIL_NONFINITE
+from armcli.sim.stepper import FAIL_VELOCITY as FAIL_VELOCITY
+from armcli.sim.stepper import FLAG_SATURATED as FLAG_SATURATED
+from armcli.sim.stepper import FLAG_STOP as FLAG_STOP
+from armcli.sim.stepper import FRICTION as FRICTION
+from armcli.sim.stepper import KD as KD
+from armcli.sim.stepper import KP as KP
+from armcli.sim.stepper import LOWER as LOWER
+from armcli.sim.stepper import PARAM_FIELDS as PARAM_FIELDS
+from armcli.sim.stepper import UPPER as UPPER
+from armcli.sim.stepper import VABORT as VABORT
+from armcli.sim.stepper import Stepper
 
 # Pinocchio joint model -> the joint code both engines use (revolute 0-3, prismatic 4-7).
 JOINT_TYPES = {
@@ -37,15 +62,7 @@ JOINT_TYPES = {
     "JointModelPZ": 6,
     "JointModelPrismaticUnaligned": 7,
 }
-
-PARAM_FIELDS = ("kp", "kd", "damping", "friction", "lower", "upper", "effort", "vabort")
-KP, KD, DAMPING, FRICTION, LOWER, UPPER, EFFORT, VABORT = range(len(PARAM_FIELDS))
-FAIL_NONE, FAIL_NONFINITE, FAIL_VELOCITY, FAIL_ENERGY = range(4)
-FLAG_SATURATED = 1
-FLAG_STOP = 2
-PGS_MAX_ITERS = 200
-PGS_TOL = 1e-14
-ENERGY_EVERY = 100  # steps between kinetic-energy checks
+RK4_ROWS = 3  # reference rows per RK4 step: t, t + dt/2, t + dt (one polynomial piece)
 
 
 @dataclass(frozen=True)
@@ -73,158 +90,45 @@ class Rollout:
     fail_code: int
 
 
-class _Stepper:
-    """The Python reference step; mirrors `_native/rollout.cpp` line by line."""
+def rows_per_step(integrator: str) -> int:
+    """Reference rows one step consumes.
 
-    def __init__(self, plant: Plant) -> None:
-        import pinocchio as pin
+    [q_ref, v_ref] at t (Euler) or at t, t + dt/2, t + dt (RK4). A reference for N steps
+    has N * rows + 1 rows (the last: t = N dt).
+    """
+    return RK4_ROWS if integrator == "rk4" else 1
 
-        self.pin = pin
-        self.model = plant.model.copy()
-        self.model.armature = np.zeros(self.model.nv)  # URDF has no rotor inertia; C++ too
-        self.data = self.model.createData()
-        self.p = plant.params
-        self.n = self.model.nv
-        self.dt = plant.dt
-        self.gc = plant.gravity_comp
-        self.sat = np.zeros(self.n, dtype=bool)
-        self.lo = np.full(self.n, -np.inf)
-        self.hi = np.full(self.n, np.inf)
-        self.vstar = np.zeros(self.n)
 
-    def motor(self, q: np.ndarray, v: np.ndarray, qr: np.ndarray, vr: np.ndarray) -> np.ndarray:
-        p = self.p
-        t = p[:, KP] * (qr - q) + p[:, KD] * (vr - v)
-        if self.gc:
-            t = t + self.pin.computeGeneralizedGravity(self.model, self.data, q)
-        self.sat = np.abs(t) > p[:, EFFORT]
-        out: np.ndarray = np.where(self.sat, np.copysign(p[:, EFFORT], t), t)
-        return out
-
-    def project(
-        self, q: np.ndarray, vs: np.ndarray, qp: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
-        p, dt, n = self.p, self.dt, self.n
-        self.hi = np.where(qp > p[:, UPPER], vs + (p[:, UPPER] - qp) / dt, np.inf)
-        self.lo = np.where(qp < p[:, LOWER], vs + (p[:, LOWER] - qp) / dt, -np.inf)
-        if not (
-            np.any(p[:, FRICTION] > 0) or np.isfinite(self.hi).any() or np.isfinite(self.lo).any()
-        ):
-            return vs.copy(), qp.copy()
-        A = self.pin.computeMinverse(self.model, self.data, q)
-        Al = A.tolist()
-        for i in range(n):  # only the upper triangle is guaranteed
-            for j in range(i):
-                Al[i][j] = Al[j][i]
-        vl, lo, hi, fr = vs.tolist(), self.lo.tolist(), self.hi.tolist(), p[:, FRICTION].tolist()
-        lam = [0.0] * n
-        for _ in range(PGS_MAX_ITERS):
-            change = scale = 0.0
-            for i in range(n):
-                Ai = Al[i]
-                w = vl[i]
-                for j in range(n):
-                    w += Ai[j] * lam[j]
-                w -= Ai[i] * lam[i]
-                thr = Ai[i] * dt * fr[i]
-                u = w - thr if w > thr else (w + thr if w < -thr else 0.0)
-                u = min(max(u, lo[i]), hi[i])
-                li = (u - w) / Ai[i]
-                change = max(change, abs(li - lam[i]))
-                lam[i] = li
-                scale = max(scale, abs(li))
-            if change <= PGS_TOL * (1.0 + scale):
-                break
-        dv = np.array([_dot(Al[i], lam) for i in range(n)])
-        return vs + dv, qp + dt * dv
-
-    def clamp(self, q: np.ndarray) -> np.ndarray:
-        out: np.ndarray = np.minimum(np.maximum(q, self.p[:, LOWER]), self.p[:, UPPER])
-        return out
-
-    def euler(self, q: np.ndarray, v: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, ...]:
-        p, dt, n = self.p, self.dt, self.n
-        tau_pd = self.motor(q, v, r[:n], r[n:])
-        b = p[:, DAMPING] + np.where(self.sat, 0.0, p[:, KD])
-        self.model.armature = dt * b
-        a = self.pin.aba(self.model, self.data, q, v, tau_pd - p[:, DAMPING] * v)
-        self.vstar = v + dt * a
-        vn, qn = self.project(q, self.vstar, q + dt * self.vstar)
-        qn = self.clamp(qn)
-        tau = np.where(self.sat, tau_pd, tau_pd - p[:, KD] * (vn - v))
-        return qn, vn, tau
-
-    def accel(self, q: np.ndarray, v: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        n = self.n
-        tau = self.motor(q, v, r[:n], r[n:])
-        a = self.pin.aba(self.model, self.data, q, v, tau - self.p[:, DAMPING] * v).copy()
-        return a, tau
-
-    def rk4(self, q: np.ndarray, v: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, ...]:
-        """r: three reference rows at t, t + dt/2, t + dt."""
-        dt = self.dt
-        k1v, tau = self.accel(q, v, r[0])
-        sat1 = self.sat
-        k1q = v
-        k2q = v + 0.5 * dt * k1v
-        k2v, _ = self.accel(q + 0.5 * dt * k1q, k2q, r[1])
-        k3q = v + 0.5 * dt * k2v
-        k3v, _ = self.accel(q + 0.5 * dt * k2q, k3q, r[1])
-        k4q = v + dt * k3v
-        k4v, _ = self.accel(q + dt * k3q, k4q, r[2])
-        self.vstar = v + (dt / 6.0) * (k1v + 2.0 * k2v + 2.0 * k3v + k4v)
-        qpred = q + (dt / 6.0) * (k1q + 2.0 * k2q + 2.0 * k3q + k4q)
-        self.sat = sat1
-        vn, qn = self.project(q, self.vstar, qpred)
-        return self.clamp(qn), vn, tau
+def steps_of(plant: Plant, ref: np.ndarray) -> int:
+    """How many steps the reference table `ref` drives."""
+    return int((ref.shape[0] - 1) // rows_per_step(plant.integrator))
 
 
 def rollout_python(plant: Plant, q0: np.ndarray, v0: np.ndarray, ref: np.ndarray) -> Rollout:
-    """Reference implementation of the rollout; the compiled `_native` one does the same.
-
-    `ref` rows are [q_ref, v_ref] at t = k dt (Euler, steps + 1 rows) or k dt/2 (RK4,
-    2 steps + 1 rows).
-    """
-    s = _Stepper(plant)
+    """Reference implementation and fallback of `native.rollout` (same contract)."""
+    s = Stepper(plant.model, plant.params, plant.gravity_comp, plant.dt)
     n = s.n
-    steps = (ref.shape[0] - 1) // (2 if plant.integrator == "rk4" else 1)
-    Q = np.full((steps + 1, n), np.nan)
-    V = np.full((steps + 1, n), np.nan)
-    T = np.full((steps, n), np.nan)
+    steps = steps_of(plant, ref)
+    table = np.asarray(ref, dtype=float)
+    q, v = [float(x) for x in q0], [float(x) for x in v0]
+    if plant.integrator == "rk4":  # the reference, sampled once, as Python floats
+        rec = rk4_loop(s, q, v, table[: RK4_ROWS * steps].tolist(), plant.energy_max)
+    else:
+        Rq, Rv = table[:steps, :n].tolist(), table[:steps, n:].tolist()
+        rec = euler_loop(s, q, v, Rq, Rv, plant.energy_max)
     F = np.zeros((steps, n), dtype=np.uint8)
-    q, v = np.array(q0, dtype=float), np.array(v0, dtype=float)
-    Q[0], V[0] = q, v
-    vabort = plant.params[:, VABORT]
-    for k in range(steps):
-        if plant.integrator == "rk4":
-            q, v, T[k] = s.rk4(q, v, ref[2 * k : 2 * k + 3])
-        else:
-            q, v, T[k] = s.euler(q, v, ref[k])
-        F[k] = s.sat * FLAG_SATURATED | (np.isfinite(s.lo) | np.isfinite(s.hi)) * FLAG_STOP
-        Q[k + 1], V[k + 1] = q, v
-        code, joint = _check(q, v, vabort)
-        if code == FAIL_NONE and (k + 1) % ENERGY_EVERY == 0:
-            s.model.armature = np.zeros(n)
-            ke = s.pin.computeKineticEnergy(s.model, s.data, q, v)
-            if not ke <= plant.energy_max:
-                code = FAIL_ENERGY
-        if code != FAIL_NONE:
-            return Rollout(Q, V, T, F, k + 1, joint, code)
-    return Rollout(Q, V, T, F, -1, -1, FAIL_NONE)
-
-
-def _check(q: np.ndarray, v: np.ndarray, vabort: np.ndarray) -> tuple[int, int]:
-    for i in range(q.shape[0]):
-        if not (np.isfinite(q[i]) and np.isfinite(v[i])):
-            return FAIL_NONFINITE, i
-        if abs(v[i]) > vabort[i]:
-            return FAIL_VELOCITY, i
-    return FAIL_NONE, -1
-
-
-def _dot(a: list[float], b: list[float]) -> float:
-    """Left-to-right sum, the same rounding as the C++ loop."""
-    out = 0.0
-    for x, y in zip(a, b, strict=True):
-        out += x * y
-    return out
+    for k, row in rec.flagged:
+        F[k] = row
+    Q = np.full((steps + 1) * n, np.nan)
+    V = np.full((steps + 1) * n, np.nan)
+    T = np.full(steps * n, np.nan)
+    Q[: len(rec.q)], V[: len(rec.v)], T[: len(rec.tau)] = rec.q, rec.v, rec.tau
+    return Rollout(
+        Q.reshape(-1, n),
+        V.reshape(-1, n),
+        T.reshape(-1, n),
+        F,
+        rec.fail_step,
+        rec.fail_joint,
+        rec.fail_code,
+    )

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -29,7 +29,9 @@ from armcli.sim import stability as stab
 
 VEL_ABORT_FACTOR = 10.0  # divergence when |v| exceeds this times the URDF velocity limit
 DEFAULT_VABORT = 1000.0  # [rad/s or m/s] when the URDF gives no velocity limit
-CHUNK_STEPS = {"native": 20_000, "python": 500}  # steps per call, for the progress bar
+# Steps per rollout call, for the progress bar; the same for both engines, since each call
+# starts the friction solver's warm start afresh.
+CHUNK_STEPS = {"native": 5_000, "python": 5_000}
 
 
 @dataclass(frozen=True)
@@ -73,8 +75,9 @@ class SimResult:
     stop_active: np.ndarray  # (N, n) bool: a joint-stop constraint acted in the step
     dt: float
     integrator: str
-    backend: str
+    backend: str  # the engine that ran: "native" (compiled) or "python"
     wall_time: float  # [s] spent in the rollout
+    notice: str | None = None  # why `auto` fell back to the Python engine
 
 
 def arm_from_model(model: Any, joints: Sequence[str] | None = None) -> Arm:
@@ -168,20 +171,25 @@ def simulate(
     plant = ro.Plant(
         arm.model, params, cfg.gravity_comp, cfg.dt, cfg.integrator, _energy_max(arm, q0, params)
     )
-    sub = 2 if cfg.integrator == "rk4" else 1
-    t_ref = np.arange(sub * steps + 1) * (cfg.dt / sub)
-    q_ref, v_ref = reference.sample(t_ref)
-    ref = np.ascontiguousarray(np.hstack([q_ref, v_ref]))
-    lib = native.load() if cfg.backend in ("auto", "native") else None
-    if cfg.backend == "native" and lib is None:
-        raise InputError(
-            f"the compiled simulator is not built ({native.why_missing()}); run `make native`"
-        )
-    run = (lambda *a: native.rollout(lib, *a)) if lib is not None else ro.rollout_python
+    sub = ro.rows_per_step(cfg.integrator)
+    ref, q_ref, v_ref = sample_reference(reference, steps, cfg.dt, cfg.integrator)
+    mod = native.load() if cfg.backend in ("auto", "native") else None
+    if cfg.backend == "native" and mod is None:
+        raise InputError(f"the compiled simulator is unavailable: {native.why_missing()}")
+    notice = None
+    if cfg.backend == "auto" and mod is None:
+        notice = f"compiled engine unavailable ({native.why_missing()}); using the Python loop"
+    compiled = native.compiled_model(mod, arm.model) if mod is not None else None
+
+    def run(p: ro.Plant, q: np.ndarray, v: np.ndarray, r: np.ndarray) -> ro.Rollout:
+        if mod is None:
+            return ro.rollout_python(p, q, v, r)
+        return native.rollout_batch(mod, [native.Job(p, q, v, r, compiled)])[0]
+
     parts: list[ro.Rollout] = []
     q, v = np.array(q0, dtype=float), np.zeros(len(q0))
     start = time.perf_counter()
-    chunk = CHUNK_STEPS["native" if lib is not None else "python"]
+    chunk = CHUNK_STEPS[native.engine_name(mod)]
     for k0 in range(0, steps, chunk):
         k1 = min(steps, k0 + chunk)
         r = run(plant, q, v, ref[sub * k0 : sub * k1 + 1])
@@ -192,8 +200,29 @@ def simulate(
         if progress is not None:
             progress(k1, steps)
     wall = time.perf_counter() - start
-    backend = "native" if lib is not None else "python"
-    return _result(arm, cfg, parts, q_ref[::sub], v_ref[::sub], backend, wall)
+    res = _result(arm, cfg, parts, q_ref, v_ref, native.engine_name(mod), wall)
+    return replace(res, notice=notice)
+
+
+def sample_reference(
+    reference: Any, steps: int, dt: float, integrator: str
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The rollout's reference table, sampled once, and q_ref, v_ref at the step times.
+
+    RK4 gets three rows per step (t, t + dt/2, t + dt) from the polynomial piece holding
+    the step's midpoint: at a knot the step's last stage sees the left limit of the
+    segment it integrates, not the next segment's velocity, which would cost RK4 its order.
+    """
+    t = np.arange(steps + 1) * dt
+    q_ref, v_ref = reference.sample(t)
+    if integrator != "rk4":
+        return np.ascontiguousarray(np.hstack([q_ref, v_ref])), q_ref, v_ref
+    offsets = np.array([0.0, 0.5, 1.0]) * dt
+    ts = (t[:-1, None] + offsets).reshape(-1)
+    mids = np.repeat(t[:-1] + 0.5 * dt, ro.RK4_ROWS)
+    qs, vs = reference.sample(ts, segment_time=mids)
+    table = np.vstack([np.hstack([qs, vs]), np.hstack([q_ref[-1:], v_ref[-1:]])])
+    return np.ascontiguousarray(table), q_ref, v_ref
 
 
 def _result(

@@ -3,8 +3,8 @@
 The work is `evaluate.evaluate_candidates` on chunks of the batch; backends only decide
 where the chunks run, and results come back in batch order:
 
-- `LocalEngine(jobs)`: a thread pool with one chunk per thread. The compiled rollout is
-  called through ctypes, which releases the GIL, so threads run rollouts on separate cores;
+- `LocalEngine(jobs)`: a thread pool with one chunk per thread. The compiled rollout
+  (the armcli.sim._rollout extension) releases the GIL, so threads run rollouts on separate cores;
 - `DaskEngine(address)`: an existing `dask.distributed` scheduler (`dask scheduler` /
   `dask worker`, or dask-jobqueue / dask-kubernetes clusters, which expose the same
   address). The problem is broadcast once; each candidate is one task.

@@ -7,8 +7,8 @@ is cut into chunks does not change any result, since every rollout is independen
 
 `rollout_batch` is the single place that runs the simulator: all rollouts of a chunk
 (candidates x models x cases) in one call. Today it loops over `sim.simulate` (the
-compiled rollout through ctypes, which releases the GIL; else the Python loop); a batch
-rollout extension replaces that one function.
+compiled rollout, which releases the GIL; else the Python loop); `sim.native.rollout_batch`
+(plants and gain sets on threads) can replace that one function.
 """
 
 from __future__ import annotations
