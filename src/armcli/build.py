@@ -15,6 +15,7 @@ from pathlib import Path
 
 from armcli.errors import BuildError, StaleBuildError
 from armcli.fsio import write_tree_atomic
+from armcli.outdir import resolve_output_dir
 from armcli.spec import RobotSpec, load_spec
 from armcli.xacro_writer import top_level_files, xacro_files
 
@@ -74,12 +75,13 @@ def spec_label(spec_path: Path) -> str:
     return spec_path.name
 
 
-def build(spec_path: str | Path, out_dir: str | Path) -> BuildResult:
-    """Build the spec into `out_dir` all-or-nothing."""
+def build(spec_path: str | Path, out_dir: str | Path, *, force: bool = False) -> BuildResult:
+    """Build the spec into `out_dir` all-or-nothing (`force`: into a foreign non-empty dir)."""
     path = Path(spec_path)
+    resolve_output_dir(out_dir, force=force)  # refuse before the work, again when writing
     spec = load_spec(path)
     files = build_files(spec, spec_label(path))
-    written = write_tree_atomic(out_dir, files)
+    written = write_tree_atomic(out_dir, files, force=force)
     return BuildResult(spec=spec, out_dir=Path(out_dir), files=tuple(written))
 
 

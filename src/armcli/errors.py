@@ -82,6 +82,10 @@ class XacroRefusedError(InputError):
     """A foreign xacro file would run code from the file; refused without --trust-xacro."""
 
 
+class OutputRefusedError(InputError):
+    """An output path armcli will not write (root, home, foreign non-empty directory, ...)."""
+
+
 class BuildError(ArmcliError):
     """Generating or expanding robot description files failed."""
 

@@ -29,6 +29,7 @@ from armcli.collision_matrix import (
 from armcli.errors import InputError
 from armcli.fsio import write_tree_atomic
 from armcli.launch_writer import render
+from armcli.outdir import resolve_output_dir
 from armcli.ros2_control_writer import moveit_urdf_xacro, ros2_control_xacro
 from armcli.rviz_config import display_rviz, moveit_rviz
 from armcli.spec import RobotSpec, load_spec
@@ -281,11 +282,13 @@ def write_ros_packages(
     samples: int = DEFAULT_SAMPLES,
     seed: int = DEFAULT_SEED,
     info: PackageInfo = PackageInfo(),
+    force: bool = False,
 ) -> tuple[RosPackages, list[Path]]:
     """Load the spec, build the packages in memory, then write them in one atomic swap."""
     path = Path(spec_path)
+    resolve_output_dir(out_dir, force=force)  # refuse before the collision sampling
     spec = load_spec(path)
     pkgs = ros_packages(
         spec, label=label or path.name, samples=samples, seed=seed, info=info, source=str(path)
     )
-    return pkgs, write_tree_atomic(out_dir, pkgs.files)
+    return pkgs, write_tree_atomic(out_dir, pkgs.files, force=force)

@@ -22,6 +22,9 @@ def ros_package_cmd(
     maintainer: str = typer.Option("armcli", "--maintainer", help="package.xml maintainer."),
     email: str = typer.Option("armcli@example.com", "--email", help="Maintainer e-mail."),
     license_: str = typer.Option("TODO", "--license", help="package.xml license."),
+    force: bool = typer.Option(
+        False, "--force", help="Write into an existing non-empty directory armcli did not create."
+    ),
 ) -> None:
     """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
     from armcli.build import spec_label
@@ -29,7 +32,7 @@ def ros_package_cmd(
 
     info = PackageInfo(maintainer=maintainer, email=email, license=license_)
     pkgs, written = write_ros_packages(
-        spec, out, label=spec_label(spec), samples=samples, seed=seed, info=info
+        spec, out, label=spec_label(spec), samples=samples, seed=seed, info=info, force=force
     )
     n, m = pkgs.names, pkgs.matrix
     counts = {r: sum(d.reason == r for d in m.disabled) for r in ("Adjacent", "Default", "Never")}

@@ -73,8 +73,13 @@ def simulate_cmd(
         raise InputError(
             f"unknown engine {engine!r}; valid: auto, native, python", field="--engine"
         )
+    from armcli.outdir import check_output_file
+
     if output is not None:
         simreport.output_format(output)
+        check_output_file(output, "--output")
+    if plot is not None:
+        check_output_file(plot, "--plot")
     spec_obj = load_spec(spec or DEFAULT_SPEC) if (spec is not None or urdf is None) else None
     job = simjob.prepare(
         spec=spec_obj,

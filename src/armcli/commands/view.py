@@ -130,8 +130,10 @@ def render_cmd(
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
+    from armcli.outdir import check_output_file
     from armcli.render import load_urdf, render_png
 
+    check_output_file(out, "--out")
     src = load_robot(robot, trust_xacro)
     values = _pose_q(src, pose, q)
     width, height = _size(size)
@@ -164,6 +166,10 @@ def tree_cmd(
 
     if fmt not in ("text", "dot"):
         raise InputError(f"unknown format {fmt!r}; known: text, dot", field="--format")
+    if out is not None:
+        from armcli.outdir import check_output_file
+
+        check_output_file(out, "--out")
     src = load_robot(robot, trust_xacro)
     tree = parse_tree(src.xml, src.source)
     if fmt == "dot":
