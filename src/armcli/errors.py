@@ -16,10 +16,16 @@ EXIT_FAILED = 1
 EXIT_UNUSABLE = 2
 
 
+EXPANDED_TAG = "#expanded"  # source suffix of a xacro file's expansion (robot_source)
+
+
 def _where(file: str | Path | None, line: int | None) -> str:
     if file is None:
         return ""
-    return f"{file}:{line}" if line else f"{file}"
+    text = str(file)
+    if line and text.endswith(EXPANDED_TAG):  # the line is in the expansion, not the xacro
+        return f"{text[: -len(EXPANDED_TAG)]} (line {line} of its xacro expansion)"
+    return f"{text}:{line}" if line else text
 
 
 class ArmcliError(Exception):

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from armcli.errors import InputError, XacroRefusedError
+from armcli.errors import EXPANDED_TAG, InputError, XacroRefusedError
 
 if TYPE_CHECKING:
     from armcli.model import LoadedModel
@@ -90,7 +90,7 @@ def read_urdf_file(path: Path, *, trust_xacro: bool = False) -> Urdf:
         raise XacroRefusedError(XACRO_REFUSED, file=path)
     from armcli.xacro_sandbox import expand_untrusted
 
-    return parse_urdf(expand_untrusted(path), f"{path}#expanded")
+    return parse_urdf(expand_untrusted(path), f"{path}{EXPANDED_TAG}")
 
 
 def load_checked_model(path: Path, *, trust_xacro: bool = False) -> LoadedModel:

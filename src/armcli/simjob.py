@@ -20,6 +20,7 @@ from armcli.trajectory import Trajectory, load_trajectory, loads_trajectory
 
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
 ARM_URDF = "standalone_arm.urdf"
+RATE_SLACK = 1e-9  # relative: --rate 1000 with dt 0.001 is exactly one sample per step
 MAX_STEPS = 2_000_000  # ~200 MB of recorded states for a 2-joint arm
 
 
@@ -193,8 +194,12 @@ def prepare(
         )
     jsp = spec.arm.joint_state_publisher if spec is not None else None
     rate = rate if rate is not None else (jsp.update_rate if jsp is not None else 10.0)
-    if not (np.isfinite(rate) and rate > 0):
-        raise InputError(f"must be > 0 Hz, got {rate:g}", field="--rate")
+    if not (np.isfinite(rate) and 0 < rate <= (1.0 + RATE_SLACK) / dt):
+        raise InputError(
+            f"must be in (0, 1/dt = {1.0 / dt:g}] Hz (one state per time step at most), "
+            f"got {rate:g}",
+            field="--rate",
+        )
     fid, off, label = _tool(arm, spec)
     frame, T_frame_root = _report_frame(arm, spec)
     label = f"{label} in {frame}"

@@ -15,6 +15,7 @@ from pathlib import Path
 from lxml import etree
 
 from armcli.errors import InputError, XacroRefusedError
+from armcli.userfile import read_regular
 from armcli.urdfdoc import (
     ZERO3,
     Geometry,
@@ -329,12 +330,5 @@ def parse_urdf(data: bytes, source: str) -> Urdf:
 def read_urdf(path: str | Path) -> Urdf:
     """Read and parse a URDF file with the size cap applied before reading it all."""
     p = Path(path)
-    try:
-        size = p.stat().st_size
-        if size > MAX_URDF_BYTES:
-            raise InputError(f"file is larger than {MAX_URDF_BYTES} bytes", file=p)
-        with p.open("rb") as fh:  # capped: /dev/zero or a pipe report no size
-            data = fh.read(MAX_URDF_BYTES + 1)
-    except OSError as exc:
-        raise InputError(f"cannot read: {exc.strerror}", file=p) from None
+    data = read_regular(p, max_bytes=MAX_URDF_BYTES, what="URDF file")
     return parse_urdf(data, str(p))

@@ -18,6 +18,7 @@ import sys
 from pathlib import Path
 
 from armcli.errors import InputError
+from armcli.userfile import check_regular
 
 XACRO_TIMEOUT = 20.0  # wall clock [s]
 XACRO_CPU_SECONDS = 20
@@ -61,8 +62,7 @@ def expand_untrusted(
 ) -> bytes:
     """The expanded URDF bytes of a user-trusted xacro file; InputError if expansion fails."""
     p = Path(path)
-    if not p.is_file():
-        raise InputError("no such file", file=p)
+    check_regular(p, "xacro file")
     args = [f"{k}:={v}" for k, v in (mappings or {}).items()]
     env = {"PATH": os.defpath, "LANG": "C.UTF-8"}
     if "ROS_PACKAGE_PATH" in os.environ:  # $(find pkg) lookups, the ROS convention

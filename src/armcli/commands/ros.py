@@ -10,15 +10,22 @@ import typer
 from armcli.defaults import DEFAULT_SPEC
 
 DEFAULT_SAMPLES = 10_000  # keep equal to armcli.collision_matrix.DEFAULT_SAMPLES (lazy import)
+MAX_SAMPLES = 1_000_000  # ~100x the default: minutes of coal queries, not days
 
 
 def ros_package_cmd(
     spec: Path = typer.Argument(DEFAULT_SPEC, help="Robot spec YAML."),
     out: Path = typer.Option(Path("ros"), "-o", "--out", help="Output directory."),
     samples: int = typer.Option(
-        DEFAULT_SAMPLES, "--samples", min=1, help="Random states for the collision matrix."
+        DEFAULT_SAMPLES,
+        "--samples",
+        min=1,
+        max=MAX_SAMPLES,
+        help="Random states for the collision matrix.",
     ),
-    seed: int = typer.Option(0, "--seed", help="Seed of the collision-matrix sampling."),
+    seed: int = typer.Option(
+        0, "--seed", min=0, max=2**32 - 1, help="Seed of the collision-matrix sampling."
+    ),
     maintainer: str = typer.Option("armcli", "--maintainer", help="package.xml maintainer."),
     email: str = typer.Option("armcli@example.com", "--email", help="Maintainer e-mail."),
     license_: str = typer.Option("TODO", "--license", help="package.xml license."),
