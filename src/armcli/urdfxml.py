@@ -15,7 +15,6 @@ from pathlib import Path
 from lxml import etree
 
 from armcli.errors import InputError, XacroRefusedError
-from armcli.userfile import read_regular
 from armcli.urdfdoc import (
     ZERO3,
     Geometry,
@@ -29,6 +28,7 @@ from armcli.urdfdoc import (
     Shape,
     Urdf,
 )
+from armcli.userfile import read_regular
 
 MAX_URDF_BYTES = 10_000_000
 MAX_URDF_DEPTH = 32
