@@ -92,6 +92,32 @@ class OutputRefusedError(InputError):
     """An output path armcli will not write (root, home, foreign non-empty directory, ...)."""
 
 
+@dataclass(frozen=True)
+class RuleViolation:
+    """An error finding of `check` (rule id, where, what) carried by ModelRefusedError."""
+
+    rule: str
+    file: str
+    line: int | None
+    message: str
+
+
+class ModelRefusedError(InputError):
+    """`check` reports errors for a model another command was asked to use; one line each."""
+
+    def __init__(self, source: str, violations: Sequence[RuleViolation]) -> None:
+        self.source = source
+        self.violations = list(violations)
+        first = self.violations[0]
+        super().__init__(f"[{first.rule}] {first.message}", file=first.file, line=first.line)
+
+    def lines(self) -> list[str]:
+        out = [f"{_where(v.file, v.line)}: [{v.rule}] {v.message}" for v in self.violations]
+        n = len(self.violations)
+        out.append(f"{self.source}: `armcli check` reports {n} error(s); the model is refused")
+        return out
+
+
 class BuildError(ArmcliError):
     """Generating or expanding robot description files failed."""
 

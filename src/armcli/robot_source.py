@@ -12,7 +12,7 @@ inside the allowed roots, so a hostile URDF cannot make armcli read
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -93,7 +93,9 @@ def read_urdf_file(path: Path, *, trust_xacro: bool = False) -> Urdf:
     return parse_urdf(expand_untrusted(path), f"{path}{EXPANDED_TAG}")
 
 
-def load_checked_model(path: Path, *, trust_xacro: bool = False) -> LoadedModel:
+def load_checked_model(
+    path: Path, *, trust_xacro: bool = False, gate: Callable[[Urdf], None] | None = None
+) -> LoadedModel:
     """A URDF/xacro file -> Pinocchio model, refusing what Pinocchio would silently accept.
 
     For commands that compute with the model (simulate --urdf): a malformed or
@@ -106,6 +108,8 @@ def load_checked_model(path: Path, *, trust_xacro: bool = False) -> LoadedModel:
     if urdf.problems:
         p = urdf.problems[0]
         raise InputError(f"{p.where}: {_PROBLEM[p.kind]} {p.text!r}", file=urdf.source, line=p.line)
+    if gate is not None:  # e.g. check_gate.refuse_check_errors, passed in by the command
+        gate(urdf)
     loaded = load_model(urdf.source, xml=urdf_text(urdf))
     said = [m for m in parser_problems(loaded.parser_messages) if "error" in m.lower()]
     if said:

@@ -9,7 +9,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -17,6 +17,9 @@ from armcli.errors import InputError
 from armcli.interpolation import Reference, build_reference
 from armcli.sim import Arm, SimConfig, SimResult, arm_from_model, check_stability, simulate
 from armcli.trajectory import Trajectory, load_trajectory, loads_trajectory
+
+if TYPE_CHECKING:
+    from armcli.urdfdoc import Urdf
 
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
 ARM_URDF = "standalone_arm.urdf"
@@ -45,6 +48,7 @@ def load_arm(
     joints: Sequence[str] | None,
     *,
     trust_xacro: bool = False,
+    gate: Callable[[Urdf], None] | None = None,
 ) -> Arm:
     """The simulated arm: the spec's standalone arm built in memory, or a given URDF.
 
@@ -57,7 +61,8 @@ def load_arm(
     if urdf is not None:
         from armcli.robot_source import load_checked_model
 
-        return arm_from_model(load_checked_model(urdf, trust_xacro=trust_xacro).model, joints)
+        loaded = load_checked_model(urdf, trust_xacro=trust_xacro, gate=gate)
+        return arm_from_model(loaded.model, joints)
     from armcli.build import expand_urdfs
 
     if spec is None:
@@ -149,6 +154,7 @@ def prepare(
     rate: float | None = None,
     backend: str = "auto",
     trust_xacro: bool = False,
+    gate: Callable[[Urdf], None] | None = None,
 ) -> SimJob:
     """Validate every input and assemble the run; raises InputError on bad input."""
     if (trajectory is None) == (message is None):
@@ -162,7 +168,7 @@ def prepare(
     dt = dt if dt is not None else (spec.control.dt if spec is not None else 0.001)
     if not (np.isfinite(dt) and 0 < dt <= 0.1):
         raise InputError(f"must be in (0, 0.1] s, got {dt:g}", field="--dt")
-    arm = load_arm(spec, urdf, joints, trust_xacro=trust_xacro)
+    arm = load_arm(spec, urdf, joints, trust_xacro=trust_xacro, gate=gate)
     limits = {
         n: (float(lo), float(hi))
         for n, lo, hi in zip(arm.joint_names, arm.lower, arm.upper, strict=True)

@@ -66,6 +66,7 @@ def simulate_cmd(
     from rich.console import Console
 
     from armcli import simjob, simreport
+    from armcli.check_gate import refuse_check_errors
     from armcli.errors import InputError
     from armcli.spec import load_spec
 
@@ -97,6 +98,7 @@ def simulate_cmd(
         rate=rate,
         backend=engine,
         trust_xacro=trust_xacro,
+        gate=refuse_check_errors,  # a model `check` reports as an error is not simulated
     )
     err = Console(stderr=True)
     for w in job.trajectory.warnings:
