@@ -2,8 +2,8 @@
 
 Package lookup order: `--package-dir NAME=PATH`, then ROS_PACKAGE_PATH-style
 search paths (each entry is a package or holds packages as subdirectories),
-then an ancestor directory of the URDF named NAME (the usual
-`NAME/urdf/robot.urdf` layout).
+then an ancestor directory of the URDF named NAME whose package.xml names NAME
+(the usual `NAME/urdf/robot.urdf` layout).
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ from pathlib import Path
 from urllib.parse import unquote, urlparse
 
 from armcli.checks import CheckOptions, Collector
+from armcli.mesh_confine import is_package
 from armcli.urdfdoc import Urdf
 
 
@@ -31,8 +32,8 @@ def package_root(name: str, urdf_path: Path, opts: CheckOptions) -> Path | None:
             return base
         if (base / name).is_dir():
             return base / name
-    for parent in urdf_path.resolve().parents:
-        if parent.name == name:
+    for parent in urdf_path.resolve().parents:  # a folder's name alone is not a package
+        if parent.name == name and is_package(parent, name):
             return parent
     return None
 

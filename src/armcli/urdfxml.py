@@ -38,6 +38,7 @@ MAX_URDF_DEPTH = 32
 # example-robot-data has 130 links and 101 DoF (tiago_dual).
 MAX_URDF_LINKS = 300
 MAX_URDF_DOF = 128
+MAX_URDF_COLLISIONS = 1000  # example-robot-data: at most 113 per robot
 _DOF = {"revolute": 1, "continuous": 1, "prismatic": 1, "planar": 3, "floating": 6}
 
 
@@ -308,6 +309,14 @@ def _check_size(root: etree._Element, source: str) -> None:
             f"more than {MAX_URDF_LINKS} links ({len(links)}); armcli's bound on robot size",
             file=source,
             line=_ln(links[MAX_URDF_LINKS]),
+        )
+    shapes = root.findall("link/collision")
+    if len(shapes) > MAX_URDF_COLLISIONS:  # pairs grow with the square: 10000 shapes hung check
+        raise InputError(
+            f"more than {MAX_URDF_COLLISIONS} collision shapes ({len(shapes)}); "
+            "armcli's bound on robot size",
+            file=source,
+            line=_ln(shapes[MAX_URDF_COLLISIONS]),
         )
     dof = sum(_DOF.get(str(j.get("type")), 0) for j in root.findall("joint"))
     if dof > MAX_URDF_DOF:
