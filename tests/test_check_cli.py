@@ -105,7 +105,7 @@ def test_trusted_xacro_is_expanded_in_a_sandbox() -> None:
 @pytest.mark.parametrize(
     ("content", "message"),
     [
-        (None, "cannot read"),
+        (None, "URDF file not found"),
         ("<robot><link", "not well-formed"),
         ('<!DOCTYPE r [<!ENTITY a "b">]><robot name="r"/>', "DOCTYPE"),
     ],
