@@ -80,18 +80,18 @@ def test_error_finding_exits_1_with_github_annotation(tmp_path: Path) -> None:
     assert line.startswith(f"::error file={path},line={mass_line},title=armcli mass-nonpositive::")
 
 
-def test_foreign_xacro_is_refused_without_running_it(tmp_path: Path) -> None:
+def test_foreign_xacro_code_is_refused_without_running_it(tmp_path: Path) -> None:
     marker = tmp_path / "pwned"
     evil = tmp_path / "evil.urdf.xacro"
     evil.write_text(
         '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
         f"<xacro:property name=\"x\" value=\"${{__import__('os').system('touch {marker}')}}\"/>"
-        '<link name="a"/></robot>'
+        '<link name="${x}"/></robot>'
     )
     r = armcli("check", evil)
     assert r.returncode == 2
     assert r.stdout == ""
-    assert "--trust-xacro" in r.stderr and "runs Python" in r.stderr
+    assert "name '__import__' is not allowed" in r.stderr and "--trust-xacro" in r.stderr
     assert not marker.exists()
 
 

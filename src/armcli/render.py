@@ -201,7 +201,6 @@ def posed_triangles(urdf: Any, q: Mapping[str, float]) -> tuple[np.ndarray, np.n
             raise InputError(
                 f"more than {MAX_RENDER_TRIANGLES:,} triangles to draw; armcli's render bound "
                 "(simplify the visual meshes)",
-
             )
         normals = np.asarray(mesh.face_normals)
         light = AMBIENT + (1 - AMBIENT) * np.clip(normals @ (LIGHT / np.linalg.norm(LIGHT)), 0, 1)

@@ -3,9 +3,9 @@
 A path given to `check`, `view`, `render`, `tree` (and `simulate --urdf`) is one
 of: a spec YAML (built in memory, nothing written), a URDF (read by urdfxml's
 strict reader) or a xacro file. Xacro runs Python from the file, so a foreign
-one is refused unless the user passes `--trust-xacro`, and then expanded in
-xacro_sandbox's resource-limited child process. Mesh URIs may only resolve
-inside the allowed roots, so a hostile URDF cannot make armcli read
+one is expanded in safe mode (xacro_safe: no code runs, files confined) unless
+the user passes `--trust-xacro` (xacro itself, sandboxed by xacro_sandbox).
+Mesh URIs may only resolve inside the allowed roots, so a hostile URDF cannot make armcli read
 `/etc/passwd` as a "mesh".
 """
 
@@ -26,11 +26,9 @@ if TYPE_CHECKING:
 
 SPEC_SUFFIXES = (".yaml", ".yml")
 XACRO_SUFFIX = ".xacro"
-TRUST_XACRO_HELP = "Expand a foreign .xacro file in a sandbox (it still runs code from the file)."
-XACRO_REFUSED = (
-    "refusing to expand a xacro file armcli did not generate: xacro runs Python from the "
-    "file ($(eval ...) can run shell commands); pass --trust-xacro if you trust it, or give "
-    "the spec or the expanded .urdf instead"
+TRUST_XACRO_HELP = (
+    "Expand a foreign xacro file with xacro itself, which runs Python from the file "
+    "(in a bubblewrap sandbox); without it, xacro files are expanded in safe mode."
 )
 
 _PROBLEM = {
@@ -79,18 +77,17 @@ def read_robot(path: Path, *, trust_xacro: bool = False) -> RobotFile:
 def read_urdf_file(path: Path, *, trust_xacro: bool = False) -> Urdf:
     """A URDF or xacro file -> Urdf; xacro (by suffix or content) only with trust_xacro."""
     from armcli.urdfxml import parse_urdf, read_urdf
+    from armcli.xacro_sandbox import expand_foreign, expand_untrusted
 
     if path.suffix != XACRO_SUFFIX:
         try:
             return read_urdf(path)
         except XacroRefusedError:
-            if not trust_xacro:
-                raise
-    elif not trust_xacro:
-        raise XacroRefusedError(XACRO_REFUSED, file=path)
-    from armcli.xacro_sandbox import expand_untrusted
-
-    return parse_urdf(expand_untrusted(path), f"{path}{EXPANDED_TAG}")
+            pass  # xacro content in a .urdf: expanded like a .xacro file
+    if trust_xacro:
+        return parse_urdf(expand_untrusted(path), f"{path}{EXPANDED_TAG}")
+    xml = expand_foreign(path, allowed_roots(path.parent))  # safe mode: no code runs
+    return parse_urdf(xml, f"{path}{EXPANDED_TAG}")
 
 
 def load_checked_model(
