@@ -45,12 +45,12 @@ test: install sysdeps lint native-or-skip
 # Compiled simulator rollout (optional: armcli falls back to its Python loop). Cached under
 # ~/.cache/armcli/native keyed by source + pin version; ~2-4 min the first time.
 native: install
-	$(BIN)/python -m armcli.native
+	$(BIN)/python -m armcli.sim.native
 
 # For the tests: build the compiled path when possible; its tests skip (with the reason)
 # where no compiler is available, and everything else uses the Python loop.
 native-or-skip: install
-	@$(BIN)/python -m armcli.native || echo "native rollout not built; its tests will skip"
+	@$(BIN)/python -m armcli.sim.native || echo "native rollout not built; its tests will skip"
 
 bench: install native
 	$(BIN)/python bench/bench_sim.py

@@ -21,12 +21,17 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
-from armcli import native  # noqa: E402
-from armcli import rollout as ro  # noqa: E402
-from armcli.interpolation import build_reference  # noqa: E402
-from armcli.model import load_model  # noqa: E402
-from armcli.sim import SimConfig, arm_from_model, params_of, simulate  # noqa: E402
-from armcli.trajectory import loads_trajectory  # noqa: E402
+from armcli.sim import native  # noqa: E402
+from armcli.sim import rollout as ro  # noqa: E402
+from armcli.sim.reference import build_reference  # noqa: E402
+from armcli.sim.simulate import (  # noqa: E402
+    SimConfig,
+    arm_from_model,
+    params_of,
+    simulate,
+)
+from armcli.sim.trajectory import loads_trajectory  # noqa: E402
+from armcli.urdf.pinocchio import load_model  # noqa: E402
 
 DT = 1e-3  # [s] the spec's control.dt
 KP, KD = 50.0, 5.0

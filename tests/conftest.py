@@ -6,8 +6,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-DEFAULT_SPEC = ROOT / "specs" / "my_robot.yaml"
+from tests.helpers import DEFAULT_SPEC, ROOT
 
 
 @pytest.fixture(scope="session")
@@ -23,7 +22,7 @@ def default_spec_path() -> Path:
 @pytest.fixture(scope="session")
 def built_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The default spec built once per session into a temporary directory."""
-    from armcli.build import build
+    from armcli.build.expand import build
 
     out = tmp_path_factory.mktemp("built")
     build(DEFAULT_SPEC, out)

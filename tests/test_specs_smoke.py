@@ -14,13 +14,15 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from armcli.build import build
-from armcli.checks import ERROR, CheckOptions, check_urdf
+from armcli.build.expand import build
+from armcli.check.rules import ERROR, CheckOptions
+from armcli.check.run import check_urdf
 from armcli.cli import main
-from armcli.spec import RobotSpec
-from armcli.urdfxml import read_urdf
+from armcli.spec.model import RobotSpec
+from armcli.urdf.read import read_urdf
+from tests.helpers import ROOT
 
-SPECS = sorted((Path(__file__).resolve().parents[1] / "specs").glob("*.yaml"))
+SPECS = sorted((ROOT / "specs").glob("*.yaml"))
 # Gravity-compensated PD holds a pose to within friction / Kp (<= 0.05 / 15 here) [rad].
 HOLD_TOL = 0.01
 SIM_SECONDS = 1.5

@@ -1,4 +1,4 @@
-"""Defaults shared by commands; kept import-free so `armcli --help` stays fast."""
+"""Defaults shared across stages, written once; import-free so `armcli --help` stays fast."""
 
 from __future__ import annotations
 
@@ -6,3 +6,11 @@ from pathlib import Path
 
 DEFAULT_SPEC = Path("specs/my_robot.yaml")
 DEFAULT_URDF_DIR = Path("urdf")
+
+# Generated file names (build, ros-package, simulate, check all refer to these).
+STANDALONE_ARM = "standalone_arm"
+STANDALONE_ARM_XACRO = f"{STANDALONE_ARM}.urdf.xacro"
+STANDALONE_ARM_URDF = f"{STANDALONE_ARM}.urdf"
+
+DEFAULT_DT = 0.001  # [s] control and simulation step when the spec gives none
+DEFAULT_STATE_RATE_HZ = 10.0  # [Hz] joint-state output without a joint_state_publisher

@@ -32,6 +32,8 @@ class ArmcliError(Exception):
     """Base of every error armcli raises on purpose."""
 
     exit_code: int = EXIT_UNUSABLE
+    #: What the CLI writes before each line; None when the lines carry their own label.
+    label: str | None = "error"
 
     def lines(self) -> list[str]:
         """The one-line-per-problem rendering the CLI prints."""
@@ -76,6 +78,7 @@ class SpecError(InputError):
         super().__init__(first.message, file=file, line=first.line, field=first.field or None)
 
     def lines(self) -> list[str]:
+        """One line per problem, each prefixed with its file:line and field path."""
         out = []
         for p in self.problems:
             where = _where(self.file, p.line)
@@ -112,10 +115,33 @@ class ModelRefusedError(InputError):
         super().__init__(f"[{first.rule}] {first.message}", file=first.file, line=first.line)
 
     def lines(self) -> list[str]:
+        """One line per violation, then one saying the model is refused."""
         out = [f"{_where(v.file, v.line)}: [{v.rule}] {v.message}" for v in self.violations]
         n = len(self.violations)
         out.append(f"{self.source}: `armcli check` reports {n} error(s); the model is refused")
         return out
+
+
+class ModelLoadError(InputError):
+    """Pinocchio refused the URDF; carries what its parser printed."""
+
+    def __init__(self, message: str, *, file: str, parser_messages: list[str]) -> None:
+        self.parser_messages = parser_messages
+        super().__init__(message, file=file)
+
+
+class UnusableInputsError(ArmcliError):
+    """One or more inputs could not be used: one line each, exit 2, after the others' report."""
+
+    exit_code = EXIT_UNUSABLE
+
+    def __init__(self, errors: Sequence[ArmcliError]) -> None:
+        self.errors = list(errors)
+        super().__init__(str(self.errors[0]))
+
+    def lines(self) -> list[str]:
+        """The lines of every unusable input, in the order they failed."""
+        return [line for e in self.errors for line in e.lines()]
 
 
 class BuildError(ArmcliError):
@@ -126,12 +152,14 @@ class StaleBuildError(ArmcliError):
     """`build --check`: committed outputs differ from a fresh build."""
 
     exit_code = EXIT_FAILED
+    label = None
 
     def __init__(self, stale: Sequence[str]) -> None:
         self.stale = list(stale)
         super().__init__("stale generated files: " + ", ".join(self.stale))
 
     def lines(self) -> list[str]:
+        """One `stale:` line per file, then a count and how to fix it."""
         return [f"stale: {s}" for s in self.stale] + [
             f"{len(self.stale)} generated file(s) differ from a fresh build; run `armcli build`"
         ]

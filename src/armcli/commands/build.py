@@ -7,12 +7,17 @@ from pathlib import Path
 
 import typer
 
+from armcli.build.expand import build, check_fresh
 from armcli.defaults import DEFAULT_SPEC
 
 
 def build_cmd(
-    spec: Path = typer.Argument(DEFAULT_SPEC, help="Robot spec YAML."),
-    out: Path = typer.Option(Path("urdf"), "-o", "--out", help="Output directory."),
+    spec: Path = typer.Argument(
+        DEFAULT_SPEC, show_default=False, help=f"Robot spec YAML (default: {DEFAULT_SPEC})."
+    ),
+    out: Path = typer.Option(
+        Path("urdf"), "-o", "--out", show_default=False, help="Output directory (default: urdf)."
+    ),
     check: bool = typer.Option(
         False, "--check", help="Do not write; exit 1 listing files that differ from a fresh build."
     ),
@@ -21,8 +26,6 @@ def build_cmd(
     ),
 ) -> None:
     """Compile SPEC into the course's xacro set and the expanded URDFs."""
-    from armcli.build import build, check_fresh
-
     if check:
         check_fresh(spec, out)
         sys.stdout.write(f"{out}: up to date with {spec}\n")
@@ -34,4 +37,5 @@ def build_cmd(
 
 
 def register(app: typer.Typer) -> None:
+    """Add the `build` command to the typer app."""
     app.command("build")(build_cmd)

@@ -4,39 +4,27 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import typer
 
+from armcli.check import report
+from armcli.check.report import counts
+from armcli.check.rules import RULES, CheckOptions, apply_policy
+from armcli.check.run import CheckResult, check_urdf
 from armcli.defaults import DEFAULT_SPEC
-from armcli.errors import EXIT_UNUSABLE, ArmcliError
-from armcli.robot_source import TRUST_XACRO_HELP
-
-if TYPE_CHECKING:
-    from armcli.checks import CheckOptions, CheckResult
-    from armcli.urdfdoc import Urdf
+from armcli.errors import ArmcliError, FindingsError, InputError, UnusableInputsError
+from armcli.spec.load import load_spec
+from armcli.urdf.doc import Urdf
+from armcli.urdf.meshes import parse_package_dirs
+from armcli.urdf.source import TRUST_XACRO_HELP, read_robot, read_urdf_file
 
 FORMATS = ("table", "json", "github")
 REPORT_WIDTH = 140  # columns when stdout is not a terminal (CI logs, pipes)
 
 
-def _package_dirs(values: list[str]) -> dict[str, Path]:
-    from armcli.errors import InputError
-
-    out = {}
-    for v in values:
-        name, sep, path = v.partition("=")
-        if not sep or not name or not path:
-            raise InputError(f"expected NAME=PATH, got {v!r}", field="--package-dir")
-        out[name] = Path(path)
-    return out
-
-
 def _documents(path: Path, trust_xacro: bool) -> list[tuple[Urdf, Any]]:
     """The URDF documents a PATH stands for, each with the spec it came from (or None)."""
-    from armcli.errors import InputError
-    from armcli.robot_source import read_robot, read_urdf_file
-
     if path.is_dir():
         files = sorted(p for p in path.rglob("*.urdf") if p.is_file())
         if not files:
@@ -50,9 +38,6 @@ def _run(
     paths: list[Path], base: CheckOptions, trust_xacro: bool
 ) -> tuple[list[CheckResult], list[ArmcliError]]:
     from dataclasses import replace
-
-    from armcli.checks import check_urdf
-    from armcli.errors import InputError
 
     results: list[CheckResult] = []
     errors: list[ArmcliError] = []
@@ -75,7 +60,13 @@ def check_cmd(
     spec: Path | None = typer.Option(
         None, "--spec", help="Spec to compare limits with; also gives gains, dt, poses, tool."
     ),
-    fmt: str = typer.Option("table", "--format", help="table, json or github."),
+    fmt: str = typer.Option(
+        "table",
+        "--format",
+        metavar="[" + "|".join(FORMATS) + "]",
+        show_default=False,
+        help="Report format (default: table).",
+    ),
     strict: bool = typer.Option(False, "--strict", help="Treat warnings as errors."),
     ignore: list[str] = typer.Option([], "--ignore", help="Silence a rule id (repeatable)."),
     package_dir: list[str] = typer.Option(
@@ -84,19 +75,13 @@ def check_cmd(
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Check robot descriptions for physical sanity; exit 1 on error findings."""
-    from armcli.checks import RULES, CheckOptions, apply_policy
-    from armcli.errors import FindingsError, InputError
-    from armcli.report import counts
-
     if fmt not in FORMATS:
         raise InputError(f"unknown format {fmt!r}; known: {', '.join(FORMATS)}", field="--format")
     unknown = sorted(set(ignore) - set(RULES))
     if unknown:
         raise InputError(f"unknown rule(s) {unknown}; known: {', '.join(RULES)}", field="--ignore")
-    base = CheckOptions(package_dirs=_package_dirs(package_dir))
+    base = CheckOptions(package_dirs=parse_package_dirs(package_dir))
     if spec is not None:
-        from armcli.spec import load_spec
-
         base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs)
     results, errors = _run(list(paths or [DEFAULT_SPEC]), base, trust_xacro)
     findings = apply_policy((f for r in results for f in r.findings), ignore=ignore, strict=strict)
@@ -104,14 +89,12 @@ def check_cmd(
     code = 2 if errors else (1 if n_err else 0)
     _print(results, findings, fmt, code)
     if errors:
-        raise _UnusableInputsError(errors)
+        raise UnusableInputsError(errors)
     if n_err:
         raise FindingsError(f"{n_err} error finding(s) in {len(results)} file(s)")
 
 
 def _print(results: list[CheckResult], findings: list[Any], fmt: str, code: int) -> None:
-    from armcli import report
-
     if fmt == "json":
         sys.stdout.write(report.to_json(results, findings, code))
     elif fmt == "github":
@@ -125,18 +108,6 @@ def _print(results: list[CheckResult], findings: list[Any], fmt: str, code: int)
             console.print(item)
 
 
-class _UnusableInputsError(ArmcliError):
-    """One or more inputs could not be used: one line each, exit 2, after the others' report."""
-
-    exit_code = EXIT_UNUSABLE
-
-    def __init__(self, errors: list[ArmcliError]) -> None:
-        self.errors = errors
-        super().__init__(str(errors[0]))
-
-    def lines(self) -> list[str]:
-        return [line for e in self.errors for line in e.lines()]
-
-
 def register(app: typer.Typer) -> None:
+    """Add the `check` command to the typer app."""
     app.command("check")(check_cmd)

@@ -7,36 +7,57 @@ from pathlib import Path
 
 import typer
 
+from armcli.build.expand import spec_label
 from armcli.defaults import DEFAULT_SPEC
+from armcli.ros.packages import PackageInfo, write_ros_packages
 
-DEFAULT_SAMPLES = 10_000  # keep equal to armcli.collision_matrix.DEFAULT_SAMPLES (lazy import)
+DEFAULT_SAMPLES = 10_000  # keep equal to armcli.ros.collision_matrix.DEFAULT_SAMPLES (lazy import)
 MAX_SAMPLES = 1_000_000  # ~100x the default: minutes of coal queries, not days
 
 
 def ros_package_cmd(
-    spec: Path = typer.Argument(DEFAULT_SPEC, help="Robot spec YAML."),
-    out: Path = typer.Option(Path("ros"), "-o", "--out", help="Output directory."),
+    spec: Path = typer.Argument(
+        DEFAULT_SPEC, show_default=False, help=f"Robot spec YAML (default: {DEFAULT_SPEC})."
+    ),
+    out: Path = typer.Option(
+        Path("ros"), "-o", "--out", show_default=False, help="Output directory (default: ros)."
+    ),
     samples: int = typer.Option(
         DEFAULT_SAMPLES,
         "--samples",
         min=1,
         max=MAX_SAMPLES,
-        help="Random states for the collision matrix.",
+        show_default=False,
+        help=f"Random states for the collision matrix (default: {DEFAULT_SAMPLES}).",
     ),
     seed: int = typer.Option(
-        0, "--seed", min=0, max=2**32 - 1, help="Seed of the collision-matrix sampling."
+        0,
+        "--seed",
+        min=0,
+        max=2**32 - 1,
+        show_default=False,
+        help="Seed of the collision-matrix sampling (default: 0).",
     ),
-    maintainer: str = typer.Option("armcli", "--maintainer", help="package.xml maintainer."),
-    email: str = typer.Option("armcli@example.com", "--email", help="Maintainer e-mail."),
-    license_: str = typer.Option("TODO", "--license", help="package.xml license."),
+    maintainer: str = typer.Option(
+        "armcli",
+        "--maintainer",
+        show_default=False,
+        help="package.xml maintainer (default: armcli).",
+    ),
+    email: str = typer.Option(
+        "armcli@example.com",
+        "--email",
+        show_default=False,
+        help="Maintainer e-mail (default: armcli@example.com).",
+    ),
+    license_: str = typer.Option(
+        "TODO", "--license", show_default=False, help="package.xml license (default: TODO)."
+    ),
     force: bool = typer.Option(
         False, "--force", help="Write into an existing non-empty directory armcli did not create."
     ),
 ) -> None:
     """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
-    from armcli.build import spec_label
-    from armcli.ros_package import PackageInfo, write_ros_packages
-
     info = PackageInfo(maintainer=maintainer, email=email, license=license_)
     pkgs, written = write_ros_packages(
         spec, out, label=spec_label(spec), samples=samples, seed=seed, info=info, force=force
@@ -60,4 +81,5 @@ def ros_package_cmd(
 
 
 def register(app: typer.Typer) -> None:
+    """Add the `ros-package` command to the typer app."""
     app.command("ros-package")(ros_package_cmd)

@@ -5,19 +5,25 @@ from __future__ import annotations
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import typer
 
+from armcli.check.gate import refuse_check_errors
 from armcli.defaults import DEFAULT_SPEC
-from armcli.robot_source import TRUST_XACRO_HELP
+from armcli.errors import InputError
+from armcli.io.outdir import check_output_file
+from armcli.sim import job as simjob
+from armcli.sim import report as simreport
+from armcli.sim.options import ENGINES, INTEGRATORS, Engine, Integrator, SimOptions
+from armcli.sim.plot import write_tracking_plot
+from armcli.spec.load import load_spec
+from armcli.urdf.source import TRUST_XACRO_HELP
 
 PROGRESS_AFTER_S = 1.0  # show a progress bar when the run is projected to take longer
 
 
 def _floats(text: str | None, option: str) -> list[float] | None:
-    from armcli.errors import InputError
-
     if text is None:
         return None
     try:
@@ -45,7 +51,13 @@ def simulate_cmd(
         None, "--gravity-comp/--no-gravity-comp", help="Add g(q) to the PD torque."
     ),
     dt: float = typer.Option(None, "--dt", help="Time step [s] (default: the spec's control.dt)."),
-    integrator: str = typer.Option("euler", "--integrator", help="euler (semi-implicit) or rk4."),
+    integrator: str = typer.Option(
+        "euler",
+        "--integrator",
+        metavar="[" + "|".join(INTEGRATORS) + "]",
+        show_default=False,
+        help="Semi-implicit Euler (default) or RK4.",
+    ),
     duration: float = typer.Option(
         None, "--duration", help="Simulated time [s] (default: last point + 2 s)."
     ),
@@ -59,22 +71,17 @@ def simulate_cmd(
     rate: float = typer.Option(
         None, "--rate", help="Output rate [Hz] (default: joint_state_publisher's)."
     ),
-    engine: str = typer.Option("auto", "--engine", help="auto, native (compiled) or python."),
+    engine: str = typer.Option(
+        "auto",
+        "--engine",
+        metavar="[" + "|".join(ENGINES) + "]",
+        show_default=False,
+        help="auto (default: compiled when available), native (compiled) or python.",
+    ),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
     from rich.console import Console
-
-    from armcli import simjob, simreport
-    from armcli.check_gate import refuse_check_errors
-    from armcli.errors import InputError
-    from armcli.spec import load_spec
-
-    if engine not in ("auto", "native", "python"):
-        raise InputError(
-            f"unknown engine {engine!r}; valid: auto, native, python", field="--engine"
-        )
-    from armcli.outdir import check_output_file
 
     if output is not None:
         simreport.output_format(output)
@@ -82,24 +89,25 @@ def simulate_cmd(
     if plot is not None:
         check_output_file(plot, "--plot")
     spec_obj = load_spec(spec or DEFAULT_SPEC) if (spec is not None or urdf is None) else None
-    job = simjob.prepare(
-        spec=spec_obj,
-        urdf=urdf,
-        joints=[j.strip() for j in joints.split(",") if j.strip()] if joints else None,
+    kp_values, kd_values = _floats(kp, "--kp"), _floats(kd, "--kd")
+    opts = SimOptions(
         trajectory=trajectory,
         message=message,
-        kp=_floats(kp, "--kp"),
-        kd=_floats(kd, "--kd"),
+        urdf=urdf,
+        joints=tuple(j.strip() for j in joints.split(",") if j.strip()) if joints else None,
+        kp=tuple(kp_values) if kp_values is not None else None,
+        kd=tuple(kd_values) if kd_values is not None else None,
         gravity_comp=gravity_comp,
         dt=dt,
-        integrator=integrator,
+        integrator=cast(Integrator, integrator),
         duration=duration,
         clamp=clamp,
         rate=rate,
-        backend=engine,
+        engine=cast(Engine, engine),
         trust_xacro=trust_xacro,
-        gate=refuse_check_errors,  # a model `check` reports as an error is not simulated
     )
+    # a model `check` reports as an error is not simulated
+    job = simjob.prepare(spec_obj, opts, gate=refuse_check_errors)
     err = Console(stderr=True)
     for w in job.trajectory.warnings:
         err.print(f"warning: {w}", markup=False, highlight=False)
@@ -110,8 +118,6 @@ def simulate_cmd(
     if output is not None:
         simreport.write_states(output, res, job.rate)
     if plot is not None:
-        from armcli.plot import write_tracking_plot
-
         write_tracking_plot(plot, res, job.arm.effort)
     out = Console(file=sys.stdout)
     if not out.is_terminal:
@@ -151,4 +157,5 @@ class _LazyProgress:
 
 
 def register(app: typer.Typer) -> None:
+    """Add the `simulate` command to the typer app."""
     app.command("simulate")(simulate_cmd)

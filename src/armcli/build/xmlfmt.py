@@ -1,0 +1,38 @@
+"""The one float formatter and XML serialiser shared by every writer.
+
+Floats use Python's shortest round-trip repr, so values survive a write/read
+cycle exactly and the same spec always gives the same bytes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from lxml import etree
+
+XACRO_NS = "http://www.ros.org/wiki/xacro"
+
+
+def fmt(x: float) -> str:
+    """Shortest exact text of a float; integers print without a trailing `.0`, -0 as 0."""
+    v = float(x)
+    if v == 0.0:
+        return "0"
+    if v.is_integer() and abs(v) < 1e15:
+        return str(int(v))
+    return repr(v)
+
+
+def vec(values: Iterable[float]) -> str:
+    """Space-separated `fmt` of each value, as URDF writes vectors (xyz, rpy, rgba)."""
+    return " ".join(fmt(v) for v in values)
+
+
+def to_bytes(root: etree._Element, *, header_comment: str | None = None) -> bytes:
+    """Serialise with an XML declaration, two-space indentation and a trailing newline."""
+    etree.indent(root, space="  ")
+    body = etree.tostring(root, encoding="unicode")
+    out = '<?xml version="1.0"?>\n'
+    if header_comment:
+        out += f"<!-- {header_comment} -->\n"
+    return (out + body + "\n").encode("utf-8")

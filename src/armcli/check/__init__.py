@@ -1,0 +1,4 @@
+"""`armcli check`: physical-sanity rules on one URDF, their findings and reports.
+
+May import `armcli.urdf` and below, and `armcli.sim.stability` (one PD bound for both).
+"""

@@ -1,0 +1,207 @@
+"""Inertia rules: mass sign, positive definiteness, triangle inequality, own geometry.
+
+Comparing the inertia with the link's own geometry catches permuted or scaled macro output.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+
+from armcli.check.rules import Collector
+from armcli.check.structure import Tree, finite
+from armcli.urdf import inertia as inr
+from armcli.urdf.doc import Geometry, Inertial, Link, Shape, Urdf
+
+# Inertia within 5 % (Frobenius, relative) of the solid-body formula counts as
+# "from the geometry"; real macro bugs (permuted axes, 4x) are off by >= 50 %.
+INERTIA_GEOMETRY_RTOL = 0.05
+# Centre of mass within 1 mm + 1 % of the shape's largest size of its centre.
+COM_ATOL = 1e-3
+COM_RTOL = 0.01
+# A link with mass needs principal moments above this [kg·m²] (MuJoCo's mjMINVAL):
+# zero is a point mass or an infinitely thin rod, and rounding noise on an
+# all-zero tensor (1e-20) must not pass as "positive".
+MIN_MOMENT = 1e-15
+
+
+def check(urdf: Urdf, tree: Tree, out: Collector) -> None:
+    """Per-link rules; the bodies the joints move are checked in checks_bodies."""
+    for link in urdf.links:
+        ine = link.inertial
+        if ine is None:
+            if tree.is_moving(link.name) and (link.visuals or link.collisions):
+                out.add(
+                    "missing-inertial",
+                    link.line,
+                    f"moving link {link.name!r} has geometry but no <inertial> (massless)",
+                    link=link.name,
+                )
+            continue
+        if link.name == tree.root and finite(ine.mass) and ine.mass > 0:  # type: ignore[operator]
+            out.add(
+                "root-inertia",
+                ine.line,
+                f"root link {link.name!r} has mass {ine.mass:g} kg; "
+                "KDL (robot_state_publisher) ignores root inertia",
+                mass=ine.mass,
+            )
+        if _mass_ok(link, ine, out):
+            J = _tensor_ok(link, ine, out)
+            if J is not None:
+                _versus_geometry(link, ine, J, out)
+
+
+def _mass_ok(link: Link, ine: Inertial, out: Collector) -> bool:
+    m = ine.mass
+    if m is None or not finite(m):
+        return False
+    if m < 0:
+        out.add(
+            "mass-nonpositive",
+            ine.mass_line,
+            f"link {link.name!r}: negative mass {m:g} kg",
+            link=link.name,
+            mass=m,
+        )
+        return False
+    return m > 0
+
+
+def _tensor_ok(link: Link, ine: Inertial, out: Collector) -> np.ndarray | None:
+    """The link's tensor if it is positive definite and obeys the triangle inequality."""
+    if ine.inertia is None or not finite(*ine.inertia):
+        return None
+    J = inr.tensor(*ine.inertia)
+    moments = inr.principal_moments(J)
+    vals = dict(zip(("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), ine.inertia, strict=True))
+    if abs(moments[0]) <= MIN_MOMENT and abs(moments[-1]) <= MIN_MOMENT:
+        return None  # a point mass: fine on its own; checks_bodies checks what joints move
+    if moments[0] <= MIN_MOMENT:
+        out.add(
+            "inertia-not-pd",
+            ine.inertia_line,
+            f"link {link.name!r}: inertia not positive definite, principal moments "
+            f"{_fmt(moments)} for mass {ine.mass:g} kg",
+            link=link.name,
+            principal=[float(x) for x in moments],
+            **vals,
+        )
+        return None
+    excess = inr.triangle_violation(J)
+    if excess > inr.TRIANGLE_RTOL:
+        a, b, c = moments
+        out.add(
+            "inertia-triangle",
+            ine.inertia_line,
+            f"link {link.name!r}: principal moments {_fmt(moments)}: "
+            f"{c:.4g} > {a:.4g} + {b:.4g} (by {excess:.1%})",
+            link=link.name,
+            principal=[float(x) for x in moments],
+            excess=excess,
+        )
+        return None
+    return J
+
+
+def primitive_shape(link: Link) -> Shape | None:
+    """The one box/cylinder/sphere the link is made of, or None.
+
+    Every visual and collision element must be that same primitive at the same
+    origin: a primitive collision next to a mesh visual is only an approximation
+    of the body, and its formula says nothing about the real inertia.
+    """
+    shapes = (*link.collisions, *link.visuals)
+    if not shapes:
+        return None
+    first = shapes[0]
+    g = first.geometry
+    if g is None or g.kind not in ("box", "cylinder", "sphere") or g.dims is None:
+        return None
+    if not all(d > 0 for d in g.dims):
+        return None
+    same = all(
+        s.geometry is not None
+        and (s.geometry.kind, s.geometry.dims) == (g.kind, g.dims)
+        and (s.origin.xyz, s.origin.rpy) == (first.origin.xyz, first.origin.rpy)
+        for s in shapes
+    )
+    return first if same else None
+
+
+def solid_inertia(g: Geometry, m: float) -> np.ndarray:
+    """The centroidal inertia of a solid primitive in its geometry frame."""
+    d = g.dims or ()
+    if g.kind == "box":
+        return inr.box_inertia(m, d[0], d[1], d[2])
+    if g.kind == "cylinder":
+        return inr.cylinder_inertia(m, d[0], d[1])
+    return inr.sphere_inertia(m, d[0])
+
+
+def _versus_geometry(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -> None:
+    shape = primitive_shape(link)
+    if shape is None or shape.geometry is None:
+        return
+    poses = (*ine.origin.xyz, *ine.origin.rpy, *shape.origin.xyz, *shape.origin.rpy)
+    if not finite(*poses):
+        return  # reported by the number rules
+    g, m = shape.geometry, float(ine.mass or 0.0)
+    R_link_geom = inr.rpy_matrix(shape.origin.rpy)
+    R_link_inertial = inr.rpy_matrix(ine.origin.rpy)
+    # Both tensors expressed in the geometry frame, where the formula is diagonal.
+    actual = inr.rotate(inr.rotate(J, R_link_inertial), R_link_geom.T)
+    expected = solid_inertia(g, m)
+    diff = inr.relative_difference(actual, expected)
+    dims = "x".join(f"{x:g}" for x in g.dims or ())
+    if diff > INERTIA_GEOMETRY_RTOL:
+        got, want = np.diag(actual), np.diag(expected)
+        out.add(
+            "inertia-geometry",
+            ine.inertia_line,
+            f"link {link.name!r}: inertia diag "
+            f"{_fmt(got)} (geometry frame) vs solid {g.kind} {dims} m, {m:g} kg: "
+            f"{_fmt(want)}{_diagnosis(got, want)}",
+            link=link.name,
+            actual=_list(got),
+            expected=_list(want),
+            relative_difference=diff,
+        )
+    offset = np.subtract(ine.origin.xyz, shape.origin.xyz)
+    tol = COM_ATOL + COM_RTOL * max(g.dims or (0.0,))
+    if float(np.linalg.norm(offset)) > tol:
+        out.add(
+            "com-geometry",
+            ine.origin.line or ine.line,
+            f"link {link.name!r}: inertial "
+            f"origin {list(ine.origin.xyz)} is {np.linalg.norm(offset):.4g} m from the "
+            f"{g.kind} centre {list(shape.origin.xyz)}",
+            link=link.name,
+            offset=_list(offset),
+        )
+
+
+def _diagnosis(got: np.ndarray, want: np.ndarray) -> str:
+    """Name the usual macro bugs: a uniform scale factor and/or permuted axes."""
+    for perm in itertools.permutations(range(3)):
+        ratio = got / want[list(perm)]
+        if np.ptp(ratio) <= INERTIA_GEOMETRY_RTOL * np.mean(ratio):
+            scale = float(np.mean(ratio))
+            parts = []
+            if perm != (0, 1, 2):
+                parts.append("axes permuted")
+            if abs(scale - 1.0) > INERTIA_GEOMETRY_RTOL:
+                parts.append(
+                    f"{scale:.3g}x too large" if scale > 1 else f"{1 / scale:.3g}x too small"
+                )
+            return " (" + ", ".join(parts) + ")" if parts else ""
+    return ""
+
+
+def _fmt(v: np.ndarray) -> str:
+    return "(" + ", ".join(f"{x:.4g}" for x in v) + ")"
+
+
+def _list(v: np.ndarray) -> list[float]:
+    return [float(x) for x in v]

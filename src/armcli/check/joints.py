@@ -1,0 +1,122 @@
+"""Joint rules: limit order and sign, axis, radians, and agreement with the spec."""
+
+from __future__ import annotations
+
+import math
+
+from armcli.check.rules import Collector
+from armcli.check.structure import finite
+from armcli.spec.model import RobotSpec
+from armcli.urdf.doc import Joint, Urdf
+
+AXIS_UNIT_TOL = 1e-6
+# A revolute limit beyond one turn that is a whole multiple of 5 (45, 90, 180, 360...)
+# is almost surely degrees typed as radians; larger values are "unlimited" sentinels
+# and non-round ones (3*pi, 10) are deliberate multi-turn ranges.
+DEGREES_SUSPECT = 2.0 * math.pi
+DEGREES_MAX = 720.0
+DEGREES_STEP = 5.0
+SPEC_LIMIT_TOL = 1e-9
+
+
+def check(urdf: Urdf, spec: RobotSpec | None, out: Collector) -> None:
+    """Joint rules: axis and limits of each moving joint, then the arm limits against the spec."""
+    for j in urdf.joints:
+        if j.type in ("revolute", "prismatic", "continuous"):
+            _axis(j, out)
+        if j.limit is not None and j.type in ("revolute", "prismatic"):
+            _limits(j, out)
+    if spec is not None:
+        _spec_limits(urdf, spec, out)
+
+
+def _axis(j: Joint, out: Collector) -> None:
+    if j.axis is None or not finite(*j.axis):
+        return
+    norm = math.sqrt(sum(a * a for a in j.axis))
+    if norm == 0.0:
+        out.add("axis", j.axis_line, f"joint {j.name!r}: axis is zero", joint=j.name)
+    elif abs(norm - 1.0) > AXIS_UNIT_TOL:
+        out.add(
+            "axis-unit",
+            j.axis_line,
+            f"joint {j.name!r}: axis {list(j.axis)} has length {norm:.6g}",
+            joint=j.name,
+            norm=norm,
+        )
+
+
+def _limits(j: Joint, out: Collector) -> None:
+    lim = j.limit
+    assert lim is not None
+    lo, hi = lim.lower, lim.upper
+    if finite(lo, hi):
+        assert lo is not None and hi is not None
+        if lo >= hi:
+            out.add(
+                "limit-order",
+                lim.line,
+                f"joint {j.name!r}: lower {lo:g} is not below upper {hi:g}",
+                joint=j.name,
+                lower=lo,
+                upper=hi,
+            )
+        if j.type == "revolute" and any(_looks_like_degrees(x) for x in (lo, hi)):
+            out.add(
+                "limit-degrees",
+                lim.line,
+                f"joint {j.name!r}: limits [{lo:g}, {hi:g}] rad "
+                f"= [{math.degrees(lo):.0f}, {math.degrees(hi):.0f}] deg",
+                joint=j.name,
+                lower=lo,
+                upper=hi,
+            )
+    for attr in ("effort", "velocity"):
+        v = getattr(lim, attr)
+        if v is not None and finite(v) and v <= 0:
+            out.add(
+                "limit-effort-velocity",
+                lim.line,
+                f"joint {j.name!r}: {attr} limit {v:g} must be > 0",
+                joint=j.name,
+                **{attr: v},
+            )
+
+
+def _looks_like_degrees(x: float) -> bool:
+    a = abs(x)
+    return (
+        DEGREES_SUSPECT < a <= DEGREES_MAX
+        and abs(a / DEGREES_STEP - round(a / DEGREES_STEP)) < 1e-9
+    )
+
+
+def _spec_limits(urdf: Urdf, spec: RobotSpec, out: Collector) -> None:
+    """The arm joints' limits must equal the spec's (e.g. the course's 0..pi/2)."""
+    by_name = {j.name: j for j in urdf.joints}
+    for name, sj in spec.arm.joints.items():
+        if sj.limit is None or name not in by_name:
+            continue
+        uj = by_name[name]
+        ul = uj.limit
+        want = {
+            "lower": sj.limit.lower,
+            "upper": sj.limit.upper,
+            "effort": sj.limit.effort,
+            "velocity": sj.limit.velocity,
+        }
+        got = {k: (getattr(ul, k) if ul is not None else None) for k in want}
+        bad = [k for k in want if (g := got[k]) is None or abs(g - want[k]) > SPEC_LIMIT_TOL]
+        if bad:
+            detail = ", ".join(f"{k} {_g(got[k])} (spec {want[k]:g})" for k in bad)
+            out.add(
+                "spec-limits",
+                ul.line if ul else uj.line,
+                f"joint {name!r}: {detail}",
+                joint=name,
+                **{f"spec_{k}": want[k] for k in bad},
+            )
+
+
+def _g(v: float | None) -> str:
+    return "missing" if v is None else f"{v:g}"

@@ -1,0 +1,193 @@
+"""Render `check` results: a rich table, stable JSON (docs/check.md), GitHub annotations.
+
+Functions return renderables or strings; the command prints them.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import asdict
+from typing import Any
+
+from armcli.check.rules import ERROR, WARNING, Finding
+from armcli.check.run import CheckResult
+
+JSON_SCHEMA = "armcli.check/1"
+
+
+def counts(findings: Sequence[Finding]) -> dict[str, int]:
+    """Number of findings per severity (`error`, `warning`) for the summary and JSON."""
+    return {
+        ERROR: sum(f.severity == ERROR for f in findings),
+        WARNING: sum(f.severity == WARNING for f in findings),
+    }
+
+
+def _clean(x: Any) -> Any:
+    """JSON has no NaN/inf: write them as strings; tuples become lists."""
+    if isinstance(x, float) and not math.isfinite(x):
+        return str(x)
+    if isinstance(x, dict):
+        return {k: _clean(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [_clean(v) for v in x]
+    return x
+
+
+def _summary_dict(r: CheckResult) -> dict[str, Any] | None:
+    s = r.summary
+    if s is None:
+        return None
+    d = asdict(s)
+    d["poses"] = [{"name": p.name, "q": dict(p.q), "xyz": list(p.xyz)} for p in s.poses]
+    return d
+
+
+def to_json(results: Sequence[CheckResult], findings: Sequence[Finding], exit_code: int) -> str:
+    """The documented JSON document (schema `armcli.check/1`)."""
+    files = []
+    for r in results:
+        mine = [f.to_dict() for f in findings if f.file == r.file]
+        files.append({"file": r.file, "findings": mine, "summary": _summary_dict(r)})
+    doc = {
+        "schema": JSON_SCHEMA,
+        "files": files,
+        "counts": counts(findings),
+        "exit_code": exit_code,
+    }
+    return json.dumps(_clean(doc), indent=2, sort_keys=False, allow_nan=False) + "\n"
+
+
+def _esc_data(s: str) -> str:
+    return s.replace("%", "%25").replace("\r", "%0D").replace("\n", "%0A")
+
+
+def _esc_prop(s: str) -> str:
+    return _esc_data(s).replace(":", "%3A").replace(",", "%2C")
+
+
+def to_github(findings: Sequence[Finding]) -> str:
+    """GitHub Actions workflow commands: one `::error`/`::warning` line per finding.
+
+    Findings in a URDF built in memory from a spec (`spec.yaml#name.urdf`)
+    point at the spec file without a line: the lines are the generated file's.
+    """
+    lines = []
+    for f in findings:
+        path, _, inner = f.file.partition("#")
+        props = [f"file={_esc_prop(path)}"]
+        if f.line and not inner:
+            props.append(f"line={f.line}")
+        props.append(f"title={_esc_prop(f'armcli {f.rule}')}")
+        where = f"{inner}:{f.line}: " if inner and f.line else ""
+        msg = f"{where}{f.message}" + (f" (fix: {f.hint})" if f.hint else "")
+        lines.append(f"::{f.severity} {','.join(props)}::{_esc_data(msg)}")
+    return "".join(line + "\n" for line in lines)
+
+
+def _num(x: float | None, fmt: str = "{:.4g}") -> str:
+    return "-" if x is None else fmt.format(x)
+
+
+def to_rich(results: Sequence[CheckResult], findings: Sequence[Finding]) -> list[Any]:
+    """Renderables: per file a findings table and the summary; then the totals line."""
+    from rich.table import Table
+    from rich.text import Text
+
+    out: list[Any] = []
+    for r in results:
+        mine = [f for f in findings if f.file == r.file]
+        out.append(Text(f"\n{r.file}", style="bold"))
+        if mine:
+            t = Table(show_header=True, header_style="bold", expand=False)
+            for col in ("severity", "rule", "line", "message"):
+                t.add_column(col, overflow="fold")
+            for f in mine:
+                style = "red" if f.severity == ERROR else "yellow"
+                msg = Text(f.message)
+                msg.append(f"\nfix: {f.hint}", style="dim")
+                t.add_row(Text(f.severity, style=style), f.rule, _num(f.line, "{}"), msg)
+            out.append(t)
+        else:
+            out.append(Text("no findings", style="green"))
+        out.extend(_summary(r))
+    c = counts(findings)
+    style = "red" if c[ERROR] else "yellow" if c[WARNING] else "green"
+    out.append(
+        Text(f"\n{c[ERROR]} error(s), {c[WARNING]} warning(s) in {len(results)} file(s)", style)
+    )
+    return out
+
+
+def _summary(r: CheckResult) -> list[Any]:
+    from rich.table import Table
+    from rich.text import Text
+
+    s = r.summary
+    if s is None:
+        return []
+    out: list[Any] = [
+        Text(f"robot {s.robot!r}: root {s.root}, total mass {s.total_mass:.4g} kg, {s.dof} DoF")
+    ]
+    if s.joints:
+        out.append(Text("joints"))
+        t = Table(header_style="bold")
+        for col in (
+            "joint",
+            "type",
+            "lower",
+            "upper",
+            "effort",
+            "velocity",
+            "damping",
+            "friction",
+            "max |gravity torque|",
+        ):
+            t.add_column(col, justify="left" if col in ("joint", "type") else "right")
+        for j in s.joints:
+            t.add_row(
+                j.name,
+                j.type,
+                _num(j.lower),
+                _num(j.upper),
+                _num(j.effort),
+                _num(j.velocity),
+                _num(j.damping),
+                _num(j.friction),
+                _num(j.gravity_max),
+            )
+        out.append(t)
+    if s.poses:
+        out.append(Text(f"end effector {s.end_effector} in {s.root} [m]"))
+        t = Table(header_style="bold")
+        for col in ("pose", "x", "y", "z"):
+            t.add_column(col, justify="left" if col == "pose" else "right")
+        for p in s.poses:
+            t.add_row(p.name, *(f"{v:.4f}" for v in p.xyz))
+        out.append(t)
+    if s.stability is not None:
+        out.append(_stability_text(s.stability))
+    out.extend(Text(n, style="dim") for n in s.notes)
+    return out
+
+
+def _stability_text(st: Any) -> Any:
+    from rich.text import Text
+
+    e, i = st.explicit, st.implicit
+    t = Text(
+        f"PD stability at dt = {st.dt:g} s: lambda_max(M^-1) = {st.lambda_max:.4g} 1/(kg m^2), "
+        f"Kp = {st.kp:g}, Kd + damping = {st.d:g}\n"
+    )
+    t.append(
+        f"  explicit damping: b = {e.b:.3g}, a = {e.a:.3g}, a + 2b = {e.a + 2 * e.b:.3g} "
+        f"(< 4 needed): ",
+    )
+    t.append("stable" if e.stable else "UNSTABLE", "green" if e.stable else "red")
+    t.append(f"; stable for dt < {e.dt_max:.3g} s or Kd < {st.kd_max_explicit:.3g}\n")
+    t.append("  implicit damping (the simulator): ")
+    t.append("stable" if i.stable else "UNSTABLE", "green" if i.stable else "red")
+    t.append(f"; Kp < {st.kp_max_implicit:.4g} or dt < {i.dt_max:.3g} s")
+    return t

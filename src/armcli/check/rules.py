@@ -1,0 +1,253 @@
+"""The vocabulary of `check`: the rule table, `Finding`, `Collector` and `CheckOptions`.
+
+Each rule has a stable id (used by `--ignore`, the JSON schema and CI
+annotations), one severity and a one-line fix hint. The rules themselves live
+in one module per topic beside this one and `run.py` runs them in order; this
+module is the floor they all stand on, so it imports none of them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from armcli.spec.model import RobotSpec
+from armcli.urdf.meshes import MeshSearch
+
+ERROR = "error"
+WARNING = "warning"
+
+Value = float | int | str | list[float] | None
+
+
+@dataclass(frozen=True)
+class Rule:
+    """One check rule: stable id (for --ignore and JSON), severity, title and fix hint."""
+
+    id: str
+    severity: str
+    title: str
+    hint: str
+
+
+_RULES = [
+    # structure
+    Rule("duplicate-name", ERROR, "link, joint or material name used twice", "rename one of them"),
+    Rule("unknown-link", ERROR, "joint parent/child is not a link", "fix the link name"),
+    Rule("multiple-parents", ERROR, "link is the child of several joints", "a link has one parent"),
+    Rule("root-count", ERROR, "the tree must have exactly one root", "connect the extra roots"),
+    Rule("disconnected", ERROR, "links not reachable from the root", "add the missing joints"),
+    Rule("joint-type", ERROR, "unknown joint type", "use revolute, continuous, prismatic, fixed"),
+    Rule(
+        "missing-limit",
+        ERROR,
+        "revolute/prismatic joint without full <limit>",
+        "give lower, upper, effort and velocity",
+    ),
+    Rule("mimic-target", ERROR, "mimic refers to an unknown joint", "fix the mimic joint name"),
+    Rule(
+        "material-conflict",
+        WARNING,
+        "material redefined with another colour",
+        "define each material once at top level",
+    ),
+    # numbers
+    Rule("number-syntax", ERROR, "number missing or not parsable", "write plain decimal numbers"),
+    Rule("non-finite", ERROR, "NaN or infinite number", "replace it with a finite value"),
+    Rule("vector-length", ERROR, "vector with the wrong number of values", "give 3 (rgba: 4)"),
+    Rule("geometry-size", ERROR, "geometry size not > 0", "give positive sizes"),
+    Rule(
+        "geometry-kind",
+        ERROR,
+        "geometry empty or of an unknown kind",
+        "use box, cylinder, sphere or mesh",
+    ),
+    Rule("rgba-range", ERROR, "colour component outside [0, 1]", "scale colours to [0, 1]"),
+    # inertia
+    Rule(
+        "mass-nonpositive",
+        ERROR,
+        "negative mass, or a moving body without mass",
+        "give the link its real mass",
+    ),
+    Rule(
+        "inertia-not-pd",
+        ERROR,
+        "inertia of a link with mass not positive definite, or a moving body's singular",
+        "use the solid-body formula for the link's shape",
+    ),
+    Rule(
+        "inertia-triangle",
+        ERROR,
+        "principal moments violate I1 + I2 >= I3",
+        "a real body has I1 + I2 >= I3; recompute the inertia",
+    ),
+    Rule(
+        "tiny-mass",
+        WARNING,
+        "mass tiny compared with the robot",
+        "simulators become stiff with mass ratios above 1e4; use a realistic mass",
+    ),
+    Rule(
+        "missing-inertial",
+        WARNING,
+        "moving link with geometry but no <inertial>",
+        "add an <inertial>; Gazebo drops links without one",
+    ),
+    Rule(
+        "root-inertia",
+        WARNING,
+        "root link has an inertia (KDL ignores it)",
+        "add a massless dummy root link, e.g. base_footprint",
+    ),
+    Rule(
+        "inertia-geometry",
+        WARNING,
+        "inertia differs from the solid-body formula of the geometry",
+        "compute it from the shape (armcli's box/cylinder/sphere formulas)",
+    ),
+    Rule(
+        "com-geometry",
+        WARNING,
+        "inertial origin is not at the geometry centre",
+        "put the inertial origin at the shape's centre",
+    ),
+    # joints
+    Rule("limit-order", ERROR, "lower limit not below upper limit", "swap or fix the limits"),
+    Rule(
+        "limit-effort-velocity",
+        ERROR,
+        "effort or velocity limit <= 0",
+        "give the actuator's real effort and velocity limits",
+    ),
+    Rule("axis", ERROR, "joint axis zero", "give a unit axis such as 0 0 1"),
+    Rule("axis-unit", WARNING, "joint axis not unit length", "normalise the axis"),
+    Rule(
+        "limit-degrees",
+        WARNING,
+        "revolute limit a round number beyond 2*pi: degrees, not radians?",
+        "URDF angles are radians",
+    ),
+    Rule("spec-limits", ERROR, "joint limits differ from the spec", "rebuild from the spec"),
+    # model and dynamics
+    Rule("parser-error", ERROR, "the URDF parser reported an error", "read the message"),
+    Rule("parser-message", WARNING, "the URDF parser printed a message", "read the message"),
+    Rule("model-load", ERROR, "Pinocchio cannot build a model", "fix the errors above"),
+    Rule(
+        "gravity-effort",
+        ERROR,
+        "gravity torque exceeds the effort limit",
+        "raise the effort limit or lighten the links",
+    ),
+    Rule(
+        "pd-unstable", ERROR, "PD loop unstable at dt even with implicit damping", "lower Kp or dt"
+    ),
+    Rule(
+        "pd-explicit-unstable",
+        WARNING,
+        "PD loop unstable at dt with explicit damping",
+        "lower Kd or dt, or treat damping implicitly",
+    ),
+    # collision and meshes
+    Rule(
+        "visual-no-collision",
+        WARNING,
+        "moving link with visual but no collision geometry",
+        "add a <collision> (a primitive is enough)",
+    ),
+    Rule(
+        "self-collision", ERROR, "links collide at a named pose", "change the pose or the geometry"
+    ),
+    Rule("mesh-missing", ERROR, "mesh file not found", "fix the path or pass --package-dir"),
+]
+RULES: dict[str, Rule] = {r.id: r for r in _RULES}
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One problem: which rule, where, what the numbers are, and how to fix it."""
+
+    rule: str
+    severity: str
+    file: str
+    line: int | None
+    message: str
+    values: Mapping[str, Value] = field(default_factory=dict)
+    hint: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        """The finding as a JSON object in the stable schema of docs/check.md."""
+        return {
+            "rule": self.rule,
+            "severity": self.severity,
+            "file": self.file,
+            "line": self.line,
+            "message": self.message,
+            "values": dict(self.values),
+            "hint": self.hint,
+        }
+
+
+class Collector:
+    """Builds findings for one file, filling severity and hint from the rule table."""
+
+    def __init__(self, file: str) -> None:
+        self.file = file
+        self.findings: list[Finding] = []
+
+    def add(self, rule: str, line: int | None, message: str, **values: Value) -> None:
+        """Record a finding of `rule` at `line`; `values` are the numbers behind the message."""
+        r = RULES[rule]
+        self.findings.append(Finding(rule, r.severity, self.file, line, message, values, r.hint))
+
+    def has_errors(self, rules: Iterable[str] | None = None) -> bool:
+        """Whether an error-severity finding was recorded, optionally only among `rules`."""
+        wanted = set(rules) if rules is not None else None
+        return any(
+            f.severity == ERROR and (wanted is None or f.rule in wanted) for f in self.findings
+        )
+
+
+@dataclass(frozen=True)
+class JointRow:
+    """One joint of the summary table: URDF limits and dynamics [SI], and the gravity load."""
+
+    name: str
+    type: str
+    lower: float | None
+    upper: float | None
+    effort: float | None
+    velocity: float | None
+    damping: float
+    friction: float
+    gravity_max: float | None = None  # worst |gravity torque| over the sample [N·m or N]
+
+
+@dataclass(frozen=True)
+class CheckOptions:
+    """What the rules may use beyond the URDF itself."""
+
+    spec: RobotSpec | None = None
+    package_dirs: Mapping[str, Path] = field(default_factory=dict)
+    search_paths: tuple[Path, ...] = ()
+
+    def mesh_search(self) -> MeshSearch:
+        """The mesh-resolver view of these options (shared with view and render)."""
+        return MeshSearch(self.package_dirs, self.search_paths)
+
+
+def apply_policy(
+    findings: Iterable[Finding], *, ignore: Iterable[str] = (), strict: bool = False
+) -> list[Finding]:
+    """Drop ignored rules; with strict, every warning becomes an error."""
+    skip = set(ignore)
+    out = []
+    for f in findings:
+        if f.rule in skip:
+            continue
+        if strict and f.severity == WARNING:
+            f = Finding(f.rule, ERROR, f.file, f.line, f.message, f.values, f.hint)
+        out.append(f)
+    return out

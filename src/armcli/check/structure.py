@@ -1,0 +1,261 @@
+"""Structure and number rules: names, tree shape, joint types, limits, sizes, colours.
+
+Also returns the kinematic tree (root, parent joint of each link, which links
+move) that the inertia, joint and model rules build on.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from dataclasses import dataclass
+
+from armcli.check.rules import Collector
+from armcli.urdf.doc import Joint, Link, Urdf
+
+JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+NUMBER_RULES = {
+    "missing": "number-syntax",
+    "not-a-number": "number-syntax",
+    "non-finite": "non-finite",
+    "length": "vector-length",
+}
+
+
+@dataclass(frozen=True)
+class Tree:
+    """The kinematic tree as far as it is well formed."""
+
+    root: str | None
+    parent_joint: dict[str, Joint]  # child link -> the joint above it
+    moving: frozenset[str]  # links below at least one movable joint
+
+    def is_moving(self, link: str) -> bool:
+        """Whether `link` is below at least one movable joint."""
+        return link in self.moving
+
+
+def check(urdf: Urdf, out: Collector) -> Tree:
+    """Run the structure and number rules and return the tree."""
+    for p in urdf.problems:
+        what = {
+            "missing": "missing",
+            "not-a-number": "not a number",
+            "non-finite": "not finite",
+            "length": "wrong number of values",
+        }[p.kind]
+        out.add(NUMBER_RULES[p.kind], p.line, f"{p.where}: {what}: {p.text!r}", text=p.text)
+    _names(urdf, out)
+    _materials(urdf, out)
+    for link in urdf.links:
+        _geometry_sizes(link, out)
+    links = {lk.name for lk in urdf.links}
+    for j in urdf.joints:
+        _joint_shape(j, links, {jj.name for jj in urdf.joints}, out)
+    tree = _tree(urdf, links, out)
+    for link in urdf.links:
+        if tree.is_moving(link.name) and link.visuals and not link.collisions:
+            out.add(
+                "visual-no-collision",
+                link.line,
+                f"moving link {link.name!r} is visible but has no <collision>: it passes "
+                "through everything in simulation",
+                link=link.name,
+            )
+    return tree
+
+
+def _names(urdf: Urdf, out: Collector) -> None:
+    for kind, items in (("link", urdf.links), ("joint", urdf.joints)):
+        counts = Counter(it.name for it in items)
+        seen: set[str] = set()
+        for it in items:
+            if not it.name:
+                out.add("duplicate-name", it.line, f"{kind} without a name")
+            elif counts[it.name] > 1 and it.name in seen:
+                out.add(
+                    "duplicate-name",
+                    it.line,
+                    f"{kind} {it.name!r} defined {counts[it.name]}x",
+                    name=it.name,
+                )
+            seen.add(it.name)
+    top = Counter(m.name for m in urdf.materials if m.top_level)
+    seen = set()
+    for m in urdf.materials:
+        if m.top_level and top[m.name] > 1 and m.name in seen:
+            out.add(
+                "duplicate-name",
+                m.line,
+                f"material {m.name!r} defined {top[m.name]}x at top level",
+                name=m.name,
+            )
+        seen.add(m.name)
+
+
+def _materials(urdf: Urdf, out: Collector) -> None:
+    first: dict[str, tuple[float, ...]] = {}
+    for m in urdf.materials:
+        if m.rgba is None:
+            continue
+        bad = [c for c in m.rgba if not 0.0 <= c <= 1.0]
+        if bad:
+            out.add(
+                "rgba-range",
+                m.line,
+                f"material {m.name!r}: rgba {list(m.rgba)} outside [0, 1]",
+                rgba=list(m.rgba),
+            )
+        prev = first.setdefault(m.name, m.rgba)
+        if prev != m.rgba:
+            out.add(
+                "material-conflict",
+                m.line,
+                f"material {m.name!r} redefined: rgba {list(m.rgba)} vs {list(prev)}",
+                rgba=list(m.rgba),
+                first=list(prev),
+            )
+
+
+def _geometry_sizes(link: Link, out: Collector) -> None:
+    for tag, shapes in (("visual", link.visuals), ("collision", link.collisions)):
+        for s in shapes:
+            g = s.geometry
+            if g is None or not g.kind:
+                out.add(
+                    "geometry-kind", s.line, f"link {link.name!r}: {tag} without a geometry shape"
+                )
+            elif g.kind not in ("box", "cylinder", "sphere", "mesh"):
+                out.add("geometry-kind", g.line, f"link {link.name!r}: unknown geometry <{g.kind}>")
+            elif g.dims is not None and not all(d > 0 for d in g.dims):
+                out.add(
+                    "geometry-size",
+                    g.line,
+                    f"link {link.name!r}: {tag} {g.kind} sizes {list(g.dims)} must be > 0",
+                    dims=list(g.dims),
+                )
+            elif g.kind == "mesh" and not all(c != 0 for c in g.scale):
+                out.add(
+                    "geometry-size",
+                    g.line,
+                    f"link {link.name!r}: mesh scale {list(g.scale)} has a zero",
+                    scale=list(g.scale),
+                )
+
+
+def _joint_shape(j: Joint, links: set[str], joints: set[str], out: Collector) -> None:
+    for role, name in (("parent", j.parent), ("child", j.child)):
+        if name is None:
+            out.add("unknown-link", j.line, f"joint {j.name!r}: no <{role} link=...>", link="")
+        elif name not in links:
+            out.add(
+                "unknown-link",
+                j.line,
+                f"joint {j.name!r}: {role} link {name!r} does not exist",
+                link=name,
+            )
+    if j.type not in JOINT_TYPES:
+        out.add("joint-type", j.line, f"joint {j.name!r}: unknown type {j.type!r}", type=j.type)
+    if j.type in ("revolute", "prismatic"):
+        lim = j.limit
+        missing = (
+            ["limit"]
+            if lim is None
+            else [a for a in ("effort", "velocity") if getattr(lim, a) is None]
+        )
+        if missing:
+            out.add(
+                "missing-limit",
+                (lim.line if lim else j.line),
+                f"{j.type} joint {j.name!r} lacks {', '.join(missing)}",
+            )
+    if j.mimic is not None and j.mimic not in joints:
+        out.add(
+            "mimic-target",
+            j.mimic_line,
+            f"joint {j.name!r} mimics unknown joint {j.mimic!r}",
+            target=j.mimic,
+        )
+
+
+def _tree(urdf: Urdf, links: set[str], out: Collector) -> Tree:
+    parent_joint: dict[str, Joint] = {}
+    for j in urdf.joints:
+        if j.child is None or j.child not in links:
+            continue
+        if j.child in parent_joint:
+            out.add(
+                "multiple-parents",
+                j.line,
+                f"link {j.child!r} is the child of {parent_joint[j.child].name!r} and {j.name!r}",
+                link=j.child,
+            )
+            continue
+        parent_joint[j.child] = j
+    roots = sorted(lk for lk in links if lk not in parent_joint)
+    if len(roots) != 1:
+        line = urdf.links[0].line if urdf.links else None
+        out.add(
+            "root-count",
+            line,
+            _root_message(roots, bool(links)),
+            roots=", ".join(roots),
+        )
+        return Tree(roots[0] if roots else None, parent_joint, frozenset())
+    moving, reached = _reach(roots[0], parent_joint)
+    # Links hanging from a joint whose parent is unknown were reported as unknown-link.
+    dangling = {c for c, j in parent_joint.items() if j.parent not in links}
+    _, below = _reach_all(dangling, parent_joint)
+    orphans = sorted(links - reached - below)
+    if orphans:
+        line = next((lk.line for lk in urdf.links if lk.name == orphans[0]), None)
+        out.add(
+            "disconnected",
+            line,
+            f"links not connected to root {roots[0]!r} (cycle?): {orphans}",
+            links=", ".join(orphans),
+        )
+    return Tree(roots[0], parent_joint, frozenset(moving))
+
+
+def _reach_all(starts: set[str], parent_joint: dict[str, Joint]) -> tuple[set[str], set[str]]:
+    moving: set[str] = set()
+    reached: set[str] = set()
+    for s in starts:
+        m, r = _reach(s, parent_joint)
+        moving |= m
+        reached |= r
+    return moving, reached
+
+
+def _reach(root: str, parent_joint: dict[str, Joint]) -> tuple[set[str], set[str]]:
+    children: dict[str, list[Joint]] = {}
+    for j in parent_joint.values():
+        children.setdefault(str(j.parent), []).append(j)
+    moving: set[str] = set()
+    reached = {root}
+    frontier = [(root, False)]
+    while frontier:
+        link, is_moving = frontier.pop()
+        for j in children.get(link, []):
+            child_moving = is_moving or j.type != "fixed"
+            if j.child in reached:
+                continue
+            reached.add(str(j.child))
+            if child_moving:
+                moving.add(str(j.child))
+            frontier.append((str(j.child), child_moving))
+    return moving, reached
+
+
+def finite(*values: float | None) -> bool:
+    """True when every value is present and finite."""
+    return all(v is not None and math.isfinite(v) for v in values)
+
+
+def _root_message(roots: list[str], has_links: bool) -> str:
+    if not has_links:
+        return "no <link>"
+    if not roots:
+        return "no root link: every link has a parent joint, so the joints form a cycle"
+    return f"expected one root link, found {len(roots)}: {', '.join(roots)}"

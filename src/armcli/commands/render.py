@@ -1,0 +1,80 @@
+"""`armcli render`: draw the robot at a pose into a PNG, headless."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import typer
+
+from armcli.defaults import DEFAULT_SPEC
+from armcli.errors import InputError
+from armcli.io.outdir import check_output_file
+from armcli.urdf.meshes import MeshSearch, parse_package_dirs
+from armcli.urdf.source import TRUST_XACRO_HELP
+from armcli.view.png import load_urdf, render_png
+from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(x) for x in text.lower().split("x"))
+    except ValueError:
+        raise InputError(f"{text!r}: expected WIDTHxHEIGHT in pixels", field="--size") from None
+    if not (100 <= w <= 8000 and 100 <= h <= 8000):
+        raise InputError(f"{text!r}: each side must be 100..8000 px", field="--size")
+    return w, h
+
+
+def render_cmd(
+    robot: Path = typer.Argument(DEFAULT_SPEC, show_default=False, help=ROBOT_HELP),
+    pose: str = typer.Option(None, "--pose", help="A named pose of the spec."),
+    q: str = typer.Option(
+        None,
+        "--q",
+        help="Joint values in rad (m if prismatic): '0.3,pi/4' in arm order, or 'joint=0.3,...'.",
+    ),
+    out: Path = typer.Option(
+        Path("robot.png"),
+        "-o",
+        "--out",
+        show_default=False,
+        help="PNG to write (default: robot.png).",
+    ),
+    size: str = typer.Option(
+        "1200x600",
+        "--size",
+        show_default=False,
+        help="Image size WIDTHxHEIGHT in pixels (default: 1200x600).",
+    ),
+    package_dir: list[str] = typer.Option(
+        [], "--package-dir", help="NAME=PATH for package://NAME/ mesh URIs (repeatable)."
+    ),
+    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
+) -> None:
+    """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
+    check_output_file(out, "--out")  # before any work: nothing else is written
+    src = load_robot(robot, trust_xacro, MeshSearch(parse_package_dirs(package_dir)))
+    values = pose_q(src, pose, q)
+    width, height = _size(size)
+    urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search)
+    res = render_png(
+        urdf,
+        values,
+        out,
+        tool=src.tool,
+        name=src.name,
+        size=(width, height),
+        field="--pose" if pose else "--q",
+    )
+    tip = (
+        ""
+        if res.tool_position is None
+        else " tool at ({:.3f}, {:.3f}, {:.3f}) m".format(*res.tool_position)
+    )
+    sys.stdout.write(f"wrote {res.path} ({res.width}x{res.height} px){tip}\n")
+
+
+def register(app: typer.Typer) -> None:
+    """Add `armcli render` to the app."""
+    app.command("render")(render_cmd)

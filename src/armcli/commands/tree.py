@@ -1,0 +1,62 @@
+"""`armcli tree`: print the kinematic tree as text or Graphviz DOT."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import typer
+
+from armcli.defaults import DEFAULT_SPEC
+from armcli.errors import InputError
+from armcli.io.files import write_file_atomic
+from armcli.io.outdir import check_output_file
+from armcli.urdf.source import TRUST_XACRO_HELP
+from armcli.urdf.tree import parse_tree, to_dot, to_rich
+from armcli.view.scene import ROBOT_HELP, load_robot
+
+TREE_FORMATS = ("text", "dot")
+
+
+def tree_cmd(
+    robot: Path = typer.Argument(DEFAULT_SPEC, show_default=False, help=ROBOT_HELP),
+    fmt: str = typer.Option(
+        "text",
+        "--format",
+        metavar="[" + "|".join(TREE_FORMATS) + "]",
+        show_default=False,
+        help="text (a tree, the default) or dot (Graphviz).",
+    ),
+    out: Path = typer.Option(None, "-o", "--out", help="Write to this file instead of stdout."),
+    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
+) -> None:
+    """Print the kinematic tree: links, and joints with their types and limits."""
+    if fmt not in TREE_FORMATS:
+        raise InputError(f"unknown format {fmt!r}; known: text, dot", field="--format")
+    if out is not None:
+        check_output_file(out, "--out")
+    src = load_robot(robot, trust_xacro)
+    tree = parse_tree(src.xml, src.source)
+    if fmt == "dot":
+        text = to_dot(tree)
+    else:
+        import io
+
+        from rich.console import Console
+
+        if out is None:
+            Console().print(to_rich(tree))
+            return
+        buf = io.StringIO()
+        Console(file=buf, width=120).print(to_rich(tree))
+        text = buf.getvalue()
+    if out is None:
+        sys.stdout.write(text)
+    else:
+        write_file_atomic(out, text.encode("utf-8"))
+        sys.stdout.write(f"wrote {out}\n")
+
+
+def register(app: typer.Typer) -> None:
+    """Add `armcli tree` to the app."""
+    app.command("tree")(tree_cmd)

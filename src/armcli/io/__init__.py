@@ -1,0 +1,4 @@
+"""Safe file input and output: YAML with line numbers, bounded reads, atomic writes.
+
+May import only `armcli.errors` and `armcli.defaults`.
+"""

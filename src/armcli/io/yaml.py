@@ -1,0 +1,216 @@
+"""Safe YAML reading for user files: no aliases, no duplicate keys, bounded size, line numbers.
+
+PyYAML's `safe_load` still expands alias bombs and silently keeps the last of
+duplicate keys, so user files go through this reader instead. It also returns
+a map from field path to line so that validation errors can point at a line.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from armcli.errors import InputError
+from armcli.io.userfile import read_regular
+
+MAX_YAML_BYTES = 1_000_000
+MAX_YAML_DEPTH = 64
+MAX_INT_BITS = 1024  # larger integers exceed the float range every consumer converts to
+
+Path_ = tuple[str | int, ...]
+_PLAIN_TAGS = {
+    f"tag:yaml.org,2002:{t}" for t in ("str", "int", "float", "bool", "null", "map", "seq")
+}
+
+
+@dataclass
+class YamlDoc:
+    """Plain Python data plus the line (1-based) each field path starts on."""
+
+    data: Any
+    lines: dict[Path_, int] = field(default_factory=dict)
+    source: str = "<string>"
+
+    def line_of(self, path: Path_) -> int | None:
+        """Line of `path`, or of its closest ancestor that has one."""
+        p = tuple(path)
+        while True:
+            if p in self.lines:
+                return self.lines[p]
+            if not p:
+                return None
+            p = p[:-1]
+
+
+_Base: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml when PyYAML has it
+
+
+class _Loader(_Base):  # type: ignore[misc]
+    """The safe loader (C-accelerated where available); anchors are refused before use."""
+
+
+# YAML 1.1 (PyYAML) reads `1e9` as a string; YAML 1.2 and ROS tools read it as a float.
+_Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
+    list("-+0123456789."),
+)
+
+
+def _scan_events(text: str, source: str) -> None:
+    """Refuse anchors/aliases and excessive nesting before building anything."""
+    depth = 0
+    try:
+        for ev in yaml.parse(text, Loader=_Loader):
+            line = ev.start_mark.line + 1 if ev.start_mark else None
+            if isinstance(ev, yaml.AliasEvent) or getattr(ev, "anchor", None):
+                raise InputError(
+                    "YAML anchors/aliases are not allowed in armcli input files",
+                    file=source,
+                    line=line,
+                )
+            if isinstance(ev, yaml.CollectionStartEvent):
+                depth += 1
+                if depth > MAX_YAML_DEPTH:
+                    raise InputError(
+                        f"nesting deeper than {MAX_YAML_DEPTH} levels", file=source, line=line
+                    )
+            elif isinstance(ev, yaml.CollectionEndEvent):
+                depth -= 1
+    except yaml.YAMLError as exc:
+        raise _yaml_error(exc, source) from None
+
+
+def _yaml_error(exc: yaml.YAMLError, source: str) -> InputError:
+    mark = getattr(exc, "problem_mark", None)
+    line = mark.line + 1 if mark is not None else None
+    problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+    return InputError(f"malformed YAML: {problem}", file=source, line=line)
+
+
+def _build(
+    node: yaml.Node,
+    loader: _Loader,
+    path: Path_,
+    doc: YamlDoc,
+    flow_sets: bool,
+) -> Any:
+    doc.lines.setdefault(path, node.start_mark.line + 1)
+    if node.tag not in _PLAIN_TAGS:
+        raise InputError(
+            f"unsupported YAML tag {node.tag!r}", file=doc.source, line=node.start_mark.line + 1
+        )
+    if isinstance(node, yaml.ScalarNode):
+        try:
+            value = loader.construct_object(node, deep=True)
+        except ValueError:  # int("9" * 5000): Python's 4300-digit conversion limit
+            value = None
+            too_big = True
+        else:  # 0xfff...: no digit limit, but beyond any float (and str() of it fails)
+            too_big = isinstance(value, int) and value.bit_length() > MAX_INT_BITS
+        if too_big:
+            raise InputError(
+                f"integer out of range ({len(node.value)} characters; at most 1.8e308)",
+                file=doc.source,
+                line=node.start_mark.line + 1,
+                field=_dotted(path) or None,
+            )
+        if isinstance(value, str | int | float | bool) or value is None:
+            return value
+        # timestamps, binary, ...: keep the source text, the schema decides.
+        return str(node.value)
+    if isinstance(node, yaml.SequenceNode):
+        return [
+            _build(child, loader, (*path, i), doc, flow_sets) for i, child in enumerate(node.value)
+        ]
+    if isinstance(node, yaml.MappingNode):
+        if (
+            flow_sets
+            and node.flow_style
+            and node.value
+            and all(
+                isinstance(v, yaml.ScalarNode) and v.tag.endswith(":null") and v.value in ("", "~")
+                for _, v in node.value
+            )
+        ):
+            # ROS tolerates `{0.0, 0.0}` (a flow mapping of null values) as a list.
+            return [
+                _build(k, loader, (*path, i), doc, flow_sets) for i, (k, _) in enumerate(node.value)
+            ]
+        out: dict[Any, Any] = {}
+        for key_node, value_node in node.value:
+            key = _build(key_node, loader, path, doc, flow_sets)
+            if isinstance(key, list | dict):
+                raise InputError(
+                    "mapping keys must be scalars",
+                    file=doc.source,
+                    line=key_node.start_mark.line + 1,
+                )
+            key = str(key) if not isinstance(key, str) else key
+            if key in out:
+                raise InputError(
+                    f"duplicate key {key!r}",
+                    file=doc.source,
+                    line=key_node.start_mark.line + 1,
+                    field=_dotted((*path, key)),
+                )
+            out[key] = _build(value_node, loader, (*path, key), doc, flow_sets)
+        return out
+    raise InputError("unsupported YAML node", file=doc.source)  # pragma: no cover
+
+
+def _dotted(path: Path_) -> str:
+    out = ""
+    for part in path:
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out
+
+
+dotted = _dotted
+
+
+def loads_yaml(text: str, source: str = "<string>", *, flow_sets: bool = False) -> YamlDoc:
+    """Parse one YAML document from text under armcli's safety rules."""
+    if len(text.encode("utf-8", "surrogatepass")) > MAX_YAML_BYTES:
+        raise InputError(f"file larger than {MAX_YAML_BYTES} bytes", file=source)
+    if "\x00" in text:
+        raise InputError("binary data (NUL byte) in a YAML file", file=source)
+    _scan_events(text, source)
+    loader = _Loader(text)
+    doc = YamlDoc(data=None, source=source)
+    try:
+        node = loader.get_single_node()
+        if node is not None:
+            doc.data = _build(node, loader, (), doc, flow_sets)
+    except yaml.YAMLError as exc:
+        raise _yaml_error(exc, source) from None
+    except RecursionError:
+        raise InputError("YAML nested too deeply", file=source) from None
+    finally:
+        loader.dispose()
+    return doc
+
+
+def read_text(path: str | Path, *, max_bytes: int = MAX_YAML_BYTES, what: str = "file") -> str:
+    """Read a user text file (regular files only) with a size cap and clear errors."""
+    raw = read_regular(path, max_bytes=max_bytes, what=what)
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise InputError(f"{what} is not UTF-8 text", file=Path(path)) from None
+
+
+def load_yaml(path: str | Path, *, flow_sets: bool = False) -> YamlDoc:
+    """Read and parse a YAML file under armcli's safety rules."""
+    text = read_text(path, what="YAML file")
+    return loads_yaml(text, str(path), flow_sets=flow_sets)
+
+
+def is_finite_number(x: object) -> bool:
+    """Whether `x` is a finite int or float; YAML booleans are not numbers here."""
+    return isinstance(x, int | float) and not isinstance(x, bool) and math.isfinite(x)

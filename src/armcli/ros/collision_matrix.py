@@ -1,0 +1,230 @@
+"""Which link pairs MoveIt may skip in collision checking, computed like its Setup Assistant.
+
+MoveIt checks every pair of links with collision geometry unless the SRDF
+disables it. The Setup Assistant disables a pair when checking it is useless:
+`Adjacent` (parent and child touch by construction; links without collision
+geometry are see-through, so their neighbours count as adjacent), `Default`
+(already in collision at the default state, so it would always report a
+collision), and `Never` (no collision in any of N random states within the
+joint limits). This module does the same with Pinocchio's GeometryModel and
+coal, seeded so that the same URDF, sample count and seed give the same matrix.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from armcli.errors import BuildError, InputError
+from armcli.urdf.doc import Urdf
+from armcli.urdf.pinocchio import load_model
+from armcli.urdf.read import parse_urdf
+
+DEFAULT_SAMPLES = 10_000  # the Setup Assistant's default "sampling density"
+DEFAULT_SEED = 0
+REASONS = ("Adjacent", "Default", "Never")
+
+
+@dataclass(frozen=True)
+class DisabledPair:
+    """One SRDF `<disable_collisions>` entry; link1 < link2 alphabetically."""
+
+    link1: str
+    link2: str
+    reason: str  # one of REASONS
+
+
+@dataclass(frozen=True)
+class EnabledPair:
+    """A pair that stays checked, with in how many of the random states it collided."""
+
+    link1: str
+    link2: str
+    collisions: int
+
+
+@dataclass(frozen=True)
+class CollisionMatrix:
+    """The pairs MoveIt may skip and the pairs it checks, with the sampling used.
+
+    `samples` and `seed` reproduce the matrix; `pose_collisions` lists pairs in contact at
+    the spec's named poses.
+    """
+
+    links: tuple[str, ...]  # links with collision geometry, sorted
+    disabled: tuple[DisabledPair, ...]  # sorted by (link1, link2)
+    enabled: tuple[EnabledPair, ...]
+    samples: int
+    seed: int
+    pose_collisions: tuple[tuple[str, str, str], ...] = ()  # (pose, link1, link2) in contact
+
+    def reason(self, a: str, b: str) -> str | None:
+        """Why the pair (a, b) is disabled, or None if MoveIt keeps checking it."""
+        key = _pair(a, b)
+        return next((d.reason for d in self.disabled if (d.link1, d.link2) == key), None)
+
+
+def _pair(a: str, b: str) -> tuple[str, str]:
+    return (a, b) if a <= b else (b, a)
+
+
+def adjacent_pairs(urdf: Urdf) -> set[tuple[str, str]]:
+    """Parent/child link pairs, bridging links that have no collision geometry (as MoveIt does)."""
+    graph: dict[str, set[str]] = {lk.name: set() for lk in urdf.links}
+    for j in urdf.joints:
+        if j.parent in graph and j.child in graph:
+            graph[j.parent].add(j.child)
+            graph[j.child].add(j.parent)
+    for lk in urdf.links:
+        if not lk.collisions:
+            for a, b in itertools.combinations(sorted(graph[lk.name]), 2):
+                graph[a].add(b)
+                graph[b].add(a)
+    solid = {lk.name for lk in urdf.links if lk.collisions}
+    return {_pair(a, b) for a in solid for b in graph[a] if b in solid and a != b}
+
+
+class _Sampler:
+    """Joint configurations for a Pinocchio model: default state and uniform random states."""
+
+    def __init__(self, model: Any) -> None:
+        self.model = model
+        self.joints = []  # (idx_q, nq, lower, upper) per actuated joint
+        for jm in list(model.joints)[1:]:
+            lo = float(model.lowerPositionLimit[jm.idx_q])
+            hi = float(model.upperPositionLimit[jm.idx_q])
+            if jm.nq == 2 and jm.nv == 1:  # continuous revolute joint stored as (cos, sin)
+                lo, hi = -math.pi, math.pi
+            elif jm.nq != 1 or not (math.isfinite(lo) and math.isfinite(hi)):
+                raise BuildError(f"collision matrix: unsupported joint {jm.shortname()}")
+            self.joints.append((jm.idx_q, jm.nq, lo, hi))
+
+    def _q(self, angles: Iterable[float]) -> np.ndarray:
+        q = np.zeros(self.model.nq)
+        for (iq, nq, _, _), x in zip(self.joints, angles, strict=True):
+            if nq == 2:
+                q[iq], q[iq + 1] = math.cos(x), math.sin(x)
+            else:
+                q[iq] = x
+        return q
+
+    def default(self) -> np.ndarray:
+        """MoveIt's default state: 0 where the limits allow it, else the middle of the range."""
+        return self._q(0.0 if lo <= 0.0 <= hi else 0.5 * (lo + hi) for _, _, lo, hi in self.joints)
+
+    def named(self, values: dict[str, float]) -> np.ndarray:
+        """The default state with the named joints set (revolute/prismatic only)."""
+        q = self.default()
+        for name, x in values.items():
+            jm = self.model.joints[self.model.getJointId(name)]
+            if jm.nq == 1:
+                q[jm.idx_q] = x
+        return q
+
+    def random(self, rng: np.random.Generator) -> np.ndarray:
+        return self._q(rng.uniform(lo, hi) for _, _, lo, hi in self.joints)
+
+
+class _Checker:
+    """Pinocchio geometry model restricted to candidate link pairs."""
+
+    def __init__(self, xml: str, source: str, candidates: list[tuple[str, str]]) -> None:
+        import pinocchio as pin
+
+        self.pin = pin
+        self.model = load_model(source, xml=xml).model
+        self.data = self.model.createData()
+        gmodel = pin.buildGeomFromUrdfString(self.model, xml, pin.GeometryType.COLLISION)
+        link_of = [self.model.frames[g.parentFrame].name for g in gmodel.geometryObjects]
+        wanted = set(candidates)
+        self.pair_links: list[tuple[str, str]] = []
+        for i, j in itertools.combinations(range(len(link_of)), 2):
+            key = _pair(link_of[i], link_of[j])
+            if link_of[i] != link_of[j] and key in wanted:
+                gmodel.addCollisionPair(pin.CollisionPair(i, j))
+                self.pair_links.append(key)
+        self.gmodel = gmodel
+        self.gdata = pin.GeometryData(gmodel)
+
+    def colliding(self, q: np.ndarray, active: Iterable[int]) -> set[tuple[str, str]]:
+        """Link pairs in collision at q, testing only the collision pairs in `active`."""
+        self.pin.updateGeometryPlacements(self.model, self.data, self.gmodel, self.gdata, q)
+        hits = set()
+        for k in active:
+            if self.pin.computeCollision(self.gmodel, self.gdata, k):
+                hits.add(self.pair_links[k])
+        return hits
+
+
+def _classify(
+    candidates: list[tuple[str, str]],
+    adjacent: set[tuple[str, str]],
+    default_hits: set[tuple[str, str]],
+    seen: set[tuple[str, str]],
+    counts: dict[tuple[str, str], int],
+) -> tuple[tuple[DisabledPair, ...], tuple[EnabledPair, ...]]:
+    """Sort every pair into Adjacent / Default / Never (disabled) or still checked."""
+    disabled = [DisabledPair(a, b, "Adjacent") for a, b in adjacent]
+    enabled = []
+    for a, b in candidates:
+        if (a, b) in default_hits:
+            disabled.append(DisabledPair(a, b, "Default"))
+        elif (a, b) in seen:
+            enabled.append(EnabledPair(a, b, counts[(a, b)]))
+        else:
+            disabled.append(DisabledPair(a, b, "Never"))
+    return tuple(sorted(disabled, key=lambda d: (d.link1, d.link2))), tuple(enabled)
+
+
+def compute_collision_matrix(
+    urdf_xml: str | bytes,
+    *,
+    samples: int = DEFAULT_SAMPLES,
+    seed: int = DEFAULT_SEED,
+    source: str = "<urdf>",
+    poses: dict[str, dict[str, float]] | None = None,
+) -> CollisionMatrix:
+    """The Setup-Assistant-style collision matrix of a URDF (see the module docstring).
+
+    `poses` (name -> joint values) are extra, deterministic samples: a pair in
+    contact at a named pose is never marked `Never`, however rarely the random
+    states hit it, and the contacts are returned in `pose_collisions`.
+    """
+    if samples < 1:
+        raise InputError("must be at least 1", field="samples")
+    data = urdf_xml.encode("utf-8") if isinstance(urdf_xml, str) else urdf_xml
+    urdf = parse_urdf(data, source)
+    links = tuple(sorted(lk.name for lk in urdf.links if lk.collisions))
+    adjacent = adjacent_pairs(urdf)
+    candidates = [p for p in itertools.combinations(links, 2) if p not in adjacent]
+    checker = _Checker(data.decode("utf-8"), source, candidates)
+    sampler = _Sampler(checker.model)
+    all_k = range(len(checker.pair_links))
+    default_hits = checker.colliding(sampler.default(), all_k)
+
+    active = [k for k in all_k if checker.pair_links[k] not in default_hits]
+    in_pose = [
+        (name, a, b)
+        for name, values in (poses or {}).items()
+        for a, b in sorted(checker.colliding(sampler.named(values), active))
+    ]
+    counts = dict.fromkeys(candidates, 0)
+    rng = np.random.default_rng(seed)
+    for _ in range(samples):
+        for key in checker.colliding(sampler.random(rng), active):
+            counts[key] += 1
+    seen = {key for key, c in counts.items() if c > 0} | {(a, b) for _, a, b in in_pose}
+    disabled, enabled = _classify(candidates, adjacent, default_hits, seen, counts)
+    return CollisionMatrix(
+        links=links,
+        disabled=disabled,
+        enabled=enabled,
+        samples=samples,
+        seed=seed,
+        pose_collisions=tuple(in_pose),
+    )

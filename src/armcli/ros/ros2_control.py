@@ -1,0 +1,75 @@
+"""The MoveIt config's robot description: the course xacro plus a ros2_control block.
+
+The MoveIt demo runs the arm on ros2_control's mock hardware, which needs a
+`<ros2_control>` tag naming every commanded joint and its initial position.
+The course description stays untouched: `config/<name>.urdf.xacro` includes
+it from the description package and adds the tag, as the Setup Assistant does.
+"""
+
+from __future__ import annotations
+
+from lxml import etree
+
+from armcli.build.xmlfmt import XACRO_NS, to_bytes
+
+X = f"{{{XACRO_NS}}}"
+MOCK_PLUGIN = "mock_components/GenericSystem"
+INITIAL_POSITIONS_FILE = "initial_positions.yaml"
+
+
+def _robot(name: str | None = None) -> etree._Element:
+    attrs = {"name": name} if name else {}
+    return etree.Element("robot", attrs, nsmap={"xacro": XACRO_NS})
+
+
+def macro_name(robot: str) -> str:
+    """Name of the xacro macro that emits the robot's `<ros2_control>` block."""
+    return f"{robot}_ros2_control"
+
+
+def ros2_control_xacro(
+    robot: str, commanded: list[str], passive: list[str], header: str | None = None
+) -> bytes:
+    """A xacro macro emitting the `<ros2_control>` block.
+
+    `commanded` joints take position commands; `passive` ones only report state.
+    """
+    root = _robot()
+    macro = etree.SubElement(
+        root, X + "macro", name=macro_name(robot), params="name initial_positions_file"
+    )
+    etree.SubElement(
+        macro,
+        X + "property",
+        name="initial_positions",
+        value="${xacro.load_yaml(initial_positions_file)['initial_positions']}",
+    )
+    rc = etree.SubElement(macro, "ros2_control", name="${name}", type="system")
+    hw = etree.SubElement(rc, "hardware")
+    etree.SubElement(hw, "plugin").text = MOCK_PLUGIN
+    for j in [*commanded, *passive]:
+        el = etree.SubElement(rc, "joint", name=j)
+        if j in commanded:
+            etree.SubElement(el, "command_interface", name="position")
+        pos = etree.SubElement(el, "state_interface", name="position")
+        param = etree.SubElement(pos, "param", name="initial_value")
+        param.text = "${initial_positions['" + j + "']}"
+        etree.SubElement(el, "state_interface", name="velocity")
+    return to_bytes(root, header_comment=header)
+
+
+def moveit_urdf_xacro(
+    robot: str, description_pkg: str, top_xacro: str, header: str | None = None
+) -> bytes:
+    """`config/<robot>.urdf.xacro`: the course description plus the ros2_control macro call."""
+    root = _robot(robot)
+    etree.SubElement(root, X + "arg", name="initial_positions_file", default=INITIAL_POSITIONS_FILE)
+    etree.SubElement(root, X + "include", filename=f"$(find {description_pkg})/urdf/{top_xacro}")
+    etree.SubElement(root, X + "include", filename=f"{robot}.ros2_control.xacro")
+    etree.SubElement(
+        root,
+        X + macro_name(robot),
+        name="MockSystem",
+        initial_positions_file="$(arg initial_positions_file)",
+    )
+    return to_bytes(root, header_comment=header)

@@ -1,0 +1,240 @@
+"""Put a simulation together from user inputs: spec or URDF, joints, gains, trajectory.
+
+The CLI only parses options and prints; everything that decides what is simulated
+(model, start state, gains, reference, duration, tool point) is here so tests can run it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from armcli.build.expand import expand_urdfs
+from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_URDF
+from armcli.errors import InputError
+from armcli.sim.options import SimOptions
+from armcli.sim.reference import Reference, build_reference
+from armcli.sim.simulate import Arm, SimConfig, SimResult, arm_from_model, check_stability, simulate
+from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
+from armcli.spec.model import RobotSpec
+from armcli.urdf.doc import Urdf
+from armcli.urdf.read import parse_urdf
+from armcli.urdf.source import checked_model, read_urdf_file
+from armcli.urdf.tool import tool_point
+
+SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
+ARM_URDF = STANDALONE_ARM_URDF
+RATE_SLACK = 1e-9  # relative: --rate 1000 with dt 0.001 is exactly one sample per step
+MAX_STEPS = 2_000_000  # ~200 MB of recorded states for a 2-joint arm
+
+
+@dataclass(frozen=True)
+class SimJob:
+    """Everything one simulation run needs, as `prepare` decided it from the user inputs."""
+
+    arm: Arm
+    trajectory: Trajectory
+    reference: Reference
+    q0: np.ndarray
+    duration: float
+    config: SimConfig
+    tool_frame: int  # pinocchio frame id of the end-effector link
+    tool_offset: np.ndarray  # [m] point in that frame
+    tool_label: str
+    rate: float  # [Hz] joint_state_publisher rate
+    T_frame_root: np.ndarray  # 4x4 pose of the arm's root link in the reporting frame
+
+
+def arm_urdf(spec: RobotSpec | None, urdf: Path | None, *, trust_xacro: bool = False) -> Urdf:
+    """The URDF to simulate: a given file or the spec's standalone arm built in memory.
+
+    A given file goes through the strict reader (a foreign xacro only when trusted).
+    """
+    if urdf is not None:
+        return read_urdf_file(urdf, trust_xacro=trust_xacro)
+    if spec is None:
+        raise InputError("give a spec or --urdf", field="--urdf")
+    return parse_urdf(expand_urdfs(spec)[ARM_URDF], ARM_URDF)
+
+
+def load_arm(
+    spec: RobotSpec | None,
+    urdf: Path | None,
+    joints: Sequence[str] | None,
+    *,
+    trust_xacro: bool = False,
+) -> Arm:
+    """The simulated arm: the spec's standalone arm built in memory, or a given URDF.
+
+    A given URDF goes through the same strict reader as `check` (no DOCTYPE, finite
+    numbers, no foreign xacro without trust), since Pinocchio alone would simulate
+    mass="nan" as 0 kg.
+    """
+    return arm_from_model(
+        checked_model(arm_urdf(spec, urdf, trust_xacro=trust_xacro)).model, joints
+    )
+
+
+def _gains(
+    arm: Arm, spec: RobotSpec | None, override: Sequence[float] | None, which: str
+) -> np.ndarray:
+    n = len(arm.joint_names)
+    if override:
+        if len(override) not in (1, n):
+            raise InputError(f"give 1 or {n} value(s), got {len(override)}", field=f"--{which}")
+        vals = np.array(list(override) * (n if len(override) == 1 else 1), dtype=np.float64)
+        if not np.all(np.isfinite(vals)) or np.any(vals < 0.0):
+            raise InputError("gains must be finite and >= 0", field=f"--{which}")
+        return vals
+    gains = spec.control.gains if spec is not None else {}
+    missing = [j for j in arm.joint_names if j not in gains]
+    if missing:
+        raise InputError(
+            f"no {which} for {', '.join(missing)} in the spec; give --{which}", field=f"--{which}"
+        )
+    return np.array([getattr(gains[j], which) for j in arm.joint_names], dtype=float)
+
+
+def _refuse_integral_gain(arm: Arm, spec: RobotSpec | None) -> None:
+    """The simulator runs PD: a spec ki would be silently dropped, so it is refused instead."""
+    gains = spec.control.gains if spec is not None else {}
+    for j in arm.joint_names:
+        if j in gains and gains[j].ki > 0.0:
+            raise InputError(
+                f"= {gains[j].ki:g}: armcli simulates PD control only (no integral term); "
+                "set ki to 0 to simulate this spec, or give --kp and --kd explicitly",
+                field=f"control.gains.{j}.ki",
+            )
+
+
+def _tool(arm: Arm, doc: Urdf, spec: RobotSpec | None) -> tuple[int, np.ndarray, str]:
+    """The tool point (armcli.urdf.tool) as (Pinocchio frame id, offset [m], label)."""
+    model = arm.model
+    tool = tool_point(doc, spec)
+    if tool is None or not model.existFrame(tool.link):
+        raise InputError("this URDF has no link to report as the end effector", file=doc.source)
+    off = np.array(tool.xyz, dtype=float)
+    label = f"{tool.link}+{_fmt(off)}" if np.any(off) else tool.link
+    return model.getFrameId(tool.link), off, label
+
+
+def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
+    """Frame the tool point is reported in, and the arm root's pose in it.
+
+    With a spec that mounts the arm on a mobile base, that is the base's root link
+    (base_footprint), composed from the fixed joint origins (moving joints at 0),
+    so the numbers match `check` and `view`; otherwise the arm's own root link.
+    """
+    import pinocchio as pin
+
+    model = arm.model
+    root = next(f.name for f in model.frames if f.parentJoint == 0 and f.name != "universe")
+    T = pin.SE3.Identity()
+    if spec is None or spec.mobile_base is None or spec.mount is None:
+        return root, T.homogeneous
+    by_child = {j.child: j for j in spec.all_joints().values()}
+    link = spec.arm_root()
+    while link in by_child:
+        joint = by_child[link]
+        rot = pin.rpy.rpyToMatrix(*joint.origin.rpy)
+        T = pin.SE3(rot, np.array(joint.origin.xyz, dtype=float)) * T
+        link = joint.parent
+    return link, T.homogeneous
+
+
+def _fmt(v: np.ndarray) -> str:
+    return "(" + ",".join(f"{x:g}" for x in v) + ")"
+
+
+def start_state(arm: Arm, spec: RobotSpec | None) -> np.ndarray:
+    """The spec's `home` pose if it has one, else zero clamped into the joint limits."""
+    q = np.zeros(len(arm.joint_names))
+    if spec is not None and "home" in spec.poses:
+        home = spec.pose("home")
+        q = np.array([home.get(j, 0.0) for j in arm.joint_names], dtype=float)
+    return np.clip(q, arm.lower, arm.upper)
+
+
+def prepare(
+    spec: RobotSpec | None, opts: SimOptions, *, gate: Callable[[Urdf], None] | None = None
+) -> SimJob:
+    """Validate every input and assemble the run; raises InputError on bad input.
+
+    `gate` sees a given URDF (`--urdf`) before it is simulated and may refuse it
+    (the simulate command passes check.gate.refuse_check_errors).
+    """
+    trajectory, message, dt, rate = opts.trajectory, opts.message, opts.dt, opts.rate
+    if (trajectory is None) == (message is None):
+        raise InputError(
+            "give exactly one of --trajectory FILE or --message '...'", field="--trajectory"
+        )
+    dt = dt if dt is not None else (spec.control.dt if spec is not None else DEFAULT_DT)
+    if not (np.isfinite(dt) and 0 < dt <= 0.1):
+        raise InputError(f"must be in (0, 0.1] s, got {dt:g}", field="--dt")
+    doc = arm_urdf(spec, opts.urdf, trust_xacro=opts.trust_xacro)
+    arm = arm_from_model(checked_model(doc, gate=gate if opts.urdf else None).model, opts.joints)
+    limits = {
+        n: (float(lo), float(hi))
+        for n, lo, hi in zip(arm.joint_names, arm.lower, arm.upper, strict=True)
+    }
+    if trajectory is not None:
+        traj = load_trajectory(trajectory, limits, clamp=opts.clamp)
+    else:
+        traj = loads_trajectory(str(message), limits, clamp=opts.clamp)
+    q0 = start_state(arm, spec)
+    ref = build_reference(traj, arm.joint_names, q0)
+    gc = (
+        opts.gravity_comp
+        if opts.gravity_comp is not None
+        else bool(spec and spec.control.gravity_compensation)
+    )
+    kp, kd = _gains(arm, spec, opts.kp, "kp"), _gains(arm, spec, opts.kd, "kd")
+    if opts.kp is None or opts.kd is None:
+        _refuse_integral_gain(arm, spec)
+    cfg = SimConfig(kp, kd, dt, opts.integrator, gc, opts.engine)
+    configs = np.vstack([q0[None, :], ref.sample(traj.times)[0]])
+    check_stability(arm, cfg, configs)
+    total = opts.duration if opts.duration is not None else traj.duration + SETTLE_EXTRA_S
+    if not (np.isfinite(total) and 0 < total <= 3600):
+        raise InputError(f"must be in (0, 3600] s, got {total:g}", field="--duration")
+    if total / dt > MAX_STEPS:
+        raise InputError(
+            f"{total:g} s at dt = {dt:g} s is {total / dt:.3g} steps, more than {MAX_STEPS:,}; "
+            "shorten --duration or raise --dt",
+            field="--duration",
+        )
+    jsp = spec.arm.joint_state_publisher if spec is not None else None
+    rate = (
+        rate
+        if rate is not None
+        else (jsp.update_rate if jsp is not None else DEFAULT_STATE_RATE_HZ)
+    )
+    if not (np.isfinite(rate) and 0 < rate <= (1.0 + RATE_SLACK) / dt):
+        raise InputError(
+            f"must be in (0, 1/dt = {1.0 / dt:g}] Hz (one state per time step at most), "
+            f"got {rate:g}",
+            field="--rate",
+        )
+    fid, off, label = _tool(arm, doc, spec)
+    frame, T_frame_root = _report_frame(arm, spec)
+    label = f"{label} in {frame}"
+    return SimJob(arm, traj, ref, q0, total, cfg, fid, off, label, float(rate), T_frame_root)
+
+
+def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
+    """End-effector point in the reporting frame (see `_report_frame`) at configuration q [m]."""
+    import pinocchio as pin
+
+    data = job.arm.model.createData()
+    pin.framesForwardKinematics(job.arm.model, data, q)
+    p_root = np.asarray(data.oMf[job.tool_frame].act(job.tool_offset), dtype=float)
+    out: np.ndarray = job.T_frame_root[:3, :3] @ p_root + job.T_frame_root[:3, 3]
+    return out
+
+
+def run(job: SimJob, progress: Callable[[int, int], None] | None = None) -> SimResult:
+    """Run the job; `progress(steps_done, steps_total)` is called between chunks of steps."""
+    return simulate(job.arm, job.reference, job.q0, job.duration, job.config, progress)

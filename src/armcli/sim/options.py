@@ -1,0 +1,68 @@
+"""What a simulate run is told besides the spec: built once (by the CLI or a caller), passed down.
+
+A frozen dataclass with `Literal` choices, so a typo in an engine or integrator name is a
+type error for library callers and a listed choice in `armcli simulate --help`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal, get_args
+
+from armcli.errors import InputError
+
+Integrator = Literal["euler", "rk4"]
+"""euler: semi-implicit (symplectic) Euler with implicit damping; rk4: classic Runge-Kutta."""
+Engine = Literal["auto", "native", "python"]
+"""auto: the compiled rollout when available, else the Python loop."""
+
+INTEGRATORS: tuple[str, ...] = get_args(Integrator)
+ENGINES: tuple[str, ...] = get_args(Engine)
+
+
+@dataclass(frozen=True)
+class SimOptions:
+    """Options of one simulate run; None means "take it from the spec" (or the default).
+
+    Attributes:
+        trajectory: JointTrajectory YAML file (exactly one of trajectory / message).
+        message: JointTrajectory as YAML text.
+        urdf: simulate this URDF instead of the spec's standalone arm.
+        joints: joints to move; the others are locked at their start value.
+        kp: P gain(s) [N·m/rad or N/m]: one value for all joints or one per joint.
+        kd: D gain(s) [N·m·s/rad or N·s/m], same shape rule as kp.
+        gravity_comp: add g(q) to the PD torque.
+        dt: time step [s].
+        integrator: see `Integrator`.
+        duration: simulated time [s] (default: last point + settle time).
+        clamp: clamp trajectory positions outside the limits instead of refusing.
+        rate: joint-state output rate [Hz].
+        engine: see `Engine`.
+        trust_xacro: expand a foreign xacro file given as `urdf` in the sandbox.
+    """
+
+    trajectory: Path | None = None
+    message: str | None = None
+    urdf: Path | None = None
+    joints: tuple[str, ...] | None = None
+    kp: tuple[float, ...] | None = None
+    kd: tuple[float, ...] | None = None
+    gravity_comp: bool | None = None
+    dt: float | None = None
+    integrator: Integrator = "euler"
+    duration: float | None = None
+    clamp: bool = False
+    rate: float | None = None
+    engine: Engine = "auto"
+    trust_xacro: bool = False
+
+    def __post_init__(self) -> None:
+        for value, choices, option in (
+            (self.integrator, INTEGRATORS, "--integrator"),
+            (self.engine, ENGINES, "--engine"),
+        ):
+            if value not in choices:
+                raise InputError(
+                    f"unknown value {value!r}; valid: {', '.join(choices)}", field=option
+                )

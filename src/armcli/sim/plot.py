@@ -1,0 +1,61 @@
+"""Tracking plot: reference vs actual position, velocity and motor torque per joint.
+
+matplotlib (Agg backend) is imported inside the function so that importing armcli
+stays cheap.
+"""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+
+from armcli.io.files import write_file_atomic
+from armcli.sim.simulate import SimResult
+
+
+def tracking_png(res: SimResult, effort_limits: np.ndarray | None = None) -> bytes:
+    """PNG bytes of a rows = (position, velocity, torque), columns = joints figure."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    n = len(res.joint_names)
+    fig, axes = plt.subplots(3, n, figsize=(5.0 * n, 7.5), sharex=True, squeeze=False)
+    t, tt = res.t, res.t[:-1]
+    for i, name in enumerate(res.joint_names):
+        ax_q, ax_v, ax_t = axes[:, i]
+        ax_q.plot(t, res.q_ref[:, i], "--", color="0.4", lw=1.5, label="reference")
+        ax_q.plot(t, res.q[:, i], color="C0", lw=1.2, label="actual")
+        ax_v.plot(t, res.v_ref[:, i], "--", color="0.4", lw=1.5, label="reference")
+        ax_v.plot(t, res.v[:, i], color="C1", lw=1.2, label="actual")
+        ax_t.plot(tt, res.tau[:, i], color="C2", lw=1.2, label="motor torque")
+        sat = res.saturated[:, i]
+        if sat.any() and effort_limits is not None:
+            for s in (-1, 1):
+                ax_t.axhline(s * effort_limits[i], color="C3", lw=0.8, ls=":", label=None)
+            ax_t.fill_between(tt, 0, 1, where=sat, color="C3", alpha=0.15,
+                              transform=ax_t.get_xaxis_transform(), label="saturated")  # fmt: skip
+        ax_q.set_title(name, fontsize=11)
+        ax_q.set_ylabel("position [rad]")
+        ax_v.set_ylabel("velocity [rad/s]")
+        ax_t.set_ylabel("torque [N·m]")
+        ax_t.set_xlabel("time [s]")
+        for ax in (ax_q, ax_v, ax_t):
+            ax.grid(True, alpha=0.3)
+            ax.legend(loc="best", fontsize=8)
+    fig.suptitle(f"armcli simulate ({res.integrator}, dt = {res.dt:g} s)", fontsize=12)
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=100, metadata={"Software": None})
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def write_tracking_plot(
+    path: Path, res: SimResult, effort_limits: np.ndarray | None = None
+) -> None:
+    """Write the tracking plot PNG atomically; `effort_limits` [N·m] mark saturation."""
+    write_file_atomic(path, tracking_png(res, effort_limits))

@@ -1,0 +1,297 @@
+"""`trajectory_msgs/JointTrajectory`-shaped input and its interpolation.
+
+The YAML mirrors the ROS message (`header.frame_id`, `joint_names`, `points` with
+`positions` and optional `velocities`, `accelerations`, `effort`, `time_from_start`), so
+the payload of `ros2 topic pub /set_joint_trajectory ...` works as is, including ROS's
+`{0.0, 0.0}` flow-mapping quirk.
+
+Interpolation follows ros2_control's joint_trajectory_controller: per segment, linear
+when the points give positions only, cubic when they give velocities, quintic when they
+also give accelerations. When the first point's time is > 0 the trajectory starts from
+the current state (velocity and acceleration as given, zero by default); a first point at
+time 0 is taken as the reference from the start. After the last point the reference holds
+its position with zero velocity. `effort` is accepted and ignored (the simulated
+controller is position-commanded). A point without `time_from_start` is reached
+DEFAULT_SEGMENT_S after the previous one (the first after the start), since ROS's default
+of 0 would ask for an instantaneous jump.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from armcli.errors import Problem, SpecError
+from armcli.io.yaml import YamlDoc, dotted, load_yaml, loads_yaml
+
+DEFAULT_SEGMENT_S = 1.0  # [s] time given to a point without time_from_start
+MIN_SEGMENT_S = 1e-6  # [s] shorter segments make the interpolated reference overflow
+MAX_TIME_S = 1e6  # [s] ~11.6 days: far beyond any simulation worth running step by step
+LIMIT_TOL = 1e-9  # [rad] slack when comparing positions with joint limits
+_TOP_KEYS = {"header", "joint_names", "points"}
+_POINT_KEYS = {"positions", "velocities", "accelerations", "effort", "time_from_start"}
+_HEADER_KEYS = {"frame_id", "stamp", "seq"}
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A validated trajectory: times strictly increasing, arrays (points, joints)."""
+
+    joint_names: tuple[str, ...]
+    times: np.ndarray  # (P,) time_from_start [s]
+    positions: np.ndarray  # (P, m)
+    velocities: np.ndarray | None  # (P, m) or None
+    accelerations: np.ndarray | None  # (P, m) or None
+    frame_id: str = ""
+    source: str = "<string>"
+    warnings: tuple[str, ...] = ()
+
+    @property
+    def duration(self) -> float:
+        """Time of the last point [s]."""
+        return float(self.times[-1])
+
+
+def load_trajectory(
+    path: str | Path, limits: Mapping[str, tuple[float, float]], *, clamp: bool = False
+) -> Trajectory:
+    """Read and validate a trajectory file; `limits` maps each valid joint to (lower, upper)."""
+    return parse_trajectory(load_yaml(path, flow_sets=True), limits, clamp=clamp)
+
+
+def loads_trajectory(
+    text: str,
+    limits: Mapping[str, tuple[float, float]],
+    *,
+    source: str = "--message",
+    clamp: bool = False,
+) -> Trajectory:
+    """Validate a trajectory given as text, e.g. the `ros2 topic pub` payload."""
+    return parse_trajectory(loads_yaml(text, source, flow_sets=True), limits, clamp=clamp)
+
+
+class _Collector:
+    def __init__(self, doc: YamlDoc) -> None:
+        self.doc = doc
+        self.problems: list[Problem] = []
+
+    def add(self, path: tuple[str | int, ...], msg: str) -> None:
+        self.problems.append(Problem(dotted(path), msg, self.doc.line_of(path)))
+
+    def unknown_keys(
+        self, data: Mapping[str, Any], allowed: set[str], path: tuple[str | int, ...]
+    ) -> None:
+        for key in data:
+            if key not in allowed:
+                self.add((*path, key), f"unknown key; expected one of {', '.join(sorted(allowed))}")
+
+
+def parse_trajectory(
+    doc: YamlDoc, limits: Mapping[str, tuple[float, float]], *, clamp: bool = False
+) -> Trajectory:
+    """Validate parsed YAML into a Trajectory, reporting every problem with its location."""
+    c = _Collector(doc)
+    data = doc.data
+    if not isinstance(data, dict):
+        raise SpecError(doc.source, [Problem("", "a trajectory must be a YAML mapping", 1)])
+    c.unknown_keys(data, _TOP_KEYS, ())
+    frame_id = _frame_id(data.get("header"), c)
+    names = _joint_names(data.get("joint_names"), limits, c)
+    raw_points = data.get("points")
+    if not isinstance(raw_points, list) or not raw_points:
+        c.add(("points",), "needs a non-empty list of points")
+        raw_points = []
+    if c.problems:
+        raise SpecError(doc.source, c.problems)
+    m = len(names)
+    fields: dict[str, list[list[float] | None]] = {
+        "positions": [],
+        "velocities": [],
+        "accelerations": [],
+    }
+    times: list[float] = []
+    for k, point in enumerate(raw_points):
+        if not isinstance(point, dict):
+            c.add(("points", k), "a point must be a mapping")
+            continue
+        c.unknown_keys(point, _POINT_KEYS, ("points", k))
+        for key in fields:
+            fields[key].append(
+                _vector(point.get(key), m, ("points", k, key), c, key == "positions")
+            )
+        if "effort" in point:
+            _vector(point["effort"], m, ("points", k, "effort"), c, False)
+        times.append(_time(point, times, k, c))
+    _consistent(fields, c)
+    if c.problems:
+        raise SpecError(doc.source, c.problems)
+    pos = np.array(fields["positions"], dtype=float)
+    warnings = _check_limits(pos, names, limits, clamp, c)
+    if c.problems:
+        raise SpecError(doc.source, c.problems)
+    vel, acc = fields["velocities"], fields["accelerations"]
+    return Trajectory(
+        joint_names=tuple(names),
+        times=np.array(times, dtype=float),
+        positions=pos,
+        velocities=np.array(vel, dtype=float) if vel[0] is not None else None,
+        accelerations=np.array(acc, dtype=float) if acc[0] is not None else None,
+        frame_id=frame_id,
+        source=doc.source,
+        warnings=tuple(warnings),
+    )
+
+
+def _frame_id(header: Any, c: _Collector) -> str:
+    if header is None:
+        return ""
+    if not isinstance(header, dict):
+        c.add(("header",), "must be a mapping like {frame_id: arm_base_link}")
+        return ""
+    c.unknown_keys(header, _HEADER_KEYS, ("header",))
+    frame = header.get("frame_id", "")
+    if not isinstance(frame, str):
+        c.add(("header", "frame_id"), "must be a string")
+        return ""
+    return frame
+
+
+def _joint_names(raw: Any, limits: Mapping[str, Any], c: _Collector) -> list[str]:
+    valid = ", ".join(limits)
+    if not isinstance(raw, list) or not raw:
+        c.add(("joint_names",), f"needs a non-empty list of joint names; valid: {valid}")
+        return []
+    seen: set[str] = set()
+    for i, name in enumerate(raw):
+        if not isinstance(name, str) or name not in limits:
+            c.add(("joint_names", i), f"unknown joint {name!r}; valid: {valid}")
+        elif name in seen:
+            c.add(("joint_names", i), f"joint {name!r} listed twice")
+        seen.add(str(name))
+    return [str(n) for n in raw]
+
+
+def _vector(
+    raw: Any, m: int, path: tuple[str | int, ...], c: _Collector, required: bool
+) -> list[float] | None:
+    if raw is None or raw == []:
+        if required:
+            c.add(path, f"missing: give {m} value(s), one per joint name")
+        return None
+    if not isinstance(raw, list):
+        c.add(path, f"must be a list of {m} number(s)")
+        return None
+    if len(raw) != m:
+        c.add(path, f"has {len(raw)} value(s) but joint_names has {m}")
+        return None
+    out = []
+    for i, x in enumerate(raw):
+        value = _finite(x)
+        if value is None:
+            c.add((*path, i), f"must be a finite number, got {_short(x)}")
+            return None
+        out.append(value)
+    return out
+
+
+def _finite(x: Any) -> float | None:
+    """`x` as a finite float, or None (bools, strings, NaN/inf, ints beyond float range)."""
+    if isinstance(x, bool) or not isinstance(x, int | float):
+        return None
+    try:
+        value = float(x)
+    except OverflowError:
+        return None
+    return value if math.isfinite(value) else None
+
+
+def _short(x: Any) -> str:
+    text = repr(x)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _time(point: dict[str, Any], previous: Sequence[float], k: int, c: _Collector) -> float:
+    path: tuple[str | int, ...] = ("points", k, "time_from_start")
+    last = previous[-1] if previous else 0.0
+    raw = point.get("time_from_start")
+    if raw is None:
+        return last + DEFAULT_SEGMENT_S
+    if isinstance(raw, dict):
+        c.unknown_keys(raw, {"sec", "nanosec"}, path)
+        sec, nsec = raw.get("sec", 0), raw.get("nanosec", 0)
+        if not all(isinstance(x, int) and not isinstance(x, bool) for x in (sec, nsec)):
+            c.add(path, "sec and nanosec must be integers")
+            return last
+        if not 0 <= nsec < 1_000_000_000:
+            c.add((*path, "nanosec"), "must be in [0, 1e9)")
+            return last
+        seconds = _finite(sec)
+        if seconds is None:
+            c.add((*path, "sec"), f"must be a finite number of seconds, got {_short(sec)}")
+            return last
+        t = seconds + nsec * 1e-9
+    elif _finite(raw) is not None:
+        t = float(raw)
+    else:
+        c.add(path, f"must be seconds or {{sec, nanosec}}, got {_short(raw)}")
+        return last
+    if t < 0:
+        c.add(path, f"must be >= 0, got {t:g}")
+    elif t > MAX_TIME_S:
+        c.add(path, f"must be <= {MAX_TIME_S:g} s, got {t:g}")
+    elif previous and t <= last:
+        c.add(path, f"times must increase: {t:g} s is not after point {k - 1} at {last:g} s")
+    elif 0 < t - last < MIN_SEGMENT_S:
+        c.add(
+            path,
+            f"{t - last:g} s after the previous point: segments must last at least "
+            f"{MIN_SEGMENT_S:g} s",
+        )
+    return float(t)
+
+
+def _consistent(fields: dict[str, list[list[float] | None]], c: _Collector) -> None:
+    """Velocities/accelerations are given on every point or on none (as JTC expects)."""
+    for key in ("velocities", "accelerations"):
+        given = [v is not None for v in fields[key]]
+        if any(given) and not all(given):
+            k = given.index(False)
+            c.add(
+                ("points", k, key),
+                f"missing: {key} are given on other points, so every point needs them",
+            )
+    if all(a is not None for a in fields["accelerations"]) and not all(
+        v is not None for v in fields["velocities"]
+    ):
+        c.add(
+            ("points", 0, "velocities"), "accelerations need velocities too (quintic interpolation)"
+        )
+
+
+def _check_limits(
+    pos: np.ndarray,
+    names: Sequence[str],
+    limits: Mapping[str, tuple[float, float]],
+    clamp: bool,
+    c: _Collector,
+) -> list[str]:
+    warnings = []
+    for k in range(pos.shape[0]):
+        for i, name in enumerate(names):
+            lo, hi = limits[name]
+            x = pos[k, i]
+            if lo - LIMIT_TOL <= x <= hi + LIMIT_TOL:
+                continue
+            where = dotted(("points", k, "positions", i))
+            msg = f"{x:g} is outside the limits of {name} [{lo:g}, {hi:g}]"
+            if clamp:
+                pos[k, i] = min(max(x, lo), hi)
+                warnings.append(f"{c.doc.source} {where}: {msg}; clamped to {pos[k, i]:g}")
+            else:
+                c.add(("points", k, "positions", i), msg + " (use --clamp to clamp)")
+    return warnings

@@ -1,0 +1,138 @@
+"""Cross-reference rules of a spec that field validation cannot express.
+
+Parents and children exist, each part is one tree, names are unique across
+parts, plugin/gain/pose joint names exist, poses are within limits. Returns
+problems with dotted field paths; `spec.spec_from_doc` adds file and line.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from armcli.errors import Problem
+from armcli.io.yaml import dotted
+from armcli.spec.model import Joint, Link, RobotSpec
+
+
+def semantic_problems(spec: RobotSpec) -> list[Problem]:
+    """Every cross-reference problem of `spec`, with dotted field paths; [] if none."""
+    out: list[Problem] = []
+
+    def add(path: tuple[str | int, ...], msg: str) -> None:
+        out.append(Problem(dotted(path), msg))
+
+    base_links = spec.mobile_base.links if spec.mobile_base else {}
+    base_joints = spec.mobile_base.joints if spec.mobile_base else {}
+    for name in spec.arm.links:
+        if name in base_links:
+            add(("arm", "links", name), "link name already used in mobile_base.links")
+    for name in spec.arm.joints:
+        if name in base_joints:
+            add(("arm", "joints", name), "joint name already used in mobile_base.joints")
+
+    parts: list[tuple[str, dict[str, Link], dict[str, Joint]]] = [
+        ("arm", spec.arm.links, spec.arm.joints)
+    ]
+    if spec.mobile_base is not None:
+        parts.append(("mobile_base", base_links, base_joints))
+    for part, links, joints in parts:
+        _tree_problems(part, links, joints, add)
+        for lname, link in links.items():
+            if link.material is not None and link.material not in spec.materials:
+                add(
+                    (part, "links", lname, "material"),
+                    f"unknown material {link.material!r}; known: {_names(spec.materials)}",
+                )
+
+    arm_movable = set(spec.movable_arm_joints()) if not out else set()
+    all_joints = {**base_joints, **spec.arm.joints}
+    _plugin_problems(spec, all_joints, add)
+    if spec.mount is not None:
+        if spec.mobile_base is None:
+            add(("mount",), "a mount needs a mobile_base")
+        elif spec.mount.parent not in base_links:
+            add(("mount", "parent"), f"unknown link; known: {_names(base_links)}")
+        if spec.mount.joint in all_joints:
+            add(("mount", "joint"), "joint name already used")
+    elif spec.mobile_base is not None:
+        add(("mount",), "a mobile_base needs a mount joint for the arm")
+
+    for jname in spec.control.gains:
+        if jname not in spec.arm.joints:
+            add(("control", "gains", jname), f"unknown arm joint; known: {_names(spec.arm.joints)}")
+    for pname, pose in spec.poses.items():
+        for jname, value in pose.items():
+            j = spec.arm.joints.get(jname)
+            if j is None or (arm_movable and jname not in arm_movable):
+                add(("poses", pname, jname), f"unknown arm joint; known: {_names(spec.arm.joints)}")
+            elif (
+                j.limit is not None
+                and j.type != "continuous"
+                and j.limit.lower <= j.limit.upper
+                and not (j.limit.lower - 1e-12 <= value <= j.limit.upper + 1e-12)
+            ):
+                add(
+                    ("poses", pname, jname),
+                    f"{value:g} is outside the joint limits [{j.limit.lower:g}, {j.limit.upper:g}]",
+                )
+    return out
+
+
+def _tree_problems(part: str, links: dict[str, Link], joints: dict[str, Joint], add: Any) -> None:
+    children: dict[str, str] = {}
+    for jname, j in joints.items():
+        for role in ("parent", "child"):
+            if getattr(j, role) not in links:
+                add((part, "joints", jname, role), f"unknown link; known: {_names(links)}")
+        if j.child in children:
+            add(
+                (part, "joints", jname, "child"),
+                f"link already has parent joint {children[j.child]}",
+            )
+        children[j.child] = jname
+        if j.parent == j.child:
+            add((part, "joints", jname, "child"), "a joint cannot connect a link to itself")
+        if j.limit is not None and j.limit.lower > j.limit.upper:
+            add(
+                (part, "joints", jname, "limit", "upper"),
+                f"must be >= lower ({j.limit.lower:g})",
+            )
+    roots = [n for n in links if n not in children]
+    if len(roots) != 1:
+        add((part, "links"), f"exactly one root link expected, found {len(roots)}: {roots}")
+        return
+    reached = {roots[0]}
+    for _ in range(len(links)):
+        reached |= {j.child for j in joints.values() if j.parent in reached}
+    orphans = sorted(set(links) - reached)
+    if orphans:
+        add((part, "joints"), f"links not connected to root {roots[0]!r}: {orphans}")
+
+
+def _plugin_problems(spec: RobotSpec, all_joints: dict[str, Joint], add: Any) -> None:
+    jsp = spec.arm.joint_state_publisher
+    if jsp is not None:
+        for i, jn in enumerate(jsp.joints):
+            if jn not in all_joints:
+                add(
+                    ("arm", "joint_state_publisher", "joints", i),
+                    f"unknown joint {jn!r}; known: {_names(all_joints)}",
+                )
+    if spec.arm.tool is not None and spec.arm.tool.link not in spec.arm.links:
+        add(("arm", "tool", "link"), f"unknown arm link; known: {_names(spec.arm.links)}")
+    dd = spec.mobile_base.diff_drive if spec.mobile_base else None
+    if dd is not None:
+        for role in ("left_joint", "right_joint"):
+            jn = getattr(dd, role)
+            if jn not in all_joints:
+                add(
+                    ("mobile_base", "diff_drive", role),
+                    f"unknown joint; known: {_names(all_joints)}",
+                )
+        links = spec.all_links()
+        if dd.robot_base_frame not in links:
+            add(("mobile_base", "diff_drive", "robot_base_frame"), "unknown link")
+
+
+def _names(d: Any) -> str:
+    return ", ".join(sorted(d)) or "(none)"

@@ -1,0 +1,137 @@
+"""The typed view of one URDF document that `urdfxml` builds and the checks read.
+
+Frozen dataclasses with the source line of every element, so findings can point
+at the line; numbers that did not parse are kept as `NumberProblem`s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+Vec3 = tuple[float, float, float]
+ZERO3: Vec3 = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class NumberProblem:
+    """A numeric attribute that is missing, unparsable, non-finite or of the wrong length."""
+
+    kind: str  # "missing" | "not-a-number" | "non-finite" | "length"
+    where: str  # e.g. "link base_link: inertial/mass@value"
+    text: str
+    line: int | None
+
+
+@dataclass(frozen=True)
+class Pose:
+    """An <origin>: `xyz` [m] and `rpy` [rad], with its source line."""
+
+    xyz: Vec3 = ZERO3
+    rpy: Vec3 = ZERO3
+    line: int | None = None
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """kind is box/cylinder/sphere/mesh (or the unknown tag); dims [m] as URDF orders them."""
+
+    kind: str
+    dims: tuple[float, ...] | None  # box (x, y, z); cylinder (radius, length); sphere (radius,)
+    line: int | None
+    filename: str | None = None
+    scale: Vec3 = (1.0, 1.0, 1.0)
+
+
+@dataclass(frozen=True)
+class Shape:
+    """A <visual> or <collision> element."""
+
+    origin: Pose
+    geometry: Geometry | None
+    line: int | None
+    material: str | None = None
+
+
+@dataclass(frozen=True)
+class Inertial:
+    """An <inertial>: mass [kg] and inertia [kg·m²], None where missing or unparsed."""
+
+    origin: Pose
+    mass: float | None
+    inertia: tuple[float, float, float, float, float, float] | None  # ixx ixy ixz iyy iyz izz
+    line: int | None
+    mass_line: int | None
+    inertia_line: int | None
+
+
+@dataclass(frozen=True)
+class Link:
+    """A <link>: its inertial and its visual and collision shapes."""
+
+    name: str
+    line: int | None
+    inertial: Inertial | None
+    visuals: tuple[Shape, ...]
+    collisions: tuple[Shape, ...]
+
+
+@dataclass(frozen=True)
+class Limit:
+    """A <limit>: lower/upper [rad or m], effort [N·m or N], velocity [rad/s or m/s]."""
+
+    lower: float | None
+    upper: float | None
+    effort: float | None
+    velocity: float | None
+    line: int | None
+
+
+@dataclass(frozen=True)
+class Joint:
+    """A <joint>: its links, origin, axis, limit, damping, friction and mimic, with lines."""
+
+    name: str
+    type: str
+    line: int | None
+    parent: str | None
+    child: str | None
+    origin: Pose
+    axis: Vec3 | None
+    axis_line: int | None
+    limit: Limit | None
+    damping: float
+    friction: float
+    mimic: str | None = None
+    mimic_line: int | None = None
+
+    @property
+    def movable(self) -> bool:
+        """Whether the joint moves along one axis: any type but fixed, floating and planar."""
+        return self.type not in ("fixed", "floating", "planar")
+
+
+@dataclass(frozen=True)
+class Material:
+    """A <material>: name, rgba colour, and whether it is declared at the robot's top level."""
+
+    name: str
+    rgba: tuple[float, ...] | None
+    line: int | None
+    top_level: bool
+
+
+@dataclass(frozen=True)
+class Urdf:
+    """What `check` needs from one URDF document."""
+
+    name: str
+    source: str
+    text: bytes
+    links: tuple[Link, ...]
+    joints: tuple[Joint, ...]
+    materials: tuple[Material, ...]
+    problems: tuple[NumberProblem, ...] = field(default=())
+
+    def link(self, name: str) -> Link | None:
+        """The link called `name`, or None."""
+        return next((lk for lk in self.links if lk.name == name), None)

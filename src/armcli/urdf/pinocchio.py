@@ -1,0 +1,140 @@
+"""URDF -> Pinocchio model; the one place parser quirks are handled.
+
+Pinocchio's URDF parser prints problems to stderr (and e.g. turns mass="nan"
+into 0) instead of raising, so loading captures the C-level stderr and returns
+what it said as warnings for the caller (checks turn them into findings).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from armcli.errors import InputError, ModelLoadError
+
+
+@dataclass
+class LoadedModel:
+    """A Pinocchio model plus what the parser said while building it."""
+
+    model: Any  # pinocchio.Model
+    source: str
+    parser_messages: list[str] = field(default_factory=list)
+
+
+def _capture_stderr(fn: Any) -> tuple[Any, list[str]]:
+    """Run fn() with the process-level stderr (fd 2) redirected to a temp file.
+
+    If fn raises, the exception gets the captured lines as `parser_messages`.
+    """
+    with tempfile.TemporaryFile(mode="w+b") as tmp:
+        saved = os.dup(2)
+        error: BaseException | None = None
+        try:
+            os.dup2(tmp.fileno(), 2)
+            result = fn()
+        except BaseException as exc:
+            error = exc
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+        tmp.seek(0)
+        text = tmp.read().decode("utf-8", "replace")
+    lines = [ln for ln in text.splitlines() if ln.strip()]
+    if error is not None:
+        error.parser_messages = lines  # type: ignore[attr-defined]
+        raise error
+    return result, lines
+
+
+def parser_problems(lines: list[str]) -> list[str]:
+    """The urdfdom messages, one per problem: continuation lines (C++ source locations) dropped."""
+    out: list[str] = []
+    for ln in lines:
+        if ln[:1].isspace():
+            continue
+        out.append(" ".join(ln.split()))
+    return out
+
+
+def load_model(path: str | Path, *, xml: str | None = None) -> LoadedModel:
+    """Build a fixed-base Pinocchio model from a URDF file (or from `xml` text)."""
+    import pinocchio as pin
+
+    source = str(path)
+    text = xml if xml is not None else Path(path).read_text(encoding="utf-8")
+    try:
+        model, messages = _capture_stderr(lambda: pin.buildModelFromXML(text))
+    except (RuntimeError, ValueError) as exc:
+        said = parser_problems(getattr(exc, "parser_messages", []))
+        detail = f" ({'; '.join(said)})" if said else ""
+        raise ModelLoadError(
+            f"Pinocchio cannot load this URDF: {exc}{detail}", file=source, parser_messages=said
+        ) from None
+    return LoadedModel(model=model, source=source, parser_messages=messages)
+
+
+@dataclass(frozen=True)
+class JointRange:
+    """One 1-DoF joint of a Pinocchio model and the range to sample it over."""
+
+    name: str
+    idx_q: int
+    idx_v: int
+    continuous: bool  # stored as (cos, sin) in q
+    lower: float  # [rad or m]
+    upper: float
+
+
+def joint_ranges(model: Any) -> list[JointRange]:
+    """The model's 1-DoF joints with finite sampling ranges (continuous: [-pi, pi]).
+
+    Multi-DoF joints (floating, planar) are left out: they stay at neutral.
+    """
+    out = []
+    for jid in range(1, model.njoints):
+        jm = model.joints[jid]
+        if jm.nv != 1:
+            continue
+        continuous = jm.nq == 2
+        lo = -math.pi if continuous else float(model.lowerPositionLimit[jm.idx_q])
+        hi = math.pi if continuous else float(model.upperPositionLimit[jm.idx_q])
+        if not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi:
+            lo, hi = -math.pi, math.pi
+        out.append(JointRange(str(model.names[jid]), jm.idx_q, jm.idx_v, continuous, lo, hi))
+    return out
+
+
+def configuration(model: Any, values: Mapping[str, float]) -> Any:
+    """Neutral q with the named 1-DoF joints set to `values` [rad or m]."""
+    import pinocchio as pin
+
+    q = pin.neutral(model)
+    for jr in joint_ranges(model):
+        if jr.name in values:
+            x = float(values[jr.name])
+            if jr.continuous:
+                q[jr.idx_q], q[jr.idx_q + 1] = math.cos(x), math.sin(x)
+            else:
+                q[jr.idx_q] = x
+    return q
+
+
+def collision_model(model: Any, xml: str, package_dirs: list[str] | None = None) -> Any:
+    """The URDF's collision geometry as a Pinocchio GeometryModel (meshes need package_dirs)."""
+    import pinocchio as pin
+
+    try:
+        gmodel, _ = _capture_stderr(
+            lambda: pin.buildGeomFromUrdfString(
+                model, xml, pin.GeometryType.COLLISION, package_dirs=package_dirs or []
+            )
+        )
+    except (RuntimeError, ValueError) as exc:
+        raise InputError(f"Pinocchio cannot load the collision geometry: {exc}") from None
+    return gmodel

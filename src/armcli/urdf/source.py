@@ -1,0 +1,144 @@
+"""Robot file argument -> URDF documents, the same way for every command.
+
+A path given to `check`, `view`, `render`, `tree` (and `simulate --urdf`) is one
+of: a spec YAML (built in memory, nothing written), a URDF (read by urdfxml's
+strict reader) or a xacro file. Xacro runs Python from the file, so a foreign
+one is expanded in safe mode (xacro_safe: no code runs, files confined) unless
+the user passes `--trust-xacro` (xacro itself, sandboxed by xacro_sandbox).
+Mesh URIs may only resolve inside the allowed roots, so a hostile URDF cannot make armcli read
+`/etc/passwd` as a "mesh".
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+from armcli.build.expand import expand_urdfs
+from armcli.defaults import STANDALONE_ARM_URDF
+from armcli.errors import EXPANDED_TAG, InputError, XacroRefusedError
+from armcli.spec.load import load_spec
+from armcli.spec.model import RobotSpec
+from armcli.urdf.doc import Urdf
+from armcli.urdf.pinocchio import LoadedModel, load_model, parser_problems
+from armcli.urdf.read import parse_urdf, read_urdf
+from armcli.urdf.xacro_sandbox import expand_foreign, expand_untrusted
+
+SPEC_SUFFIXES = (".yaml", ".yml")
+XACRO_SUFFIX = ".xacro"
+TRUST_XACRO_HELP = (
+    "Expand a foreign xacro file with xacro itself, which runs Python from the file "
+    "(in a bubblewrap sandbox); without it, xacro files are expanded in safe mode."
+)
+
+_PROBLEM = {
+    "missing": "missing number",
+    "not-a-number": "not a number:",
+    "non-finite": "non-finite number",
+    "length": "wrong number of values:",
+}
+
+
+@dataclass(frozen=True)
+class RobotFile:
+    """What a robot file argument stands for: its URDF document(s) and, for a spec, the spec."""
+
+    path: Path
+    urdfs: tuple[Urdf, ...]  # a spec gives the whole robot and the standalone arm
+    spec: RobotSpec | None = None
+
+    @property
+    def robot(self) -> Urdf:
+        """The whole robot: the spec's `<name>.urdf`, else the only document."""
+        if self.spec is not None:
+            for name in (f"{self.spec.name}.urdf", STANDALONE_ARM_URDF):
+                found = next((u for u in self.urdfs if u.source.endswith(f"#{name}")), None)
+                if found is not None:
+                    return found
+        return self.urdfs[0]
+
+
+def read_robot(path: Path, *, trust_xacro: bool = False) -> RobotFile:
+    """Spec YAML, URDF or (trusted) xacro -> RobotFile; InputError when unusable."""
+    if path.is_dir():
+        raise InputError("is a directory, expected a robot spec, URDF or xacro file", file=path)
+    if path.suffix in SPEC_SUFFIXES:
+        spec = load_spec(path)
+        urdfs = expand_urdfs(spec)
+        docs = tuple(parse_urdf(urdfs[n], f"{path}#{n}") for n in sorted(urdfs))
+        return RobotFile(path, docs, spec)
+    return RobotFile(path, (read_urdf_file(path, trust_xacro=trust_xacro),))
+
+
+def read_urdf_file(path: Path, *, trust_xacro: bool = False) -> Urdf:
+    """A URDF or xacro file -> Urdf; xacro (by suffix or content) only with trust_xacro."""
+    if path.suffix != XACRO_SUFFIX:
+        try:
+            return read_urdf(path)
+        except XacroRefusedError:
+            pass  # xacro content in a .urdf: expanded like a .xacro file
+    if trust_xacro:
+        return parse_urdf(expand_untrusted(path), f"{path}{EXPANDED_TAG}")
+    xml = expand_foreign(path, allowed_roots(path.parent))  # safe mode: no code runs
+    return parse_urdf(xml, f"{path}{EXPANDED_TAG}")
+
+
+def load_checked_model(
+    path: Path, *, trust_xacro: bool = False, gate: Callable[[Urdf], None] | None = None
+) -> LoadedModel:
+    """A URDF/xacro file -> Pinocchio model, refusing what Pinocchio would silently accept.
+
+    For commands that compute with the model (simulate --urdf): a malformed or
+    non-finite number (Pinocchio turns mass="nan" into 0) or any error the URDF
+    parser prints is an InputError naming the file and line, not a wrong result.
+    """
+    return checked_model(read_urdf_file(path, trust_xacro=trust_xacro), gate=gate)
+
+
+def checked_model(urdf: Urdf, *, gate: Callable[[Urdf], None] | None = None) -> LoadedModel:
+    """A parsed URDF -> Pinocchio model, refusing what Pinocchio would silently accept.
+
+    `gate`, when given, may refuse the document after the number checks (e.g.
+    check.gate.refuse_check_errors: the model `check` reports as an error).
+    """
+    if urdf.problems:
+        p = urdf.problems[0]
+        raise InputError(f"{p.where}: {_PROBLEM[p.kind]} {p.text!r}", file=urdf.source, line=p.line)
+    if gate is not None:
+        gate(urdf)
+    loaded = load_model(urdf.source, xml=urdf_text(urdf))
+    said = [m for m in parser_problems(loaded.parser_messages) if "error" in m.lower()]
+    if said:
+        raise InputError(f"the URDF parser reported: {said[0]}", file=urdf.source)
+    return loaded
+
+
+def urdf_text(urdf: Urdf) -> str:
+    """The document as text for parsers that take str (Pinocchio, yourdfpy)."""
+    try:
+        return urdf.text.decode("utf-8")
+    except UnicodeDecodeError:
+        raise InputError("URDF is not UTF-8 text", file=urdf.source) from None
+
+
+def allowed_roots(urdf_dir: Path, extra: Iterable[Path] = ()) -> tuple[Path, ...]:
+    """Directories mesh files may come from.
+
+    The URDF's directory, the ROS package it sits in (nearest ancestor with a package.xml),
+    `extra` (--package-dir) and ROS_PACKAGE_PATH.
+    """
+    here = urdf_dir.resolve()
+    roots = [here, *extra]
+    roots += [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
+    package = next((d for d in (here, *here.parents) if (d / "package.xml").is_file()), None)
+    if package is not None:
+        roots.append(package)
+    return tuple(dict.fromkeys(r.resolve() for r in roots))
+
+
+def inside_roots(path: Path, roots: Iterable[Path]) -> bool:
+    """Whether `path` (symlinks followed, `..` collapsed) lies inside one of `roots`."""
+    real = path.resolve()
+    return any(real.is_relative_to(r) for r in roots)

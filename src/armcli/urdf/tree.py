@@ -1,0 +1,192 @@
+"""The kinematic tree of a URDF: links, joints with types and limits, as text or Graphviz.
+
+`armcli tree` is the stand-in for `check_urdf` and `urdf_to_graphviz`, which
+most armcli users do not have; the DOT output follows urdf_to_graphviz's
+layout (links as boxes, joints as blue ellipses, origins on the edges, children
+in joint-name order) so the same tooling can read it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
+from armcli.errors import InputError
+from armcli.urdf.doc import Joint, Urdf
+from armcli.urdf.read import parse_urdf
+
+MOVABLE = ("revolute", "continuous", "prismatic", "floating", "planar")
+_TYPES = ("fixed", *MOVABLE)
+
+
+@dataclass(frozen=True)
+class JointInfo:
+    """One URDF joint as the tree shows it; lengths [m], angles [rad]."""
+
+    name: str
+    type: str
+    parent: str
+    child: str
+    xyz: tuple[float, float, float]
+    rpy: tuple[float, float, float]
+    axis: tuple[float, float, float]
+    lower: float | None = None
+    upper: float | None = None
+    effort: float | None = None
+    velocity: float | None = None
+
+
+@dataclass(frozen=True)
+class KinematicTree:
+    """Links and joints of one robot, with its single root link."""
+
+    robot: str
+    root: str
+    links: tuple[str, ...]
+    joints: tuple[JointInfo, ...]
+
+    def children(self, link: str) -> list[JointInfo]:
+        """Joints whose parent is `link`, in name order (as urdfdom stores them)."""
+        return sorted((j for j in self.joints if j.parent == link), key=lambda j: j.name)
+
+    def walk(self) -> Iterator[tuple[int, JointInfo]]:
+        """Depth-first (depth, joint) pairs from the root."""
+        stack = [(1, j) for j in reversed(self.children(self.root))]
+        while stack:
+            depth, j = stack.pop()
+            yield depth, j
+            stack.extend((depth + 1, c) for c in reversed(self.children(j.child)))
+
+    def movable(self) -> list[JointInfo]:
+        """Joints that move, in depth-first order."""
+        return [j for _, j in self.walk() if j.type in MOVABLE]
+
+
+def _joint(j: Joint, source: str) -> JointInfo:
+    if j.type not in _TYPES:
+        raise InputError(
+            f"joint {j.name!r}: unknown type {j.type!r}; known: {', '.join(_TYPES)}",
+            file=source,
+            line=j.line,
+        )
+    if not j.parent or not j.child:
+        raise InputError(
+            f"joint {j.name!r}: needs <parent link=...> and <child link=...>",
+            file=source,
+            line=j.line,
+        )
+    lim = j.limit
+    return JointInfo(
+        name=j.name,
+        type=j.type,
+        parent=j.parent,
+        child=j.child,
+        xyz=j.origin.xyz,
+        rpy=j.origin.rpy,
+        axis=j.axis or (1.0, 0.0, 0.0),
+        lower=lim.lower if lim else None,
+        upper=lim.upper if lim else None,
+        effort=lim.effort if lim else None,
+        velocity=lim.velocity if lim else None,
+    )
+
+
+def tree_from_urdf(urdf: Urdf) -> KinematicTree:
+    """The tree of a parsed URDF: exactly one root, no cycles, sound numbers, or InputError."""
+    source = urdf.source
+    if urdf.problems:
+        p = urdf.problems[0]
+        raise InputError(f"{p.where}: {p.kind} number {p.text!r}", file=source, line=p.line)
+    links = tuple(lk.name for lk in urdf.links)
+    joints = tuple(_joint(j, source) for j in urdf.joints)
+    by_name = {j.name: j for j in urdf.joints}
+    known = set(links)
+    for j in joints:
+        for role in ("parent", "child"):
+            if getattr(j, role) not in known:
+                raise InputError(
+                    f"joint {j.name!r}: unknown {role} link {getattr(j, role)!r}",
+                    file=source,
+                    line=by_name[j.name].line,
+                )
+    children = [j.child for j in joints]
+    roots = [n for n in links if n not in children]
+    if not links:
+        raise InputError("no <link> elements: not a robot description", file=source)
+    if len(roots) != 1:
+        found = ", ".join(roots) if roots else "none: the joints form a cycle"
+        raise InputError(f"expected exactly one root link, found {found}", file=source)
+    tree = KinematicTree(urdf.name, roots[0], links, joints)
+    reached = {tree.root} | {j.child for _, j in tree.walk()}
+    if len(reached) != len(known) or len(set(children)) != len(children):
+        raise InputError("links are not one tree (a link has two parents, or a cycle)", file=source)
+    return tree
+
+
+def parse_tree(xml: str | bytes, source: str = "<urdf>") -> KinematicTree:
+    """Parse URDF text safely (see urdfxml) into its KinematicTree."""
+    data = xml.encode("utf-8") if isinstance(xml, str) else xml
+    return tree_from_urdf(parse_urdf(data, source))
+
+
+def _num(x: float) -> str:
+    """Shortest readable form, like C++ ostream's default (6 significant digits)."""
+    return f"{x:.6g}"
+
+
+def _vec(v: tuple[float, ...]) -> str:
+    return " ".join(_num(x) for x in v)
+
+
+def joint_summary(j: JointInfo) -> str:
+    """Type, axis and limits of a joint in one line with units."""
+    parts = [j.type]
+    if j.type != "fixed":
+        parts.append(f"axis ({_vec(j.axis)})")
+    unit = "m" if j.type == "prismatic" else "rad"
+    if j.lower is not None and j.upper is not None and j.type != "continuous":
+        parts.append(f"[{_num(j.lower)}, {_num(j.upper)}] {unit}")
+    if j.effort is not None:
+        parts.append(f"effort {_num(j.effort)} {'N' if unit == 'm' else 'N·m'}")
+    if j.velocity is not None:
+        parts.append(f"velocity {_num(j.velocity)} {unit}/s")
+    return ", ".join(parts)
+
+
+def to_rich(tree: KinematicTree) -> Any:
+    """A rich.tree.Tree: links in bold, each reached through its joint and its summary."""
+    from rich.markup import escape
+    from rich.tree import Tree
+
+    top = Tree(f"[bold]{escape(tree.root)}[/bold]  [dim](robot {escape(tree.robot)})[/dim]")
+    nodes = {tree.root: top}
+    for _, j in tree.walk():
+        style = "cyan" if j.type in MOVABLE else "dim"
+        label = (
+            f"[bold]{escape(j.child)}[/bold]  [{style}]← {escape(j.name)}: "
+            f"{escape(joint_summary(j))}[/{style}]"
+        )
+        nodes[j.child] = nodes[j.parent].add(label)
+    return top
+
+
+def _q(text: str) -> str:
+    r"""A DOT double-quoted string (text may hold DOT's own `\n` line breaks)."""
+    return '"' + text.replace('"', '\\"') + '"'
+
+
+def to_dot(tree: KinematicTree) -> str:
+    """Graphviz text in urdf_to_graphviz's layout, joint nodes labelled with type and limits."""
+    out = ["digraph G {", "node [shape=box];"]
+    out += [f"{_q(n)} [label={_q(n)}];" for n in [tree.root, *(j.child for _, j in tree.walk())]]
+    out.append("node [shape=ellipse, color=blue, fontcolor=blue];")
+    for _, j in tree.walk():
+        label = _q(f"{j.name}\\n{joint_summary(j)}")
+        out.append(f"{_q(j.name)} [label={label}];")
+    for _, j in tree.walk():
+        label = _q(f"xyz: {_vec(j.xyz)} \\nrpy: {_vec(j.rpy)}")
+        out.append(f"{_q(j.parent)} -> {_q(j.name)} [label={label}]")
+        out.append(f"{_q(j.name)} -> {_q(j.child)}")
+    out.append("}")
+    return "\n".join(out) + "\n"

@@ -1,0 +1,118 @@
+"""A recorded `armcli simulate` run read back for replay: times, positions, references.
+
+The CSV is the one `simulate --output` writes (`time`, then per joint
+`NAME.position`, `NAME.velocity`, `NAME.effort`, `NAME.reference`); it is user
+input here, so every cell is checked and errors name the file, line and column.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from armcli.errors import InputError
+from armcli.io.yaml import read_text
+
+MAX_REPLAY_BYTES = 200_000_000
+MAX_REPLAY_ROWS = 2_000_000  # = simjob.MAX_STEPS: the most states `simulate` records
+
+
+@dataclass(frozen=True)
+class Replay:
+    """A recorded run: time [s], joint positions and (where given) references over time."""
+
+    source: str
+    time: np.ndarray
+    position: dict[str, np.ndarray]
+    reference: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def duration(self) -> float:
+        """Length of the record [s]."""
+        return float(self.time[-1] - self.time[0])
+
+    def positions_at(self, t: float) -> dict[str, float]:
+        """Linearly interpolated joint positions at time t [s] (clamped to the record)."""
+        return {j: float(np.interp(t, self.time, v)) for j, v in self.position.items()}
+
+    def reference_at(self, t: float) -> dict[str, float] | None:
+        """The reference pose at t [s], or None where the file gives no reference then."""
+        if not self.reference:
+            return None
+        i = int(np.clip(np.searchsorted(self.time, t, side="right") - 1, 0, len(self.time) - 1))
+        ref = {j: float(v[i]) for j, v in self.reference.items()}
+        return ref if all(math.isfinite(v) for v in ref.values()) else None
+
+
+def _parse_cell(text: str, col: str, line: int, source: str, blank_ok: bool) -> float:
+    if blank_ok and text.strip().lower() in ("", "nan"):
+        return math.nan
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise InputError(
+            f"expected a finite number, got {text!r}", file=source, line=line, field=col
+        )
+    return value
+
+
+def _rows(text: str, source: str) -> list[list[str]]:
+    """CSV rows, at most MAX_REPLAY_ROWS; csv's own limits become InputErrors with a line."""
+    reader = csv.reader(io.StringIO(text))
+    rows: list[list[str]] = []
+    try:
+        for row in reader:
+            rows.append(row)
+            if len(rows) > MAX_REPLAY_ROWS + 1:
+                raise InputError(f"more than {MAX_REPLAY_ROWS:,} data rows", file=source)
+    except csv.Error as exc:  # e.g. a field over csv.field_size_limit() characters
+        raise InputError(f"unreadable CSV: {exc}", file=source, line=reader.line_num) from None
+    return rows
+
+
+def load_replay(path: str | Path, joints: Sequence[str]) -> Replay:
+    """Read a `simulate` CSV (time, NAME.position/.velocity/.effort/.reference) for `joints`."""
+    source = str(path)
+    rows = _rows(read_text(path, max_bytes=MAX_REPLAY_BYTES, what="CSV"), source)
+    if not rows or not rows[0] or rows[0][0].strip() != "time":
+        raise InputError("first column must be 'time'", file=source, line=1)
+    header = [h.strip() for h in rows[0]]
+    pos_cols = {h[: -len(".position")]: i for i, h in enumerate(header) if h.endswith(".position")}
+    ref_cols = {
+        h[: -len(".reference")]: i for i, h in enumerate(header) if h.endswith(".reference")
+    }
+    for name in [*pos_cols, *ref_cols]:
+        if name not in joints:
+            known = ", ".join(joints) or "(none)"
+            raise InputError(f"unknown joint {name!r}; known: {known}", file=source, line=1)
+    if not pos_cols:
+        raise InputError("no NAME.position columns", file=source, line=1)
+    data = [r for r in rows[1:] if r]
+    if not data:
+        raise InputError("no data rows", file=source, line=2)
+    table = np.empty((len(data), len(header)))
+    for k, row in enumerate(data):
+        line = k + 2
+        if len(row) != len(header):
+            raise InputError(f"{len(row)} cells, header has {len(header)}", file=source, line=line)
+        for i, cell in enumerate(row):
+            blank_ok = header[i].endswith((".reference", ".velocity", ".effort"))
+            table[k, i] = _parse_cell(cell, header[i], line, source, blank_ok)
+    t = table[:, 0]
+    bad = np.nonzero(np.diff(t) <= 0)[0]
+    if len(bad):
+        raise InputError("time must increase", file=source, line=int(bad[0]) + 3, field="time")
+    return Replay(
+        source=source,
+        time=t,
+        position={j: table[:, i] for j, i in pos_cols.items()},
+        reference={j: table[:, i] for j, i in ref_cols.items()},
+    )

@@ -1,0 +1,104 @@
+"""The robot a viewer shows: URDF text, named poses, tool point and the joints `--q` sets.
+
+Shared by `view`, `render` and `tree`: a spec is built in memory (xacro
+expansion, nothing written); a URDF is read strictly; a foreign xacro file only
+with --trust-xacro (see armcli.urdf.source).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from armcli.defaults import DEFAULT_SPEC
+from armcli.errors import InputError
+from armcli.spec.expr import eval_expr
+from armcli.urdf.meshes import MeshSearch
+from armcli.urdf.source import read_robot, urdf_text
+from armcli.urdf.tool import ToolPoint, tool_point
+from armcli.urdf.tree import tree_from_urdf
+
+ROBOT_HELP = (
+    f"Robot spec YAML, URDF file, or xacro file (with --trust-xacro); default: {DEFAULT_SPEC}."
+)
+
+
+@dataclass(frozen=True)
+class RobotSource:
+    """A robot to show: URDF text plus what a spec adds (named poses, tool point)."""
+
+    xml: str
+    source: str
+    name: str
+    mesh_dir: Path | None
+    joints: tuple[str, ...]  # the joints `--q a,b,...` assigns, in order
+    poses: dict[str, dict[str, float]] = field(default_factory=dict)
+    tool: ToolPoint | None = None
+    search: MeshSearch = field(default_factory=MeshSearch)  # --package-dir
+
+
+def load_robot(
+    path: Path, trust_xacro: bool = False, search: MeshSearch | None = None
+) -> RobotSource:
+    """Spec YAML (built in memory), URDF or trusted xacro file -> RobotSource.
+
+    Mesh URIs resolve with armcli.urdf.meshes (honouring `search`, the --package-dir
+    options) and must stay inside the allowed roots; the tool point is armcli.urdf.tool's.
+    """
+    robot = read_robot(path, trust_xacro=trust_xacro)
+    spec = robot.spec
+    where = search or MeshSearch()
+    if spec is not None:
+        return RobotSource(
+            xml=urdf_text(robot.robot),
+            source=str(path),
+            name=spec.name,
+            mesh_dir=None,
+            joints=tuple(spec.movable_arm_joints()),
+            poses={p: spec.pose(p) for p in spec.poses},
+            tool=tool_point(robot.robot, spec),
+            search=where,
+        )
+    urdf = robot.robot
+    tree = tree_from_urdf(urdf)
+    return RobotSource(
+        xml=urdf_text(urdf),
+        source=str(path),
+        name=tree.robot or path.stem,
+        mesh_dir=path.parent,
+        joints=tuple(j.name for j in tree.movable()),
+        tool=tool_point(urdf),
+        search=where,
+    )
+
+
+def parse_q(text: str, robot: RobotSource) -> dict[str, float]:
+    """`0.3,pi/4` (in robot.joints order) or `joint=0.3,other=pi/4` -> {joint: value}."""
+    items = [s.strip() for s in text.split(",") if s.strip()]
+    out: dict[str, float] = {}
+    try:
+        if items and all("=" in s for s in items):
+            for s in items:
+                name, value = s.split("=", 1)
+                out[name.strip()] = float(eval_expr(value.strip()))
+            return out
+        if len(items) != len(robot.joints):
+            order = ", ".join(robot.joints) or "(none)"
+            raise InputError(f"expected {len(robot.joints)} values, for: {order}", field="--q")
+        return {j: float(eval_expr(s)) for j, s in zip(robot.joints, items, strict=True)}
+    except InputError as exc:
+        raise InputError(exc.message, field="--q") from None
+    except (ValueError, ArithmeticError) as exc:
+        raise InputError(f"{text!r}: {exc}", field="--q") from None
+
+
+def pose_q(robot: RobotSource, pose: str | None, q: str | None) -> dict[str, float]:
+    """The joint values a `--pose NAME` or `--q VALUES` option stands for."""
+    if pose is not None and q is not None:
+        raise InputError("give --pose or --q, not both", field="--pose")
+    if pose is not None:
+        if pose not in robot.poses:
+            known = ", ".join(robot.poses) or "(none: a URDF has no named poses)"
+            raise InputError(f"unknown pose {pose!r}; known: {known}", field="--pose")
+        return dict(robot.poses[pose])
+    return parse_q(q, robot) if q is not None else {}

@@ -1,0 +1,358 @@
+"""Every `check` rule fires on a deliberately broken copy of the generated robot, and
+only that rule; the clean robot fires none; the course's macro output is caught."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+from lxml import etree
+
+from armcli.check.rules import RULES, CheckOptions, apply_policy
+from armcli.check.run import check_urdf
+from armcli.spec.load import load_spec
+from armcli.spec.model import RobotSpec
+from armcli.urdf.read import parse_urdf, read_urdf
+from armcli.urdf.xacro_sandbox import expand_untrusted
+from tests.helpers import ROOT
+
+FIXTURES = ROOT / "tests" / "fixtures" / "check"
+BASE = (ROOT / "urdf" / "my_robot.urdf").read_bytes()
+SPEC = load_spec(ROOT / "specs" / "my_robot.yaml")
+# The issue: the hand tip is at (0.15, 0, 0.92) m in base_footprint at q = 0
+# (base_joint 0.1 + mount 0.2 + arm base 0.02 + forearm 0.3 + hand 0.3; mount x 0.15).
+HAND_TIP_HOME = (0.15, 0.0, 0.92)
+FK_ATOL = 1e-12
+
+
+def _el(root: Any, tag: str, name: str) -> Any:
+    el = root.find(f"{tag}[@name='{name}']")
+    assert el is not None, name
+    return el
+
+
+def link(name: str) -> Callable[[Any], Any]:
+    return lambda r: _el(r, "link", name)
+
+
+def joint(name: str) -> Callable[[Any], Any]:
+    return lambda r: _el(r, "joint", name)
+
+
+HAND, FOREARM, J2, J1 = (
+    link("hand_link"),
+    link("forearm_link"),
+    joint("forearm_hand_joint"),
+    joint("arm_base_forearm_joint"),
+)
+
+
+def set_attr(get: Callable[[Any], Any], path: str, attr: str, value: str) -> Callable[[Any], None]:
+    def edit(r: Any) -> None:
+        el = get(r) if not path else get(r).find(path)
+        el.set(attr, value)
+
+    return edit
+
+
+def remove(get: Callable[[Any], Any], path: str) -> Callable[[Any], None]:
+    def edit(r: Any) -> None:
+        parent = get(r)
+        parent.remove(parent.find(path))
+
+    return edit
+
+
+def append(xml: str, get: Callable[[Any], Any] | None = None) -> Callable[[Any], None]:
+    def edit(r: Any) -> None:
+        (get(r) if get else r).append(etree.fromstring(xml))
+
+    return edit
+
+
+def scale_hand(mass: float) -> Callable[[Any], None]:
+    """Give the hand another mass with its inertia scaled to match (shape unchanged)."""
+
+    def edit(r: Any) -> None:
+        ine = HAND(r).find("inertial")
+        old = float(ine.find("mass").get("value"))
+        ine.find("mass").set("value", repr(mass))
+        el = ine.find("inertia")
+        for a in ("ixx", "iyy", "izz"):
+            el.set(a, repr(float(el.get(a)) * mass / old))
+
+    return edit
+
+
+def swap_hand_ixx_izz(r: Any) -> None:
+    el = HAND(r).find("inertial/inertia")
+    ixx, izz = el.get("ixx"), el.get("izz")
+    el.set("ixx", izz)
+    el.set("izz", ixx)
+
+
+def hand_mesh(r: Any) -> None:
+    geo = HAND(r).find("visual/geometry")
+    geo.remove(geo.find("cylinder"))
+    geo.append(etree.fromstring('<mesh filename="package://no_such_pkg/meshes/hand.stl"/>'))
+
+
+def with_gains(kp: float, kd: float) -> RobotSpec:
+    gains = {j: g.model_copy(update={"kp": kp, "kd": kd}) for j, g in SPEC.control.gains.items()}
+    return SPEC.model_copy(update={"control": SPEC.control.model_copy(update={"gains": gains})})
+
+
+def disconnected(r: Any) -> None:
+    """Two links that are each other's parent: a cycle away from the root."""
+    for xml in (
+        '<link name="c1"/>',
+        '<link name="c2"/>',
+        '<joint name="c12" type="fixed"><parent link="c1"/><child link="c2"/></joint>',
+        '<joint name="c21" type="fixed"><parent link="c2"/><child link="c1"/></joint>',
+    ):
+        r.append(etree.fromstring(xml))
+
+
+def capsule(r: Any) -> None:
+    """An unknown shape in the visual; urdfdom also says it cannot parse the visual."""
+    geo = HAND(r).find("visual/geometry")
+    geo.remove(geo.find("cylinder"))
+    geo.append(etree.fromstring('<capsule radius="0.02" length="0.3"/>'))
+
+
+def hand_orange_redefined(r: Any) -> None:
+    """The hand's visual redefines the top-level orange with another colour."""
+    mat = HAND(r).find("visual/material")
+    mat.append(etree.fromstring('<color rgba="1 0.6 0 1"/>'))
+
+
+def tool_without_inertial(r: Any) -> None:
+    """A tool with geometry but no <inertial>, fixed to the hand (whose mass carries it)."""
+    geo = '<geometry><box size="0.02 0.02 0.02"/></geometry>'
+    r.append(
+        etree.fromstring(
+            f'<link name="tool"><visual>{geo}</visual><collision>{geo}</collision></link>'
+        )
+    )
+    r.append(
+        etree.fromstring(
+            '<joint name="tool_joint" type="fixed"><parent link="hand_link"/>'
+            '<child link="tool"/><origin xyz="0 0 0.3"/></joint>'
+        )
+    )
+
+
+SAFE_SPEC = with_gains(50.0, 2.0)  # Kd = 2 keeps even the explicit loop stable at 1 ms
+
+# (edit of urdf/my_robot.urdf, spec or None, the exact set of rules expected)
+CASES: dict[str, tuple[Callable[[Any], None], RobotSpec | None, set[str]]] = {
+    "duplicate-name": (append('<link name="hand_link"/>'), None, {"duplicate-name"}),
+    "unknown-link": (set_attr(J2, "parent", "link", "no_such_link"), None, {"unknown-link"}),
+    "multiple-parents": (
+        append(
+            '<joint name="extra" type="fixed"><parent link="arm_base_link"/>'
+            '<child link="hand_link"/></joint>'
+        ),
+        None,
+        {"multiple-parents"},
+    ),
+    "root-count": (append('<link name="floating_frame"/>'), None, {"root-count"}),
+    "disconnected": (disconnected, None, {"disconnected"}),
+    "joint-type": (set_attr(J2, "", "type", "hinge"), None, {"joint-type"}),
+    "missing-limit": (remove(J2, "limit"), None, {"missing-limit"}),
+    "mimic-target": (append('<mimic joint="no_such_joint"/>', J2), None, {"mimic-target"}),
+    "material-conflict": (hand_orange_redefined, None, {"material-conflict"}),
+    "number-syntax": (set_attr(HAND, "visual/origin", "xyz", "0 0 0.15m"), None, {"number-syntax"}),
+    # urdfdom refuses NaN/inf too (and says so on stderr).
+    "non-finite": (
+        set_attr(HAND, "visual/origin", "xyz", "0 0 nan"),
+        None,
+        {"non-finite", "parser-error"},
+    ),
+    "vector-length": (set_attr(J2, "origin", "xyz", "0 0"), None, {"vector-length"}),
+    "geometry-size": (
+        set_attr(HAND, "visual/geometry/cylinder", "radius", "0"),
+        None,
+        {"geometry-size"},
+    ),
+    # urdfdom also says it cannot parse that visual.
+    "geometry-kind": (capsule, None, {"geometry-kind", "parser-error"}),
+    # urdfdom also rejects the colour and then the material.
+    "rgba-range": (
+        set_attr(lambda r: _el(r, "material", "orange"), "color", "rgba", "2 0.5 0 1"),
+        None,
+        {"rgba-range", "parser-error"},
+    ),
+    "mass-nonpositive": (
+        set_attr(HAND, "inertial/mass", "value", "-0.3"),
+        None,
+        {"mass-nonpositive"},
+    ),
+    "inertia-not-pd": (
+        set_attr(HAND, "inertial/inertia", "ixx", "-0.00228"),
+        None,
+        {"inertia-not-pd"},
+    ),
+    "inertia-triangle": (
+        set_attr(HAND, "inertial/inertia", "izz", "0.01"),
+        None,
+        {"inertia-triangle"},
+    ),
+    "tiny-mass": (scale_hand(1e-5), None, {"tiny-mass"}),
+    "missing-inertial": (tool_without_inertial, None, {"missing-inertial"}),
+    "root-inertia": (
+        append(
+            '<inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" '
+            'izz="1"/></inertial>',
+            link("base_footprint"),
+        ),
+        None,
+        {"root-inertia"},
+    ),
+    "inertia-geometry": (swap_hand_ixx_izz, None, {"inertia-geometry"}),
+    "com-geometry": (set_attr(HAND, "inertial/origin", "xyz", "0 0 0.2"), None, {"com-geometry"}),
+    "limit-order": (set_attr(J2, "limit", "upper", "0"), None, {"limit-order"}),
+    "limit-effort-velocity": (
+        set_attr(J2, "limit", "velocity", "0"),
+        None,
+        {"limit-effort-velocity"},
+    ),
+    "axis": (set_attr(J2, "axis", "xyz", "0 0 0"), None, {"axis"}),
+    "axis-unit": (set_attr(J2, "axis", "xyz", "0 2 0"), None, {"axis-unit"}),
+    "limit-degrees": (set_attr(J2, "limit", "upper", "90"), None, {"limit-degrees"}),
+    "spec-limits": (set_attr(J2, "limit", "upper", "1.5"), SAFE_SPEC, {"spec-limits"}),
+    "parser-message": (lambda r: None, None, set()),
+    "parser-error": (
+        append('<material name="texture_only"><texture/></material>'),
+        None,
+        {"parser-error"},
+    ),
+    "model-load": (append('<calibration rising="abc"/>', J2), None, {"model-load"}),
+    "gravity-effort": (set_attr(J1, "limit", "effort", "1"), None, {"gravity-effort"}),
+    # An implicit-damping divergence is always an explicit one too (Kp bound is looser).
+    "pd-unstable": (lambda r: None, with_gains(1e6, 5.0), {"pd-unstable", "pd-explicit-unstable"}),
+    "pd-explicit-unstable": (lambda r: None, SPEC, {"pd-explicit-unstable"}),
+    "visual-no-collision": (remove(HAND, "collision"), None, {"visual-no-collision"}),
+    "self-collision": (
+        set_attr(joint("mobile_base_arm_joint"), "origin", "xyz", "0.15 0 0.15"),
+        SAFE_SPEC,
+        {"self-collision"},
+    ),
+    "mesh-missing": (hand_mesh, None, {"mesh-missing"}),
+}
+
+
+def run(edit: Callable[[Any], None], spec: RobotSpec | None) -> Any:
+    root = etree.fromstring(BASE)
+    edit(root)
+    data = etree.tostring(root, xml_declaration=True, encoding="utf-8")
+    return check_urdf(parse_urdf(data, "broken.urdf"), CheckOptions(spec=spec))
+
+
+def test_every_rule_has_a_case() -> None:
+    # parser-message (non-error urdfdom output) has no known trigger with urdfdom 4:
+    # everything it prints starts with "Error"; it stays for other parser versions.
+    assert set(RULES) - set(CASES) == set()
+
+
+@pytest.mark.parametrize("rule", sorted(r for r in CASES if r != "parser-message"))
+def test_broken_fixture_triggers_exactly_its_rule(rule: str) -> None:
+    edit, spec, expected = CASES[rule]
+    result = run(edit, spec)
+    assert {f.rule for f in result.findings} == expected, [f.message for f in result.findings]
+    for f in result.findings:
+        assert f.severity == RULES[f.rule].severity and f.hint and f.message
+
+
+@pytest.mark.parametrize("name", ["my_robot.urdf", "standalone_arm.urdf"])
+def test_generated_robot_is_clean(root: Path, built_dir: Path, name: str) -> None:
+    for path in (root / "urdf" / name, built_dir / name):
+        result = check_urdf(read_urdf(path), CheckOptions(spec=SAFE_SPEC))
+        rules = {f.rule for f in result.findings}
+        # The standalone arm's root link carries the arm base's mass, as the course's
+        # standalone_arm.urdf.xacro does; KDL warns about exactly that.
+        assert rules == (set() if name == "my_robot.urdf" else {"root-inertia"}), rules
+
+
+def test_summary_of_the_default_robot(root: Path) -> None:
+    s = check_urdf(read_urdf(root / "urdf" / "my_robot.urdf"), CheckOptions(spec=SPEC)).summary
+    # Spec masses: base 5 + wheels 2 x 1 + caster 0.5 + arm 0.5 + 0.3 + 0.3.
+    assert s.total_mass == pytest.approx(8.6, abs=1e-12)
+    assert s.dof == 4  # two wheels + two arm joints
+    home = next(p for p in s.poses if p.name == "home")
+    assert home.xyz == pytest.approx(HAND_TIP_HOME, abs=FK_ATOL)
+    # folded: q1 = q2 = pi/2, the forearm points along +x (0.3 m) and the hand down (0.3 m).
+    folded = next(p for p in s.poses if p.name == "folded")
+    assert folded.xyz == pytest.approx((0.15 + 0.3, 0.0, 0.32 - 0.3), abs=FK_ATOL)
+    j1 = next(j for j in s.joints if j.name == "arm_base_forearm_joint")
+    # Worst gravity torque on joint 1: both links horizontal, 0.3 kg at 0.15 m and 0.45 m.
+    assert j1.gravity_max == pytest.approx(0.3 * 9.81 * (0.15 + 0.45), rel=1e-9)
+    assert s.stability is not None and not s.stability.explicit.stable
+
+
+def test_issue_stability_verdict_for_the_seed_gains(root: Path) -> None:
+    result = check_urdf(read_urdf(root / "urdf" / "standalone_arm.urdf"), CheckOptions(spec=SPEC))
+    (f,) = [f for f in result.findings if f.rule == "pd-explicit-unstable"]
+    assert f.values["lambda_max"] == pytest.approx(554.0, rel=1e-3)  # the issue's number
+    assert "pd-unstable" not in {x.rule for x in result.findings}  # implicit damping is fine
+
+
+# The course macros: box_inertia(m, l, w, h) gives ixx = m/12 (h² + l²), iyy = m/12 (w² + l²),
+# izz = m/12 (w² + h²); the base calls pass 2*size. Solid-body references: box
+# m/12 (y²+z², x²+z², x²+y²), cylinder m/12 (3r²+h²) twice and m r²/2, sphere 2/5 m r².
+def _course_box(m: float, ln: float, w: float, h: float) -> tuple[float, float, float]:
+    return (m / 12 * (h * h + ln * ln), m / 12 * (w * w + ln * ln), m / 12 * (w * w + h * h))
+
+
+COURSE_FLAGGED = {
+    "base_link": (_course_box(5.0, 1.2, 0.8, 0.4), (5 / 12 * 0.2, 5 / 12 * 0.4, 5 / 12 * 0.52)),
+    "right_wheel_link": (
+        (1 / 12 * (3 * 0.04 + 0.01),) * 2 + (0.5 * 0.04,),
+        (1 / 12 * (3 * 0.01 + 0.0025),) * 2 + (0.5 * 0.01,),
+    ),
+    "left_wheel_link": (
+        (1 / 12 * (3 * 0.04 + 0.01),) * 2 + (0.5 * 0.04,),
+        (1 / 12 * (3 * 0.01 + 0.0025),) * 2 + (0.5 * 0.01,),
+    ),
+    "caster_wheel_link": ((0.4 * 0.5 * 0.01,) * 3, (0.4 * 0.5 * 0.0025,) * 3),
+    "arm_base_link": (
+        _course_box(0.5, 0.1, 0.1, 0.02),
+        (0.5 / 12 * 0.0104, 0.5 / 12 * 0.0104, 0.5 / 12 * 0.02),
+    ),
+}
+INERTIA_RTOL = 1e-9
+
+
+def test_course_macros_are_flagged_link_by_link() -> None:
+    data = expand_untrusted(FIXTURES / "course_macros.urdf.xacro")
+    result = check_urdf(parse_urdf(data, "course.urdf"))
+    found = {f.values["link"]: f for f in result.findings if f.rule == "inertia-geometry"}
+    assert set(found) == set(COURSE_FLAGGED)  # forearm and hand (correct sizes) pass
+    for name, (course, solid) in COURSE_FLAGGED.items():
+        f = found[name]
+        # Wheels are rotated by rpy = (pi/2, 0, 0): the geometry-frame diagonal is the macro's.
+        assert f.values["actual"] == pytest.approx(course, rel=INERTIA_RTOL), name
+        assert f.values["expected"] == pytest.approx(solid, rel=INERTIA_RTOL), name
+    assert "axes permuted" in found["arm_base_link"].message
+    assert "axes permuted, 4x too large" in found["base_link"].message
+    assert "4x too large" in found["right_wheel_link"].message
+    assert {f.rule for f in result.findings} == {"inertia-geometry"}
+
+
+def test_ignore_and_strict() -> None:
+    result = run(*CASES["com-geometry"][:2])
+    assert apply_policy(result.findings, ignore=["com-geometry"]) == []
+    (strict,) = apply_policy(result.findings, strict=True)
+    assert strict.severity == "error"
+
+
+def test_sampled_range_reaches_the_gravity_worst_case() -> None:
+    # Joint 1 at pi/2 with joint 2 at 0 is a corner of the range box; with four joints
+    # (wheels included) the sample is corners + random draws, and must contain it.
+    result = check_urdf(parse_urdf(BASE, "x.urdf"))
+    j1 = next(j for j in result.summary.joints if j.name == "arm_base_forearm_joint")
+    assert j1.gravity_max == pytest.approx(0.3 * 9.81 * 0.6, rel=1e-9)
+    assert math.isfinite(j1.gravity_max)

@@ -1,0 +1,153 @@
+"""`armcli simulate` end to end through the real command."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from armcli.cli import main
+from tests.helpers import ROOT
+
+TRAJ = ROOT / "specs" / "trajectories"
+J1, J2 = "arm_base_forearm_joint", "forearm_hand_joint"
+SEED = (
+    "{header: {frame_id: arm_base_link}, joint_names: [arm_base_forearm_joint, "
+    "forearm_hand_joint], points: [{positions: {0.0, 0.0}}]}"
+)  # the course's `ros2 topic pub /set_joint_trajectory` payload
+RATE = 10.0  # [Hz] joint_state_publisher update_rate in specs/my_robot.yaml
+TRACK_TOL = 0.01  # [rad] final tracking: friction 0.05 / Kp 50 and gravity sag 0.6*9.81*0.15/50
+
+
+def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    try:
+        main(["simulate", *args])
+        code = 0
+    except SystemExit as exc:
+        code = int(exc.code or 0)
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+@pytest.fixture(autouse=True)
+def _cwd(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(ROOT)  # the default spec path is relative
+
+
+def test_seed_message(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run(["--message", SEED], capsys)
+    assert code == 0, err
+    assert J1 in out and J2 in out and "end effector" in out
+    # The seed holds q = 0: tip in base_footprint at (base_length/4, 0, 0.1 + 0.2 + 0.02 + 0.6),
+    # the same frame and numbers `check` and `view` report.
+    assert "in base_footprint" in out
+    assert "(0.1500, 0.0000, 0.9200) m" in out
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in TRAJ.glob("*.yaml")))
+def test_example_trajectories_csv(
+    name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out_csv = tmp_path / "states.csv"
+    code, _, err = run(["--trajectory", str(TRAJ / name), "--output", str(out_csv)], capsys)
+    assert code == 0, err
+    with out_csv.open() as fh:
+        rows = list(csv.reader(fh))
+    header, body = rows[0], np.array(rows[1:], dtype=float)
+    cols = [f"{j}.{f}" for j in (J1, J2) for f in ("position", "velocity", "effort", "reference")]
+    assert header == ["time", *cols]
+    np.testing.assert_allclose(np.diff(body[:, 0]), 1.0 / RATE, atol=1e-9)
+    q = body[:, [1, 5]]
+    assert np.all(q >= 0.0) and np.all(q <= math.pi / 2)  # the seed's joint limits
+    final_ref = body[-1, [4, 8]]
+    np.testing.assert_allclose(q[-1], final_ref, atol=TRACK_TOL)
+
+
+def test_json_and_plot(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out_json, png = tmp_path / "s.json", tmp_path / "t.png"
+    args = ["-t", str(TRAJ / "pick.yaml"), "-o", str(out_json), "--plot", str(png), "--rate", "20"]
+    code, out, err = run(args, capsys)
+    assert code == 0, err
+    data = json.loads(out_json.read_text())
+    assert next(iter(data)) == "time" and f"{J2}.reference" in data
+    # pick.yaml ends at 5 s, +2 s default settle time, sampled at 20 Hz
+    assert len(data["time"]) == int(7.0 * 20) + 1
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
+    assert f"wrote {png}" in out
+
+
+def test_unknown_joint_one_clear_line_no_output(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out_csv = tmp_path / "s.csv"
+    msg = "{joint_names: [elbow], points: [{positions: [0.1]}]}"
+    code, _out, err = run(["--message", msg, "-o", str(out_csv)], capsys)
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1
+    assert "--message" in lines[0] and "joint_names[0]" in lines[0] and J1 in lines[0]
+    assert not out_csv.exists()
+
+
+def test_limits_error_or_clamp(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "far.yaml"
+    bad.write_text(f"joint_names: [{J1}]\npoints:\n  - positions: [2.0]\n")
+    code, _, err = run(["-t", str(bad)], capsys)
+    assert code == 2 and f"{bad}:3" in err and "points[0].positions[0]" in err
+    code, _out, err = run(["-t", str(bad), "--clamp"], capsys)
+    assert code == 0 and "warning" in err and "clamped" in err
+
+
+def test_rk4_at_default_dt_is_refused_with_advice(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run(["--message", SEED, "--integrator", "rk4"], capsys)
+    assert code == 2 and "--dt <=" in err
+    code, _, err = run(["--message", SEED, "--integrator", "rk4", "--dt", "0.0005"], capsys)
+    assert code == 0, err
+
+
+def test_any_urdf_with_locked_joints(built_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    urdf = built_dir / "standalone_arm.urdf"
+    msg = "{joint_names: [forearm_hand_joint], points: [{positions: [0.7], time_from_start: 1}]}"
+    args = ["--urdf", str(urdf), "--joints", J2, "--kp", "50", "--kd", "5", "-m", msg]
+    code, out, err = run(args, capsys)
+    assert code == 0, err
+    assert J2 in out and J1 not in out
+
+
+def test_bad_output_extension_fails_before_running(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, _, err = run(["--message", SEED, "-o", str(tmp_path / "s.txt")], capsys)
+    assert code == 2 and "--output" in err
+    assert not (tmp_path / "s.txt").exists()
+
+
+def test_integral_gain_is_refused_not_ignored(tmp_path: Path) -> None:
+    """The simulator is PD: a spec ki > 0 is an error naming the field, unless --kp/--kd given."""
+    text = (ROOT / "specs" / "my_robot.yaml").read_text()
+    assert "kd: 5" in text
+    spec = tmp_path / "ki.yaml"
+    spec.write_text(text.replace("kd: 5", "kd: 5, ki: 0.5", 1))
+    traj = str(ROOT / "specs" / "trajectories" / "pick.yaml")
+    res = subprocess.run(
+        [sys.executable, "-m", "armcli", "simulate", str(spec), "-t", traj, "--duration", "0.5"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert res.returncode == 2
+    assert "control.gains." in res.stderr and ".ki" in res.stderr and "PD" in res.stderr
+    ok = subprocess.run(
+        [sys.executable, "-m", "armcli", "simulate", str(spec), "-t", traj, "--duration", "0.5",
+         "--kp", "50", "--kd", "5"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )  # fmt: skip
+    assert ok.returncode == 0, ok.stderr

@@ -1,0 +1,94 @@
+"""Shared test helpers: repository paths, and mutation strategies for fuzzing loaders.
+
+Mutations start from a valid document and change one place at a time (replace
+a value with a hostile one, drop a key, add an unknown key), so the fuzzer
+spends its time just past the validator's edge rather than on random bytes.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from pathlib import Path
+from typing import Any
+
+from hypothesis import strategies as st
+
+ROOT = Path(__file__).resolve().parents[1]  # the repository checkout
+SPECS = ROOT / "specs"
+DEFAULT_SPEC = SPECS / "my_robot.yaml"
+FIXTURES = ROOT / "tests" / "fixtures"
+BAD_INPUTS = ROOT / "tests" / "bad_inputs"
+
+HOSTILE_SCALARS = st.one_of(
+    st.sampled_from(
+        [
+            math.nan,
+            math.inf,
+            -math.inf,
+            0,
+            -1,
+            -1e300,
+            1e300,
+            "",
+            "pi/0",
+            "__import__('os')",
+            "pi/2",
+            True,
+            None,
+            "../../etc/passwd",
+            "\x00",
+            "0" * 200,
+            [],
+            {},
+        ]
+    ),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.integers(min_value=-(2**70), max_value=2**70),
+    st.text(max_size=20),
+    st.lists(st.floats(allow_nan=False), max_size=4),
+)
+
+
+def paths(data: Any, prefix: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
+    """Every path to a node of nested dicts/lists."""
+    out = [prefix]
+    if isinstance(data, dict):
+        for k, v in data.items():
+            out += paths(v, (*prefix, k))
+    elif isinstance(data, list):
+        for i, v in enumerate(data):
+            out += paths(v, (*prefix, i))
+    return out
+
+
+def _parent(data: Any, path: tuple[Any, ...]) -> Any:
+    node = data
+    for p in path[:-1]:
+        node = node[p]
+    return node
+
+
+@st.composite
+def mutated(draw: st.DrawFn, base: Any, max_mutations: int = 3) -> Any:
+    """`base` with 1..max_mutations structured changes."""
+    doc = copy.deepcopy(base)
+    for _ in range(draw(st.integers(1, max_mutations))):
+        candidates = [p for p in paths(doc) if p]
+        if not candidates:
+            break
+        path = draw(st.sampled_from(candidates))
+        parent = _parent(doc, path)
+        action = draw(st.sampled_from(["replace", "delete", "add", "wrap"]))
+        if action == "replace":
+            parent[path[-1]] = draw(HOSTILE_SCALARS)
+        elif action == "delete":
+            if isinstance(parent, dict):
+                del parent[path[-1]]
+            else:
+                parent.pop(path[-1])
+        elif action == "add" and isinstance(parent, dict):
+            parent[draw(st.text(min_size=1, max_size=8))] = draw(HOSTILE_SCALARS)
+        elif action == "wrap":
+            parent[path[-1]] = [parent[path[-1]]]
+    return doc

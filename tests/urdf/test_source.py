@@ -1,0 +1,115 @@
+"""robot_source: one loader for every robot file argument (spec, URDF, xacro) and mesh roots."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from armcli.errors import InputError, XacroRefusedError
+from armcli.urdf.source import (
+    allowed_roots,
+    inside_roots,
+    load_checked_model,
+    read_robot,
+    read_urdf_file,
+)
+from tests.helpers import ROOT
+
+COURSE_XACRO = ROOT / "tests" / "fixtures" / "check" / "course_macros.urdf.xacro"
+BAD = ROOT / "tests" / "bad_inputs"
+ARM_MASS_KG = 0.5 + 0.3 + 0.3  # spec: arm_base_link + forearm_link + hand_link masses
+MASS_TOL = 1e-12
+
+
+def test_spec_gives_both_urdfs_and_the_whole_robot(default_spec_path: Path) -> None:
+    robot = read_robot(default_spec_path)
+    names = [u.source.rsplit("#", 1)[1] for u in robot.urdfs]
+    assert names == ["my_robot.urdf", "standalone_arm.urdf"]
+    assert robot.spec is not None and robot.robot.source.endswith("#my_robot.urdf")
+
+
+def test_urdf_is_read_strictly(root: Path) -> None:
+    robot = read_robot(root / "urdf" / "standalone_arm.urdf")
+    assert robot.spec is None and robot.robot.name == "standalone_arm"
+    with pytest.raises(InputError, match="DOCTYPE"):
+        read_robot(BAD / "urdf" / "external_entity.urdf")
+
+
+def test_directory_is_refused(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="is a directory"):
+        read_robot(tmp_path)
+
+
+@pytest.mark.parametrize("name", ["robot.urdf.xacro", "robot.urdf"])
+def test_foreign_xacro_safe_by_suffix_or_content(tmp_path: Path, name: str) -> None:
+    path = tmp_path / name
+    path.write_bytes(COURSE_XACRO.read_bytes())
+    safe = read_urdf_file(path)  # xacro_safe: no code from the file runs
+    trusted = read_urdf_file(path, trust_xacro=True)  # xacro itself, in xacro_sandbox
+    assert safe.source == trusted.source == f"{path}#expanded"
+    assert safe.text == trusted.text
+    assert {j.name for j in safe.joints} >= {"arm_base_forearm_joint", "forearm_hand_joint"}
+
+
+def test_checked_model_refuses_what_pinocchio_would_accept(root: Path) -> None:
+    with pytest.raises(InputError, match=r"nan_mass\.urdf:\d+: .*mass@value: non-finite"):
+        load_checked_model(BAD / "urdf" / "nan_mass.urdf")
+    with pytest.raises(InputError, match="not a number: '0x1p-1'"):
+        load_checked_model(BAD / "urdf" / "hex_number.urdf")
+    with pytest.raises(XacroRefusedError):
+        load_checked_model(BAD / "xacro" / "eval_exploit_renamed.urdf")
+    loaded = load_checked_model(root / "urdf" / "standalone_arm.urdf")
+    assert loaded.model.nq == 2
+    assert abs(sum(i.mass for i in loaded.model.inertias) - ARM_MASS_KG) < MASS_TOL
+
+
+def test_allowed_roots_include_the_ros_package(tmp_path: Path) -> None:
+    pkg = tmp_path / "my_pkg"
+    (pkg / "urdf").mkdir(parents=True)
+    (pkg / "meshes").mkdir()
+    (pkg / "package.xml").write_text("<package/>")
+    roots = allowed_roots(pkg / "urdf")
+    assert inside_roots(pkg / "urdf" / ".." / "meshes" / "arm.stl", roots)
+    assert not inside_roots(tmp_path / "elsewhere.stl", roots)
+    assert not inside_roots(Path("/etc/passwd"), roots)
+
+
+def test_inside_roots_follows_symlinks_and_dotdot(tmp_path: Path) -> None:
+    here = tmp_path / "robot"
+    here.mkdir()
+    (here / "escape.stl").symlink_to("/etc/passwd")
+    roots = allowed_roots(here)
+    assert not inside_roots(here / "escape.stl", roots)
+    assert not inside_roots(here / ".." / ".." / "etc" / "shadow", roots)
+    assert inside_roots(here / "sub" / ".." / "ok.stl", roots)
+
+
+def test_ros_package_path_entries_are_roots(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    monkeypatch.setenv("ROS_PACKAGE_PATH", os.pathsep.join([str(shared), ""]))
+    assert inside_roots(shared / "pkg" / "mesh.stl", allowed_roots(tmp_path / "robot"))
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        "check",
+        "view",
+        "render",
+        "tree",
+        "simulate",
+    ],
+)
+def test_every_robot_file_command_offers_trust_xacro(command: str) -> None:
+    from typer.testing import CliRunner
+
+    from armcli.cli import app
+
+    result = CliRunner().invoke(app, [command, "--help"])
+    assert result.exit_code == 0, result.output
+    assert "--trust-xacro" in result.output

@@ -1,0 +1,153 @@
+"""`armcli tree`: the kinematic tree against the spec it was built from and against urdfdom."""
+
+from __future__ import annotations
+
+import io
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from armcli.errors import InputError
+from armcli.spec.load import load_spec
+from armcli.urdf.tree import parse_tree, to_dot, to_rich
+from armcli.view.scene import load_robot
+
+LIMIT_TOL = 1e-9  # [rad] limits pass through xacro as shortest-repr decimals of the spec value
+CHAIN = ("arm_base_link", "forearm_link", "hand_link")  # the seed's arm, root to tip
+LABEL_TOL = 1e-5  # urdf_to_graphviz prints C++ ostream's 6 significant digits
+
+
+@pytest.fixture(scope="module")
+def robot(default_spec_path: Path):  # type: ignore[no-untyped-def]
+    return load_robot(default_spec_path)
+
+
+def test_tree_matches_the_spec(robot, default_spec_path: Path) -> None:  # type: ignore[no-untyped-def]
+    """Every spec joint appears with its parent, child, type and limits; the root is the base."""
+    spec = load_spec(default_spec_path)
+    tree = parse_tree(robot.xml, robot.source)
+    assert tree.root == "base_footprint"  # the only spec link that is no joint's child
+    assert set(tree.links) == set(spec.all_links())
+    by_name = {j.name: j for j in tree.joints}
+    assert set(by_name) == set(spec.all_joints())
+    for name, sj in spec.all_joints().items():
+        tj = by_name[name]
+        assert (tj.parent, tj.child, tj.type) == (sj.parent, sj.child, sj.type)
+        assert tj.xyz == pytest.approx(sj.origin.xyz, abs=LIMIT_TOL)
+        if sj.limit is not None:
+            assert tj.lower == pytest.approx(sj.limit.lower, abs=LIMIT_TOL)
+            assert tj.upper == pytest.approx(sj.limit.upper, abs=LIMIT_TOL)
+            assert tj.effort == sj.limit.effort
+    # The seed: two revolute arm joints, 0..pi/2, effort 100, velocity 100.
+    assert [j.name for j in tree.movable() if j.type == "revolute"] == [
+        "arm_base_forearm_joint",
+        "forearm_hand_joint",
+    ]
+
+
+def test_rich_tree_shows_links_types_and_limits(robot) -> None:  # type: ignore[no-untyped-def]
+    from rich.console import Console
+
+    buf = io.StringIO()
+    Console(file=buf, width=200).print(to_rich(parse_tree(robot.xml)))
+    lines = buf.getvalue().splitlines()
+    assert lines[0].startswith("base_footprint")
+    hand = next(ln for ln in lines if "hand_link" in ln)
+    # pi/2 = 1.5708 to 6 significant digits; effort and velocity from the seed.
+    assert "forearm_hand_joint: revolute, axis (0 1 0), [0, 1.5708] rad" in hand
+    assert "effort 100 N·m, velocity 100 rad/s" in hand
+    # hand_link hangs below forearm_link below arm_base_link: deeper indentation each step.
+    col = [next(ln.index(n) for ln in lines if f"{n}  " in ln) for n in CHAIN]
+    assert col == sorted(col) and len(set(col)) == len(CHAIN)
+
+
+def _edges(dot: str) -> list[tuple[str, str, list[float]]]:
+    """(tail, head, numbers in the label) for every edge of a DOT file, in file order."""
+    out = []
+    for m in re.finditer(r'^"([^"]+)" -> "([^"]+)"(?: \[label="([^"]*)"\])?', dot, re.M):
+        nums = [float(x) for x in re.findall(r"-?\d+(?:\.\d+)?(?:e-?\d+)?", m.group(3) or "")]
+        out.append((m.group(1), m.group(2), nums))
+    return out
+
+
+def test_dot_matches_urdf_to_graphviz(robot, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    """Same link boxes, same edges in the same order, same origins as urdfdom's own tool."""
+    exe = shutil.which("urdf_to_graphviz")
+    if exe is None:
+        pytest.skip("urdf_to_graphviz not installed (Debian liburdfdom-tools; `make sysdeps`)")
+    urdf = tmp_path / "robot.urdf"
+    urdf.write_text(robot.xml)
+    subprocess.run([exe, str(urdf), "ref"], cwd=tmp_path, capture_output=True, timeout=30)
+    ref = (tmp_path / "ref.gv").read_text()
+    ours = to_dot(parse_tree(robot.xml))
+    boxes = re.compile(r'^"([^"]+)" \[label="\1"\];$', re.M)
+    assert boxes.findall(ours) == boxes.findall(ref)
+    ref_edges, our_edges = _edges(ref), _edges(ours)
+    assert [e[:2] for e in our_edges] == [e[:2] for e in ref_edges]
+    for (_, _, a), (_, _, b) in zip(our_edges, ref_edges, strict=True):
+        assert a == pytest.approx(b, abs=LABEL_TOL)
+
+
+def _urdf(body: str) -> str:
+    return f'<robot name="r">{body}</robot>'
+
+
+@pytest.mark.parametrize(
+    ("body", "message"),
+    [
+        ('<link name="a"/><link name="b"/>', "exactly one root link"),
+        (
+            '<link name="a"/><joint name="j" type="fixed"><parent link="a"/>'
+            '<child link="zz"/></joint>',
+            "unknown child link 'zz'",
+        ),
+        (
+            '<link name="a"/><link name="b"/><joint name="j" type="hinge"><parent link="a"/>'
+            '<child link="b"/></joint>',
+            "unknown type 'hinge'",
+        ),
+        (
+            '<link name="a"/><link name="b"/><joint name="j" type="fixed"><parent link="a"/>'
+            '<child link="b"/><origin xyz="0 nan 0"/></joint>',
+            "non-finite",
+        ),
+    ],
+)
+def test_bad_urdf_is_one_clear_error(body: str, message: str) -> None:
+    with pytest.raises(InputError, match=message) as info:
+        parse_tree(_urdf(body), "bad.urdf")
+    assert info.value.file == "bad.urdf"
+
+
+def test_entities_are_refused() -> None:
+    xml = '<!DOCTYPE r [<!ENTITY x SYSTEM "file:///etc/passwd">]><robot name="&x;"/>'
+    with pytest.raises(InputError, match="DOCTYPE"):
+        parse_tree(xml, "evil.urdf")
+
+
+def _cli(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "armcli.cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+        cwd=cwd,
+    )
+
+
+def test_cli_tree_text_dot_and_bad_format(root: Path, tmp_path: Path) -> None:
+    text = _cli("tree", cwd=root)
+    assert text.returncode == 0, text.stderr
+    assert "forearm_link" in text.stdout and "revolute" in text.stdout
+    out = tmp_path / "robot.gv"
+    dot = _cli("tree", "urdf/my_robot.urdf", "--format", "dot", "-o", str(out), cwd=root)
+    assert dot.returncode == 0, dot.stderr
+    assert out.read_text().startswith("digraph G {")
+    bad = _cli("tree", "--format", "svg", cwd=root)
+    assert bad.returncode == 2
+    assert bad.stderr.strip() == "error: --format: unknown format 'svg'; known: text, dot"

@@ -1,0 +1,212 @@
+"""`armcli render`: image size, the robot's colours, poses that show, and the tool point."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from armcli.errors import InputError
+from armcli.view.png import AMBIENT, load_urdf, render_png
+from armcli.view.scene import load_robot
+
+SHADE_TOL = 0.05  # max distance in RGB [0..1] of a pixel from a shade of a material colour
+MIN_PIXELS = 150  # a drawn part covers at least this many pixels at 1200x600
+TIP_TOL = 1e-6  # [m] forward kinematics vs closed form
+L = 0.3  # [m] forearm and hand length (seed)
+MOUNT = (0.15, 0.32)  # [m] (x, z) of the forearm joint: mount 0.15 ahead, 0.1 + 0.2 + 0.02 up
+
+
+def tip(q1: float, q2: float) -> tuple[float, float, float]:
+    """Closed-form hand tip for the planar 2-link arm rotating about +y (x = L sin, z = L cos)."""
+    x = MOUNT[0] + L * math.sin(q1) + L * math.sin(q1 + q2)
+    z = MOUNT[1] + L * math.cos(q1) + L * math.cos(q1 + q2)
+    return (x, 0.0, z)
+
+
+@pytest.fixture(scope="module")
+def robot(default_spec_path: Path):  # type: ignore[no-untyped-def]
+    return load_robot(default_spec_path)
+
+
+@pytest.fixture(scope="module")
+def renders(robot, tmp_path_factory: pytest.TempPathFactory):  # type: ignore[no-untyped-def]
+    """The default robot at home and folded, rendered once for the module."""
+    out = tmp_path_factory.mktemp("render")
+    urdf = load_urdf(robot.xml, robot.source)
+    return {
+        pose: render_png(urdf, robot.poses[pose], out / f"{pose}.png", tool=robot.tool)
+        for pose in ("home", "folded")
+    }
+
+
+def pixels(path: Path) -> np.ndarray:
+    with Image.open(path) as im:
+        return np.asarray(im.convert("RGB"), dtype=float) / 255.0
+
+
+def size(path: Path) -> tuple[int, int]:
+    with Image.open(path) as im:
+        return im.size
+
+
+def shade_mask(img: np.ndarray, rgb: tuple[float, float, float]) -> np.ndarray:
+    """Pixels equal to k * rgb with k in the lit range [AMBIENT, 1] (Lambert shading)."""
+    c = np.asarray(rgb)
+    k = img @ c / (c @ c)
+    resid = np.linalg.norm(img - k[..., None] * c, axis=-1)
+    return (resid < SHADE_TOL) & (k > AMBIENT - SHADE_TOL) & (k < 1 + SHADE_TOL)
+
+
+def test_image_size_and_determinism(renders, robot, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    home = renders["home"]
+    assert size(home.path) == (1200, 600) == (home.width, home.height)
+    again = render_png(
+        load_urdf(robot.xml), robot.poses["home"], tmp_path / "again.png", tool=robot.tool
+    )
+    assert again.path.read_bytes() == home.path.read_bytes()
+    small = render_png(load_urdf(robot.xml), {}, tmp_path / "small.png", size=(640, 320))
+    assert size(small.path) == (640, 320)
+
+
+def test_robot_colours_are_present(renders, default_spec_path: Path) -> None:  # type: ignore[no-untyped-def]
+    from armcli.spec.load import load_spec
+
+    spec = load_spec(default_spec_path)
+    used = {lk.material for lk in spec.all_links().values() if lk.material}
+    img = pixels(renders["home"].path)
+    for name in sorted(used):
+        rgb = spec.materials[name].rgba[:3]
+        assert shade_mask(img, rgb).sum() > MIN_PIXELS, f"{name} {rgb} not drawn"
+
+
+def test_tool_point_matches_closed_form(renders) -> None:  # type: ignore[no-untyped-def]
+    # The brief: hand tip at (0.15, 0, 0.92) at q = 0.
+    assert renders["home"].tool_position == pytest.approx((0.15, 0.0, 0.92), abs=TIP_TOL)
+    assert renders["folded"].tool_position == pytest.approx(
+        tip(math.pi / 2, math.pi / 2), abs=TIP_TOL
+    )
+
+
+def _yellow_box(path: Path) -> tuple[int, int]:
+    """(width, height) [px] of the yellow forearm in the side view (right half)."""
+    img = pixels(path)
+    side = img[:, img.shape[1] // 2 :]
+    ys, xs = np.nonzero(shade_mask(side, (1.0, 1.0, 0.0)))
+    return int(xs.max() - xs.min()), int(ys.max() - ys.min())
+
+
+def test_two_poses_give_different_images(renders) -> None:  # type: ignore[no-untyped-def]
+    a, b = pixels(renders["home"].path), pixels(renders["folded"].path)
+    changed = (np.abs(a - b).max(axis=-1) > 0.1).sum()
+    assert changed > 10 * MIN_PIXELS
+    # Side view: the forearm stands upright at home and lies along x when folded (q1 = pi/2).
+    w_home, h_home = _yellow_box(renders["home"].path)
+    w_fold, h_fold = _yellow_box(renders["folded"].path)
+    assert h_home > 3 * w_home
+    assert w_fold > 3 * h_fold
+
+
+def test_out_of_limits_is_refused_and_nothing_written(robot, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    out = tmp_path / "x.png"
+    with pytest.raises(InputError, match=r"outside its limits \[0, 1.5708\]"):
+        render_png(load_urdf(robot.xml), {"forearm_hand_joint": 2.0}, out, field="--q")
+    with pytest.raises(InputError, match="unknown movable joint 'elbow'"):
+        render_png(load_urdf(robot.xml), {"elbow": 0.0}, out, field="--q")
+    assert not out.exists()
+
+
+def _cli(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "armcli.cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+        cwd=cwd,
+    )
+
+
+def test_cli_render_q_and_errors(root: Path, tmp_path: Path) -> None:
+    out = tmp_path / "r.png"
+    ok = _cli("render", "--q", "pi/4,pi/4", "-o", str(out), cwd=root)
+    assert ok.returncode == 0, ok.stderr
+    x, _, z = tip(math.pi / 4, math.pi / 4)
+    assert ok.stdout.strip() == f"wrote {out} (1200x600 px) tool at ({x:.3f}, 0.000, {z:.3f}) m"
+    both = _cli("render", "--pose", "home", "--q", "0,0", "-o", str(tmp_path / "b.png"), cwd=root)
+    assert both.returncode == 2
+    assert both.stderr.strip() == "error: --pose: give --pose or --q, not both"
+    count = _cli("render", "--q", "0.1", "-o", str(tmp_path / "c.png"), cwd=root)
+    assert count.returncode == 2
+    assert "expected 2 values, for: arm_base_forearm_joint, forearm_hand_joint" in count.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.png"]
+
+
+def test_mesh_geometry_is_drawn_and_a_missing_mesh_is_an_error(tmp_path: Path) -> None:
+    import trimesh
+
+    trimesh.creation.icosphere(radius=0.2).export(tmp_path / "ball.stl")
+    link = (
+        '<link name="a"><visual><geometry><mesh filename="{}"/></geometry>'
+        '<material name="red"><color rgba="1 0 0 1"/></material></visual></link>'
+    )
+    ok = f'<robot name="r">{link.format("ball.stl")}</robot>'
+    res = render_png(load_urdf(ok, "m.urdf", tmp_path), {}, tmp_path / "m.png")
+    assert shade_mask(pixels(res.path), (1.0, 0.0, 0.0)).sum() > 10 * MIN_PIXELS
+    bad = f'<robot name="r">{link.format("package://nope/cube.stl")}</robot>'
+    with pytest.raises(InputError, match=r"mesh file not found: package://nope/cube\.stl"):
+        load_urdf(bad, "bad.urdf", tmp_path)
+
+
+def test_foreign_textured_meshes(root: Path, tmp_path: Path) -> None:
+    """A URDF nobody here wrote, with COLLADA meshes whose colour comes from a texture
+    material (trimesh TextureVisuals, which has no face_colors): it used to crash."""
+    import sysconfig
+
+    share = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix" / "share"
+    urdf = share / "example-robot-data/robots/ur_description/urdf/ur5_robot.urdf"
+    if not urdf.is_file():
+        pytest.skip("example-robot-data (dev dependency) not installed")
+    out = tmp_path / "ur5.png"
+    proc = _cli("render", str(urdf), "--q", "0,-1.2,1.5,0,0,0", "-o", str(out), cwd=root)
+    assert proc.returncode == 0, proc.stderr
+    img = pixels(out)
+    assert img.shape[:2] == (600, 1200)
+    # The UR5's dark grey links cover a good part of the 3-D view (left half).
+    dark = (img[:, :600].max(axis=-1) < 0.35).sum()
+    assert dark > MIN_PIXELS
+
+
+def test_render_resolves_package_meshes_with_package_dir(tmp_path: Path) -> None:
+    """`render` uses check's mesh resolver: package://NAME needs --package-dir NAME=PATH."""
+    import trimesh
+
+    pkg = tmp_path / "meshes_pkg"
+    pkg.mkdir()
+    trimesh.creation.box(extents=(0.1, 0.1, 0.3)).export(pkg / "hand.stl")
+    urdf = tmp_path / "robot" / "arm.urdf"
+    urdf.parent.mkdir()
+    urdf.write_text(
+        '<robot name="meshy"><link name="base"/><link name="hand"><visual><geometry>'
+        '<mesh filename="package://my_meshes/hand.stl"/></geometry></visual></link>'
+        '<joint name="j" type="revolute"><parent link="base"/><child link="hand"/>'
+        '<axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+        "</robot>"
+    )
+    out = tmp_path / "meshy.png"
+    res = _cli("render", str(urdf), "-o", str(out), cwd=tmp_path)
+    assert (
+        res.returncode == 2 and "my_meshes/hand.stl" in res.stderr and "--package-dir" in res.stderr
+    )
+    assert not out.exists()
+    res = _cli(
+        "render", str(urdf), "-o", str(out), "--package-dir", f"my_meshes={pkg}", cwd=tmp_path
+    )
+    assert res.returncode == 0, res.stderr
+    with Image.open(out) as img:
+        assert img.size == (1200, 600)
