@@ -17,6 +17,8 @@ import armcli
 from armcli.commands import build, check, render, ros, simulate, tree, view
 from armcli.errors import EXIT_FAILED, ArmcliError
 
+UNSANDBOXED_FLAG = "--trust-xacro-unsandboxed"  # what `--trust-xacro=unsandboxed` becomes
+
 # Typer escapes "[" for rich's HTML export whenever rich is importable, even with
 # rich_markup_mode=None (plain click help), which prints "\\[default: ...]" in --help.
 # Plain click help needs no escaping, and nothing else of typer's rich path is used here.
@@ -75,6 +77,8 @@ def main(argv: list[str] | None = None) -> None:
     armcli raises on purpose is an ArmcliError carrying its own exit code.
     """
     args = list(sys.argv[1:] if argv is None else argv)
+    # `--trust-xacro=unsandboxed` is the documented spelling; a bool flag cannot take a value
+    args = [UNSANDBOXED_FLAG if a == "--trust-xacro=unsandboxed" else a for a in args]
     debug = _debug_requested(args)
     try:
         app(args=args, prog_name="armcli")

@@ -17,13 +17,20 @@ from armcli.errors import ArmcliError, FindingsError, InputError, UnusableInputs
 from armcli.spec.load import load_spec
 from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import parse_package_dirs
-from armcli.urdf.source import TRUST_XACRO_HELP, read_robot, read_urdf_file
+from armcli.urdf.source import (
+    TRUST_XACRO_HELP,
+    UNSANDBOXED_HELP,
+    Trust,
+    read_robot,
+    read_urdf_file,
+    trust_mode,
+)
 
 FORMATS = ("table", "json", "github")
 REPORT_WIDTH = 140  # columns when stdout is not a terminal (CI logs, pipes)
 
 
-def _documents(path: Path, trust_xacro: bool) -> list[tuple[Urdf, Any]]:
+def _documents(path: Path, trust_xacro: Trust) -> list[tuple[Urdf, Any]]:
     """The URDF documents a PATH stands for, each with the spec it came from (or None)."""
     if path.is_dir():
         files = sorted(p for p in path.rglob("*.urdf") if p.is_file())
@@ -35,7 +42,7 @@ def _documents(path: Path, trust_xacro: bool) -> list[tuple[Urdf, Any]]:
 
 
 def _run(
-    paths: list[Path], base: CheckOptions, trust_xacro: bool
+    paths: list[Path], base: CheckOptions, trust_xacro: Trust
 ) -> tuple[list[CheckResult], list[ArmcliError]]:
     from dataclasses import replace
 
@@ -73,6 +80,7 @@ def check_cmd(
         [], "--package-dir", help="NAME=PATH for package://NAME/ mesh URIs (repeatable)."
     ),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
+    unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Check robot descriptions for physical sanity; exit 1 on error findings."""
     if fmt not in FORMATS:
@@ -83,7 +91,9 @@ def check_cmd(
     base = CheckOptions(package_dirs=parse_package_dirs(package_dir))
     if spec is not None:
         base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs)
-    results, errors = _run(list(paths or [DEFAULT_SPEC]), base, trust_xacro)
+    results, errors = _run(
+        list(paths or [DEFAULT_SPEC]), base, trust_mode(trust_xacro, unsandboxed)
+    )
     findings = apply_policy((f for r in results for f in r.findings), ignore=ignore, strict=strict)
     n_err = counts(findings)["error"]
     code = 2 if errors else (1 if n_err else 0)

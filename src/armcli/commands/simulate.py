@@ -18,7 +18,7 @@ from armcli.sim import report as simreport
 from armcli.sim.options import ENGINES, INTEGRATORS, Engine, Integrator, SimOptions
 from armcli.sim.plot import write_tracking_plot
 from armcli.spec.load import load_spec
-from armcli.urdf.source import TRUST_XACRO_HELP
+from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 PROGRESS_AFTER_S = 1.0  # show a progress bar when the run is projected to take longer
 
@@ -79,6 +79,7 @@ def simulate_cmd(
         help="auto (default: compiled when available), native (compiled) or python.",
     ),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
+    unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
     from rich.console import Console
@@ -104,7 +105,7 @@ def simulate_cmd(
         clamp=clamp,
         rate=rate,
         engine=cast(Engine, engine),
-        trust_xacro=trust_xacro,
+        trust_xacro=trust_mode(trust_xacro, unsandboxed),
     )
     # a model `check` reports as an error is not simulated
     job = simjob.prepare(spec_obj, opts, gate=refuse_check_errors)

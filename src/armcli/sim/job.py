@@ -22,7 +22,7 @@ from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_urdf
-from armcli.urdf.source import checked_model, read_urdf_file
+from armcli.urdf.source import Trust, checked_model, read_urdf_file
 from armcli.urdf.tool import tool_point
 
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
@@ -48,7 +48,7 @@ class SimJob:
     T_frame_root: np.ndarray  # 4x4 pose of the arm's root link in the reporting frame
 
 
-def arm_urdf(spec: RobotSpec | None, urdf: Path | None, *, trust_xacro: bool = False) -> Urdf:
+def arm_urdf(spec: RobotSpec | None, urdf: Path | None, *, trust_xacro: Trust = False) -> Urdf:
     """The URDF to simulate: a given file or the spec's standalone arm built in memory.
 
     A given file goes through the strict reader (a foreign xacro only when trusted).
@@ -65,7 +65,7 @@ def load_arm(
     urdf: Path | None,
     joints: Sequence[str] | None,
     *,
-    trust_xacro: bool = False,
+    trust_xacro: Trust = False,
 ) -> Arm:
     """The simulated arm: the spec's standalone arm built in memory, or a given URDF.
 

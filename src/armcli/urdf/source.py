@@ -15,6 +15,7 @@ import os
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Literal
 
 from armcli.build.expand import expand_urdfs
 from armcli.defaults import STANDALONE_ARM_URDF
@@ -29,9 +30,18 @@ from armcli.urdf.xacro_sandbox import expand_foreign, expand_untrusted
 SPEC_SUFFIXES = (".yaml", ".yml")
 XACRO_SUFFIX = ".xacro"
 TRUST_XACRO_HELP = (
-    "Expand a foreign xacro file with xacro itself, which runs Python from the file "
-    "(in a bubblewrap sandbox); without it, xacro files are expanded in safe mode."
+    "Expand a foreign xacro file with xacro itself, which runs Python from the file, inside "
+    "a bubblewrap sandbox (--trust-xacro=unsandboxed: resource limits only). Without it, "
+    "xacro files are expanded in safe mode, where no code from the file runs."
 )
+UNSANDBOXED_HELP = "Same as --trust-xacro=unsandboxed: xacro itself with resource limits only."
+Trust = bool | Literal["unsandboxed"]  # --trust-xacro: False, True (sandboxed), "unsandboxed"
+
+
+def trust_mode(trust_xacro: bool, unsandboxed: bool) -> Trust:
+    """The --trust-xacro / --trust-xacro=unsandboxed options as one value."""
+    return "unsandboxed" if unsandboxed else trust_xacro
+
 
 _PROBLEM = {
     "missing": "missing number",
@@ -60,7 +70,7 @@ class RobotFile:
         return self.urdfs[0]
 
 
-def read_robot(path: Path, *, trust_xacro: bool = False) -> RobotFile:
+def read_robot(path: Path, *, trust_xacro: Trust = False) -> RobotFile:
     """Spec YAML, URDF or (trusted) xacro -> RobotFile; InputError when unusable."""
     if path.is_dir():
         raise InputError("is a directory, expected a robot spec, URDF or xacro file", file=path)
@@ -72,7 +82,7 @@ def read_robot(path: Path, *, trust_xacro: bool = False) -> RobotFile:
     return RobotFile(path, (read_urdf_file(path, trust_xacro=trust_xacro),))
 
 
-def read_urdf_file(path: Path, *, trust_xacro: bool = False) -> Urdf:
+def read_urdf_file(path: Path, *, trust_xacro: Trust = False) -> Urdf:
     """A URDF or xacro file -> Urdf; xacro (by suffix or content) only with trust_xacro."""
     if path.suffix != XACRO_SUFFIX:
         try:
@@ -80,13 +90,14 @@ def read_urdf_file(path: Path, *, trust_xacro: bool = False) -> Urdf:
         except XacroRefusedError:
             pass  # xacro content in a .urdf: expanded like a .xacro file
     if trust_xacro:
-        return parse_urdf(expand_untrusted(path), f"{path}{EXPANDED_TAG}")
+        xml = expand_untrusted(path, unsandboxed=trust_xacro == "unsandboxed")
+        return parse_urdf(xml, f"{path}{EXPANDED_TAG}")
     xml = expand_foreign(path, allowed_roots(path.parent))  # safe mode: no code runs
     return parse_urdf(xml, f"{path}{EXPANDED_TAG}")
 
 
 def load_checked_model(
-    path: Path, *, trust_xacro: bool = False, gate: Callable[[Urdf], None] | None = None
+    path: Path, *, trust_xacro: Trust = False, gate: Callable[[Urdf], None] | None = None
 ) -> LoadedModel:
     """A URDF/xacro file -> Pinocchio model, refusing what Pinocchio would silently accept.
 

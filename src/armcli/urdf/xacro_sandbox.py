@@ -28,6 +28,7 @@ from pathlib import Path
 
 from armcli.errors import InputError, XacroRefusedError
 from armcli.io.userfile import check_regular
+from armcli.urdf.xacro_jail import jail_argv, sandbox_problem, seccomp_program
 
 XACRO_TIMEOUT = 20.0  # wall clock [s]
 XACRO_CPU_SECONDS = 20
@@ -35,7 +36,6 @@ XACRO_MEMORY_BYTES = 1 << 30
 XACRO_MAX_OUTPUT = 10_000_000  # same cap as urdfxml.MAX_URDF_BYTES
 XACRO_MAX_STDERR = 100_000
 XACRO_MAX_FILES = 64
-XACRO_MAX_PROCESSES = 1  # RLIMIT_NPROC headroom over the user's count (no forks)
 _CHUNK = 65536
 
 _SCRIPT = """
@@ -88,7 +88,7 @@ def run_limited(
     *,
     timeout: float = XACRO_TIMEOUT,
     env: dict[str, str] | None = None,
-    preexec: bool = True,
+    pass_fds: Sequence[int] = (),
 ) -> ChildResult:
     """Run `argv` limited, reading stdout/stderr with streaming caps; kill the group on excess."""
     proc = subprocess.Popen(
@@ -98,7 +98,8 @@ def run_limited(
         stdin=subprocess.DEVNULL,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
-        preexec_fn=limit_child if preexec else None,  # no threads exist before exec
+        preexec_fn=limit_child,  # no threads exist before exec
+        pass_fds=tuple(pass_fds),
         start_new_session=True,
     )
     assert proc.stdout is not None and proc.stderr is not None
@@ -193,8 +194,14 @@ def expand_untrusted(
     *,
     mappings: dict[str, str] | None = None,
     timeout: float = XACRO_TIMEOUT,
+    unsandboxed: bool = False,
 ) -> bytes:
-    """The expanded URDF bytes of a user-trusted xacro file; InputError if expansion fails."""
+    """The expanded URDF bytes of a user-trusted xacro file; InputError if expansion fails.
+
+    xacro runs inside xacro_jail's bubblewrap sandbox; where that cannot run, the
+    expansion is refused unless `unsandboxed` (`--trust-xacro=unsandboxed`: the
+    resource limits only).
+    """
     p = Path(path)
     check_regular(p, "xacro file")
     args = [f"{k}:={v}" for k, v in (mappings or {}).items()]
@@ -202,9 +209,38 @@ def expand_untrusted(
     if "ROS_PACKAGE_PATH" in os.environ:
         env["ROS_PACKAGE_PATH"] = os.environ["ROS_PACKAGE_PATH"]
     argv = [*_python(), "-c", _SCRIPT, str(p.resolve()), *args]
-    res = run_limited(argv, p.resolve().parent, timeout=timeout, env=env)
+    if unsandboxed:
+        res = run_limited(argv, p.resolve().parent, timeout=timeout, env=env)
+    else:
+        res = _run_jailed(argv, p, env, timeout)
     if res.why is not None:
         raise InputError(f"xacro expansion {res.why}", file=p)
     if res.returncode != 0:
         raise InputError(f"xacro expansion failed: {_last_line(res)}", file=p)
     return res.out
+
+
+def _run_jailed(argv: list[str], p: Path, env: dict[str, str], timeout: float) -> ChildResult:
+    problem = sandbox_problem()
+    program = seccomp_program()
+    if problem is not None or program is None:
+        raise XacroRefusedError(
+            f"--trust-xacro runs xacro in a bubblewrap sandbox, which cannot run here: {problem}; "
+            "install the Debian package bubblewrap, or pass --trust-xacro=unsandboxed to run "
+            "xacro with resource limits only (the file's code can then read your files)",
+            file=p,
+        )
+    read_end, write_end = os.pipe()
+    try:
+        os.write(write_end, program)
+        os.close(write_end)
+        roots = [
+            p.resolve().parent,
+            *(Path(r) for r in env.get("ROS_PACKAGE_PATH", "").split(":") if r),
+        ]
+        jailed = jail_argv(argv, binds=roots, env=env, cwd=p.resolve().parent, seccomp_fd=read_end)
+        return run_limited(
+            jailed, p.resolve().parent, timeout=timeout, env=env, pass_fds=[read_end]
+        )
+    finally:
+        os.close(read_end)
