@@ -55,7 +55,7 @@ def test_fork_and_setsid_cannot_outlive_the_sandbox(tmp_path: Path) -> None:
         "import os, time\nif os.fork() == 0:\n    os.setsid()\n    time.sleep(120)\nout = 'parent'"
     )
     start = time.monotonic()
-    with pytest.raises(InputError, match="PermissionError|Operation not permitted"):
+    with pytest.raises(InputError, match=r"PermissionError|Operation not permitted"):
         expand_untrusted(hostile(tmp_path, code))
     assert time.monotonic() - start < FAST_S  # before: armcli returned after 75 s
 
@@ -65,14 +65,15 @@ def test_fork_memory_cannot_add_up(tmp_path: Path) -> None:
         "import os, time\nfor i in range(3):\n    if os.fork() == 0:\n"
         "        b = bytearray(700 * 2**20)\n        time.sleep(5)\n        os._exit(0)\nout = 'x'"
     ).replace("os._exit", "os.abort")  # no dunder-free _exit needed: fork is refused first
-    with pytest.raises(InputError, match="PermissionError|Operation not permitted"):
+    with pytest.raises(InputError, match=r"PermissionError|Operation not permitted"):
         expand_untrusted(hostile(tmp_path, code))
 
 
 @pytest.mark.parametrize(
     "code",
     [
-        "import mmap\nf = open(VICTIM, 'r+b')\nm = mmap.mmap(f.fileno(), 0)\nm[0:5] = b'owned'\nm.flush()",
+        "import mmap\nf = open(VICTIM, 'r+b')\nm = mmap.mmap(f.fileno(), 0)\n"
+        "m[0:5] = b'owned'\nm.flush()",
         "import os\nos.rename(VICTIM, VICTIM + '.moved')",
         "import os\nos.symlink('/etc/passwd', VICTIM + '.link')",
         "open(VICTIM, 'w').write('owned')",
@@ -83,14 +84,17 @@ def test_no_file_can_change(code: str, tmp_path: Path) -> None:
     victim = tmp_path / "victim.txt"
     victim.write_text("hello world")
     path = hostile(tmp_path, code.replace("VICTIM", repr(str(victim))))
-    with pytest.raises(InputError, match="Read-only file system|OSError|PermissionError"):
+    with pytest.raises(InputError, match=r"Read-only file system|OSError|PermissionError"):
         expand_untrusted(path)
     assert victim.read_text() == "hello world"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["evil.xacro", "victim.txt"]
 
 
 def test_stdout_flood_is_capped_while_streaming(tmp_path: Path) -> None:
-    code = "import sys\nchunk = b'x' * 2**20\nfor i in range(1500):\n    sys.stdout.buffer.write(chunk)"
+    code = (
+        "import sys\nchunk = b'x' * 2**20\nfor i in range(1500):\n"
+        "    sys.stdout.buffer.write(chunk)"
+    )
     before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # [KiB] peak so far
     with pytest.raises(InputError, match=f"output is larger than {XACRO_MAX_OUTPUT} bytes"):
         expand_untrusted(hostile(tmp_path, code))
@@ -117,7 +121,7 @@ def test_no_network(tmp_path: Path) -> None:
     code = (
         "import socket\ns = socket.create_connection(('1.1.1.1', 53), timeout=2)\nout = 'connected'"
     )
-    with pytest.raises(InputError, match="OSError|unreachable|Network"):
+    with pytest.raises(InputError, match=r"OSError|unreachable|Network"):
         expand_untrusted(hostile(tmp_path, code))
 
 
