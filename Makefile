@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 SPEC ?= specs/my_robot.yaml
 
-.PHONY: install sysdeps demo test lint bench native native-or-skip fuzz clean
+.PHONY: spec-docs install sysdeps demo test lint bench native native-or-skip fuzz clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -60,3 +60,7 @@ fuzz: install
 
 clean:
 	rm -rf $(VENV) build dist out .pytest_cache .ruff_cache .mypy_cache
+
+# The spec reference is generated from the pydantic models (a test keeps it in sync).
+spec-docs: install
+	$(BIN)/python -m armcli.spec.reference > docs/spec.md

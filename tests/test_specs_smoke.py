@@ -98,3 +98,29 @@ def test_ros_package(built: tuple[Path, RobotSpec, Path], tmp_path: Path) -> Non
     assert info.value.code in (0, None)
     srdf = tmp_path / f"{spec.name}_moveit_config" / "config" / f"{spec.name}.srdf"
     assert srdf.is_file()
+
+
+def test_ros_package_jazzy(built: tuple[Path, RobotSpec, Path], tmp_path: Path) -> None:
+    path, spec, _ = built
+    with pytest.raises(SystemExit) as info:
+        main(
+            ["ros-package", str(path), "-o", str(tmp_path), "--samples", "200", "--target", "jazzy"]
+        )
+    assert info.value.code in (0, None)
+    bringup = tmp_path / f"{spec.name}_bringup"
+    assert (bringup / "config" / f"{spec.name}_controllers.yaml").is_file()
+    assert (bringup / "launch" / f"{spec.name}_gz.launch.py").is_file()
+    assert (
+        tmp_path / f"{spec.name}_description" / "urdf" / "standalone_arm_gz.urdf.xacro"
+    ).is_file()
+
+
+def test_export_mjcf_loads_in_mujoco(built: tuple[Path, RobotSpec, Path], tmp_path: Path) -> None:
+    mujoco = pytest.importorskip("mujoco")
+    path, spec, _ = built
+    out = tmp_path / "robot.xml"
+    with pytest.raises(SystemExit) as info:
+        main(["export", "mjcf", str(path), "-o", str(out)])
+    assert info.value.code in (0, None)
+    m = mujoco.MjModel.from_xml_path(str(tmp_path / "scene.xml"))
+    assert m.nu == len(spec.control.gains) and m.nkey == len({"home", *spec.poses})

@@ -1,23 +1,94 @@
 """The `armcli` command line: a thin typer layer over the library.
 
 This is the only module that prints errors and chooses exit codes. Commands
-live in `armcli.commands.*`, each exposing `register(app)`; the library modules
-they call import heavy libraries (pinocchio, xacro, matplotlib, viser) inside
-functions, so that `armcli --help` stays fast.
+live in `armcli.commands.*`, each exposing `register(app)`. They are imported only
+when run (the composition root is the one place armcli imports its own modules
+lazily): `armcli --help` lists them from `COMMANDS` without loading pydantic,
+numpy or any command's library, and `armcli build` loads only what build needs.
 """
 
 from __future__ import annotations
 
+import importlib
 import sys
+from typing import Any
 
+import click
 import typer
 import typer.core
+import typer.main
 
 import armcli
-from armcli.commands import build, check, render, ros, simulate, tree, view
 from armcli.errors import EXIT_FAILED, ArmcliError
 
 UNSANDBOXED_FLAG = "--trust-xacro-unsandboxed"  # what `--trust-xacro=unsandboxed` becomes
+
+# name -> (module, one-line help for the command list). A test checks that each help
+# line is the first line of the command's own docstring.
+COMMANDS: dict[str, tuple[str, str]] = {
+    "build": (
+        "armcli.commands.build",
+        "Compile SPEC into the course's xacro set and the expanded URDFs.",
+    ),
+    "check": (
+        "armcli.commands.check",
+        "Check robot descriptions for physical sanity; exit 1 on error findings.",
+    ),
+    "simulate": (
+        "armcli.commands.simulate",
+        "Simulate the arm tracking a trajectory (Pinocchio ABA under PD control).",
+    ),
+    "ros-package": (
+        "armcli.commands.ros",
+        "Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config.",
+    ),
+    "view": (
+        "armcli.commands.view",
+        "Open a browser 3-D viewer with joint sliders, named poses and simulation replay.",
+    ),
+    "render": (
+        "armcli.commands.render",
+        "Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU).",
+    ),
+    "tree": (
+        "armcli.commands.tree",
+        "Print the kinematic tree: links, and joints with their types and limits.",
+    ),
+    "export": ("armcli.commands.export", "Export the robot to other simulators' formats."),
+}
+
+
+class _LazyGroup(typer.core.TyperGroup):
+    """Lists commands from COMMANDS and imports a command's module only when it runs."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return list(COMMANDS)
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        if cmd_name not in COMMANDS:
+            return None
+        return load_command(cmd_name)
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        rows = [(name, help_line) for name, (_, help_line) in COMMANDS.items()]
+        with formatter.section("Commands"):
+            formatter.write_dl(rows)
+
+
+def load_command(name: str) -> click.Command:
+    """The click command `name`, built from its module's `register(app)`."""
+    module = importlib.import_module(COMMANDS[name][0])
+    holder = typer.Typer(rich_markup_mode=None, add_completion=False)
+
+    @holder.callback()
+    def _group() -> None:  # a callback makes typer build a group even for one command
+        """Holder."""
+
+    module.register(holder)
+    group: Any = typer.main.get_command(holder)
+    command: click.Command = group.commands[name]
+    return command
+
 
 # Typer escapes "[" for rich's HTML export whenever rich is importable, even with
 # rich_markup_mode=None (plain click help), which prints "\\[default: ...]" in --help.
@@ -25,6 +96,7 @@ UNSANDBOXED_FLAG = "--trust-xacro-unsandboxed"  # what `--trust-xacro=unsandboxe
 typer.core.HAS_RICH = False
 
 app = typer.Typer(
+    cls=_LazyGroup,
     name="armcli",
     help="Typed robot-arm specs -> ROS-ready xacro/URDF, physical sanity checks, and simulation.",
     no_args_is_help=True,
@@ -48,10 +120,6 @@ def _root(
     ),
 ) -> None:
     """armcli: robot descriptions without ROS."""
-
-
-for _module in (build, check, simulate, ros, view, render, tree):
-    _module.register(app)
 
 
 def _print_error(exc: ArmcliError) -> None:

@@ -147,7 +147,29 @@ def tool_without_inertial(r: Any) -> None:
 
 SAFE_SPEC = with_gains(50.0, 2.0)  # Kd = 2 keeps even the explicit loop stable at 1 ms
 
+
 # (edit of urdf/my_robot.urdf, spec or None, the exact set of rules expected)
+def gz_position_servo(gain: float) -> Callable[[Any], None]:
+    """A gz_ros2_control block commanding forearm_hand_joint by position at `gain`."""
+    block = append(
+        '<ros2_control name="s" type="system"><hardware>'
+        "<plugin>gz_ros2_control/GazeboSimSystem</plugin></hardware>"
+        '<joint name="forearm_hand_joint"><command_interface name="position"/>'
+        '<state_interface name="position"/></joint></ros2_control>'
+    )
+    plugin = append(
+        '<gazebo><plugin filename="gz_ros2_control-system" '
+        'name="gz_ros2_control::GazeboSimROS2ControlPlugin">'
+        f"<position_proportional_gain>{gain}</position_proportional_gain></plugin></gazebo>"
+    )
+
+    def edit(r: Any) -> None:
+        block(r)
+        plugin(r)
+
+    return edit
+
+
 CASES: dict[str, tuple[Callable[[Any], None], RobotSpec | None, set[str]]] = {
     "duplicate-name": (append('<link name="hand_link"/>'), None, {"duplicate-name"}),
     "unknown-link": (set_attr(J2, "parent", "link", "no_such_link"), None, {"unknown-link"}),
@@ -235,6 +257,9 @@ CASES: dict[str, tuple[Callable[[Any], None], RobotSpec | None, set[str]]] = {
     # An implicit-damping divergence is always an explicit one too (Kp bound is looser).
     "pd-unstable": (lambda r: None, with_gains(1e6, 5.0), {"pd-unstable", "pd-explicit-unstable"}),
     "pd-explicit-unstable": (lambda r: None, SPEC, {"pd-explicit-unstable"}),
+    # gz_ros2_control position servo: the error is multiplied by (1 - gain) per period
+    "servo-unstable": (gz_position_servo(2.5), None, {"servo-unstable"}),
+    "servo-oscillates": (gz_position_servo(1.5), None, {"servo-oscillates"}),
     "visual-no-collision": (remove(HAND, "collision"), None, {"visual-no-collision"}),
     "self-collision": (
         set_attr(joint("mobile_base_arm_joint"), "origin", "xyz", "0.15 0 0.15"),

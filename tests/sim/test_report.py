@@ -7,8 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from armcli.sim.report import joint_metrics, sample_states, states_bytes
+from armcli.sim.report import joint_metrics
 from armcli.sim.simulate import SimResult
+from armcli.sim.states import sample_states, states_bytes
 
 DT = 1e-3
 

@@ -30,8 +30,8 @@ import pytest
 from PIL import Image
 
 from armcli.errors import InputError
+from armcli.sim.states import load_replay
 from armcli.view.browser import Viewer, moving_parts
-from armcli.view.replay import load_replay
 from armcli.view.scene import load_robot
 
 TIP_TOL = 1e-6  # [m] forward kinematics vs closed form

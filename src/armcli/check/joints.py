@@ -7,7 +7,7 @@ import math
 from armcli.check.rules import Collector
 from armcli.check.structure import finite
 from armcli.spec.model import RobotSpec
-from armcli.urdf.doc import Joint, Urdf
+from armcli.urdf.doc import ONE_DOF_TYPES, Joint, Urdf
 
 AXIS_UNIT_TOL = 1e-6
 # A revolute limit beyond one turn that is a whole multiple of 5 (45, 90, 180, 360...)
@@ -22,7 +22,7 @@ SPEC_LIMIT_TOL = 1e-9
 def check(urdf: Urdf, spec: RobotSpec | None, out: Collector) -> None:
     """Joint rules: axis and limits of each moving joint, then the arm limits against the spec."""
     for j in urdf.joints:
-        if j.type in ("revolute", "prismatic", "continuous"):
+        if j.type in ONE_DOF_TYPES:
             _axis(j, out)
         if j.limit is not None and j.type in ("revolute", "prismatic"):
             _limits(j, out)

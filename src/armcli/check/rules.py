@@ -150,6 +150,18 @@ _RULES = [
         "PD loop unstable at dt with explicit damping",
         "lower Kd or dt, or treat damping implicitly",
     ),
+    Rule(
+        "servo-unstable",
+        ERROR,
+        "gz_ros2_control position servo diverges: position_proportional_gain not in (0, 2)",
+        "set <position_proportional_gain> in the gz_ros2_control plugin below 1",
+    ),
+    Rule(
+        "servo-oscillates",
+        WARNING,
+        "gz_ros2_control position servo overshoots: position_proportional_gain in (1, 2)",
+        "set <position_proportional_gain> to at most 1",
+    ),
     # collision and meshes
     Rule(
         "visual-no-collision",

@@ -11,9 +11,9 @@ from collections import Counter
 from dataclasses import dataclass
 
 from armcli.check.rules import Collector
-from armcli.urdf.doc import Joint, Link, Urdf
+from armcli.spec.graph import root_links
+from armcli.urdf.doc import JOINT_TYPES, Joint, Link, Urdf
 
-JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 NUMBER_RULES = {
     "missing": "number-syntax",
     "not-a-number": "number-syntax",
@@ -192,7 +192,7 @@ def _tree(urdf: Urdf, links: set[str], out: Collector) -> Tree:
             )
             continue
         parent_joint[j.child] = j
-    roots = sorted(lk for lk in links if lk not in parent_joint)
+    roots = sorted(root_links(links, parent_joint))
     if len(roots) != 1:
         line = urdf.links[0].line if urdf.links else None
         out.add(

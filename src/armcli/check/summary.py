@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from armcli.check import dynamics as dyn
+from armcli.check import interface
 from armcli.check.rules import CheckOptions, Collector, JointRow
 from armcli.check.structure import Tree, finite
 from armcli.errors import ModelLoadError
@@ -128,7 +129,10 @@ def _with_model(
     else:
         samples = dyn.samples(model, ranges)
         rows = dyn.gravity(urdf, model, data, samples, rows, out)
-        report = dyn.stability(urdf, opts, model, data, samples, ranges, out, notes)
+        servo = interface.check(urdf.text, opts, out, notes)
+        gained = set(opts.spec.control.gains) if opts.spec is not None else set()
+        if not (servo and gained <= servo):  # a position servo is not a PD loop
+            report = dyn.stability(urdf, opts, model, data, samples, ranges, out, notes)
     if opts.spec is not None and opts.spec.poses:
         dyn.self_collision(urdf, opts, model, poses, out, notes)
     return Summary(

@@ -5,11 +5,12 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+import click
 import typer
 
 from armcli.build.expand import spec_label
 from armcli.defaults import DEFAULT_SPEC
-from armcli.ros.packages import PackageInfo, write_ros_packages
+from armcli.ros.packages import DEFAULT_TARGET, TARGETS, PackageInfo, write_ros_packages
 
 DEFAULT_SAMPLES = 10_000  # keep equal to armcli.ros.collision_matrix.DEFAULT_SAMPLES (lazy import)
 MAX_SAMPLES = 1_000_000  # ~100x the default: minutes of coal queries, not days
@@ -53,6 +54,14 @@ def ros_package_cmd(
     license_: str = typer.Option(
         "TODO", "--license", show_default=False, help="package.xml license (default: TODO)."
     ),
+    target: str = typer.Option(
+        DEFAULT_TARGET,
+        "--target",
+        click_type=click.Choice(TARGETS),
+        show_default=False,
+        help="humble-classic: the course's ROS 2 Humble + Gazebo classic (default); "
+        "jazzy: ROS 2 Jazzy + Gazebo Harmonic with ros2_control (effort, the spec's gains).",
+    ),
     force: bool = typer.Option(
         False, "--force", help="Write into an existing non-empty directory armcli did not create."
     ),
@@ -60,7 +69,14 @@ def ros_package_cmd(
     """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
     info = PackageInfo(maintainer=maintainer, email=email, license=license_)
     pkgs, written = write_ros_packages(
-        spec, out, label=spec_label(spec), samples=samples, seed=seed, info=info, force=force
+        spec,
+        out,
+        label=spec_label(spec),
+        samples=samples,
+        seed=seed,
+        info=info,
+        target=target,
+        force=force,
     )
     n, m = pkgs.names, pkgs.matrix
     counts = {r: sum(d.reason == r for d in m.disabled) for r in ("Adjacent", "Default", "Never")}

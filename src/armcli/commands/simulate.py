@@ -15,6 +15,7 @@ from armcli.errors import InputError
 from armcli.io.outdir import check_output_file
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
+from armcli.sim import states
 from armcli.sim.options import ENGINES, INTEGRATORS, Engine, Integrator, SimOptions
 from armcli.sim.plot import write_tracking_plot
 from armcli.spec.load import load_spec
@@ -85,7 +86,7 @@ def simulate_cmd(
     from rich.console import Console
 
     if output is not None:
-        simreport.output_format(output)
+        states.output_format(output)
         check_output_file(output, "--output")
     if plot is not None:
         check_output_file(plot, "--plot")
@@ -117,7 +118,7 @@ def simulate_cmd(
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
     if output is not None:
-        simreport.write_states(output, res, job.rate)
+        states.write_states(output, res, job.rate)
     if plot is not None:
         write_tracking_plot(plot, res, job.arm.effort)
     out = Console(file=sys.stdout)

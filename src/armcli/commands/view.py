@@ -9,11 +9,11 @@ import typer
 
 from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import InputError
+from armcli.sim.states import load_replay
 from armcli.urdf.meshes import MeshSearch, parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 from armcli.view.browser import Viewer
 from armcli.view.png import joint_limits, load_urdf
-from armcli.view.replay import load_replay
 from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
 
 

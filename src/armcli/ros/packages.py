@@ -24,6 +24,7 @@ from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.io.files import write_tree_atomic
 from armcli.io.outdir import resolve_output_dir
+from armcli.ros import jazzy
 from armcli.ros import moveit as mc
 from armcli.ros.collision_matrix import (
     DEFAULT_SAMPLES,
@@ -31,10 +32,12 @@ from armcli.ros.collision_matrix import (
     CollisionMatrix,
     compute_collision_matrix,
 )
+from armcli.ros.jazzy_readme import readme as jazzy_readme
 from armcli.ros.launch import render
 from armcli.ros.ros2_control import moveit_urdf_xacro, ros2_control_xacro
 from armcli.ros.rviz import display_rviz, moveit_rviz
 from armcli.ros.srdf import chain_joints, srdf_bytes
+from armcli.spec.graph import root_links
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
 from armcli.urdf.read import parse_urdf
@@ -56,6 +59,8 @@ MOVEIT_DEPENDS = [
     "moveit_planners", "moveit_ros_move_group", "moveit_ros_visualization",
     "moveit_simple_controller_manager", "robot_state_publisher", "rviz2", "tf2_ros", "xacro",
 ]  # fmt: skip
+TARGETS = ("humble-classic", "jazzy")  # the course's ROS 2 Humble + Gazebo classic; Jazzy + gz
+DEFAULT_TARGET = TARGETS[0]
 MOVEIT_LAUNCHES = {  # launch file -> (moveit_configs_utils generator, what it starts)
     "demo.launch.py": ("generate_demo_launch", "MoveIt demo on mock hardware with RViz."),
     "move_group.launch.py": ("generate_move_group_launch", "The move_group node."),
@@ -106,8 +111,8 @@ class Names:
         whole = top_level_files(spec).get(f"{spec.name}.urdf", STANDALONE_ARM)
         root = spec.arm_root()
         if spec.mobile_base is not None and whole != STANDALONE_ARM:
-            children = {j.child for j in spec.mobile_base.joints.values()}
-            root = next(n for n in spec.mobile_base.links if n not in children)
+            base = spec.mobile_base
+            root = root_links(base.links, (j.child for j in base.joints.values()))[0]
         return Names(
             robot=spec.name,
             description=f"{spec.name}_description",
@@ -200,10 +205,20 @@ def _launch_values(n: Names) -> dict[str, str]:
     }
 
 
-def description_files(spec: RobotSpec, n: Names, label: str, info: PackageInfo) -> dict[str, bytes]:
-    """The `<name>_description` files: the `build` xacro set, a display launch and RViz config."""
+def description_files(
+    spec: RobotSpec,
+    n: Names,
+    label: str,
+    info: PackageInfo,
+    extra: Mapping[str, bytes] | None = None,
+) -> dict[str, bytes]:
+    """The `<name>_description` files: the `build` xacro set, a display launch and RViz config.
+
+    `extra` adds xacro files under `urdf/` (the Jazzy top levels).
+    """
     note = GENERATED.format(spec=label)
-    files = {f"urdf/{name}": data for name, data in xacro_files(spec, label).items()}
+    xacros = {**xacro_files(spec, label), **(extra or {})}
+    files = {f"urdf/{name}": data for name, data in xacros.items()}
     files["launch/display.launch.py"] = render("display.launch.py.tmpl", _launch_values(n), note)
     files[f"rviz/{DISPLAY_RVIZ}"] = mc.dump_yaml(display_rviz(n.robot_root), note)
     about = f"Robot description (xacro, URDF, RViz) of {n.robot}. {note}"
@@ -237,9 +252,12 @@ def moveit_files(
     matrix: CollisionMatrix,
     note: str,
     info: PackageInfo,
+    target: str = DEFAULT_TARGET,
 ) -> dict[str, bytes]:
     """The `<name>_moveit_config` files: SRDF, config YAML, ros2_control xacro, RViz, launches."""
     yamls = _moveit_yaml(spec, urdf_xml)
+    if target == "jazzy":
+        yamls["moveit_controllers.yaml"] = jazzy.moveit_controllers(spec)
     files = {f"config/{name}": mc.dump_yaml(data, note) for name, data in yamls.items()}
     urdf_xacro = f"config/{n.robot}.urdf.xacro"
     files[n.srdf] = srdf_bytes(spec, matrix, note)
@@ -252,8 +270,12 @@ def moveit_files(
     for launch, (generator, what) in MOVEIT_LAUNCHES.items():
         values = {"robot": n.robot, "moveit_pkg": n.moveit, "generator": generator}
         files[f"launch/{launch}"] = render("moveit.launch.py.tmpl", values, f"{what}\n\n{note}")
+    if target == "jazzy":
+        gz_launch = jazzy.move_group_launch(n.robot, n.moveit, note)
+        files[f"launch/{jazzy.MOVE_GROUP_LAUNCH}"] = gz_launch
     about = f"MoveIt 2 configuration of {n.robot}. {note}"
-    return _package(n.moveit, about, [n.description, *MOVEIT_DEPENDS], files, info)
+    depends = sorted({*MOVEIT_DEPENDS, *(jazzy.MOVEIT_DEPENDS if target == "jazzy" else ())})
+    return _package(n.moveit, about, [n.description, *depends], files, info)
 
 
 def ros_packages(
@@ -264,13 +286,19 @@ def ros_packages(
     seed: int = DEFAULT_SEED,
     info: PackageInfo = PackageInfo(),
     source: str | None = None,
+    target: str = DEFAULT_TARGET,
 ) -> RosPackages:
     """All files of the three packages, in memory; deterministic for fixed samples and seed.
 
-    `source` (the spec file) is only used to point at it in input errors.
+    `source` (the spec file) is only used to point at it in input errors. `target`
+    "jazzy" swaps the Gazebo classic bringup for Gazebo Harmonic + ros2_control.
     """
+    if target not in TARGETS:
+        raise InputError(f"unknown target {target!r}; known: {', '.join(TARGETS)}")
     n = Names.of(spec, source)
     mc.controller_update_rate(spec, source)  # refuse bad input before the slow sampling
+    if target == "jazzy":
+        jazzy.required_gains(spec, source)
     urdfs = expand_urdfs(spec)
     urdf_xml = urdfs.get(f"{n.robot}.urdf", urdfs[STANDALONE_ARM_URDF])
     poses = {name: spec.pose(name) for name in spec.poses}
@@ -278,12 +306,43 @@ def ros_packages(
         urdf_xml, samples=samples, seed=seed, source=n.robot_xacro, poses=poses
     )
     note = GENERATED.format(spec=label)
-    files = {
-        **description_files(spec, n, label, info),
-        **bringup_files(n, note, info),
-        **moveit_files(spec, n, urdf_xml, matrix, note, info),
-    }
+    if target == "jazzy":
+        files = jazzy_files(spec, n, label, info, source)
+    else:
+        files = {**description_files(spec, n, label, info), **bringup_files(n, note, info)}
+    files.update(moveit_files(spec, n, urdf_xml, matrix, note, info, target))
     return RosPackages(files=dict(sorted(files.items())), names=n, matrix=matrix)
+
+
+def jazzy_files(
+    spec: RobotSpec, n: Names, label: str, info: PackageInfo, source: str | None
+) -> dict[str, bytes]:
+    """Description (course xacro + Jazzy top levels) and the Gazebo Harmonic bringup."""
+    note = GENERATED.format(spec=label)
+    tops = jazzy.description_xacros(spec, n.bringup, note)
+    whole = jazzy.TOP.format(name=n.robot)
+    launch = jazzy.GZ_LAUNCH.format(name=n.robot)
+    values = {
+        **_launch_values(n),
+        "robot_xacro": whole if whole in tops else jazzy.STANDALONE,
+        "standalone_xacro": jazzy.STANDALONE,
+        "controllers": jazzy.controllers_file(n.robot),
+        "gz_launch": launch,
+        "arm_controller": mc.ARM_CONTROLLER,
+        "joint_state_broadcaster": mc.JOINT_STATE_BROADCASTER,
+    }
+    files = {
+        f"config/{jazzy.controllers_file(n.robot)}": mc.dump_yaml(
+            jazzy.controllers(spec, source), note
+        ),
+        f"launch/{launch}": jazzy.bringup_launch(values, note),
+        "README.md": jazzy_readme(spec, n.bringup, launch, n.moveit, note),
+    }
+    about = f"Gazebo Harmonic + ros2_control bringup of {n.robot} (ROS 2 Jazzy). {note}"
+    return {
+        **description_files(spec, n, label, info, tops),
+        **_package(n.bringup, about, [n.description, *jazzy.BRINGUP_DEPENDS], files, info),
+    }
 
 
 def write_ros_packages(
@@ -294,6 +353,7 @@ def write_ros_packages(
     samples: int = DEFAULT_SAMPLES,
     seed: int = DEFAULT_SEED,
     info: PackageInfo = PackageInfo(),
+    target: str = DEFAULT_TARGET,
     force: bool = False,
 ) -> tuple[RosPackages, list[Path]]:
     """Load the spec, build the packages in memory, then write them in one atomic swap."""
@@ -301,6 +361,12 @@ def write_ros_packages(
     resolve_output_dir(out_dir, force=force)  # refuse before the collision sampling
     spec = load_spec(path)
     pkgs = ros_packages(
-        spec, label=label or path.name, samples=samples, seed=seed, info=info, source=str(path)
+        spec,
+        label=label or path.name,
+        samples=samples,
+        seed=seed,
+        info=info,
+        source=str(path),
+        target=target,
     )
     return pkgs, write_tree_atomic(out_dir, pkgs.files, force=force)

@@ -1,22 +1,13 @@
-"""Tracking metrics, the summary table and joint-state output (CSV/JSON) of a simulation.
-
-The output mimics Gazebo's joint_state_publisher: one row per publish period (the
-spec's `joint_state_publisher.update_rate`, 10 Hz) with position, velocity and effort of
-every joint, plus the reference the controller was tracking.
-"""
+"""Tracking metrics and the summary table of a simulation (the states file: sim/states.py)."""
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from armcli.errors import InputError
-from armcli.io.files import write_file_atomic
 from armcli.sim.simulate import SimResult
 
 SETTLE_TOL = 0.01  # [rad or m] |q - q_ref| band for "settled"
@@ -100,50 +91,3 @@ def summary_table(
 
 def _xyz(p: np.ndarray) -> str:
     return "(" + ", ".join(f"{x:.4f}" for x in p) + ") m"
-
-
-def sample_states(res: SimResult, rate: float) -> dict[str, np.ndarray]:
-    """Columns `time`, `NAME.position|velocity|effort|reference` at `rate` [Hz]."""
-    steps = len(res.t) - 1
-    period = 1.0 / rate
-    n_samples = int(np.floor(res.t[-1] / period + 1e-9)) + 1
-    idx = np.minimum(np.round(np.arange(n_samples) * period / res.dt).astype(int), steps)
-    tau_idx = np.minimum(idx, steps - 1)
-    cols: dict[str, np.ndarray] = {"time": res.t[idx]}
-    for i, name in enumerate(res.joint_names):
-        cols[f"{name}.position"] = res.q[idx, i]
-        cols[f"{name}.velocity"] = res.v[idx, i]
-        cols[f"{name}.effort"] = res.tau[tau_idx, i]
-        cols[f"{name}.reference"] = res.q_ref[idx, i]
-    return cols
-
-
-def states_bytes(cols: dict[str, np.ndarray], fmt: str) -> bytes:
-    """CSV or JSON text of the sampled states (deterministic formatting)."""
-    names = list(cols)
-    if fmt == "json":
-        data = {k: [float(FLOAT_FMT.format(x)) for x in v] for k, v in cols.items()}
-        return (json.dumps(data, indent=1) + "\n").encode()
-    lines = [",".join(names)]
-    rows = np.column_stack([cols[k] for k in names])
-    lines += [",".join(FLOAT_FMT.format(x) for x in row) for row in rows]
-    return ("\n".join(lines) + "\n").encode()
-
-
-def output_format(path: Path) -> str:
-    """The joint-state file format named by the extension of `path`: "csv" or "json".
-
-    Raises:
-        InputError: any other extension.
-    """
-    ext = path.suffix.lower()
-    if ext not in (".csv", ".json"):
-        raise InputError(
-            f"unknown output format {ext or '(none)'!r}; use .csv or .json", field="--output"
-        )
-    return ext[1:]
-
-
-def write_states(path: Path, res: SimResult, rate: float) -> None:
-    """Write the joint states sampled at `rate` [Hz] atomically, as CSV or JSON by extension."""
-    write_file_atomic(path, states_bytes(sample_states(res, rate), output_format(path)))

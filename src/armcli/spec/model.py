@@ -24,6 +24,7 @@ from pydantic import (
 
 from armcli.defaults import DEFAULT_DT
 from armcli.spec.expr import eval_expr
+from armcli.spec.graph import root_links
 
 
 def _number(v: Any) -> Any:
@@ -56,42 +57,50 @@ class _Model(BaseModel):
 class Material(_Model):
     """A colour for RViz (`rgba`) and its Gazebo classic material name."""
 
-    rgba: tuple[Unit, Unit, Unit, Unit]
-    gazebo: str = Field(pattern=r"^[A-Za-z0-9_/]+$", max_length=64)
+    rgba: tuple[Unit, Unit, Unit, Unit] = Field(
+        description="red, green, blue, alpha in [0, 1] (RViz colour)"
+    )
+    gazebo: str = Field(
+        pattern=r"^[A-Za-z0-9_/]+$",
+        max_length=64,
+        description="Gazebo classic material name, e.g. Gazebo/Orange",
+    )
 
 
 class Origin(_Model):
     """A frame offset: translation `xyz` [m] and roll-pitch-yaw `rpy` [rad], as URDF's <origin>."""
 
-    xyz: Vec3 = (0.0, 0.0, 0.0)
-    rpy: Vec3 = (0.0, 0.0, 0.0)
+    xyz: Vec3 = Field((0.0, 0.0, 0.0), description="translation [m]")
+    rpy: Vec3 = Field(
+        (0.0, 0.0, 0.0), description="roll, pitch, yaw [rad], applied about fixed x, y, z"
+    )
 
 
 class Box(_Model):
     """A box with edge lengths `size` [m] along x, y and z."""
 
-    size: tuple[Positive, Positive, Positive]
+    size: tuple[Positive, Positive, Positive] = Field(description="edge lengths along x, y, z [m]")
 
 
 class Cylinder(_Model):
     """A cylinder of `radius` and `length` [m], its axis along z."""
 
-    radius: Positive
-    length: Positive
+    radius: Positive = Field(description="radius [m]")
+    length: Positive = Field(description="length along the z axis [m]")
 
 
 class Sphere(_Model):
     """A sphere of `radius` [m]."""
 
-    radius: Positive
+    radius: Positive = Field(description="radius [m]")
 
 
 class Geometry(_Model):
     """Exactly one primitive shape, as in URDF's <geometry>."""
 
-    box: Box | None = None
-    cylinder: Cylinder | None = None
-    sphere: Sphere | None = None
+    box: Box | None = Field(None, description="a box")
+    cylinder: Cylinder | None = Field(None, description="a cylinder")
+    sphere: Sphere | None = Field(None, description="a sphere")
 
     @model_validator(mode="after")
     def _exactly_one(self) -> Geometry:
@@ -109,8 +118,8 @@ class Geometry(_Model):
 class Contact(_Model):
     """Gazebo surface friction coefficients for a link."""
 
-    mu1: NonNeg
-    mu2: NonNeg
+    mu1: NonNeg = Field(description="Gazebo friction coefficient along the first direction [-]")
+    mu2: NonNeg = Field(description="Gazebo friction coefficient along the second direction [-]")
 
 
 class Link(_Model):
@@ -120,11 +129,18 @@ class Link(_Model):
     A link without geometry is an empty frame such as `base_footprint`.
     """
 
-    geometry: Geometry | None = None
-    origin: Origin = Origin()
-    material: Name | None = None
-    mass: Positive | None = None
-    contact: Contact | None = None
+    geometry: Geometry | None = Field(
+        None,
+        description="the solid's shape (visual, collision and inertia); none for an empty frame",
+    )
+    origin: Origin = Field(
+        Origin(), description="pose of the shape and its centre of mass in the link frame"
+    )
+    material: Name | None = Field(None, description="name of an entry of `materials`")
+    mass: Positive | None = Field(
+        None, description="mass [kg]; the inertia tensor follows from the shape"
+    )
+    contact: Contact | None = Field(None, description="Gazebo surface friction")
 
     @model_validator(mode="after")
     def _solid(self) -> Link:
@@ -138,17 +154,19 @@ class Link(_Model):
 class Limit(_Model):
     """Joint limits: `lower`/`upper` [rad or m], `effort` [N·m or N], `velocity` [rad/s or m/s]."""
 
-    lower: Real
-    upper: Real
-    effort: Positive
-    velocity: Positive
+    lower: Real = Field(description="lower position limit [rad or m]")
+    upper: Real = Field(description="upper position limit [rad or m], >= lower")
+    effort: Positive = Field(description="largest motor torque or force [N·m or N]")
+    velocity: Positive = Field(description="largest speed [rad/s or m/s]")
 
 
 class Dynamics(_Model):
     """Joint `friction` [N·m or N] and viscous `damping` [N·m·s/rad or N·s/m]."""
 
-    friction: NonNeg = 0.0
-    damping: NonNeg = 0.0
+    friction: NonNeg = Field(
+        0.0, description="Coulomb (static) friction torque or force [N·m or N]"
+    )
+    damping: NonNeg = Field(0.0, description="viscous damping [N·m·s/rad or N·s/m]")
 
 
 JointType = Literal["revolute", "continuous", "prismatic", "fixed"]
@@ -161,13 +179,18 @@ class Joint(_Model):
     in the joint frame.
     """
 
-    type: JointType
-    parent: Name
-    child: Name
-    origin: Origin = Origin()
-    axis: Vec3 = (0.0, 0.0, 1.0)
-    limit: Limit | None = None
-    dynamics: Dynamics | None = None
+    type: JointType = Field(description="revolute, continuous, prismatic or fixed")
+    parent: Name = Field(description="parent link name")
+    child: Name = Field(description="child link name")
+    origin: Origin = Field(Origin(), description="pose of the joint frame in the parent link frame")
+    axis: Vec3 = Field(
+        (0.0, 0.0, 1.0),
+        description="rotation or translation axis in the joint frame (non-zero) [-]",
+    )
+    limit: Limit | None = Field(
+        None, description="limits; required for revolute and prismatic joints"
+    )
+    dynamics: Dynamics | None = Field(None, description="friction and damping")
 
     @model_validator(mode="after")
     def _limits(self) -> Joint:
@@ -181,72 +204,106 @@ class Joint(_Model):
 class DiffDrive(_Model):
     """gazebo_ros_diff_drive parameters."""
 
-    update_rate: Positive
-    left_joint: Name
-    right_joint: Name
-    wheel_separation: Positive
-    wheel_diameter: Positive
-    max_wheel_torque: Positive = 20.0
-    max_wheel_acceleration: Positive = 1.0
-    publish_odom: bool = True
-    publish_odom_tf: bool = True
-    publish_wheel_tf: bool = True
-    odometry_frame: Name = "odom"
-    robot_base_frame: Name = "base_footprint"
+    update_rate: Positive = Field(description="plugin update rate [Hz]")
+    left_joint: Name = Field(description="left wheel joint name")
+    right_joint: Name = Field(description="right wheel joint name")
+    wheel_separation: Positive = Field(description="distance between the wheels [m]")
+    wheel_diameter: Positive = Field(description="wheel diameter [m]")
+    max_wheel_torque: Positive = Field(20.0, description="largest wheel torque [N·m]")
+    max_wheel_acceleration: Positive = Field(1.0, description="largest wheel acceleration [rad/s²]")
+    publish_odom: bool = Field(True, description="publish the odometry topic")
+    publish_odom_tf: bool = Field(True, description="publish the odom -> base transform")
+    publish_wheel_tf: bool = Field(True, description="publish the wheel transforms")
+    odometry_frame: Name = Field("odom", description="odometry frame name")
+    robot_base_frame: Name = Field("base_footprint", description="frame the odometry moves")
 
 
 class JointStatePublisher(_Model):
     """gazebo_ros_joint_state_publisher: publishes these joints at `update_rate` [Hz]."""
 
-    update_rate: Positive
-    joints: list[Name] = Field(min_length=1)
+    update_rate: Positive = Field(description="publish rate [Hz]; also `simulate`'s output rate")
+    joints: list[Name] = Field(min_length=1, description="joints to publish")
 
 
 class JointPoseTrajectory(_Model):
     """gazebo_ros_joint_pose_trajectory: follows /set_joint_trajectory at `update_rate` [Hz]."""
 
-    update_rate: Positive
+    update_rate: Positive = Field(description="rate the trajectory is applied at [Hz]")
 
 
 class Tool(_Model):
     """The end-effector point: a fixed offset [m] in `link`'s frame (e.g. the hand tip)."""
 
-    link: Name
-    xyz: Vec3 = (0.0, 0.0, 0.0)
+    link: Name = Field(description="link the tool point is fixed in")
+    xyz: Vec3 = Field(
+        (0.0, 0.0, 0.0), description="offset of the tool point in that link's frame [m]"
+    )
 
 
 class MobileBase(_Model):
     """The mobile base: its links and joints (one tree) and an optional diff-drive plugin."""
 
-    links: dict[Name, Link]
-    joints: dict[Name, Joint] = {}
-    diff_drive: DiffDrive | None = None
+    links: dict[Name, Link] = Field(description="links by name")
+    joints: dict[Name, Joint] = Field({}, description="joints by name (one tree)")
+    diff_drive: DiffDrive | None = Field(None, description="differential-drive plugin")
 
 
 class Arm(_Model):
     """The arm: its links and joints (one tree), its Gazebo plugins and the tool point."""
 
-    links: dict[Name, Link] = Field(min_length=1)
-    joints: dict[Name, Joint] = {}
-    joint_state_publisher: JointStatePublisher | None = None
-    joint_pose_trajectory: JointPoseTrajectory | None = None
-    tool: Tool | None = None
+    links: dict[Name, Link] = Field(min_length=1, description="links by name")
+    joints: dict[Name, Joint] = Field({}, description="joints by name (one tree)")
+    joint_state_publisher: JointStatePublisher | None = Field(
+        None, description="Gazebo joint-state publisher plugin"
+    )
+    joint_pose_trajectory: JointPoseTrajectory | None = Field(
+        None, description="Gazebo joint pose-trajectory plugin (the course's)"
+    )
+    tool: Tool | None = Field(
+        None, description="end-effector point reported by check, simulate, view and render"
+    )
 
 
 class Mount(_Model):
     """The fixed joint that puts the arm's root link on the mobile base."""
 
-    joint: Name
-    parent: Name
-    origin: Origin = Origin()
+    joint: Name = Field(description="name of the fixed mount joint")
+    parent: Name = Field(description="base link the arm is mounted on")
+    origin: Origin = Field(Origin(), description="pose of the arm root in that link's frame")
 
 
 class Gains(_Model):
     """PD(+I) gains of one joint: torque = kp*(q_ref - q) + kd*(v_ref - v) [+ ki*integral]."""
 
-    kp: NonNeg
-    kd: NonNeg
-    ki: NonNeg = 0.0
+    kp: NonNeg = Field(description="proportional gain [N·m/rad or N/m]")
+    kd: NonNeg = Field(description="derivative gain [N·m·s/rad or N·s/m]")
+    ki: NonNeg = Field(
+        0.0,
+        description="integral gain [N·m/(rad·s) or N/(m·s)]; ROS only (simulate refuses it)",
+    )
+
+
+class Tolerances(_Model):
+    """Trajectory-following limits for the Jazzy JointTrajectoryController (`constraints`).
+
+    Defaults: `stopped_velocity_tolerance` and `trajectory` are the controller's own
+    defaults (0.01 rad/s; 0 = not checked: a PD loop under gravity lags its reference);
+    `goal_time` is MoveIt's default goal-duration margin; `goal` is 0.05 rad because a
+    P(D) loop without integral action settles off the goal by gravity torque / Kp.
+    """
+
+    goal_time: NonNeg = Field(
+        0.5, description="extra time allowed to reach the goal [s]; 0 = unlimited"
+    )
+    stopped_velocity_tolerance: NonNeg = Field(
+        0.01, description="speed under which a joint counts as stopped [rad/s or m/s]"
+    )
+    goal: NonNeg = Field(
+        0.05, description="position error allowed at the goal [rad or m]; 0 = not checked"
+    )
+    trajectory: NonNeg = Field(
+        0.0, description="position error allowed along the way [rad or m]; 0 = not checked"
+    )
 
 
 class Control(_Model):
@@ -256,22 +313,33 @@ class Control(_Model):
     `controller_update_rate` the ros2_control rate [Hz].
     """
 
-    dt: Positive = DEFAULT_DT
-    gains: dict[Name, Gains] = {}
-    controller_update_rate: Positive = 100.0
-    gravity_compensation: bool = False
+    dt: Positive = Field(DEFAULT_DT, description="control and simulation time step [s]")
+    gains: dict[Name, Gains] = Field({}, description="PD gains per arm joint")
+    controller_update_rate: Positive = Field(
+        100.0, description="ros2_control controller manager rate [Hz]"
+    )
+    gravity_compensation: bool = Field(
+        False, description="add the gravity torque g(q) to the PD torque"
+    )
+    tolerances: Tolerances = Field(
+        Tolerances(), description="JointTrajectoryController constraints (Jazzy target)"
+    )
 
 
 class RobotSpec(_Model):
     """The whole robot: base, arm, how they are mounted, and how the arm is controlled."""
 
-    name: Name
-    materials: dict[Name, Material] = {}
-    mobile_base: MobileBase | None = None
-    arm: Arm
-    mount: Mount | None = None
-    control: Control = Control()
-    poses: dict[Name, dict[Name, Real]] = {}
+    name: Name = Field(description="robot name; also the ROS package prefix")
+    materials: dict[Name, Material] = Field({}, description="colours by name")
+    mobile_base: MobileBase | None = Field(
+        None, description="the mobile base, if the arm rides on one"
+    )
+    arm: Arm = Field(description="the arm")
+    mount: Mount | None = Field(None, description="where the arm sits on the base")
+    control: Control = Field(Control(), description="controller gains and time step")
+    poses: dict[Name, dict[Name, Real]] = Field(
+        {}, description="named poses: joint name -> position [rad or m]"
+    )
 
     # -- derived views used by writers, checks and the simulator ----------------
     def all_links(self) -> dict[str, Link]:
@@ -290,9 +358,7 @@ class RobotSpec(_Model):
 
     def arm_root(self) -> str:
         """The arm link that is no arm joint's child (a valid spec has exactly one)."""
-        children = {j.child for j in self.arm.joints.values()}
-        roots = [name for name in self.arm.links if name not in children]
-        return roots[0]
+        return root_links(self.arm.links, (j.child for j in self.arm.joints.values()))[0]
 
     def mount_joint(self) -> Joint:
         """The mount as the fixed `Joint` from the base to the arm root; needs a mount."""

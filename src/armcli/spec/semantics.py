@@ -11,6 +11,7 @@ from typing import Any
 
 from armcli.errors import Problem
 from armcli.io.yaml import dotted
+from armcli.spec.graph import root_links
 from armcli.spec.model import Joint, Link, RobotSpec
 
 
@@ -97,7 +98,7 @@ def _tree_problems(part: str, links: dict[str, Link], joints: dict[str, Joint], 
                 (part, "joints", jname, "limit", "upper"),
                 f"must be >= lower ({j.limit.lower:g})",
             )
-    roots = [n for n in links if n not in children]
+    roots = root_links(links, children)
     if len(roots) != 1:
         add((part, "links"), f"exactly one root link expected, found {len(roots)}: {roots}")
         return

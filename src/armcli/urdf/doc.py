@@ -12,6 +12,20 @@ Vec3 = tuple[float, float, float]
 ZERO3: Vec3 = (0.0, 0.0, 0.0)
 
 
+# The one joint-type table: every URDF joint type and the degrees of freedom it adds.
+JOINT_DOF: dict[str, int] = {
+    "fixed": 0,
+    "revolute": 1,
+    "continuous": 1,
+    "prismatic": 1,
+    "floating": 6,
+    "planar": 3,
+}
+JOINT_TYPES: tuple[str, ...] = tuple(JOINT_DOF)
+MOVABLE_TYPES: tuple[str, ...] = tuple(k for k, n in JOINT_DOF.items() if n > 0)
+ONE_DOF_TYPES: tuple[str, ...] = tuple(k for k, n in JOINT_DOF.items() if n == 1)
+
+
 @dataclass(frozen=True)
 class NumberProblem:
     """A numeric attribute that is missing, unparsable, non-finite or of the wrong length."""
@@ -107,7 +121,7 @@ class Joint:
     @property
     def movable(self) -> bool:
         """Whether the joint moves along one axis: any type but fixed, floating and planar."""
-        return self.type not in ("fixed", "floating", "planar")
+        return JOINT_DOF.get(self.type, 1) == 1  # an unknown type is reported elsewhere
 
 
 @dataclass(frozen=True)

@@ -17,6 +17,7 @@ from lxml import etree
 from armcli.errors import InputError, XacroRefusedError
 from armcli.io.userfile import read_regular
 from armcli.urdf.doc import (
+    JOINT_DOF,
     ZERO3,
     Geometry,
     Inertial,
@@ -39,7 +40,6 @@ MAX_URDF_DEPTH = 32
 MAX_URDF_LINKS = 300
 MAX_URDF_DOF = 128
 MAX_URDF_COLLISIONS = 1000  # example-robot-data: at most 113 per robot
-_DOF = {"revolute": 1, "continuous": 1, "prismatic": 1, "planar": 3, "floating": 6}
 
 
 def _ln(el: etree._Element) -> int | None:
@@ -318,7 +318,7 @@ def _check_size(root: etree._Element, source: str) -> None:
             file=source,
             line=_ln(shapes[MAX_URDF_COLLISIONS]),
         )
-    dof = sum(_DOF.get(str(j.get("type")), 0) for j in root.findall("joint"))
+    dof = sum(JOINT_DOF.get(str(j.get("type")), 0) for j in root.findall("joint"))
     if dof > MAX_URDF_DOF:
         raise InputError(
             f"more than {MAX_URDF_DOF} degrees of freedom ({dof}); armcli's bound on robot size",

@@ -13,11 +13,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from armcli.errors import InputError
-from armcli.urdf.doc import Joint, Urdf
+from armcli.spec.graph import root_links
+from armcli.urdf.doc import JOINT_TYPES, MOVABLE_TYPES, Joint, Urdf
 from armcli.urdf.read import parse_urdf
-
-MOVABLE = ("revolute", "continuous", "prismatic", "floating", "planar")
-_TYPES = ("fixed", *MOVABLE)
 
 
 @dataclass(frozen=True)
@@ -60,13 +58,13 @@ class KinematicTree:
 
     def movable(self) -> list[JointInfo]:
         """Joints that move, in depth-first order."""
-        return [j for _, j in self.walk() if j.type in MOVABLE]
+        return [j for _, j in self.walk() if j.type in MOVABLE_TYPES]
 
 
 def _joint(j: Joint, source: str) -> JointInfo:
-    if j.type not in _TYPES:
+    if j.type not in JOINT_TYPES:
         raise InputError(
-            f"joint {j.name!r}: unknown type {j.type!r}; known: {', '.join(_TYPES)}",
+            f"joint {j.name!r}: unknown type {j.type!r}; known: {', '.join(JOINT_TYPES)}",
             file=source,
             line=j.line,
         )
@@ -111,7 +109,7 @@ def tree_from_urdf(urdf: Urdf) -> KinematicTree:
                     line=by_name[j.name].line,
                 )
     children = [j.child for j in joints]
-    roots = [n for n in links if n not in children]
+    roots = root_links(links, children)
     if not links:
         raise InputError("no <link> elements: not a robot description", file=source)
     if len(roots) != 1:
@@ -162,7 +160,7 @@ def to_rich(tree: KinematicTree) -> Any:
     top = Tree(f"[bold]{escape(tree.root)}[/bold]  [dim](robot {escape(tree.robot)})[/dim]")
     nodes = {tree.root: top}
     for _, j in tree.walk():
-        style = "cyan" if j.type in MOVABLE else "dim"
+        style = "cyan" if j.type in MOVABLE_TYPES else "dim"
         label = (
             f"[bold]{escape(j.child)}[/bold]  [{style}]← {escape(j.name)}: "
             f"{escape(joint_summary(j))}[/{style}]"

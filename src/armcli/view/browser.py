@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import InputError
+from armcli.sim.states import Replay
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_root
 from armcli.urdf.tool import ToolPoint
@@ -33,7 +34,6 @@ from armcli.view.png import (
     neutral,
     tool_position,
 )
-from armcli.view.replay import Replay
 
 GHOST_RGBA = (0.35, 0.65, 1.0, 0.35)  # translucent blue for the reference pose
 FRAME_RATE = 30.0  # [Hz] replay updates sent to the browser

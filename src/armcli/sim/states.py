@@ -1,14 +1,18 @@
-"""A recorded `armcli simulate` run read back for replay: times, positions, references.
+"""The joint-states file of `armcli simulate --output`: its schema, writer and reader.
 
-The CSV is the one `simulate --output` writes (`time`, then per joint
-`NAME.position`, `NAME.velocity`, `NAME.effort`, `NAME.reference`); it is user
-input here, so every cell is checked and errors name the file, line and column.
+The file mimics Gazebo's joint_state_publisher: one row per publish period (the spec's
+`joint_state_publisher.update_rate`, 10 Hz) with columns `time` [s] and, per joint,
+`NAME.position` [rad or m], `NAME.velocity` [rad/s or m/s], `NAME.effort` [N·m or N] and
+`NAME.reference` (the position the controller was tracking). The reader (used by
+`view --replay`) treats the file as user input: every cell is checked and errors name
+the file, line and column.
 """
 
 from __future__ import annotations
 
 import csv
 import io
+import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -17,7 +21,72 @@ from pathlib import Path
 import numpy as np
 
 from armcli.errors import InputError
+from armcli.io.files import write_file_atomic
 from armcli.io.yaml import read_text
+from armcli.sim.simulate import SimResult
+
+TIME = "time"
+FIELDS = ("position", "velocity", "effort", "reference")  # per-joint columns, in file order
+FLOAT_FMT = "{:.9g}"
+
+
+def column(joint: str, field: str) -> str:
+    """The column name of one joint's field: `NAME.field`."""
+    return f"{joint}.{field}"
+
+
+# -- writer ----------------------------------------------------------------------------------
+
+
+def sample_states(res: SimResult, rate: float) -> dict[str, np.ndarray]:
+    """Columns `time`, `NAME.position|velocity|effort|reference` at `rate` [Hz]."""
+    steps = len(res.t) - 1
+    period = 1.0 / rate
+    n_samples = int(np.floor(res.t[-1] / period + 1e-9)) + 1
+    idx = np.minimum(np.round(np.arange(n_samples) * period / res.dt).astype(int), steps)
+    tau_idx = np.minimum(idx, steps - 1)
+    cols: dict[str, np.ndarray] = {TIME: res.t[idx]}
+    for i, name in enumerate(res.joint_names):
+        cols[column(name, "position")] = res.q[idx, i]
+        cols[column(name, "velocity")] = res.v[idx, i]
+        cols[column(name, "effort")] = res.tau[tau_idx, i]
+        cols[column(name, "reference")] = res.q_ref[idx, i]
+    return cols
+
+
+def states_bytes(cols: dict[str, np.ndarray], fmt: str) -> bytes:
+    """CSV or JSON text of the sampled states (deterministic formatting)."""
+    names = list(cols)
+    if fmt == "json":
+        data = {k: [float(FLOAT_FMT.format(x)) for x in v] for k, v in cols.items()}
+        return (json.dumps(data, indent=1) + "\n").encode()
+    lines = [",".join(names)]
+    rows = np.column_stack([cols[k] for k in names])
+    lines += [",".join(FLOAT_FMT.format(x) for x in row) for row in rows]
+    return ("\n".join(lines) + "\n").encode()
+
+
+def output_format(path: Path) -> str:
+    """The joint-state file format named by the extension of `path`: "csv" or "json".
+
+    Raises:
+        InputError: any other extension.
+    """
+    ext = path.suffix.lower()
+    if ext not in (".csv", ".json"):
+        raise InputError(
+            f"unknown output format {ext or '(none)'!r}; use .csv or .json", field="--output"
+        )
+    return ext[1:]
+
+
+def write_states(path: Path, res: SimResult, rate: float) -> None:
+    """Write the joint states sampled at `rate` [Hz] atomically, as CSV or JSON by extension."""
+    write_file_atomic(path, states_bytes(sample_states(res, rate), output_format(path)))
+
+
+# -- reader ----------------------------------------------------------------------------------
+
 
 MAX_REPLAY_BYTES = 200_000_000
 MAX_REPLAY_ROWS = 2_000_000  # = simjob.MAX_STEPS: the most states `simulate` records
@@ -82,7 +151,7 @@ def load_replay(path: str | Path, joints: Sequence[str]) -> Replay:
     """Read a `simulate` CSV (time, NAME.position/.velocity/.effort/.reference) for `joints`."""
     source = str(path)
     rows = _rows(read_text(path, max_bytes=MAX_REPLAY_BYTES, what="CSV"), source)
-    if not rows or not rows[0] or rows[0][0].strip() != "time":
+    if not rows or not rows[0] or rows[0][0].strip() != TIME:
         raise InputError("first column must be 'time'", file=source, line=1)
     header = [h.strip() for h in rows[0]]
     pos_cols = {h[: -len(".position")]: i for i, h in enumerate(header) if h.endswith(".position")}

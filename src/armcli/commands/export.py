@@ -1,0 +1,78 @@
+"""`armcli export mjcf`: the robot as a MuJoCo model (plus scene.xml, meshes/)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+import typer
+
+from armcli.build.expand import spec_label
+from armcli.defaults import DEFAULT_SPEC
+from armcli.export.mjcf import BASES
+from armcli.export.mjcf_files import export_mjcf
+from armcli.urdf.meshes import MeshSearch, parse_package_dirs
+from armcli.urdf.source import TRUST_XACRO_HELP
+
+export_app = typer.Typer(
+    help="Export the robot to other simulators' formats.", no_args_is_help=True
+)
+
+
+@export_app.command("mjcf")
+def mjcf_cmd(
+    robot: Path = typer.Argument(
+        DEFAULT_SPEC,
+        show_default=False,
+        help=f"Robot spec YAML, URDF or xacro file (default: {DEFAULT_SPEC}).",
+    ),
+    out: Path = typer.Option(
+        Path("robot.xml"),
+        "-o",
+        "--out",
+        show_default=False,
+        help="MJCF model file (default: robot.xml).",
+    ),
+    base: str = typer.Option(
+        "fixed",
+        "--base",
+        click_type=click.Choice(BASES),
+        show_default=False,
+        help="fixed (default): the root link is welded to the world; free: on a free joint.",
+    ),
+    whole_robot: bool = typer.Option(
+        False, "--whole-robot", help="For a spec: the whole robot instead of the arm alone."
+    ),
+    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
+    package_dir: list[str] = typer.Option(
+        [], "--package-dir", help="NAME=PATH: where package://NAME/ meshes live (repeatable)."
+    ),
+) -> None:
+    """Write a MuJoCo MJCF model of ROBOT to OUT, with scene.xml (floor, light) beside it.
+
+    Joints with spec gains get `position` actuators (kp = Kp, kv = Kd, force range =
+    the effort limit); the report lists what MuJoCo cannot represent.
+    """
+    res = export_mjcf(
+        robot,
+        out,
+        base=base,
+        whole_robot=whole_robot,
+        trust_xacro=trust_xacro,
+        search=MeshSearch(parse_package_dirs(package_dir)),
+        label=spec_label(robot),
+    )
+    exp = res.export
+    w = sys.stdout.write
+    w(f"wrote {len(res.files)} files beside {out} from {res.robot}\n")
+    w(
+        f"{len(exp.joints)} joints, {len(exp.actuators)} actuators, "
+        f"keyframes: {', '.join(exp.keyframes)}\n"
+    )
+    w(res.report)
+
+
+def register(app: typer.Typer) -> None:
+    """Add `armcli export ...` as a sub-app (one subcommand per format)."""
+    app.add_typer(export_app, name="export")

@@ -1,0 +1,1 @@
+"""Exports of the robot to other simulators' formats (MuJoCo MJCF)."""

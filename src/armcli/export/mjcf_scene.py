@@ -1,0 +1,64 @@
+"""`scene.xml` beside the model, in the style of mujoco_menagerie: include, floor, light, sky.
+
+The model file stays free of world dressing so that it can be included into
+other scenes; this file is what a user opens in `python -m mujoco.viewer`.
+"""
+
+from __future__ import annotations
+
+from lxml import etree
+
+from armcli.build.xmlfmt import to_bytes
+
+SCENE = "scene.xml"
+
+
+def scene_xml(model_file: str, model_name: str, header: str | None = None) -> bytes:
+    """The scene file: includes `model_file` (relative) and adds floor, light and sky."""
+    root = etree.Element("mujoco", model=f"{model_name} scene")
+    etree.SubElement(root, "include", file=model_file)
+    visual = etree.SubElement(root, "visual")
+    etree.SubElement(
+        visual, "headlight", diffuse="0.6 0.6 0.6", ambient="0.3 0.3 0.3", specular="0 0 0"
+    )
+    etree.SubElement(visual, "rgba", haze="0.15 0.25 0.35 1")
+    etree.SubElement(visual, "global", azimuth="120", elevation="-20")
+    asset = etree.SubElement(root, "asset")
+    etree.SubElement(
+        asset,
+        "texture",
+        type="skybox",
+        builtin="gradient",
+        rgb1="0.3 0.5 0.7",
+        rgb2="0 0 0",
+        width="512",
+        height="3072",
+    )
+    etree.SubElement(
+        asset,
+        "texture",
+        type="2d",
+        name="groundplane",
+        builtin="checker",
+        mark="edge",
+        rgb1="0.2 0.3 0.4",
+        rgb2="0.1 0.2 0.3",
+        markrgb="0.8 0.8 0.8",
+        width="300",
+        height="300",
+    )
+    etree.SubElement(
+        asset,
+        "material",
+        name="groundplane",
+        texture="groundplane",
+        texuniform="true",
+        texrepeat="5 5",
+        reflectance="0.2",
+    )
+    world = etree.SubElement(root, "worldbody")
+    etree.SubElement(world, "light", pos="0 0 1.5", dir="0 0 -1", directional="true")
+    etree.SubElement(
+        world, "geom", name="floor", size="0 0 0.05", type="plane", material="groundplane"
+    )
+    return to_bytes(root, header_comment=header)

@@ -1,0 +1,51 @@
+"""The command-line shell: lazy command table, --version, python -m armcli, error labels."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from armcli.cli import COMMANDS, load_command
+
+
+@pytest.mark.parametrize("name", list(COMMANDS))
+def test_command_table_help_is_the_commands_docstring(name: str) -> None:
+    """The list in `armcli --help` comes from COMMANDS; it must say what the command says."""
+    command = load_command(name)
+    assert command.name == name
+    assert COMMANDS[name][1] == (command.help or "").strip().splitlines()[0]
+
+
+def test_help_imports_no_command_module() -> None:
+    """`armcli --help` stays instant: no command, pydantic or numpy import."""
+    code = (
+        "import sys\nfrom armcli.cli import main\n"
+        "try:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
+        "heavy = ('armcli.commands.', 'pydantic', 'numpy')\n"
+        "print('LOADED:' + ','.join(sorted(m for m in sys.modules if m.startswith(heavy))))"
+    )
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert "Commands:" in res.stdout
+    assert res.stdout.strip().splitlines()[-1] == "LOADED:"
+
+
+def test_version_and_module_entry_point() -> None:
+    from importlib.metadata import version
+
+    res = subprocess.run(
+        [sys.executable, "-m", "armcli", "--version"], capture_output=True, text=True, check=False
+    )
+    assert res.returncode == 0
+    assert res.stdout.strip() == f"armcli {version('armcli')}"
+
+
+def test_unknown_command_is_a_usage_error() -> None:
+    res = subprocess.run(
+        [sys.executable, "-m", "armcli", "no-such-command"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert res.returncode == 2 and "No such command" in res.stderr
