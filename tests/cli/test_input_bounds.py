@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from armcli.errors import InputError
-from armcli.view.replay import load_replay
+from armcli.sim.states import load_replay
 
 TIME_LIMIT_S = 120.0  # one CLI run on a loaded 2-core machine
 CSV_FIELD_LIMIT = csv.field_size_limit()  # 131072: the csv module's default
