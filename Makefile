@@ -54,6 +54,7 @@ native-or-skip: install
 
 bench: install native
 	$(BIN)/python bench/bench_sim.py
+	$(BIN)/python bench/bench_tune.py
 
 fuzz: install
 	HYPOTHESIS_PROFILE=fuzz $(BIN)/python -m pytest -q tests -k fuzz

@@ -7,6 +7,7 @@ exercised by the whole tool chain without writing a test for it.
 from __future__ import annotations
 
 import csv
+import json
 import math
 from pathlib import Path
 
@@ -124,3 +125,16 @@ def test_export_mjcf_loads_in_mujoco(built: tuple[Path, RobotSpec, Path], tmp_pa
     assert info.value.code in (0, None)
     m = mujoco.MjModel.from_xml_path(str(tmp_path / "scene.xml"))
     assert m.nu == len(spec.control.gains) and m.nkey == len({"home", *spec.poses})
+
+
+def test_tune(built: tuple[Path, RobotSpec, Path], tmp_path: Path) -> None:
+    path, spec, _ = built
+    out = tmp_path / "tune.json"
+    with pytest.raises(SystemExit) as info:
+        main(
+            ["tune", str(path), "--trials", "3", "--batch", "3", "--settle", "0.5", "-o", str(out)]
+        )
+    assert info.value.code in (0, None)
+    doc = json.loads(out.read_text(encoding="utf-8"))
+    assert doc["problem"]["joints"] == spec.movable_arm_joints()
+    assert doc["results"]["tuned"]["feasible"]

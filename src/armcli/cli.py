@@ -38,6 +38,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "armcli.commands.simulate",
         "Simulate the arm tracking a trajectory (Pinocchio ABA under PD control).",
     ),
+    "tune": (
+        "armcli.commands.tune",
+        "Tune PD gains: model-based start, then a seeded search over simulated rollouts.",
+    ),
     "ros-package": (
         "armcli.commands.ros",
         "Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config.",

@@ -200,12 +200,12 @@ def test_docs_list_every_rule() -> None:
 
 
 @pytest.mark.parametrize(
-    "command", ["build", "check", "simulate", "ros-package", "view", "render", "tree"]
+    "command", ["build", "check", "simulate", "tune", "ros-package", "view", "render", "tree"]
 )
 def test_help_lists_choices_and_prints_no_stray_escapes(command: str) -> None:
     """Every --help renders plainly: no rich escape backslash before `[...]`."""
     res = armcli(command, "--help")
     assert res.returncode == 0 and "Usage:" in res.stdout
     assert "\\" not in res.stdout
-    if command in ("check", "simulate"):
+    if command in ("check", "simulate", "tune"):
         assert "[" in res.stdout and "|" in res.stdout  # a Choice lists its values

@@ -37,11 +37,12 @@ def test_tree_matches_the_spec(robot, default_spec_path: Path) -> None:  # type:
     for name, sj in spec.all_joints().items():
         tj = by_name[name]
         assert (tj.parent, tj.child, tj.type) == (sj.parent, sj.child, sj.type)
-        assert tj.xyz == pytest.approx(sj.origin.xyz, abs=LIMIT_TOL)
+        assert tj.origin.xyz == pytest.approx(sj.origin.xyz, abs=LIMIT_TOL)
         if sj.limit is not None:
-            assert tj.lower == pytest.approx(sj.limit.lower, abs=LIMIT_TOL)
-            assert tj.upper == pytest.approx(sj.limit.upper, abs=LIMIT_TOL)
-            assert tj.effort == sj.limit.effort
+            assert tj.limit is not None
+            assert tj.limit.lower == pytest.approx(sj.limit.lower, abs=LIMIT_TOL)
+            assert tj.limit.upper == pytest.approx(sj.limit.upper, abs=LIMIT_TOL)
+            assert tj.limit.effort == sj.limit.effort
     # The seed: two revolute arm joints, 0..pi/2, effort 100, velocity 100.
     assert [j.name for j in tree.movable() if j.type == "revolute"] == [
         "arm_base_forearm_joint",

@@ -19,49 +19,33 @@ from armcli.urdf.read import parse_urdf
 
 
 @dataclass(frozen=True)
-class JointInfo:
-    """One URDF joint as the tree shows it; lengths [m], angles [rad]."""
-
-    name: str
-    type: str
-    parent: str
-    child: str
-    xyz: tuple[float, float, float]
-    rpy: tuple[float, float, float]
-    axis: tuple[float, float, float]
-    lower: float | None = None
-    upper: float | None = None
-    effort: float | None = None
-    velocity: float | None = None
-
-
-@dataclass(frozen=True)
 class KinematicTree:
     """Links and joints of one robot, with its single root link."""
 
     robot: str
     root: str
     links: tuple[str, ...]
-    joints: tuple[JointInfo, ...]
+    joints: tuple[Joint, ...]  # validated: known type, parent and child links of this tree
 
-    def children(self, link: str) -> list[JointInfo]:
+    def children(self, link: str) -> list[Joint]:
         """Joints whose parent is `link`, in name order (as urdfdom stores them)."""
         return sorted((j for j in self.joints if j.parent == link), key=lambda j: j.name)
 
-    def walk(self) -> Iterator[tuple[int, JointInfo]]:
+    def walk(self) -> Iterator[tuple[int, Joint]]:
         """Depth-first (depth, joint) pairs from the root."""
         stack = [(1, j) for j in reversed(self.children(self.root))]
         while stack:
             depth, j = stack.pop()
             yield depth, j
-            stack.extend((depth + 1, c) for c in reversed(self.children(j.child)))
+            stack.extend((depth + 1, c) for c in reversed(self.children(str(j.child))))
 
-    def movable(self) -> list[JointInfo]:
+    def movable(self) -> list[Joint]:
         """Joints that move, in depth-first order."""
         return [j for _, j in self.walk() if j.type in MOVABLE_TYPES]
 
 
-def _joint(j: Joint, source: str) -> JointInfo:
+def _valid(j: Joint, source: str) -> Joint:
+    """The joint itself, once its type is known and it names both links."""
     if j.type not in JOINT_TYPES:
         raise InputError(
             f"joint {j.name!r}: unknown type {j.type!r}; known: {', '.join(JOINT_TYPES)}",
@@ -74,20 +58,7 @@ def _joint(j: Joint, source: str) -> JointInfo:
             file=source,
             line=j.line,
         )
-    lim = j.limit
-    return JointInfo(
-        name=j.name,
-        type=j.type,
-        parent=j.parent,
-        child=j.child,
-        xyz=j.origin.xyz,
-        rpy=j.origin.rpy,
-        axis=j.axis or (1.0, 0.0, 0.0),
-        lower=lim.lower if lim else None,
-        upper=lim.upper if lim else None,
-        effort=lim.effort if lim else None,
-        velocity=lim.velocity if lim else None,
-    )
+    return j
 
 
 def tree_from_urdf(urdf: Urdf) -> KinematicTree:
@@ -97,8 +68,7 @@ def tree_from_urdf(urdf: Urdf) -> KinematicTree:
         p = urdf.problems[0]
         raise InputError(f"{p.where}: {p.kind} number {p.text!r}", file=source, line=p.line)
     links = tuple(lk.name for lk in urdf.links)
-    joints = tuple(_joint(j, source) for j in urdf.joints)
-    by_name = {j.name: j for j in urdf.joints}
+    joints = tuple(_valid(j, source) for j in urdf.joints)
     known = set(links)
     for j in joints:
         for role in ("parent", "child"):
@@ -106,9 +76,9 @@ def tree_from_urdf(urdf: Urdf) -> KinematicTree:
                 raise InputError(
                     f"joint {j.name!r}: unknown {role} link {getattr(j, role)!r}",
                     file=source,
-                    line=by_name[j.name].line,
+                    line=j.line,
                 )
-    children = [j.child for j in joints]
+    children = [str(j.child) for j in joints]
     roots = root_links(links, children)
     if not links:
         raise InputError("no <link> elements: not a robot description", file=source)
@@ -116,7 +86,7 @@ def tree_from_urdf(urdf: Urdf) -> KinematicTree:
         found = ", ".join(roots) if roots else "none: the joints form a cycle"
         raise InputError(f"expected exactly one root link, found {found}", file=source)
     tree = KinematicTree(urdf.name, roots[0], links, joints)
-    reached = {tree.root} | {j.child for _, j in tree.walk()}
+    reached = {tree.root} | {str(j.child) for _, j in tree.walk()}
     if len(reached) != len(known) or len(set(children)) != len(children):
         raise InputError("links are not one tree (a link has two parents, or a cycle)", file=source)
     return tree
@@ -137,18 +107,21 @@ def _vec(v: tuple[float, ...]) -> str:
     return " ".join(_num(x) for x in v)
 
 
-def joint_summary(j: JointInfo) -> str:
-    """Type, axis and limits of a joint in one line with units."""
+def joint_summary(j: Joint) -> str:
+    """Type, axis and limits of a joint in one line with units (URDF's default axis is x)."""
     parts = [j.type]
     if j.type != "fixed":
-        parts.append(f"axis ({_vec(j.axis)})")
+        parts.append(f"axis ({_vec(j.axis or (1.0, 0.0, 0.0))})")
     unit = "m" if j.type == "prismatic" else "rad"
-    if j.lower is not None and j.upper is not None and j.type != "continuous":
-        parts.append(f"[{_num(j.lower)}, {_num(j.upper)}] {unit}")
-    if j.effort is not None:
-        parts.append(f"effort {_num(j.effort)} {'N' if unit == 'm' else 'N·m'}")
-    if j.velocity is not None:
-        parts.append(f"velocity {_num(j.velocity)} {unit}/s")
+    lim = j.limit
+    if lim is None:
+        return ", ".join(parts)
+    if lim.lower is not None and lim.upper is not None and j.type != "continuous":
+        parts.append(f"[{_num(lim.lower)}, {_num(lim.upper)}] {unit}")
+    if lim.effort is not None:
+        parts.append(f"effort {_num(lim.effort)} {'N' if unit == 'm' else 'N·m'}")
+    if lim.velocity is not None:
+        parts.append(f"velocity {_num(lim.velocity)} {unit}/s")
     return ", ".join(parts)
 
 
@@ -162,10 +135,10 @@ def to_rich(tree: KinematicTree) -> Any:
     for _, j in tree.walk():
         style = "cyan" if j.type in MOVABLE_TYPES else "dim"
         label = (
-            f"[bold]{escape(j.child)}[/bold]  [{style}]← {escape(j.name)}: "
+            f"[bold]{escape(str(j.child))}[/bold]  [{style}]← {escape(j.name)}: "
             f"{escape(joint_summary(j))}[/{style}]"
         )
-        nodes[j.child] = nodes[j.parent].add(label)
+        nodes[str(j.child)] = nodes[str(j.parent)].add(label)
     return top
 
 
@@ -177,14 +150,16 @@ def _q(text: str) -> str:
 def to_dot(tree: KinematicTree) -> str:
     """Graphviz text in urdf_to_graphviz's layout, joint nodes labelled with type and limits."""
     out = ["digraph G {", "node [shape=box];"]
-    out += [f"{_q(n)} [label={_q(n)}];" for n in [tree.root, *(j.child for _, j in tree.walk())]]
+    out += [
+        f"{_q(n)} [label={_q(n)}];" for n in [tree.root, *(str(j.child) for _, j in tree.walk())]
+    ]
     out.append("node [shape=ellipse, color=blue, fontcolor=blue];")
     for _, j in tree.walk():
         label = _q(f"{j.name}\\n{joint_summary(j)}")
         out.append(f"{_q(j.name)} [label={label}];")
     for _, j in tree.walk():
-        label = _q(f"xyz: {_vec(j.xyz)} \\nrpy: {_vec(j.rpy)}")
-        out.append(f"{_q(j.parent)} -> {_q(j.name)} [label={label}]")
-        out.append(f"{_q(j.name)} -> {_q(j.child)}")
+        label = _q(f"xyz: {_vec(j.origin.xyz)} \\nrpy: {_vec(j.origin.rpy)}")
+        out.append(f"{_q(str(j.parent))} -> {_q(j.name)} [label={label}]")
+        out.append(f"{_q(j.name)} -> {_q(str(j.child))}")
     out.append("}")
     return "\n".join(out) + "\n"

@@ -68,7 +68,7 @@ def moving_parts(urdf_xml: str, joints: Collection[str], source: str = "<urdf>")
     moving: set[str] = set()
     for _, j in tree.walk():  # parents come before children
         if j.name in joints or j.parent in moving:
-            moving.add(j.child)
+            moving.add(str(j.child))
     root = parse_root(urdf_xml.encode("utf-8"), source)
     for link in root.findall("link"):
         if link.get("name") not in moving:

@@ -1,0 +1,177 @@
+"""`armcli tune`: PD gains from the model, refined over rollouts, locally or on Dask."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+import click
+import typer
+
+from armcli.defaults import DEFAULT_SPEC
+from armcli.errors import InputError
+from armcli.io.files import write_file_atomic
+from armcli.spec.load import load_spec
+from armcli.tune import job as tjob
+from armcli.tune import report, session
+from armcli.tune.engine import Engine, make_engine
+from armcli.tune.model_gains import LOOPS
+from armcli.tune.plot import write_tune_plot
+from armcli.tune.problem import nominal_arm
+from armcli.tune.search import ROBUST_MODES, SearchOptions, validate
+from armcli.tune.write import check_writable, write_gains
+
+
+def _pair(text: str, option: str) -> tuple[float, float]:
+
+    try:
+        a, b = (float(x) for x in text.split(","))
+    except ValueError:
+        raise InputError(f"expected two numbers 'a,b', got {text!r}", field=option) from None
+    return a, b
+
+
+def tune_cmd(
+    spec: Path = typer.Argument(None, help=f"Robot spec YAML (default: {DEFAULT_SPEC})."),
+    trajectory: list[Path] = typer.Option(
+        None,
+        "--trajectory",
+        "-t",
+        help="JointTrajectory YAML (repeatable; default: trajectories/*.yaml next to the spec, "
+        "else the named poses as steps).",
+    ),
+    joints: str = typer.Option(None, "--joints", help="Comma-separated joints; others locked."),
+    loop: str = typer.Option(
+        "implicit",
+        "--loop",
+        click_type=click.Choice(LOOPS),
+        show_default=False,
+        help="Stability bound: implicit (default: armcli's simulator) or explicit (a torque "
+        "loop stepped explicitly, e.g. Gazebo's effort controller).",
+    ),
+    zeta: float = typer.Option(1.0, "--zeta", help="Damping ratio of the start gains."),
+    wn: float = typer.Option(
+        None, "--wn", help="Target natural frequency [rad/s] (default: 2π·update rate / 10)."
+    ),
+    trials: int = typer.Option(60, "--trials", help="Candidates to evaluate (Optuna trials)."),
+    batch: int = typer.Option(8, "--batch", help="Candidates per batch (result depends on it)."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the sampler and of the perturbed models."),
+    span: float = typer.Option(4.0, "--span", help="Search kp, kd in [start/span, start*span]."),
+    settle: float = typer.Option(2.0, "--settle", help="Simulated after the last point [s]."),
+    robust: int = typer.Option(0, "--robust", help="Score every candidate on N perturbed models."),
+    mass_scale: str = typer.Option("0.8,1.2", "--mass-scale", help="Mass/inertia scale range."),
+    friction_scale: str = typer.Option("0.5,2", "--friction-scale", help="Friction scale range."),
+    robust_mode: str = typer.Option(
+        "worst",
+        "--robust-mode",
+        click_type=click.Choice(ROBUST_MODES),
+        show_default=False,
+        help="Aggregate over the perturbed models: worst (default) or quantile.",
+    ),
+    quantile: float = typer.Option(0.9, "--quantile", help="Quantile for --robust-mode quantile."),
+    jobs: int = typer.Option(
+        None,
+        "--jobs",
+        "-j",
+        show_default=False,
+        help="Local threads scoring candidates (default: every core).",
+    ),
+    scheduler: str = typer.Option(
+        None,
+        "--scheduler",
+        help="Dask scheduler address, e.g. tcp://HOST:8786 (needs armcli[dask]).",
+    ),
+    output: Path = typer.Option(None, "--output", "-o", help="Write the results as JSON."),
+    plot: Path = typer.Option(None, "--plot", help="Write history + before/after tracking PNG."),
+    write: bool = typer.Option(False, "--write", help="Update control.gains in the spec in place."),
+) -> None:
+    """Tune PD gains: model-based start, then a seeded search over simulated rollouts."""
+    spec_path = spec or DEFAULT_SPEC
+    opts = SearchOptions(trials, batch, seed, span, robust_mode, quantile)
+    validate(opts)
+    if output is not None and output.suffix.lower() != ".json":
+        raise InputError("the output file must end in .json", field="--output")
+    if write:
+        check_writable(spec_path)
+    settings = tjob.TuneSettings(
+        tuple(j.strip() for j in joints.split(",") if j.strip()) if joints else None,
+        loop,
+        zeta,
+        wn,
+        settle,
+        robust,
+        _pair(mass_scale, "--mass-scale"),
+        _pair(friction_scale, "--friction-scale"),
+        seed,
+    )
+    job = tjob.prepare(load_spec(spec_path), spec_path, trajectory or [], settings)
+    engine = make_engine(jobs if jobs is not None else (os.cpu_count() or 1), scheduler)
+    try:
+        _run(job, engine, opts, output, plot, write, spec_path)
+    finally:
+        engine.close()
+
+
+def _run(
+    job: tjob.TuneJob,
+    engine: Engine,
+    opts: SearchOptions,
+    output: Path | None,
+    plot: Path | None,
+    write: bool,
+    spec_path: Path,
+) -> None:
+    from rich.console import Console
+    from rich.progress import Progress
+
+    out = Console(file=sys.stdout) if sys.stdout.isatty() else Console(file=sys.stdout, width=130)
+    out.print(report.reasoning_table(job.start))
+    arm_damping = nominal_arm(job.problem).damping
+    with Progress(console=Console(stderr=True), transient=True) as bar:
+        task = bar.add_task(f"tuning on {engine.name}", total=opts.trials)
+        outcome = session.run(job, engine, opts, lambda d, t: bar.update(task, completed=d))
+    out.print(report.comparison_table(job.problem, job.start, outcome.rows, arm_damping))
+    _summary(out, outcome)
+    if output is not None:
+        write_file_atomic(
+            output,
+            report.to_json(
+                job.problem, job.start, outcome.rows, outcome.result, opts, engine.name, arm_damping
+            ),
+        )
+    if plot is not None:
+        case = session.showcase_case(job, outcome)
+        runs = session.tracking_runs(job, outcome, case)
+        write_tune_plot(plot, outcome.result.history, runs, job.problem.cases[case].label)
+    if write:
+        n = len(job.problem.joints)
+        best = outcome.result.best
+        write_gains(
+            spec_path,
+            {j: (float(best[i]), float(best[n + i])) for i, j in enumerate(job.problem.joints)},
+        )
+    for path in (output, plot, spec_path if write else None):
+        if path is not None:
+            out.print(f"wrote {path}", markup=False, highlight=False)
+
+
+def _summary(out: Any, outcome: session.Outcome) -> None:
+
+    tuned = outcome.row("tuned")
+    parts = []
+    for row in outcome.rows:
+        if row.label != "tuned" and row.nominal.feasible and tuned.nominal.feasible:
+            a, b = session.mean_rms(row), session.mean_rms(tuned)
+            parts.append(f"{row.label} {a:.4g} -> tuned {b:.4g} rad ({100 * (b - a) / a:+.1f} %)")
+    if parts:
+        out.print("mean RMS error: " + "; ".join(parts), markup=False, highlight=False)
+    if tuned.robust_cost is not None:
+        costs = ", ".join(f"{r.label} {r.robust_cost:.4g}" for r in outcome.rows)
+        out.print(f"robust cost over the perturbed models: {costs}", markup=False, highlight=False)
+
+
+def register(app: typer.Typer) -> None:
+    """Add `tune` to the app."""
+    app.command("tune")(tune_cmd)

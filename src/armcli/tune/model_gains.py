@@ -1,0 +1,231 @@
+"""The model-based start: PD gains from the joint-space inertia, no rollouts.
+
+Per joint j, over a sample of the joint range (Pinocchio CRBA), with m_j = max M_jj:
+
+    kp_j = m_j wn_j²,   kd_j = 2 zeta sqrt(kp_j m_j) = 2 zeta wn_j m_j
+
+so the joint, seen as a single inertia m_j, has natural frequency wn_j and damping ratio
+zeta. wn_j is the smallest of three caps, and the binding one is reported:
+
+- `target`: the requested wn, by default a decade under the controller's update rate
+  (2 pi f_c / TARGET_RATIO), the usual rule for a sampled loop;
+- `stability`: the loop chosen by `--loop` stays stable at STABILITY_MARGIN * dt, by the
+  scalar-mode bound of `armcli.sim.stability` (`implicit_dt_max` for armcli's simulator,
+  `explicit_dt_max` for an explicitly stepped torque loop such as Gazebo's effort
+  controller) with lambda_j = max (M^-1)_jj over the sample, the joint's own mode;
+- `effort`: kp_j * (largest step of joint j) + max |g_j(q)| stays within the effort limit.
+
+The full gain vector is then verified on every sampled M with the verdict of
+`armcli.sim.stability` (spectral radius of the real step maps, `worst_radius`).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from armcli.errors import InputError
+from armcli.sim import stability as stab
+from armcli.sim.simulate import Arm
+
+TARGET_RATIO = 10.0  # wn <= 2 pi f_c / TARGET_RATIO for a loop closed at f_c [Hz]
+STABILITY_MARGIN = 2.0  # gains must be stable at this multiple of dt
+GRID_POINTS = 5  # per joint while the grid has at most MAX_GRID samples
+MAX_GRID = 125
+RANDOM_SAMPLES = 100
+SAMPLE_SEED = 0
+WN_BRACKET = (1e-6, 1e9)  # [rad/s] search interval for the stability cap
+LOOPS = ("implicit", "explicit")
+
+
+@dataclass(frozen=True)
+class JointReasoning:
+    """Why joint `name` got its start gains."""
+
+    name: str
+    m_min: float  # min M_jj over the sample [kg·m² or kg]
+    m_max: float  # max M_jj (the inertia the gains are sized for)
+    gravity_max: float  # max |g_j(q)| over the sample [N·m or N]
+    step: float  # largest step in the trajectories [rad or m]
+    lambda_j: float  # max (M^-1)_jj over the sample, the joint's mode [1/(kg·m²)]
+    wn_target: float  # [rad/s]
+    wn_stability: float  # [rad/s]
+    wn_effort: float  # [rad/s] (inf without an effort limit)
+    wn: float  # chosen [rad/s]
+    zeta: float
+    kp: float  # [N·m/rad]
+    kd: float  # [N·m·s/rad]
+    binding: str  # "target" | "stability" | "effort"
+
+
+@dataclass(frozen=True)
+class StartGains:
+    """The model-based gains and the evidence for them."""
+
+    kp: np.ndarray
+    kd: np.ndarray
+    rows: tuple[JointReasoning, ...]
+    lambda_max: float  # max lambda_max(M^-1) over the sample [1/(kg·m²)]
+    lambda_joint: np.ndarray  # per joint, max (M^-1)_jj over the sample [1/(kg·m²)]
+    loop: str
+    dt: float  # [s]
+
+
+def sample_configurations(arm: Arm) -> np.ndarray:
+    """Joint-space sample: a full grid for few joints, else seeded uniform draws."""
+    n = len(arm.joint_names)
+    lo = np.where(np.isfinite(arm.lower), arm.lower, -math.pi)
+    hi = np.where(np.isfinite(arm.upper), arm.upper, math.pi)
+    if GRID_POINTS**n <= MAX_GRID:
+        axes = [np.linspace(a, b, GRID_POINTS) for a, b in zip(lo, hi, strict=True)]
+        return np.array(list(itertools.product(*axes)), dtype=float)
+    rng = np.random.default_rng(SAMPLE_SEED)
+    return np.vstack([np.clip(np.zeros(n), lo, hi), rng.uniform(lo, hi, size=(RANDOM_SAMPLES, n))])
+
+
+def mass_matrices(arm: Arm, qs: np.ndarray) -> list[np.ndarray]:
+    """Symmetric M(q) (CRBA) at every sample."""
+    import pinocchio as pin
+
+    data = arm.model.createData()
+    out = []
+    for q in qs:
+        M = pin.crba(arm.model, data, q)
+        out.append(np.triu(M) + np.triu(M, 1).T)
+    return out
+
+
+def gravity_max(arm: Arm, qs: np.ndarray) -> np.ndarray:
+    """Max |g(q)| per joint over the sample [N·m or N]."""
+    import pinocchio as pin
+
+    data = arm.model.createData()
+    worst = np.zeros(len(arm.joint_names))
+    for q in qs:
+        worst = np.maximum(worst, np.abs(pin.computeGeneralizedGravity(arm.model, data, q)))
+    return worst
+
+
+def lambda_max(Ms: Sequence[np.ndarray]) -> float:
+    """Largest eigenvalue of M^-1 over the sample [1/(kg·m²)]."""
+    return max(float(np.linalg.eigvalsh(np.linalg.inv(M))[-1]) for M in Ms)
+
+
+def dt_max(loop: str, kp: float, d: float, lam: float) -> float:
+    """Largest stable dt for one mode, from `armcli.stability` [s]."""
+    bound = stab.implicit_dt_max if loop == "implicit" else stab.explicit_dt_max
+    return float(bound(kp, d, lam))
+
+
+def _largest(ok: Callable[[float], bool], lo: float, hi: float) -> float:
+    """Largest x in [lo, hi] with ok(x), for ok true below a threshold (log bisection)."""
+    if ok(hi):
+        return hi
+    for _ in range(100):
+        mid = math.sqrt(lo * hi)
+        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
+    return lo
+
+
+def stability_cap(loop: str, m: float, zeta: float, damping: float, lam: float, dt: float) -> float:
+    """Largest wn whose gains keep the loop stable at STABILITY_MARGIN * dt [rad/s]."""
+
+    def ok(wn: float) -> bool:
+        kp, kd = m * wn * wn, 2.0 * zeta * wn * m
+        return dt_max(loop, kp, kd + damping, lam) >= STABILITY_MARGIN * dt
+
+    return _largest(ok, *WN_BRACKET)
+
+
+def start_gains(
+    arm: Arm,
+    *,
+    dt: float,
+    loop: str,
+    zeta: float,
+    wn_target: float,
+    steps: np.ndarray,
+) -> StartGains:
+    """Model-based kp, kd per joint (see the module docstring).
+
+    Raises InputError when the effort limit cannot even hold the arm against gravity.
+    """
+    qs = sample_configurations(arm)
+    Ms = mass_matrices(arm, qs)
+    lam = lambda_max(Ms)
+    lam_j = np.max([np.diag(np.linalg.inv(M)) for M in Ms], axis=0)
+    g = gravity_max(arm, qs)
+    diag = np.array([np.diag(M) for M in Ms])
+    rows = []
+    for j, name in enumerate(arm.joint_names):
+        m_max = float(diag[:, j].max())
+        wn_s = stability_cap(loop, m_max, zeta, float(arm.damping[j]), float(lam_j[j]), dt)
+        wn_e = _effort_cap(name, float(arm.effort[j]), float(g[j]), float(steps[j]), m_max)
+        caps = {"target": wn_target, "stability": wn_s, "effort": wn_e}
+        binding = min(caps, key=lambda k: caps[k])
+        wn = caps[binding]
+        kp_j, kd_j = m_max * wn * wn, 2.0 * zeta * wn * m_max
+        rows.append(
+            JointReasoning(
+                name, float(diag[:, j].min()), m_max, float(g[j]), float(steps[j]), float(lam_j[j]),
+                wn_target, wn_s, wn_e, wn, zeta, kp_j, kd_j, binding,
+            )
+        )  # fmt: skip
+    kp = np.array([r.kp for r in rows])
+    kd = np.array([r.kd for r in rows])
+    scale = _coupled_scale(arm, Ms, kp, kd, loop, dt)
+    if scale < 1.0:
+        kp, kd = kp * scale, kd * math.sqrt(scale)
+        rows = [_scaled(r, scale) for r in rows]
+    return StartGains(kp, kd, tuple(rows), lam, lam_j, loop, dt)
+
+
+def _effort_cap(name: str, effort: float, g: float, step: float, m: float) -> float:
+    if not math.isfinite(effort):
+        return math.inf
+    if g >= effort:
+        raise InputError(
+            f"joint {name!r}: gravity torque up to {g:.4g} exceeds the effort limit "
+            f"{effort:g}; no PD gains can hold it (raise the limit or enable gravity "
+            "compensation)",
+            field="limit.effort",
+        )
+    if step <= 0.0:
+        return math.inf
+    return math.sqrt((effort - g) / (step * m))
+
+
+def loop_stable(
+    arm: Arm, Ms: Sequence[np.ndarray], kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
+) -> bool:
+    """The verdict of `armcli.sim.stability` on the full step maps, for `loop` at dt."""
+    idx = list(range(len(kp)))
+    D = np.asarray(kd, dtype=float) + arm.damping
+    scheme: stab.Scheme = "implicit" if loop == "implicit" else "explicit"
+    radius, _ = stab.worst_radius(Ms, idx, np.asarray(kp, dtype=float), D, dt, scheme)
+    return stab.is_stable(radius)
+
+
+def _coupled_scale(
+    arm: Arm, Ms: Sequence[np.ndarray], kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
+) -> float:
+    """Common kp scale keeping the coupled loop stable at margin * dt (1 when it is).
+
+    kd is scaled by sqrt(s), which keeps zeta.
+    """
+    h = STABILITY_MARGIN * dt
+    if loop_stable(arm, Ms, kp, kd, loop, h):
+        return 1.0
+    return _largest(lambda s: loop_stable(arm, Ms, s * kp, math.sqrt(s) * kd, loop, h), 1e-9, 1.0)
+
+
+def _scaled(r: JointReasoning, s: float) -> JointReasoning:
+    from dataclasses import replace
+
+    return replace(
+        r, kp=r.kp * s, kd=r.kd * math.sqrt(s), wn=r.wn * math.sqrt(s), binding="stability"
+    )

@@ -1,0 +1,142 @@
+"""What a tuning evaluates: the arm (as URDF text), the cases and the perturbed models.
+
+A `TuneProblem` is plain picklable data so that it can be shipped once to every Dask
+worker; `arms()` rebuilds the Pinocchio models on first use in each process and caches
+them under the problem's content key, so a worker pays for the URDF parse once.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import pickle
+import threading
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from armcli.sim.reference import Reference
+from armcli.sim.simulate import Arm, arm_from_model
+from armcli.tune.model_gains import mass_matrices, sample_configurations
+from armcli.urdf.pinocchio import load_model
+
+_CACHE: dict[str, tuple[Scored, ...]] = {}
+_LOCK = threading.Lock()
+
+
+@dataclass(frozen=True, eq=False)
+class Scored:
+    """One model candidates are scored on, with its inertia sample for the stability check."""
+
+    arm: Arm
+    qs: np.ndarray  # (S, n) sampled configurations
+    Ms: tuple[np.ndarray, ...]  # M(q) at each sample
+
+
+@dataclass(frozen=True, eq=False)
+class Case:
+    """One closed-loop run: start at rest at `q0`, track `reference` for `duration` [s]."""
+
+    label: str
+    reference: Reference
+    q0: np.ndarray
+    t_end: float  # [s] time of the trajectory's last point
+    duration: float  # [s] simulated time (t_end + settle window)
+
+
+@dataclass(frozen=True)
+class Variant:
+    """A perturbed model: every body's mass and inertia scaled, every joint's friction."""
+
+    mass_scale: tuple[float, ...]  # per body of the reduced model, in model order
+    friction_scale: tuple[float, ...]  # per simulated joint
+
+
+@dataclass(frozen=True)
+class TuneProblem:
+    """Everything a worker needs to score a candidate; immutable and picklable."""
+
+    urdf_xml: str
+    urdf_name: str
+    joints: tuple[str, ...]
+    dt: float  # [s]
+    integrator: str
+    gravity_comp: bool
+    loop: str  # "implicit" | "explicit": which stability bound makes a candidate infeasible
+    stability_margin: float  # nominal model: stable at stability_margin * dt; variants: at dt
+    cases: tuple[Case, ...]
+    variants: tuple[Variant, ...]  # empty: the nominal model only
+    key: str = field(default="", compare=False)
+
+    def with_key(self) -> TuneProblem:
+        """The same problem tagged with a digest of its content (the worker cache key)."""
+        blob = pickle.dumps(replace(self, key=""), protocol=5)
+        return replace(self, key=hashlib.sha256(blob).hexdigest()[:16])
+
+
+def nominal_arm(problem: TuneProblem) -> Arm:
+    """The unperturbed arm of `problem`."""
+    model = load_model(problem.urdf_name, xml=problem.urdf_xml).model
+    return arm_from_model(model, list(problem.joints))
+
+
+def perturb(arm: Arm, variant: Variant) -> Arm:
+    """`arm` with scaled masses/inertias (same centre of mass) and scaled friction."""
+    import pinocchio as pin
+
+    model = arm.model.copy()
+    for i, s in enumerate(variant.mass_scale, start=1):
+        Y = model.inertias[i]
+        model.inertias[i] = pin.Inertia(Y.mass * s, Y.lever.copy(), Y.inertia * s)
+    friction = arm.friction * np.asarray(variant.friction_scale, dtype=float)
+    return replace(arm, model=model, friction=friction)
+
+
+def scored_models(problem: TuneProblem) -> tuple[Scored, ...]:
+    """The models every candidate is scored on: the variants, or the nominal arm alone.
+
+    Built once per process and cached under the problem's key.
+    """
+    key = problem.key or problem.with_key().key
+    with _LOCK:
+        if key not in _CACHE:
+            arm = nominal_arm(problem)
+            qs = sample_configurations(arm)
+            built = tuple(perturb(arm, v) for v in problem.variants) or (arm,)
+            _CACHE[key] = tuple(Scored(a, qs, tuple(mass_matrices(a, qs))) for a in built)
+        return _CACHE[key]
+
+
+def draw_variants(
+    arm: Arm, count: int, mass_range: tuple[float, float], friction_range: tuple[float, float],
+    seed: int,
+) -> tuple[Variant, ...]:  # fmt: skip
+    """`count` perturbed models, scales uniform in the given ranges, from a seeded stream."""
+    rng = np.random.default_rng(seed)
+    bodies = arm.model.njoints - 1
+    n = len(arm.joint_names)
+    out = []
+    for _ in range(count):
+        ms = rng.uniform(mass_range[0], mass_range[1], size=bodies)
+        fs = rng.uniform(friction_range[0], friction_range[1], size=n)
+        out.append(Variant(tuple(float(x) for x in ms), tuple(float(x) for x in fs)))
+    return tuple(out)
+
+
+def describe(problem: TuneProblem) -> dict[str, Any]:
+    """A JSON-ready summary of the problem (for the output file)."""
+    return {
+        "joints": list(problem.joints),
+        "dt": problem.dt,
+        "integrator": problem.integrator,
+        "gravity_compensation": problem.gravity_comp,
+        "loop": problem.loop,
+        "stability_margin": problem.stability_margin,
+        "cases": [
+            {"label": c.label, "t_end": c.t_end, "duration": c.duration} for c in problem.cases
+        ],
+        "variants": [
+            {"mass_scale": list(v.mass_scale), "friction_scale": list(v.friction_scale)}
+            for v in problem.variants
+        ],
+    }

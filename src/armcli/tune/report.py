@@ -1,0 +1,204 @@
+"""Tuning results for people and programs: tables and the JSON document.
+
+The JSON schema is in docs/tune.md; `SCHEMA_VERSION` changes on breaking changes.
+
+Per-joint figures come from the nominal model and aggregate the trajectories: RMS is the
+mean over trajectories, max and |final| the largest, settle the longest, saturated the
+mean share of steps. The stability margin is dt_max / dt for the chosen loop
+(scalar-mode bound of `armcli.sim.stability` with the joint's lambda_j = max (M^-1)_jj).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from armcli.tune.evaluate import CandidateEval
+from armcli.tune.model_gains import StartGains, dt_max
+from armcli.tune.objective import FINAL, MAX, RMS, SATURATED, SETTLE
+from armcli.tune.problem import TuneProblem, describe
+from armcli.tune.search import SearchOptions, SearchResult, TrialRecord
+
+SCHEMA_VERSION = 1
+
+
+@dataclass(frozen=True, eq=False)
+class Row:
+    """One labelled gain set ("spec", "start", "tuned") and its nominal evaluation."""
+
+    label: str
+    gains: np.ndarray  # [kp..., kd...]
+    nominal: CandidateEval
+    robust_cost: float | None  # the aggregate over the perturbed models, when robust
+
+
+def joint_summary(ev: CandidateEval, j: int) -> dict[str, float | None]:
+    """Aggregated nominal metrics of joint j (see the module docstring)."""
+    m = ev.metrics[0, :, j, :]
+    if not ev.feasible:
+        return {k: None for k in ("rms", "max", "final", "settle", "saturated_pct")}
+    return {
+        "rms": float(np.mean(m[:, RMS])),
+        "max": float(np.max(m[:, MAX])),
+        "final": float(np.max(np.abs(m[:, FINAL]))),
+        "settle": float(np.max(m[:, SETTLE])),
+        "saturated_pct": float(100.0 * np.mean(m[:, SATURATED])),
+    }
+
+
+def margin(start: StartGains, j: int, kp: float, kd: float, damping: float) -> float:
+    """dt_max / dt of joint j's gains for the chosen loop [-]."""
+    return dt_max(start.loop, kp, kd + damping, float(start.lambda_joint[j])) / start.dt
+
+
+def reasoning_table(start: StartGains) -> Any:
+    """A rich Table of the model-based start, one row per joint."""
+    from rich.table import Table
+
+    t = Table(title=f"model-based start ({start.loop} loop, dt = {start.dt:g} s)")
+    for col in (
+        "joint",
+        "M_ii [kg·m²]",
+        "|g| max",
+        "step",
+        "wn target/stab/effort",
+        "wn",
+        "zeta",
+        "kp",
+        "kd",
+        "binding",
+    ):
+        t.add_column(col, justify="left" if col in ("joint", "binding") else "right")
+    for r in start.rows:
+        t.add_row(
+            r.name,
+            f"{r.m_min:.4g}..{r.m_max:.4g}",
+            f"{r.gravity_max:.3g}",
+            f"{r.step:.3g}",
+            f"{r.wn_target:.3g} / {r.wn_stability:.3g} / {r.wn_effort:.3g}",
+            f"{r.wn:.4g}",
+            f"{r.zeta:g}",
+            f"{r.kp:.4g}",
+            f"{r.kd:.4g}",
+            r.binding,
+        )
+    return t
+
+
+def comparison_table(
+    problem: TuneProblem, start: StartGains, rows: Sequence[Row], damping: np.ndarray
+) -> Any:
+    """A rich Table: per joint and gain set, gains, errors, settle, saturation, margin."""
+    from rich.table import Table
+
+    n = len(problem.joints)
+    t = Table(title="before / after (nominal model, all trajectories)")
+    for col in (
+        "joint",
+        "gains",
+        "kp",
+        "kd",
+        "RMS [rad]",
+        "max",
+        "|final|",
+        "settle [s]",
+        "saturated",
+        "margin",
+    ):
+        t.add_column(col, justify="left" if col in ("joint", "gains") else "right")
+    for j, name in enumerate(problem.joints):
+        for row in rows:
+            s = joint_summary(row.nominal, j)
+            kp, kd = float(row.gains[j]), float(row.gains[n + j])
+            cells = [_f(s[k]) for k in ("rms", "max", "final", "settle")]
+            sat = "-" if s["saturated_pct"] is None else f"{s['saturated_pct']:.1f} %"
+            t.add_row(
+                name,
+                row.label,
+                f"{kp:.4g}",
+                f"{kd:.4g}",
+                *cells,
+                sat,
+                f"{margin(start, j, kp, kd, float(damping[j])):.3g}x",
+            )
+        if j < n - 1:
+            t.add_section()
+    return t
+
+
+def _f(x: float | None) -> str:
+    return "-" if x is None else f"{x:.4g}"
+
+
+def to_json(
+    problem: TuneProblem,
+    start: StartGains,
+    rows: Sequence[Row],
+    result: SearchResult,
+    opts: SearchOptions,
+    engine: str,
+    damping: np.ndarray,
+) -> str:
+    """The output document (schema in docs/tune.md; stable key order, no timestamps)."""
+    n = len(problem.joints)
+    search = {k: getattr(opts, k) for k in ("trials", "batch", "seed", "span", "robust")}
+    doc = {
+        "schema_version": SCHEMA_VERSION,
+        "problem": describe(problem),
+        "search": {
+            **search,
+            "quantile": opts.quantile,
+            "engine": engine,
+            "weights": vars(opts.weights),
+        },
+        "start": [
+            {k: _num(v) if isinstance(v, float) else v for k, v in vars(r).items()}
+            for r in start.rows
+        ],
+        "results": {row.label: _row_doc(problem, start, row, damping) for row in rows},
+        "best": {
+            "cost": _num(result.best_cost),
+            "kp": result.best[:n].tolist(),
+            "kd": result.best[n:].tolist(),
+        },
+        "history": [_trial_doc(r) for r in result.history],
+    }
+    return json.dumps(doc, indent=2, allow_nan=False) + "\n"
+
+
+def _row_doc(problem: TuneProblem, start: StartGains, row: Row, damping: np.ndarray
+             ) -> dict[str, Any]:  # fmt: skip
+    n = len(problem.joints)
+    return {
+        "robust_cost": _num(row.robust_cost),
+        "feasible": row.nominal.feasible,
+        "joints": {
+            name: _joint_doc(start, row, j, n, float(damping[j]))
+            for j, name in enumerate(problem.joints)
+        },
+    }
+
+
+def _trial_doc(r: TrialRecord) -> dict[str, Any]:
+    return {"trial": r.number, "cost": _num(r.cost), "feasible": r.feasible,
+            "reason": r.reason, "gains": r.gains.tolist()}  # fmt: skip
+
+
+def _joint_doc(start: StartGains, row: Row, j: int, n: int, damping: float) -> dict[str, Any]:
+    kp, kd = float(row.gains[j]), float(row.gains[n + j])
+    summary = {k: _num(v) for k, v in joint_summary(row.nominal, j).items()}
+    return {
+        "kp": kp,
+        "kd": kd,
+        "stability_margin": _num(margin(start, j, kp, kd, damping)),
+        **summary,
+    }
+
+
+def _num(x: float | None) -> float | None:
+    return None if x is None or not math.isfinite(x) else float(x)
