@@ -227,3 +227,23 @@ def test_simulate_validates_every_output_first(
     )
     _fail(proc, r"plots --plot: is a directory, expected a file path")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["plots"]
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["export", "mjcf", "{spec}", "-o", "{dir}"],
+        ["tune", "{spec}", "--output", "{tmp}/t.json", "--plot", "{dir}"],
+        ["render", "{spec}", "-o", "{dir}"],
+        ["tree", "{spec}", "-o", "{dir}"],
+    ],
+    ids=["export", "tune", "render", "tree"],
+)
+def test_output_file_paths_checked_first(
+    args: list[str], tmp_path: Path, root: Path, default_spec_path: Path
+) -> None:
+    (tmp_path / "plots").mkdir()
+    where = {"spec": str(default_spec_path), "dir": str(tmp_path / "plots"), "tmp": str(tmp_path)}
+    proc = run_cli([a.format(**where) for a in args], root)
+    _fail(proc, r"plots --(out|plot): is a directory, expected a file path")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plots"]

@@ -13,6 +13,7 @@ import typer
 from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
+from armcli.io.outdir import check_output_file
 from armcli.spec.load import load_spec
 from armcli.tune import job as tjob
 from armcli.tune import report, session
@@ -93,6 +94,9 @@ def tune_cmd(
     validate(opts)
     if output is not None and output.suffix.lower() != ".json":
         raise InputError("the output file must end in .json", field="--output")
+    for path, option in ((output, "--output"), (plot, "--plot")):
+        if path is not None:
+            check_output_file(path, option)  # before the search: no partial outputs
     if write:
         check_writable(spec_path)
     settings = tjob.TuneSettings(
