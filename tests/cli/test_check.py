@@ -162,7 +162,7 @@ def test_bad_options_exit_2() -> None:
     r = armcli("check", "urdf/my_robot.urdf", "--ignore", "no-such-rule")
     assert r.returncode == 2 and "unknown rule" in r.stderr
     r = armcli("check", "urdf/my_robot.urdf", "--format", "xml")
-    assert r.returncode == 2 and "unknown format" in r.stderr
+    assert r.returncode == 2 and "unknown value 'xml'; valid: table, json, github" in r.stderr
 
 
 SLOW_XACRO = (

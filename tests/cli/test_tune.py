@@ -92,7 +92,7 @@ def test_bad_options(args: list[str], message: str, spec_copy: Path,
 def test_unknown_loop_lists_the_choices(capsys: pytest.CaptureFixture[str]) -> None:
     code, _, err = run(["--loop", "magic"], capsys)
     assert code == 2  # click's usage error
-    assert "'magic' is not one of 'implicit', 'explicit'" in err
+    assert "unknown value 'magic'; valid: implicit, explicit" in err
 
 
 def test_trajectory_outside_limits(spec_copy: Path, tmp_path: Path,

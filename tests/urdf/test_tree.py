@@ -151,4 +151,4 @@ def test_cli_tree_text_dot_and_bad_format(root: Path, tmp_path: Path) -> None:
     assert out.read_text().startswith("digraph G {")
     bad = _cli("tree", "--format", "svg", cwd=root)
     assert bad.returncode == 2
-    assert bad.stderr.strip() == "error: --format: unknown format 'svg'; known: text, dot"
+    assert bad.stderr.strip() == "error: --format: unknown value 'svg'; valid: text, dot"

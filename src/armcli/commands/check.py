@@ -12,6 +12,7 @@ from armcli.check import report
 from armcli.check.report import counts
 from armcli.check.rules import RULES, CheckOptions, apply_policy
 from armcli.check.run import CheckResult, check_urdf
+from armcli.commands.options import choice
 from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import ArmcliError, FindingsError, InputError, UnusableInputsError
 from armcli.spec.load import load_spec
@@ -67,13 +68,7 @@ def check_cmd(
     spec: Path | None = typer.Option(
         None, "--spec", help="Spec to compare limits with; also gives gains, dt, poses, tool."
     ),
-    fmt: str = typer.Option(
-        "table",
-        "--format",
-        metavar="[" + "|".join(FORMATS) + "]",
-        show_default=False,
-        help="Report format (default: table).",
-    ),
+    fmt: str = choice("table", FORMATS, "--format", help="Report format (default: table)."),
     strict: bool = typer.Option(False, "--strict", help="Treat warnings as errors."),
     ignore: list[str] = typer.Option([], "--ignore", help="Silence a rule id (repeatable)."),
     package_dir: list[str] = typer.Option(

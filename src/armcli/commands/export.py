@@ -5,10 +5,10 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import click
 import typer
 
 from armcli.build.expand import spec_label
+from armcli.commands.options import choice
 from armcli.defaults import DEFAULT_SPEC
 from armcli.export.mjcf import BASES
 from armcli.export.mjcf_files import export_mjcf
@@ -35,11 +35,10 @@ def mjcf_cmd(
         show_default=False,
         help="MJCF model file (default: robot.xml).",
     ),
-    base: str = typer.Option(
+    base: str = choice(
         "fixed",
+        BASES,
         "--base",
-        click_type=click.Choice(BASES),
-        show_default=False,
         help="fixed (default): the root link is welded to the world; free: on a free joint.",
     ),
     whole_robot: bool = typer.Option(

@@ -5,64 +5,38 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import click
 import typer
 
 from armcli.build.expand import spec_label
-from armcli.defaults import DEFAULT_SPEC
+from armcli.commands.options import choice, option, out_option, spec_argument
 from armcli.ros.packages import DEFAULT_TARGET, TARGETS, PackageInfo, write_ros_packages
 
+TARGET_HELP = (
+    "humble-classic: the course's ROS 2 Humble + Gazebo classic (default); jazzy: ROS 2 Jazzy "
+    "+ Gazebo Harmonic with ros2_control (effort, the spec's gains)."
+)
 DEFAULT_SAMPLES = 10_000  # keep equal to armcli.ros.collision_matrix.DEFAULT_SAMPLES (lazy import)
 MAX_SAMPLES = 1_000_000  # ~100x the default: minutes of coal queries, not days
 
 
 def ros_package_cmd(
-    spec: Path = typer.Argument(
-        DEFAULT_SPEC, show_default=False, help=f"Robot spec YAML (default: {DEFAULT_SPEC})."
-    ),
-    out: Path = typer.Option(
-        Path("ros"), "-o", "--out", show_default=False, help="Output directory (default: ros)."
-    ),
-    samples: int = typer.Option(
+    spec: Path = spec_argument(),
+    out: Path = out_option(Path("ros"), "Output directory"),
+    samples: int = option(
         DEFAULT_SAMPLES,
         "--samples",
         min=1,
         max=MAX_SAMPLES,
-        show_default=False,
-        help=f"Random states for the collision matrix (default: {DEFAULT_SAMPLES}).",
+        help="Random states for the collision matrix",
     ),
-    seed: int = typer.Option(
-        0,
-        "--seed",
-        min=0,
-        max=2**32 - 1,
-        show_default=False,
-        help="Seed of the collision-matrix sampling (default: 0).",
+    seed: int = option(
+        0, "--seed", min=0, max=2**32 - 1, help="Seed of the collision-matrix sampling"
     ),
-    maintainer: str = typer.Option(
-        "armcli",
-        "--maintainer",
-        show_default=False,
-        help="package.xml maintainer (default: armcli).",
-    ),
-    email: str = typer.Option(
-        "armcli@example.com",
-        "--email",
-        show_default=False,
-        help="Maintainer e-mail (default: armcli@example.com).",
-    ),
-    license_: str = typer.Option(
-        "TODO", "--license", show_default=False, help="package.xml license (default: TODO)."
-    ),
-    target: str = typer.Option(
-        DEFAULT_TARGET,
-        "--target",
-        click_type=click.Choice(TARGETS),
-        show_default=False,
-        help="humble-classic: the course's ROS 2 Humble + Gazebo classic (default); "
-        "jazzy: ROS 2 Jazzy + Gazebo Harmonic with ros2_control (effort, the spec's gains).",
-    ),
-    force: bool = typer.Option(
+    maintainer: str = option("armcli", "--maintainer", help="package.xml maintainer"),
+    email: str = option("armcli@example.com", "--email", help="Maintainer e-mail"),
+    license_: str = option("TODO", "--license", help="package.xml license"),
+    target: str = choice(DEFAULT_TARGET, TARGETS, "--target", help=TARGET_HELP),
+    force: bool = option(
         False, "--force", help="Write into an existing non-empty directory armcli did not create."
     ),
 ) -> None:

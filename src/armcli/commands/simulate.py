@@ -10,6 +10,7 @@ from typing import Any, cast
 import typer
 
 from armcli.check.gate import refuse_check_errors
+from armcli.commands.options import choice, option
 from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import InputError
 from armcli.io.outdir import check_output_file
@@ -21,6 +22,10 @@ from armcli.sim.plot import write_tracking_plot
 from armcli.spec.load import load_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
+ENGINE_HELP = "auto (default: compiled when available), native (compiled) or python."
+INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
+GRAVITY_HELP = "Add g(q) to the PD torque (default: the spec's control.gravity_compensation)."
+TRAJECTORY_HELP = "JointTrajectory YAML (a point without time_from_start: previous + 1 s)."
 PROGRESS_AFTER_S = 1.0  # show a progress bar when the run is projected to take longer
 
 
@@ -35,56 +40,25 @@ def _floats(text: str | None, option: str) -> list[float] | None:
 
 def simulate_cmd(
     spec: Path = typer.Argument(None, help=f"Robot spec YAML (default: {DEFAULT_SPEC})."),
-    trajectory: Path = typer.Option(
-        None,
-        "--trajectory",
-        "-t",
-        help="JointTrajectory YAML (a point without time_from_start: previous + 1 s).",
-    ),
-    message: str = typer.Option(None, "--message", "-m", help="JointTrajectory as YAML text."),
-    urdf: Path = typer.Option(None, "--urdf", help="Simulate this URDF instead of the spec's arm."),
-    joints: str = typer.Option(
-        None, "--joints", help="Comma-separated joints to move; others are locked."
-    ),
-    kp: str = typer.Option(None, "--kp", help="P gain(s): one value or one per joint [N·m/rad]."),
-    kd: str = typer.Option(None, "--kd", help="D gain(s): one value or one per joint [N·m·s/rad]."),
-    gravity_comp: bool = typer.Option(
-        None, "--gravity-comp/--no-gravity-comp", help="Add g(q) to the PD torque."
-    ),
-    dt: float = typer.Option(None, "--dt", help="Time step [s] (default: the spec's control.dt)."),
-    integrator: str = typer.Option(
-        "euler",
-        "--integrator",
-        metavar="[" + "|".join(INTEGRATORS) + "]",
-        show_default=False,
-        help="Semi-implicit Euler (default) or RK4.",
-    ),
-    duration: float = typer.Option(
-        None, "--duration", help="Simulated time [s] (default: last point + 2 s)."
-    ),
-    clamp: bool = typer.Option(
-        False, "--clamp", help="Clamp positions outside the limits (with a warning)."
-    ),
-    output: Path = typer.Option(
-        None, "--output", "-o", help="Joint states at --rate: .csv or .json."
-    ),
-    plot: Path = typer.Option(None, "--plot", help="Write a tracking plot PNG."),
-    rate: float = typer.Option(
-        None, "--rate", help="Output rate [Hz] (default: joint_state_publisher's)."
-    ),
-    engine: str = typer.Option(
-        "auto",
-        "--engine",
-        metavar="[" + "|".join(ENGINES) + "]",
-        show_default=False,
-        help="auto (default: compiled when available), native (compiled) or python.",
-    ),
-    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
-    unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
+    trajectory: Path = option(None, "--trajectory", "-t", help=TRAJECTORY_HELP),
+    message: str = option(None, "--message", "-m", help="JointTrajectory as YAML text."),
+    urdf: Path = option(None, "--urdf", help="Simulate this URDF instead of the spec's arm."),
+    joints: str = option(None, "--joints", help="Comma-separated joints to move; others locked."),
+    kp: str = option(None, "--kp", help="P gain(s): one value or one per joint [N·m/rad]."),
+    kd: str = option(None, "--kd", help="D gain(s): one value or one per joint [N·m·s/rad]."),
+    gravity_comp: bool = option(None, "--gravity-comp/--no-gravity-comp", help=GRAVITY_HELP),
+    dt: float = option(None, "--dt", help="Time step [s] (default: the spec's control.dt)."),
+    integrator: str = choice("euler", INTEGRATORS, "--integrator", help=INTEGRATOR_HELP),
+    duration: float = option(None, "--duration", help="Simulated time [s] (default: end + 2 s)."),
+    clamp: bool = option(False, "--clamp", help="Clamp positions outside the limits (warns)."),
+    output: Path = option(None, "--output", "-o", help="Joint states at --rate: .csv or .json."),
+    plot: Path = option(None, "--plot", help="Write a tracking plot PNG."),
+    rate: float = option(None, "--rate", help="Output rate [Hz] (default: the spec's publisher)."),
+    engine: str = choice("auto", ENGINES, "--engine", help=ENGINE_HELP),
+    trust_xacro: bool = option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
+    unsandboxed: bool = option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
-    from rich.console import Console
-
     if output is not None:
         states.output_format(output)
         check_output_file(output, "--output")
@@ -108,8 +82,14 @@ def simulate_cmd(
         engine=cast(Engine, engine),
         trust_xacro=trust_mode(trust_xacro, unsandboxed),
     )
-    # a model `check` reports as an error is not simulated
-    job = simjob.prepare(spec_obj, opts, gate=refuse_check_errors)
+    # a model `check` reports as an error is not simulated (same rule ids)
+    _run(simjob.prepare(spec_obj, opts, gate=refuse_check_errors), output, plot)
+
+
+def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
+    """Run the prepared job with a progress bar, write the files, print the summary."""
+    from rich.console import Console
+
     err = Console(stderr=True)
     for w in job.trajectory.warnings:
         err.print(f"warning: {w}", markup=False, highlight=False)

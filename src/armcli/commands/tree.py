@@ -7,6 +7,7 @@ from pathlib import Path
 
 import typer
 
+from armcli.commands.options import choice
 from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
@@ -20,12 +21,8 @@ TREE_FORMATS = ("text", "dot")
 
 def tree_cmd(
     robot: Path = typer.Argument(DEFAULT_SPEC, show_default=False, help=ROBOT_HELP),
-    fmt: str = typer.Option(
-        "text",
-        "--format",
-        metavar="[" + "|".join(TREE_FORMATS) + "]",
-        show_default=False,
-        help="text (a tree, the default) or dot (Graphviz).",
+    fmt: str = choice(
+        "text", TREE_FORMATS, "--format", help="text (a tree, the default) or dot (Graphviz)."
     ),
     out: Path = typer.Option(None, "-o", "--out", help="Write to this file instead of stdout."),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),

@@ -7,9 +7,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
-import click
 import typer
 
+from armcli.commands.options import choice, option
 from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
@@ -24,69 +24,51 @@ from armcli.tune.problem import nominal_arm
 from armcli.tune.search import ROBUST_MODES, SearchOptions, validate
 from armcli.tune.write import check_writable, write_gains
 
+TRAJECTORY_HELP = (
+    "JointTrajectory YAML (repeatable; default: trajectories/*.yaml next to the spec, "
+    "else the named poses as steps)."
+)
+LOOP_HELP = (
+    "Stability bound: implicit (default: armcli's simulator) or explicit (a torque loop "
+    "stepped explicitly, e.g. Gazebo's effort controller)."
+)
+ROBUST_MODE_HELP = "Aggregate over the perturbed models: worst (default) or quantile."
+SCHEDULER_HELP = "Dask scheduler address, e.g. tcp://HOST:8786 (needs armcli[dask])."
 
-def _pair(text: str, option: str) -> tuple[float, float]:
+
+def _pair(text: str, name: str) -> tuple[float, float]:
 
     try:
         a, b = (float(x) for x in text.split(","))
     except ValueError:
-        raise InputError(f"expected two numbers 'a,b', got {text!r}", field=option) from None
+        raise InputError(f"expected two numbers 'a,b', got {text!r}", field=name) from None
     return a, b
 
 
 def tune_cmd(
     spec: Path = typer.Argument(None, help=f"Robot spec YAML (default: {DEFAULT_SPEC})."),
-    trajectory: list[Path] = typer.Option(
-        None,
-        "--trajectory",
-        "-t",
-        help="JointTrajectory YAML (repeatable; default: trajectories/*.yaml next to the spec, "
-        "else the named poses as steps).",
+    trajectory: list[Path] = option(None, "--trajectory", "-t", help=TRAJECTORY_HELP),
+    joints: str = option(None, "--joints", help="Comma-separated joints; others locked."),
+    loop: str = choice("implicit", LOOPS, "--loop", help=LOOP_HELP),
+    zeta: float = option(1.0, "--zeta", help="Damping ratio of the start gains"),
+    wn: float = option(
+        None, "--wn", help="Target natural frequency [rad/s] (default: 2π·rate/10)."
     ),
-    joints: str = typer.Option(None, "--joints", help="Comma-separated joints; others locked."),
-    loop: str = typer.Option(
-        "implicit",
-        "--loop",
-        click_type=click.Choice(LOOPS),
-        show_default=False,
-        help="Stability bound: implicit (default: armcli's simulator) or explicit (a torque "
-        "loop stepped explicitly, e.g. Gazebo's effort controller).",
-    ),
-    zeta: float = typer.Option(1.0, "--zeta", help="Damping ratio of the start gains."),
-    wn: float = typer.Option(
-        None, "--wn", help="Target natural frequency [rad/s] (default: 2π·update rate / 10)."
-    ),
-    trials: int = typer.Option(60, "--trials", help="Candidates to evaluate (Optuna trials)."),
-    batch: int = typer.Option(8, "--batch", help="Candidates per batch (result depends on it)."),
-    seed: int = typer.Option(0, "--seed", help="Seed of the sampler and of the perturbed models."),
-    span: float = typer.Option(4.0, "--span", help="Search kp, kd in [start/span, start*span]."),
-    settle: float = typer.Option(2.0, "--settle", help="Simulated after the last point [s]."),
-    robust: int = typer.Option(0, "--robust", help="Score every candidate on N perturbed models."),
-    mass_scale: str = typer.Option("0.8,1.2", "--mass-scale", help="Mass/inertia scale range."),
-    friction_scale: str = typer.Option("0.5,2", "--friction-scale", help="Friction scale range."),
-    robust_mode: str = typer.Option(
-        "worst",
-        "--robust-mode",
-        click_type=click.Choice(ROBUST_MODES),
-        show_default=False,
-        help="Aggregate over the perturbed models: worst (default) or quantile.",
-    ),
-    quantile: float = typer.Option(0.9, "--quantile", help="Quantile for --robust-mode quantile."),
-    jobs: int = typer.Option(
-        None,
-        "--jobs",
-        "-j",
-        show_default=False,
-        help="Local threads scoring candidates (default: every core).",
-    ),
-    scheduler: str = typer.Option(
-        None,
-        "--scheduler",
-        help="Dask scheduler address, e.g. tcp://HOST:8786 (needs armcli[dask]).",
-    ),
-    output: Path = typer.Option(None, "--output", "-o", help="Write the results as JSON."),
-    plot: Path = typer.Option(None, "--plot", help="Write history + before/after tracking PNG."),
-    write: bool = typer.Option(False, "--write", help="Update control.gains in the spec in place."),
+    trials: int = option(60, "--trials", help="Candidates to evaluate (Optuna trials)"),
+    batch: int = option(8, "--batch", help="Candidates per batch (the result depends on it)"),
+    seed: int = option(0, "--seed", help="Seed of the sampler and of the perturbed models"),
+    span: float = option(4.0, "--span", help="Search kp, kd in [start/span, start*span]"),
+    settle: float = option(2.0, "--settle", help="Simulated time after the last point [s]"),
+    robust: int = option(0, "--robust", help="Score every candidate on N perturbed models"),
+    mass_scale: str = option("0.8,1.2", "--mass-scale", help="Mass/inertia scale range"),
+    friction_scale: str = option("0.5,2", "--friction-scale", help="Friction scale range"),
+    robust_mode: str = choice("worst", ROBUST_MODES, "--robust-mode", help=ROBUST_MODE_HELP),
+    quantile: float = option(0.9, "--quantile", help="Quantile for --robust-mode quantile"),
+    jobs: int = option(None, "--jobs", "-j", help="Local threads (default: every core)."),
+    scheduler: str = option(None, "--scheduler", help=SCHEDULER_HELP),
+    output: Path = option(None, "--output", "-o", help="Write the results as JSON."),
+    plot: Path = option(None, "--plot", help="Write history + before/after tracking PNG."),
+    write: bool = option(False, "--write", help="Update control.gains in the spec in place."),
 ) -> None:
     """Tune PD gains: model-based start, then a seeded search over simulated rollouts."""
     spec_path = spec or DEFAULT_SPEC
@@ -94,9 +76,9 @@ def tune_cmd(
     validate(opts)
     if output is not None and output.suffix.lower() != ".json":
         raise InputError("the output file must end in .json", field="--output")
-    for path, option in ((output, "--output"), (plot, "--plot")):
+    for path, name in ((output, "--output"), (plot, "--plot")):
         if path is not None:
-            check_output_file(path, option)  # before the search: no partial outputs
+            check_output_file(path, name)  # before the search: no partial outputs
     if write:
         check_writable(spec_path)
     settings = tjob.TuneSettings(

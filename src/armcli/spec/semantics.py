@@ -48,6 +48,17 @@ def semantic_problems(spec: RobotSpec) -> list[Problem]:
     arm_movable = set(spec.movable_arm_joints()) if not out else set()
     all_joints = {**base_joints, **spec.arm.joints}
     _plugin_problems(spec, all_joints, add)
+    _mount_problems(spec, all_joints, add)
+    for jname in spec.control.gains:
+        if jname not in spec.arm.joints:
+            add(("control", "gains", jname), f"unknown arm joint; known: {_names(spec.arm.joints)}")
+    _pose_problems(spec, arm_movable, add)
+    return out
+
+
+def _mount_problems(spec: RobotSpec, all_joints: dict[str, Joint], add: Any) -> None:
+    """The mount joint: needed with a base, on a base link, under an unused name."""
+    base_links = spec.mobile_base.links if spec.mobile_base else {}
     if spec.mount is not None:
         if spec.mobile_base is None:
             add(("mount",), "a mount needs a mobile_base")
@@ -58,9 +69,9 @@ def semantic_problems(spec: RobotSpec) -> list[Problem]:
     elif spec.mobile_base is not None:
         add(("mount",), "a mobile_base needs a mount joint for the arm")
 
-    for jname in spec.control.gains:
-        if jname not in spec.arm.joints:
-            add(("control", "gains", jname), f"unknown arm joint; known: {_names(spec.arm.joints)}")
+
+def _pose_problems(spec: RobotSpec, arm_movable: set[str], add: Any) -> None:
+    """Named poses: known moving arm joints, values within the limits."""
     for pname, pose in spec.poses.items():
         for jname, value in pose.items():
             j = spec.arm.joints.get(jname)
@@ -76,7 +87,6 @@ def semantic_problems(spec: RobotSpec) -> list[Problem]:
                     ("poses", pname, jname),
                     f"{value:g} is outside the joint limits [{j.limit.lower:g}, {j.limit.upper:g}]",
                 )
-    return out
 
 
 def _tree_problems(part: str, links: dict[str, Link], joints: dict[str, Joint], add: Any) -> None:
