@@ -18,7 +18,6 @@ import typer
 import typer.core
 import typer.main
 
-import armcli
 from armcli.errors import EXIT_FAILED, ArmcliError
 
 UNSANDBOXED_FLAG = "--trust-xacro-unsandboxed"  # what `--trust-xacro=unsandboxed` becomes
@@ -26,6 +25,10 @@ UNSANDBOXED_FLAG = "--trust-xacro-unsandboxed"  # what `--trust-xacro=unsandboxe
 # name -> (module, one-line help for the command list). A test checks that each help
 # line is the first line of the command's own docstring.
 COMMANDS: dict[str, tuple[str, str]] = {
+    "init": (
+        "armcli.commands.init",
+        "Write an example spec (armcli.yaml), its trajectories and a README; never overwrites.",
+    ),
     "build": (
         "armcli.commands.build",
         "Compile SPEC into the course's xacro set and the expanded URDFs.",
@@ -112,7 +115,9 @@ app = typer.Typer(
 
 def _version(value: bool) -> None:
     if value:
-        sys.stdout.write(f"armcli {armcli.__version__}\n")
+        from armcli.commands.version import version_lines  # loads the engine: only here
+
+        sys.stdout.write("".join(f"{line}\n" for line in version_lines()))
         raise typer.Exit()
 
 
@@ -120,7 +125,11 @@ def _version(value: bool) -> None:
 def _root(
     debug: bool = typer.Option(False, "--debug", help="Show Python tracebacks for errors."),
     version: bool = typer.Option(
-        False, "--version", callback=_version, is_eager=True, help="Print the version and exit."
+        False,
+        "--version",
+        callback=_version,
+        is_eager=True,
+        help="Show the version, the simulator engine (compiled or Python), pin and xacro.",
     ),
 ) -> None:
     """armcli: robot descriptions without ROS."""

@@ -200,3 +200,11 @@ class SimulationError(ArmcliError):
         if cause:
             text += f"; likely cause: {cause}"
         super().__init__(text)
+
+
+class NoSpecError(InputError):
+    """No spec argument and none found in the current directory; says what to run."""
+
+
+class ExistingFileError(InputError):
+    """A file `armcli init` would write already exists; nothing was written."""

@@ -38,7 +38,7 @@ def test_version_and_module_entry_point() -> None:
         [sys.executable, "-m", "armcli", "--version"], capture_output=True, text=True, check=False
     )
     assert res.returncode == 0
-    assert res.stdout.strip() == f"armcli {version('armcli')}"
+    assert res.stdout.startswith(f"armcli {version('armcli')} (")  # then engine, pin, xacro
 
 
 def test_unknown_command_is_a_usage_error() -> None:

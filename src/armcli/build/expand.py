@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import os
 import tempfile
 import xml.dom.minidom
 from dataclasses import dataclass
@@ -73,8 +74,10 @@ def build_files(spec: RobotSpec, spec_label: str) -> dict[str, bytes]:
 
 def spec_label(spec_path: Path) -> str:
     """How generated files name their spec: relative to the cwd when possible."""
-    with contextlib.suppress(ValueError):
-        return spec_path.resolve().relative_to(Path.cwd().resolve()).as_posix()
+    cwd = Path.cwd()
+    for path in (Path(os.path.abspath(spec_path)), spec_path.resolve()):  # specs/ is a symlink
+        with contextlib.suppress(ValueError):
+            return path.relative_to(cwd).as_posix()
     return spec_path.name
 
 

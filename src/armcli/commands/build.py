@@ -8,13 +8,12 @@ from pathlib import Path
 import typer
 
 from armcli.build.expand import build, check_fresh
-from armcli.defaults import DEFAULT_SPEC
+from armcli.commands.options import spec_argument
+from armcli.spec.discover import find_spec
 
 
 def build_cmd(
-    spec: Path = typer.Argument(
-        DEFAULT_SPEC, show_default=False, help=f"Robot spec YAML (default: {DEFAULT_SPEC})."
-    ),
+    spec: Path | None = spec_argument(),
     out: Path = typer.Option(
         Path("urdf"), "-o", "--out", show_default=False, help="Output directory (default: urdf)."
     ),
@@ -26,6 +25,7 @@ def build_cmd(
     ),
 ) -> None:
     """Compile SPEC into the course's xacro set and the expanded URDFs."""
+    spec = find_spec(spec)
     if check:
         check_fresh(spec, out)
         sys.stdout.write(f"{out}: up to date with {spec}\n")

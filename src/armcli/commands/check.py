@@ -13,8 +13,8 @@ from armcli.check.report import counts
 from armcli.check.rules import RULES, CheckOptions, apply_policy
 from armcli.check.run import CheckResult, check_urdf
 from armcli.commands.options import choice
-from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import ArmcliError, FindingsError, InputError, UnusableInputsError
+from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
 from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import parse_package_dirs
@@ -63,7 +63,9 @@ def _run(
 
 def check_cmd(
     paths: list[Path] = typer.Argument(
-        None, help="URDF files, spec YAMLs (built in memory) or directories (every *.urdf)."
+        None,
+        help="URDF files, spec YAMLs (built in memory) or directories (every *.urdf); "
+        "default: ./armcli.yaml, else the spec in specs/.",
     ),
     spec: Path | None = typer.Option(
         None, "--spec", help="Spec to compare limits with; also gives gains, dt, poses, tool."
@@ -87,7 +89,7 @@ def check_cmd(
     if spec is not None:
         base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs)
     results, errors = _run(
-        list(paths or [DEFAULT_SPEC]), base, trust_mode(trust_xacro, unsandboxed)
+        list(paths or [find_spec(None)]), base, trust_mode(trust_xacro, unsandboxed)
     )
     findings = apply_policy((f for r in results for f in r.findings), ignore=ignore, strict=strict)
     n_err = counts(findings)["error"]

@@ -9,10 +9,10 @@ import typer
 
 from armcli.build.expand import spec_label
 from armcli.commands.options import choice
-from armcli.defaults import DEFAULT_SPEC
 from armcli.export.mjcf import BASES
 from armcli.export.mjcf_files import export_mjcf
 from armcli.io.outdir import check_output_file
+from armcli.spec.discover import find_spec
 from armcli.urdf.meshes import MeshSearch, parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
@@ -23,10 +23,11 @@ export_app = typer.Typer(
 
 @export_app.command("mjcf")
 def mjcf_cmd(
-    robot: Path = typer.Argument(
-        DEFAULT_SPEC,
+    robot: Path | None = typer.Argument(
+        None,
         show_default=False,
-        help=f"Robot spec YAML, URDF or xacro file (default: {DEFAULT_SPEC}).",
+        help="Robot spec YAML, URDF or xacro file (default: ./armcli.yaml, else the spec in "
+        "specs/).",
     ),
     out: Path = typer.Option(
         Path("robot.xml"),
@@ -56,6 +57,7 @@ def mjcf_cmd(
     the effort limit); the report lists what MuJoCo cannot represent.
     """
     check_output_file(out, "--out")  # before any work: nothing else is written
+    robot = find_spec(robot)
     res = export_mjcf(
         robot,
         out,

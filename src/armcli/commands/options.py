@@ -13,7 +13,7 @@ from typing import Any
 
 import typer
 
-from armcli.defaults import DEFAULT_SPEC
+from armcli.defaults import SPEC_HELP
 from armcli.errors import InputError
 
 
@@ -37,11 +37,9 @@ def choice(default: str, choices: Sequence[str], *names: str, help: str) -> Any:
     )
 
 
-def spec_argument(help: str = "Robot spec YAML") -> Any:
-    """The optional SPEC argument, defaulting to the course spec."""
-    return typer.Argument(
-        DEFAULT_SPEC, show_default=False, help=f"{help} (default: {DEFAULT_SPEC})."
-    )
+def spec_argument(help: str = SPEC_HELP) -> Any:
+    """The optional SPEC argument; None means "find it" (armcli.spec.discover)."""
+    return typer.Argument(None, show_default=False, help=help)
 
 
 def out_option(default: Path, help: str) -> Any:

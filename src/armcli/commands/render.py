@@ -7,9 +7,10 @@ from pathlib import Path
 
 import typer
 
-from armcli.defaults import DEFAULT_SPEC
+from armcli.commands.options import spec_argument
 from armcli.errors import InputError
 from armcli.io.outdir import check_output_file
+from armcli.spec.discover import find_spec
 from armcli.urdf.meshes import MeshSearch, parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 from armcli.view.png import load_urdf, render_png
@@ -27,7 +28,7 @@ def _size(text: str) -> tuple[int, int]:
 
 
 def render_cmd(
-    robot: Path = typer.Argument(DEFAULT_SPEC, show_default=False, help=ROBOT_HELP),
+    robot: Path | None = spec_argument(ROBOT_HELP),
     pose: str = typer.Option(None, "--pose", help="A named pose of the spec."),
     q: str = typer.Option(
         None,
@@ -56,7 +57,9 @@ def render_cmd(
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
     check_output_file(out, "--out")  # before any work: nothing else is written
     src = load_robot(
-        robot, trust_mode(trust_xacro, unsandboxed), MeshSearch(parse_package_dirs(package_dir))
+        find_spec(robot),
+        trust_mode(trust_xacro, unsandboxed),
+        MeshSearch(parse_package_dirs(package_dir)),
     )
     values = pose_q(src, pose, q)
     width, height = _size(size)

@@ -10,6 +10,7 @@ import typer
 from armcli.build.expand import spec_label
 from armcli.commands.options import choice, option, out_option, spec_argument
 from armcli.ros.packages import DEFAULT_TARGET, TARGETS, PackageInfo, write_ros_packages
+from armcli.spec.discover import find_spec
 
 TARGET_HELP = (
     "humble-classic: the course's ROS 2 Humble + Gazebo classic (default); jazzy: ROS 2 Jazzy "
@@ -20,7 +21,7 @@ MAX_SAMPLES = 1_000_000  # ~100x the default: minutes of coal queries, not days
 
 
 def ros_package_cmd(
-    spec: Path = spec_argument(),
+    spec: Path | None = spec_argument(),
     out: Path = out_option(Path("ros"), "Output directory"),
     samples: int = option(
         DEFAULT_SAMPLES,
@@ -41,6 +42,7 @@ def ros_package_cmd(
     ),
 ) -> None:
     """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
+    spec = find_spec(spec)
     info = PackageInfo(maintainer=maintainer, email=email, license=license_)
     pkgs, written = write_ros_packages(
         spec,

@@ -10,8 +10,7 @@ from typing import Any, cast
 import typer
 
 from armcli.check.gate import refuse_check_errors
-from armcli.commands.options import choice, option
-from armcli.defaults import DEFAULT_SPEC
+from armcli.commands.options import choice, option, spec_argument
 from armcli.errors import InputError
 from armcli.io.outdir import check_output_file
 from armcli.sim import job as simjob
@@ -19,6 +18,7 @@ from armcli.sim import report as simreport
 from armcli.sim import states
 from armcli.sim.options import ENGINES, INTEGRATORS, Engine, Integrator, SimOptions
 from armcli.sim.plot import write_tracking_plot
+from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
@@ -39,7 +39,7 @@ def _floats(text: str | None, option: str) -> list[float] | None:
 
 
 def simulate_cmd(
-    spec: Path = typer.Argument(None, help=f"Robot spec YAML (default: {DEFAULT_SPEC})."),
+    spec: Path | None = spec_argument(),
     trajectory: Path = option(None, "--trajectory", "-t", help=TRAJECTORY_HELP),
     message: str = option(None, "--message", "-m", help="JointTrajectory as YAML text."),
     urdf: Path = option(None, "--urdf", help="Simulate this URDF instead of the spec's arm."),
@@ -64,7 +64,7 @@ def simulate_cmd(
         check_output_file(output, "--output")
     if plot is not None:
         check_output_file(plot, "--plot")
-    spec_obj = load_spec(spec or DEFAULT_SPEC) if (spec is not None or urdf is None) else None
+    spec_obj = load_spec(find_spec(spec)) if (spec is not None or urdf is None) else None
     kp_values, kd_values = _floats(kp, "--kp"), _floats(kd, "--kd")
     opts = SimOptions(
         trajectory=trajectory,

@@ -7,11 +7,11 @@ from pathlib import Path
 
 import typer
 
-from armcli.commands.options import choice
-from armcli.defaults import DEFAULT_SPEC
+from armcli.commands.options import choice, spec_argument
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
 from armcli.io.outdir import check_output_file
+from armcli.spec.discover import find_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 from armcli.urdf.tree import parse_tree, to_dot, to_rich
 from armcli.view.scene import ROBOT_HELP, load_robot
@@ -20,7 +20,7 @@ TREE_FORMATS = ("text", "dot")
 
 
 def tree_cmd(
-    robot: Path = typer.Argument(DEFAULT_SPEC, show_default=False, help=ROBOT_HELP),
+    robot: Path | None = spec_argument(ROBOT_HELP),
     fmt: str = choice(
         "text", TREE_FORMATS, "--format", help="text (a tree, the default) or dot (Graphviz)."
     ),
@@ -33,7 +33,7 @@ def tree_cmd(
         raise InputError(f"unknown format {fmt!r}; known: text, dot", field="--format")
     if out is not None:
         check_output_file(out, "--out")
-    src = load_robot(robot, trust_mode(trust_xacro, unsandboxed))
+    src = load_robot(find_spec(robot), trust_mode(trust_xacro, unsandboxed))
     tree = parse_tree(src.xml, src.source)
     if fmt == "dot":
         text = to_dot(tree)

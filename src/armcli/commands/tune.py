@@ -9,11 +9,11 @@ from typing import Any
 
 import typer
 
-from armcli.commands.options import choice, option
-from armcli.defaults import DEFAULT_SPEC
+from armcli.commands.options import choice, option, spec_argument
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
 from armcli.io.outdir import check_output_file
+from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
 from armcli.tune import job as tjob
 from armcli.tune import report, session
@@ -46,7 +46,7 @@ def _pair(text: str, name: str) -> tuple[float, float]:
 
 
 def tune_cmd(
-    spec: Path = typer.Argument(None, help=f"Robot spec YAML (default: {DEFAULT_SPEC})."),
+    spec: Path | None = spec_argument(),
     trajectory: list[Path] = option(None, "--trajectory", "-t", help=TRAJECTORY_HELP),
     joints: str = option(None, "--joints", help="Comma-separated joints; others locked."),
     loop: str = choice("implicit", LOOPS, "--loop", help=LOOP_HELP),
@@ -71,7 +71,7 @@ def tune_cmd(
     write: bool = option(False, "--write", help="Update control.gains in the spec in place."),
 ) -> None:
     """Tune PD gains: model-based start, then a seeded search over simulated rollouts."""
-    spec_path = spec or DEFAULT_SPEC
+    spec_path = find_spec(spec)
     opts = SearchOptions(trials, batch, seed, span, robust_mode, quantile)
     validate(opts)
     if output is not None and output.suffix.lower() != ".json":

@@ -7,9 +7,10 @@ from pathlib import Path
 
 import typer
 
-from armcli.defaults import DEFAULT_SPEC
+from armcli.commands.options import spec_argument
 from armcli.errors import InputError
 from armcli.sim.states import load_replay
+from armcli.spec.discover import find_spec
 from armcli.urdf.meshes import MeshSearch, parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 from armcli.view.browser import Viewer
@@ -18,7 +19,7 @@ from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
 
 
 def view_cmd(
-    robot: Path = typer.Argument(DEFAULT_SPEC, show_default=False, help=ROBOT_HELP),
+    robot: Path | None = spec_argument(ROBOT_HELP),
     replay: Path = typer.Option(None, "--replay", help="A CSV written by `armcli simulate`."),
     pose: str = typer.Option(None, "--pose", help="Start at this named pose."),
     host: str = typer.Option(
@@ -38,7 +39,9 @@ def view_cmd(
 ) -> None:
     """Open a browser 3-D viewer with joint sliders, named poses and simulation replay."""
     src = load_robot(
-        robot, trust_mode(trust_xacro, unsandboxed), MeshSearch(parse_package_dirs(package_dir))
+        find_spec(robot),
+        trust_mode(trust_xacro, unsandboxed),
+        MeshSearch(parse_package_dirs(package_dir)),
     )
     pose_q(src, pose, None)  # validate before starting the server
     if not 0 <= port <= 65535:

@@ -79,6 +79,8 @@ def library_path() -> Path:
 
 def build(force: bool = False) -> Path:
     """Compile the rollout library if needed; returns its path. Raises BuildError."""
+    if not SOURCE.is_file():
+        raise BuildError(f"{SOURCE} is not installed; the Python simulator is used instead")
     path = library_path()
     if path.exists() and not force:
         return path
@@ -100,12 +102,16 @@ def build(force: bool = False) -> Path:
 
 def why_missing() -> str:
     """Why `load()` gave None, for the fallback message: not built, or failed to load."""
+    if not SOURCE.is_file():  # a wheel install ships no C++ source
+        return f"this installation has no {SOURCE.name}"
     path = library_path()
     return f"{path} does not exist" if not path.exists() else "it failed to load"
 
 
 def load() -> Any | None:
     """The loaded library, or None when it has not been built (never compiles)."""
+    if not SOURCE.is_file():  # a wheel install ships no C++ source: the Python loop runs
+        return None
     path = library_path()
     key = str(path)
     if key in _cache:

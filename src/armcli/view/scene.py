@@ -10,7 +10,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from armcli.defaults import DEFAULT_SPEC
 from armcli.errors import InputError
 from armcli.spec.expr import eval_expr
 from armcli.urdf.meshes import MeshSearch
@@ -19,7 +18,8 @@ from armcli.urdf.tool import ToolPoint, tool_point
 from armcli.urdf.tree import tree_from_urdf
 
 ROBOT_HELP = (
-    f"Robot spec YAML, URDF file, or xacro file (with --trust-xacro); default: {DEFAULT_SPEC}."
+    "Robot spec YAML, URDF file, or xacro file (with --trust-xacro); "
+    "default: ./armcli.yaml, else the spec in specs/."
 )
 
 

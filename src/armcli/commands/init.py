@@ -1,0 +1,44 @@
+"""`armcli init`: start a project outside the repository from a shipped example."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import click
+import typer
+
+from armcli.defaults import SPEC_FILE, TRAJECTORY_DIR
+from armcli.spec.scaffold import DEFAULT_TEMPLATE, TEMPLATES, init_project
+
+
+def init_cmd(
+    directory: Path = typer.Argument(
+        Path("."), show_default=False, help="Where to write (created if missing; default: here)."
+    ),
+    template: str = typer.Option(
+        DEFAULT_TEMPLATE,
+        "--template",
+        click_type=click.Choice(tuple(TEMPLATES)),
+        show_default=False,
+        help="course (default: a 2-axis arm on a mobile base) or tabletop (a 3-axis arm).",
+    ),
+) -> None:
+    """Write an example spec (armcli.yaml), its trajectories and a README; never overwrites."""
+    written = init_project(directory, template)
+    where = "." if directory == Path(".") else str(directory)
+    sys.stdout.write(f"wrote {len(written)} files into {where}{os.sep}\n")
+    for path in written:
+        sys.stdout.write(f"  {path}\n")
+    cd = "" if where == "." else f"cd {where} && "
+    pick = (TRAJECTORY_DIR / "pick.yaml").as_posix()
+    sys.stdout.write(
+        f"next: {cd}armcli build && armcli check && armcli simulate --trajectory {pick}"
+        f"  (commands read ./{SPEC_FILE} when no spec is given)\n"
+    )
+
+
+def register(app: typer.Typer) -> None:
+    """Add `init` to the app."""
+    app.command("init")(init_cmd)

@@ -1,0 +1,48 @@
+"""What `armcli --version` reports: armcli, the simulator engine, pin and xacro.
+
+A bug report needs to say which installation ran (the path), whether `simulate` uses the
+compiled rollout or the Python loop, and the versions of the two libraries that shape
+every output (Pinocchio for dynamics and checks, xacro for expansion). Versions come
+from the installed metadata so that no heavy library is imported.
+"""
+
+from __future__ import annotations
+
+import platform
+import sys
+from importlib import metadata
+from pathlib import Path
+
+import armcli
+from armcli.sim import native
+
+LIBRARIES = ("pin", "xacro")  # distributions whose versions change armcli's results
+
+
+def _dist_version(name: str) -> str:
+    try:
+        return metadata.version(name)
+    except metadata.PackageNotFoundError:
+        return "not installed"
+
+
+def engine() -> str:
+    """`compiled` or `Python`: what `simulate --engine auto` runs, and where or why not.
+
+    Asks `native.load()`, the same check the simulator makes, so the answer cannot differ
+    from what `simulate` does.
+    """
+    lib = native.load()
+    if lib is None:
+        return f"Python (no compiled rollout: {native.why_missing()})"
+    where = getattr(lib, "__file__", None) or getattr(lib, "_name", "")  # module or CDLL
+    return f"compiled ({where})"
+
+
+def version_lines() -> list[str]:
+    """The lines `armcli --version` prints, armcli's own version first."""
+    lines = [f"armcli {armcli.__version__} ({Path(armcli.__file__).parent})"]
+    lines.append(f"simulator engine: {engine()}")
+    lines += [f"{name} {_dist_version(name)}" for name in LIBRARIES]
+    lines.append(f"Python {platform.python_version()} ({sys.executable})")
+    return lines

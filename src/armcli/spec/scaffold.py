@@ -1,0 +1,89 @@
+"""`armcli init`: a first project (spec, trajectories, README) from the shipped examples.
+
+The example specs live once, in the package (`armcli/examples/`, which the repository's
+`specs/` links to), so a user who installed the wheel gets exactly the robots the
+repository tests. The spec is written as `armcli.yaml`, the name `find_spec` looks for
+first, so every command then runs without arguments; trajectories go to `trajectories/`
+beside it (they name joints, not files, so nothing inside needs rewriting).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from string import Template
+
+from armcli.defaults import SPEC_FILE, TRAJECTORY_DIR
+from armcli.errors import InputError
+from armcli.io.newfiles import create_files
+
+README = "README.md"
+
+
+@dataclass(frozen=True)
+class ExampleTemplate:
+    """One example project: where its files are in `armcli/examples/`, what it is."""
+
+    spec: str  # spec file under examples/; its stem is the spec's `name`
+    trajectories: str  # directory under examples/ with this robot's trajectories
+    pose: str  # a named pose of the spec, for the README's render command
+    about: str  # one sentence for the README
+
+
+TEMPLATES = {
+    "course": ExampleTemplate(
+        spec="my_robot.yaml",
+        trajectories="trajectories",
+        pose="reach",
+        about="the ROS 2 for Beginners course robot: a 2-axis arm on a differential-drive base.",
+    ),
+    "tabletop": ExampleTemplate(
+        spec="tabletop_arm.yaml",
+        trajectories="trajectories/tabletop_arm",
+        pose="ready",
+        about="a 3-axis tabletop arm (yaw, shoulder, elbow) without a mobile base.",
+    ),
+}
+DEFAULT_TEMPLATE = "course"
+
+
+def _template(name: str) -> ExampleTemplate:
+    if name not in TEMPLATES:
+        known = ", ".join(TEMPLATES)
+        raise InputError(f"unknown template {name!r}; known: {known}", field="--template")
+    return TEMPLATES[name]
+
+
+def template_files(name: str) -> dict[str, bytes]:
+    """Relative path -> content of everything `armcli init --template NAME` writes."""
+    t = _template(name)
+    examples = resources.files("armcli").joinpath("examples")
+    files = {SPEC_FILE.as_posix(): examples.joinpath(t.spec).read_bytes()}
+    trajectories = sorted(
+        (f for f in examples.joinpath(t.trajectories).iterdir() if f.name.endswith(".yaml")),
+        key=lambda f: f.name,
+    )
+    for f in trajectories:
+        files[(TRAJECTORY_DIR / f.name).as_posix()] = f.read_bytes()
+    readme = Template(resources.files("armcli").joinpath("data", "init_readme.md.tmpl").read_text())
+    files[README] = readme.substitute(
+        name=Path(t.spec).stem,
+        about=t.about,
+        template=name,
+        spec=SPEC_FILE.as_posix(),
+        pose=t.pose,
+        pick=(TRAJECTORY_DIR / "pick.yaml").as_posix(),
+        trajectories=", ".join(f"`{(TRAJECTORY_DIR / f.name).as_posix()}`" for f in trajectories),
+    ).encode("utf-8")
+    return files
+
+
+def init_project(directory: str | Path, template: str = DEFAULT_TEMPLATE) -> list[Path]:
+    """Write the example project into `directory` (created if missing), all or nothing.
+
+    Raises:
+        ExistingFileError: one of the files already exists; nothing was written.
+        InputError: unknown template.
+    """
+    return create_files(directory, template_files(template))
