@@ -166,9 +166,21 @@ class StaleBuildError(ArmcliError):
 
 
 class FindingsError(ArmcliError):
-    """`check` found problems of error severity."""
+    """`check` found problems of error severity.
+
+    `unusable` are files it could not read (inside a directory, next to usable ones),
+    printed one line each before the total.
+    """
 
     exit_code = EXIT_FAILED
+
+    def __init__(self, message: str, unusable: Sequence[ArmcliError] = ()) -> None:
+        self.unusable = list(unusable)
+        super().__init__(message)
+
+    def lines(self) -> list[str]:
+        """The unusable files' lines, then the total."""
+        return [*(line for e in self.unusable for line in e.lines()), str(self)]
 
 
 class SimulationError(ArmcliError):

@@ -98,9 +98,9 @@ def test_foreign_xacro_code_is_refused_without_running_it(tmp_path: Path) -> Non
 
 def test_trusted_xacro_is_expanded_in_a_sandbox() -> None:
     r = armcli("check", "--trust-xacro", FIXTURES / "course_macros.urdf.xacro", "--format", "json")
-    assert r.returncode == 0, r.stderr  # the macro bugs are warnings
+    assert r.returncode == 1, r.stderr  # the 4x inertias are impossible for their shapes
     (f,) = json.loads(r.stdout)["files"]
-    assert {x["rule"] for x in f["findings"]} == {"inertia-geometry"}
+    assert {x["rule"] for x in f["findings"]} == {"inertia-geometry", "inertia-exceeds-geometry"}
 
 
 @pytest.mark.parametrize(
@@ -125,8 +125,11 @@ def test_good_and_bad_inputs_report_the_good_and_exit_2(tmp_path: Path) -> None:
     r = armcli("check", "urdf/my_robot.urdf", tmp_path / "missing.urdf", "--format", "json")
     assert r.returncode == 2
     doc = json.loads(r.stdout)
-    assert [f["file"] for f in doc["files"]] == ["urdf/my_robot.urdf"]
-    assert doc["exit_code"] == 2
+    good, bad = doc["files"]
+    assert good["file"] == "urdf/my_robot.urdf" and "error" not in good
+    assert bad["file"] == str(tmp_path / "missing.urdf") and "cannot read" in bad["error"]
+    assert [f["rule"] for f in bad["findings"]] == ["input-unusable"]
+    assert doc["exit_code"] == 2  # a file named on the command line is unusable
 
 
 def test_directory_and_spec_option(tmp_path: Path) -> None:
@@ -192,11 +195,14 @@ def test_sandbox_stops_runaway_xacro(tmp_path: Path) -> None:
 
 
 def test_docs_list_every_rule() -> None:
+    from armcli.check.rule_docs import render
     from armcli.check.rules import RULES
 
     doc = (ROOT / "docs" / "check.md").read_text()
     for rule in RULES.values():
         assert f"| `{rule.id}` | {rule.severity} |" in doc, rule.id
+    # The table is the registry's: `python -m armcli.check.rule_docs docs/check.md` regenerates it.
+    assert render(doc) == doc
 
 
 @pytest.mark.parametrize(

@@ -24,6 +24,9 @@ from armcli.urdf.doc import Joint, Link, Urdf
 
 # A moving body lighter than this fraction of the robot makes the dynamics stiff.
 TINY_MASS_RATIO = 1e-4
+# A link-level finding of these rules already names the problem of the body it belongs to
+# (negative mass is not reported again as "the body has no mass").
+LINK_ERRORS = ("mass-nonpositive", "inertia-not-pd", "inertia-triangle")
 
 
 @dataclass(frozen=True)
@@ -113,8 +116,8 @@ def check(urdf: Urdf, tree: Tree, out: Collector) -> None:
     total = _robot_mass(urdf)
     lines = {lk.name: lk.line for lk in urdf.links}
     for b in moving_bodies(urdf, tree):
-        if b.unknown:
-            continue
+        if b.unknown or any(out.has(LINK_ERRORS, link=name) for name in b.links):
+            continue  # one finding per problem: the link's own finding explains the body
         where = f"the body moved by {b.joint!r} ({', '.join(b.links)})"
         if b.mass <= 0.0:
             out.add(

@@ -32,6 +32,28 @@ SAMPLE_SEED = 0
 # Shapes must overlap by more than this to count as colliding: links that merely
 # touch by construction (e.g. a link resting on the base top) are not a collision.
 PENETRATION_TOL = 1e-4  # [m]
+# Remedies: an effort limit covering the worst gravity torque with this margin (payload,
+# acceleration), and time steps / gains this fraction inside the strict stability bounds,
+# both rounded to 2 significant digits (up for effort, down for dt, Kd and Kp).
+EFFORT_MARGIN = 1.5
+STABLE_MARGIN = 0.9
+REMEDY_DIGITS = 2
+
+
+def round_up(x: float, digits: int = REMEDY_DIGITS) -> float:
+    """X rounded up to `digits` significant digits (an effort that still covers x)."""
+    if x <= 0 or not np.isfinite(x):
+        return x
+    step = 10.0 ** (np.floor(np.log10(x)) - digits + 1)
+    return float(f"{np.ceil(x / step - 1e-9) * step:.{digits}g}")
+
+
+def round_down(x: float, digits: int = REMEDY_DIGITS) -> float:
+    """X rounded down to `digits` significant digits (a dt or gain still below a bound)."""
+    if x <= 0 or not np.isfinite(x):
+        return x
+    step = 10.0 ** (np.floor(np.log10(x)) - digits + 1)
+    return float(f"{np.floor(x / step + 1e-9) * step:.{digits}g}")
 
 
 def samples(model: Any, ranges: list[Any]) -> list[tuple[dict[str, float], Any]]:
@@ -84,11 +106,14 @@ def gravity(
     for r in rows:
         g = float(worst[by_name[r.name]]) if r.name in by_name else None
         if g is not None and r.effort is not None and finite(r.effort) and g > r.effort > 0:
+            effort = round_up(EFFORT_MARGIN * g)
             out.add(
                 "gravity-effort",
                 lines.get(r.name),
                 f"joint {r.name!r}: gravity torque "
-                f"up to {g:.4g} exceeds the effort limit {r.effort:g}",
+                f"up to {g:.4g} exceeds the effort limit {r.effort:g}; "
+                f'effort="{effort:g}" covers it with a {EFFORT_MARGIN:g}x margin',
+                {"effort": effort},
                 joint=r.name,
                 gravity_max=g,
                 effort=r.effort,
@@ -138,11 +163,23 @@ def stability(
         [joints[n].damping for n in names],
         spec.control.dt,
     )
+    line = next((j.line for j in urdf.joints if j.name == names[0]), None)
+    _report_stability(rep, names, line, out)
+    return rep
+
+
+def _report_stability(
+    rep: StabilityReport, names: list[str], line: int | None, out: Collector
+) -> None:
+    """The two PD findings, with the numbers that explain them and a remedy."""
     q_txt = ", ".join(f"{n} = {v:.3g}" for n, v in zip(names, rep.q_worst, strict=True))
     common = dict(lambda_max=rep.lambda_max, dt=rep.dt, kp=rep.kp, kd_plus_damping=rep.d)
-    line = next((j.line for j in urdf.joints if j.name == names[0]), None)
     if not rep.explicit.stable:
         e = rep.explicit
+        fix = {
+            "dt": round_down(STABLE_MARGIN * e.dt_max),
+            "kd": round_down(STABLE_MARGIN * rep.kd_max_explicit),
+        }
         out.add(
             "pd-explicit-unstable",
             line,
@@ -155,7 +192,9 @@ def stability(
                 f"Kp < {rep.kp_max_implicit:.4g}"
                 if rep.implicit.stable
                 else ""
-            ),
+            )
+            + f"; e.g. dt = {fix['dt']:g} s or Kd = {fix['kd']:g}",
+            fix,
             **common,
             a=e.a,
             b=e.b,
@@ -163,17 +202,21 @@ def stability(
             kd_max=rep.kd_max_explicit,
         )
     if not rep.implicit.stable:
+        fix = {
+            "dt": round_down(STABLE_MARGIN * rep.implicit.dt_max),
+            "kp": round_down(STABLE_MARGIN * rep.kp_max_implicit),
+        }
         out.add(
             "pd-unstable",
             line,
             f"PD at dt = {rep.dt:g} s diverges even with implicit "
             f"damping: Kp = {rep.kp:g} > {rep.kp_max_implicit:.4g}; stable for dt < "
-            f"{rep.implicit.dt_max:.3g} s",
+            f"{rep.implicit.dt_max:.3g} s; e.g. dt = {fix['dt']:g} s or Kp = {fix['kp']:g}",
+            fix,
             **common,
             kp_max=rep.kp_max_implicit,
             dt_max=rep.implicit.dt_max,
         )
-    return rep
 
 
 def self_collision(

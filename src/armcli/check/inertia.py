@@ -12,7 +12,8 @@ import numpy as np
 from armcli.check.rules import Collector
 from armcli.check.structure import Tree, finite
 from armcli.urdf import inertia as inr
-from armcli.urdf.doc import Geometry, Inertial, Link, Shape, Urdf
+from armcli.urdf import inertia_bounds as bounds
+from armcli.urdf.doc import Inertial, Link, Shape, Urdf
 
 # Inertia within 5 % (Frobenius, relative) of the solid-body formula counts as
 # "from the geometry"; real macro bugs (permuted axes, 4x) are off by >= 50 %.
@@ -24,6 +25,12 @@ COM_RTOL = 0.01
 # zero is a point mass or an infinitely thin rod, and rounding noise on an
 # all-zero tensor (1e-20) must not pass as "positive".
 MIN_MOMENT = 1e-15
+# A tensor that is not all zeros but whose principal moments are all within
+# max(MIN_MOMENT, ZERO_RTOL * m * L²) of zero (L: the link's size, see _size) is
+# rounding noise, not a body: iCub's ankles write ixz = 1.36e-20 and nothing else.
+# MuJoCo rejects such a tensor ("inertia must have positive eigenvalues"); so does
+# this rule. 1e-9 m L² is the moment of a rod 3e-5 L thick: no real part is thinner.
+ZERO_RTOL = 1e-9
 
 
 def check(urdf: Urdf, tree: Tree, out: Collector) -> None:
@@ -76,14 +83,30 @@ def _tensor_ok(link: Link, ine: Inertial, out: Collector) -> np.ndarray | None:
     J = inr.tensor(*ine.inertia)
     moments = inr.principal_moments(J)
     vals = dict(zip(("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), ine.inertia, strict=True))
-    if abs(moments[0]) <= MIN_MOMENT and abs(moments[-1]) <= MIN_MOMENT:
+    if all(x == 0.0 for x in ine.inertia):
         return None  # a point mass: fine on its own; checks_bodies checks what joints move
+    noise = max(MIN_MOMENT, ZERO_RTOL * float(ine.mass or 0.0) * _size(link) ** 2)
+    if max(abs(moments[0]), abs(moments[-1])) <= noise:
+        out.add(
+            "inertia-not-pd",
+            ine.inertia_line,
+            f"link {link.name!r}: inertia is rounding noise, principal moments {_fmt(moments)} "
+            f"all within {noise:.3g} kg m² of zero for mass {ine.mass:g} kg; MuJoCo rejects a "
+            "non-zero tensor without positive eigenvalues: write the part's inertia"
+            + _fix_suffix(fix := _solid_fix(link, ine)),
+            fix,
+            link=link.name,
+            principal=[float(x) for x in moments],
+            **vals,
+        )
+        return None
     if moments[0] <= MIN_MOMENT:
         out.add(
             "inertia-not-pd",
             ine.inertia_line,
             f"link {link.name!r}: inertia not positive definite, principal moments "
-            f"{_fmt(moments)} for mass {ine.mass:g} kg",
+            f"{_fmt(moments)} for mass {ine.mass:g} kg" + _fix_suffix(fix := _solid_fix(link, ine)),
+            fix,
             link=link.name,
             principal=[float(x) for x in moments],
             **vals,
@@ -96,7 +119,9 @@ def _tensor_ok(link: Link, ine: Inertial, out: Collector) -> np.ndarray | None:
             "inertia-triangle",
             ine.inertia_line,
             f"link {link.name!r}: principal moments {_fmt(moments)}: "
-            f"{c:.4g} > {a:.4g} + {b:.4g} (by {excess:.1%})",
+            f"{c:.4g} > {a:.4g} + {b:.4g} (by {excess:.1%})"
+            + _fix_suffix(fix := _solid_fix(link, ine)),
+            fix,
             link=link.name,
             principal=[float(x) for x in moments],
             excess=excess,
@@ -130,17 +155,43 @@ def primitive_shape(link: Link) -> Shape | None:
     return first if same else None
 
 
-def solid_inertia(g: Geometry, m: float) -> np.ndarray:
-    """The centroidal inertia of a solid primitive in its geometry frame."""
-    d = g.dims or ()
-    if g.kind == "box":
-        return inr.box_inertia(m, d[0], d[1], d[2])
-    if g.kind == "cylinder":
-        return inr.cylinder_inertia(m, d[0], d[1])
-    return inr.sphere_inertia(m, d[0])
+def _size(link: Link) -> float:
+    """The link's size L [m] for ZERO_RTOL.
+
+    Its largest primitive dimension (a diameter for spheres and cylinders), else the
+    distance of its centre of mass from the link origin.
+    """
+    sizes = [
+        max((2.0 * g.dims[0], *g.dims[1:])) if g.kind in ("sphere", "cylinder") else max(g.dims)
+        for s in (*link.collisions, *link.visuals)
+        if (g := s.geometry) is not None and g.dims and finite(*g.dims)
+    ]
+    if sizes:
+        return max(sizes)
+    ine = link.inertial
+    xyz = ine.origin.xyz if ine is not None and finite(*ine.origin.xyz) else (0.0, 0.0, 0.0)
+    return float(np.linalg.norm(xyz))
+
+
+def _solid_fix(link: Link, ine: Inertial) -> dict[str, float]:
+    """The solid-body inertia of the link's one primitive, in its inertial frame, or {}."""
+    shape = primitive_shape(link)
+    if shape is None or shape.geometry is None or not finite(ine.mass) or (ine.mass or 0) <= 0:
+        return {}
+    if not finite(*ine.origin.rpy, *shape.origin.rpy):
+        return {}
+    R_geom_inertial = inr.rpy_matrix(shape.origin.rpy).T @ inr.rpy_matrix(ine.origin.rpy)
+    return bounds.fix_values(
+        bounds.solid_inertia(shape.geometry, float(ine.mass or 0.0)), R_geom_inertial
+    )
+
+
+def _fix_suffix(fix: dict[str, float]) -> str:
+    return f"; the solid shape's inertia would be {bounds.fix_text(fix)}" if fix else ""
 
 
 def _versus_geometry(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -> None:
+    exceeded = _exceeds(link, ine, J, out)
     shape = primitive_shape(link)
     if shape is None or shape.geometry is None:
         return
@@ -152,17 +203,19 @@ def _versus_geometry(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -
     R_link_inertial = inr.rpy_matrix(ine.origin.rpy)
     # Both tensors expressed in the geometry frame, where the formula is diagonal.
     actual = inr.rotate(inr.rotate(J, R_link_inertial), R_link_geom.T)
-    expected = solid_inertia(g, m)
+    expected = bounds.solid_inertia(g, m)
     diff = inr.relative_difference(actual, expected)
     dims = "x".join(f"{x:g}" for x in g.dims or ())
-    if diff > INERTIA_GEOMETRY_RTOL:
+    if diff > INERTIA_GEOMETRY_RTOL and not exceeded:
         got, want = np.diag(actual), np.diag(expected)
+        fix = bounds.fix_values(expected, R_link_geom.T @ R_link_inertial)
         out.add(
             "inertia-geometry",
             ine.inertia_line,
             f"link {link.name!r}: inertia diag "
             f"{_fmt(got)} (geometry frame) vs solid {g.kind} {dims} m, {m:g} kg: "
-            f"{_fmt(want)}{_diagnosis(got, want)}",
+            f"{_fmt(want)}{_diagnosis(got, want)}{_fix_suffix(fix)}",
+            fix,
             link=link.name,
             actual=_list(got),
             expected=_list(want),
@@ -180,6 +233,50 @@ def _versus_geometry(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -
             link=link.name,
             offset=_list(offset),
         )
+
+
+def _exceeds(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -> bool:
+    """`inertia-exceeds-geometry` for a link made of one primitive; True if it fired.
+
+    Every visual and collision element must be that primitive (primitive_shape): a box
+    collision next to a mesh visual is a simplification of a body that may reach beyond it
+    (example-robot-data's a1 and go1 legs: 165 false errors with the collision alone).
+    """
+    shape = primitive_shape(link)
+    if shape is None or shape.geometry is None:
+        return False
+    if not finite(*ine.origin.xyz, *ine.origin.rpy, *shape.origin.xyz, *shape.origin.rpy):
+        return False  # reported by the number rules
+    g, m = shape.geometry, float(ine.mass or 0.0)
+    R_link_geom = inr.rpy_matrix(shape.origin.rpy)
+    R_geom_inertial = R_link_geom.T @ inr.rpy_matrix(ine.origin.rpy)
+    offset = R_link_geom.T @ np.subtract(ine.origin.xyz, shape.origin.xyz)
+    ex = bounds.excess(inr.rotate(J, R_geom_inertial), m, offset, g)
+    if not ex.axes:
+        return False
+    k = [bounds.AXES.index(a) for a in ex.axes]
+    fix = bounds.fix_values(bounds.solid_inertia(g, m), R_geom_inertial)
+    dims = "x".join(f"{x:g}" for x in g.dims or ())
+    moments = ", ".join(
+        f"{a}: {ex.centre[i]:.4g} > {ex.bound[i]:.4g}" for a, i in zip(ex.axes, k, strict=True)
+    )
+    solid = np.asarray(ex.solid)
+    out.add(
+        "inertia-exceeds-geometry",
+        ine.inertia_line,
+        f"link {link.name!r}: moments about its {g.kind} {dims} m centre ({moments}) exceed "
+        f"the most {m:g} kg inside that collision shape can have (all mass on its extremes); "
+        f"solid {g.kind}: {_fmt(solid)} "
+        f"(geometry frame){_diagnosis(np.diag(inr.rotate(J, R_geom_inertial)), solid)}"
+        f"{_fix_suffix(fix)}",
+        fix,
+        link=link.name,
+        axes=", ".join(ex.axes),
+        about_centre=list(ex.centre),
+        bound=list(ex.bound),
+        solid=list(ex.solid),
+    )
+    return True
 
 
 def _diagnosis(got: np.ndarray, want: np.ndarray) -> str:

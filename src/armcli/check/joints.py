@@ -10,10 +10,11 @@ from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import ONE_DOF_TYPES, Joint, Urdf
 
 AXIS_UNIT_TOL = 1e-6
-# A revolute limit beyond one turn that is a whole multiple of 5 (45, 90, 180, 360...)
-# is almost surely degrees typed as radians; larger values are "unlimited" sentinels
-# and non-round ones (3*pi, 10) are deliberate multi-turn ranges.
-DEGREES_SUSPECT = 2.0 * math.pi
+# A revolute limit that is a whole multiple of 5 from 15 to 720 (45, 90, 180, 360...)
+# is almost surely degrees typed as radians; larger values are "unlimited" sentinels,
+# non-round ones (3*pi) and round ones up to 10 rad (bolt's and solo's -10..10, 1.6
+# turns) are deliberate multi-turn ranges.
+DEGREES_MIN = 15.0
 DEGREES_MAX = 720.0
 DEGREES_STEP = 5.0
 SPEC_LIMIT_TOL = 1e-9
@@ -50,7 +51,7 @@ def _limits(j: Joint, out: Collector) -> None:
     lim = j.limit
     assert lim is not None
     lo, hi = lim.lower, lim.upper
-    if finite(lo, hi):
+    if finite(lo, hi) and not lim.missing_bounds:  # missing ones are `missing-limit`
         assert lo is not None and hi is not None
         if lo >= hi:
             out.add(
@@ -86,8 +87,7 @@ def _limits(j: Joint, out: Collector) -> None:
 def _looks_like_degrees(x: float) -> bool:
     a = abs(x)
     return (
-        DEGREES_SUSPECT < a <= DEGREES_MAX
-        and abs(a / DEGREES_STEP - round(a / DEGREES_STEP)) < 1e-9
+        DEGREES_MIN <= a <= DEGREES_MAX and abs(a / DEGREES_STEP - round(a / DEGREES_STEP)) < 1e-9
     )
 
 

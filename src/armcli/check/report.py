@@ -45,12 +45,24 @@ def _summary_dict(r: CheckResult) -> dict[str, Any] | None:
     return d
 
 
-def to_json(results: Sequence[CheckResult], findings: Sequence[Finding], exit_code: int) -> str:
-    """The documented JSON document (schema `armcli.check/1`)."""
+def to_json(
+    results: Sequence[CheckResult],
+    findings: Sequence[Finding],
+    exit_code: int,
+    unusable: Sequence[tuple[str, str]] = (),
+) -> str:
+    """The documented JSON document (schema `armcli.check/1`).
+
+    `unusable` lists (file, error message) of inputs that could not be read: each gets an
+    entry with `"error"`, its `input-unusable` finding and no summary.
+    """
     files = []
     for r in results:
         mine = [f.to_dict() for f in findings if f.file == r.file]
         files.append({"file": r.file, "findings": mine, "summary": _summary_dict(r)})
+    for file, error in unusable:
+        mine = [f.to_dict() for f in findings if f.file == file]
+        files.append({"file": file, "error": error, "findings": mine, "summary": None})
     doc = {
         "schema": JSON_SCHEMA,
         "files": files,
@@ -91,15 +103,24 @@ def _num(x: float | None, fmt: str = "{:.4g}") -> str:
     return "-" if x is None else fmt.format(x)
 
 
-def to_rich(results: Sequence[CheckResult], findings: Sequence[Finding]) -> list[Any]:
-    """Renderables: per file a findings table and the summary; then the totals line."""
+def to_rich(
+    results: Sequence[CheckResult],
+    findings: Sequence[Finding],
+    unusable: Sequence[str] = (),
+) -> list[Any]:
+    """Renderables: per file a findings table and the summary; then the totals line.
+
+    `unusable` names the files that could not be read; their `input-unusable` finding is
+    shown like any other.
+    """
     from rich.table import Table
     from rich.text import Text
 
     out: list[Any] = []
-    for r in results:
-        mine = [f for f in findings if f.file == r.file]
-        out.append(Text(f"\n{r.file}", style="bold"))
+    files = [(r.file, r) for r in results] + [(u, None) for u in unusable]
+    for file, r in files:
+        mine = [f for f in findings if f.file == file]
+        out.append(Text(f"\n{file}", style="bold"))
         if mine:
             t = Table(show_header=True, header_style="bold", expand=False)
             for col in ("severity", "rule", "line", "message"):
@@ -108,17 +129,28 @@ def to_rich(results: Sequence[CheckResult], findings: Sequence[Finding]) -> list
                 style = "red" if f.severity == ERROR else "yellow"
                 msg = Text(f.message)
                 msg.append(f"\nfix: {f.hint}", style="dim")
+                if f.fix:
+                    msg.append(f"\nwrite: {_fix_text(f.fix)}", style="dim")
                 t.add_row(Text(f.severity, style=style), f.rule, _num(f.line, "{}"), msg)
             out.append(t)
         else:
             out.append(Text("no findings", style="green"))
-        out.extend(_summary(r))
+        if r is not None:
+            out.extend(_summary(r))
     c = counts(findings)
     style = "red" if c[ERROR] else "yellow" if c[WARNING] else "green"
+    bad = f", {len(unusable)} unusable" if unusable else ""
     out.append(
-        Text(f"\n{c[ERROR]} error(s), {c[WARNING]} warning(s) in {len(results)} file(s)", style)
+        Text(
+            f"\n{c[ERROR]} error(s), {c[WARNING]} warning(s) in {len(results)} file(s){bad}",
+            style,
+        )
     )
     return out
+
+
+def _fix_text(fix: Any) -> str:
+    return " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in fix.items())
 
 
 def _summary(r: CheckResult) -> list[Any]:

@@ -48,10 +48,19 @@ _RULES = [
     ),
     Rule("mimic-target", ERROR, "mimic refers to an unknown joint", "fix the mimic joint name"),
     Rule(
+        "robot-name", ERROR, "<robot> without a name", 'give the robot a name: <robot name="...">'
+    ),
+    Rule(
         "material-conflict",
         WARNING,
         "material redefined with another colour",
         "define each material once at top level",
+    ),
+    Rule(
+        "material-undefined",
+        ERROR,
+        "material used by a visual but never given a colour or texture",
+        "define it at top level with <color rgba=...> or <texture>",
     ),
     # numbers
     Rule("number-syntax", ERROR, "number missing or not parsable", "write plain decimal numbers"),
@@ -101,6 +110,12 @@ _RULES = [
         WARNING,
         "root link has an inertia (KDL ignores it)",
         "add a massless dummy root link, e.g. base_footprint",
+    ),
+    Rule(
+        "inertia-exceeds-geometry",
+        ERROR,
+        "a moment of inertia above what any mass inside the link's one primitive can have",
+        "write the inertia of the shape and mass (the value in the message)",
     ),
     Rule(
         "inertia-geometry",
@@ -173,6 +188,13 @@ _RULES = [
         "self-collision", ERROR, "links collide at a named pose", "change the pose or the geometry"
     ),
     Rule("mesh-missing", ERROR, "mesh file not found", "fix the path or pass --package-dir"),
+    # inputs
+    Rule(
+        "input-unusable",
+        ERROR,
+        "file could not be read as a URDF (not XML, not URDF, refused, too large)",
+        "fix or remove the file",
+    ),
 ]
 RULES: dict[str, Rule] = {r.id: r for r in _RULES}
 
@@ -188,6 +210,7 @@ class Finding:
     message: str
     values: Mapping[str, Value] = field(default_factory=dict)
     hint: str = ""
+    fix: Mapping[str, Value] = field(default_factory=dict)  # the numbers that would pass
 
     def to_dict(self) -> dict[str, Any]:
         """The finding as a JSON object in the stable schema of docs/check.md."""
@@ -199,6 +222,7 @@ class Finding:
             "message": self.message,
             "values": dict(self.values),
             "hint": self.hint,
+            "fix": dict(self.fix),
         }
 
 
@@ -209,10 +233,32 @@ class Collector:
         self.file = file
         self.findings: list[Finding] = []
 
-    def add(self, rule: str, line: int | None, message: str, **values: Value) -> None:
-        """Record a finding of `rule` at `line`; `values` are the numbers behind the message."""
+    def add(
+        self,
+        rule: str,
+        line: int | None,
+        message: str,
+        fix: Mapping[str, Value] | None = None,
+        /,
+        **values: Value,
+    ) -> None:
+        """Record a finding of `rule` at `line`.
+
+        `values` are the numbers behind the message, `fix` the numeric remedy (e.g. the
+        inertia that would pass); `fix` is positional-only so no value can shadow it.
+        """
         r = RULES[rule]
-        self.findings.append(Finding(rule, r.severity, self.file, line, message, values, r.hint))
+        self.findings.append(
+            Finding(rule, r.severity, self.file, line, message, values, r.hint, dict(fix or {}))
+        )
+
+    def has(self, rules: Iterable[str], **values: Value) -> bool:
+        """True when a finding of one of `rules` already carries these values (one per problem)."""
+        wanted = set(rules)
+        return any(
+            f.rule in wanted and all(f.values.get(k) == v for k, v in values.items())
+            for f in self.findings
+        )
 
     def has_errors(self, rules: Iterable[str] | None = None) -> bool:
         """Whether an error-severity finding was recorded, optionally only among `rules`."""
@@ -260,6 +306,6 @@ def apply_policy(
         if f.rule in skip:
             continue
         if strict and f.severity == WARNING:
-            f = Finding(f.rule, ERROR, f.file, f.line, f.message, f.values, f.hint)
+            f = Finding(f.rule, ERROR, f.file, f.line, f.message, f.values, f.hint, f.fix)
         out.append(f)
     return out

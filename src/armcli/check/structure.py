@@ -45,8 +45,11 @@ def check(urdf: Urdf, out: Collector) -> Tree:
             "length": "wrong number of values",
         }[p.kind]
         out.add(NUMBER_RULES[p.kind], p.line, f"{p.where}: {what}: {p.text!r}", text=p.text)
+    if not urdf.name:
+        out.add("robot-name", urdf.line, "<robot> has no name attribute (urdfdom refuses it)")
     _names(urdf, out)
     _materials(urdf, out)
+    _material_refs(urdf, out)
     for link in urdf.links:
         _geometry_sizes(link, out)
     links = {lk.name for lk in urdf.links}
@@ -117,6 +120,26 @@ def _materials(urdf: Urdf, out: Collector) -> None:
             )
 
 
+def _material_refs(urdf: Urdf, out: Collector) -> None:
+    """A visual's material must get a colour or texture somewhere (check_urdf refuses it)."""
+    defined = {m.name for m in urdf.materials if m.rgba is not None or m.texture}
+    reported: set[str] = set()
+    for link in urdf.links:
+        for s in link.visuals:
+            name = s.material
+            if name is None or name in defined or name in reported:
+                continue
+            reported.add(name)
+            out.add(
+                "material-undefined",
+                s.line,
+                f"link {link.name!r}: material {name!r} has no colour or texture anywhere "
+                "in the file",
+                material=name,
+                link=link.name,
+            )
+
+
 def _geometry_sizes(link: Link, out: Collector) -> None:
     for tag, shapes in (("visual", link.visuals), ("collision", link.collisions)):
         for s in shapes:
@@ -161,7 +184,10 @@ def _joint_shape(j: Joint, links: set[str], joints: set[str], out: Collector) ->
         missing = (
             ["limit"]
             if lim is None
-            else [a for a in ("effort", "velocity") if getattr(lim, a) is None]
+            else [
+                *(lim.missing_bounds if j.type == "revolute" else ()),
+                *(a for a in ("effort", "velocity") if getattr(lim, a) is None),
+            ]
         )
         if missing:
             out.add(

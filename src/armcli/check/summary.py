@@ -23,9 +23,13 @@ from armcli.urdf.doc import Urdf
 from armcli.urdf.pinocchio import configuration, joint_ranges, load_model, parser_problems
 from armcli.urdf.tool import tool_point
 
+# Skip the model after these: urdfdom would only repeat them (a NaN mass came back as
+# two parser errors; a nameless <robot> as model-load).
 _STRUCTURE_ERRORS = (
+    "robot-name",
     "duplicate-name",
     "number-syntax",
+    "non-finite",
     "vector-length",
     "unknown-link",
     "multiple-parents",

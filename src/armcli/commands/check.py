@@ -9,56 +9,25 @@ from typing import Any
 import typer
 
 from armcli.check import report
+from armcli.check.inputs import CheckRun, run_check
 from armcli.check.report import counts
 from armcli.check.rules import RULES, CheckOptions, apply_policy
-from armcli.check.run import CheckResult, check_urdf
+from armcli.check.sarif import to_sarif
 from armcli.commands.options import choice
-from armcli.errors import ArmcliError, FindingsError, InputError, UnusableInputsError
+from armcli.errors import (
+    EXIT_FAILED,
+    EXIT_UNUSABLE,
+    FindingsError,
+    InputError,
+    UnusableInputsError,
+)
 from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
-from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import parse_package_dirs
-from armcli.urdf.source import (
-    TRUST_XACRO_HELP,
-    UNSANDBOXED_HELP,
-    Trust,
-    read_robot,
-    read_urdf_file,
-    trust_mode,
-)
+from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
-FORMATS = ("table", "json", "github")
+FORMATS = ("table", "json", "github", "sarif")
 REPORT_WIDTH = 140  # columns when stdout is not a terminal (CI logs, pipes)
-
-
-def _documents(path: Path, trust_xacro: Trust) -> list[tuple[Urdf, Any]]:
-    """The URDF documents a PATH stands for, each with the spec it came from (or None)."""
-    if path.is_dir():
-        files = sorted(p for p in path.rglob("*.urdf") if p.is_file())
-        if not files:
-            raise InputError("no *.urdf files under this directory", file=path)
-        return [(read_urdf_file(p, trust_xacro=trust_xacro), None) for p in files]
-    robot = read_robot(path, trust_xacro=trust_xacro)
-    return [(urdf, robot.spec) for urdf in robot.urdfs]
-
-
-def _run(
-    paths: list[Path], base: CheckOptions, trust_xacro: Trust
-) -> tuple[list[CheckResult], list[ArmcliError]]:
-    from dataclasses import replace
-
-    results: list[CheckResult] = []
-    errors: list[ArmcliError] = []
-    for path in paths:
-        try:
-            docs = _documents(path, trust_xacro)
-        except InputError as exc:
-            errors.append(exc)
-            continue
-        for urdf, spec in docs:
-            opts = replace(base, spec=spec) if spec is not None else base
-            results.append(check_urdf(urdf, opts))
-    return results, errors
 
 
 def check_cmd(
@@ -80,38 +49,43 @@ def check_cmd(
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Check robot descriptions for physical sanity; exit 1 on error findings."""
-    if fmt not in FORMATS:
-        raise InputError(f"unknown format {fmt!r}; known: {', '.join(FORMATS)}", field="--format")
     unknown = sorted(set(ignore) - set(RULES))
     if unknown:
         raise InputError(f"unknown rule(s) {unknown}; known: {', '.join(RULES)}", field="--ignore")
     base = CheckOptions(package_dirs=parse_package_dirs(package_dir))
     if spec is not None:
         base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs)
-    results, errors = _run(
-        list(paths or [find_spec(None)]), base, trust_mode(trust_xacro, unsandboxed)
-    )
-    findings = apply_policy((f for r in results for f in r.findings), ignore=ignore, strict=strict)
-    n_err = counts(findings)["error"]
-    code = 2 if errors else (1 if n_err else 0)
-    _print(results, findings, fmt, code)
-    if errors:
-        raise UnusableInputsError(errors)
-    if n_err:
-        raise FindingsError(f"{n_err} error finding(s) in {len(results)} file(s)")
+    trust = trust_mode(trust_xacro, unsandboxed)
+    run = run_check(list(paths or [find_spec(None)]), base, trust_xacro=trust)
+    everything = [f for r in run.results for f in r.findings]
+    everything += [u.finding() for u in run.unusable]
+    findings = apply_policy(everything, ignore=ignore, strict=strict)
+    code = run.exit_code(findings)
+    _print(run, findings, fmt, code)
+    if code == EXIT_UNUSABLE:
+        raise UnusableInputsError([u.error for u in run.unusable])
+    if code == EXIT_FAILED:
+        n_err = counts(findings)["error"]
+        raise FindingsError(
+            f"{n_err} error finding(s) in {len(run.results) + len(run.unusable)} file(s)",
+            [u.error for u in run.unusable],
+        )
 
 
-def _print(results: list[CheckResult], findings: list[Any], fmt: str, code: int) -> None:
+def _print(run: CheckRun, findings: list[Any], fmt: str, code: int) -> None:
+    unusable = [(u.file, u.error.message) for u in run.unusable]
     if fmt == "json":
-        sys.stdout.write(report.to_json(results, findings, code))
+        sys.stdout.write(report.to_json(run.results, findings, code, unusable))
     elif fmt == "github":
         sys.stdout.write(report.to_github(findings))
-    elif results:
+    elif fmt == "sarif":
+        sys.stdout.write(to_sarif(findings))
+    elif run.results:  # nothing usable: the stderr lines say it all
         from rich.console import Console
 
         width = None if sys.stdout.isatty() else REPORT_WIDTH
         console = Console(file=sys.stdout, highlight=False, soft_wrap=False, width=width)
-        for item in report.to_rich(results, findings):
+        for item in report.to_rich(run.results, findings, [u for u, _ in unusable]):
             console.print(item)
 
 

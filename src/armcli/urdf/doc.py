@@ -98,6 +98,7 @@ class Limit:
     effort: float | None
     velocity: float | None
     line: int | None
+    missing_bounds: tuple[str, ...] = ()  # "lower"/"upper" absent (URDF reads them as 0)
 
 
 @dataclass(frozen=True)
@@ -132,6 +133,7 @@ class Material:
     rgba: tuple[float, ...] | None
     line: int | None
     top_level: bool
+    texture: str | None = None  # <texture filename=...>
 
 
 @dataclass(frozen=True)
@@ -145,6 +147,7 @@ class Urdf:
     joints: tuple[Joint, ...]
     materials: tuple[Material, ...]
     problems: tuple[NumberProblem, ...] = field(default=())
+    line: int | None = None  # the <robot> element's
 
     def link(self, name: str) -> Link | None:
         """The link called `name`, or None."""

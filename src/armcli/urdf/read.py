@@ -194,6 +194,7 @@ def _joint(num: _Numbers, el: etree._Element) -> Joint:
             effort=_optional(num, limit_el, "effort", where),
             velocity=_optional(num, limit_el, "velocity", where),
             line=_ln(limit_el),
+            missing_bounds=tuple(a for a in ("lower", "upper") if limit_el.get(a) is None),
         )
     parent, child = el.find("parent"), el.find("child")
     return Joint(
@@ -224,7 +225,9 @@ def _materials(num: _Numbers, root: etree._Element) -> tuple[Material, ...]:
         name = el.get("name", "")
         color = el.find("color")
         rgba = num.vec(color, "rgba", 4, f"material {name}: color") if color is not None else None
-        out.append(Material(name, rgba, _ln(el), el.getparent() is root))
+        texture = el.find("texture")
+        tex = texture.get("filename") if texture is not None else None
+        out.append(Material(name, rgba, _ln(el), el.getparent() is root, tex))
     return tuple(out)
 
 
@@ -333,7 +336,16 @@ def parse_urdf(data: bytes, source: str) -> Urdf:
     links = tuple(_link(num, el) for el in root.findall("link"))
     joints = tuple(_joint(num, el) for el in root.findall("joint"))
     materials = _materials(num, root)
-    return Urdf(root.get("name", ""), source, data, links, joints, materials, tuple(num.problems))
+    return Urdf(
+        root.get("name", ""),
+        source,
+        data,
+        links,
+        joints,
+        materials,
+        tuple(num.problems),
+        _ln(root),
+    )
 
 
 def read_urdf(path: str | Path) -> Urdf:

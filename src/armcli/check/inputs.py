@@ -1,0 +1,93 @@
+"""`check` PATH arguments -> checked documents plus the files that could not be used.
+
+Why a module of its own: a directory in someone else's repository can hold a truncated
+or empty URDF next to good ones. Every usable file is checked; every unusable one
+becomes an `input-unusable` finding (with the reader's message and line), so the table,
+the JSON document and SARIF all show it, instead of one bad file hiding the others.
+The command decides the exit code from `CheckRun.exit_code`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from armcli.check.rules import ERROR, RULES, CheckOptions, Finding
+from armcli.check.run import CheckResult, check_urdf
+from armcli.errors import EXIT_FAILED, EXIT_OK, EXIT_UNUSABLE, InputError
+from armcli.spec.model import RobotSpec
+from armcli.urdf.doc import Urdf
+from armcli.urdf.source import Trust, read_robot, read_urdf_file
+
+URDF_GLOB = "*.urdf"
+
+
+@dataclass(frozen=True)
+class Unusable:
+    """An input file that could not be read as a robot description."""
+
+    file: str
+    error: InputError
+    named: bool  # given on the command line (not found inside a directory)
+
+    def finding(self) -> Finding:
+        """The `input-unusable` finding that stands for this file in every report."""
+        rule = RULES["input-unusable"]
+        return Finding(
+            rule.id, rule.severity, self.file, self.error.line, self.error.message, {}, rule.hint
+        )
+
+
+@dataclass(frozen=True)
+class CheckRun:
+    """Everything one `armcli check` invocation checked or failed to read."""
+
+    results: tuple[CheckResult, ...]
+    unusable: tuple[Unusable, ...]
+
+    def exit_code(self, findings: list[Finding]) -> int:
+        """2 if nothing was usable or a named file was not; else 1 on error findings, else 0.
+
+        `findings` are after --ignore/--strict and include the unusable files' findings,
+        so an unreadable file inside a directory counts as an error (exit 1).
+        """
+        if not self.results or any(u.named for u in self.unusable):
+            return EXIT_UNUSABLE
+        return EXIT_FAILED if any(f.severity == ERROR for f in findings) else EXIT_OK
+
+
+def _documents(
+    path: Path, trust_xacro: Trust
+) -> tuple[list[tuple[Urdf, RobotSpec | None]], list[Unusable]]:
+    """The URDF documents a PATH stands for, each with its spec (or None); the unusable files."""
+    if not path.is_dir():
+        robot = read_robot(path, trust_xacro=trust_xacro)
+        return [(urdf, robot.spec) for urdf in robot.urdfs], []
+    files = sorted(p for p in path.rglob(URDF_GLOB) if p.is_file())
+    if not files:
+        raise InputError(f"no {URDF_GLOB} files under this directory", file=path)
+    docs: list[tuple[Urdf, RobotSpec | None]] = []
+    bad: list[Unusable] = []
+    for p in files:
+        try:
+            docs.append((read_urdf_file(p, trust_xacro=trust_xacro), None))
+        except InputError as exc:
+            bad.append(Unusable(str(p), exc, named=False))
+    return docs, bad
+
+
+def run_check(paths: list[Path], base: CheckOptions, *, trust_xacro: Trust = False) -> CheckRun:
+    """Check every usable document under `paths`; collect the unusable ones."""
+    results: list[CheckResult] = []
+    unusable: list[Unusable] = []
+    for path in paths:
+        try:
+            docs, bad = _documents(path, trust_xacro)
+        except InputError as exc:
+            unusable.append(Unusable(str(path), exc, named=True))
+            continue
+        unusable.extend(bad)
+        for urdf, spec in docs:
+            opts = replace(base, spec=spec) if spec is not None else base
+            results.append(check_urdf(urdf, opts))
+    return CheckRun(tuple(results), tuple(unusable))
