@@ -127,7 +127,7 @@ def test_good_and_bad_inputs_report_the_good_and_exit_2(tmp_path: Path) -> None:
     doc = json.loads(r.stdout)
     good, bad = doc["files"]
     assert good["file"] == "urdf/my_robot.urdf" and "error" not in good
-    assert bad["file"] == str(tmp_path / "missing.urdf") and "cannot read" in bad["error"]
+    assert bad["file"] == str(tmp_path / "missing.urdf") and "not found" in bad["error"]
     assert [f["rule"] for f in bad["findings"]] == ["input-unusable"]
     assert doc["exit_code"] == 2  # a file named on the command line is unusable
 

@@ -9,6 +9,7 @@ create PWNED).
 
 from __future__ import annotations
 
+import json
 import shutil
 import subprocess
 import sys
@@ -159,14 +160,19 @@ def test_exponential_macro_bomb_bounded(tmp_path: Path) -> None:
 
 
 def test_cli_checks_foreign_xacro_without_trust(root: Path) -> None:
+    """Safe mode gives `check` the same document, so the same findings, as --trust-xacro."""
     fixture = root / "tests" / "fixtures" / "check" / "course_macros.urdf.xacro"
-    proc = subprocess.run(
-        [sys.executable, "-m", "armcli.cli", "check", str(fixture)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        check=False,
-        cwd=root,
-    )
-    assert proc.returncode == 0, proc.stderr  # the macro bugs are warnings (test_checks)
-    assert "inertia-geometry" in proc.stdout
+    runs = [
+        subprocess.run(
+            [sys.executable, "-m", "armcli.cli", "check", *flags, str(fixture), "--format", "json"],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            check=False,
+            cwd=root,
+        )
+        for flags in ([], ["--trust-xacro"])
+    ]
+    safe, trusted = (json.loads(r.stdout)["files"][0]["findings"] for r in runs)
+    assert runs[0].returncode == runs[1].returncode == 1  # the course's 4x inertias (test_check)
+    assert safe == trusted and {f["rule"] for f in safe} >= {"inertia-geometry"}
