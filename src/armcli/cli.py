@@ -20,6 +20,8 @@ import typer.main
 
 from armcli.errors import EXIT_FAILED, ArmcliError
 
+UNSANDBOXED_FLAG = "--trust-xacro-unsandboxed"  # what `--trust-xacro=unsandboxed` becomes
+
 # name -> (module, one-line help for the command list). A test checks that each help
 # line is the first line of the command's own docstring.
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -156,6 +158,8 @@ def main(argv: list[str] | None = None) -> None:
     armcli raises on purpose is an ArmcliError carrying its own exit code.
     """
     args = list(sys.argv[1:] if argv is None else argv)
+    # `--trust-xacro=unsandboxed` is the documented spelling; a bool flag cannot take a value
+    args = [UNSANDBOXED_FLAG if a == "--trust-xacro=unsandboxed" else a for a in args]
     debug = _debug_requested(args)
     try:
         app(args=args, prog_name="armcli")

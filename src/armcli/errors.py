@@ -16,10 +16,16 @@ EXIT_FAILED = 1
 EXIT_UNUSABLE = 2
 
 
+EXPANDED_TAG = "#expanded"  # source suffix of a xacro file's expansion (robot_source)
+
+
 def _where(file: str | Path | None, line: int | None) -> str:
     if file is None:
         return ""
-    return f"{file}:{line}" if line else f"{file}"
+    text = str(file)
+    if line and text.endswith(EXPANDED_TAG):  # the line is in the expansion, not the xacro
+        return f"{text[: -len(EXPANDED_TAG)]} (line {line} of its xacro expansion)"
+    return f"{text}:{line}" if line else text
 
 
 class ArmcliError(Exception):
@@ -83,6 +89,37 @@ class SpecError(InputError):
 
 class XacroRefusedError(InputError):
     """A foreign xacro file would run code from the file; refused without --trust-xacro."""
+
+
+class OutputRefusedError(InputError):
+    """An output path armcli will not write (root, home, foreign non-empty directory, ...)."""
+
+
+@dataclass(frozen=True)
+class RuleViolation:
+    """An error finding of `check` (rule id, where, what) carried by ModelRefusedError."""
+
+    rule: str
+    file: str
+    line: int | None
+    message: str
+
+
+class ModelRefusedError(InputError):
+    """`check` reports errors for a model another command was asked to use; one line each."""
+
+    def __init__(self, source: str, violations: Sequence[RuleViolation]) -> None:
+        self.source = source
+        self.violations = list(violations)
+        first = self.violations[0]
+        super().__init__(f"[{first.rule}] {first.message}", file=first.file, line=first.line)
+
+    def lines(self) -> list[str]:
+        """One line per violation, then one saying the model is refused."""
+        out = [f"{_where(v.file, v.line)}: [{v.rule}] {v.message}" for v in self.violations]
+        n = len(self.violations)
+        out.append(f"{self.source}: `armcli check` reports {n} error(s); the model is refused")
+        return out
 
 
 class ModelLoadError(InputError):

@@ -10,6 +10,7 @@ the problem.
 from __future__ import annotations
 
 import json
+import os
 import re
 import subprocess
 import sys
@@ -170,16 +171,35 @@ def test_directory_instead_of_urdf(tmp_path: Path, root: Path) -> None:
         assert_clean_failure(run_cli(args, root), 2, r"robot\.urdf: is a directory", out)
 
 
-@pytest.mark.parametrize(
-    ("command", "message"),
-    [("check", "larger than 10000000 bytes"), ("tree", "larger than"), ("build", "larger than")],
-)
-def test_endless_device(command: str, message: str, tmp_path: Path, root: Path) -> None:
-    """/dev/zero reports size 0 and never ends: reads are capped, not trusted to stat."""
+@pytest.mark.parametrize("command", ["check", "tree", "build", "simulate", "simulate-urdf"])
+def test_endless_device(command: str, tmp_path: Path, root: Path) -> None:
+    """/dev/zero reports size 0 and never ends: refused by type before it is opened."""
     out = tmp_path / "out"
     out.mkdir()
     args = [a.format(file="/dev/zero", out=out) for a in COMMANDS[command]]
-    assert_clean_failure(run_cli(args, root), 2, rf"/dev/zero: .*{message}", out)
+    assert_clean_failure(run_cli(args, root), 2, r"/dev/zero: is a character device", out)
+
+
+@pytest.mark.parametrize(
+    ("command", "name"),
+    [
+        ("check", "robot.urdf"),
+        ("tree", "robot.urdf"),
+        ("build", "spec.yaml"),
+        ("simulate", "trajectory.yaml"),
+        ("simulate-urdf", "robot.urdf"),
+        ("check-trusted", "robot.xacro"),
+    ],
+)
+def test_fifo_input_refused(command: str, name: str, tmp_path: Path, root: Path) -> None:
+    """A FIFO blocked open() forever (no writer): refused before opening."""
+    out = tmp_path / "out"
+    out.mkdir()
+    fifo = tmp_path / name
+    os.mkfifo(fifo)
+    args = [a.format(file=fifo, out=out) for a in COMMANDS[command]]
+    message = rf"{re.escape(name)}: is a FIFO, expected a regular"
+    assert_clean_failure(run_cli(args, root), 2, message, out)
 
 
 def test_diverging_simulation_exits_1_without_output(tmp_path: Path, root: Path) -> None:

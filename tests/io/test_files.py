@@ -14,6 +14,7 @@ import pytest
 import armcli.io.files as fsio
 from armcli.errors import BuildError
 from armcli.io.files import write_file_atomic, write_tree_atomic
+from armcli.io.outdir import MARKER_NAME, MARKER_TEXT
 
 KILL_WAIT_S = 60.0  # bound on how long the child may take to reach the injected pause
 
@@ -106,7 +107,7 @@ def test_fallback_without_exchange(tmp_path: Path, monkeypatch: pytest.MonkeyPat
     write_tree_atomic(tmp_path / "o", {"a.txt": b"1", "keep.txt": b"k"})
     monkeypatch.setattr(fsio, "_exchange", lambda a, b: False)
     write_tree_atomic(tmp_path / "o", {"a.txt": b"2"})
-    assert _snapshot(tmp_path / "o") == {"a.txt": b"2", "keep.txt": b"k"}
+    assert _snapshot(tmp_path / "o") == {"a.txt": b"2", "keep.txt": b"k", MARKER_NAME: MARKER_TEXT}
     assert sorted(p.name for p in tmp_path.iterdir()) == ["o"]
 
 
@@ -114,8 +115,8 @@ def test_refuses_escaping_names_and_directories(tmp_path: Path) -> None:
     for bad in ("../evil.txt", "/etc/passwd", "a/../../b", ""):
         with pytest.raises(BuildError, match="outside the output directory"):
             write_tree_atomic(tmp_path / "o", {bad: b"x"})
-    (tmp_path / "o" / "dir").mkdir(parents=True)
-    (tmp_path / "o" / "f.txt").write_bytes(b"old")
+    write_tree_atomic(tmp_path / "o", {"f.txt": b"old"})
+    (tmp_path / "o" / "dir").mkdir()
     with pytest.raises(BuildError, match="is a directory"):
         write_tree_atomic(tmp_path / "o", {"dir": b"x", "f.txt": b"new"})
     assert (tmp_path / "o" / "f.txt").read_bytes() == b"old"

@@ -405,7 +405,7 @@ def test_command_writes_the_tree_and_rewrites_identically(root: Path, tmp_path: 
     assert "my_robot_moveit_config" in first.stdout
     assert "named pose 'folded'" in first.stderr  # see test_collision_matrix
     snapshot = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
-    assert len(snapshot) == 33
+    assert len(snapshot) == 34  # 33 package files + the armcli marker
     second = _cli(*args, cwd=root)
     assert second.returncode == 0
     assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == snapshot

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
@@ -113,5 +114,10 @@ def test_xacro_content_is_refused_whatever_the_suffix(ns: str) -> None:
 
 
 def test_unreadable_file(tmp_path: Path) -> None:
-    with pytest.raises(InputError, match="cannot read"):
+    with pytest.raises(InputError, match="URDF file not found"):
         read_urdf(tmp_path / "missing.urdf")
+    (tmp_path / "locked.urdf").write_text("<robot name='r'/>")
+    (tmp_path / "locked.urdf").chmod(0)
+    if os.geteuid() != 0:  # root reads mode-0 files
+        with pytest.raises(InputError, match="cannot read URDF file: Permission denied"):
+            read_urdf(tmp_path / "locked.urdf")

@@ -173,7 +173,11 @@ def test_foreign_textured_meshes(root: Path, tmp_path: Path) -> None:
     if not urdf.is_file():
         pytest.skip("example-robot-data (dev dependency) not installed")
     out = tmp_path / "ur5.png"
-    proc = _cli("render", str(urdf), "--q", "0,-1.2,1.5,0,0,0", "-o", str(out), cwd=root)
+    # Its package.xml names example_robot_descriptions, so package://example-robot-data/
+    # is only a root when given (a folder's name alone is not a package, issue 15).
+    pkg = f"example-robot-data={share / 'example-robot-data'}"
+    args = ("--q", "0,-1.2,1.5,0,0,0", "--package-dir", pkg, "-o", str(out))
+    proc = _cli("render", str(urdf), *args, cwd=root)
     assert proc.returncode == 0, proc.stderr
     img = pixels(out)
     assert img.shape[:2] == (600, 1200)

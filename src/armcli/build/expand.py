@@ -17,6 +17,7 @@ from pathlib import Path
 from armcli.build.xacro_writer import top_level_files, xacro_files
 from armcli.errors import BuildError, StaleBuildError
 from armcli.io.files import write_tree_atomic
+from armcli.io.outdir import resolve_output_dir
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
 
@@ -80,12 +81,13 @@ def spec_label(spec_path: Path) -> str:
     return spec_path.name
 
 
-def build(spec_path: str | Path, out_dir: str | Path) -> BuildResult:
-    """Build the spec into `out_dir` all-or-nothing."""
+def build(spec_path: str | Path, out_dir: str | Path, *, force: bool = False) -> BuildResult:
+    """Build the spec into `out_dir` all-or-nothing (`force`: into a foreign non-empty dir)."""
     path = Path(spec_path)
+    resolve_output_dir(out_dir, force=force)  # refuse before the work, again when writing
     spec = load_spec(path)
     files = build_files(spec, spec_label(path))
-    written = write_tree_atomic(out_dir, files)
+    written = write_tree_atomic(out_dir, files, force=force)
     return BuildResult(spec=spec, out_dir=Path(out_dir), files=tuple(written))
 
 

@@ -10,7 +10,6 @@ from __future__ import annotations
 import itertools
 import random
 from dataclasses import replace
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -21,6 +20,7 @@ from armcli.errors import InputError
 from armcli.sim import stability as stab
 from armcli.sim.stability import StabilityReport
 from armcli.urdf.doc import Urdf
+from armcli.urdf.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
 from armcli.urdf.meshes import mesh_paths
 from armcli.urdf.pinocchio import collision_model, configuration
 
@@ -238,9 +238,10 @@ def self_collision(
     if any(p is None or not p.is_file() for p in meshes.values()):
         notes.append("self-collision skipped: some meshes cannot be found")
         return
-    dirs = sorted({str(Path(p).parent) for p in meshes.values() if p is not None})
-    try:
-        gmodel = collision_model(model, urdf.text.decode("utf-8"), dirs)
+    real = {uri: bounded_mesh_file(p, urdf.source) for uri, p in meshes.items() if p is not None}
+    check_total(real.values(), urdf.source)
+    try:  # Pinocchio gets absolute confined paths and no search directories
+        gmodel = collision_model(model, with_real_mesh_paths(urdf.text, real), [])
     except InputError as exc:
         notes.append(f"self-collision skipped: {exc.message}")
         return
@@ -252,8 +253,11 @@ def self_collision(
             gmodel.addCollisionPair(pin.CollisionPair(i, k))
             pairs.append((link_of[i], link_of[k]))
     gdata = pin.GeometryData(gmodel)
-    for req in gdata.collisionRequests:
-        req.security_margin = -PENETRATION_TOL
+    for req, pair in zip(gdata.collisionRequests, gmodel.collisionPairs, strict=True):
+        # coal refuses negative margins on meshes ("not handled yet for BVHModel"): there,
+        # touching counts as colliding.
+        meshy = _is_mesh(gmodel, pair.first) or _is_mesh(gmodel, pair.second)
+        req.security_margin = 0.0 if meshy else -PENETRATION_TOL
     data = model.createData()
     named = [p for p in poses if p[0] in (opts.spec.poses if opts.spec else {})]
     for name, values in named:
@@ -268,6 +272,13 @@ def self_collision(
                     link1=a,
                     link2=b,
                 )
+
+
+def _is_mesh(gmodel: Any, index: int) -> bool:
+    import coal
+
+    geometry = gmodel.geometryObjects[index].geometry
+    return bool(geometry.getObjectType() == coal.OBJECT_TYPE.OT_BVH)
 
 
 def _link_line(urdf: Urdf, name: str) -> int | None:

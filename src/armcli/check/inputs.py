@@ -17,7 +17,7 @@ from armcli.check.run import CheckResult, check_urdf
 from armcli.errors import EXIT_FAILED, EXIT_OK, EXIT_UNUSABLE, InputError
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
-from armcli.urdf.source import read_robot, read_urdf_file
+from armcli.urdf.source import Trust, read_robot, read_urdf_file
 
 URDF_GLOB = "*.urdf"
 
@@ -57,7 +57,7 @@ class CheckRun:
 
 
 def _documents(
-    path: Path, trust_xacro: bool
+    path: Path, trust_xacro: Trust
 ) -> tuple[list[tuple[Urdf, RobotSpec | None]], list[Unusable]]:
     """The URDF documents a PATH stands for, each with its spec (or None); the unusable files."""
     if not path.is_dir():
@@ -76,7 +76,7 @@ def _documents(
     return docs, bad
 
 
-def run_check(paths: list[Path], base: CheckOptions, *, trust_xacro: bool = False) -> CheckRun:
+def run_check(paths: list[Path], base: CheckOptions, *, trust_xacro: Trust = False) -> CheckRun:
     """Check every usable document under `paths`; collect the unusable ones."""
     results: list[CheckResult] = []
     unusable: list[Unusable] = []

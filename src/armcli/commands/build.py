@@ -20,6 +20,9 @@ def build_cmd(
     check: bool = typer.Option(
         False, "--check", help="Do not write; exit 1 listing files that differ from a fresh build."
     ),
+    force: bool = typer.Option(
+        False, "--force", help="Write into an existing non-empty directory armcli did not create."
+    ),
 ) -> None:
     """Compile SPEC into the course's xacro set and the expanded URDFs."""
     spec = find_spec(spec)
@@ -27,7 +30,7 @@ def build_cmd(
         check_fresh(spec, out)
         sys.stdout.write(f"{out}: up to date with {spec}\n")
         return
-    result = build(spec, out)
+    result = build(spec, out, force=force)
     sys.stdout.write(f"built {len(result.files)} files from {spec} into {out}/\n")
     for f in result.files:
         sys.stdout.write(f"  {f}\n")

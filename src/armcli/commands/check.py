@@ -24,7 +24,7 @@ from armcli.errors import (
 from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
 from armcli.urdf.meshes import parse_package_dirs
-from armcli.urdf.source import TRUST_XACRO_HELP
+from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 FORMATS = ("table", "json", "github", "sarif")
 REPORT_WIDTH = 140  # columns when stdout is not a terminal (CI logs, pipes)
@@ -46,6 +46,7 @@ def check_cmd(
         [], "--package-dir", help="NAME=PATH for package://NAME/ mesh URIs (repeatable)."
     ),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
+    unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Check robot descriptions for physical sanity; exit 1 on error findings."""
     unknown = sorted(set(ignore) - set(RULES))
@@ -54,7 +55,8 @@ def check_cmd(
     base = CheckOptions(package_dirs=parse_package_dirs(package_dir))
     if spec is not None:
         base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs)
-    run = run_check(list(paths or [find_spec(None)]), base, trust_xacro=trust_xacro)
+    trust = trust_mode(trust_xacro, unsandboxed)
+    run = run_check(list(paths or [find_spec(None)]), base, trust_xacro=trust)
     everything = [f for r in run.results for f in r.findings]
     everything += [u.finding() for u in run.unusable]
     findings = apply_policy(everything, ignore=ignore, strict=strict)

@@ -11,9 +11,10 @@ from armcli.build.expand import spec_label
 from armcli.commands.options import choice
 from armcli.export.mjcf import BASES
 from armcli.export.mjcf_files import export_mjcf
+from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
 from armcli.urdf.meshes import MeshSearch, parse_package_dirs
-from armcli.urdf.source import TRUST_XACRO_HELP
+from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 export_app = typer.Typer(
     help="Export the robot to other simulators' formats.", no_args_is_help=True
@@ -45,6 +46,7 @@ def mjcf_cmd(
         False, "--whole-robot", help="For a spec: the whole robot instead of the arm alone."
     ),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
+    unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
     package_dir: list[str] = typer.Option(
         [], "--package-dir", help="NAME=PATH: where package://NAME/ meshes live (repeatable)."
     ),
@@ -54,13 +56,14 @@ def mjcf_cmd(
     Joints with spec gains get `position` actuators (kp = Kp, kv = Kd, force range =
     the effort limit); the report lists what MuJoCo cannot represent.
     """
+    check_output_file(out, "--out")  # before any work: nothing else is written
     robot = find_spec(robot)
     res = export_mjcf(
         robot,
         out,
         base=base,
         whole_robot=whole_robot,
-        trust_xacro=trust_xacro,
+        trust_xacro=trust_mode(trust_xacro, unsandboxed),
         search=MeshSearch(parse_package_dirs(package_dir)),
         label=spec_label(robot),
     )

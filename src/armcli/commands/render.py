@@ -9,9 +9,10 @@ import typer
 
 from armcli.commands.options import spec_argument
 from armcli.errors import InputError
+from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
 from armcli.urdf.meshes import MeshSearch, parse_package_dirs
-from armcli.urdf.source import TRUST_XACRO_HELP
+from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 from armcli.view.png import load_urdf, render_png
 from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
 
@@ -51,9 +52,15 @@ def render_cmd(
         [], "--package-dir", help="NAME=PATH for package://NAME/ mesh URIs (repeatable)."
     ),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
+    unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
-    src = load_robot(find_spec(robot), trust_xacro, MeshSearch(parse_package_dirs(package_dir)))
+    check_output_file(out, "--out")  # before any work: nothing else is written
+    src = load_robot(
+        find_spec(robot),
+        trust_mode(trust_xacro, unsandboxed),
+        MeshSearch(parse_package_dirs(package_dir)),
+    )
     values = pose_q(src, pose, q)
     width, height = _size(size)
     urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search)

@@ -17,25 +17,42 @@ TARGET_HELP = (
     "+ Gazebo Harmonic with ros2_control (effort, the spec's gains)."
 )
 DEFAULT_SAMPLES = 10_000  # keep equal to armcli.ros.collision_matrix.DEFAULT_SAMPLES (lazy import)
+MAX_SAMPLES = 1_000_000  # ~100x the default: minutes of coal queries, not days
 
 
 def ros_package_cmd(
     spec: Path | None = spec_argument(),
     out: Path = out_option(Path("ros"), "Output directory"),
     samples: int = option(
-        DEFAULT_SAMPLES, "--samples", min=1, help="Random states for the collision matrix"
+        DEFAULT_SAMPLES,
+        "--samples",
+        min=1,
+        max=MAX_SAMPLES,
+        help="Random states for the collision matrix",
     ),
-    seed: int = option(0, "--seed", help="Seed of the collision-matrix sampling"),
+    seed: int = option(
+        0, "--seed", min=0, max=2**32 - 1, help="Seed of the collision-matrix sampling"
+    ),
     maintainer: str = option("armcli", "--maintainer", help="package.xml maintainer"),
     email: str = option("armcli@example.com", "--email", help="Maintainer e-mail"),
     license_: str = option("TODO", "--license", help="package.xml license"),
     target: str = choice(DEFAULT_TARGET, TARGETS, "--target", help=TARGET_HELP),
+    force: bool = option(
+        False, "--force", help="Write into an existing non-empty directory armcli did not create."
+    ),
 ) -> None:
     """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
     spec = find_spec(spec)
     info = PackageInfo(maintainer=maintainer, email=email, license=license_)
     pkgs, written = write_ros_packages(
-        spec, out, label=spec_label(spec), samples=samples, seed=seed, info=info, target=target
+        spec,
+        out,
+        label=spec_label(spec),
+        samples=samples,
+        seed=seed,
+        info=info,
+        target=target,
+        force=force,
     )
     n, m = pkgs.names, pkgs.matrix
     counts = {r: sum(d.reason == r for d in m.disabled) for r in ("Adjacent", "Default", "Never")}

@@ -9,8 +9,10 @@ from typing import Any, cast
 
 import typer
 
+from armcli.check.gate import refuse_check_errors
 from armcli.commands.options import choice, option, spec_argument
 from armcli.errors import InputError
+from armcli.io.outdir import check_output_file
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
 from armcli.sim import states
@@ -18,7 +20,7 @@ from armcli.sim.options import ENGINES, INTEGRATORS, Engine, Integrator, SimOpti
 from armcli.sim.plot import write_tracking_plot
 from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
-from armcli.urdf.source import TRUST_XACRO_HELP
+from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 ENGINE_HELP = "auto (default: compiled when available), native (compiled) or python."
 INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
@@ -54,10 +56,14 @@ def simulate_cmd(
     rate: float = option(None, "--rate", help="Output rate [Hz] (default: the spec's publisher)."),
     engine: str = choice("auto", ENGINES, "--engine", help=ENGINE_HELP),
     trust_xacro: bool = option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
+    unsandboxed: bool = option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
     if output is not None:
         states.output_format(output)
+        check_output_file(output, "--output")
+    if plot is not None:
+        check_output_file(plot, "--plot")
     spec_obj = load_spec(find_spec(spec)) if (spec is not None or urdf is None) else None
     kp_values, kd_values = _floats(kp, "--kp"), _floats(kd, "--kd")
     opts = SimOptions(
@@ -74,9 +80,10 @@ def simulate_cmd(
         clamp=clamp,
         rate=rate,
         engine=cast(Engine, engine),
-        trust_xacro=trust_xacro,
+        trust_xacro=trust_mode(trust_xacro, unsandboxed),
     )
-    _run(simjob.prepare(spec_obj, opts), output, plot)
+    # a model `check` reports as an error is not simulated (same rule ids)
+    _run(simjob.prepare(spec_obj, opts, gate=refuse_check_errors), output, plot)
 
 
 def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:

@@ -10,8 +10,9 @@ import typer
 from armcli.commands.options import choice, spec_argument
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
+from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
-from armcli.urdf.source import TRUST_XACRO_HELP
+from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 from armcli.urdf.tree import parse_tree, to_dot, to_rich
 from armcli.view.scene import ROBOT_HELP, load_robot
 
@@ -25,11 +26,14 @@ def tree_cmd(
     ),
     out: Path = typer.Option(None, "-o", "--out", help="Write to this file instead of stdout."),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
+    unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Print the kinematic tree: links, and joints with their types and limits."""
     if fmt not in TREE_FORMATS:
         raise InputError(f"unknown format {fmt!r}; known: text, dot", field="--format")
-    src = load_robot(find_spec(robot), trust_xacro)
+    if out is not None:
+        check_output_file(out, "--out")
+    src = load_robot(find_spec(robot), trust_mode(trust_xacro, unsandboxed))
     tree = parse_tree(src.xml, src.source)
     if fmt == "dot":
         text = to_dot(tree)

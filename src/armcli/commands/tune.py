@@ -12,6 +12,7 @@ import typer
 from armcli.commands.options import choice, option, spec_argument
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
+from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
 from armcli.tune import job as tjob
@@ -75,6 +76,9 @@ def tune_cmd(
     validate(opts)
     if output is not None and output.suffix.lower() != ".json":
         raise InputError("the output file must end in .json", field="--output")
+    for path, name in ((output, "--output"), (plot, "--plot")):
+        if path is not None:
+            check_output_file(path, name)  # before the search: no partial outputs
     if write:
         check_writable(spec_path)
     settings = tjob.TuneSettings(

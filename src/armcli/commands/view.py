@@ -12,7 +12,7 @@ from armcli.errors import InputError
 from armcli.sim.states import load_replay
 from armcli.spec.discover import find_spec
 from armcli.urdf.meshes import MeshSearch, parse_package_dirs
-from armcli.urdf.source import TRUST_XACRO_HELP
+from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 from armcli.view.browser import Viewer
 from armcli.view.png import joint_limits, load_urdf
 from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
@@ -35,9 +35,14 @@ def view_cmd(
         [], "--package-dir", help="NAME=PATH for package://NAME/ mesh URIs (repeatable)."
     ),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
+    unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Open a browser 3-D viewer with joint sliders, named poses and simulation replay."""
-    src = load_robot(find_spec(robot), trust_xacro, MeshSearch(parse_package_dirs(package_dir)))
+    src = load_robot(
+        find_spec(robot),
+        trust_mode(trust_xacro, unsandboxed),
+        MeshSearch(parse_package_dirs(package_dir)),
+    )
     pose_q(src, pose, None)  # validate before starting the server
     if not 0 <= port <= 65535:
         raise InputError(f"{port} is not a port number", field="--port")

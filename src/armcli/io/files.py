@@ -14,16 +14,25 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import os
-import shutil
+import stat
 import tempfile
 from collections.abc import Mapping
 from pathlib import Path, PurePosixPath
 
-from armcli.errors import BuildError
+from armcli.errors import BuildError, OutputRefusedError
+from armcli.io.outdir import (
+    MARKER_NAME,
+    MARKER_TEXT,
+    STAGE_TAG,
+    carry_entries,
+    clean_stale_stages,
+    no_links_below,
+    remove_entry,
+    resolve_output_dir,
+)
 
 _AT_FDCWD = -100
 _RENAME_EXCHANGE = 2
-_STAGE_TAG = ".armcli-stage-"
 
 
 def _safe_relpath(rel: str) -> PurePosixPath:
@@ -74,7 +83,7 @@ def write_file_atomic(path: str | Path, data: bytes | str) -> Path:
                 os.unlink(tmp)
             raise
     except OSError as exc:
-        raise BuildError(f"{target}: cannot write: {exc.strerror}") from None
+        raise BuildError(f"{target}: cannot write: {_why(exc)}") from None
     return target
 
 
@@ -88,105 +97,98 @@ def _exchange(a: Path, b: Path) -> bool:
     return bool(rc == 0)
 
 
-def _clean_stale_stages(parent: Path, name: str) -> None:
-    """Remove staging directories left by armcli processes that were killed."""
-    for stage in parent.glob(f".{name}{_STAGE_TAG}*"):
-        pid = stage.name.rsplit("-", 2)[-2]
-        alive = pid.isdigit() and _pid_alive(int(pid))
-        if not alive:
-            shutil.rmtree(stage, ignore_errors=True)
-
-
-def _pid_alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
-
-
-def _link_or_copy(src: str, dst: str) -> None:
-    try:
-        os.link(src, dst)
-    except OSError:
-        shutil.copy2(src, dst)
-
-
 def _stage(root: Path, files: Mapping[str, bytes]) -> Path:
     """A complete new version of `root` beside it: untouched entries linked, files written."""
-    stage = Path(
-        tempfile.mkdtemp(dir=root.parent, prefix=f".{root.name}{_STAGE_TAG}{os.getpid()}-")
-    )
+    stage = Path(tempfile.mkdtemp(dir=root.parent, prefix=f".{root.name}{STAGE_TAG}{os.getpid()}-"))
     try:
         _populate(stage, root, files)
     except BaseException:
-        shutil.rmtree(stage, ignore_errors=True)
+        remove_entry(stage)
         raise
     return stage
 
 
 def _populate(stage: Path, root: Path, files: Mapping[str, bytes]) -> None:
-    os.chmod(stage, 0o777 & ~_umask())
+    modes: list[tuple[Path, int]] = []
     if root.is_dir():
-        for entry in os.scandir(root):
-            if entry.name in files:
-                continue
-            if entry.is_dir(follow_symlinks=False):
-                shutil.copytree(
-                    entry.path, stage / entry.name, symlinks=True, copy_function=_link_or_copy
-                )
-            elif entry.is_symlink():
-                os.symlink(os.readlink(entry.path), stage / entry.name)
-            else:
-                _link_or_copy(entry.path, str(stage / entry.name))
+        carry_entries(root, stage, {r for r in files if "/" not in r}, modes)
     for rel, data in files.items():
         target = stage / rel
-        if target.is_dir():
+        if not no_links_below(stage, PurePosixPath(rel).parent):
+            raise OutputRefusedError(
+                f"{rel}: a directory on the way is a symlink; armcli does not write through "
+                "links inside the output directory",
+                file=root,
+            )
+        if target.is_dir() and not target.is_symlink():
             raise BuildError(f"{root / rel}: is a directory, cannot write a file there")
         target.parent.mkdir(parents=True, exist_ok=True)
         if target.exists() or target.is_symlink():
             target.unlink()  # a hard link to the old file: never write through it
         os.replace(_write_temp(target.parent, target.name, data), target)
+    for path, mode in modes:  # innermost first: read-only directories receive files first
+        os.chmod(path, mode)
+    keep = stat.S_IMODE(os.stat(root).st_mode) if root.is_dir() else 0o777 & ~_umask()
+    os.chmod(stage, keep)
 
 
 def _unchanged(root: Path, files: Mapping[str, bytes]) -> bool:
-    return all((root / r).is_file() and (root / r).read_bytes() == d for r, d in files.items())
+    for rel, data in files.items():
+        path = root / rel
+        if not no_links_below(root, PurePosixPath(rel)):
+            return False
+        try:
+            st = os.lstat(path)
+        except OSError:
+            return False
+        if not stat.S_ISREG(st.st_mode) or st.st_size != len(data) or path.read_bytes() != data:
+            return False
+    return True
 
 
-def write_tree_atomic(out_dir: str | Path, files: Mapping[str, bytes | str]) -> list[Path]:
+def write_tree_atomic(
+    out_dir: str | Path, files: Mapping[str, bytes | str], *, force: bool = False
+) -> list[Path]:
     """Write a set of files under `out_dir` all-or-nothing; returns the written paths.
 
+    `out_dir` must pass outdir.resolve_output_dir (not `/`, not home, not a
+    foreign non-empty directory unless `force`); armcli's marker file is added.
     A rebuild with identical content touches nothing (same bytes, same mtimes).
     """
-    root = Path(out_dir)
+    given = Path(out_dir)
     payloads = {str(_safe_relpath(r)): _payload(d) for r, d in sorted(files.items())}
-    paths = [root.joinpath(*PurePosixPath(r).parts) for r in payloads]
+    paths = [given.joinpath(*PurePosixPath(r).parts) for r in payloads]
+    payloads[MARKER_NAME] = MARKER_TEXT
+    root = resolve_output_dir(given, force=force)
     try:
-        root.parent.mkdir(parents=True, exist_ok=True)
-        if root.exists() and not root.is_dir():
-            raise BuildError(f"{root}: exists and is not a directory")
-        for p in paths:
-            if p.is_dir():
-                raise BuildError(f"{p}: is a directory, cannot write a file there")
+        for rel in payloads:
+            if (root / rel).is_dir() and not (root / rel).is_symlink():
+                raise BuildError(f"{given / rel}: is a directory, cannot write a file there")
         if root.is_dir() and _unchanged(root, payloads):
             return paths
-        _clean_stale_stages(root.parent, root.name)
+        root.parent.mkdir(parents=True, exist_ok=True)
+        clean_stale_stages(root.parent, root.name)
+        if given.is_symlink():  # left by versions that swapped the link itself
+            clean_stale_stages(given.parent, given.name)
         stage = _stage(root, payloads)
         try:
             if not root.exists():
                 os.rename(stage, root)
             elif _exchange(stage, root):
-                shutil.rmtree(stage, ignore_errors=True)  # `stage` now holds the old tree
+                pass  # `stage` now holds the old tree, removed below
             else:
                 _replace_one_by_one(stage, root, payloads)
         finally:
-            if stage.exists():
-                shutil.rmtree(stage, ignore_errors=True)
+            remove_entry(stage)
     except OSError as exc:
-        raise BuildError(f"{root}: cannot write: {exc.strerror} ({exc.filename})") from None
+        raise BuildError(f"{given}: cannot write: {_why(exc)}") from None
     return paths
+
+
+def _why(exc: OSError) -> str:
+    """`strerror (file)` without the `(None)` of errors that carry no file name."""
+    text = exc.strerror or str(exc)
+    return f"{text} ({exc.filename})" if exc.filename else text
 
 
 def _replace_one_by_one(stage: Path, root: Path, files: Mapping[str, bytes]) -> None:

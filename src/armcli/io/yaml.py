@@ -8,6 +8,7 @@ a map from field path to line so that validation errors can point at a line.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -15,9 +16,11 @@ from typing import Any
 import yaml
 
 from armcli.errors import InputError
+from armcli.io.userfile import read_regular
 
 MAX_YAML_BYTES = 1_000_000
 MAX_YAML_DEPTH = 64
+MAX_INT_BITS = 1024  # larger integers exceed the float range every consumer converts to
 
 Path_ = tuple[str | int, ...]
 _PLAIN_TAGS = {
@@ -49,6 +52,14 @@ _Base: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml when PyYAM
 
 class _Loader(_Base):  # type: ignore[misc]
     """The safe loader (C-accelerated where available); anchors are refused before use."""
+
+
+# YAML 1.1 (PyYAML) reads `1e9` as a string; YAML 1.2 and ROS tools read it as a float.
+_Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
+    list("-+0123456789."),
+)
 
 
 def _scan_events(text: str, source: str) -> None:
@@ -95,7 +106,20 @@ def _build(
             f"unsupported YAML tag {node.tag!r}", file=doc.source, line=node.start_mark.line + 1
         )
     if isinstance(node, yaml.ScalarNode):
-        value = loader.construct_object(node, deep=True)
+        try:
+            value = loader.construct_object(node, deep=True)
+        except ValueError:  # int("9" * 5000): Python's 4300-digit conversion limit
+            value = None
+            too_big = True
+        else:  # 0xfff...: no digit limit, but beyond any float (and str() of it fails)
+            too_big = isinstance(value, int) and value.bit_length() > MAX_INT_BITS
+        if too_big:
+            raise InputError(
+                f"integer out of range ({len(node.value)} characters; at most 1.8e308)",
+                file=doc.source,
+                line=node.start_mark.line + 1,
+                field=_dotted(path) or None,
+            )
         if isinstance(value, str | int | float | bool) or value is None:
             return value
         # timestamps, binary, ...: keep the source text, the schema decides.
@@ -173,28 +197,12 @@ def loads_yaml(text: str, source: str = "<string>", *, flow_sets: bool = False) 
 
 
 def read_text(path: str | Path, *, max_bytes: int = MAX_YAML_BYTES, what: str = "file") -> str:
-    """Read a user text file with a size cap and clear errors."""
-    p = Path(path)
-    if not p.exists():
-        raise InputError(f"{what} not found", file=p)
-    if p.is_dir():
-        raise InputError(f"is a directory, expected a {what}", file=p)
-    try:
-        size = p.stat().st_size
-        if size > max_bytes:
-            raise InputError(
-                f"{what} is {size} bytes, larger than the {max_bytes}-byte cap", file=p
-            )
-        with p.open("rb") as fh:  # capped: /dev/zero or a pipe report no size
-            raw = fh.read(max_bytes + 1)
-        if len(raw) > max_bytes:
-            raise InputError(f"{what} is larger than the {max_bytes}-byte cap", file=p)
-    except OSError as exc:
-        raise InputError(f"cannot read {what}: {exc.strerror}", file=p) from None
+    """Read a user text file (regular files only) with a size cap and clear errors."""
+    raw = read_regular(path, max_bytes=max_bytes, what=what)
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError:
-        raise InputError(f"{what} is not UTF-8 text", file=p) from None
+        raise InputError(f"{what} is not UTF-8 text", file=Path(path)) from None
 
 
 def load_yaml(path: str | Path, *, flow_sets: bool = False) -> YamlDoc:

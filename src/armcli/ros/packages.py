@@ -23,6 +23,7 @@ from armcli.build.xacro_writer import GENERATED, STANDALONE_ARM, top_level_files
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.io.files import write_tree_atomic
+from armcli.io.outdir import resolve_output_dir
 from armcli.ros import jazzy
 from armcli.ros import moveit as mc
 from armcli.ros.collision_matrix import (
@@ -353,9 +354,11 @@ def write_ros_packages(
     seed: int = DEFAULT_SEED,
     info: PackageInfo = PackageInfo(),
     target: str = DEFAULT_TARGET,
+    force: bool = False,
 ) -> tuple[RosPackages, list[Path]]:
     """Load the spec, build the packages in memory, then write them in one atomic swap."""
     path = Path(spec_path)
+    resolve_output_dir(out_dir, force=force)  # refuse before the collision sampling
     spec = load_spec(path)
     pkgs = ros_packages(
         spec,
@@ -366,4 +369,4 @@ def write_ros_packages(
         source=str(path),
         target=target,
     )
-    return pkgs, write_tree_atomic(out_dir, pkgs.files)
+    return pkgs, write_tree_atomic(out_dir, pkgs.files, force=force)

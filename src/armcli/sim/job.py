@@ -22,11 +22,12 @@ from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_urdf
-from armcli.urdf.source import checked_model, read_urdf_file
+from armcli.urdf.source import Trust, checked_model, read_urdf_file
 from armcli.urdf.tool import tool_point
 
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
 ARM_URDF = STANDALONE_ARM_URDF
+RATE_SLACK = 1e-9  # relative: --rate 1000 with dt 0.001 is exactly one sample per step
 MAX_STEPS = 2_000_000  # ~200 MB of recorded states for a 2-joint arm
 
 
@@ -47,7 +48,7 @@ class SimJob:
     T_frame_root: np.ndarray  # 4x4 pose of the arm's root link in the reporting frame
 
 
-def arm_urdf(spec: RobotSpec | None, urdf: Path | None, *, trust_xacro: bool = False) -> Urdf:
+def arm_urdf(spec: RobotSpec | None, urdf: Path | None, *, trust_xacro: Trust = False) -> Urdf:
     """The URDF to simulate: a given file or the spec's standalone arm built in memory.
 
     A given file goes through the strict reader (a foreign xacro only when trusted).
@@ -64,7 +65,7 @@ def load_arm(
     urdf: Path | None,
     joints: Sequence[str] | None,
     *,
-    trust_xacro: bool = False,
+    trust_xacro: Trust = False,
 ) -> Arm:
     """The simulated arm: the spec's standalone arm built in memory, or a given URDF.
 
@@ -157,8 +158,14 @@ def start_state(arm: Arm, spec: RobotSpec | None) -> np.ndarray:
     return np.clip(q, arm.lower, arm.upper)
 
 
-def prepare(spec: RobotSpec | None, opts: SimOptions) -> SimJob:
-    """Validate every input and assemble the run; raises InputError on bad input."""
+def prepare(
+    spec: RobotSpec | None, opts: SimOptions, *, gate: Callable[[Urdf], None] | None = None
+) -> SimJob:
+    """Validate every input and assemble the run; raises InputError on bad input.
+
+    `gate` sees a given URDF (`--urdf`) before it is simulated and may refuse it
+    (the simulate command passes check.gate.refuse_check_errors).
+    """
     trajectory, message, dt, rate = opts.trajectory, opts.message, opts.dt, opts.rate
     if (trajectory is None) == (message is None):
         raise InputError(
@@ -168,7 +175,7 @@ def prepare(spec: RobotSpec | None, opts: SimOptions) -> SimJob:
     if not (np.isfinite(dt) and 0 < dt <= 0.1):
         raise InputError(f"must be in (0, 0.1] s, got {dt:g}", field="--dt")
     doc = arm_urdf(spec, opts.urdf, trust_xacro=opts.trust_xacro)
-    arm = arm_from_model(checked_model(doc).model, opts.joints)
+    arm = arm_from_model(checked_model(doc, gate=gate if opts.urdf else None).model, opts.joints)
     limits = {
         n: (float(lo), float(hi))
         for n, lo, hi in zip(arm.joint_names, arm.lower, arm.upper, strict=True)
@@ -205,8 +212,12 @@ def prepare(spec: RobotSpec | None, opts: SimOptions) -> SimJob:
         if rate is not None
         else (jsp.update_rate if jsp is not None else DEFAULT_STATE_RATE_HZ)
     )
-    if not (np.isfinite(rate) and rate > 0):
-        raise InputError(f"must be > 0 Hz, got {rate:g}", field="--rate")
+    if not (np.isfinite(rate) and 0 < rate <= (1.0 + RATE_SLACK) / dt):
+        raise InputError(
+            f"must be in (0, 1/dt = {1.0 / dt:g}] Hz (one state per time step at most), "
+            f"got {rate:g}",
+            field="--rate",
+        )
     fid, off, label = _tool(arm, doc, spec)
     frame, T_frame_root = _report_frame(arm, spec)
     label = f"{label} in {frame}"

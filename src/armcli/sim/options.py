@@ -8,9 +8,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal, get_args
+from typing import TYPE_CHECKING, Literal, get_args
 
 from armcli.errors import InputError
+
+if TYPE_CHECKING:
+    from armcli.urdf.source import Trust
 
 Integrator = Literal["euler", "rk4"]
 """euler: semi-implicit (symplectic) Euler with implicit damping; rk4: classic Runge-Kutta."""
@@ -55,7 +58,7 @@ class SimOptions:
     clamp: bool = False
     rate: float | None = None
     engine: Engine = "auto"
-    trust_xacro: bool = False
+    trust_xacro: Trust = False
 
     def __post_init__(self) -> None:
         for value, choices, option in (

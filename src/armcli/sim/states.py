@@ -89,6 +89,7 @@ def write_states(path: Path, res: SimResult, rate: float) -> None:
 
 
 MAX_REPLAY_BYTES = 200_000_000
+MAX_REPLAY_ROWS = 2_000_000  # = simjob.MAX_STEPS: the most states `simulate` records
 
 
 @dataclass(frozen=True)
@@ -132,10 +133,24 @@ def _parse_cell(text: str, col: str, line: int, source: str, blank_ok: bool) -> 
     return value
 
 
+def _rows(text: str, source: str) -> list[list[str]]:
+    """CSV rows, at most MAX_REPLAY_ROWS; csv's own limits become InputErrors with a line."""
+    reader = csv.reader(io.StringIO(text))
+    rows: list[list[str]] = []
+    try:
+        for row in reader:
+            rows.append(row)
+            if len(rows) > MAX_REPLAY_ROWS + 1:
+                raise InputError(f"more than {MAX_REPLAY_ROWS:,} data rows", file=source)
+    except csv.Error as exc:  # e.g. a field over csv.field_size_limit() characters
+        raise InputError(f"unreadable CSV: {exc}", file=source, line=reader.line_num) from None
+    return rows
+
+
 def load_replay(path: str | Path, joints: Sequence[str]) -> Replay:
     """Read a `simulate` CSV (time, NAME.position/.velocity/.effort/.reference) for `joints`."""
     source = str(path)
-    rows = list(csv.reader(io.StringIO(read_text(path, max_bytes=MAX_REPLAY_BYTES, what="CSV"))))
+    rows = _rows(read_text(path, max_bytes=MAX_REPLAY_BYTES, what="CSV"), source)
     if not rows or not rows[0] or rows[0][0].strip() != TIME:
         raise InputError("first column must be 'time'", file=source, line=1)
     header = [h.strip() for h in rows[0]]

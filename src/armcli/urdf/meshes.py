@@ -2,8 +2,8 @@
 
 Package lookup order: `--package-dir NAME=PATH`, then ROS_PACKAGE_PATH-style
 search paths (each entry is a package or holds packages as subdirectories),
-then the URDF's directory or an ancestor named NAME (the usual
-`NAME/urdf/robot.urdf` layout). Relative URIs start at the URDF's directory.
+then the URDF's directory or an ancestor named NAME whose package.xml names NAME
+(the usual `NAME/urdf/robot.urdf` layout). Relative URIs start at the URDF's directory.
 A resolved path must lie inside the allowed roots (see `confined`), so a hostile
 URDF cannot make armcli read `/etc/passwd` as a mesh.
 """
@@ -18,6 +18,7 @@ from urllib.parse import unquote, urlparse
 
 from armcli.errors import InputError
 from armcli.urdf.doc import Urdf
+from armcli.urdf.mesh_confine import is_package
 from armcli.urdf.source import allowed_roots, inside_roots
 
 
@@ -56,8 +57,8 @@ def package_root(name: str, base_dir: Path, search: MeshSearch) -> Path | None:
         if (base / name).is_dir():
             return base / name
     here = base_dir.resolve()
-    for parent in (here, *here.parents):
-        if parent.name == name:
+    for parent in (here, *here.parents):  # a folder's name alone is not a package
+        if parent.name == name and is_package(parent, name):
             return parent
     return None
 

@@ -15,6 +15,7 @@ from pathlib import Path
 from lxml import etree
 
 from armcli.errors import InputError, XacroRefusedError
+from armcli.io.userfile import read_regular
 from armcli.urdf.doc import (
     JOINT_DOF,
     ZERO3,
@@ -38,6 +39,7 @@ MAX_URDF_DEPTH = 32
 # example-robot-data has 130 links and 101 DoF (tiago_dual).
 MAX_URDF_LINKS = 300
 MAX_URDF_DOF = 128
+MAX_URDF_COLLISIONS = 1000  # example-robot-data: at most 113 per robot
 
 
 def _ln(el: etree._Element) -> int | None:
@@ -311,6 +313,14 @@ def _check_size(root: etree._Element, source: str) -> None:
             file=source,
             line=_ln(links[MAX_URDF_LINKS]),
         )
+    shapes = root.findall("link/collision")
+    if len(shapes) > MAX_URDF_COLLISIONS:  # pairs grow with the square: 10000 shapes hung check
+        raise InputError(
+            f"more than {MAX_URDF_COLLISIONS} collision shapes ({len(shapes)}); "
+            "armcli's bound on robot size",
+            file=source,
+            line=_ln(shapes[MAX_URDF_COLLISIONS]),
+        )
     dof = sum(JOINT_DOF.get(str(j.get("type")), 0) for j in root.findall("joint"))
     if dof > MAX_URDF_DOF:
         raise InputError(
@@ -341,12 +351,5 @@ def parse_urdf(data: bytes, source: str) -> Urdf:
 def read_urdf(path: str | Path) -> Urdf:
     """Read and parse a URDF file with the size cap applied before reading it all."""
     p = Path(path)
-    try:
-        size = p.stat().st_size
-        if size > MAX_URDF_BYTES:
-            raise InputError(f"file is larger than {MAX_URDF_BYTES} bytes", file=p)
-        with p.open("rb") as fh:  # capped: /dev/zero or a pipe report no size
-            data = fh.read(MAX_URDF_BYTES + 1)
-    except OSError as exc:
-        raise InputError(f"cannot read: {exc.strerror}", file=p) from None
+    data = read_regular(p, max_bytes=MAX_URDF_BYTES, what="URDF file")
     return parse_urdf(data, str(p))

@@ -3,37 +3,45 @@
 A path given to `check`, `view`, `render`, `tree` (and `simulate --urdf`) is one
 of: a spec YAML (built in memory, nothing written), a URDF (read by urdfxml's
 strict reader) or a xacro file. Xacro runs Python from the file, so a foreign
-one is refused unless the user passes `--trust-xacro`, and then expanded in
-xacro_sandbox's resource-limited child process. Mesh URIs may only resolve
-inside the allowed roots, so a hostile URDF cannot make armcli read
+one is expanded in safe mode (xacro_safe: no code runs, files confined) unless
+the user passes `--trust-xacro` (xacro itself, sandboxed by xacro_sandbox).
+Mesh URIs may only resolve inside the allowed roots, so a hostile URDF cannot make armcli read
 `/etc/passwd` as a "mesh".
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Literal
 
 from armcli.build.expand import expand_urdfs
 from armcli.defaults import STANDALONE_ARM_URDF
-from armcli.errors import InputError, XacroRefusedError
+from armcli.errors import EXPANDED_TAG, InputError, XacroRefusedError
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
 from armcli.urdf.pinocchio import LoadedModel, load_model, parser_problems
 from armcli.urdf.read import parse_urdf, read_urdf
-from armcli.urdf.xacro_sandbox import expand_untrusted
+from armcli.urdf.xacro_sandbox import expand_foreign, expand_untrusted
 
 SPEC_SUFFIXES = (".yaml", ".yml")
 XACRO_SUFFIX = ".xacro"
-TRUST_XACRO_HELP = "Expand a foreign .xacro file in a sandbox (it still runs code from the file)."
-XACRO_REFUSED = (
-    "refusing to expand a xacro file armcli did not generate: xacro runs Python from the "
-    "file ($(eval ...) can run shell commands); pass --trust-xacro if you trust it, or give "
-    "the spec or the expanded .urdf instead"
+TRUST_XACRO_HELP = (
+    "Expand a foreign xacro file with xacro itself, which runs Python from the file, inside "
+    "a bubblewrap sandbox (--trust-xacro=unsandboxed: resource limits only). Without it, "
+    "xacro files are expanded in safe mode, where no code from the file runs."
 )
+UNSANDBOXED_HELP = "Same as --trust-xacro=unsandboxed: xacro itself with resource limits only."
+Trust = bool | Literal["unsandboxed"]  # --trust-xacro: False, True (sandboxed), "unsandboxed"
+
+
+def trust_mode(trust_xacro: bool, unsandboxed: bool) -> Trust:
+    """The --trust-xacro / --trust-xacro=unsandboxed options as one value."""
+    return "unsandboxed" if unsandboxed else trust_xacro
+
 
 _PROBLEM = {
     "missing": "missing number",
@@ -62,7 +70,7 @@ class RobotFile:
         return self.urdfs[0]
 
 
-def read_robot(path: Path, *, trust_xacro: bool = False) -> RobotFile:
+def read_robot(path: Path, *, trust_xacro: Trust = False) -> RobotFile:
     """Spec YAML, URDF or (trusted) xacro -> RobotFile; InputError when unusable."""
     if path.is_dir():
         raise InputError("is a directory, expected a robot spec, URDF or xacro file", file=path)
@@ -74,35 +82,43 @@ def read_robot(path: Path, *, trust_xacro: bool = False) -> RobotFile:
     return RobotFile(path, (read_urdf_file(path, trust_xacro=trust_xacro),))
 
 
-def read_urdf_file(path: Path, *, trust_xacro: bool = False) -> Urdf:
+def read_urdf_file(path: Path, *, trust_xacro: Trust = False) -> Urdf:
     """A URDF or xacro file -> Urdf; xacro (by suffix or content) only with trust_xacro."""
     if path.suffix != XACRO_SUFFIX:
         try:
             return read_urdf(path)
         except XacroRefusedError:
-            if not trust_xacro:
-                raise
-    elif not trust_xacro:
-        raise XacroRefusedError(XACRO_REFUSED, file=path)
+            pass  # xacro content in a .urdf: expanded like a .xacro file
+    if trust_xacro:
+        xml = expand_untrusted(path, unsandboxed=trust_xacro == "unsandboxed")
+        return parse_urdf(xml, f"{path}{EXPANDED_TAG}")
+    xml = expand_foreign(path, allowed_roots(path.parent))  # safe mode: no code runs
+    return parse_urdf(xml, f"{path}{EXPANDED_TAG}")
 
-    return parse_urdf(expand_untrusted(path), f"{path}#expanded")
 
-
-def load_checked_model(path: Path, *, trust_xacro: bool = False) -> LoadedModel:
+def load_checked_model(
+    path: Path, *, trust_xacro: Trust = False, gate: Callable[[Urdf], None] | None = None
+) -> LoadedModel:
     """A URDF/xacro file -> Pinocchio model, refusing what Pinocchio would silently accept.
 
     For commands that compute with the model (simulate --urdf): a malformed or
     non-finite number (Pinocchio turns mass="nan" into 0) or any error the URDF
     parser prints is an InputError naming the file and line, not a wrong result.
     """
-    return checked_model(read_urdf_file(path, trust_xacro=trust_xacro))
+    return checked_model(read_urdf_file(path, trust_xacro=trust_xacro), gate=gate)
 
 
-def checked_model(urdf: Urdf) -> LoadedModel:
-    """A parsed URDF -> Pinocchio model, refusing what Pinocchio would silently accept."""
+def checked_model(urdf: Urdf, *, gate: Callable[[Urdf], None] | None = None) -> LoadedModel:
+    """A parsed URDF -> Pinocchio model, refusing what Pinocchio would silently accept.
+
+    `gate`, when given, may refuse the document after the number checks (e.g.
+    check.gate.refuse_check_errors: the model `check` reports as an error).
+    """
     if urdf.problems:
         p = urdf.problems[0]
         raise InputError(f"{p.where}: {_PROBLEM[p.kind]} {p.text!r}", file=urdf.source, line=p.line)
+    if gate is not None:
+        gate(urdf)
     loaded = load_model(urdf.source, xml=urdf_text(urdf))
     said = [m for m in parser_problems(loaded.parser_messages) if "error" in m.lower()]
     if said:

@@ -1,29 +1,42 @@
-"""Expand a xacro file that armcli did not generate, in a resource-limited subprocess.
+"""Expand a xacro file in a resource-limited child process: safe mode and --trust-xacro.
 
-Xacro evaluates Python from the file (`${...}`, `$(eval ...)` with builtins),
-so a foreign `.xacro` is code. armcli only expands one when the user passes
-`--trust-xacro`, and even then in a child process with a wall-clock timeout,
-CPU, memory, file-size and open-file limits, an empty environment, no stdin
-and its own process group (killed as a whole on timeout). This limits damage
-from accidents (runaway recursion, huge output); it is not a security boundary
-against a malicious file, which is why the user's explicit trust is required.
+Two kinds of expansion run here, both in a child with a wall-clock timeout,
+CPU, memory, file-size and open-file limits, an empty environment, no stdin,
+its own process group (killed as a whole) and stdout read with a streaming
+cap (the child is killed as soon as it writes more than the cap):
+
+- `expand_foreign` (the default): xacro_safe's expansion, where the file
+  cannot run code (AST-whitelisted expressions, confined includes);
+- `expand_untrusted` (`--trust-xacro`): xacro itself, which runs Python from
+  the file. It runs under xacro_jail (bubblewrap: read-only root, private
+  /tmp, no network, PID namespace, cleared environment) when available, and
+  only with `--trust-xacro=unsandboxed` otherwise. See docs/security.md.
 """
 
 from __future__ import annotations
 
+import contextlib
+import json
 import os
+import selectors
 import signal
 import subprocess
 import sys
+import time
+from collections.abc import Sequence
 from pathlib import Path
 
-from armcli.errors import InputError
+from armcli.errors import InputError, XacroRefusedError
+from armcli.io.userfile import check_regular
+from armcli.urdf.xacro_jail import jail_argv, sandbox_problem, seccomp_program
 
 XACRO_TIMEOUT = 20.0  # wall clock [s]
 XACRO_CPU_SECONDS = 20
 XACRO_MEMORY_BYTES = 1 << 30
 XACRO_MAX_OUTPUT = 10_000_000  # same cap as urdfxml.MAX_URDF_BYTES
+XACRO_MAX_STDERR = 100_000
 XACRO_MAX_FILES = 64
+_CHUNK = 65536
 
 _SCRIPT = """
 import sys, xacro
@@ -41,9 +54,15 @@ except BaseException as exc:
     sys.exit(1)
 sys.stdout.buffer.write(doc.toprettyxml(indent="  ", encoding="utf-8"))
 """
+_SAFE_SCRIPT = """
+import sys
+from armcli.urdf.xacro_safe import child_main
+sys.exit(child_main(sys.argv[1:]))
+"""
 
 
-def _limit_child() -> None:  # runs in the child between fork and exec
+def limit_child() -> None:
+    """Resource limits, applied in the child between fork and exec."""
     import resource
 
     resource.setrlimit(resource.RLIMIT_CPU, (XACRO_CPU_SECONDS, XACRO_CPU_SECONDS))
@@ -53,40 +72,175 @@ def _limit_child() -> None:  # runs in the child between fork and exec
     resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
 
 
+class ChildResult:
+    """Exit status and captured (capped) output of a limited child."""
+
+    def __init__(self, returncode: int, out: bytes, err: bytes, why: str | None) -> None:
+        self.returncode = returncode
+        self.out = out
+        self.err = err
+        self.why = why  # set when armcli killed the child (timeout, output cap)
+
+
+def run_limited(
+    argv: Sequence[str],
+    cwd: Path,
+    *,
+    timeout: float = XACRO_TIMEOUT,
+    env: dict[str, str] | None = None,
+    pass_fds: Sequence[int] = (),
+) -> ChildResult:
+    """Run `argv` limited, reading stdout/stderr with streaming caps; kill the group on excess."""
+    proc = subprocess.Popen(
+        list(argv),
+        cwd=cwd,
+        env=env if env is not None else {"PATH": os.defpath, "LANG": "C.UTF-8"},
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        preexec_fn=limit_child,  # no threads exist before exec
+        pass_fds=tuple(pass_fds),
+        start_new_session=True,
+    )
+    assert proc.stdout is not None and proc.stderr is not None
+    caps: dict[object, int] = {proc.stdout: XACRO_MAX_OUTPUT, proc.stderr: XACRO_MAX_STDERR}
+    bufs: dict[object, bytearray] = {proc.stdout: bytearray(), proc.stderr: bytearray()}
+    why = _pump(proc, caps, bufs, time.monotonic() + timeout, timeout)
+    if why is not None:
+        _kill_group(proc.pid)
+    proc.wait()
+    proc.stdout.close()
+    proc.stderr.close()
+    return ChildResult(proc.returncode, bytes(bufs[proc.stdout]), bytes(bufs[proc.stderr]), why)
+
+
+def _pump(
+    proc: subprocess.Popen[bytes],
+    caps: dict[object, int],
+    bufs: dict[object, bytearray],
+    deadline: float,
+    timeout: float,
+) -> str | None:
+    with selectors.DefaultSelector() as sel:
+        for stream in caps:
+            sel.register(stream, selectors.EVENT_READ)  # type: ignore[arg-type]
+        while sel.get_map():
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return f"took longer than {timeout:g} s"
+            for key, _ in sel.select(timeout=left):
+                chunk = os.read(key.fd, _CHUNK)
+                if not chunk:
+                    sel.unregister(key.fileobj)
+                    continue
+                buf = bufs[key.fileobj]
+                buf += chunk
+                if len(buf) > caps[key.fileobj]:
+                    what = "output" if key.fileobj is proc.stdout else "error output"
+                    return f"{what} is larger than {caps[key.fileobj]} bytes"
+    return None
+
+
+def _kill_group(pgid: int) -> None:
+    with contextlib.suppress(ProcessLookupError):
+        os.killpg(pgid, signal.SIGKILL)
+
+
+def _python() -> list[str]:
+    return [sys.executable, "-I"]
+
+
+def expand_foreign(path: str | Path, roots: Sequence[Path]) -> bytes:
+    """Safe-mode expansion (xacro_safe) of a foreign xacro file in a limited child."""
+    p = Path(path)
+    check_regular(p, "xacro file")
+    argv = [*_python(), "-c", _SAFE_SCRIPT, str(p.resolve()), *map(str, roots)]
+    env = {"PATH": os.defpath, "LANG": "C.UTF-8"}
+    if "ROS_PACKAGE_PATH" in os.environ:  # $(find pkg) lookups, the ROS convention
+        env["ROS_PACKAGE_PATH"] = os.environ["ROS_PACKAGE_PATH"]
+    res = run_limited(argv, p.resolve().parent, env=env)
+    if res.why is not None:
+        raise InputError(f"xacro expansion {res.why}", file=p)
+    if res.returncode != 0:
+        _raise_report(p, res)
+    return res.out
+
+
+def _raise_report(p: Path, res: ChildResult) -> None:
+    lines = [ln for ln in res.err.decode("utf-8", "replace").splitlines() if ln.strip()]
+    if lines:
+        try:
+            rep = json.loads(lines[-1])
+        except ValueError:
+            rep = None
+        if isinstance(rep, dict) and "message" in rep:
+            cls = XacroRefusedError if rep.get("kind") == "refused" else InputError
+            file = rep.get("file") or str(p.resolve())
+            shown = p if file == str(p.resolve()) else file  # the path as the user gave it
+            raise cls(str(rep["message"]), file=shown, line=rep.get("line"))
+    why = _last_line(res) or f"exit status {res.returncode}"
+    raise InputError(f"xacro expansion failed: {why}", file=p)
+
+
+def _last_line(res: ChildResult) -> str | None:
+    if res.returncode < 0:
+        return f"killed by signal {signal.Signals(-res.returncode).name}"
+    lines = [ln for ln in res.err.decode("utf-8", "replace").splitlines() if ln.strip()]
+    return lines[-1] if lines else None
+
+
 def expand_untrusted(
     path: str | Path,
     *,
     mappings: dict[str, str] | None = None,
     timeout: float = XACRO_TIMEOUT,
+    unsandboxed: bool = False,
 ) -> bytes:
-    """The expanded URDF bytes of a user-trusted xacro file; InputError if expansion fails."""
+    """The expanded URDF bytes of a user-trusted xacro file; InputError if expansion fails.
+
+    xacro runs inside xacro_jail's bubblewrap sandbox; where that cannot run, the
+    expansion is refused unless `unsandboxed` (`--trust-xacro=unsandboxed`: the
+    resource limits only).
+    """
     p = Path(path)
-    if not p.is_file():
-        raise InputError("no such file", file=p)
+    check_regular(p, "xacro file")
     args = [f"{k}:={v}" for k, v in (mappings or {}).items()]
     env = {"PATH": os.defpath, "LANG": "C.UTF-8"}
-    if "ROS_PACKAGE_PATH" in os.environ:  # $(find pkg) lookups, the ROS convention
+    if "ROS_PACKAGE_PATH" in os.environ:
         env["ROS_PACKAGE_PATH"] = os.environ["ROS_PACKAGE_PATH"]
-    proc = subprocess.Popen(
-        [sys.executable, "-I", "-c", _SCRIPT, str(p.resolve()), *args],
-        cwd=p.resolve().parent,
-        env=env,
-        stdin=subprocess.DEVNULL,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        preexec_fn=_limit_child,  # no threads exist before exec in the child
-        start_new_session=True,
-    )
+    argv = [*_python(), "-c", _SCRIPT, str(p.resolve()), *args]
+    if unsandboxed:
+        res = run_limited(argv, p.resolve().parent, timeout=timeout, env=env)
+    else:
+        res = _run_jailed(argv, p, env, timeout)
+    if res.why is not None:
+        raise InputError(f"xacro expansion {res.why}", file=p)
+    if res.returncode != 0:
+        raise InputError(f"xacro expansion failed: {_last_line(res)}", file=p)
+    return res.out
+
+
+def _run_jailed(argv: list[str], p: Path, env: dict[str, str], timeout: float) -> ChildResult:
+    problem = sandbox_problem()
+    program = seccomp_program()
+    if problem is not None or program is None:
+        raise XacroRefusedError(
+            f"--trust-xacro runs xacro in a bubblewrap sandbox, which cannot run here: {problem}; "
+            "install the Debian package bubblewrap, or pass --trust-xacro=unsandboxed to run "
+            "xacro with resource limits only (the file's code can then read your files)",
+            file=p,
+        )
+    read_end, write_end = os.pipe()
     try:
-        out, err = proc.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)
-        proc.communicate()
-        raise InputError(f"xacro expansion took longer than {timeout:g} s", file=p) from None
-    if proc.returncode != 0:
-        lines = [ln for ln in err.decode("utf-8", "replace").splitlines() if ln.strip()]
-        why = lines[-1] if lines else f"exit status {proc.returncode}"
-        raise InputError(f"xacro expansion failed: {why}", file=p)
-    if len(out) > XACRO_MAX_OUTPUT:
-        raise InputError(f"xacro output is larger than {XACRO_MAX_OUTPUT} bytes", file=p)
-    return out
+        os.write(write_end, program)
+        os.close(write_end)
+        roots = [
+            p.resolve().parent,
+            *(Path(r) for r in env.get("ROS_PACKAGE_PATH", "").split(":") if r),
+        ]
+        jailed = jail_argv(argv, binds=roots, env=env, cwd=p.resolve().parent, seccomp_fd=read_end)
+        return run_limited(
+            jailed, p.resolve().parent, timeout=timeout, env=env, pass_fds=[read_end]
+        )
+    finally:
+        os.close(read_end)

@@ -20,11 +20,14 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
+from armcli.urdf.mesh_confine import bounded_mesh_file, check_total
 from armcli.urdf.meshes import MeshSearch, confined, resolve
 from armcli.urdf.read import parse_root
 from armcli.urdf.tool import ToolPoint
 
 MAX_EDGE = 0.04  # [m] faces are split to this edge length so depth sorting works
+SPLIT_ROUNDS = 8  # halvings at most; longer edges stay longer than MAX_EDGE
+MAX_RENDER_TRIANGLES = 2_000_000  # after splitting: ~1 GB of matplotlib polygons
 LIGHT = np.array([0.35, -0.55, 0.76])  # direction towards the light, world frame
 AMBIENT = 0.3  # share of colour that does not depend on the light
 VIEWS = (  # (title, elevation [deg], azimuth [deg])
@@ -72,6 +75,7 @@ def load_urdf(
     missing: list[str] = []
     base = Path(mesh_dir or ".")
     where = search or MeshSearch()
+    loaded: set[Path] = set()
 
     def resolve_mesh(fname: str) -> str:
         path = resolve(fname, base, where)
@@ -84,7 +88,10 @@ def load_urdf(
         if path is None or not path.is_file():
             missing.append(fname)
             return fname
-        return str(path)
+        real = bounded_mesh_file(path, source)  # trimesh opens the checked real path
+        loaded.add(real)
+        check_total(loaded, source)
+        return str(real)
 
     log = logging.getLogger("yourdfpy")
     level, log.level = log.level, logging.CRITICAL  # its warnings become our error below
@@ -171,14 +178,32 @@ def _mesh_rgba(mesh: Any) -> np.ndarray:
         return np.array([FALLBACK_RGBA])
 
 
+def _split_for_sorting(mesh: Any) -> Any:
+    """Faces split to about MAX_EDGE, coarser for large shapes so at most 2**SPLIT_ROUNDS per edge.
+
+    A fixed MAX_EDGE made trimesh give up ("max_iter exceeded") on a 10 m box.
+    """
+    size = float(np.linalg.norm(mesh.extents))
+    if not size > MAX_EDGE:
+        return mesh
+    edge = max(MAX_EDGE, size / 2 ** (SPLIT_ROUNDS - 1))
+    return mesh.subdivide_to_size(edge, max_iter=SPLIT_ROUNDS)
+
+
 def posed_triangles(urdf: Any, q: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
     """World-frame triangles (n, 3, 3) [m] and their shaded RGBA colours (n, 4) at pose q."""
     urdf.update_cfg(dict(q))
     tris, cols = [], []
+    n_faces = 0
     for mesh in urdf.scene.dump():
         rgba = _mesh_rgba(mesh)
-        if mesh.extents.max() > MAX_EDGE:
-            mesh = mesh.subdivide_to_size(MAX_EDGE, max_iter=8)
+        mesh = _split_for_sorting(mesh)
+        n_faces += len(mesh.faces)
+        if n_faces > MAX_RENDER_TRIANGLES:
+            raise InputError(
+                f"more than {MAX_RENDER_TRIANGLES:,} triangles to draw; armcli's render bound "
+                "(simplify the visual meshes)",
+            )
         normals = np.asarray(mesh.face_normals)
         light = AMBIENT + (1 - AMBIENT) * np.clip(normals @ (LIGHT / np.linalg.norm(LIGHT)), 0, 1)
         c = np.repeat(rgba, len(mesh.faces), axis=0)

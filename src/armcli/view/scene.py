@@ -13,7 +13,7 @@ from pathlib import Path
 from armcli.errors import InputError
 from armcli.spec.expr import eval_expr
 from armcli.urdf.meshes import MeshSearch
-from armcli.urdf.source import read_robot, urdf_text
+from armcli.urdf.source import Trust, read_robot, urdf_text
 from armcli.urdf.tool import ToolPoint, tool_point
 from armcli.urdf.tree import tree_from_urdf
 
@@ -38,7 +38,7 @@ class RobotSource:
 
 
 def load_robot(
-    path: Path, trust_xacro: bool = False, search: MeshSearch | None = None
+    path: Path, trust_xacro: Trust = False, search: MeshSearch | None = None
 ) -> RobotSource:
     """Spec YAML (built in memory), URDF or trusted xacro file -> RobotSource.
 

@@ -1,0 +1,27 @@
+"""`simulate --urdf` refuses a model that `check` reports as an error, with the same rule id.
+
+Pinocchio simulates a zero joint axis, an inertia that violates the triangle
+inequality or a negative mass without complaint, and the run then fails late
+with a misleading cause ("kinetic energy exceeded", blamed on the gains) or,
+worse, succeeds with wrong numbers. Running the same rules as `armcli check`
+first makes the two commands agree on what a usable model is.
+"""
+
+from __future__ import annotations
+
+from armcli.check.rules import ERROR, CheckOptions
+from armcli.check.run import check_urdf
+from armcli.errors import ModelRefusedError, RuleViolation
+from armcli.urdf.doc import Urdf
+
+
+def refuse_check_errors(urdf: Urdf, options: CheckOptions | None = None) -> None:
+    """Raise ModelRefusedError when any check rule reports an error for `urdf`."""
+    result = check_urdf(urdf, options)
+    errors = [
+        RuleViolation(f.rule, f.file, f.line, f.message)
+        for f in result.findings
+        if f.severity == ERROR
+    ]
+    if errors:
+        raise ModelRefusedError(urdf.source, errors)

@@ -1,0 +1,83 @@
+"""Numeric options and file-derived counts are bounded (issue 15); each case crashed or ran away."""
+
+from __future__ import annotations
+
+import csv
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from armcli.errors import InputError
+from armcli.sim.states import load_replay
+
+TIME_LIMIT_S = 120.0  # one CLI run on a loaded 2-core machine
+CSV_FIELD_LIMIT = csv.field_size_limit()  # 131072: the csv module's default
+TRAJECTORY = (
+    "{joint_names: [arm_base_forearm_joint], points: [{positions: [0.2], time_from_start: 0.5}]}"
+)
+
+
+def run_cli(args: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "armcli.cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=TIME_LIMIT_S,
+        check=False,
+        cwd=cwd,
+    )
+
+
+def test_replay_field_over_csv_limit_is_an_input_error(tmp_path: Path) -> None:
+    huge = tmp_path / "huge.csv"
+    huge.write_text("time,j.position\n0," + "1" * (CSV_FIELD_LIMIT + 1) + "\n")
+    with pytest.raises(InputError, match=r"huge\.csv:2: unreadable CSV: field larger than"):
+        load_replay(huge, ["j"])
+
+
+def test_replay_field_through_view(tmp_path: Path, root: Path, default_spec_path: Path) -> None:
+    huge = tmp_path / "huge.csv"
+    huge.write_text("time,arm_base_forearm_joint.position\n0," + "1" * 200_000 + "\n")
+    proc = run_cli(["view", str(default_spec_path), "--replay", str(huge), "--port", "0"], root)
+    assert proc.returncode == 2, proc.stderr
+    assert "unreadable CSV: field larger than field limit" in proc.stderr
+    assert "internal error" not in proc.stderr
+
+
+@pytest.mark.parametrize("rate", ["1e9", "1000.5", "-1", "nan"])
+def test_rate_bounded_by_time_step(
+    rate: str, tmp_path: Path, root: Path, default_spec_path: Path
+) -> None:
+    # The default spec's dt is 0.001 s, so 1/dt = 1000 Hz; 1e9 Hz asked for 52 GiB before.
+    out = tmp_path / "s.csv"
+    args = ["simulate", str(default_spec_path), "-m", TRAJECTORY, "--output", str(out)]
+    proc = run_cli([*args, "--rate", rate], root)
+    assert proc.returncode == 2, proc.stderr
+    assert "--rate: must be in (0, 1/dt = 1000] Hz" in proc.stderr
+    assert not out.exists()
+
+
+def test_rate_equal_to_one_per_step_writes_every_step(
+    tmp_path: Path, root: Path, default_spec_path: Path
+) -> None:
+    out = tmp_path / "s.csv"
+    args = ["simulate", str(default_spec_path), "-m", TRAJECTORY, "--duration", "0.1"]
+    proc = run_cli([*args, "--rate", "1000", "--output", str(out)], root)
+    assert proc.returncode == 0, proc.stderr
+    # 0.1 s at dt = 0.001 s: steps 0..100 inclusive, one row each, plus the header.
+    assert len(out.read_text().splitlines()) == 101 + 1
+
+
+@pytest.mark.parametrize(
+    ("option", "value"), [("--samples", "1000000001"), ("--samples", "0"), ("--seed", "-1")]
+)
+def test_ros_package_counts_bounded(
+    option: str, value: str, tmp_path: Path, root: Path, default_spec_path: Path
+) -> None:
+    out = tmp_path / "ros"
+    proc = run_cli(["ros-package", str(default_spec_path), "-o", str(out), option, value], root)
+    assert proc.returncode == 2, proc.stderr
+    assert f"Invalid value for '{option}'" in proc.stderr
+    assert not out.exists()
