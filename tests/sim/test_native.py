@@ -81,3 +81,48 @@ def test_model_arrays_keep_unaligned_axes() -> None:
     arrays = native.model_arrays(model)
     np.testing.assert_array_equal(arrays["axis"], [axis, pin_axis])
     assert arrays["jtype"].tolist() == [3, 7]
+
+
+def test_simulate_batch_equals_simulate_run_by_run() -> None:
+    """The batch entry point (used by `armcli tune`) gives each run's `simulate` result exactly,
+    diverged runs included."""
+    from armcli.errors import SimulationError
+    from armcli.sim.job import load_arm
+    from armcli.sim.reference import build_reference
+    from armcli.sim.simulate import Run, SimConfig, simulate, simulate_batch
+    from armcli.sim.trajectory import loads_trajectory
+    from armcli.spec.load import load_spec
+    from tests.helpers import DEFAULT_SPEC
+
+    arm = load_arm(load_spec(DEFAULT_SPEC), None, None)
+    limits = {
+        n: (float(lo), float(hi))
+        for n, lo, hi in zip(arm.joint_names, arm.lower, arm.upper, strict=True)
+    }
+    text = (
+        "joint_names: [arm_base_forearm_joint, forearm_hand_joint]\n"
+        "points: [{positions: [0.8, 0.4]}, {positions: [0.2, 1.2]}]"
+    )
+    traj = loads_trajectory(text, limits)
+    q0 = np.zeros(2)
+    ref = build_reference(traj, arm.joint_names, q0)
+    runs = [
+        Run(arm, ref, q0, 3.0, SimConfig(kp=np.full(2, kp), kd=np.full(2, kd), integrator=integ))
+        for kp, kd, integ in [
+            (50, 5, "euler"),
+            (200, 2, "euler"),
+            (50, 5, "rk4"),
+            (5e5, 0.0, "rk4"),
+        ]
+    ]
+    batch = simulate_batch(runs)
+    assert sum(isinstance(r, SimulationError) for r in batch) == 1  # negative Kd pumps energy in: diverges
+    for run, got in zip(runs, batch, strict=True):
+        try:
+            want = simulate(run.arm, run.reference, run.q0, run.duration, run.cfg)
+        except SimulationError as exc:
+            assert isinstance(got, SimulationError) and str(got) == str(exc)
+            continue
+        assert not isinstance(got, SimulationError)
+        np.testing.assert_array_equal(got.q, want.q)
+        np.testing.assert_array_equal(got.tau, want.tau)

@@ -204,6 +204,91 @@ def simulate(
     return replace(res, notice=notice)
 
 
+@dataclass(frozen=True)
+class Run:
+    """One closed-loop run of a batch: an arm, its reference, start and settings."""
+
+    arm: Arm
+    reference: Any  # reference.Reference
+    q0: np.ndarray
+    duration: float  # [s]
+    cfg: SimConfig
+
+
+@dataclass
+class _Progress:
+    """One run of a batch between chunks: its plant and tables, state so far, outcome."""
+
+    plant: ro.Plant
+    params: np.ndarray
+    ref: np.ndarray
+    q_ref: np.ndarray
+    v_ref: np.ndarray
+    steps: int
+    q: np.ndarray
+    v: np.ndarray
+    parts: list[ro.Rollout]
+    error: SimulationError | None = None
+
+
+def _start(r: Run) -> _Progress:
+    steps = max(1, round(r.duration / r.cfg.dt))
+    params = params_of(r.arm, r.cfg)
+    energy = _energy_max(r.arm, r.q0, params)
+    plant = ro.Plant(r.arm.model, params, r.cfg.gravity_comp, r.cfg.dt, r.cfg.integrator, energy)
+    ref, q_ref, v_ref = sample_reference(r.reference, steps, r.cfg.dt, r.cfg.integrator)
+    q0 = np.array(r.q0, dtype=float)
+    return _Progress(plant, params, ref, q_ref, v_ref, steps, q0, np.zeros(len(q0)), [])
+
+
+def simulate_batch(runs: Sequence[Run]) -> list[SimResult | SimulationError]:
+    """Many independent runs; each result equals `simulate`'s (or its SimulationError).
+
+    With the compiled engine, the same chunk of every run goes to the extension in one
+    `native.rollout_batch` call on one thread (callers such as `armcli tune` parallelise
+    across batches); without it, the runs go through `simulate` one by one.
+    """
+    mod = native.load()
+    if not runs or mod is None or any(r.cfg.backend == "python" for r in runs):
+        return [_simulate_or_error(r) for r in runs]
+    state = [_start(r) for r in runs]
+    compiled = {id(r.arm.model): native.compiled_model(mod, r.arm.model) for r in runs}
+    chunk = CHUNK_STEPS[native.engine_name(mod)]
+    start = time.perf_counter()
+    for k0 in range(0, max(s.steps for s in state), chunk):
+        live = [i for i, s in enumerate(state) if k0 < s.steps and s.error is None]
+        jobs = []
+        for i in live:
+            s, sub = state[i], ro.rows_per_step(runs[i].cfg.integrator)
+            table = s.ref[sub * k0 : sub * min(s.steps, k0 + chunk) + 1]
+            jobs.append(native.Job(s.plant, s.q, s.v, table, compiled[id(s.plant.model)]))
+        for i, r in zip(live, native.rollout_batch(mod, jobs, threads=1), strict=True):
+            s = state[i]
+            s.parts.append(r)
+            if r.fail_step >= 0:
+                try:
+                    _raise(runs[i].arm, s.params, s.plant, r, k0)
+                except SimulationError as exc:
+                    s.error = exc
+                continue
+            s.q, s.v = r.q[-1], r.v[-1]
+    wall = (time.perf_counter() - start) / max(1, len(runs))
+    name = native.engine_name(mod)
+    return [
+        s.error
+        if s.error is not None
+        else _result(r.arm, r.cfg, s.parts, s.q_ref, s.v_ref, name, wall)
+        for r, s in zip(runs, state, strict=True)
+    ]
+
+
+def _simulate_or_error(r: Run) -> SimResult | SimulationError:
+    try:
+        return simulate(r.arm, r.reference, r.q0, r.duration, r.cfg)
+    except SimulationError as exc:
+        return exc
+
+
 def sample_reference(
     reference: Any, steps: int, dt: float, integrator: str
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -6,9 +6,8 @@ numbers for the same inputs (same compiled rollout, same operation order); how a
 is cut into chunks does not change any result, since every rollout is independent.
 
 `rollout_batch` is the single place that runs the simulator: all rollouts of a chunk
-(candidates x models x cases) in one call. Today it loops over `sim.simulate` (the
-compiled rollout, which releases the GIL; else the Python loop); `sim.native.rollout_batch`
-(plants and gain sets on threads) can replace that one function.
+(candidates x models x cases) in one `sim.simulate.simulate_batch` call, which hands them
+to the compiled extension's batch rollout together (GIL released; else the Python loop).
 """
 
 from __future__ import annotations
@@ -18,8 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from armcli.errors import SimulationError
-from armcli.sim.simulate import Arm, SimConfig, SimResult, simulate
+from armcli.sim.simulate import Arm, Run, SimConfig, SimResult, simulate_batch
 from armcli.tune.model_gains import loop_stable
 from armcli.tune.objective import METRIC_FIELDS, Weights, run_cost, run_metrics
 from armcli.tune.problem import Case, TuneProblem, scored_models
@@ -45,15 +43,9 @@ class RolloutJob:
 
 
 def rollout_batch(jobs: Sequence[RolloutJob]) -> list[SimResult | None]:
-    """Run every job; None for a run that diverged. The batch-extension switch point."""
-    out: list[SimResult | None] = []
-    for job in jobs:
-        try:
-            out.append(simulate(job.arm, job.case.reference, job.case.q0, job.case.duration,
-                                job.cfg))  # fmt: skip
-        except SimulationError:
-            out.append(None)
-    return out
+    """Run every job through the simulator's batch entry point; None for a diverged run."""
+    runs = [Run(j.arm, j.case.reference, j.case.q0, j.case.duration, j.cfg) for j in jobs]
+    return [r if isinstance(r, SimResult) else None for r in simulate_batch(runs)]
 
 
 def _unstable_reason(problem: TuneProblem, kp: np.ndarray, kd: np.ndarray) -> str:
