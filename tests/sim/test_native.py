@@ -112,11 +112,12 @@ def test_simulate_batch_equals_simulate_run_by_run() -> None:
             (50, 5, "euler"),
             (200, 2, "euler"),
             (50, 5, "rk4"),
-            (5e5, 0.0, "rk4"),
+            (50, -5, "euler"),
         ]
     ]
     batch = simulate_batch(runs)
-    assert sum(isinstance(r, SimulationError) for r in batch) == 1  # negative Kd pumps energy in: diverges
+    # negative Kd pumps energy in: that run diverges
+    assert sum(isinstance(r, SimulationError) for r in batch) == 1
     for run, got in zip(runs, batch, strict=True):
         try:
             want = simulate(run.arm, run.reference, run.q0, run.duration, run.cfg)
