@@ -109,7 +109,7 @@ def test_strict_and_extra_args(tmp_path: Path) -> None:
     ("inputs", "message"),
     [
         ({"paths": "robots", "strict": "maybe"}, "input 'strict' must be true or false"),
-        ({"paths": "no_such_dir"}, "cannot read"),
+        ({"paths": "no_such_dir"}, "URDF file not found"),
     ],
 )
 def test_bad_inputs_exit_2(tmp_path: Path, inputs: dict[str, str], message: str) -> None:

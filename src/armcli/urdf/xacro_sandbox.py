@@ -220,6 +220,13 @@ def expand_untrusted(
     return res.out
 
 
+def _interpreter_dirs() -> list[Path]:
+    """Where this Python and its packages live: the jail must see them even under /tmp."""
+    dirs = {sys.prefix, sys.base_prefix, sys.exec_prefix, os.path.dirname(sys.executable)}
+    dirs |= {d for d in sys.path if d and os.path.isdir(d)}
+    return [Path(d) for d in sorted(dirs)]
+
+
 def _run_jailed(argv: list[str], p: Path, env: dict[str, str], timeout: float) -> ChildResult:
     problem = sandbox_problem()
     program = seccomp_program()
@@ -237,6 +244,7 @@ def _run_jailed(argv: list[str], p: Path, env: dict[str, str], timeout: float) -
         roots = [
             p.resolve().parent,
             *(Path(r) for r in env.get("ROS_PACKAGE_PATH", "").split(":") if r),
+            *_interpreter_dirs(),
         ]
         jailed = jail_argv(argv, binds=roots, env=env, cwd=p.resolve().parent, seccomp_fd=read_end)
         return run_limited(
