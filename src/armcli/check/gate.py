@@ -14,14 +14,22 @@ from armcli.check.run import check_urdf
 from armcli.errors import ModelRefusedError, RuleViolation
 from armcli.urdf.doc import Urdf
 
+# Errors about what the simulator never reads or what a run itself shows: meshes and colours
+# (the dynamics come from <inertial>), contact at named poses, the URDF's name, and a motor
+# too weak for gravity (the run reports the saturation).
+NOT_SIMULATED = frozenset(
+    {"mesh-missing", "self-collision", "material-undefined", "rgba-range", "robot-name",
+     "gravity-effort"}
+)  # fmt: skip
+
 
 def refuse_check_errors(urdf: Urdf, options: CheckOptions | None = None) -> None:
-    """Raise ModelRefusedError when any check rule reports an error for `urdf`."""
+    """Raise ModelRefusedError when a check rule that bears on the dynamics reports an error."""
     result = check_urdf(urdf, options)
     errors = [
         RuleViolation(f.rule, f.file, f.line, f.message)
         for f in result.findings
-        if f.severity == ERROR
+        if f.severity == ERROR and f.rule not in NOT_SIMULATED
     ]
     if errors:
         raise ModelRefusedError(urdf.source, errors)
