@@ -177,3 +177,20 @@ def test_collision_shape_count_bounded(tmp_path: Path, root: Path) -> None:
     proc = run_cli(["check", "--spec", str(spec), str(urdf)], root)
     assert proc.returncode == 2, proc.stderr
     assert f"more than {MAX_URDF_COLLISIONS} collision shapes (10003)" in proc.stderr
+
+
+def test_ament_index_registered_share_dir_is_a_package_root(tmp_path: Path) -> None:
+    """ROS 2 resolves package://NAME through the ament index (<prefix>/share/NAME), whatever
+    package.xml says (example-robot-data's names example_robot_descriptions)."""
+    from armcli.urdf.mesh_confine import is_package
+
+    share = tmp_path / "prefix" / "share"
+    pkg = share / "robot-data"
+    pkg.mkdir(parents=True)
+    (pkg / "package.xml").write_text(PACKAGE_XML.format(name="robot_descriptions"))
+    assert not is_package(pkg, "robot-data")  # neither package.xml nor the index says so
+    marker = share / "ament_index" / "resource_index" / "packages" / "robot-data"
+    marker.parent.mkdir(parents=True)
+    marker.touch()
+    assert is_package(pkg, "robot-data")
+    assert not is_package(pkg, "other")

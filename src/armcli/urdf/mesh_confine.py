@@ -45,8 +45,18 @@ def package_xml_name(directory: Path) -> str | None:
 
 
 def is_package(directory: Path, name: str) -> bool:
-    """Whether `directory` is the ROS package `name` (its package.xml says so)."""
-    return package_xml_name(directory) == name
+    """Whether `directory` is the ROS package `name`.
+
+    Either its package.xml says so, or it is an installed ROS 2 package: `<prefix>/share/NAME`
+    registered in the ament index (`<prefix>/share/ament_index/resource_index/packages/NAME`),
+    which is how `package://NAME` resolves in ROS 2 even when package.xml names it otherwise
+    (example-robot-data's says example_robot_descriptions).
+    """
+    if package_xml_name(directory) == name:
+        return True
+    share = directory.parent
+    marker = share / "ament_index" / "resource_index" / "packages" / name
+    return directory.name == name and share.name == "share" and marker.is_file()
 
 
 def bounded_mesh_file(path: Path, source: str) -> Path:
