@@ -93,6 +93,28 @@ def _yaml_error(exc: yaml.YAMLError, source: str) -> InputError:
     return InputError(f"malformed YAML: {problem}", file=source, line=line)
 
 
+def _scalar(node: yaml.ScalarNode, loader: _Loader, path: Path_, doc: YamlDoc) -> Any:
+    """A scalar as str/int/float/bool/None; integers beyond any float are refused."""
+    try:
+        value = loader.construct_object(node, deep=True)
+    except ValueError:  # int("9" * 5000): Python's 4300-digit conversion limit
+        value = None
+        too_big = True
+    else:  # 0xfff...: no digit limit, but beyond any float (and str() of it fails)
+        too_big = isinstance(value, int) and value.bit_length() > MAX_INT_BITS
+    if too_big:
+        raise InputError(
+            f"integer out of range ({len(node.value)} characters; at most 1.8e308)",
+            file=doc.source,
+            line=node.start_mark.line + 1,
+            field=_dotted(path) or None,
+        )
+    if isinstance(value, str | int | float | bool) or value is None:
+        return value
+    # timestamps, binary, ...: keep the source text, the schema decides.
+    return str(node.value)
+
+
 def _build(
     node: yaml.Node,
     loader: _Loader,
@@ -106,24 +128,7 @@ def _build(
             f"unsupported YAML tag {node.tag!r}", file=doc.source, line=node.start_mark.line + 1
         )
     if isinstance(node, yaml.ScalarNode):
-        try:
-            value = loader.construct_object(node, deep=True)
-        except ValueError:  # int("9" * 5000): Python's 4300-digit conversion limit
-            value = None
-            too_big = True
-        else:  # 0xfff...: no digit limit, but beyond any float (and str() of it fails)
-            too_big = isinstance(value, int) and value.bit_length() > MAX_INT_BITS
-        if too_big:
-            raise InputError(
-                f"integer out of range ({len(node.value)} characters; at most 1.8e308)",
-                file=doc.source,
-                line=node.start_mark.line + 1,
-                field=_dotted(path) or None,
-            )
-        if isinstance(value, str | int | float | bool) or value is None:
-            return value
-        # timestamps, binary, ...: keep the source text, the schema decides.
-        return str(node.value)
+        return _scalar(node, loader, path, doc)
     if isinstance(node, yaml.SequenceNode):
         return [
             _build(child, loader, (*path, i), doc, flow_sets) for i, child in enumerate(node.value)

@@ -158,6 +158,35 @@ def start_state(arm: Arm, spec: RobotSpec | None) -> np.ndarray:
     return np.clip(q, arm.lower, arm.upper)
 
 
+def _duration_and_rate(
+    spec: RobotSpec | None, opts: SimOptions, t_last: float, dt: float
+) -> tuple[float, float]:
+    """Simulated time [s] (default: the last point + settle time) and output rate [Hz], bounded."""
+    rate = opts.rate
+    total = opts.duration if opts.duration is not None else t_last + SETTLE_EXTRA_S
+    if not (np.isfinite(total) and 0 < total <= 3600):
+        raise InputError(f"must be in (0, 3600] s, got {total:g}", field="--duration")
+    if total / dt > MAX_STEPS:
+        raise InputError(
+            f"{total:g} s at dt = {dt:g} s is {total / dt:.3g} steps, more than {MAX_STEPS:,}; "
+            "shorten --duration or raise --dt",
+            field="--duration",
+        )
+    jsp = spec.arm.joint_state_publisher if spec is not None else None
+    rate = (
+        rate
+        if rate is not None
+        else (jsp.update_rate if jsp is not None else DEFAULT_STATE_RATE_HZ)
+    )
+    if not (np.isfinite(rate) and 0 < rate <= (1.0 + RATE_SLACK) / dt):
+        raise InputError(
+            f"must be in (0, 1/dt = {1.0 / dt:g}] Hz (one state per time step at most), "
+            f"got {rate:g}",
+            field="--rate",
+        )
+    return float(total), float(rate)
+
+
 def prepare(
     spec: RobotSpec | None, opts: SimOptions, *, gate: Callable[[Urdf], None] | None = None
 ) -> SimJob:
@@ -166,7 +195,7 @@ def prepare(
     `gate` sees a given URDF (`--urdf`) before it is simulated and may refuse it
     (the simulate command passes check.gate.refuse_check_errors).
     """
-    trajectory, message, dt, rate = opts.trajectory, opts.message, opts.dt, opts.rate
+    trajectory, message, dt = opts.trajectory, opts.message, opts.dt
     if (trajectory is None) == (message is None):
         raise InputError(
             "give exactly one of --trajectory FILE or --message '...'", field="--trajectory"
@@ -197,27 +226,7 @@ def prepare(
     cfg = SimConfig(kp, kd, dt, opts.integrator, gc, opts.engine)
     configs = np.vstack([q0[None, :], ref.sample(traj.times)[0]])
     check_stability(arm, cfg, configs)
-    total = opts.duration if opts.duration is not None else traj.duration + SETTLE_EXTRA_S
-    if not (np.isfinite(total) and 0 < total <= 3600):
-        raise InputError(f"must be in (0, 3600] s, got {total:g}", field="--duration")
-    if total / dt > MAX_STEPS:
-        raise InputError(
-            f"{total:g} s at dt = {dt:g} s is {total / dt:.3g} steps, more than {MAX_STEPS:,}; "
-            "shorten --duration or raise --dt",
-            field="--duration",
-        )
-    jsp = spec.arm.joint_state_publisher if spec is not None else None
-    rate = (
-        rate
-        if rate is not None
-        else (jsp.update_rate if jsp is not None else DEFAULT_STATE_RATE_HZ)
-    )
-    if not (np.isfinite(rate) and 0 < rate <= (1.0 + RATE_SLACK) / dt):
-        raise InputError(
-            f"must be in (0, 1/dt = {1.0 / dt:g}] Hz (one state per time step at most), "
-            f"got {rate:g}",
-            field="--rate",
-        )
+    total, rate = _duration_and_rate(spec, opts, traj.duration, dt)
     fid, off, label = _tool(arm, doc, spec)
     frame, T_frame_root = _report_frame(arm, spec)
     label = f"{label} in {frame}"

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import io
 import textwrap
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -53,6 +53,31 @@ FALLBACK_RGBA = (0.6, 0.6, 0.6, 1.0)  # meshes whose colour cannot be read
 TITLE_WIDTH = 110  # [characters] per title line, so many joints do not run off the figure
 
 
+def _mesh_handler(
+    base: Path, where: MeshSearch, source: str, missing: list[str]
+) -> Callable[[str], str]:
+    """Yourdfpy's filename handler: armcli's resolver, confinement and size caps."""
+    loaded: set[Path] = set()
+
+    def resolve_mesh(fname: str) -> str:
+        path = resolve(fname, base, where)
+        if path is not None and not confined(fname, path, base, where):
+            raise InputError(  # never read files outside the roots
+                f"mesh {fname!r} resolves to {path}, outside the allowed directories "
+                "(the URDF's directory and ROS package, --package-dir, ROS_PACKAGE_PATH)",
+                file=source,
+            )
+        if path is None or not path.is_file():
+            missing.append(fname)
+            return fname
+        real = bounded_mesh_file(path, source)  # trimesh opens the checked real path
+        loaded.add(real)
+        check_total(loaded, source)
+        return str(real)
+
+    return resolve_mesh
+
+
 def load_urdf(
     xml: str,
     source: str = "<urdf>",
@@ -72,26 +97,9 @@ def load_urdf(
     import yourdfpy
 
     parse_root(xml.encode("utf-8"), source)
-    missing: list[str] = []
     base = Path(mesh_dir or ".")
-    where = search or MeshSearch()
-    loaded: set[Path] = set()
-
-    def resolve_mesh(fname: str) -> str:
-        path = resolve(fname, base, where)
-        if path is not None and not confined(fname, path, base, where):
-            raise InputError(  # never read files outside the roots
-                f"mesh {fname!r} resolves to {path}, outside the allowed directories "
-                "(the URDF's directory and ROS package, --package-dir, ROS_PACKAGE_PATH)",
-                file=source,
-            )
-        if path is None or not path.is_file():
-            missing.append(fname)
-            return fname
-        real = bounded_mesh_file(path, source)  # trimesh opens the checked real path
-        loaded.add(real)
-        check_total(loaded, source)
-        return str(real)
+    missing: list[str] = []
+    resolve_mesh = _mesh_handler(base, search or MeshSearch(), source, missing)
 
     log = logging.getLogger("yourdfpy")
     level, log.level = log.level, logging.CRITICAL  # its warnings become our error below
