@@ -25,7 +25,7 @@ RK4 has no implicit damping; its step map is the 4th-order Taylor polynomial.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -152,6 +152,14 @@ def worst_radius(
     return radii[k], k
 
 
+def _bisect(ok: Callable[[float], bool], lo: float, hi: float) -> float:
+    """The edge between ok(lo) and not ok(hi), from below, to BISECT_STEPS halvings."""
+    for _ in range(BISECT_STEPS):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
+    return lo
+
+
 def largest_stable_dt(
     M_samples: Sequence[NDArray[np.float64]],
     controlled: Sequence[int],
@@ -170,10 +178,7 @@ def largest_stable_dt(
         lo, hi = hi, 2.0 * hi
         if hi > 1e6:
             return math.inf
-    for _ in range(BISECT_STEPS):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
-    return lo
+    return _bisect(ok, lo, hi)
 
 
 def largest_stable_scale(
@@ -192,10 +197,7 @@ def largest_stable_scale(
     lo, hi = 0.0, 1.0
     if ok(hi):
         return 1.0
-    for _ in range(BISECT_STEPS):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
-    return lo
+    return _bisect(ok, lo, hi)
 
 
 def analyse(
