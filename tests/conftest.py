@@ -22,7 +22,7 @@ def default_spec_path() -> Path:
 @pytest.fixture(scope="session")
 def built_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The default spec built once per session into a temporary directory."""
-    from armcli.build.expand import build
+    from armcli.compiler.expand import build
 
     out = tmp_path_factory.mktemp("built")
     build(DEFAULT_SPEC, out)

@@ -90,7 +90,7 @@ def wheelhouse() -> Path:
 def _not_source(directory: str, names: list[str]) -> set[str]:
     """Names copytree skips: checkout-local state at the top, caches anywhere.
 
-    Only at the top: `src/armcli/build/` is a package, not a build directory.
+    Only at the top: the checkout's own build/ is local state.
     """
     skip = set(ANYWHERE_LOCAL(directory, names))
     if Path(directory) == ROOT:

@@ -15,10 +15,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from armcli.build.expand import build
 from armcli.check.rules import ERROR, CheckOptions
 from armcli.check.run import check_urdf
 from armcli.cli import main
+from armcli.compiler.expand import build
 from armcli.spec.model import RobotSpec
 from armcli.urdf.read import read_urdf
 from tests.helpers import ROOT

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from lxml import etree
 
-from armcli.build.expand import expand_urdfs
+from armcli.compiler.expand import expand_urdfs
 from armcli.errors import InputError
 from armcli.ros.collision_matrix import adjacent_pairs, compute_collision_matrix
 from armcli.spec.load import load_spec

@@ -20,7 +20,7 @@ import yaml
 from catkin_pkg.package import parse_package_string
 from lxml import etree
 
-from armcli.build.xacro_writer import xacro_files
+from armcli.compiler.xacro_writer import xacro_files
 from armcli.errors import InputError
 from armcli.io.files import write_tree_atomic
 from armcli.ros.launch import module_constants

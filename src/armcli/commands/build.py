@@ -7,8 +7,8 @@ from pathlib import Path
 
 import typer
 
-from armcli.build.expand import build, check_fresh
 from armcli.commands.options import spec_argument
+from armcli.compiler.expand import build, check_fresh
 from armcli.spec.discover import find_spec
 
 

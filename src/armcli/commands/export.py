@@ -7,8 +7,8 @@ from pathlib import Path
 
 import typer
 
-from armcli.build.expand import spec_label
 from armcli.commands.options import choice
+from armcli.compiler.expand import spec_label
 from armcli.export.mjcf import BASES
 from armcli.export.mjcf_files import export_mjcf
 from armcli.io.outdir import check_output_file

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import typer
 
-from armcli.build.expand import spec_label
 from armcli.commands.options import choice, option, out_option, spec_argument
+from armcli.compiler.expand import spec_label
 from armcli.ros.packages import DEFAULT_TARGET, TARGETS, PackageInfo, write_ros_packages
 from armcli.spec.discover import find_spec
 

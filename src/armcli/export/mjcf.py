@@ -25,7 +25,7 @@ from pathlib import Path, PurePosixPath
 import numpy as np
 from lxml import etree
 
-from armcli.build.xmlfmt import fmt, to_bytes, vec
+from armcli.compiler.xmlfmt import fmt, to_bytes, vec
 from armcli.errors import InputError
 from armcli.export import mjcf_parts as parts
 from armcli.export.mjcf_report import Extras, Note, scan, text

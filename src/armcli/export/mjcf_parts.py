@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from lxml import etree
 
-from armcli.build.xmlfmt import fmt, vec
+from armcli.compiler.xmlfmt import fmt, vec
 from armcli.export.mjcf_report import EXTRA_TAGS, Extras, Note
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Joint, Urdf

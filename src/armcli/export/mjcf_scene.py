@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from lxml import etree
 
-from armcli.build.xmlfmt import to_bytes
+from armcli.compiler.xmlfmt import to_bytes
 
 SCENE = "scene.xml"
 

@@ -18,8 +18,8 @@ from typing import Any
 
 from lxml import etree
 
-from armcli.build.xacro_writer import ARM, COMMON, MOBILE_BASE, joint_element
-from armcli.build.xmlfmt import XACRO_NS, fmt, to_bytes
+from armcli.compiler.xacro_writer import ARM, COMMON, MOBILE_BASE, joint_element
+from armcli.compiler.xmlfmt import XACRO_NS, fmt, to_bytes
 from armcli.errors import InputError
 from armcli.ros import moveit as mc
 from armcli.ros.launch import render

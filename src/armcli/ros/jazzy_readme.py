@@ -8,7 +8,7 @@ its first named pose, so they can be pasted as they are.
 
 from __future__ import annotations
 
-from armcli.build.xmlfmt import fmt
+from armcli.compiler.xmlfmt import fmt
 from armcli.ros.jazzy import GZ_PLUGIN_NAME, MOCK_ARG, controllers_file
 from armcli.ros.moveit import ARM_CONTROLLER
 from armcli.ros.srdf import chain_joints

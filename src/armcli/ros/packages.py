@@ -18,8 +18,8 @@ from typing import Any
 
 from lxml import etree
 
-from armcli.build.expand import expand_urdfs
-from armcli.build.xacro_writer import GENERATED, STANDALONE_ARM, top_level_files, xacro_files
+from armcli.compiler.expand import expand_urdfs
+from armcli.compiler.xacro_writer import GENERATED, STANDALONE_ARM, top_level_files, xacro_files
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.io.files import write_tree_atomic

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from lxml import etree
 
-from armcli.build.xmlfmt import XACRO_NS, to_bytes
+from armcli.compiler.xmlfmt import XACRO_NS, to_bytes
 
 X = f"{{{XACRO_NS}}}"
 MOCK_PLUGIN = "mock_components/GenericSystem"

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from lxml import etree
 
-from armcli.build.xmlfmt import fmt, to_bytes
+from armcli.compiler.xmlfmt import fmt, to_bytes
 from armcli.ros.collision_matrix import CollisionMatrix
 from armcli.spec.model import RobotSpec
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from armcli.build.expand import expand_urdfs
+from armcli.compiler.expand import expand_urdfs
 from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.sim.options import SimOptions

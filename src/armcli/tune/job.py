@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from armcli.build.expand import expand_urdfs
+from armcli.compiler.expand import expand_urdfs
 from armcli.errors import InputError
 from armcli.io.yaml import load_yaml
 from armcli.sim.job import ARM_URDF, SETTLE_EXTRA_S, start_state

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
-from armcli.build.expand import expand_urdfs
+from armcli.compiler.expand import expand_urdfs
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import EXPANDED_TAG, InputError, XacroRefusedError
 from armcli.spec.load import load_spec

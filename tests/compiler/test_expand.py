@@ -12,8 +12,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-import armcli.build.expand as build_mod
-from armcli.build.expand import build, stale_files
+import armcli.compiler.expand as build_mod
+from armcli.compiler.expand import build, stale_files
 from armcli.errors import BuildError
 
 ARM_JOINTS = ["arm_base_forearm_joint", "forearm_hand_joint"]

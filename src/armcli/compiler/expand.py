@@ -14,7 +14,7 @@ import xml.dom.minidom
 from dataclasses import dataclass
 from pathlib import Path
 
-from armcli.build.xacro_writer import top_level_files, xacro_files
+from armcli.compiler.xacro_writer import top_level_files, xacro_files
 from armcli.errors import BuildError, StaleBuildError
 from armcli.io.files import write_tree_atomic
 from armcli.io.outdir import resolve_output_dir

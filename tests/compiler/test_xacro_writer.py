@@ -14,9 +14,9 @@ import pinocchio as pin
 import pytest
 from lxml import etree
 
-from armcli.build.expand import expand_urdfs
-from armcli.build.xacro_writer import xacro_files
-from armcli.build.xmlfmt import fmt
+from armcli.compiler.expand import expand_urdfs
+from armcli.compiler.xacro_writer import xacro_files
+from armcli.compiler.xmlfmt import fmt
 from armcli.spec.load import load_spec, loads_spec
 from tests.helpers import ROOT
 

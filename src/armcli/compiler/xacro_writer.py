@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from lxml import etree
 
-from armcli.build.xmlfmt import XACRO_NS, fmt, to_bytes, vec
+from armcli.compiler.xmlfmt import XACRO_NS, fmt, to_bytes, vec
 from armcli.defaults import STANDALONE_ARM as STANDALONE_ARM_NAME
 from armcli.defaults import STANDALONE_ARM_URDF, STANDALONE_ARM_XACRO
 from armcli.spec.model import Joint, Link, RobotSpec
