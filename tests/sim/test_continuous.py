@@ -18,6 +18,7 @@ import pytest
 from armcli.cli import main
 from armcli.sim import rollout as ro
 from armcli.sim.simulate import Arm, SimConfig, arm_from_model, params_of
+from tests.helpers import DEFAULT_SPEC
 from tests.sim.engines import FAST
 from tests.sim.test_simulate import _run
 
@@ -132,3 +133,25 @@ def test_simulate_cli_runs_continuous_joints(
     # tracked to the target angle 7.5 rad (> 2 pi), not wrapped to 7.5 - 2 pi = 1.22
     assert final == pytest.approx(7.5, abs=0.01)
     assert float(rows[-1]["joint1.reference"]) == 7.5
+
+
+def test_spec_path_runs_a_continuous_joint(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The default spec with its hand joint made continuous, driven past 2 pi."""
+    text = DEFAULT_SPEC.read_text(encoding="utf-8")
+    head, tail = text.split("forearm_hand_joint:\n      type: revolute", 1)
+    spec = tmp_path / "robot.yaml"
+    spec.write_text(head + "forearm_hand_joint:\n      type: continuous" + tail, encoding="utf-8")
+    out = tmp_path / "states.csv"
+    msg = "{joint_names: [forearm_hand_joint], points: [{positions: [7.0], time_from_start: 3}]}"
+    try:
+        main(["simulate", str(spec), "--message", msg, "--output", str(out)])
+        code = 0
+    except SystemExit as exc:
+        code = int(exc.code or 0)
+    assert code == 0, capsys.readouterr().err
+    with out.open() as fh:
+        last = list(csv.DictReader(fh))[-1]
+    # the spec's gains (Kp 50) track to within the friction band 0.05 / 50 plus gravity sag
+    assert float(last["forearm_hand_joint.position"]) == pytest.approx(7.0, abs=0.02)
