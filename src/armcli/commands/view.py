@@ -9,6 +9,7 @@ import typer
 
 from armcli.commands.options import spec_argument
 from armcli.errors import InputError
+from armcli.sim import rosbag
 from armcli.sim.states import load_replay
 from armcli.spec.discover import find_spec
 from armcli.urdf.meshes import MeshSearch, parse_package_dirs
@@ -49,7 +50,8 @@ def view_cmd(
     run = None
     if replay is not None:
         names = list(joint_limits(load_urdf(src.xml, src.source, src.mesh_dir, src.search)))
-        run = load_replay(replay, names)
+        load = rosbag.load_replay if rosbag.is_mcap(replay) else load_replay
+        run = load(replay, names)
     viewer = Viewer(
         src.xml,
         name=src.name,

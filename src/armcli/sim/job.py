@@ -54,6 +54,7 @@ class SimJob:
     tool_label: str
     rate: float  # [Hz] joint_state_publisher rate
     T_frame_root: np.ndarray  # 4x4 pose of the arm's root link in the reporting frame
+    urdf: Urdf  # the simulated robot description (for an MCAP's /robot_description and /tf)
 
 
 def arm_urdf(spec: RobotSpec | None, urdf: Path | None, *, trust_xacro: Trust = False) -> Urdf:
@@ -238,7 +239,7 @@ def prepare(
     fid, off, label = _tool(arm, doc, spec)
     frame, T_frame_root = _report_frame(arm, spec)
     label = f"{label} in {frame}"
-    return SimJob(arm, traj, ref, q0, total, cfg, fid, off, label, float(rate), T_frame_root)
+    return SimJob(arm, traj, ref, q0, total, cfg, fid, off, label, float(rate), T_frame_root, doc)
 
 
 def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
