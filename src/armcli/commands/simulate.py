@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 import time
 from pathlib import Path
 from typing import Any, cast
@@ -15,7 +16,7 @@ from armcli.io import terminal
 from armcli.io.outdir import check_output_file
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
-from armcli.sim import states
+from armcli.sim import rosbag, states
 from armcli.sim.options import ENGINES, INTEGRATORS, Engine, Integrator, SimOptions
 from armcli.sim.plot import write_tracking_plot
 from armcli.spec.discover import find_spec
@@ -51,7 +52,9 @@ def simulate_cmd(
     integrator: str = choice("euler", INTEGRATORS, "--integrator", help=INTEGRATOR_HELP),
     duration: float = option(None, "--duration", help="Simulated time [s] (default: end + 2 s)."),
     clamp: bool = option(False, "--clamp", help="Clamp positions outside the limits (warns)."),
-    output: Path = option(None, "--output", "-o", help="Joint states at --rate: .csv or .json."),
+    output: Path = option(
+        None, "--output", "-o", help="Joint states at --rate: .csv, .json or .mcap (rosbag2)."
+    ),
     plot: Path = option(None, "--plot", help="Write a tracking plot PNG."),
     rate: float = option(None, "--rate", help="Output rate [Hz] (default: the spec's publisher)."),
     engine: str = choice("auto", ENGINES, "--engine", help=ENGINE_HELP),
@@ -60,7 +63,8 @@ def simulate_cmd(
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
     if output is not None:
-        states.output_format(output)
+        if not rosbag.is_mcap(output):
+            states.output_format(output)
         check_output_file(output, "--output")
     if plot is not None:
         check_output_file(plot, "--plot")
@@ -88,9 +92,7 @@ def simulate_cmd(
 
 def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
     """Run the prepared job with a progress bar, write the files, print the summary."""
-    from rich.console import Console
-
-    err = Console(stderr=True)
+    err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
     for w in job.trajectory.warnings:
         err.print(f"warning: {w}", markup=False, highlight=False)
     with _LazyProgress(err) as progress:
@@ -99,7 +101,9 @@ def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
         err.print(f"note: {res.notice}", markup=False, highlight=False, soft_wrap=True)
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
-    if output is not None:
+    if output is not None and rosbag.is_mcap(output):
+        rosbag.write_mcap(output, res, job.rate, job.urdf)
+    elif output is not None:
         states.write_states(output, res, job.rate)
     if plot is not None:
         write_tracking_plot(plot, res, job.arm.effort)
