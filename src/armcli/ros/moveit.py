@@ -155,9 +155,9 @@ def initial_positions(spec: RobotSpec) -> dict[str, Any]:
     joints = spec.all_joints()
     out = {}
     for name in [*chain_joints(spec), *passive_joints(spec)]:
-        lim, v = joints[name].limit, values.get(name, 0.0)
-        if lim is not None and joints[name].type != "continuous":
-            v = min(max(v, lim.lower), lim.upper)
+        bounds, v = joints[name].bounds, values.get(name, 0.0)
+        if bounds is not None and joints[name].type != "continuous":
+            v = min(max(v, bounds[0]), bounds[1])
         out[name] = float(v)
     return {"initial_positions": out}
 

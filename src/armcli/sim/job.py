@@ -78,6 +78,25 @@ def load_arm(
     )
 
 
+def refuse_mimic(doc: Urdf, joints: Sequence[str] | None) -> None:
+    """Mimic joints are not coupled to their lead here: refuse them rather than drive them alone.
+
+    Locking the followers (`--joints` without them) simulates the rest of the arm.
+    """
+    movable = [j.name for j in doc.joints if j.movable]
+    chosen = list(joints) if joints else movable
+    followers = [j for j in doc.joints if j.mimic is not None and j.name in chosen]
+    if followers:
+        f = followers[0]
+        rest = ",".join(n for n in chosen if n not in {j.name for j in followers})
+        raise InputError(
+            f"joint {f.name!r} mimics {f.mimic!r}: armcli simulate does not couple mimic "
+            f"joints; lock the followers with --joints {rest}",
+            file=doc.source,
+            field="--joints",
+        )
+
+
 def _gains(
     arm: Arm, spec: RobotSpec | None, override: Sequence[float] | None, which: str
 ) -> np.ndarray:
@@ -204,6 +223,7 @@ def prepare(
     if not (np.isfinite(dt) and 0 < dt <= 0.1):
         raise InputError(f"must be in (0, 0.1] s, got {dt:g}", field="--dt")
     doc = arm_urdf(spec, opts.urdf, trust_xacro=opts.trust_xacro)
+    refuse_mimic(doc, opts.joints)
     arm = arm_from_model(checked_model(doc, gate=gate if opts.urdf else None).model, opts.joints)
     limits = {
         n: (float(lo), float(hi))
