@@ -30,7 +30,7 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.sim import stability as stab
-from armcli.sim.simulate import Arm
+from armcli.sim.simulate import Arm, configuration
 from armcli.urdf.pinocchio import mass_matrix
 
 TARGET_RATIO = 10.0  # wn <= 2 pi f_c / TARGET_RATIO for a loop closed at f_c [Hz]
@@ -91,7 +91,7 @@ def sample_configurations(arm: Arm) -> np.ndarray:
 def mass_matrices(arm: Arm, qs: np.ndarray) -> list[np.ndarray]:
     """Symmetric M(q) (CRBA) at every sample."""
     data = arm.model.createData()
-    return [mass_matrix(arm.model, data, q) for q in qs]
+    return [mass_matrix(arm.model, data, configuration(arm.model, q)) for q in qs]
 
 
 def gravity_max(arm: Arm, qs: np.ndarray) -> np.ndarray:
@@ -101,7 +101,10 @@ def gravity_max(arm: Arm, qs: np.ndarray) -> np.ndarray:
     data = arm.model.createData()
     worst = np.zeros(len(arm.joint_names))
     for q in qs:
-        worst = np.maximum(worst, np.abs(pin.computeGeneralizedGravity(arm.model, data, q)))
+        worst = np.maximum(
+            worst,
+            np.abs(pin.computeGeneralizedGravity(arm.model, data, configuration(arm.model, q))),
+        )
     return worst
 
 
