@@ -184,8 +184,7 @@ def _end_effector(
     if tool is None or not model.existFrame(tool.link):
         name = str(model.frames[0].name)
         return name, model.getFrameId(name), (0.0, 0.0, 0.0)
-    label = f"{tool.link} + {tool.xyz}" if tool.xyz != (0.0, 0.0, 0.0) else tool.link
-    return label, model.getFrameId(tool.link), tool.xyz
+    return tool.label, model.getFrameId(tool.link), tool.xyz
 
 
 def _poses(urdf: Urdf, opts: CheckOptions, ranges: list[Any]) -> list[tuple[str, dict[str, float]]]:

@@ -97,7 +97,7 @@ def _top(name: str, includes: list[str]) -> etree._Element:
 
 def has_base(spec: RobotSpec) -> bool:
     """Whether the spec has a mobile base with a mount (a whole-robot top-level file)."""
-    return spec.mobile_base is not None and spec.mount is not None
+    return spec.mounted_base() is not None
 
 
 def xacro_files(
@@ -122,12 +122,12 @@ def xacro_files(
     }
     if spec.passthrough:
         trees[PASSTHROUGH] = passthrough_tree(spec.passthrough)
-    if spec.mobile_base is not None and spec.mount is not None:
-        base = spec.mobile_base
+    base = spec.mounted_base()
+    if base is not None:
         trees[MOBILE_BASE] = part(base.links, base.joints, prefixes, names, "mobile_base")
         trees[MOBILE_BASE_GAZEBO] = mobile_base_gazebo(spec)
         top = _top(spec.name, [COMMON, MOBILE_BASE, MOBILE_BASE_GAZEBO, ARM, ARM_GAZEBO, *extra])
-        joint_element(top, spec.mount.joint, spec.mount_joint())
+        joint_element(top, spec.mount_joint_name(), spec.mount_joint())
         trees[TOP.format(name=spec.name)] = top
     return {name: to_bytes(tree, header_comment=header) for name, tree in sorted(trees.items())}
 

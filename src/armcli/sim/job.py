@@ -143,9 +143,7 @@ def _tool(arm: Arm, doc: Urdf, spec: RobotSpec | None) -> tuple[int, np.ndarray,
     tool = tool_point(doc, spec)
     if tool is None or not model.existFrame(tool.link):
         raise InputError("this URDF has no link to report as the end effector", file=doc.source)
-    off = np.array(tool.xyz, dtype=float)
-    label = f"{tool.link}+{_fmt(off)}" if np.any(off) else tool.link
-    return model.getFrameId(tool.link), off, label
+    return model.getFrameId(tool.link), np.array(tool.xyz, dtype=float), tool.label
 
 
 def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
@@ -160,7 +158,7 @@ def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
     model = arm.model
     root = next(f.name for f in model.frames if f.parentJoint == 0 and f.name != "universe")
     T = pin.SE3.Identity()
-    if spec is None or spec.mobile_base is None or spec.mount is None:
+    if spec is None or spec.mounted_base() is None:
         return root, T.homogeneous
     by_child = {j.child: j for j in spec.all_joints().values()}
     link = spec.arm_root()
@@ -170,10 +168,6 @@ def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
         T = pin.SE3(rot, np.array(joint.origin.xyz, dtype=float)) * T
         link = joint.parent
     return link, T.homogeneous
-
-
-def _fmt(v: np.ndarray) -> str:
-    return "(" + ",".join(f"{x:g}" for x in v) + ")"
 
 
 def start_state(arm: Arm, spec: RobotSpec | None) -> np.ndarray:
