@@ -19,7 +19,7 @@ from armcli.check.rules import CheckOptions, Collector, JointRow
 from armcli.check.structure import Tree, finite
 from armcli.errors import ModelLoadError
 from armcli.sim.stability import StabilityReport
-from armcli.urdf.doc import Urdf
+from armcli.urdf.doc import Urdf, position_bounds, total_dof
 from armcli.urdf.pinocchio import configuration, joint_ranges, load_model, parser_problems
 from armcli.urdf.tool import tool_point
 
@@ -86,7 +86,7 @@ def check(urdf: Urdf, tree: Tree, opts: CheckOptions, out: Collector) -> Summary
         "robot": urdf.name,
         "root": tree.root,
         "total_mass": _total_mass(urdf),
-        "dof": sum(1 for r in rows),
+        "dof": total_dof(j.type for j in urdf.joints),
     }
     if out.has_errors(_STRUCTURE_ERRORS):
         note = "model checks skipped: fix the structure errors first"
@@ -160,12 +160,13 @@ def _joint_rows(urdf: Urdf) -> tuple[JointRow, ...]:
         if j.type in ("fixed", ""):
             continue
         lim = j.limit
+        lower, upper = position_bounds(j.type, lim) or (None, None)
         rows.append(
             JointRow(
                 j.name,
                 j.type,
-                lim.lower if lim and j.type != "continuous" else None,
-                lim.upper if lim and j.type != "continuous" else None,
+                lower,
+                upper,
                 lim.effort if lim else None,
                 lim.velocity if lim else None,
                 j.damping,
@@ -183,8 +184,7 @@ def _end_effector(
     if tool is None or not model.existFrame(tool.link):
         name = str(model.frames[0].name)
         return name, model.getFrameId(name), (0.0, 0.0, 0.0)
-    label = f"{tool.link} + {tool.xyz}" if tool.xyz != (0.0, 0.0, 0.0) else tool.link
-    return label, model.getFrameId(tool.link), tool.xyz
+    return tool.label, model.getFrameId(tool.link), tool.xyz
 
 
 def _poses(urdf: Urdf, opts: CheckOptions, ranges: list[Any]) -> list[tuple[str, dict[str, float]]]:

@@ -297,11 +297,12 @@ def xacro_files(spec: RobotSpec, spec_label: str = "the armcli spec") -> dict[st
         ARM_GAZEBO: arm_gazebo(spec),
         STANDALONE_ARM: _top(STANDALONE_ARM_NAME, [COMMON, ARM, ARM_GAZEBO]),
     }
-    if spec.mobile_base is not None and spec.mount is not None:
-        trees[MOBILE_BASE] = part(spec.mobile_base.links, spec.mobile_base.joints, prefixes)
+    base = spec.mounted_base()
+    if base is not None:
+        trees[MOBILE_BASE] = part(base.links, base.joints, prefixes)
         trees[MOBILE_BASE_GAZEBO] = mobile_base_gazebo(spec)
         top = _top(spec.name, [COMMON, MOBILE_BASE, MOBILE_BASE_GAZEBO, ARM, ARM_GAZEBO])
-        joint_element(top, spec.mount.joint, spec.mount_joint())
+        joint_element(top, spec.mount_joint_name(), spec.mount_joint())
         trees[TOP.format(name=spec.name)] = top
     return {name: to_bytes(tree, header_comment=header) for name, tree in sorted(trees.items())}
 
@@ -309,6 +310,6 @@ def xacro_files(spec: RobotSpec, spec_label: str = "the armcli spec") -> dict[st
 def top_level_files(spec: RobotSpec) -> dict[str, str]:
     """Expanded URDF name -> the top-level xacro file it comes from."""
     out = {STANDALONE_ARM_URDF: STANDALONE_ARM}
-    if spec.mobile_base is not None and spec.mount is not None:
+    if spec.mounted_base() is not None:
         out[f"{spec.name}.urdf"] = TOP.format(name=spec.name)
     return out

@@ -33,7 +33,7 @@ from armcli.errors import InputError
 from armcli.export import mjcf_parts as parts
 from armcli.export.mjcf_report import Extras, Note, scan, text
 from armcli.spec.model import RobotSpec
-from armcli.urdf.doc import Joint, Link, Pose, Shape, Urdf
+from armcli.urdf.doc import Joint, Link, Pose, Shape, Urdf, position_bounds
 from armcli.urdf.read import parse_root
 
 BASES = ("fixed", "free")
@@ -164,9 +164,9 @@ class _Builder:
 
     def joint(self, body: etree._Element, j: Joint) -> None:
         attrs = {"name": j.name, "type": _HINGE[j.type], "axis": vec(j.axis or (1.0, 0.0, 0.0))}
-        lim = j.limit
-        if j.type != "continuous" and lim is not None and None not in (lim.lower, lim.upper):
-            attrs["range"] = vec((float(lim.lower or 0.0), float(lim.upper or 0.0)))
+        bounds = position_bounds(j.type, j.limit)
+        if bounds is not None:
+            attrs["range"] = vec(bounds)
         attrs.update(damping=fmt(j.damping), frictionloss=fmt(j.friction), armature="0")
         etree.SubElement(body, "joint", attrs)
         self.joints.append(j)

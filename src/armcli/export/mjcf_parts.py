@@ -17,17 +17,14 @@ from lxml import etree
 from armcli.compiler.xmlfmt import fmt, vec
 from armcli.export.mjcf_report import EXTRA_TAGS, Extras, Note
 from armcli.spec.model import RobotSpec
-from armcli.urdf.doc import Joint, Urdf
+from armcli.urdf.doc import Joint, Urdf, position_bounds
 
 HOME = "home"
 FREE_QPOS = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)  # origin, identity quaternion (w x y z)
 
 
 def _range(j: Joint) -> tuple[float, float] | None:
-    lim = j.limit
-    if j.type == "continuous" or lim is None or lim.lower is None or lim.upper is None:
-        return None
-    return (lim.lower, lim.upper)
+    return position_bounds(j.type, j.limit)
 
 
 def actuators(

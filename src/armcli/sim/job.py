@@ -17,7 +17,15 @@ from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_UR
 from armcli.errors import InputError
 from armcli.sim.options import SimOptions
 from armcli.sim.reference import Reference, build_reference
-from armcli.sim.simulate import Arm, SimConfig, SimResult, arm_from_model, check_stability, simulate
+from armcli.sim.simulate import (
+    Arm,
+    SimConfig,
+    SimResult,
+    arm_from_model,
+    check_stability,
+    configuration,
+    simulate,
+)
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
@@ -116,9 +124,7 @@ def _tool(arm: Arm, doc: Urdf, spec: RobotSpec | None) -> tuple[int, np.ndarray,
     tool = tool_point(doc, spec)
     if tool is None or not model.existFrame(tool.link):
         raise InputError("this URDF has no link to report as the end effector", file=doc.source)
-    off = np.array(tool.xyz, dtype=float)
-    label = f"{tool.link}+{_fmt(off)}" if np.any(off) else tool.link
-    return model.getFrameId(tool.link), off, label
+    return model.getFrameId(tool.link), np.array(tool.xyz, dtype=float), tool.label
 
 
 def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
@@ -133,7 +139,7 @@ def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
     model = arm.model
     root = next(f.name for f in model.frames if f.parentJoint == 0 and f.name != "universe")
     T = pin.SE3.Identity()
-    if spec is None or spec.mobile_base is None or spec.mount is None:
+    if spec is None or spec.mounted_base() is None:
         return root, T.homogeneous
     by_child = {j.child: j for j in spec.all_joints().values()}
     link = spec.arm_root()
@@ -143,10 +149,6 @@ def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
         T = pin.SE3(rot, np.array(joint.origin.xyz, dtype=float)) * T
         link = joint.parent
     return link, T.homogeneous
-
-
-def _fmt(v: np.ndarray) -> str:
-    return "(" + ",".join(f"{x:g}" for x in v) + ")"
 
 
 def start_state(arm: Arm, spec: RobotSpec | None) -> np.ndarray:
@@ -238,7 +240,7 @@ def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
     import pinocchio as pin
 
     data = job.arm.model.createData()
-    pin.framesForwardKinematics(job.arm.model, data, q)
+    pin.framesForwardKinematics(job.arm.model, data, configuration(job.arm.model, q))
     p_root = np.asarray(data.oMf[job.tool_frame].act(job.tool_offset), dtype=float)
     out: np.ndarray = job.T_frame_root[:3, :3] @ p_root + job.T_frame_root[:3, 3]
     return out

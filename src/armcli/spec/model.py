@@ -352,9 +352,21 @@ class RobotSpec(_Model):
         """Joints of the base and the arm by name, plus the mount joint with a base."""
         out = dict(self.mobile_base.joints) if self.mobile_base else {}
         out.update(self.arm.joints)
-        if self.mount is not None and self.mobile_base is not None:
-            out[self.mount.joint] = self.mount_joint()
+        if self.mounted_base() is not None:
+            out[self.mount_joint_name()] = self.mount_joint()
         return out
+
+    def mounted_base(self) -> MobileBase | None:
+        """The mobile base the arm is mounted on; None for an arm alone.
+
+        A valid spec has both a base and a mount or neither; this is the one test of it.
+        """
+        return self.mobile_base if self.mount is not None else None
+
+    def mount_joint_name(self) -> str:
+        """The name of the fixed joint from the base to the arm root; needs a mount."""
+        assert self.mount is not None
+        return self.mount.joint
 
     def arm_root(self) -> str:
         """The arm link that is no arm joint's child (a valid spec has exactly one)."""
