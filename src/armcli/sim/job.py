@@ -87,6 +87,25 @@ def load_arm(
     )
 
 
+def refuse_mimic(doc: Urdf, joints: Sequence[str] | None) -> None:
+    """Mimic joints are not coupled to their lead here: refuse them rather than drive them alone.
+
+    Locking the followers (`--joints` without them) simulates the rest of the arm.
+    """
+    movable = [j.name for j in doc.joints if j.movable]
+    chosen = list(joints) if joints else movable
+    followers = [j for j in doc.joints if j.mimic is not None and j.name in chosen]
+    if followers:
+        f = followers[0]
+        rest = ",".join(n for n in chosen if n not in {j.name for j in followers})
+        raise InputError(
+            f"joint {f.name!r} mimics {f.mimic!r}: armcli simulate does not couple mimic "
+            f"joints; lock the followers with --joints {rest}",
+            file=doc.source,
+            field="--joints",
+        )
+
+
 def _gains(
     arm: Arm, spec: RobotSpec | None, override: Sequence[float] | None, which: str
 ) -> np.ndarray:
@@ -125,9 +144,7 @@ def _tool(arm: Arm, doc: Urdf, spec: RobotSpec | None) -> tuple[int, np.ndarray,
     tool = tool_point(doc, spec)
     if tool is None or not model.existFrame(tool.link):
         raise InputError("this URDF has no link to report as the end effector", file=doc.source)
-    off = np.array(tool.xyz, dtype=float)
-    label = f"{tool.link}+{_fmt(off)}" if np.any(off) else tool.link
-    return model.getFrameId(tool.link), off, label
+    return model.getFrameId(tool.link), np.array(tool.xyz, dtype=float), tool.label
 
 
 def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
@@ -142,7 +159,7 @@ def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
     model = arm.model
     root = next(f.name for f in model.frames if f.parentJoint == 0 and f.name != "universe")
     T = pin.SE3.Identity()
-    if spec is None or spec.mobile_base is None or spec.mount is None:
+    if spec is None or spec.mounted_base() is None:
         return root, T.homogeneous
     by_child = {j.child: j for j in spec.all_joints().values()}
     link = spec.arm_root()
@@ -152,10 +169,6 @@ def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
         T = pin.SE3(rot, np.array(joint.origin.xyz, dtype=float)) * T
         link = joint.parent
     return link, T.homogeneous
-
-
-def _fmt(v: np.ndarray) -> str:
-    return "(" + ",".join(f"{x:g}" for x in v) + ")"
 
 
 def start_state(arm: Arm, spec: RobotSpec | None) -> np.ndarray:
@@ -213,6 +226,7 @@ def prepare(
     if not (np.isfinite(dt) and 0 < dt <= 0.1):
         raise InputError(f"must be in (0, 0.1] s, got {dt:g}", field="--dt")
     doc = arm_urdf(spec, opts.urdf, trust_xacro=opts.trust_xacro)
+    refuse_mimic(doc, opts.joints)
     arm = arm_from_model(checked_model(doc, gate=gate if opts.urdf else None).model, opts.joints)
     limits = {
         n: (float(lo), float(hi))

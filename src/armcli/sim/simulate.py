@@ -26,6 +26,7 @@ from armcli.errors import InputError, SimulationError
 from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim import stability as stab
+from armcli.urdf.pinocchio import mass_matrix
 
 VEL_ABORT_FACTOR = 10.0  # divergence when |v| exceeds this times the URDF velocity limit
 DEFAULT_VABORT = 1000.0  # [rad/s or m/s] when the URDF gives no velocity limit
@@ -154,14 +155,9 @@ def check_stability(arm: Arm, cfg: SimConfig, configurations: np.ndarray) -> Non
 
     Euler steps damping implicitly, as `check`'s implicit loop; RK4 is explicit.
     """
-    import pinocchio as pin
-
     data = arm.model.createData()
     K, B = np.asarray(cfg.kp, float), np.asarray(cfg.kd, float) + arm.damping
-    Ms = []
-    for q in configurations:
-        M = pin.crba(arm.model, data, configuration(arm.model, q))
-        Ms.append(np.triu(M) + np.triu(M, 1).T)
+    Ms = [mass_matrix(arm.model, data, configuration(arm.model, q)) for q in configurations]
     controlled = list(range(arm.model.nv))
     scheme: stab.Scheme = "rk4" if cfg.integrator == "rk4" else "implicit"
     rho, k = stab.worst_radius(Ms, controlled, K, B, cfg.dt, scheme)
@@ -363,10 +359,7 @@ def _result(
 
 
 def _energy_max(arm: Arm, q0: np.ndarray, params: np.ndarray) -> float:
-    import pinocchio as pin
-
-    M = pin.crba(arm.model, arm.model.createData(), configuration(arm.model, q0))
-    M = np.triu(M) + np.triu(M, 1).T
+    M = mass_matrix(arm.model, arm.model.createData(), configuration(arm.model, q0))
     return float(0.5 * np.max(np.linalg.eigvalsh(M)) * np.sum(params[:, ro.VABORT] ** 2))
 
 

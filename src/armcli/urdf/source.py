@@ -90,7 +90,8 @@ def read_urdf_file(path: Path, *, trust_xacro: Trust = False) -> Urdf:
         except XacroRefusedError:
             pass  # xacro content in a .urdf: expanded like a .xacro file
     if trust_xacro:
-        xml = expand_untrusted(path, unsandboxed=trust_xacro == "unsandboxed")
+        unsandboxed = trust_xacro == "unsandboxed"
+        xml = expand_untrusted(path, unsandboxed=unsandboxed, roots=allowed_roots(path.parent))
         return parse_urdf(xml, f"{path}{EXPANDED_TAG}")
     xml = expand_foreign(path, allowed_roots(path.parent))  # safe mode: no code runs
     return parse_urdf(xml, f"{path}{EXPANDED_TAG}")

@@ -15,7 +15,7 @@ from typing import Any
 from armcli.errors import InputError
 from armcli.io.terminal import wrap_parts
 from armcli.spec.graph import root_links
-from armcli.urdf.doc import JOINT_TYPES, MOVABLE_TYPES, Joint, Urdf
+from armcli.urdf.doc import JOINT_TYPES, MOVABLE_TYPES, Joint, Urdf, position_bounds
 from armcli.urdf.read import parse_urdf
 
 
@@ -117,8 +117,9 @@ def joint_parts(j: Joint) -> list[str]:
     lim = j.limit
     if lim is None:
         return parts
-    if lim.lower is not None and lim.upper is not None and j.type != "continuous":
-        parts.append(f"[{_num(lim.lower)}, {_num(lim.upper)}] {unit}")
+    bounds = position_bounds(j.type, lim)
+    if bounds is not None:
+        parts.append(f"[{_num(bounds[0])}, {_num(bounds[1])}] {unit}")
     if lim.effort is not None:
         parts.append(f"effort {_num(lim.effort)} {'N' if unit == 'm' else 'N·m'}")
     if lim.velocity is not None:
