@@ -22,7 +22,7 @@ from armcli.sim.stability import StabilityReport
 from armcli.urdf.doc import Urdf
 from armcli.urdf.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
 from armcli.urdf.meshes import mesh_paths
-from armcli.urdf.pinocchio import collision_model, configuration
+from armcli.urdf.pinocchio import collision_model, configuration, mass_matrix
 
 GRID_POINTS = 5  # per joint, when the grid has at most MAX_GRID samples
 MAX_GRID = 125
@@ -137,8 +137,6 @@ def stability(
     The mass matrix at every sample bounds the gains (armcli.sim.stability). Returns None
     without a spec that has gains, and adds a note when no controlled joint is in the URDF.
     """
-    import pinocchio as pin
-
     spec = opts.spec
     if spec is None or not spec.control.gains:
         return None
@@ -148,10 +146,7 @@ def stability(
     if not names:
         notes.append("stability skipped: no controlled joint found in this URDF")
         return None
-    Ms = []
-    for _, q in samples:
-        M = pin.crba(model, data, q)
-        Ms.append(np.triu(M) + np.triu(M, 1).T)
+    Ms = [mass_matrix(model, data, q) for _, q in samples]
     qs = [[p[n] for n in names] for p, _ in samples]
     gains = [spec.control.gains[n] for n in names]
     rep = stab.analyse(

@@ -29,12 +29,12 @@ from armcli.errors import (
     InputError,
     UnusableInputsError,
 )
+from armcli.io import terminal
 from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 FORMATS = ("table", "json", "github", "sarif")
-REPORT_WIDTH = 140  # columns when stdout is not a terminal (CI logs, pipes)
 
 
 def check_cmd(
@@ -70,7 +70,7 @@ def check_cmd(
         write_notes([note], file.removesuffix(EXPANDED_TAG))
     everything = [f for r in run.results for f in r.findings]
     everything += [u.finding() for u in run.unusable]
-    findings = apply_policy(everything, ignore=ignore, strict=strict)
+    findings = report.by_severity(apply_policy(everything, ignore=ignore, strict=strict))
     code = run.exit_code(findings)
     _print(run, findings, fmt, code)
     if code == EXIT_UNUSABLE:
@@ -92,12 +92,9 @@ def _print(run: CheckRun, findings: list[Any], fmt: str, code: int) -> None:
     elif fmt == "sarif":
         sys.stdout.write(to_sarif(findings))
     elif run.results:  # nothing usable: the stderr lines say it all
-        from rich.console import Console
-
-        width = None if sys.stdout.isatty() else REPORT_WIDTH
-        console = Console(file=sys.stdout, highlight=False, soft_wrap=False, width=width)
+        console = terminal.console()
         for item in report.to_rich(run.results, findings, [u for u, _ in unusable]):
-            console.print(item)
+            console.print(item, crop=False)
 
 
 def register(app: typer.Typer) -> None:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 import time
 from pathlib import Path
 from typing import Any, cast
@@ -20,6 +19,7 @@ from armcli.commands.xacro_inputs import (
     xacro_inputs,
 )
 from armcli.errors import InputError
+from armcli.io import terminal
 from armcli.io.outdir import check_output_file
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
@@ -118,10 +118,8 @@ def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
         states.write_states(output, res, job.rate)
     if plot is not None:
         write_tracking_plot(plot, res, job.arm.effort)
-    out = Console(file=sys.stdout)
-    if not out.is_terminal:
-        out = Console(file=sys.stdout, width=110)
-    out.print(simreport.summary_table(metrics, ee, job.tool_label, res))
+    out = terminal.console()
+    out.print(simreport.summary_table(metrics, ee, job.tool_label, res), crop=False)
     for path in (output, plot):
         if path is not None:
             out.print(f"wrote {path}", markup=False, highlight=False)

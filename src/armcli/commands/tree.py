@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import sys
 from pathlib import Path
 
@@ -17,6 +18,7 @@ from armcli.commands.xacro_inputs import (
     xacro_inputs,
 )
 from armcli.errors import InputError
+from armcli.io import terminal
 from armcli.io.files import write_file_atomic
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
@@ -54,15 +56,11 @@ def tree_cmd(
     if fmt == "dot":
         text = to_dot(tree)
     else:
-        import io
-
-        from rich.console import Console
-
         if out is None:
-            Console().print(to_rich(tree))
+            terminal.console().print(to_rich(tree), crop=False)
             return
         buf = io.StringIO()
-        Console(file=buf, width=120).print(to_rich(tree))
+        terminal.console(buf, terminal.UNBOUNDED).print(to_rich(tree), crop=False)
         text = buf.getvalue()
     if out is None:
         sys.stdout.write(text)

@@ -17,7 +17,15 @@ from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_UR
 from armcli.errors import InputError
 from armcli.sim.options import SimOptions
 from armcli.sim.reference import Reference, build_reference
-from armcli.sim.simulate import Arm, SimConfig, SimResult, arm_from_model, check_stability, simulate
+from armcli.sim.simulate import (
+    Arm,
+    SimConfig,
+    SimResult,
+    arm_from_model,
+    check_stability,
+    configuration,
+    simulate,
+)
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
@@ -87,6 +95,25 @@ def load_arm(
     )
 
 
+def refuse_mimic(doc: Urdf, joints: Sequence[str] | None) -> None:
+    """Mimic joints are not coupled to their lead here: refuse them rather than drive them alone.
+
+    Locking the followers (`--joints` without them) simulates the rest of the arm.
+    """
+    movable = [j.name for j in doc.joints if j.movable]
+    chosen = list(joints) if joints else movable
+    followers = [j for j in doc.joints if j.mimic is not None and j.name in chosen]
+    if followers:
+        f = followers[0]
+        rest = ",".join(n for n in chosen if n not in {j.name for j in followers})
+        raise InputError(
+            f"joint {f.name!r} mimics {f.mimic!r}: armcli simulate does not couple mimic "
+            f"joints; lock the followers with --joints {rest}",
+            file=doc.source,
+            field="--joints",
+        )
+
+
 def _gains(
     arm: Arm, spec: RobotSpec | None, override: Sequence[float] | None, which: str
 ) -> np.ndarray:
@@ -125,9 +152,7 @@ def _tool(arm: Arm, doc: Urdf, spec: RobotSpec | None) -> tuple[int, np.ndarray,
     tool = tool_point(doc, spec)
     if tool is None or not model.existFrame(tool.link):
         raise InputError("this URDF has no link to report as the end effector", file=doc.source)
-    off = np.array(tool.xyz, dtype=float)
-    label = f"{tool.link}+{_fmt(off)}" if np.any(off) else tool.link
-    return model.getFrameId(tool.link), off, label
+    return model.getFrameId(tool.link), np.array(tool.xyz, dtype=float), tool.label
 
 
 def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
@@ -142,7 +167,7 @@ def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
     model = arm.model
     root = next(f.name for f in model.frames if f.parentJoint == 0 and f.name != "universe")
     T = pin.SE3.Identity()
-    if spec is None or spec.mobile_base is None or spec.mount is None:
+    if spec is None or spec.mounted_base() is None:
         return root, T.homogeneous
     by_child = {j.child: j for j in spec.all_joints().values()}
     link = spec.arm_root()
@@ -152,10 +177,6 @@ def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
         T = pin.SE3(rot, np.array(joint.origin.xyz, dtype=float)) * T
         link = joint.parent
     return link, T.homogeneous
-
-
-def _fmt(v: np.ndarray) -> str:
-    return "(" + ",".join(f"{x:g}" for x in v) + ")"
 
 
 def start_state(arm: Arm, spec: RobotSpec | None) -> np.ndarray:
@@ -213,6 +234,7 @@ def prepare(
     if not (np.isfinite(dt) and 0 < dt <= 0.1):
         raise InputError(f"must be in (0, 0.1] s, got {dt:g}", field="--dt")
     doc = arm_urdf(spec, opts.urdf, trust_xacro=opts.trust_xacro, inputs=opts.xacro)
+    refuse_mimic(doc, opts.joints)
     arm = arm_from_model(checked_model(doc, gate=gate if opts.urdf else None).model, opts.joints)
     limits = {
         n: (float(lo), float(hi))
@@ -249,7 +271,7 @@ def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
     import pinocchio as pin
 
     data = job.arm.model.createData()
-    pin.framesForwardKinematics(job.arm.model, data, q)
+    pin.framesForwardKinematics(job.arm.model, data, configuration(job.arm.model, q))
     p_root = np.asarray(data.oMf[job.tool_frame].act(job.tool_offset), dtype=float)
     out: np.ndarray = job.T_frame_root[:3, :3] @ p_root + job.T_frame_root[:3, 3]
     return out

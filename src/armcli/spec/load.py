@@ -54,8 +54,8 @@ def _split(field: str) -> tuple[str | int, ...]:
 
 
 def load_spec(path: str | Path) -> RobotSpec:
-    """Read, parse and validate a spec file."""
-    return spec_from_doc(load_yaml(path))
+    """Read, parse and validate a spec file (relative mesh paths start at its directory)."""
+    return spec_from_doc(load_yaml(path)).with_source(Path(path))
 
 
 def loads_spec(text: str, source: str = "<string>") -> RobotSpec:

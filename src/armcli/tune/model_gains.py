@@ -30,7 +30,8 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.sim import stability as stab
-from armcli.sim.simulate import Arm
+from armcli.sim.simulate import Arm, configuration
+from armcli.urdf.pinocchio import mass_matrix
 
 TARGET_RATIO = 10.0  # wn <= 2 pi f_c / TARGET_RATIO for a loop closed at f_c [Hz]
 STABILITY_MARGIN = 2.0  # gains must be stable at this multiple of dt
@@ -89,14 +90,8 @@ def sample_configurations(arm: Arm) -> np.ndarray:
 
 def mass_matrices(arm: Arm, qs: np.ndarray) -> list[np.ndarray]:
     """Symmetric M(q) (CRBA) at every sample."""
-    import pinocchio as pin
-
     data = arm.model.createData()
-    out = []
-    for q in qs:
-        M = pin.crba(arm.model, data, q)
-        out.append(np.triu(M) + np.triu(M, 1).T)
-    return out
+    return [mass_matrix(arm.model, data, configuration(arm.model, q)) for q in qs]
 
 
 def gravity_max(arm: Arm, qs: np.ndarray) -> np.ndarray:
@@ -106,7 +101,10 @@ def gravity_max(arm: Arm, qs: np.ndarray) -> np.ndarray:
     data = arm.model.createData()
     worst = np.zeros(len(arm.joint_names))
     for q in qs:
-        worst = np.maximum(worst, np.abs(pin.computeGeneralizedGravity(arm.model, data, q)))
+        worst = np.maximum(
+            worst,
+            np.abs(pin.computeGeneralizedGravity(arm.model, data, configuration(arm.model, q))),
+        )
     return worst
 
 

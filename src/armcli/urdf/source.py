@@ -117,8 +117,10 @@ def expand_xacro(
     """
     given = inputs or XacroInputs()
     if trust_xacro:
+        unsandboxed = trust_xacro == "unsandboxed"
+        roots = allowed_roots(path.parent)
         xml = expand_untrusted(
-            path, mappings=dict(given.args), unsandboxed=trust_xacro == "unsandboxed"
+            path, mappings=dict(given.args), unsandboxed=unsandboxed, roots=roots
         )
         return xml, Expansion(args=dict(given.args), given=tuple(given.args))
     request = request_json(allowed_roots(path.parent), given)
