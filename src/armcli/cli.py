@@ -64,6 +64,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "Print the kinematic tree: links, and joints with their types and limits.",
     ),
     "export": ("armcli.commands.export", "Export the robot to other simulators' formats."),
+    "expand": (
+        "armcli.commands.expand",
+        "Expand a xacro file like `xacro FILE NAME:=VALUE...`, without running its code.",
+    ),
 }
 
 

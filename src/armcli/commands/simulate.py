@@ -11,6 +11,14 @@ import typer
 
 from armcli.check.gate import refuse_check_errors
 from armcli.commands.options import choice, option, spec_argument
+from armcli.commands.xacro_inputs import (
+    args_argument,
+    env_option,
+    package_dir_option,
+    split_robot,
+    write_notes,
+    xacro_inputs,
+)
 from armcli.errors import InputError
 from armcli.io import terminal
 from armcli.io.outdir import check_output_file
@@ -41,6 +49,7 @@ def _floats(text: str | None, option: str) -> list[float] | None:
 
 def simulate_cmd(
     spec: Path | None = spec_argument(),
+    args: list[str] = args_argument(),
     trajectory: Path = option(None, "--trajectory", "-t", help=TRAJECTORY_HELP),
     message: str = option(None, "--message", "-m", help="JointTrajectory as YAML text."),
     urdf: Path = option(None, "--urdf", help="Simulate this URDF instead of the spec's arm."),
@@ -58,10 +67,14 @@ def simulate_cmd(
     plot: Path = option(None, "--plot", help="Write a tracking plot PNG."),
     rate: float = option(None, "--rate", help="Output rate [Hz] (default: the spec's publisher)."),
     engine: str = choice("auto", ENGINES, "--engine", help=ENGINE_HELP),
+    package_dir: list[str] = package_dir_option(),
+    env: list[str] = env_option(),
     trust_xacro: bool = option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
+    spec, tokens = split_robot(spec, args)
+    inputs = xacro_inputs(tokens, env, package_dir)
     if output is not None:
         if not rosbag.is_mcap(output):
             states.output_format(output)
@@ -85,6 +98,7 @@ def simulate_cmd(
         rate=rate,
         engine=cast(Engine, engine),
         trust_xacro=trust_mode(trust_xacro, unsandboxed),
+        xacro=inputs,
     )
     # a model `check` reports as an error is not simulated (same rule ids)
     _run(simjob.prepare(spec_obj, opts, gate=refuse_check_errors), output, plot)
@@ -93,6 +107,7 @@ def simulate_cmd(
 def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
     """Run the prepared job with a progress bar, write the files, print the summary."""
     err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
+    write_notes(job.notes)
     for w in job.trajectory.warnings:
         err.print(f"warning: {w}", markup=False, highlight=False)
     with _LazyProgress(err) as progress:

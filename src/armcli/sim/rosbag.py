@@ -272,8 +272,10 @@ def _messages(chans: Sequence[Channel]) -> Iterator[tuple[int, int, int, dict[st
             yield ns, rank, k, msg
 
 
-def write_mcap(path: Path, res: SimResult, rate: float, urdf: Urdf) -> None:
+def write_mcap(path: Path, res: SimResult, rate: float, urdf: Urdf | None) -> None:
     """Write the run sampled at `rate` [Hz] as a rosbag2 MCAP file, atomically."""
+    if urdf is None:
+        raise ValueError("an MCAP file needs the simulated robot description")
     cols = sample_states(res, rate)
     write_file_atomic(path, mcap_bytes(channels(cols, res.joint_names, urdf)))
 
