@@ -9,20 +9,18 @@ from typing import Any, cast
 
 import typer
 
-from armcli.check.gate import refuse_check_errors
 from armcli.commands.options import choice, option, spec_argument
 from armcli.errors import InputError
 from armcli.io.outdir import check_output_file
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
 from armcli.sim import states
-from armcli.sim.options import ENGINES, INTEGRATORS, Engine, Integrator, SimOptions
+from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 from armcli.sim.plot import write_tracking_plot
 from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
-ENGINE_HELP = "auto (default: compiled when available), native (compiled) or python."
 INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
 GRAVITY_HELP = "Add g(q) to the PD torque (default: the spec's control.gravity_compensation)."
 TRAJECTORY_HELP = "JointTrajectory YAML (a point without time_from_start: previous + 1 s)."
@@ -54,7 +52,6 @@ def simulate_cmd(
     output: Path = option(None, "--output", "-o", help="Joint states at --rate: .csv or .json."),
     plot: Path = option(None, "--plot", help="Write a tracking plot PNG."),
     rate: float = option(None, "--rate", help="Output rate [Hz] (default: the spec's publisher)."),
-    engine: str = choice("auto", ENGINES, "--engine", help=ENGINE_HELP),
     trust_xacro: bool = option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
@@ -79,10 +76,12 @@ def simulate_cmd(
         duration=duration,
         clamp=clamp,
         rate=rate,
-        engine=cast(Engine, engine),
         trust_xacro=trust_mode(trust_xacro, unsandboxed),
     )
-    # a model `check` reports as an error is not simulated (same rule ids)
+    # a model `check` reports as an error is not simulated (same rule ids); imported here:
+    # the check rules are not needed for `--help`
+    from armcli.check.gate import refuse_check_errors
+
     _run(simjob.prepare(spec_obj, opts, gate=refuse_check_errors), output, plot)
 
 
@@ -94,9 +93,7 @@ def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
     for w in job.trajectory.warnings:
         err.print(f"warning: {w}", markup=False, highlight=False)
     with _LazyProgress(err) as progress:
-        res = simjob.run(job, progress)
-    if res.notice:
-        err.print(f"note: {res.notice}", markup=False, highlight=False, soft_wrap=True)
+        res = simjob.run(job, progress, plot=plot is not None)
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
     if output is not None:
