@@ -87,6 +87,38 @@ class SpecError(InputError):
         return out
 
 
+class UnstableLoopError(InputError):
+    """The PD gains diverge at the time step (armcli.sim.verdict); carries the one remedy.
+
+    The library names no option: the command layer says where dt and the gains came from
+    (`located`).
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        scheme: str,
+        dt: float,
+        suggestion_dt: float,
+        kp: Sequence[float] | None,
+        kd: Sequence[float] | None,
+        file: str | Path | None = None,
+        field: str | None = None,
+    ) -> None:
+        self.scheme, self.dt, self.suggestion_dt = scheme, dt, suggestion_dt
+        self.kp = tuple(kp) if kp is not None else None
+        self.kd = tuple(kd) if kd is not None else None
+        super().__init__(message, file=file, field=field)
+
+    def located(self, *, file: str | Path | None, field: str) -> UnstableLoopError:
+        """The same error, saying which file and field (or option) dt and gains came from."""
+        return UnstableLoopError(
+            self.message, scheme=self.scheme, dt=self.dt, suggestion_dt=self.suggestion_dt,
+            kp=self.kp, kd=self.kd, file=file, field=field,
+        )  # fmt: skip
+
+
 class XacroRefusedError(InputError):
     """A foreign xacro file would run code from the file; refused without --trust-xacro."""
 

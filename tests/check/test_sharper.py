@@ -10,7 +10,8 @@ from typing import Any
 import pytest
 from lxml import etree
 
-from armcli.check.dynamics import EFFORT_MARGIN, round_down, round_up
+from armcli.check.dynamics import EFFORT_MARGIN, round_up
+from armcli.sim.stability import round_down
 from armcli.check.rules import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.spec.load import load_spec

@@ -157,13 +157,16 @@ _RULES = [
         "raise the effort limit or lighten the links",
     ),
     Rule(
-        "pd-unstable", ERROR, "PD loop unstable at dt even with implicit damping", "lower Kp or dt"
+        "pd-unstable",
+        ERROR,
+        "PD loop unstable at dt in armcli simulate (damping implicit); gravity's stiffness counts",
+        "lower dt or Kp (`armcli tune` picks stable gains)",
     ),
     Rule(
         "pd-explicit-unstable",
         WARNING,
-        "PD loop unstable at dt with explicit damping",
-        "lower Kd or dt, or treat damping implicitly",
+        "PD loop unstable at dt in an explicit torque loop (ros2_control effort controller)",
+        "lower dt, or Kp and Kd together (`armcli tune --loop explicit`)",
     ),
     Rule(
         "servo-unstable",

@@ -18,7 +18,7 @@ from armcli.check import interface
 from armcli.check.rules import CheckOptions, Collector, JointRow
 from armcli.check.structure import Tree, finite
 from armcli.errors import ModelLoadError
-from armcli.sim.stability import StabilityReport
+from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf
 from armcli.urdf.pinocchio import configuration, joint_ranges, load_model, parser_problems
 from armcli.urdf.tool import tool_point
@@ -136,7 +136,7 @@ def _with_model(
         servo = interface.check(urdf.text, opts, out, notes)
         gained = set(opts.spec.control.gains) if opts.spec is not None else set()
         if not (servo and gained <= servo):  # a position servo is not a PD loop
-            report = dyn.stability(urdf, opts, model, data, samples, ranges, out, notes)
+            report = dyn.stability(urdf, opts, model, samples, ranges, out, notes)
     if opts.spec is not None and opts.spec.poses:
         dyn.self_collision(urdf, opts, model, poses, out, notes)
     return Summary(
