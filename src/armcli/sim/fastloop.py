@@ -71,7 +71,8 @@ def finish(rec: Record, s: Stepper, k: int, q: list[float], v: list[float], emax
         code, rec.fail_joint = check(q, v, s.vabort)
     if code == FAIL_NONE and (k + 1) % ENERGY_EVERY == 0:
         s.set_armature(None)  # the kinetic energy of the arm alone
-        s.qa[:], s.va[:] = q, v
+        s.setq(q)
+        s.va[:] = v
         if not s.pin.computeKineticEnergy(s.model, s.data, s.qa, s.va) <= emax:
             code = FAIL_ENERGY
     if code != FAIL_NONE:
@@ -96,13 +97,17 @@ def euler_loop(
     free_lo, free_hi, fdt, n = [-math.inf] * s.n, [math.inf] * s.n, [dt * f for f in s.fric], s.n
     rec = Record(list(q), list(v), [], [])
     Qx, Vx, Tx = rec.q.extend, rec.v.extend, rec.tau.extend
+    setq, fast = (
+        s.setq,
+        True not in s.unbounded,
+    )  # continuous joints: every step through Stepper.euler
     for k, (qr, vr) in enumerate(zip(Rq, Rv, strict=True)):
         done = False
         t = [a * (b - c) + e * (f - g) for a, b, c, e, f, g in zip(kp, qr, q, kd, vr, v)]  # noqa: B905
         if gc:
-            qa[:] = q
+            setq(q)
             t = [x + y for x, y in zip(t, gravity(model, data, qa).tolist())]  # noqa: B905
-        if not any(map(gt, map(abs, t), effort)):
+        if fast and not any(map(gt, map(abs, t), effort)):
             if not armed:
                 s.set_armature(nosat)
                 armed = True

@@ -17,7 +17,15 @@ from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_UR
 from armcli.errors import InputError
 from armcli.sim.options import SimOptions
 from armcli.sim.reference import Reference, build_reference
-from armcli.sim.simulate import Arm, SimConfig, SimResult, arm_from_model, check_stability, simulate
+from armcli.sim.simulate import (
+    Arm,
+    SimConfig,
+    SimResult,
+    arm_from_model,
+    check_stability,
+    configuration,
+    simulate,
+)
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
@@ -238,7 +246,7 @@ def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
     import pinocchio as pin
 
     data = job.arm.model.createData()
-    pin.framesForwardKinematics(job.arm.model, data, q)
+    pin.framesForwardKinematics(job.arm.model, data, configuration(job.arm.model, q))
     p_root = np.asarray(data.oMf[job.tool_frame].act(job.tool_offset), dtype=float)
     out: np.ndarray = job.T_frame_root[:3, :3] @ p_root + job.T_frame_root[:3, 3]
     return out

@@ -22,8 +22,12 @@ import numpy as np
 
 from armcli.sim import rollout as ro
 
-ABI_VERSION = 2
-_UNALIGNED = ("JointModelRevoluteUnaligned", "JointModelPrismaticUnaligned")
+ABI_VERSION = 3
+_UNALIGNED = (
+    "JointModelRevoluteUnaligned",
+    "JointModelPrismaticUnaligned",
+    "JointModelRevoluteUnboundedUnaligned",
+)
 _state: dict[str, Any] = {}
 
 

@@ -51,7 +51,8 @@ from armcli.sim.stepper import UPPER as UPPER
 from armcli.sim.stepper import VABORT as VABORT
 from armcli.sim.stepper import Stepper
 
-# Pinocchio joint model -> the joint code both engines use (revolute 0-3, prismatic 4-7).
+# Pinocchio joint model -> the joint code both engines use (revolute 0-3, prismatic 4-7,
+# continuous 8-11: a revolute joint without limits, configuration (cos, sin) in Pinocchio).
 JOINT_TYPES = {
     "JointModelRX": 0,
     "JointModelRY": 1,
@@ -61,6 +62,10 @@ JOINT_TYPES = {
     "JointModelPY": 5,
     "JointModelPZ": 6,
     "JointModelPrismaticUnaligned": 7,
+    "JointModelRUBX": 8,
+    "JointModelRUBY": 9,
+    "JointModelRUBZ": 10,
+    "JointModelRevoluteUnboundedUnaligned": 11,
 }
 RK4_ROWS = 3  # reference rows per RK4 step: t, t + dt/2, t + dt (one polynomial piece)
 
@@ -69,7 +74,7 @@ RK4_ROWS = 3  # reference rows per RK4 step: t, t + dt/2, t + dt (one polynomial
 class Plant:
     """Everything a rollout needs besides the initial state and the reference."""
 
-    model: Any  # pinocchio.Model, only nq == nv one-dof joints
+    model: Any  # pinocchio.Model of one-dof joints (a continuous joint: nq 2, nv 1)
     params: np.ndarray  # (n, len(PARAM_FIELDS))
     gravity_comp: bool
     dt: float  # [s]

@@ -96,25 +96,49 @@ def arm_from_model(model: Any, joints: Sequence[str] | None = None) -> Arm:
         model = pin.buildReducedModel(model, lock, pin.neutral(model))
     for jid in range(1, model.njoints):
         j = model.joints[jid]
-        if j.shortname() not in ro.JOINT_TYPES or j.nq != 1:
+        if j.shortname() not in ro.JOINT_TYPES or j.nv != 1:
             raise InputError(
                 f"joint {model.names[jid]!r} ({j.shortname()}) cannot be simulated: only "
-                "revolute and prismatic joints are supported (lock it with --joints)",
+                "revolute, continuous and prismatic joints are supported (lock it with --joints)",
                 field="--joints",
             )
     order = list(model.names)[1:]  # simulated in model (tree) order whatever --joints says
+    iq = [model.idx_qs[j] for j in range(1, model.njoints)]
+    bounded = np.array([model.nqs[j] == 1 for j in range(1, model.njoints)])
+    # a continuous joint's angle is unbounded: no stops (Pinocchio's limits are on cos, sin)
+    lower = np.where(bounded, np.array(model.lowerPositionLimit, dtype=float)[iq], -np.inf)
+    upper = np.where(bounded, np.array(model.upperPositionLimit, dtype=float)[iq], np.inf)
     effort = np.array(model.effortLimit, dtype=float)
     effort = np.where((effort > 0) & np.isfinite(effort), effort, np.inf)
     return Arm(
         model=model,
         joint_names=tuple(order),
-        lower=np.array(model.lowerPositionLimit, dtype=float),
-        upper=np.array(model.upperPositionLimit, dtype=float),
+        lower=lower,
+        upper=upper,
         effort=effort,
         velocity=np.array(model.velocityLimit, dtype=float),
         damping=np.array(model.damping, dtype=float),
         friction=np.array(model.friction, dtype=float),
     )
+
+
+def configuration(model: Any, q: np.ndarray) -> np.ndarray:
+    """Pinocchio's configuration vector of the joint positions `q` [rad or m], one per joint.
+
+    The simulator's state holds a continuous joint's angle, unbounded; Pinocchio holds
+    (cos, sin) of it (nq = 2, nv = 1).
+    """
+    q = np.asarray(q, dtype=float)
+    if model.nq == model.nv:
+        return q
+    out = np.empty(model.nq)
+    for i, jid in enumerate(range(1, model.njoints)):
+        k = model.idx_qs[jid]
+        if model.nqs[jid] == 2:
+            out[k], out[k + 1] = np.cos(q[i]), np.sin(q[i])
+        else:
+            out[k] = q[i]
+    return out
 
 
 def params_of(arm: Arm, cfg: SimConfig) -> np.ndarray:
@@ -136,7 +160,7 @@ def check_stability(arm: Arm, cfg: SimConfig, configurations: np.ndarray) -> Non
     K, B = np.asarray(cfg.kp, float), np.asarray(cfg.kd, float) + arm.damping
     Ms = []
     for q in configurations:
-        M = pin.crba(arm.model, data, q)
+        M = pin.crba(arm.model, data, configuration(arm.model, q))
         Ms.append(np.triu(M) + np.triu(M, 1).T)
     controlled = list(range(arm.model.nv))
     scheme: stab.Scheme = "rk4" if cfg.integrator == "rk4" else "implicit"
@@ -341,7 +365,7 @@ def _result(
 def _energy_max(arm: Arm, q0: np.ndarray, params: np.ndarray) -> float:
     import pinocchio as pin
 
-    M = pin.crba(arm.model, arm.model.createData(), np.asarray(q0, dtype=float))
+    M = pin.crba(arm.model, arm.model.createData(), configuration(arm.model, q0))
     M = np.triu(M) + np.triu(M, 1).T
     return float(0.5 * np.max(np.linalg.eigvalsh(M)) * np.sum(params[:, ro.VABORT] ** 2))
 

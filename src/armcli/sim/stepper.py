@@ -52,9 +52,13 @@ class Stepper:
         self.any_friction = any(f > 0.0 for f in self.fric)
         self.gc = gravity_comp
         self.dt = dt
-        self.buf = np.zeros(3 * n)  # q, v, tau for Pinocchio, filled by one struct pack
-        self.qa, self.va, self.ta = self.buf[:n], self.buf[n : 2 * n], self.buf[2 * n :]
-        self.pack3 = struct.Struct(f"{3 * n}d").pack_into
+        nq = self.model.nq
+        # continuous joints: Pinocchio's configuration holds (cos, sin) of their angle
+        self.unbounded = [self.model.nqs[j] == 2 for j in range(1, self.model.njoints)]
+        self.iq = [self.model.idx_qs[j] for j in range(1, self.model.njoints)]
+        self.buf = np.zeros(nq + 2 * n)  # q, v, tau for Pinocchio, filled by one struct pack
+        self.qa, self.va, self.ta = self.buf[:nq], self.buf[nq : nq + n], self.buf[nq + n :]
+        self.pack3 = struct.Struct(f"{nq + 2 * n}d").pack_into
         self.sat = [False] * n
         self.lam = [0.0] * n  # the last PGS impulses: the next solve starts from them
         self.locked: list[int] = []  # RK4: joints held by their stops during the stages
@@ -86,10 +90,22 @@ class Stepper:
             )
         self._armature_key = key
 
+    def setq(self, q: list[float]) -> None:
+        """Pinocchio's configuration of the joint angles/positions q into `qa`."""
+        if True not in self.unbounded:
+            self.qa[:] = q
+            return
+        for i, x in enumerate(q):
+            if self.unbounded[i]:
+                self.qa[self.iq[i]], self.qa[self.iq[i] + 1] = math.cos(x), math.sin(x)
+            else:
+                self.qa[self.iq[i]] = x
+
     def _aba(self, q: list[float], v: list[float], tau: list[float]) -> list[float]:
-        qa, va, ta = self.qa, self.va, self.ta
-        qa[:], va[:], ta[:] = q, v, tau
-        out: list[float] = self.pin.aba(self.model, self.data, qa, va, ta).tolist()
+        va, ta = self.va, self.ta
+        self.setq(q)
+        va[:], ta[:] = v, tau
+        out: list[float] = self.pin.aba(self.model, self.data, self.qa, va, ta).tolist()
         return out
 
     def motor(
@@ -101,7 +117,7 @@ class Stepper:
             for kp, a, b, kd, c, d in zip(self.kp, qr, q, self.kd, vr, v, strict=True)
         ]
         if self.gc:
-            self.qa[:] = q
+            self.setq(q)
             g = self.pin.computeGeneralizedGravity(self.model, self.data, self.qa).tolist()
             t = [x + y for x, y in zip(t, g, strict=True)]
         return t
@@ -164,7 +180,7 @@ class Stepper:
         a + A[:, S] x with A[S, S] x = -a[S] (A = M⁻¹): exactly the constrained dynamics.
         """
         S = self.locked
-        self.qa[:] = q
+        self.setq(q)
         A = self.pin.computeMinverse(self.model, self.data, self.qa).tolist()
         x = solve_spd([[A[min(i, j)][max(i, j)] for j in S] for i in S], [-a[i] for i in S])
         self.force = x
@@ -265,7 +281,7 @@ class Stepper:
         self.stop = [hi[i] < INF or lo[i] > -INF for i in range(n)]
         if not (self.any_friction or any(self.stop)):
             return qp, vs
-        self.qa[:] = q
+        self.setq(q)
         A = self.pin.computeMinverse(self.model, self.data, self.qa).tolist()
         for i in range(n):  # only the upper triangle is guaranteed
             for j in range(i):

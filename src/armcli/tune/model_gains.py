@@ -30,7 +30,7 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.sim import stability as stab
-from armcli.sim.simulate import Arm
+from armcli.sim.simulate import Arm, configuration
 
 TARGET_RATIO = 10.0  # wn <= 2 pi f_c / TARGET_RATIO for a loop closed at f_c [Hz]
 STABILITY_MARGIN = 2.0  # gains must be stable at this multiple of dt
@@ -94,7 +94,7 @@ def mass_matrices(arm: Arm, qs: np.ndarray) -> list[np.ndarray]:
     data = arm.model.createData()
     out = []
     for q in qs:
-        M = pin.crba(arm.model, data, q)
+        M = pin.crba(arm.model, data, configuration(arm.model, q))
         out.append(np.triu(M) + np.triu(M, 1).T)
     return out
 
@@ -106,7 +106,10 @@ def gravity_max(arm: Arm, qs: np.ndarray) -> np.ndarray:
     data = arm.model.createData()
     worst = np.zeros(len(arm.joint_names))
     for q in qs:
-        worst = np.maximum(worst, np.abs(pin.computeGeneralizedGravity(arm.model, data, q)))
+        worst = np.maximum(
+            worst,
+            np.abs(pin.computeGeneralizedGravity(arm.model, data, configuration(arm.model, q))),
+        )
     return worst
 
 

@@ -44,7 +44,7 @@ constexpr double PGS_TOL = 1e-14;
 constexpr long ENERGY_EVERY = 100;
 constexpr int RK4_ROWS = 3;
 constexpr double INF = std::numeric_limits<double>::infinity();
-constexpr int ABI_VERSION = 2;
+constexpr int ABI_VERSION = 3;
 constexpr double REST_POS = 1e-12;  // mirrors armcli.sim.stepper.REST_POS
 constexpr double REST_VEL = 1e-9;
 
@@ -86,6 +86,10 @@ Plant build_model(In<int32_t> jtype, In<int32_t> parent, In<double> placement, I
       case 5: id = model.addJoint(par, pin::JointModelPY(), M, name); break;
       case 6: id = model.addJoint(par, pin::JointModelPZ(), M, name); break;
       case 7: id = model.addJoint(par, pin::JointModelPrismaticUnaligned(ax), M, name); break;
+      case 8: id = model.addJoint(par, pin::JointModelRUBX(), M, name); break;
+      case 9: id = model.addJoint(par, pin::JointModelRUBY(), M, name); break;
+      case 10: id = model.addJoint(par, pin::JointModelRUBZ(), M, name); break;
+      case 11: id = model.addJoint(par, pin::JointModelRevoluteUnboundedUnaligned(ax), M, name); break;
       default: throw std::invalid_argument("unknown joint type code");
     }
     const double* I = inertia.data() + 13 * i;  // mass, com[3], I[9] row-major
@@ -115,16 +119,28 @@ struct Stepper {
   Eigen::MatrixXd Ah;
   std::vector<char> arm_key;  // saturation pattern of the current armature; empty: zero
   bool arm_set = false;
+  std::vector<int> iq;        // each joint's first index in Pinocchio's configuration
+  std::vector<char> unbounded;  // continuous joint: configuration (cos, sin) of its angle
 
   Stepper(const pin::Model& m, const double* params, bool gravity_comp, double dt_)
-      : model(m), data(m), n(m.nv), prm(params), gc(gravity_comp), dt(dt_), qa(n), va(n),
+      : model(m), data(m), n(m.nv), prm(params), gc(gravity_comp), dt(dt_), qa(m.nq), va(n),
         ta(n), A(n, n), Ah(n, n), tau(n), lo(n), hi(n), fdt(n), lam(n), dv(n), tpd(n), t1(n), sat(n),
-        stop(n), sat1(n) {
+        stop(n), sat1(n), iq(n), unbounded(n) {
     for (int i = 0; i < n; ++i) {
       any_friction = any_friction || p(i, FRICTION) > 0.0;
       fdt[i] = dt * p(i, FRICTION);
+      iq[i] = model.idx_qs[i + 1];
+      unbounded[i] = model.nqs[i + 1] == 2;
     }
     set_armature(nullptr);
+  }
+
+  // Pinocchio's configuration of the joint angles/positions q (cos, sin for a continuous joint).
+  void setq(const double* q) {
+    for (int i = 0; i < n; ++i) {
+      if (unbounded[i]) qa[iq[i]] = std::cos(q[i]), qa[iq[i] + 1] = std::sin(q[i]);
+      else qa[iq[i]] = q[i];
+    }
   }
 
   double p(int i, int f) const { return prm[NPARAM * i + f]; }
@@ -139,7 +155,8 @@ struct Stepper {
   }
 
   const Vec& aba(const double* q, const double* v, const double* t) {
-    for (int i = 0; i < n; ++i) qa[i] = q[i], va[i] = v[i], ta[i] = t[i];
+    setq(q);
+    for (int i = 0; i < n; ++i) va[i] = v[i], ta[i] = t[i];
     return pin::aba(model, data, CRef(qa), CRef(va), CRef(ta), pin::Convention::LOCAL);
   }
 
@@ -147,7 +164,7 @@ struct Stepper {
   void motor(const double* q, const double* v, const double* qr, const double* vr, double* out) {
     for (int i = 0; i < n; ++i) out[i] = p(i, KP) * (qr[i] - q[i]) + p(i, KD) * (vr[i] - v[i]);
     if (gc) {
-      for (int i = 0; i < n; ++i) qa[i] = q[i];
+      setq(q);
       const Vec& g = pin::computeGeneralizedGravity(model, data, CRef(qa));
       for (int i = 0; i < n; ++i) out[i] = out[i] + g[i];
     }
@@ -199,7 +216,7 @@ struct Stepper {
       for (int i = 0; i < n; ++i) qn[i] = qp[i], vn[i] = vs[i];
       return;
     }
-    for (int i = 0; i < n; ++i) qa[i] = q[i];
+    setq(q);
     A = pin::computeMinverse(model, data, CRef(qa));
     A.triangularView<Eigen::StrictlyLower>() = A.transpose();
     pgs(vs);
@@ -252,7 +269,7 @@ struct Stepper {
   // Cancel the locked joints' accelerations with stop forces (armcli.sim.stepper.Stepper.hold).
   void hold(const double* q, double* a) {
     const size_t m = locked.size();
-    for (int i = 0; i < n; ++i) qa[i] = q[i];
+    setq(q);
     Ah = pin::computeMinverse(model, data, CRef(qa));
     auto Au = [&](int i, int j) { return Ah(std::min(i, j), std::max(i, j)); };
     std::vector<double> As(m * m), b(m);
@@ -383,7 +400,8 @@ Outcome run(const pin::Model& model, const double* params, bool gc, double dt, b
     }
     if (code == FAIL_NONE && (k + 1) % ENERGY_EVERY == 0) {
       s.set_armature(nullptr);  // the kinetic energy of the arm alone
-      for (int i = 0; i < n; ++i) s.qa[i] = q[i], s.va[i] = v[i];
+      s.setq(q.data());
+      for (int i = 0; i < n; ++i) s.va[i] = v[i];
       const double ke = pin::computeKineticEnergy(s.model, s.data, CRef(s.qa), CRef(s.va));
       if (!(ke <= energy_max)) code = FAIL_ENERGY;
     }
