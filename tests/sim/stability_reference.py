@@ -72,11 +72,13 @@ def largest_stable_dt(Ms, Gs, idx, kp, D, scheme, start) -> float:  # type: igno
     return _bisect(ok, lo, hi)
 
 
-def largest_stable_scale(Ms, Gs, idx, kp, kd, damping, dt, scheme, kd_too) -> float:  # type: ignore[no-untyped-def]
-    """Largest s in [0, 1] with s Kp (and s Kd when `kd_too`) stable at dt."""
+def largest_stable_scale(Ms, Gs, idx, kp, kd, damping, dt, scheme, kp_too, kd_too) -> float:  # type: ignore[no-untyped-def]
+    """Largest s in [0, 1] with s Kp (when `kp_too`) and s Kd (when `kd_too`) stable at dt."""
 
     def ok(s: float) -> bool:
         D = (s * kd if kd_too else kd) + damping
-        return worst_radius(Ms, Gs, idx, s * kp, D, dt, scheme) <= 1.0 + RADIUS_TOL
+        return (
+            worst_radius(Ms, Gs, idx, s * kp if kp_too else kp, D, dt, scheme) <= 1.0 + RADIUS_TOL
+        )
 
     return 1.0 if ok(1.0) else _bisect(ok, 0.0, 1.0)

@@ -61,9 +61,7 @@ def test_verdict_equals_the_eigenvalue_reference(seed: int, scheme: stab.Scheme)
 
 @pytest.mark.parametrize("seed", range(CASES))
 @pytest.mark.parametrize("scheme", ["implicit", "explicit"])
-def test_largest_stable_dt_equals_the_eigenvalue_reference(
-    seed: int, scheme: stab.Scheme
-) -> None:
+def test_largest_stable_dt_equals_the_eigenvalue_reference(seed: int, scheme: stab.Scheme) -> None:
     lin, pd, dt = _case(seed)
     Ms, Gs, idx, kp, D = _ref_args(lin, pd)
     expected = ref.largest_stable_dt(Ms, Gs, idx, kp, D, scheme, dt)
@@ -79,11 +77,20 @@ def test_largest_stable_dt_equals_the_eigenvalue_reference(
 def test_gain_scale_equals_the_eigenvalue_reference(seed: int, scheme: stab.Scheme) -> None:
     lin, pd, dt = _case(seed)
     Ms, Gs, idx, _, _ = _ref_args(lin, pd)
-    kd_too = scheme != "implicit"  # implicit damping: Kp alone is scaled
-    expected = ref.largest_stable_scale(Ms, Gs, idx, pd.kp, pd.kd, pd.damping, dt, scheme, kd_too)
     got = stab.gain_scale(lin, pd, dt, scheme)
-    got_01 = 0.0 if got is None else min(got, 1.0)
+    # implicit damping scales Kp alone; explicit Kd alone when that can be stable, else both
+    kp_too, kd_too = (got.kp, got.kd) if got is not None else (True, scheme != "implicit")
+    assert kp_too or scheme != "implicit"
+    expected = ref.largest_stable_scale(
+        Ms, Gs, idx, pd.kp, pd.kd, pd.damping, dt, scheme, kp_too, kd_too
+    )
+    got_01 = 0.0 if got is None else min(got.factor, 1.0)
     assert got_01 == pytest.approx(expected, abs=SCALE_ATOL, rel=DT_RTOL)
+    if got is not None and got.kp and got.kd and scheme == "explicit":
+        # Kd alone could not make it: even Kd = 0 is unstable at this dt
+        assert ref.largest_stable_scale(
+            Ms, Gs, idx, pd.kp, pd.kd, pd.damping, dt, scheme, False, True
+        ) == 0.0 or not np.any(pd.kd > 0)
 
 
 @pytest.mark.parametrize("a", [0.01, 0.5, 1.5, 3.0, 3.9, 4.1, 6.0])

@@ -154,7 +154,10 @@ def stability(
 
 
 def _report_stability(
-    rep: StabilityReport, names: list[str], qs: list[list[float]], line: int | None,
+    rep: StabilityReport,
+    names: list[str],
+    qs: list[list[float]],
+    line: int | None,
     out: Collector,
 ) -> None:
     """One finding per unstable loop, saying which loop, why, where and its one remedy."""

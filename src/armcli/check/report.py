@@ -222,7 +222,7 @@ def _stability_text(st: Any) -> Any:
 
 def _loop_bounds(v: Any) -> str:
     """How far a loop is from its edge: the largest dt, and the gain factor at this dt."""
-    what = "Kp" if v.scheme == "implicit" else "Kp and Kd"
+    what = v.scaled
     head = " (up to" if v.stable else " (stable for"
     edge = "dt = " if v.stable else "dt <= "
     dt = "any dt" if v.dt_max == float("inf") else f"{edge}{v.dt_max:.3g} s"

@@ -166,7 +166,7 @@ _RULES = [
         "pd-explicit-unstable",
         WARNING,
         "PD loop unstable at dt in an explicit torque loop (ros2_control effort controller)",
-        "lower dt, or Kp and Kd together (`armcli tune --loop explicit`)",
+        "lower dt or Kd (`armcli tune --loop explicit` picks gains for this loop)",
     ),
     Rule(
         "servo-unstable",
@@ -200,6 +200,11 @@ _RULES = [
     ),
 ]
 RULES: dict[str, Rule] = {r.id: r for r in _RULES}
+
+
+def unknown_rules(ids: Iterable[str]) -> list[str]:
+    """The ids among `ids` that name no rule, sorted (for `--ignore`)."""
+    return sorted(set(ids) - set(RULES))
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,7 @@ own, which is what a smaller dt can fix.
 A is decreasing in dt (A / dt² = 4 M / dt² + 2 c D / dt - K), so the stable time steps
 are an interval [0, dt_max], found by bisection; A is affine in a common gain scale s, so
 the largest stable scale is a generalised eigenvalue (closed form). `suggest` turns both
-into the remedy that `check` reports and `simulate` prints, with one margin and rounding.
+into the remedy that `check` reports and `simulate` prints (armcli.sim.verdict).
 
 RK4 has no implicit damping: its step map is the 4th-order Taylor polynomial p(h mu) of
 the continuous modes mu (eigenvalues of the linearised loop), stable where |p| <= 1.
@@ -39,10 +39,11 @@ import contextlib
 import math
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
+from functools import partial
 from typing import Any, Literal
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 # The loop counts as stable when its step map does not grow: spectral radius <= 1 + RADIUS_TOL
 # (RK4 and reports), or A + PSD_RTOL * 4M positive definite (Euler). Undamped symplectic
@@ -80,9 +81,7 @@ class PD:
     damping: Array  # joint viscous damping of the controlled joints [N·m·s/rad]
 
     @staticmethod
-    def of(
-        idx: Sequence[int], kp: Sequence[float], kd: Sequence[float], damping: Sequence[float]
-    ) -> PD:
+    def of(idx: Sequence[int], kp: ArrayLike, kd: ArrayLike, damping: ArrayLike) -> PD:
         """Gains as float arrays (one entry per controlled joint)."""
         arr = [np.asarray(x, dtype=float).reshape(-1) for x in (kp, kd, damping)]
         return PD(tuple(int(i) for i in idx), arr[0], arr[1], arr[2])
@@ -185,7 +184,7 @@ def _psd(A: Array, M: Array) -> bool:
     return True
 
 
-def _euler_ok(lin: Linearised, k: int, pd: PD, dt: float, scheme: Scheme) -> bool:
+def _euler_ok(lin: Linearised, k: int, pd: PD, dt: float, *, scheme: Scheme) -> bool:
     return _psd(margin_matrix(lin.M[k], lin.G[k], pd, dt, scheme), lin.M[k])
 
 
@@ -218,9 +217,9 @@ def _euler_dt_max(lin: Linearised, pd: PD, scheme: Scheme, start: float) -> tupl
     """
     best, worst = math.inf, 0
     for k in range(len(lin)):
-        if math.isfinite(best) and _euler_ok(lin, k, pd, best, scheme):
+        if math.isfinite(best) and _euler_ok(lin, k, pd, best, scheme=scheme):
             continue
-        edge = _edge(lambda h, k=k: _euler_ok(lin, k, pd, h, scheme), min(start, best))
+        edge = _edge(partial(_euler_ok, lin, k, pd, scheme=scheme), min(start, best))
         if edge < best:
             best, worst = edge, k
     return best, worst
@@ -253,17 +252,42 @@ def largest_along(lin: Linearised, base: PD, p: Array, dt: float, scheme: Scheme
     return best
 
 
-def factors(s: float, scheme: Scheme) -> tuple[float, float]:
-    """(Kp factor, Kd factor) of a gain scale s: implicit damping scales Kp only (Kd makes
-    that loop more stable, never less); explicit damping and RK4 scale Kp and Kd together."""
-    return (s, 1.0) if scheme == "implicit" else (s, s)
+@dataclass(frozen=True)
+class GainScale:
+    """The largest stable factor on some of the gains at dt: which gains, and how far."""
+
+    factor: float  # >= 1 when the gains are stable; inf: any factor
+    kp: bool  # Kp is scaled
+    kd: bool  # Kd is scaled
+
+    @property
+    def label(self) -> str:
+        """The scaled gains, in words."""
+        return "Kp and Kd" if self.kp and self.kd else ("Kp" if self.kp else "Kd")
+
+    def apply(self, pd: PD, s: float) -> PD:
+        """`pd` with the scaled gains multiplied by s."""
+        return pd.scaled(s if self.kp else 1.0, s if self.kd else 1.0)
 
 
-def _euler_scale(lin: Linearised, pd: PD, dt: float, scheme: Scheme) -> float | None:
-    """Largest gain scale (see `factors`) stable at dt on every point."""
-    f_kp, f_kd = factors(0.0, scheme)
-    p = dt * dt * pd.kp + (2.0 * dt * pd.kd if f_kd == 0.0 else 0.0)
-    return largest_along(lin, pd.scaled(f_kp, f_kd), p, dt, scheme)
+def _euler_scale(lin: Linearised, pd: PD, dt: float, scheme: Scheme) -> GainScale | None:
+    """Largest stable factor at dt on every point, along the gains that matter.
+
+    Implicit damping: Kp alone (Kd makes that loop more stable, never less). Explicit
+    damping: Kd alone when vanishing Kd would be stable (Kp kept), else Kp and Kd together.
+    """
+    if scheme == "implicit":
+        directions = [GainScale(0.0, kp=True, kd=False)]
+    else:
+        directions = [GainScale(0.0, kp=True, kd=True)]
+        if np.any(pd.kd > 0.0):
+            directions.insert(0, GainScale(0.0, kp=False, kd=True))
+    for d in directions:
+        p = (dt * dt * pd.kp if d.kp else 0.0 * pd.kp) + (2.0 * dt * pd.kd if d.kd else 0.0)
+        factor = largest_along(lin, d.apply(pd, 0.0), p, dt, scheme)
+        if factor is not None:
+            return GainScale(factor, d.kp, d.kd)
+    return None
 
 
 # -- RK4: continuous modes through the Taylor polynomial ------------------------------------
@@ -276,8 +300,8 @@ def continuous_modes(M: Array, G: Array, pd: PD) -> NDArray[np.complex128]:
     D = np.diag(_diag(n, pd, pd.kd + pd.damping))
     Minv = np.linalg.inv(M)
     top = np.hstack([np.zeros((n, n)), np.eye(n)])
-    out: NDArray[np.complex128] = np.linalg.eigvals(np.vstack([top, np.hstack([-Minv @ K, -Minv @ D])]))
-    return out
+    mu = np.linalg.eigvals(np.vstack([top, np.hstack([-Minv @ K, -Minv @ D])]))
+    return np.asarray(mu, dtype=np.complex128)
 
 
 def _rk4_radius(mu: NDArray[np.complex128], h: float) -> float:
@@ -289,16 +313,20 @@ def _rk4_radius(mu: NDArray[np.complex128], h: float) -> float:
     return float(np.max(np.abs(p)))
 
 
+def _rk4_ok(mu: NDArray[np.complex128], h: float) -> bool:
+    return _rk4_radius(mu, h) <= 1.0 + RADIUS_TOL
+
+
 def _rk4_dt_max(modes: Sequence[NDArray[np.complex128]], start: float) -> tuple[float, int]:
     best, worst = math.inf, 0
     for k, mu in enumerate(modes):
-        edge = _edge(lambda h, mu=mu: _rk4_radius(mu, h) <= 1.0 + RADIUS_TOL, min(start, best))
+        edge = _edge(partial(_rk4_ok, mu), min(start, best))
         if edge < best:
             best, worst = edge, k
     return best, worst
 
 
-def _rk4_scale(lin: Linearised, pd: PD, dt: float, k: int) -> float | None:
+def _rk4_scale(lin: Linearised, pd: PD, dt: float, k: int) -> GainScale | None:
     """Largest common Kp, Kd factor in [0, 1] stable at dt on point k (bisection)."""
 
     def ok(s: float) -> bool:
@@ -308,12 +336,12 @@ def _rk4_scale(lin: Linearised, pd: PD, dt: float, k: int) -> float | None:
     if not ok(0.0):
         return None
     if ok(1.0):
-        return 1.0
+        return GainScale(1.0, kp=True, kd=True)
     lo, hi = 0.0, 1.0
     for _ in range(BISECT_STEPS):
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if ok(mid) else (lo, mid)
-    return lo
+    return GainScale(lo, kp=True, kd=True)
 
 
 # -- one loop's verdict and remedy ----------------------------------------------------------
@@ -354,7 +382,7 @@ def stable(lin: Linearised, pd: PD, dt: float, scheme: Scheme) -> bool:
             _rk4_radius(continuous_modes(lin.M[k], lin.G[k], pd), dt) <= 1.0 + RADIUS_TOL
             for k in range(len(lin))
         )
-    return all(_euler_ok(lin, k, pd, dt, scheme) for k in range(len(lin)))
+    return all(_euler_ok(lin, k, pd, dt, scheme=scheme) for k in range(len(lin)))
 
 
 def largest_stable_dt(lin: Linearised, pd: PD, scheme: Scheme, start: float) -> float:
@@ -363,15 +391,19 @@ def largest_stable_dt(lin: Linearised, pd: PD, scheme: Scheme, start: float) -> 
 
 
 def dt_max_at(lin: Linearised, pd: PD, scheme: Scheme, start: float) -> tuple[float, int]:
+    """Largest stable dt [s] over the points, and the index of the point that sets it."""
     if scheme == "rk4":
         modes = [continuous_modes(lin.M[k], lin.G[k], pd) for k in range(len(lin))]
         return _rk4_dt_max(modes, start)
     return _euler_dt_max(lin, pd, scheme, start)
 
 
-def gain_scale(lin: Linearised, pd: PD, dt: float, scheme: Scheme) -> float | None:
-    """Largest common gain factor stable at dt (Kp only for implicit damping; Kp and Kd
-    otherwise): >= 1 when the gains are stable, None when no factor >= 0 is."""
+def gain_scale(lin: Linearised, pd: PD, dt: float, scheme: Scheme) -> GainScale | None:
+    """Largest stable factor at dt on every point, and which gains it scales.
+
+    At least 1 when the gains are stable; None when no factor >= 0 is (gravity or
+    damping alone too stiff).
+    """
     if scheme != "rk4":
         return _euler_scale(lin, pd, dt, scheme)
     _, k = dt_max_at(lin, pd, scheme, dt)

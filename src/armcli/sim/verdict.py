@@ -43,8 +43,8 @@ class Suggestion:
     dt: float  # [s] STABLE_MARGIN inside dt_max, rounded down
     kp: tuple[float, ...] | None  # per controlled joint; None: no gain scale helps at dt
     kd: tuple[float, ...] | None
-    kp_factor: float | None  # the factor applied to Kp before rounding (None with kp)
-    kd_factor: float | None  # the same for Kd (1.0 when Kd is kept)
+    kp_factor: float | None  # the factor applied to Kp before rounding (1.0: kept; None: none)
+    kd_factor: float | None  # the same for Kd
 
 
 @dataclass(frozen=True)
@@ -58,7 +58,8 @@ class LoopVerdict:
     b: float  # D dt lambda
     spectral_radius: float  # of the linearised step at the worst point
     dt_max: float  # largest stable dt with these gains [s] (inf: every dt)
-    gain_scale: float | None  # largest stable gain factor at dt (stab.factors; None: none)
+    gain_scale: float | None  # largest stable factor on `scaled` at dt (None: none helps)
+    scaled: str | None  # which gains that factor scales: "Kp", "Kd" or "Kp and Kd"
     suggestion: Suggestion | None  # None when stable
     worst: int  # index of the operating point that sets dt_max
 
@@ -87,15 +88,18 @@ def round_down(x: float, digits: int = REMEDY_DIGITS) -> float:
     return float(f"{np.floor(x / step + 1e-9) * step:.{digits}g}")
 
 
-def suggest(dt_max: float, scale: float | None, pd: PD, scheme: Scheme) -> Suggestion:
-    """The one remedy: dt STABLE_MARGIN inside dt_max, or the gains scaled STABLE_MARGIN
-    inside the largest stable factor, rounded down (so the rounded values stay stable)."""
+def suggest(dt_max: float, scale: stab.GainScale | None, pd: PD) -> Suggestion:
+    """The one remedy: dt, or the gains scaled, STABLE_MARGIN inside their bound.
+
+    Both are rounded down, so the rounded values stay stable.
+    """
     dt = round_down(STABLE_MARGIN * dt_max)
-    if scale is None or scale <= 0.0:
+    if scale is None or scale.factor <= 0.0:
         return Suggestion(dt, None, None, None, None)
-    f_kp, f_kd = stab.factors(STABLE_MARGIN * min(scale, 1.0), scheme)
-    kp = tuple(round_down(f_kp * float(x)) for x in pd.kp)
-    kd = tuple(round_down(f_kd * float(x)) if f_kd != 1.0 else float(x) for x in pd.kd)
+    f = STABLE_MARGIN * min(scale.factor, 1.0)
+    f_kp, f_kd = (f if scale.kp else 1.0), (f if scale.kd else 1.0)
+    kp = tuple(round_down(f_kp * float(x)) if scale.kp else float(x) for x in pd.kp)
+    kd = tuple(round_down(f_kd * float(x)) if scale.kd else float(x) for x in pd.kd)
     return Suggestion(dt, kp, kd, f_kp, f_kd)
 
 
@@ -110,8 +114,9 @@ def verdict(lin: Linearised, pd: PD, dt: float, scheme: Scheme) -> LoopVerdict:
         radius = stab.spectral_radius(step)
     kp, d = _largest(pd.kp), _largest(pd.kd + pd.damping)
     return LoopVerdict(
-        scheme, LOOP_NAMES[scheme], ok, kp * dt * dt * lam, d * dt * lam, radius, dt_max, scale,
-        None if ok else suggest(dt_max, scale, pd, scheme), worst,
+        scheme, LOOP_NAMES[scheme], ok, kp * dt * dt * lam, d * dt * lam, radius, dt_max,
+        None if scale is None else scale.factor, None if scale is None else scale.label,
+        None if ok else suggest(dt_max, scale, pd), worst,
     )  # fmt: skip
 
 
@@ -144,7 +149,11 @@ def analyse(
 def cause(v: LoopVerdict, kp: float, d: float, gravity: float, lam: float) -> str:
     """What is too stiff for the inertia, in the loop's terms."""
     grav = f", gravity's stiffness up to {gravity:.3g} N·m/rad" if gravity > 0 else ""
-    gains = f"Kp up to {kp:g}" if v.scheme == "implicit" else f"Kp up to {kp:g}, Kd + damping up to {d:g}"
+    gains = (
+        f"Kp up to {kp:g}"
+        if v.scheme == "implicit"
+        else f"Kp up to {kp:g}, Kd + damping up to {d:g}"
+    )
     return f"{gains}{grav} too stiff for lambda_max(M^-1) = {lam:.4g}"
 
 
@@ -153,8 +162,9 @@ def remedy(s: Suggestion, names: Sequence[str], dt: float) -> str:
     text = f"e.g. dt = {s.dt:g} s"
     if s.kp is None or s.kd is None or s.kp_factor is None:
         return text + " (at this dt no lower gains are stable)"
-    what = "Kp" if s.kd_factor == 1.0 else "Kp and Kd"
-    text += f", or keep dt = {dt:g} s with {what} x {s.kp_factor:.3g}"
+    scaled = [g for g, f in (("Kp", s.kp_factor), ("Kd", s.kd_factor)) if f != 1.0]
+    factor = s.kp_factor if s.kp_factor != 1.0 else s.kd_factor
+    text += f", or keep dt = {dt:g} s with {' and '.join(scaled)} x {factor:.3g}"
     if len(names) <= LIST_GAINS:
         each = (f"{n} kp {p:g} kd {d:g}" for n, p, d in zip(names, s.kp, s.kd, strict=True))
         text += " (" + ", ".join(each) + ")"
@@ -182,14 +192,16 @@ def refuse_unstable(lin: Linearised, pd: PD, dt: float, scheme: Scheme,
     with stab.one_blas_thread():
         if stab.stable(lin, pd, dt, scheme):
             return
+        euler_ok = scheme == "rk4" and stab.stable(lin, pd, dt, "implicit")
     v = verdict(lin, pd, dt, scheme)
     g = float(np.linalg.eigvalsh(lin.G[v.worst])[-1])
     numbers = (_largest(pd.kp), _largest(pd.kd + pd.damping), g, _lambda_max(lin.M[v.worst], pd))
-    assert v.suggestion is not None  # an unstable verdict always carries one
-    raise UnstableLoopError(
-        message(v, names, qs[v.worst], dt, numbers), scheme=scheme, dt=dt,
-        suggestion_dt=v.suggestion.dt, kp=v.suggestion.kp, kd=v.suggestion.kd,
-    )  # fmt: skip
+    text = message(v, names, qs[v.worst], dt, numbers)
+    if euler_ok:
+        text += f"; or the default euler integrator: {LOOP_NAMES['implicit']} is stable here"
+    s = v.suggestion
+    assert s is not None  # an unstable verdict always carries one
+    raise UnstableLoopError(text, scheme=scheme, dt=dt, suggestion_dt=s.dt, kp=s.kp, kd=s.kd)
 
 
 def _largest(x: np.ndarray) -> float:
