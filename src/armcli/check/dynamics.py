@@ -117,6 +117,7 @@ def stability(
     urdf: Urdf,
     opts: CheckOptions,
     model: Any,
+    data: Any,
     samples: list[Any],
     ranges: list[Any],
     out: Collector,
@@ -138,7 +139,7 @@ def stability(
         notes.append("stability skipped: no controlled joint found in this URDF")
         return None
     gravity = not spec.control.gravity_compensation
-    lin = stab.linearise(model, [q for _, q in samples], gravity=gravity)
+    lin = stab.linearise(model, [q for _, q in samples], gravity=gravity, data=data)
     gains = [spec.control.gains[n] for n in names]
     pd = stab.PD.of(
         [v_of[n] for n in names],

@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from armcli.io.terminal import Column, FitTable
 from armcli.sim.simulate import SimResult
 
 SETTLE_TOL = 0.01  # [rad or m] |q - q_ref| band for "settled"
@@ -57,29 +58,35 @@ def _settle(t: np.ndarray, e: np.ndarray, t_end: float, tol: float) -> float | N
     return max(0.0, float(start) - t_end)
 
 
+SUMMARY_HEADERS = (
+    "RMS err\n[rad]",
+    "max err\n[rad]",
+    "final err\n[rad]",
+    "settle\n[s]",
+    "saturated\n[%]",
+    "stop\nhits",
+)
 ENGINE_LABEL = {"native": "compiled (native)", "python": "Python"}
 
 
 def summary_table(
     metrics: Sequence[JointMetrics], ee: np.ndarray | None, ee_label: str, res: SimResult
 ) -> Any:
-    """A rich Table; the caller prints it."""
-    from rich.table import Table
-    from rich.text import Text
-
+    """A table (rich renderable, numbers whole at any width); the caller prints it."""
     caption = (
         f"{res.integrator}, dt = {res.dt:g} s, {len(res.t) - 1} steps, "
         f"{ENGINE_LABEL.get(res.backend, res.backend)} engine "
         f"({res.wall_time * 1e6 / max(1, len(res.t) - 1):.2f} µs/step)\n"
-        f"errors q - q_ref [rad]; settle: time after the last point until |error| stays "
-        f"< {SETTLE_TOL:g}"
+        f"errors q - q_ref; settle: time after the last point until |error| stays "
+        f"< {SETTLE_TOL:g}; stop hits: times a joint stop engaged"
     )
     if ee is not None:
-        caption += f"\nend effector {ee_label} at t = {res.t[-1]:g} s: " + _xyz(ee)
-    table = Table(title="armcli simulate: tracking", caption=Text(caption), caption_justify="left")
-    table.add_column("joint", no_wrap=True)
-    for col in ("RMS err", "max err", "final err", "settle [s]", "saturated", "stop hits"):
-        table.add_column(Text(col), justify="right")
+        caption += f"\nend effector {ee_label} at t = {res.t[-1]:g} s:\n  " + _xyz(ee)
+    table = FitTable(
+        [Column("joint", number=False), *(Column(h) for h in SUMMARY_HEADERS)],
+        title="armcli simulate: tracking",
+        caption=caption,
+    )
     for m in metrics:
         table.add_row(
             m.name,
@@ -87,7 +94,7 @@ def summary_table(
             f"{m.max_error:.4f}",
             f"{m.final_error:+.4f}",
             "not settled" if m.settle_time is None else f"{m.settle_time:.3f}",
-            f"{m.saturated_pct:.1f}%",
+            f"{m.saturated_pct:.1f}",
             str(m.limit_contacts),
         )
     return table

@@ -27,6 +27,7 @@ from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim import stability as stab
 from armcli.sim import verdict as verdicts
+from armcli.urdf.pinocchio import mass_matrix
 
 VEL_ABORT_FACTOR = 10.0  # divergence when |v| exceeds this times the URDF velocity limit
 DEFAULT_VABORT = 1000.0  # [rad/s or m/s] when the URDF gives no velocity limit
@@ -347,10 +348,7 @@ def _result(
 
 
 def _energy_max(arm: Arm, q0: np.ndarray, params: np.ndarray) -> float:
-    import pinocchio as pin
-
-    M = pin.crba(arm.model, arm.model.createData(), configuration(arm.model, q0))
-    M = np.triu(M) + np.triu(M, 1).T
+    M = mass_matrix(arm.model, arm.model.createData(), configuration(arm.model, q0))
     return float(0.5 * np.max(np.linalg.eigvalsh(M)) * np.sum(params[:, ro.VABORT] ** 2))
 
 

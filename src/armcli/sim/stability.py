@@ -45,6 +45,8 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from armcli.urdf.pinocchio import mass_matrix
+
 # The loop counts as stable when its step map does not grow: spectral radius <= 1 + RADIUS_TOL
 # (RK4 and reports), or A + PSD_RTOL * 4M positive definite (Euler). Undamped symplectic
 # Euler sits exactly on |z| = 1 (a bounded oscillation); the slack absorbs rounding there.
@@ -134,19 +136,20 @@ def implicit_dt_max(kp: float, d: float, lam: float) -> float:
 # -- the operating points -------------------------------------------------------------------
 
 
-def linearise(model: Any, configurations: Sequence[Any], *, gravity: bool = True) -> Linearised:
-    """M(q) (CRBA, symmetrised) and G(q) = dg/dq at each Pinocchio configuration.
+def linearise(
+    model: Any, configurations: Sequence[Any], *, gravity: bool = True, data: Any = None
+) -> Linearised:
+    """M(q) (CRBA, symmetric) and G(q) = dg/dq at each Pinocchio configuration.
 
     `gravity=False` for a loop that compensates g(q) (then G = 0).
     """
     import pinocchio as pin
 
-    data = model.createData()
+    data = data if data is not None else model.createData()
     Ms, Gs = [], []
     for q in configurations:
         q = np.asarray(q, dtype=float)
-        M = pin.crba(model, data, q)
-        Ms.append(np.triu(M) + np.triu(M, 1).T)
+        Ms.append(mass_matrix(model, data, q))
         if gravity:
             G = np.array(pin.computeGeneralizedGravityDerivatives(model, data, q), dtype=float)
             Gs.append(0.5 * (G + G.T))
