@@ -13,6 +13,7 @@ from typing import Any
 
 from armcli.check.rules import ERROR, WARNING, Finding
 from armcli.check.run import CheckResult
+from armcli.io.terminal import Column, FitTable, Hanging
 
 JSON_SCHEMA = "armcli.check/1"
 
@@ -103,38 +104,33 @@ def _num(x: float | None, fmt: str = "{:.4g}") -> str:
     return "-" if x is None else fmt.format(x)
 
 
+SEVERITY_ORDER = {ERROR: 0, WARNING: 1}
+SEVERITY_WIDTH = len(WARNING) + 1  # [columns] the message column starts here
+
+
+def by_severity(findings: Sequence[Finding]) -> list[Finding]:
+    """Errors first, then warnings; the rules' own order within each (a stable sort)."""
+    return sorted(findings, key=lambda f: SEVERITY_ORDER.get(f.severity, len(SEVERITY_ORDER)))
+
+
 def to_rich(
     results: Sequence[CheckResult],
     findings: Sequence[Finding],
     unusable: Sequence[str] = (),
 ) -> list[Any]:
-    """Renderables: per file a findings table and the summary; then the totals line.
+    """Renderables: per file its findings (errors first) and the summary; then the totals.
 
     `unusable` names the files that could not be read; their `input-unusable` finding is
-    shown like any other.
+    shown like any other. Every renderable keeps its numbers whole at any width.
     """
-    from rich.table import Table
     from rich.text import Text
 
     out: list[Any] = []
     files = [(r.file, r) for r in results] + [(u, None) for u in unusable]
     for file, r in files:
-        mine = [f for f in findings if f.file == file]
+        mine = by_severity([f for f in findings if f.file == file])
         out.append(Text(f"\n{file}", style="bold"))
-        if mine:
-            t = Table(show_header=True, header_style="bold", expand=False)
-            for col in ("severity", "rule", "line", "message"):
-                t.add_column(col, overflow="fold")
-            for f in mine:
-                style = "red" if f.severity == ERROR else "yellow"
-                msg = Text(f.message)
-                msg.append(f"\nfix: {f.hint}", style="dim")
-                if f.fix:
-                    msg.append(f"\nwrite: {_fix_text(f.fix)}", style="dim")
-                t.add_row(Text(f.severity, style=style), f.rule, _num(f.line, "{}"), msg)
-            out.append(t)
-        else:
-            out.append(Text("no findings", style="green"))
+        out.append(_findings_grid(mine) if mine else Text("no findings", style="green"))
         if r is not None:
             out.extend(_summary(r))
     c = counts(findings)
@@ -149,12 +145,60 @@ def to_rich(
     return out
 
 
+def _findings_grid(findings: Sequence[Finding]) -> Any:
+    """Per finding: severity, then rule and place, message, fix and remedy indented beside it."""
+    from rich.console import Group
+    from rich.text import Text
+
+    items = []
+    for f in findings:
+        style = "red" if f.severity == ERROR else "yellow"
+        body = Text(f.rule, style="bold")
+        if f.line:
+            body.append(f"  line {f.line}")
+        body.append(f"\n{f.message}")
+        if f.hint:
+            body.append(f"\nfix: {f.hint}", style="dim")
+        if f.fix:
+            body.append(f"\nwrite: {_fix_text(f.fix)}", style="dim")
+        items.append(Hanging(Text(f.severity, style=style), body, SEVERITY_WIDTH))
+    return Group(*items)
+
+
 def _fix_text(fix: Any) -> str:
     return " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in fix.items())
 
 
+JOINT_COLUMNS = (
+    ("joint", False),
+    ("type", False),
+    ("lower\n[rad]", True),
+    ("upper\n[rad]", True),
+    ("effort\n[N·m]", True),
+    ("velocity\n[rad/s]", True),
+    ("damping\n[N·m·s]", True),
+    ("friction\n[N·m]", True),
+    ("gravity\n[N·m]", True),
+)
+JOINT_CAPTION = (
+    "gravity: the largest |gravity torque| over the sampled poses; "
+    "prismatic joints in m, N, m/s, N·s/m"
+)
+
+
+def _joint_table(s: Any) -> Any:
+    t = FitTable([Column(h, n) for h, n in JOINT_COLUMNS], title="joints", caption=JOINT_CAPTION)
+    for j in s.joints:
+        t.add_row(
+            j.name,
+            j.type,
+            *(_num(x) for x in (j.lower, j.upper, j.effort, j.velocity, j.damping, j.friction)),
+            _num(j.gravity_max),
+        )
+    return t
+
+
 def _summary(r: CheckResult) -> list[Any]:
-    from rich.table import Table
     from rich.text import Text
 
     s = r.summary
@@ -164,38 +208,12 @@ def _summary(r: CheckResult) -> list[Any]:
         Text(f"robot {s.robot!r}: root {s.root}, total mass {s.total_mass:.4g} kg, {s.dof} DoF")
     ]
     if s.joints:
-        out.append(Text("joints"))
-        t = Table(header_style="bold")
-        for col in (
-            "joint",
-            "type",
-            "lower",
-            "upper",
-            "effort",
-            "velocity",
-            "damping",
-            "friction",
-            "max |gravity torque|",
-        ):
-            t.add_column(col, justify="left" if col in ("joint", "type") else "right")
-        for j in s.joints:
-            t.add_row(
-                j.name,
-                j.type,
-                _num(j.lower),
-                _num(j.upper),
-                _num(j.effort),
-                _num(j.velocity),
-                _num(j.damping),
-                _num(j.friction),
-                _num(j.gravity_max),
-            )
-        out.append(t)
+        out.append(_joint_table(s))
     if s.poses:
-        out.append(Text(f"end effector {s.end_effector} in {s.root} [m]"))
-        t = Table(header_style="bold")
-        for col in ("pose", "x", "y", "z"):
-            t.add_column(col, justify="left" if col == "pose" else "right")
+        t = FitTable(
+            [Column("pose", False), Column("x [m]"), Column("y [m]"), Column("z [m]")],
+            title=f"end effector {s.end_effector} in {s.root}",
+        )
         for p in s.poses:
             t.add_row(p.name, *(f"{v:.4f}" for v in p.xyz))
         out.append(t)
@@ -208,18 +226,25 @@ def _summary(r: CheckResult) -> list[Any]:
 def _stability_text(st: Any) -> Any:
     from rich.text import Text
 
-    e, i = st.explicit, st.implicit
     t = Text(
         f"PD stability at dt = {st.dt:g} s: lambda_max(M^-1) = {st.lambda_max:.4g} 1/(kg m^2), "
-        f"Kp = {st.kp:g}, Kd + damping = {st.d:g}\n"
+        f"gravity's stiffness up to {st.gravity_stiffness:.3g} N·m/rad, Kp up to {st.kp:g}, "
+        f"Kd + damping up to {st.d:g}"
     )
-    t.append(
-        f"  explicit damping: b = {e.b:.3g}, a = {e.a:.3g}, a + 2b = {e.a + 2 * e.b:.3g} "
-        f"(< 4 needed): ",
-    )
-    t.append("stable" if e.stable else "UNSTABLE", "green" if e.stable else "red")
-    t.append(f"; stable for dt < {e.dt_max:.3g} s or Kd < {st.kd_max_explicit:.3g}\n")
-    t.append("  implicit damping (the simulator): ")
-    t.append("stable" if i.stable else "UNSTABLE", "green" if i.stable else "red")
-    t.append(f"; Kp < {st.kp_max_implicit:.4g} or dt < {i.dt_max:.3g} s")
+    for v in (st.implicit, st.explicit):
+        t.append(f"\n  {v.loop}: ")
+        t.append("stable" if v.stable else "UNSTABLE", "green" if v.stable else "red")
+        t.append(_loop_bounds(v))
     return t
+
+
+def _loop_bounds(v: Any) -> str:
+    """How far a loop is from its edge: the largest dt, and the gain factor at this dt."""
+    what = v.scaled
+    head = " (up to" if v.stable else " (stable for"
+    edge = "dt = " if v.stable else "dt <= "
+    dt = "any dt" if v.dt_max == float("inf") else f"{edge}{v.dt_max:.3g} s"
+    if v.gain_scale is None:
+        return f"{head} {dt}; at this dt gravity or damping alone is too stiff)"
+    factor = "any factor" if v.gain_scale == float("inf") else f"x {v.gain_scale:.3g}"
+    return f"{head} {dt}, or {what} {factor} at this dt)"

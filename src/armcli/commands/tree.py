@@ -2,13 +2,23 @@
 
 from __future__ import annotations
 
+import io
 import sys
 from pathlib import Path
 
 import typer
 
 from armcli.commands.options import choice, spec_argument
+from armcli.commands.xacro_inputs import (
+    args_argument,
+    env_option,
+    package_dir_option,
+    split_robot,
+    write_notes,
+    xacro_inputs,
+)
 from armcli.errors import InputError
+from armcli.io import terminal
 from armcli.io.files import write_file_atomic
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
@@ -21,10 +31,13 @@ TREE_FORMATS = ("text", "dot")
 
 def tree_cmd(
     robot: Path | None = spec_argument(ROBOT_HELP),
+    args: list[str] = args_argument(),
     fmt: str = choice(
         "text", TREE_FORMATS, "--format", help="text (a tree, the default) or dot (Graphviz)."
     ),
     out: Path = typer.Option(None, "-o", "--out", help="Write to this file instead of stdout."),
+    package_dir: list[str] = package_dir_option(),
+    env: list[str] = env_option(),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
@@ -33,20 +46,21 @@ def tree_cmd(
         raise InputError(f"unknown format {fmt!r}; known: text, dot", field="--format")
     if out is not None:
         check_output_file(out, "--out")
-    src = load_robot(find_spec(robot), trust_mode(trust_xacro, unsandboxed))
+    robot, tokens = split_robot(robot, args)
+    inputs = xacro_inputs(tokens, env, package_dir)
+    src = load_robot(
+        find_spec(robot), trust_mode(trust_xacro, unsandboxed), inputs.packages, inputs
+    )
+    write_notes(src.notes)
     tree = parse_tree(src.xml, src.source)
     if fmt == "dot":
         text = to_dot(tree)
     else:
-        import io
-
-        from rich.console import Console
-
         if out is None:
-            Console().print(to_rich(tree))
+            terminal.console().print(to_rich(tree), crop=False)
             return
         buf = io.StringIO()
-        Console(file=buf, width=120).print(to_rich(tree))
+        terminal.console(buf, terminal.UNBOUNDED).print(to_rich(tree), crop=False)
         text = buf.getvalue()
     if out is None:
         sys.stdout.write(text)

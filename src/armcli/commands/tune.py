@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -11,10 +10,12 @@ import typer
 
 from armcli.commands.options import choice, option, spec_argument
 from armcli.errors import InputError
+from armcli.io import terminal
 from armcli.io.files import write_file_atomic
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
+from armcli.tune import gains as gain_vector
 from armcli.tune import job as tjob
 from armcli.tune import report, session
 from armcli.tune.engine import Engine, make_engine
@@ -33,7 +34,7 @@ LOOP_HELP = (
     "stepped explicitly, e.g. Gazebo's effort controller)."
 )
 ROBUST_MODE_HELP = "Aggregate over the perturbed models: worst (default) or quantile."
-SCHEDULER_HELP = "Dask scheduler address, e.g. tcp://HOST:8786 (needs armcli[dask])."
+SCHEDULER_HELP = "Dask scheduler address, e.g. tcp://HOST:8786 (needs dask[distributed])."
 
 
 def _pair(text: str, name: str) -> tuple[float, float]:
@@ -112,13 +113,15 @@ def _run(
     from rich.console import Console
     from rich.progress import Progress
 
-    out = Console(file=sys.stdout) if sys.stdout.isatty() else Console(file=sys.stdout, width=130)
-    out.print(report.reasoning_table(job.start))
+    out = terminal.console()
+    out.print(report.reasoning_table(job.start), crop=False)
     arm_damping = nominal_arm(job.problem).damping
     with Progress(console=Console(stderr=True), transient=True) as bar:
         task = bar.add_task(f"tuning on {engine.name}", total=opts.trials)
         outcome = session.run(job, engine, opts, lambda d, t: bar.update(task, completed=d))
-    out.print(report.comparison_table(job.problem, job.start, outcome.rows, arm_damping))
+    out.print(
+        report.comparison_table(job.problem, job.start, outcome.rows, arm_damping), crop=False
+    )
     _summary(out, outcome)
     if output is not None:
         write_file_atomic(
@@ -132,12 +135,7 @@ def _run(
         runs = session.tracking_runs(job, outcome, case)
         write_tune_plot(plot, outcome.result.history, runs, job.problem.cases[case].label)
     if write:
-        n = len(job.problem.joints)
-        best = outcome.result.best
-        write_gains(
-            spec_path,
-            {j: (float(best[i]), float(best[n + i])) for i, j in enumerate(job.problem.joints)},
-        )
+        write_gains(spec_path, gain_vector.by_joint(outcome.result.best, job.problem.joints))
     for path in (output, plot, spec_path if write else None):
         if path is not None:
             out.print(f"wrote {path}", markup=False, highlight=False)

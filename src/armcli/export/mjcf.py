@@ -10,9 +10,12 @@ the primitives; meshes are copied into `meshes/` beside the model.
 Actuators: a joint with spec gains gets a `position` actuator with kp = Kp,
 kv = Kd and forcerange = the effort limit, i.e. the torque
 `Kp (ctrl - q) - Kd v`, clipped. armcli's controller is `Kp (q_ref - q) + Kd (v_ref - v)`;
-both agree with ctrl = q_ref + (Kd / Kp) v_ref. A joint without gains but with an
-effort limit gets a `motor` (ctrl = torque). The integrator is `implicitfast`,
-which, like `armcli simulate`, treats damping and Kd implicitly.
+both agree with ctrl = q_ref + (Kd / Kp) v_ref, which is why the control is not
+clipped to the joint range. A joint without gains but with an effort limit gets a
+`motor` (ctrl = torque). The integrator is `implicitfast`, which, like `armcli
+simulate`, treats damping and Kd implicitly. armcli's joint stops are hard; MuJoCo's
+limits are soft constraints, made as stiff as MuJoCo allows (`solreflimit` time
+constant = 2 time steps, its stability floor).
 """
 
 from __future__ import annotations
@@ -30,7 +33,7 @@ from armcli.errors import InputError
 from armcli.export import mjcf_parts as parts
 from armcli.export.mjcf_report import Extras, Note, scan, text
 from armcli.spec.model import RobotSpec
-from armcli.urdf.doc import Joint, Link, Pose, Shape, Urdf
+from armcli.urdf.doc import Joint, Link, Pose, Shape, Urdf, position_bounds
 from armcli.urdf.read import parse_root
 
 BASES = ("fixed", "free")
@@ -38,6 +41,7 @@ MESH_SUFFIXES = (".stl", ".obj", ".msh")  # what MuJoCo loads
 MESH_DIR = "meshes"
 FREE_JOINT = "root"
 INTEGRATOR = "implicitfast"
+LIMIT_STEPS = 2.0  # solreflimit time constant in time steps: MuJoCo's floor (refsafe)
 CONTACT_FRICTION = ("0.005", "0.0001")  # MuJoCo's default torsional and rolling friction
 _HINGE = {"revolute": "hinge", "continuous": "hinge", "prismatic": "slide"}
 
@@ -160,9 +164,9 @@ class _Builder:
 
     def joint(self, body: etree._Element, j: Joint) -> None:
         attrs = {"name": j.name, "type": _HINGE[j.type], "axis": vec(j.axis or (1.0, 0.0, 0.0))}
-        lim = j.limit
-        if j.type != "continuous" and lim is not None and None not in (lim.lower, lim.upper):
-            attrs["range"] = vec((float(lim.lower or 0.0), float(lim.upper or 0.0)))
+        bounds = position_bounds(j.type, j.limit)
+        if bounds is not None:
+            attrs["range"] = vec(bounds)
         attrs.update(damping=fmt(j.damping), frictionloss=fmt(j.friction), armature="0")
         etree.SubElement(body, "joint", attrs)
         self.joints.append(j)
@@ -226,6 +230,8 @@ def _header(root: etree._Element, name: str, spec: RobotSpec | None) -> None:
         opt = {"timestep": fmt(spec.control.dt), **opt}
     etree.SubElement(root, "option", opt)
     top = etree.SubElement(etree.SubElement(root, "default"), "default", {"class": name})
+    if spec is not None:  # stops as stiff as the time step allows (armcli's are hard)
+        etree.SubElement(top, "joint", solreflimit=vec((LIMIT_STEPS * spec.control.dt, 1.0)))
     vis = etree.SubElement(top, "default", {"class": "visual"})
     etree.SubElement(vis, "geom", contype="0", conaffinity="0", group="2")
     col = etree.SubElement(top, "default", {"class": "collision"})

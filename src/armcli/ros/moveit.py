@@ -16,7 +16,7 @@ import yaml
 from armcli.errors import InputError
 from armcli.ros.srdf import ARM_GROUP, chain_joints
 from armcli.spec.model import RobotSpec
-from armcli.urdf.doc import Urdf
+from armcli.urdf.doc import Urdf, position_bounds
 
 ARM_CONTROLLER = "arm_controller"
 JOINT_STATE_BROADCASTER = "joint_state_broadcaster"
@@ -155,9 +155,9 @@ def initial_positions(spec: RobotSpec) -> dict[str, Any]:
     joints = spec.all_joints()
     out = {}
     for name in [*chain_joints(spec), *passive_joints(spec)]:
-        lim, v = joints[name].limit, values.get(name, 0.0)
-        if lim is not None and joints[name].type != "continuous":
-            v = min(max(v, lim.lower), lim.upper)
+        bounds, v = position_bounds(joints[name].type, joints[name].limit), values.get(name, 0.0)
+        if bounds is not None:
+            v = min(max(v, bounds[0]), bounds[1])
         out[name] = float(v)
     return {"initial_positions": out}
 

@@ -14,6 +14,7 @@ from armcli.errors import InputError
 
 if TYPE_CHECKING:
     from armcli.urdf.source import Trust
+    from armcli.urdf.xacro_args import XacroInputs
 
 Integrator = Literal["euler", "rk4"]
 """euler: semi-implicit Euler, Kd and damping implicit (first order; symplectic only for a
@@ -40,6 +41,7 @@ class SimOptions:
         clamp: clamp trajectory positions outside the limits instead of refusing.
         rate: joint-state output rate [Hz].
         trust_xacro: expand a foreign xacro file given as `urdf` in the sandbox.
+        xacro: a xacro `urdf`'s NAME:=VALUE arguments, --env values and package lookup.
     """
 
     trajectory: Path | None = None
@@ -55,6 +57,7 @@ class SimOptions:
     clamp: bool = False
     rate: float | None = None
     trust_xacro: Trust = False
+    xacro: XacroInputs | None = None
 
     def __post_init__(self) -> None:
         if self.integrator not in INTEGRATORS:

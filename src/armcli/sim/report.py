@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from armcli.io.terminal import Column, FitTable
 from armcli.sim.simulate import SETTLE_TOL, SimResult
 
 __all__ = ["SETTLE_TOL", "JointMetrics", "joint_metrics", "summary_table"]
@@ -52,25 +53,33 @@ def joint_metrics(res: SimResult, t_end: float) -> list[JointMetrics]:
     return out
 
 
+SUMMARY_HEADERS = (
+    "RMS err\n[rad]",
+    "max err\n[rad]",
+    "final err\n[rad]",
+    "settle\n[s]",
+    "saturated\n[%]",
+    "stop\nhits",
+)
+
+
 def summary_table(
     metrics: Sequence[JointMetrics], ee: np.ndarray | None, ee_label: str, res: SimResult
 ) -> Any:
-    """A rich Table; the caller prints it."""
-    from rich.table import Table
-    from rich.text import Text
-
+    """A table (rich renderable, numbers whole at any width); the caller prints it."""
     caption = (
         f"{res.integrator}, dt = {res.dt:g} s, {res.steps} steps, compiled engine "
         f"({res.wall_time * 1e6 / max(1, res.steps):.2f} µs/step)\n"
-        f"errors q - q_ref [rad]; settle: time after the last point until |error| stays "
-        f"< {res.settle_tol:g}"
+        f"errors q - q_ref; settle: time after the last point until |error| stays "
+        f"< {res.settle_tol:g}; stop hits: times a joint stop engaged"
     )
     if ee is not None:
-        caption += f"\nend effector {ee_label} at t = {res.steps * res.dt:g} s: " + _xyz(ee)
-    table = Table(title="armcli simulate: tracking", caption=Text(caption), caption_justify="left")
-    table.add_column("joint", no_wrap=True)
-    for col in ("RMS err", "max err", "final err", "settle [s]", "saturated", "stop hits"):
-        table.add_column(Text(col), justify="right")
+        caption += f"\nend effector {ee_label} at t = {res.steps * res.dt:g} s:\n  " + _xyz(ee)
+    table = FitTable(
+        [Column("joint", number=False), *(Column(h) for h in SUMMARY_HEADERS)],
+        title="armcli simulate: tracking",
+        caption=caption,
+    )
     for m in metrics:
         table.add_row(
             m.name,
@@ -78,7 +87,7 @@ def summary_table(
             f"{m.max_error:.4f}",
             f"{m.final_error:+.4f}",
             "not settled" if m.settle_time is None else f"{m.settle_time:.3f}",
-            f"{m.saturated_pct:.1f}%",
+            f"{m.saturated_pct:.1f}",
             str(m.limit_contacts),
         )
     return table

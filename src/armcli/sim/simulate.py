@@ -17,9 +17,8 @@ exact across trajectory knots (the step is split there) and error-controlled aft
 reference velocity jumps; it treats everything explicitly, so dt (Kd + D) λ_max(M⁻¹) must
 stay below ~2.8.
 
-Stability bound: for one joint of inertia m, Euler needs dt² Kp < 4 m + 2 dt (Kd + D); for
-the arm it is checked on the linearised closed loop (spectral radius of the step map <= 1)
-at the start and at every trajectory point.
+Gains the integrator cannot handle at dt are refused before the run with `check`'s verdict
+for the same loop (`sim/stability.py`, `sim/verdict.py`).
 """
 
 from __future__ import annotations
@@ -37,12 +36,15 @@ from armcli.errors import InputError, SimulationError
 from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim import stability as stab
+from armcli.sim import verdict as verdicts
 from armcli.sim.options import INTEGRATORS, Integrator
 from armcli.sim.reference import Reference
+from armcli.urdf.pinocchio import mass_matrix
 
 VEL_ABORT_FACTOR = 10.0  # divergence when |v| exceeds this times the URDF velocity limit
 DEFAULT_VABORT = 1000.0  # [rad/s or m/s] when the URDF gives no velocity limit
 SETTLE_TOL = 0.01  # [rad or m] |q - q_ref| band for "settled"
+MAX_STEPS = 2_000_000  # the longest run `simulate` accepts: bounds its time, ~1 µs a step
 
 
 @dataclass(frozen=True)
@@ -220,35 +222,18 @@ def plant_of(arm: Arm, cfg: SimConfig, energy_max: float = np.inf) -> ro.Plant:
 
 
 def check_stability(arm: Arm, cfg: SimConfig, configurations: np.ndarray) -> None:
-    """Refuse gains/dt the integrator cannot handle (the bound `check` reports), saying what would.
+    """Refuse gains/dt the integrator cannot handle: `check`'s verdict for this loop.
 
-    Euler steps damping implicitly, as `check`'s implicit loop; RK4 is explicit.
+    The verdict and its remedy come from armcli.sim.verdict (Euler steps damping
+    implicitly, RK4 explicitly).
+
+    Raises UnstableLoopError, which names no option: the command says where dt came from.
     """
-    import pinocchio as pin
-
-    data = arm.model.createData()
-    K, B = np.asarray(cfg.kp, float), np.asarray(cfg.kd, float) + arm.damping
-    Ms = []
-    for q in configurations:
-        M = pin.crba(arm.model, data, configuration(arm.model, q))
-        Ms.append(np.triu(M) + np.triu(M, 1).T)
-    controlled = list(range(arm.model.nv))
+    qs = [configuration(arm.model, q) for q in configurations]
+    lin = stab.linearise(arm.model, qs, gravity=not cfg.gravity_comp)
+    pd = stab.PD.of(range(arm.model.nv), cfg.kp, cfg.kd, arm.damping)
     scheme: stab.Scheme = "rk4" if cfg.integrator == "rk4" else "implicit"
-    rho, k = stab.worst_radius(Ms, controlled, K, B, cfg.dt, scheme)
-    if stab.is_stable(rho):
-        return
-    dt_ok = stab.largest_stable_dt([Ms[k]], controlled, K, B, scheme, cfg.dt)
-    scale = stab.largest_stable_scale([Ms[k]], controlled, K, B, cfg.dt, scheme)
-    what = "Kd + damping" if cfg.integrator == "rk4" else "Kp"
-    hint = " or the default euler integrator" if cfg.integrator == "rk4" else ""
-    raise InputError(
-        f"the {cfg.integrator} integrator is unstable with these gains at dt = {cfg.dt:g} s "
-        f"(closed-loop step spectral radius {rho:.3f} > 1 at "
-        f"q = {np.round(configurations[k], 3).tolist()}); "
-        f"{what} is too stiff for this inertia: use --dt <= {dt_ok:.3g} or gains scaled by "
-        f"<= {scale:.3g}{hint}",
-        field="--dt",
-    )
+    verdicts.refuse_unstable(lin, pd, cfg.dt, scheme, arm.joint_names, configurations.tolist())
 
 
 @dataclass(frozen=True)
@@ -348,10 +333,7 @@ def _run(
 
 def _energy_max(arm: Arm, q0: np.ndarray, vabort: np.ndarray) -> float:
     """[J] A kinetic energy no run within the velocity limits reaches: a blow-up beyond it."""
-    import pinocchio as pin
-
-    M = pin.crba(arm.model, arm.model.createData(), configuration(arm.model, q0))
-    M = np.triu(M) + np.triu(M, 1).T
+    M = mass_matrix(arm.model, arm.model.createData(), configuration(arm.model, q0))
     return float(0.5 * np.max(np.linalg.eigvalsh(M)) * np.sum(vabort**2))
 
 

@@ -23,7 +23,7 @@ import numpy as np
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
 from armcli.io.yaml import read_text
-from armcli.sim.simulate import SimResult
+from armcli.sim.simulate import MAX_STEPS, SimResult
 
 TIME = "time"
 FIELDS = ("position", "velocity", "effort", "reference")  # per-joint columns, in file order
@@ -104,7 +104,7 @@ def write_states(path: Path, res: SimResult, rate: float) -> None:
 
 
 MAX_REPLAY_BYTES = 200_000_000
-MAX_REPLAY_ROWS = 2_000_000  # = simjob.MAX_STEPS: the most states `simulate` records
+MAX_REPLAY_ROWS = MAX_STEPS  # the most states `simulate` records
 
 
 @dataclass(frozen=True)

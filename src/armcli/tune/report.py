@@ -18,6 +18,8 @@ from typing import Any
 
 import numpy as np
 
+from armcli.io.terminal import Column, FitTable
+from armcli.tune import gains as gain_vector
 from armcli.tune.evaluate import CandidateEval
 from armcli.tune.model_gains import StartGains, dt_max
 from armcli.tune.objective import FINAL, MAX, RMS, SATURATED, SETTLE
@@ -56,31 +58,43 @@ def margin(start: StartGains, j: int, kp: float, kd: float, damping: float) -> f
     return dt_max(start.loop, kp, kd + damping, float(start.lambda_joint[j])) / start.dt
 
 
-def reasoning_table(start: StartGains) -> Any:
-    """A rich Table of the model-based start, one row per joint."""
-    from rich.table import Table
+REASONING_COLUMNS = (
+    ("joint", False),
+    ("M_jj\n[kg·m²]", True),
+    ("|g| max\n[N·m]", True),
+    ("step\n[rad]", True),
+    ("ωn goal\n[rad/s]", True),
+    ("stab.\n[rad/s]", True),
+    ("effort\n[rad/s]", True),
+    ("ωn\n[rad/s]", True),
+    ("ζ", True),
+    ("kp", True),
+    ("kd", True),
+    ("binding", False),
+)
+REASONING_CAPTION = (
+    "M_jj: min..max over the sampled poses; ωn = the smallest of the goal and the "
+    "stability and effort caps (binding: which one), scaled down when the coupled loop "
+    "needs it; kp [N·m/rad], kd [N·m·s/rad]; prismatic joints in kg, N, m"
+)
 
-    t = Table(title=f"model-based start ({start.loop} loop, dt = {start.dt:g} s)")
-    for col in (
-        "joint",
-        "M_ii [kg·m²]",
-        "|g| max",
-        "step",
-        "wn target/stab/effort",
-        "wn",
-        "zeta",
-        "kp",
-        "kd",
-        "binding",
-    ):
-        t.add_column(col, justify="left" if col in ("joint", "binding") else "right")
+
+def reasoning_table(start: StartGains) -> Any:
+    """A table of the model-based start, one row per joint (numbers whole at any width)."""
+    t = FitTable(
+        [Column(h, n) for h, n in REASONING_COLUMNS],
+        title=f"model-based start ({start.loop} loop, dt = {start.dt:g} s)",
+        caption=REASONING_CAPTION,
+    )
     for r in start.rows:
         t.add_row(
             r.name,
-            f"{r.m_min:.4g}..{r.m_max:.4g}",
+            _range(r.m_min, r.m_max),
             f"{r.gravity_max:.3g}",
             f"{r.step:.3g}",
-            f"{r.wn_target:.3g} / {r.wn_stability:.3g} / {r.wn_effort:.3g}",
+            f"{r.wn_target:.3g}",
+            f"{r.wn_stability:.3g}",
+            f"{r.wn_effort:.3g}",
             f"{r.wn:.4g}",
             f"{r.zeta:g}",
             f"{r.kp:.4g}",
@@ -90,45 +104,53 @@ def reasoning_table(start: StartGains) -> Any:
     return t
 
 
+COMPARISON_COLUMNS = (
+    ("gains", False),
+    ("kp", True),
+    ("kd", True),
+    ("RMS\n[rad]", True),
+    ("max\n[rad]", True),
+    ("|final|\n[rad]", True),
+    ("settle\n[s]", True),
+    ("saturated\n[%]", True),
+    ("margin\n[x]", True),
+)
+COMPARISON_CAPTION = (
+    "errors q - q_ref; kp [N·m/rad], kd [N·m·s/rad]; margin: dt_max / dt of the loop "
+    "(above 1 is stable)"
+)
+
+
 def comparison_table(
     problem: TuneProblem, start: StartGains, rows: Sequence[Row], damping: np.ndarray
 ) -> Any:
-    """A rich Table: per joint and gain set, gains, errors, settle, saturation, margin."""
-    from rich.table import Table
-
-    n = len(problem.joints)
-    t = Table(title="before / after (nominal model, all trajectories)")
-    for col in (
-        "joint",
-        "gains",
-        "kp",
-        "kd",
-        "RMS [rad]",
-        "max",
-        "|final|",
-        "settle [s]",
-        "saturated",
-        "margin",
-    ):
-        t.add_column(col, justify="left" if col in ("joint", "gains") else "right")
+    """Per joint (a group) and gain set: gains, errors, settle, saturation, margin."""
+    t = FitTable(
+        [Column(h, num) for h, num in COMPARISON_COLUMNS],
+        title="before / after (nominal model, all trajectories)",
+        caption=COMPARISON_CAPTION,
+    )
     for j, name in enumerate(problem.joints):
+        t.add_group(name)
         for row in rows:
             s = joint_summary(row.nominal, j)
-            kp, kd = float(row.gains[j]), float(row.gains[n + j])
+            kp, kd = gain_vector.of_joint(row.gains, j)
             cells = [_f(s[k]) for k in ("rms", "max", "final", "settle")]
-            sat = "-" if s["saturated_pct"] is None else f"{s['saturated_pct']:.1f} %"
+            sat = "-" if s["saturated_pct"] is None else f"{s['saturated_pct']:.1f}"
             t.add_row(
-                name,
                 row.label,
                 f"{kp:.4g}",
                 f"{kd:.4g}",
                 *cells,
                 sat,
-                f"{margin(start, j, kp, kd, float(damping[j])):.3g}x",
+                f"{margin(start, j, kp, kd, float(damping[j])):.3g}",
             )
-        if j < n - 1:
-            t.add_section()
     return t
+
+
+def _range(lo: float, hi: float) -> str:
+    a, b = f"{lo:.3g}", f"{hi:.3g}"
+    return a if a == b else f"{a}..{b}"
 
 
 def _f(x: float | None) -> str:
@@ -145,7 +167,7 @@ def to_json(
     damping: np.ndarray,
 ) -> str:
     """The output document (schema in docs/tune.md; stable key order, no timestamps)."""
-    n = len(problem.joints)
+    best_kp, best_kd = gain_vector.split(result.best)
     search = {k: getattr(opts, k) for k in ("trials", "batch", "seed", "span", "robust")}
     doc = {
         "schema_version": SCHEMA_VERSION,
@@ -163,8 +185,8 @@ def to_json(
         "results": {row.label: _row_doc(problem, start, row, damping) for row in rows},
         "best": {
             "cost": _num(result.best_cost),
-            "kp": result.best[:n].tolist(),
-            "kd": result.best[n:].tolist(),
+            "kp": best_kp.tolist(),
+            "kd": best_kd.tolist(),
         },
         "history": [_trial_doc(r) for r in result.history],
     }
@@ -173,12 +195,11 @@ def to_json(
 
 def _row_doc(problem: TuneProblem, start: StartGains, row: Row, damping: np.ndarray
              ) -> dict[str, Any]:  # fmt: skip
-    n = len(problem.joints)
     return {
         "robust_cost": _num(row.robust_cost),
         "feasible": row.nominal.feasible,
         "joints": {
-            name: _joint_doc(start, row, j, n, float(damping[j]))
+            name: _joint_doc(start, row, j, float(damping[j]))
             for j, name in enumerate(problem.joints)
         },
     }
@@ -189,8 +210,8 @@ def _trial_doc(r: TrialRecord) -> dict[str, Any]:
             "reason": r.reason, "gains": r.gains.tolist()}  # fmt: skip
 
 
-def _joint_doc(start: StartGains, row: Row, j: int, n: int, damping: float) -> dict[str, Any]:
-    kp, kd = float(row.gains[j]), float(row.gains[n + j])
+def _joint_doc(start: StartGains, row: Row, j: int, damping: float) -> dict[str, Any]:
+    kp, kd = gain_vector.of_joint(row.gains, j)
     summary = {k: _num(v) for k, v in joint_summary(row.nominal, j).items()}
     return {
         "kp": kp,

@@ -15,6 +15,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+from numpy.typing import NDArray
+
 from armcli.errors import InputError, ModelLoadError
 
 
@@ -123,6 +126,17 @@ def configuration(model: Any, values: Mapping[str, float]) -> Any:
             else:
                 q[jr.idx_q] = x
     return q
+
+
+def mass_matrix(model: Any, data: Any, q: Any) -> NDArray[np.float64]:
+    """The joint-space mass matrix M(q) [kg·m² or kg], symmetric.
+
+    Pinocchio's CRBA fills only the upper triangle; every user needs the whole matrix.
+    """
+    import pinocchio as pin
+
+    M = pin.crba(model, data, q)
+    return np.asarray(np.triu(M) + np.triu(M, 1).T, dtype=np.float64)
 
 
 def collision_model(model: Any, xml: str, package_dirs: list[str] | None = None) -> Any:

@@ -17,7 +17,6 @@ from lxml import etree
 from armcli.errors import InputError, XacroRefusedError
 from armcli.io.userfile import read_regular
 from armcli.urdf.doc import (
-    JOINT_DOF,
     ZERO3,
     Geometry,
     Inertial,
@@ -29,6 +28,7 @@ from armcli.urdf.doc import (
     Pose,
     Shape,
     Urdf,
+    total_dof,
 )
 
 MAX_URDF_BYTES = 10_000_000
@@ -321,7 +321,7 @@ def _check_size(root: etree._Element, source: str) -> None:
             file=source,
             line=_ln(shapes[MAX_URDF_COLLISIONS]),
         )
-    dof = sum(JOINT_DOF.get(str(j.get("type")), 0) for j in root.findall("joint"))
+    dof = total_dof(str(j.get("type")) for j in root.findall("joint"))
     if dof > MAX_URDF_DOF:
         raise InputError(
             f"more than {MAX_URDF_DOF} degrees of freedom ({dof}); armcli's bound on robot size",

@@ -13,8 +13,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from armcli.errors import InputError
+from armcli.io.terminal import wrap_parts
 from armcli.spec.graph import root_links
-from armcli.urdf.doc import JOINT_TYPES, MOVABLE_TYPES, Joint, Urdf
+from armcli.urdf.doc import JOINT_TYPES, MOVABLE_TYPES, Joint, Urdf, position_bounds
 from armcli.urdf.read import parse_urdf
 
 
@@ -107,39 +108,67 @@ def _vec(v: tuple[float, ...]) -> str:
     return " ".join(_num(x) for x in v)
 
 
-def joint_summary(j: Joint) -> str:
-    """Type, axis and limits of a joint in one line with units (URDF's default axis is x)."""
+def joint_parts(j: Joint) -> list[str]:
+    """Type, axis and limits of a joint with units, one part each (URDF's default axis is x)."""
     parts = [j.type]
     if j.type != "fixed":
         parts.append(f"axis ({_vec(j.axis or (1.0, 0.0, 0.0))})")
     unit = "m" if j.type == "prismatic" else "rad"
     lim = j.limit
     if lim is None:
-        return ", ".join(parts)
-    if lim.lower is not None and lim.upper is not None and j.type != "continuous":
-        parts.append(f"[{_num(lim.lower)}, {_num(lim.upper)}] {unit}")
+        return parts
+    bounds = position_bounds(j.type, lim)
+    if bounds is not None:
+        parts.append(f"[{_num(bounds[0])}, {_num(bounds[1])}] {unit}")
     if lim.effort is not None:
         parts.append(f"effort {_num(lim.effort)} {'N' if unit == 'm' else 'N·m'}")
     if lim.velocity is not None:
         parts.append(f"velocity {_num(lim.velocity)} {unit}/s")
-    return ", ".join(parts)
+    return parts
 
 
-def to_rich(tree: KinematicTree) -> Any:
-    """A rich.tree.Tree: links in bold, each reached through its joint and its summary."""
-    from rich.markup import escape
-    from rich.tree import Tree
+def joint_summary(j: Joint) -> str:
+    """The joint's parts in one line, as the DOT labels and the text tree show them."""
+    return ", ".join(joint_parts(j))
 
-    top = Tree(f"[bold]{escape(tree.root)}[/bold]  [dim](robot {escape(tree.robot)})[/dim]")
-    nodes = {tree.root: top}
-    for _, j in tree.walk():
-        style = "cyan" if j.type in MOVABLE_TYPES else "dim"
-        label = (
-            f"[bold]{escape(str(j.child))}[/bold]  [{style}]← {escape(j.name)}: "
-            f"{escape(joint_summary(j))}[/{style}]"
-        )
-        nodes[str(j.child)] = nodes[str(j.parent)].add(label)
-    return top
+
+@dataclass(frozen=True)
+class TreeView:
+    """The tree as text: each link under its parent, with its joint's type and limits.
+
+    At a terminal a long line breaks between the joint's parts (never inside
+    `[0, 1.5708] rad`); into a file or pipe each link stays on one line.
+    """
+
+    tree: KinematicTree
+
+    def __rich_console__(self, console: Any, options: Any) -> Any:
+        from rich.text import Text
+
+        t = self.tree
+        yield Text.assemble((t.root, "bold"), ("  ", ""), (f"(robot {t.robot})", "dim"))
+        width = options.max_width
+        yield from self._below(t.root, "", width)
+
+    def _below(self, link: str, prefix: str, width: int) -> Any:
+        from rich.text import Text
+
+        kids = self.tree.children(link)
+        for i, j in enumerate(kids):
+            last = i == len(kids) - 1
+            style = "cyan" if j.type in MOVABLE_TYPES else "dim"
+            head = Text.assemble((str(j.child), "bold"), ("  ", ""), (f"← {j.name}:", style))
+            parts = [head, *(Text(p, style=style) for p in joint_parts(j))]
+            seps = [" ", *([", "] * (len(parts) - 2))]
+            inner = prefix + ("    " if last else "│   ")
+            first = prefix + ("└── " if last else "├── ")
+            yield from wrap_parts(parts, width, first, inner + "  ", seps)
+            yield from self._below(str(j.child), inner, width)
+
+
+def to_rich(tree: KinematicTree) -> TreeView:
+    """A rich renderable of the tree (see TreeView)."""
+    return TreeView(tree)
 
 
 def _q(text: str) -> str:

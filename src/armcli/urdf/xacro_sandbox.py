@@ -16,19 +16,25 @@ cap (the child is killed as soon as it writes more than the cap):
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import json
 import os
 import selectors
 import signal
+import site
 import subprocess
 import sys
+import sysconfig
 import time
-from collections.abc import Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 from armcli.errors import InputError, XacroRefusedError
 from armcli.io.userfile import check_regular
+from armcli.urdf.xacro_args import XacroInputs
 from armcli.urdf.xacro_jail import jail_argv, sandbox_problem, seccomp_program
+from armcli.urdf.xacro_safe import request_json
 
 XACRO_TIMEOUT = 20.0  # wall clock [s]
 XACRO_CPU_SECONDS = 20
@@ -150,34 +156,42 @@ def _python() -> list[str]:
     return [sys.executable, "-I"]
 
 
-def expand_foreign(path: str | Path, roots: Sequence[Path]) -> bytes:
+def expand_foreign(path: str | Path, roots: Sequence[Path], request: str | None = None) -> bytes:
     """Safe-mode expansion (xacro_safe) of a foreign xacro file in a limited child."""
+    return run_safe(path, request or request_json(roots, XacroInputs()))[0]
+
+
+def run_safe(path: str | Path, request: str) -> tuple[bytes, dict[str, Any]]:
+    """xacro_safe's child on `path` with its JSON `request`: the URDF bytes and its report."""
     p = Path(path)
     check_regular(p, "xacro file")
-    argv = [*_python(), "-c", _SAFE_SCRIPT, str(p.resolve()), *map(str, roots)]
-    env = {"PATH": os.defpath, "LANG": "C.UTF-8"}
-    if "ROS_PACKAGE_PATH" in os.environ:  # $(find pkg) lookups, the ROS convention
-        env["ROS_PACKAGE_PATH"] = os.environ["ROS_PACKAGE_PATH"]
-    res = run_limited(argv, p.resolve().parent, env=env)
+    argv = [*_python(), "-c", _SAFE_SCRIPT, os.path.abspath(p), request]  # as given, like xacro
+    res = run_limited(argv, p.resolve().parent, env={"PATH": os.defpath, "LANG": "C.UTF-8"})
     if res.why is not None:
         raise InputError(f"xacro expansion {res.why}", file=p)
     if res.returncode != 0:
         _raise_report(p, res)
-    return res.out
+    return res.out, _report(res) or {}
+
+
+def _report(res: ChildResult) -> dict[str, Any] | None:
+    """The JSON object on the child's last stderr line (None when there is none)."""
+    lines = [ln for ln in res.err.decode("utf-8", "replace").splitlines() if ln.strip()]
+    try:
+        rep = json.loads(lines[-1]) if lines else None
+    except ValueError:
+        return None
+    return rep if isinstance(rep, dict) else None
 
 
 def _raise_report(p: Path, res: ChildResult) -> None:
-    lines = [ln for ln in res.err.decode("utf-8", "replace").splitlines() if ln.strip()]
-    if lines:
-        try:
-            rep = json.loads(lines[-1])
-        except ValueError:
-            rep = None
-        if isinstance(rep, dict) and "message" in rep:
-            cls = XacroRefusedError if rep.get("kind") == "refused" else InputError
-            file = rep.get("file") or str(p.resolve())
-            shown = p if file == str(p.resolve()) else file  # the path as the user gave it
-            raise cls(str(rep["message"]), file=shown, line=rep.get("line"))
+    rep = _report(res)
+    if rep is not None and "message" in rep:
+        cls = XacroRefusedError if rep.get("kind") == "refused" else InputError
+        file = rep.get("file") or os.path.abspath(p)
+        same = file in (str(p.resolve()), os.path.abspath(p))
+        shown = p if same else file  # the path as the user gave it
+        raise cls(str(rep["message"]), file=shown, line=rep.get("line"))
     why = _last_line(res) or f"exit status {res.returncode}"
     raise InputError(f"xacro expansion failed: {why}", file=p)
 
@@ -195,12 +209,14 @@ def expand_untrusted(
     mappings: dict[str, str] | None = None,
     timeout: float = XACRO_TIMEOUT,
     unsandboxed: bool = False,
+    roots: Sequence[Path] = (),
 ) -> bytes:
     """The expanded URDF bytes of a user-trusted xacro file; InputError if expansion fails.
 
-    xacro runs inside xacro_jail's bubblewrap sandbox; where that cannot run, the
-    expansion is refused unless `unsandboxed` (`--trust-xacro=unsandboxed`: the
-    resource limits only).
+    xacro runs inside xacro_jail's bubblewrap sandbox, where it can read only the
+    system and interpreter directories, the file's directory, ROS_PACKAGE_PATH and
+    `roots` (package roots); where the sandbox cannot run, the expansion is refused
+    unless `unsandboxed` (`--trust-xacro=unsandboxed`: the resource limits only).
     """
     p = Path(path)
     check_regular(p, "xacro file")
@@ -212,7 +228,7 @@ def expand_untrusted(
     if unsandboxed:
         res = run_limited(argv, p.resolve().parent, timeout=timeout, env=env)
     else:
-        res = _run_jailed(argv, p, env, timeout)
+        res = _run_jailed(argv, p, env, timeout, jail_readable(p, env, roots))
     if res.why is not None:
         raise InputError(f"xacro expansion {res.why}", file=p)
     if res.returncode != 0:
@@ -221,13 +237,34 @@ def expand_untrusted(
 
 
 def _interpreter_dirs() -> list[Path]:
-    """Where this Python and its packages live: the jail must see them even under /tmp."""
+    """Where this Python, its standard library, site-packages and xacro live.
+
+    Nothing else of sys.path: it may hold the working directory, a home directory perhaps.
+    """
     dirs = {sys.prefix, sys.base_prefix, sys.exec_prefix, os.path.dirname(sys.executable)}
-    dirs |= {d for d in sys.path if d and os.path.isdir(d)}
-    return [Path(d) for d in sorted(dirs)]
+    dirs.add(os.path.dirname(os.path.realpath(sys.executable)))
+    dirs |= {v for k, v in sysconfig.get_paths().items() if k.endswith(("stdlib", "lib"))}
+    dirs |= set(site.getsitepackages())
+    for name in ("xacro", "yaml"):  # what _SCRIPT imports, wherever it is installed
+        spec = importlib.util.find_spec(name)
+        if spec is not None and spec.origin:
+            dirs.add(str(Path(spec.origin).parent.parent))
+    return [Path(d) for d in sorted(dirs) if os.path.isdir(d)]
 
 
-def _run_jailed(argv: list[str], p: Path, env: dict[str, str], timeout: float) -> ChildResult:
+def jail_readable(p: Path, env: Mapping[str, str], roots: Iterable[Path] = ()) -> list[Path]:
+    """What the sandboxed xacro may read besides the system directories.
+
+    Its own directory, ROS_PACKAGE_PATH entries, `roots` (package roots) and this
+    interpreter's directories; xacro_jail binds each read-only at its real path.
+    """
+    package_path = [Path(r) for r in env.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if r]
+    return [p.resolve().parent, *package_path, *roots, *_interpreter_dirs()]
+
+
+def _run_jailed(
+    argv: list[str], p: Path, env: dict[str, str], timeout: float, readable: list[Path]
+) -> ChildResult:
     problem = sandbox_problem()
     program = seccomp_program()
     if problem is not None or program is None:
@@ -241,12 +278,8 @@ def _run_jailed(argv: list[str], p: Path, env: dict[str, str], timeout: float) -
     try:
         os.write(write_end, program)
         os.close(write_end)
-        roots = [
-            p.resolve().parent,
-            *(Path(r) for r in env.get("ROS_PACKAGE_PATH", "").split(":") if r),
-            *_interpreter_dirs(),
-        ]
-        jailed = jail_argv(argv, binds=roots, env=env, cwd=p.resolve().parent, seccomp_fd=read_end)
+        cwd = p.resolve().parent
+        jailed = jail_argv(argv, readable=readable, env=env, cwd=cwd, seccomp_fd=read_end)
         return run_limited(
             jailed, p.resolve().parent, timeout=timeout, env=env, pass_fds=[read_end]
         )

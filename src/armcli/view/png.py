@@ -20,6 +20,7 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
+from armcli.urdf.doc import position_bounds
 from armcli.urdf.mesh_confine import bounded_mesh_file, check_total
 from armcli.urdf.meshes import MeshSearch, confined, resolve
 from armcli.urdf.read import parse_root
@@ -129,9 +130,7 @@ def joint_limits(urdf: Any) -> dict[str, tuple[float, float] | None]:
     """Movable joints in yourdfpy's order -> (lower, upper), None for unlimited joints."""
     out: dict[str, tuple[float, float] | None] = {}
     for name, joint in zip(urdf.actuated_joint_names, urdf.actuated_joints, strict=True):
-        lim = joint.limit
-        bounded = joint.type != "continuous" and lim is not None and lim.lower is not None
-        out[name] = (float(lim.lower), float(lim.upper)) if bounded else None
+        out[name] = position_bounds(joint.type, joint.limit)
     return out
 
 
