@@ -42,7 +42,7 @@ from armcli.spec.shapes import (
     Shape,
     Sphere,
 )
-from armcli.spec.types import Name, NonNeg, Positive, Real, UrdfName, Vec3, _Model
+from armcli.spec.types import Name, NonNeg, Positive, Real, RobotName, UrdfName, Vec3, _Model
 
 __all__ = [
     "Arm", "Box", "Calibration", "Contact", "Control", "Cylinder", "DiffDrive", "Dynamics",
@@ -181,8 +181,8 @@ class Control(_Model):
 class RobotSpec(_Model):
     """The whole robot: base, arm, how they are mounted, and how the arm is controlled."""
 
-    name: Name = Field(description="robot name; also the ROS package prefix")
-    materials: dict[Name, Material] = Field({}, description="colours by name")
+    name: RobotName = Field(description="robot name; also the ROS package prefix")
+    materials: dict[UrdfName, Material] = Field({}, description="colours by name")
     mobile_base: MobileBase | None = Field(
         None, description="the mobile base, if the arm rides on one"
     )
