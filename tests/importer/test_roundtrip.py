@@ -58,7 +58,7 @@ CORPUS = _corpus()
 def round_trip(source: Path, tmp: Path) -> tuple[Path, Path, list[str]]:
     """Import `source` into tmp/armcli.yaml, build it into tmp/urdf; (built, spec, diffs)."""
     spec_path = tmp / "armcli.yaml"
-    result = import_file(source, spec_path)
+    result, _ = import_file(source, spec_path)
     out = build(spec_path, tmp / "urdf")
     spec = out.spec
     name = f"{spec.name}.urdf" if spec.mount is not None else "standalone_arm.urdf"

@@ -8,8 +8,15 @@ from pathlib import Path
 import typer
 
 from armcli.commands.options import option
+from armcli.commands.xacro_inputs import (
+    env_option,
+    package_dir_option,
+    write_notes,
+    xacro_inputs,
+)
 from armcli.defaults import SPEC_FILE
-from armcli.importer.file import import_file, parse_args
+from armcli.errors import InputError
+from armcli.importer.file import import_file
 from armcli.importer.run import ImportResult
 from armcli.tune.spec_start import spec_start_gains
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
@@ -53,19 +60,25 @@ def import_cmd(
     strict: bool = typer.Option(
         False, "--strict", help="Exit 1 when the round trip is not exact (the spec is written)."
     ),
+    package_dir: list[str] = package_dir_option(),
+    env: list[str] = env_option(),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Import a URDF or xacro file into a spec that builds the same URDF back."""
-    result = import_file(
+    stray = [a for a in args or [] if ":=" not in a]
+    if stray:
+        raise InputError(f"unexpected argument {stray[0]!r}: expected NAME:=VALUE", field="ARGS")
+    result, notes = import_file(
         file,
         out,
-        args=parse_args(list(args or [])),
+        inputs=xacro_inputs(args or [], env, package_dir),
         trust_xacro=trust_mode(trust_xacro, unsandboxed),
         arm_root=arm_root,
         force=force,
         gains=spec_start_gains,
     )
+    write_notes(notes)
     sys.stdout.write(report(result, file, out))
     if strict and result.differences:
         raise typer.Exit(1)

@@ -10,6 +10,7 @@ import click
 import typer
 
 from armcli.commands.importer import report
+from armcli.commands.xacro_inputs import write_notes
 from armcli.defaults import SPEC_FILE, TRAJECTORY_DIR
 from armcli.importer.file import import_file
 from armcli.spec.scaffold import DEFAULT_TEMPLATE, TEMPLATES, init_project
@@ -37,7 +38,8 @@ def init_cmd(
     if source is not None:
         directory.mkdir(parents=True, exist_ok=True)
         out = directory / SPEC_FILE
-        result = import_file(source, out, gains=spec_start_gains)
+        result, notes = import_file(source, out, gains=spec_start_gains)
+        write_notes(notes)
         sys.stdout.write(report(result, source, out))
         return
     written = init_project(directory, template)

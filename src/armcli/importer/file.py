@@ -7,49 +7,30 @@ from pathlib import Path
 from armcli.errors import ExistingFileError, InputError
 from armcli.importer.run import GainSource, ImportResult, import_urdf
 from armcli.io.files import write_file_atomic
-from armcli.urdf.source import XACRO_SUFFIX, Trust, read_urdf_file
-from armcli.urdf.xacro_sandbox import expand_untrusted
+from armcli.urdf.source import Trust, read_urdf_file
+from armcli.urdf.xacro_args import XacroInputs
 
 
-def parse_args(values: list[str]) -> dict[str, str]:
-    """`NAME:=VALUE` xacro arguments -> {NAME: VALUE}; InputError on a malformed one."""
-    out = {}
-    for v in values:
-        name, sep, value = v.partition(":=")
-        if not sep or not name:
-            raise InputError(f"expected NAME:=VALUE, got {v!r}", field="ARGS")
-        out[name] = value
-    return out
-
-
-def read_source(path: Path, args: dict[str, str], trust_xacro: Trust) -> tuple[bytes, str]:
-    """The URDF bytes of `path` (a xacro file expanded) and how to name it in the spec."""
-    label = path.as_posix()
-    if args:
-        label += " (" + " ".join(f"{k}:={v}" for k, v in args.items()) + ")"
-        if not trust_xacro:
-            raise InputError(
-                "xacro arguments are passed to xacro itself: add --trust-xacro (sandboxed)",
-                field="ARGS",
-            )
-        if path.suffix != XACRO_SUFFIX and b"xacro" not in path.read_bytes()[:100_000]:
-            raise InputError("NAME:=VALUE arguments are for xacro files", field="ARGS")
-        xml = expand_untrusted(path, mappings=args, unsandboxed=trust_xacro == "unsandboxed")
-        return xml, label
-    return read_urdf_file(path, trust_xacro=trust_xacro).text, label
+def source_label(path: Path, inputs: XacroInputs | None) -> str:
+    """How the spec names its source: the file, with the xacro arguments given."""
+    args = dict(inputs.args) if inputs is not None else {}
+    given = " ".join(f"{k}:={v}" for k, v in args.items())
+    return path.as_posix() + (f" {given}" if given else "")
 
 
 def import_file(
     path: Path,
     out: Path,
     *,
-    args: dict[str, str] | None = None,
+    inputs: XacroInputs | None = None,
     trust_xacro: Trust = False,
     arm_root: str | None = None,
     force: bool = False,
     gains: GainSource | None = None,
-) -> ImportResult:
+) -> tuple[ImportResult, tuple[str, ...]]:
     """Import `path` and write the spec to `out` (all or nothing; never over a file unless forced).
+
+    Returns the result and the `note:` lines of a xacro expansion (arguments it used).
 
     Raises:
         ExistingFileError: `out` exists and `force` is not set (nothing was read or written).
@@ -59,7 +40,14 @@ def import_file(
         raise ExistingFileError(f"{out} exists; pass --force to replace it", file=out)
     if out.is_dir():
         raise InputError("is a directory; give the spec file to write", file=out, field="--out")
-    xml, label = read_source(path, args or {}, trust_xacro)
-    result = import_urdf(xml, label, out, arm_root=arm_root, source_dir=path.parent, gains=gains)
+    urdf = read_urdf_file(path, trust_xacro=trust_xacro, inputs=inputs)
+    result = import_urdf(
+        urdf.text,
+        source_label(path, inputs),
+        out,
+        arm_root=arm_root,
+        source_dir=path.parent,
+        gains=gains,
+    )
     write_file_atomic(out, result.text)
-    return result
+    return result, urdf.notes
