@@ -132,6 +132,12 @@ def test_meshed_arm_keeps_mimic_meshes_and_extensions(tmp_path: Path) -> None:
     gripper = spec.arm.links["gripper_base_link"]  # the cylinder formula was recognised:
     assert gripper.shorthand  # one solid, as the course writes links
     assert spec.arm.links["left_finger_link"].contact is not None
+    control = spec.ros2_control  # typed: one block of joints with interfaces and limits
+    assert control is not None and control.hardware is not None
+    assert control.hardware.plugin == "mock_components/GenericSystem"
+    pan_io = control.joints["shoulder_pan_joint"]
+    assert list(pan_io.command_interfaces) == ["position", "velocity"]
+    assert pan_io.command_interfaces["velocity"].max == 3.15
     text = spec_path.read_text()
     assert "<transmission" in text and "provideFeedback" in text  # kept verbatim
     assert "-2*pi" in text and "1.570796325" in text  # exact pi where exact, else as written

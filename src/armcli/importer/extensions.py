@@ -26,6 +26,7 @@ from armcli.compiler.gazebo import (
     joint_state_publisher_element,
 )
 from armcli.importer.compare import canon
+from armcli.importer.control import read_ros2_control
 from armcli.importer.yamltext import Num
 from armcli.spec.model import DiffDrive, JointPoseTrajectory, JointStatePublisher
 
@@ -41,6 +42,7 @@ class Extensions:
     contacts: dict[str, dict[str, Num]] = field(default_factory=dict)  # link -> mu1, mu2
     plugins: dict[str, dict[str, Any]] = field(default_factory=dict)  # spec field -> data
     plugin_blocks: dict[str, etree._Element] = field(default_factory=dict)  # as read
+    ros2_control: dict[str, Any] | None = None  # the one block, typed
     passthrough: list[etree._Element] = field(default_factory=list)
 
 
@@ -168,13 +170,15 @@ def _plugin_block(block: etree._Element, ext: Extensions) -> None:
     ext.passthrough.append(copy.deepcopy(block))
 
 
-def read_extensions(root: etree._Element) -> Extensions:
+def read_extensions(root: etree._Element, robot: str) -> Extensions:
     """Sort the top-level elements other than links, joints and materials.
 
     Colours and friction are typed for `<gazebo reference=LINK>` only; Gazebo tags of
     joints (or unknown names) are kept verbatim.
     """
     links = {str(el.get("name")) for el in root.findall("link")}
+    movable = {str(j.get("name")) for j in root.findall("joint") if j.get("type") != "fixed"}
+    blocks = root.findall("ros2_control")
     ext = Extensions()
     by_ref: dict[str, list[etree._Element]] = {}
     for el in root:
@@ -186,6 +190,10 @@ def read_extensions(root: etree._Element) -> Extensions:
             )
         elif el.tag == "gazebo":
             _plugin_block(el, ext)
+        elif el.tag == "ros2_control" and len(blocks) == 1:
+            ext.ros2_control = read_ros2_control(el, robot, movable)
+            if ext.ros2_control is None:
+                ext.passthrough.append(copy.deepcopy(el))
         else:
             ext.passthrough.append(copy.deepcopy(el))
     for ref, children in by_ref.items():

@@ -181,6 +181,8 @@ def _assemble(
         data["mount"] = {"joint": split.mount, "parent": mount["parent"]}
         if "origin" in mount:
             data["mount"]["origin"] = mount["origin"]
+    if ext.ros2_control is not None:
+        data["ros2_control"] = ext.ros2_control
     if ext.passthrough:
         data["passthrough"] = [Block(xml_text(el)) for el in ext.passthrough]
     return data
@@ -240,10 +242,10 @@ def import_urdf(
     named = materials.named()
     base = source_dir if source_dir is not None else Path(source).parent
     _rebase(parts.links, base, out.parent)
-    ext = read_extensions(root)
+    name = _spec_name(str(root.get("name", "robot")), notes)
+    ext = read_extensions(root, name)
     _colours(parts.links, ext, named)
     split = _choose_split(parts, arm_root, ext)
-    name = _spec_name(str(root.get("name", "robot")), notes)
     data = _assemble(name, parts, named, ext, split)
     header = [
         f"armcli spec imported by `armcli import` from {source}.",

@@ -16,6 +16,7 @@ from pathlib import Path
 from pydantic import Field, PrivateAttr
 
 from armcli.defaults import DEFAULT_DT
+from armcli.spec.control import Hardware, Interface, JointControl, Ros2Control
 from armcli.spec.graph import root_links
 from armcli.spec.joints import (
     Calibration,
@@ -45,11 +46,41 @@ from armcli.spec.shapes import (
 from armcli.spec.types import Name, NonNeg, Positive, Real, RobotName, UrdfName, Vec3, _Model
 
 __all__ = [
-    "Arm", "Box", "Calibration", "Contact", "Control", "Cylinder", "DiffDrive", "Dynamics",
-    "Gains", "Geometry", "Inertia", "Inertial", "InlineMaterial", "Joint",
-    "JointPoseTrajectory", "JointStatePublisher", "JointType", "Limit", "Link", "Material",
-    "Mesh", "Mimic", "MobileBase", "Mount", "Origin", "RobotSpec", "SafetyController", "Shape",
-    "Sphere", "Tolerances", "Tool",
+    "Arm",
+    "Box",
+    "Calibration",
+    "Contact",
+    "Control",
+    "Cylinder",
+    "DiffDrive",
+    "Dynamics",
+    "Gains",
+    "Geometry",
+    "Hardware",
+    "Inertia",
+    "Inertial",
+    "InlineMaterial",
+    "Interface",
+    "Joint",
+    "JointControl",
+    "JointPoseTrajectory",
+    "JointStatePublisher",
+    "JointType",
+    "Limit",
+    "Link",
+    "Material",
+    "Mesh",
+    "Mimic",
+    "MobileBase",
+    "Mount",
+    "Origin",
+    "RobotSpec",
+    "Ros2Control",
+    "SafetyController",
+    "Shape",
+    "Sphere",
+    "Tolerances",
+    "Tool",
 ]  # fmt: skip
 
 
@@ -191,6 +222,9 @@ class RobotSpec(_Model):
     control: Control = Field(Control(), description="controller gains and time step")
     poses: dict[Name, dict[UrdfName, Real]] = Field(
         {}, description="named poses: joint name -> position [rad or m]"
+    )
+    ros2_control: Ros2Control | None = Field(
+        None, description="ros2_control interfaces per joint (both ROS targets), hardware"
     )
     passthrough: list[PassthroughElement] = Field(
         [],
