@@ -116,7 +116,8 @@ def test_strict_levels_spec_findings_and_remedies() -> None:
     assert pd["message"]["text"].startswith(
         ("control.gains (my_robot.urdf:", "control.gains (standalone_arm.urdf:")
     )
-    assert pd["properties"]["fix"] == {"dt": 0.00063, "kd": 3.1}
+    # dt, or Kd alone scaled into the stable range (Kp kept), 0.9 inside the bounds
+    assert pd["properties"]["fix"] == {"dt": 0.00063, "kp": [50.0, 50.0], "kd": [3.1, 3.1]}
     fingerprints = [r["partialFingerprints"]["armcliFinding/v1"] for r in results]
     assert len(set(fingerprints)) == len(fingerprints)
 
