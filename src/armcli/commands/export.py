@@ -75,6 +75,7 @@ def mjcf_cmd(
         f"keyframes: {', '.join(exp.keyframes)}\n"
     )
     w(res.report)
+    w(f"{res.verdict.text}\n")
 
 
 def register(app: typer.Typer) -> None:
