@@ -26,6 +26,7 @@ from armcli.errors import InputError, SimulationError
 from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim import stability as stab
+from armcli.sim import verdict as verdicts
 from armcli.urdf.pinocchio import mass_matrix
 
 VEL_ABORT_FACTOR = 10.0  # divergence when |v| exceeds this times the URDF velocity limit
@@ -151,30 +152,18 @@ def params_of(arm: Arm, cfg: SimConfig) -> np.ndarray:
 
 
 def check_stability(arm: Arm, cfg: SimConfig, configurations: np.ndarray) -> None:
-    """Refuse gains/dt the integrator cannot handle (the bound `check` reports), saying what would.
+    """Refuse gains/dt the integrator cannot handle: `check`'s verdict for this loop.
 
-    Euler steps damping implicitly, as `check`'s implicit loop; RK4 is explicit.
+    The verdict and its remedy come from armcli.sim.verdict (Euler steps damping
+    implicitly, RK4 explicitly).
+
+    Raises UnstableLoopError, which names no option: the command says where dt came from.
     """
-    data = arm.model.createData()
-    K, B = np.asarray(cfg.kp, float), np.asarray(cfg.kd, float) + arm.damping
-    Ms = [mass_matrix(arm.model, data, configuration(arm.model, q)) for q in configurations]
-    controlled = list(range(arm.model.nv))
+    qs = [configuration(arm.model, q) for q in configurations]
+    lin = stab.linearise(arm.model, qs, gravity=not cfg.gravity_comp)
+    pd = stab.PD.of(range(arm.model.nv), cfg.kp, cfg.kd, arm.damping)
     scheme: stab.Scheme = "rk4" if cfg.integrator == "rk4" else "implicit"
-    rho, k = stab.worst_radius(Ms, controlled, K, B, cfg.dt, scheme)
-    if stab.is_stable(rho):
-        return
-    dt_ok = stab.largest_stable_dt([Ms[k]], controlled, K, B, scheme, cfg.dt)
-    scale = stab.largest_stable_scale([Ms[k]], controlled, K, B, cfg.dt, scheme)
-    what = "Kd + damping" if cfg.integrator == "rk4" else "Kp"
-    hint = " or the default euler integrator" if cfg.integrator == "rk4" else ""
-    raise InputError(
-        f"the {cfg.integrator} integrator is unstable with these gains at dt = {cfg.dt:g} s "
-        f"(closed-loop step spectral radius {rho:.3f} > 1 at "
-        f"q = {np.round(configurations[k], 3).tolist()}); "
-        f"{what} is too stiff for this inertia: use --dt <= {dt_ok:.3g} or gains scaled by "
-        f"<= {scale:.3g}{hint}",
-        field="--dt",
-    )
+    verdicts.refuse_unstable(lin, pd, cfg.dt, scheme, arm.joint_names, configurations.tolist())
 
 
 def simulate(

@@ -57,7 +57,7 @@ def _unstable_reason(problem: TuneProblem, kp: np.ndarray, kd: np.ndarray) -> st
     """
     margin = 1.0 if problem.variants else problem.stability_margin
     for v, sm in enumerate(scored_models(problem)):
-        if not loop_stable(sm.arm, sm.Ms, kp, kd, problem.loop, margin * problem.dt):
+        if not loop_stable(sm.arm, sm.lin, kp, kd, problem.loop, margin * problem.dt):
             return f"model {v}: {problem.loop} loop unstable at {margin:g} x dt"
     return ""
 
