@@ -247,7 +247,7 @@ def test_implicit_damping_stable_for_large_kd(arm: Arm, dt: float) -> None:
 
 def test_stability_check_refuses_and_explains(arm: Arm) -> None:
     cfg = SimConfig(kp=np.full(2, 50.0), kd=np.full(2, 5.0), dt=1e-3, integrator="rk4")
-    with pytest.raises(InputError, match=r"--dt <= .*euler"):
+    with pytest.raises(InputError, match=r"`SimConfig.dt` <= .*euler"):
         check_stability(arm, cfg, np.zeros((1, 2)))
     stiff = SimConfig(kp=np.full(2, 1e8), kd=np.full(2, 5.0), dt=1e-3)
     with pytest.raises(InputError, match="Kp is too stiff"):

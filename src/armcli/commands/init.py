@@ -9,10 +9,12 @@ from pathlib import Path
 import click
 import typer
 
+from armcli.commands.flags import flag_errors
 from armcli.defaults import SPEC_FILE, TRAJECTORY_DIR
 from armcli.spec.scaffold import DEFAULT_TEMPLATE, TEMPLATES, init_project
 
 
+@flag_errors({"template": "--template"})
 def init_cmd(
     directory: Path = typer.Argument(
         Path("."), show_default=False, help="Where to write (created if missing; default: here)."

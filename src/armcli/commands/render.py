@@ -7,6 +7,7 @@ from pathlib import Path
 
 import typer
 
+from armcli.commands.flags import flag_errors
 from armcli.commands.options import spec_argument
 from armcli.errors import InputError
 from armcli.io.outdir import check_output_file
@@ -27,6 +28,7 @@ def _size(text: str) -> tuple[int, int]:
     return w, h
 
 
+@flag_errors({"pose": "--pose", "q": "--q"})
 def render_cmd(
     robot: Path | None = spec_argument(ROBOT_HELP),
     pose: str = typer.Option(None, "--pose", help="A named pose of the spec."),

@@ -62,8 +62,8 @@ class SimOptions:
 
     def __post_init__(self) -> None:
         for value, choices, option in (
-            (self.integrator, INTEGRATORS, "--integrator"),
-            (self.engine, ENGINES, "--engine"),
+            (self.integrator, INTEGRATORS, "SimOptions.integrator"),
+            (self.engine, ENGINES, "SimOptions.engine"),
         ):
             if value not in choices:
                 raise InputError(

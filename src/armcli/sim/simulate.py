@@ -26,6 +26,7 @@ from armcli.errors import InputError, SimulationError
 from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim import stability as stab
+from armcli.sim.options import Engine, Integrator
 from armcli.urdf.pinocchio import mass_matrix
 
 VEL_ABORT_FACTOR = 10.0  # divergence when |v| exceeds this times the URDF velocity limit
@@ -56,9 +57,9 @@ class SimConfig:
     kp: np.ndarray
     kd: np.ndarray
     dt: float = DEFAULT_DT  # [s]
-    integrator: str = "euler"
+    integrator: Integrator = "euler"
     gravity_comp: bool = False
-    backend: str = "auto"  # "auto" | "native" | "python"
+    backend: Engine = "auto"
 
 
 @dataclass(frozen=True)
@@ -75,7 +76,7 @@ class SimResult:
     saturated: np.ndarray  # (N, n) bool
     stop_active: np.ndarray  # (N, n) bool: a joint-stop constraint acted in the step
     dt: float
-    integrator: str
+    integrator: Integrator
     backend: str  # the engine that ran: "native" (compiled) or "python"
     wall_time: float  # [s] spent in the rollout
     notice: str | None = None  # why `auto` fell back to the Python engine
@@ -89,9 +90,9 @@ def arm_from_model(model: Any, joints: Sequence[str] | None = None) -> Arm:
     chosen = list(joints) if joints else names
     for name in chosen:
         if name not in names:
-            raise InputError(f"unknown joint {name!r}; valid: {', '.join(names)}", field="--joints")
+            raise InputError(f"unknown joint {name!r}; valid: {', '.join(names)}", field="joints")
     if len(set(chosen)) != len(chosen):
-        raise InputError("a joint is listed twice", field="--joints")
+        raise InputError("a joint is listed twice", field="joints")
     lock = [model.getJointId(nm) for nm in names if nm not in chosen]
     if lock:
         model = pin.buildReducedModel(model, lock, pin.neutral(model))
@@ -100,8 +101,9 @@ def arm_from_model(model: Any, joints: Sequence[str] | None = None) -> Arm:
         if j.shortname() not in ro.JOINT_TYPES or j.nv != 1:
             raise InputError(
                 f"joint {model.names[jid]!r} ({j.shortname()}) cannot be simulated: only "
-                "revolute, continuous and prismatic joints are supported (lock it with --joints)",
-                field="--joints",
+                "revolute, continuous and prismatic joints are supported (leave it out of `joints` "
+                "to lock it)",
+                field="joints",
             )
     order = list(model.names)[1:]  # simulated in model (tree) order whatever --joints says
     iq = [model.idx_qs[j] for j in range(1, model.njoints)]
@@ -171,15 +173,15 @@ def check_stability(arm: Arm, cfg: SimConfig, configurations: np.ndarray) -> Non
         f"the {cfg.integrator} integrator is unstable with these gains at dt = {cfg.dt:g} s "
         f"(closed-loop step spectral radius {rho:.3f} > 1 at "
         f"q = {np.round(configurations[k], 3).tolist()}); "
-        f"{what} is too stiff for this inertia: use --dt <= {dt_ok:.3g} or gains scaled by "
-        f"<= {scale:.3g}{hint}",
-        field="--dt",
+        f"{what} is too stiff for this inertia: use `SimConfig.dt` <= {dt_ok:.3g} or gains "
+        f"scaled by <= {scale:.3g}{hint}",
+        field="SimConfig.dt",
     )
 
 
 def simulate(
     arm: Arm,
-    reference: Any,  # interpolation.Reference
+    reference: Any,  # armcli.sim.reference.Reference
     q0: np.ndarray,
     duration: float,
     cfg: SimConfig,
