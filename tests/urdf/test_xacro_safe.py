@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import json
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
@@ -20,6 +19,7 @@ import xacro
 
 from armcli.errors import InputError, XacroRefusedError
 from armcli.urdf.xacro_safe import MAX_MACRO_CALLS, expand_safe
+from tests.helpers import run_cli
 
 EXAMPLE_ROBOTS = (
     Path(sys.prefix)
@@ -163,14 +163,7 @@ def test_cli_checks_foreign_xacro_without_trust(root: Path) -> None:
     """Safe mode gives `check` the same document, so the same findings, as --trust-xacro."""
     fixture = root / "tests" / "fixtures" / "check" / "course_macros.urdf.xacro"
     runs = [
-        subprocess.run(
-            [sys.executable, "-m", "armcli.cli", "check", *flags, str(fixture), "--format", "json"],
-            capture_output=True,
-            text=True,
-            timeout=120,
-            check=False,
-            cwd=root,
-        )
+        run_cli(["check", *flags, fixture, "--format", "json"], root)
         for flags in ([], ["--trust-xacro"])
     ]
     safe, trusted = (json.loads(r.stdout)["files"][0]["findings"] for r in runs)
