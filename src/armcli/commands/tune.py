@@ -35,7 +35,7 @@ LOOP_HELP = (
     "stepped explicitly, e.g. Gazebo's effort controller)."
 )
 ROBUST_MODE_HELP = "Aggregate over the perturbed models: worst (default) or quantile."
-SCHEDULER_HELP = "Dask scheduler address, e.g. tcp://HOST:8786 (needs armcli[dask])."
+SCHEDULER_HELP = "Dask scheduler address, e.g. tcp://HOST:8786 (needs dask[distributed])."
 # The library's names for what these flags set (errors name them; commands.flags maps back).
 FLAGS = {
     **option_flags(SearchOptions, robust="--robust-mode"),
