@@ -7,7 +7,7 @@ is cut into chunks does not change any result, since every rollout is independen
 
 `rollout_batch` is the single place that runs the simulator: all rollouts of a chunk
 (candidates x models x cases) in one `sim.simulate.simulate_batch` call, which hands them
-to the compiled extension's batch rollout together (GIL released; else the Python loop).
+to the compiled engine together.
 """
 
 from __future__ import annotations
@@ -72,7 +72,7 @@ def evaluate_candidates(
     cfgs, reasons, jobs = [], [], []
     for gains in chunk:
         kp, kd = gain_vector.split(gains)
-        cfg = SimConfig(kp, kd, problem.dt, problem.integrator, problem.gravity_comp, "auto")
+        cfg = SimConfig(kp, kd, problem.dt, problem.integrator, problem.gravity_comp)
         cfgs.append(cfg)
         reasons.append(_unstable_reason(problem, kp, kd))
         if not reasons[-1]:

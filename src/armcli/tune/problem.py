@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from armcli.sim.options import Integrator
 from armcli.sim.reference import Reference
 from armcli.sim.simulate import Arm, arm_from_model
 from armcli.sim.stability import Linearised
@@ -61,7 +62,7 @@ class TuneProblem:
     urdf_name: str
     joints: tuple[str, ...]
     dt: float  # [s]
-    integrator: str
+    integrator: Integrator
     gravity_comp: bool
     loop: str  # "implicit" | "explicit": which stability bound makes a candidate infeasible
     stability_margin: float  # nominal model: stable at stability_margin * dt; variants: at dt
