@@ -394,6 +394,7 @@ def test_cli_writes_model_and_scene_and_prints_the_report(
         main(["export", "mjcf", str(ROOT / "specs" / "my_robot.yaml"), "-o", str(out)])
     assert exc.value.code == 0
     text = capsys.readouterr().out
+    assert f"wrote {out} and {tmp_path / 'scene.xml'} from " in text  # names what it wrote
     assert "2 joints, 2 actuators, keyframes: home, reach, folded" in text
     assert "velocity limits" in text
     scene = etree.parse(str(tmp_path / "scene.xml"))
