@@ -89,10 +89,10 @@ def test_two_files_on_one_package_path_are_refused(project: Path, tmp_path: Path
     write_meshes(tmp_path)
     (tmp_path / "other" / "meshes").mkdir(parents=True)
     shutil.copy(project / "meshes" / "link.stl", tmp_path / "other" / "meshes" / "base.stl")
-    text = (project / "armcli.yaml").read_text().replace(
-        "filename: meshes/base.stl", "filename: other/meshes/base.stl", 1
-    ).replace("visual:\n        - geometry: {mesh: {filename: meshes/link.stl, scale: [1, 1, 0.8]}}",
-              "visual:\n        - geometry: {mesh: {filename: meshes/base.stl}}")  # fmt: skip
+    shoulder = "geometry: {mesh: {filename: meshes/link.stl, scale: [1, 1, 0.8]}}"
+    text = (project / "armcli.yaml").read_text()
+    text = text.replace("filename: meshes/base.stl", "filename: other/meshes/base.stl", 1)
+    text = text.replace(shoulder, "geometry: {mesh: {filename: meshes/base.stl}}", 1)
     (tmp_path / "armcli.yaml").write_text(text)
-    with pytest.raises(InputError, match="would both be copied to meshes/base.stl"):
+    with pytest.raises(InputError, match=r"would both be copied to meshes/base\.stl"):
         ros_packages(load_spec(tmp_path / "armcli.yaml"), samples=50)
