@@ -9,11 +9,17 @@ SPEC ?= specs/my_robot.yaml
 
 # The install builds the compiled rollout (armcli.sim._rollout, CMakeLists.txt) too, so a
 # change to its C++ source or build files reinstalls.
+# pip prints what it collects and builds: a first install downloads ~80 packages and
+# compiles the engine (README, "Set-up": minutes and memory measured here).
 $(STAMP): pyproject.toml CMakeLists.txt src/armcli/sim/_native/rollout.cpp
+	@echo "install [1/3]: virtual environment in $(VENV)"
 	$(PY) -m venv $(VENV)
+	@echo "install [2/3]: pip"
 	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -e '.[dev]'
+	@echo "install [3/3]: armcli and its dependencies, compiling the engine (the longest step)"
+	$(BIN)/python -m pip install --progress-bar off -e '.[dev]'
 	touch $(STAMP)
+	@echo "install: done"
 
 install: $(STAMP)
 
@@ -46,7 +52,8 @@ test: install sysdeps lint native-check
 
 # Rebuild the compiled rollout after editing its C++ (the editable install does not rebuild
 # on import): incremental, in build/, with the build tools of the dev extra.
-native: install
+native: | $(STAMP)
+	@echo "native: recompiling the engine (armcli.sim._rollout)"
 	$(BIN)/python -m pip install -q --no-build-isolation --no-deps -e .
 	$(BIN)/python -m armcli.sim.native
 
@@ -55,7 +62,7 @@ native: install
 native-check: install
 	@if command -v c++ >/dev/null 2>&1 || command -v g++ >/dev/null 2>&1; then \
 	  $(BIN)/python -m armcli.sim.native; \
-	else echo "no C++ compiler: armcli uses its Python engine; compiled-engine tests skip"; fi
+	else echo "no C++ compiler: armcli installs without its simulator; simulator tests skip"; fi
 
 bench: install native-check
 	$(BIN)/python bench/bench_sim.py

@@ -10,7 +10,9 @@ numpy or any command's library, and `armcli build` loads only what build needs.
 from __future__ import annotations
 
 import importlib
+import signal
 import sys
+import threading
 from typing import Any
 
 import click
@@ -28,6 +30,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "init": (
         "armcli.commands.init",
         "Write an example spec (armcli.yaml), its trajectories and a README; never overwrites.",
+    ),
+    "import": (
+        "armcli.commands.importer",
+        "Import a URDF or xacro file into a spec that builds the same URDF back.",
     ),
     "build": (
         "armcli.commands.build",
@@ -155,6 +161,17 @@ def _debug_requested(argv: list[str]) -> bool:
     return False
 
 
+class _Interrupted(BaseException):
+    """Ctrl-C, raised instead of KeyboardInterrupt, which typer turns into a silent exit 130."""
+
+
+INTERRUPTED = "interrupted (Ctrl-C): stopped; no file was left half-written\n"
+
+
+def _raise_interrupted(signum: int, frame: object) -> None:
+    raise _Interrupted
+
+
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry point: run the app and map exceptions to exit codes.
 
@@ -165,16 +182,18 @@ def main(argv: list[str] | None = None) -> None:
     # `--trust-xacro=unsandboxed` is the documented spelling; a bool flag cannot take a value
     args = [UNSANDBOXED_FLAG if a == "--trust-xacro=unsandboxed" else a for a in args]
     debug = _debug_requested(args)
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, _raise_interrupted) if main_thread else None
     try:
         app(args=args, prog_name="armcli")
+    except (_Interrupted, KeyboardInterrupt):
+        sys.stderr.write(INTERRUPTED)
+        raise SystemExit(130) from None
     except ArmcliError as exc:
         if debug:
             raise
         _print_error(exc)
         raise SystemExit(exc.exit_code) from None
-    except KeyboardInterrupt:
-        sys.stderr.write("interrupted\n")
-        raise SystemExit(130) from None
     except Exception as exc:  # a bug: say so in one line unless --debug
         if debug:
             raise
@@ -182,6 +201,9 @@ def main(argv: list[str] | None = None) -> None:
             f"internal error: {type(exc).__name__}: {exc} (rerun with --debug for a traceback)\n"
         )
         raise SystemExit(EXIT_FAILED) from None
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
 
 
 if __name__ == "__main__":

@@ -226,18 +226,25 @@ def _summary(r: CheckResult) -> list[Any]:
 def _stability_text(st: Any) -> Any:
     from rich.text import Text
 
-    e, i = st.explicit, st.implicit
     t = Text(
         f"PD stability at dt = {st.dt:g} s: lambda_max(M^-1) = {st.lambda_max:.4g} 1/(kg m^2), "
-        f"Kp = {st.kp:g}, Kd + damping = {st.d:g}\n"
+        f"gravity's stiffness up to {st.gravity_stiffness:.3g} N·m/rad, Kp up to {st.kp:g}, "
+        f"Kd + damping up to {st.d:g}"
     )
-    t.append(
-        f"  explicit damping: b = {e.b:.3g}, a = {e.a:.3g}, a + 2b = {e.a + 2 * e.b:.3g} "
-        f"(< 4 needed): ",
-    )
-    t.append("stable" if e.stable else "UNSTABLE", "green" if e.stable else "red")
-    t.append(f"; stable for dt < {e.dt_max:.3g} s or Kd < {st.kd_max_explicit:.3g}\n")
-    t.append("  implicit damping (the simulator): ")
-    t.append("stable" if i.stable else "UNSTABLE", "green" if i.stable else "red")
-    t.append(f"; Kp < {st.kp_max_implicit:.4g} or dt < {i.dt_max:.3g} s")
+    for v in (st.implicit, st.explicit):
+        t.append(f"\n  {v.loop}: ")
+        t.append("stable" if v.stable else "UNSTABLE", "green" if v.stable else "red")
+        t.append(_loop_bounds(v))
     return t
+
+
+def _loop_bounds(v: Any) -> str:
+    """How far a loop is from its edge: the largest dt, and the gain factor at this dt."""
+    what = v.scaled
+    head = " (up to" if v.stable else " (stable for"
+    edge = "dt = " if v.stable else "dt <= "
+    dt = "any dt" if v.dt_max == float("inf") else f"{edge}{v.dt_max:.3g} s"
+    if v.gain_scale is None:
+        return f"{head} {dt}; at this dt gravity or damping alone is too stiff)"
+    factor = "any factor" if v.gain_scale == float("inf") else f"x {v.gain_scale:.3g}"
+    return f"{head} {dt}, or {what} {factor} at this dt)"

@@ -238,13 +238,16 @@ _RULES = [
         "raise the effort limit or lighten the links",
     ),
     Rule(
-        "pd-unstable", ERROR, "PD loop unstable at dt even with implicit damping", "lower Kp or dt"
+        "pd-unstable",
+        ERROR,
+        "PD loop unstable at dt in armcli simulate (damping implicit); gravity's stiffness counts",
+        "lower dt or Kp (`armcli tune` picks stable gains)",
     ),
     Rule(
         "pd-explicit-unstable",
         WARNING,
-        "PD loop unstable at dt with explicit damping",
-        "lower Kd or dt, or treat damping implicitly",
+        "PD loop unstable at dt in an explicit torque loop (ros2_control effort controller)",
+        "lower dt or Kd (`armcli tune --loop explicit` picks gains for this loop)",
     ),
     Rule(
         "servo-unstable",
@@ -278,6 +281,11 @@ _RULES = [
     ),
 ]
 RULES: dict[str, Rule] = {r.id: r for r in _RULES}
+
+
+def unknown_rules(ids: Iterable[str]) -> list[str]:
+    """The ids among `ids` that name no rule, sorted (for `--ignore`)."""
+    return sorted(set(ids) - set(RULES))
 
 
 @dataclass(frozen=True)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 
 import typer
@@ -91,7 +92,20 @@ def render_cmd(
         sys.stderr.write(
             f"warning: {src.source}: mesh {uri!r} not found, not drawn ({MESH_HINT})\n"
         )
-    sys.stdout.write(f"wrote {res.path} ({res.width}x{res.height} px){tip}\n")
+    drawn = _drawn(src.poses, pose, q)
+    sys.stdout.write(f"wrote {res.path} ({res.width}x{res.height} px) at {drawn};{tip}\n")
+
+
+def _drawn(poses: Mapping[str, Mapping[str, float]], pose: str | None, q: str | None) -> str:
+    """Which configuration the picture shows, so a render without options is not a guess."""
+    if pose is not None:
+        return f"pose {pose!r}"
+    if q is not None:
+        return f"--q {q}"
+    zero = [name for name, values in poses.items() if not any(values.values())]
+    same = f", the pose {zero[0]!r}" if zero else ""
+    others = f" (others: --pose {'|'.join(poses)})" if poses else ""
+    return f"q = 0{same}, as no --pose or --q was given{others}"
 
 
 def register(app: typer.Typer) -> None:

@@ -34,7 +34,7 @@ LOOP_HELP = (
     "stepped explicitly, e.g. Gazebo's effort controller)."
 )
 ROBUST_MODE_HELP = "Aggregate over the perturbed models: worst (default) or quantile."
-SCHEDULER_HELP = "Dask scheduler address, e.g. tcp://HOST:8786 (needs armcli[dask])."
+SCHEDULER_HELP = "Dask scheduler address, e.g. tcp://HOST:8786 (needs dask[distributed])."
 
 
 def _pair(text: str, name: str) -> tuple[float, float]:

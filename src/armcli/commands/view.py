@@ -17,6 +17,7 @@ from armcli.commands.xacro_inputs import (
     xacro_inputs,
 )
 from armcli.errors import InputError
+from armcli.sim import rosbag
 from armcli.sim.states import load_replay
 from armcli.spec.discover import find_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
@@ -57,7 +58,8 @@ def view_cmd(
     run = None
     if replay is not None:
         names = list(joint_limits(load_urdf(src.xml, src.source, src.mesh_dir, src.search)))
-        run = load_replay(replay, names)
+        load = rosbag.load_replay if rosbag.is_mcap(replay) else load_replay
+        run = load(replay, names)
     viewer = Viewer(
         src.xml,
         name=src.name,
