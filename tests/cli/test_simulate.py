@@ -5,15 +5,13 @@ from __future__ import annotations
 import csv
 import json
 import math
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from armcli.cli import main
-from tests.helpers import ROOT
+from tests.helpers import ROOT, run_cli
 
 TRAJ = ROOT / "specs" / "trajectories"
 J1, J2 = "arm_base_forearm_joint", "forearm_hand_joint"
@@ -146,21 +144,10 @@ def test_integral_gain_is_refused_not_ignored(tmp_path: Path) -> None:
     spec = tmp_path / "ki.yaml"
     spec.write_text(text.replace("kd: 5", "kd: 5, ki: 0.5", 1))
     traj = str(ROOT / "specs" / "trajectories" / "pick.yaml")
-    res = subprocess.run(
-        [sys.executable, "-m", "armcli", "simulate", str(spec), "-t", traj, "--duration", "0.5"],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    res = run_cli(["simulate", spec, "-t", traj, "--duration", "0.5"])
     assert res.returncode == 2
     assert "control.gains." in res.stderr and ".ki" in res.stderr and "PD" in res.stderr
-    ok = subprocess.run(
-        [sys.executable, "-m", "armcli", "simulate", str(spec), "-t", traj, "--duration", "0.5",
-         "--kp", "50", "--kd", "5"],
-        capture_output=True,
-        text=True,
-        check=False,
-    )  # fmt: skip
+    ok = run_cli(["simulate", spec, "-t", traj, "--duration", "0.5", "--kp", "50", "--kd", "5"])
     assert ok.returncode == 0, ok.stderr
 
 

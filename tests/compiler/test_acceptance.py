@@ -111,6 +111,6 @@ def test_simulate_refuses_mimic_joints_naming_the_way_out(built: Path) -> None:
         refuse_mimic(doc, None)
     message = str(info.value)
     assert "'right_finger_joint' mimics 'left_finger_joint'" in message
-    hint = message.split("lock the followers with --joints ")[1]
+    hint = message.split("lock the followers with `SimOptions.joints` ")[1]
     assert hint.startswith("shoulder_pan_joint,") and "right_finger_joint" not in hint
     refuse_mimic(doc, ["shoulder_pan_joint", "left_finger_joint"])  # followers locked: accepted

@@ -3,7 +3,7 @@
 Why SARIF next to `--format github`: workflow annotations vanish with the run, while a
 SARIF file uploaded with `github/codeql-action/upload-sarif` becomes code-scanning alerts
 that persist, are tracked across commits (`partialFingerprints`) and are closed when the
-problem is fixed. The document lists every rule of the registry (`checks.RULES`) in
+problem is fixed. The document lists every rule of the registry (`armcli.check.rules.RULES`) in
 `tool.driver.rules`, so a viewer can explain rules that did not fire too.
 
 Locations are repository-relative (`uriBaseId` `%SRCROOT%`, relative to `root`, the
@@ -79,6 +79,10 @@ def _location(f: Finding, root: Path) -> tuple[dict[str, Any], str]:
     if f.line and f.line > 0 and not inner:
         physical["region"] = {"startLine": f.line}
     prefix = f"{inner}:{f.line}: " if inner and f.line else (f"{inner}: " if inner else "")
+    if f.spec is not None:  # the spec field's line; the generated URDF's in the message
+        if f.spec.line:
+            physical["region"] = {"startLine": f.spec.line}
+        prefix = f"{f.spec.field} ({prefix.rstrip(': ')}): "
     return {"physicalLocation": physical}, prefix
 
 

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import typer
 
+from armcli.commands.flags import flag_errors
 from armcli.commands.options import spec_argument
 from armcli.commands.xacro_inputs import (
     args_argument,
@@ -35,6 +36,7 @@ def _size(text: str) -> tuple[int, int]:
     return w, h
 
 
+@flag_errors({"pose": "--pose", "q": "--q"})
 def render_cmd(
     robot: Path | None = spec_argument(ROBOT_HELP),
     args: list[str] = args_argument(),

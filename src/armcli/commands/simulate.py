@@ -9,6 +9,7 @@ from typing import Any, cast
 
 import typer
 
+from armcli.commands.flags import flag_errors, option_flags
 from armcli.commands.options import choice, option, spec_argument
 from armcli.commands.xacro_inputs import (
     args_argument,
@@ -35,6 +36,13 @@ GRAVITY_HELP = "Add g(q) to the PD torque (default: the spec's control.gravity_c
 IGNORE_HELP = "Simulate a --urdf despite this `check` rule's error (repeatable)."
 TRAJECTORY_HELP = "JointTrajectory YAML (a point without time_from_start: previous + 1 s)."
 PROGRESS_AFTER_S = 1.0  # show a progress bar when the run is projected to take longer
+# The library's names for what these flags set (errors name them; commands.flags maps back).
+FLAGS = {
+    **option_flags(SimOptions),
+    "SimConfig.dt": "--dt",
+    "joints": "--joints",
+    "output": "--output",
+}
 
 
 def _floats(text: str | None, option: str) -> list[float] | None:
@@ -46,6 +54,7 @@ def _floats(text: str | None, option: str) -> list[float] | None:
         raise InputError(f"expected comma-separated numbers, got {text!r}", field=option) from None
 
 
+@flag_errors(FLAGS)
 def simulate_cmd(
     spec: Path | None = spec_argument(),
     args: list[str] = args_argument(),

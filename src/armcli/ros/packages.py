@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import yaml
 from lxml import etree
 
 from armcli.compiler.expand import expand_urdfs
@@ -325,6 +326,7 @@ def jazzy_files(
         "robot_xacro": whole if whole in tops else jazzy.STANDALONE,
         "standalone_xacro": jazzy.STANDALONE,
         "controllers": jazzy.controllers_file(n.robot),
+        "bridge": jazzy.bridge_file(n.robot),
         "gz_launch": launch,
         "arm_controller": mc.ARM_CONTROLLER,
         "joint_state_broadcaster": mc.JOINT_STATE_BROADCASTER,
@@ -333,6 +335,7 @@ def jazzy_files(
         f"config/{jazzy.controllers_file(n.robot)}": mc.dump_yaml(
             jazzy.controllers(spec, source), note
         ),
+        f"config/{jazzy.bridge_file(n.robot)}": _bridge_yaml(jazzy.bridge(spec), note),
         f"launch/{launch}": jazzy.bringup_launch(values, note),
         "README.md": jazzy_readme(spec, n.bringup, launch, n.moveit, note),
     }
@@ -341,6 +344,12 @@ def jazzy_files(
         **description_files(spec, n, label, info, tops),
         **_package(n.bringup, about, [n.description, *jazzy.BRINGUP_DEPENDS], files, info),
     }
+
+
+def _bridge_yaml(entries: list[dict[str, Any]], note: str) -> bytes:
+    """ros_gz_bridge's config file: a YAML list of topic entries."""
+    body = yaml.dump(entries, Dumper=mc.Dumper, sort_keys=False, default_flow_style=False)
+    return ("".join(f"# {line}\n" for line in note.splitlines()) + body).encode("utf-8")
 
 
 def write_ros_packages(

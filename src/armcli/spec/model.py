@@ -28,6 +28,7 @@ from armcli.spec.joints import (
     SafetyController,
 )
 from armcli.spec.passthrough import PassthroughElement
+from armcli.spec.sensors import Camera, Imu, Lidar, Noise, Sensor
 from armcli.spec.shapes import (
     Box,
     Contact,
@@ -49,6 +50,7 @@ __all__ = [
     "Arm",
     "Box",
     "Calibration",
+    "Camera",
     "Contact",
     "Control",
     "Cylinder",
@@ -57,6 +59,7 @@ __all__ = [
     "Gains",
     "Geometry",
     "Hardware",
+    "Imu",
     "Inertia",
     "Inertial",
     "InlineMaterial",
@@ -66,6 +69,7 @@ __all__ = [
     "JointPoseTrajectory",
     "JointStatePublisher",
     "JointType",
+    "Lidar",
     "Limit",
     "Link",
     "Material",
@@ -73,10 +77,12 @@ __all__ = [
     "Mimic",
     "MobileBase",
     "Mount",
+    "Noise",
     "Origin",
     "RobotSpec",
     "Ros2Control",
     "SafetyController",
+    "Sensor",
     "Shape",
     "Sphere",
     "Tolerances",
@@ -222,6 +228,9 @@ class RobotSpec(_Model):
     control: Control = Field(Control(), description="controller gains and time step")
     poses: dict[Name, dict[UrdfName, Real]] = Field(
         {}, description="named poses: joint name -> position [rad or m]"
+    )
+    sensors: dict[Name, Sensor] = Field(
+        {}, description="cameras, lidars and IMUs on links, by name"
     )
     ros2_control: Ros2Control | None = Field(
         None, description="ros2_control interfaces per joint (both ROS targets), hardware"

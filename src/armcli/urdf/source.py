@@ -1,7 +1,7 @@
 """Robot file argument -> URDF documents, the same way for every command.
 
 A path given to `check`, `view`, `render`, `tree` (and `simulate --urdf`) is one
-of: a spec YAML (built in memory, nothing written), a URDF (read by urdfxml's
+of: a spec YAML (built in memory, nothing written), a URDF (read by urdf.read's
 strict reader) or a xacro file. Xacro runs Python from the file, so a foreign
 one is expanded in safe mode (xacro_safe: no code runs, files confined) unless
 the user passes `--trust-xacro` (xacro itself, sandboxed by xacro_sandbox).

@@ -39,7 +39,7 @@ from armcli.urdf.xacro_safe import request_json
 XACRO_TIMEOUT = 20.0  # wall clock [s]
 XACRO_CPU_SECONDS = 20
 XACRO_MEMORY_BYTES = 1 << 30
-XACRO_MAX_OUTPUT = 10_000_000  # same cap as urdfxml.MAX_URDF_BYTES
+XACRO_MAX_OUTPUT = 10_000_000  # same cap as urdf.read.MAX_URDF_BYTES
 XACRO_MAX_STDERR = 100_000
 XACRO_MAX_FILES = 64
 _CHUNK = 65536
