@@ -25,7 +25,7 @@ from armcli.urdf.pinocchio import LoadedModel, load_model, parser_problems
 from armcli.urdf.read import parse_urdf, read_urdf
 from armcli.urdf.xacro_args import Expansion, XacroInputs
 from armcli.urdf.xacro_safe import request_json
-from armcli.urdf.xacro_sandbox import expand_untrusted, run_safe
+from armcli.urdf.xacro_sandbox import run_safe, run_trusted
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -38,6 +38,7 @@ TRUST_XACRO_HELP = (
     "xacro files are expanded in safe mode, where no code from the file runs."
 )
 UNSANDBOXED_HELP = "Same as --trust-xacro=unsandboxed: xacro itself with resource limits only."
+TRUSTED_ENV_REFUSED = ("LD_", "PYTHON")  # --env names that would change how the child runs
 Trust = bool | Literal["unsandboxed"]  # --trust-xacro: False, True (sandboxed), "unsandboxed"
 
 
@@ -121,14 +122,39 @@ def expand_xacro(
     """
     given = inputs or XacroInputs()
     if trust_xacro:
-        unsandboxed = trust_xacro == "unsandboxed"
-        roots = allowed_roots(path.parent)
-        xml = expand_untrusted(
-            path, mappings=dict(given.args), unsandboxed=unsandboxed, roots=roots
-        )
-        return xml, Expansion(args=dict(given.args), given=tuple(given.args))
+        return _expand_trusted(path, given, unsandboxed=trust_xacro == "unsandboxed")
     request = request_json(allowed_roots(path.parent), given)
     xml, report = run_safe(path, request)  # safe mode: no code runs
+    return xml, Expansion.from_dict(report.get("expansion", {}))
+
+
+def _expand_trusted(
+    path: Path, given: XacroInputs, *, unsandboxed: bool
+) -> tuple[bytes, Expansion]:
+    """Xacro itself in xacro_sandbox's jail, `$(find)` answered by armcli's package lookup.
+
+    Every package the lookup knows is passed in with its directories bound read-only
+    (the install prefixes' share/ and each package's real roots: a symlink-install tree
+    points into the sources).
+    """
+    refused = sorted(k for k in given.env if k.startswith(TRUSTED_ENV_REFUSED) or k == "PATH")
+    if refused:
+        raise InputError(
+            f"{refused[0]} may not be set for the xacro child (it would change how Python "
+            "or the loader runs)",
+            field="--env",
+        )
+    known = given.packages.known(near=path)
+    roots = [*allowed_roots(path.parent), *(p / "share" for p in given.packages.prefixes())]
+    roots += [r for root in known.values() for r in real_roots(root)]
+    xml, report = run_trusted(
+        path,
+        mappings=given.args,
+        packages=known,
+        environ=given.env,
+        unsandboxed=unsandboxed,
+        roots=roots,
+    )
     return xml, Expansion.from_dict(report.get("expansion", {}))
 
 
