@@ -13,11 +13,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
+from armcli.check.balance import StaticBalance
 from armcli.check.rules import RULES, CheckOptions, Collector, JointRow
 from armcli.check.structure import Tree
+from armcli.sim.tipping import ZmpReport
 from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf, position_bounds
 from armcli.urdf.pinocchio import JointRange
+from armcli.urdf.stance import Stance
 
 Stage = Literal["urdf", "model", "dynamics"]
 URDF: Stage = "urdf"
@@ -49,6 +52,9 @@ class Context:
     samples: list[tuple[dict[str, float], Any]] = field(default_factory=list)  # dynamics
     servo: set[str] = field(default_factory=set)  # joints a position servo drives
     stability: StabilityReport | None = None
+    balance: StaticBalance | None = None  # check/tipover.py
+    stance: Stance | None = None  # the robot on its support polygon (check/tipover.py)
+    zmp: ZmpReport | None = None  # check/zmp.py: the trajectory's zero-moment point
     stage: Stage | Literal["unloaded", "refused", "no-dynamics"] = "unloaded"
 
 

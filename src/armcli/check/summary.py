@@ -12,9 +12,11 @@ from typing import Any
 
 import numpy as np
 
+from armcli.check.balance import StaticBalance
 from armcli.check.context import Context, poses
 from armcli.check.rules import CheckOptions, JointRow
 from armcli.check.structure import finite
+from armcli.sim.tipping import ZmpReport
 from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf, total_dof
 from armcli.urdf.pinocchio import configuration
@@ -43,6 +45,8 @@ class Summary:
     poses: tuple[PoseRow, ...]
     stability: StabilityReport | None
     notes: tuple[str, ...]
+    balance: StaticBalance | None = None  # static balance over the support polygon
+    zmp: ZmpReport | None = None  # the --trajectory's zero-moment point
 
 
 def summarise(ctx: Context) -> Summary:
@@ -56,6 +60,8 @@ def summarise(ctx: Context) -> Summary:
         "joints": ctx.rows,
         "stability": ctx.stability,
         "notes": tuple(ctx.notes),
+        "balance": ctx.balance,
+        "zmp": ctx.zmp,
     }
     if ctx.model is None:
         return Summary(**base, end_effector="", poses=())

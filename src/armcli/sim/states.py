@@ -101,9 +101,15 @@ def output_format(path: Path) -> str:
     return ext[1:]
 
 
-def write_states(path: Path, res: SimResult, rate: float) -> None:
-    """Write the joint states sampled at `rate` [Hz] atomically, as CSV or JSON by extension."""
-    write_file_atomic(path, states_bytes(sample_states(res, rate), output_format(path)))
+def write_states(
+    path: Path, res: SimResult, rate: float, extra: dict[str, np.ndarray] | None = None
+) -> None:
+    """Write the joint states sampled at `rate` [Hz] atomically, as CSV or JSON by extension.
+
+    `extra`: more columns on the same rows (the zero-moment point's, sim.tipping).
+    """
+    cols = {**sample_states(res, rate), **(extra or {})}
+    write_file_atomic(path, states_bytes(cols, output_format(path)))
 
 
 # -- reader ----------------------------------------------------------------------------------
