@@ -129,12 +129,14 @@ class _Mass:
         import pinocchio as pin
 
         q = self.q(x)
-        J0 = np.array(pin.jacobianCenterOfMass(self.model, self.data, q))[:, self.iv]
+        J0 = np.array(pin.jacobianCenterOfMass(self.model, self.data, q)).reshape(3, -1)
+        J0 = J0[:, self.iv]  # nv = 1 comes back 1-D
         c0 = np.array(self.data.com[0])
         if self.frame is None or m <= 0:
             return c0, J0
-        J = pin.computeFrameJacobian(self.model, self.data, q, self.frame,
-                                     pin.LOCAL_WORLD_ALIGNED)[:, self.iv]  # fmt: skip
+        J6 = pin.computeFrameJacobian(self.model, self.data, q, self.frame,
+                                      pin.LOCAL_WORLD_ALIGNED)  # fmt: skip
+        J = np.asarray(J6, dtype=float).reshape(6, -1)[:, self.iv]
         T = self.data.oMf[self.frame]
         r = np.asarray(T.rotation, dtype=float) @ self.xyz
         p = np.asarray(T.translation, dtype=float) + r

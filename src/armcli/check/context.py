@@ -21,6 +21,7 @@ from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf, position_bounds
 from armcli.urdf.pinocchio import JointRange
 from armcli.urdf.stance import Stance
+from armcli.urdf.workspace import ReachPoint, Workspace
 
 Stage = Literal["urdf", "model", "dynamics"]
 URDF: Stage = "urdf"
@@ -55,6 +56,8 @@ class Context:
     balance: StaticBalance | None = None  # check/tipover.py
     stance: Stance | None = None  # the robot on its support polygon (check/tipover.py)
     zmp: ZmpReport | None = None  # check/zmp.py: the trajectory's zero-moment point
+    reach: Workspace | None = None  # check/reach.py: the tool point's envelope
+    reach_points: tuple[ReachPoint, ...] = ()  # --reach-point verdicts
     stage: Stage | Literal["unloaded", "refused", "no-dynamics"] = "unloaded"
 
 

@@ -300,6 +300,12 @@ _RULES = [
         "zero-moment point closer to the support polygon's edge than the threshold",
         "slow the arm down or lower the base's acceleration",
     ),
+    Rule(
+        "reach-point",
+        ERROR,
+        "a --reach-point the tool point cannot reach within the joint limits",
+        "move the point or the arm's mount (the message says how close the arm gets)",
+    ),
     # inputs
     Rule(
         "input-unusable",

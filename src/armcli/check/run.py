@@ -11,7 +11,17 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from armcli.check import bodies, inertia, interface, joints, meshes, structure, summary, tipover
+from armcli.check import (
+    bodies,
+    inertia,
+    interface,
+    joints,
+    meshes,
+    reach,
+    structure,
+    summary,
+    tipover,
+)
 from armcli.check import dynamics as dyn
 from armcli.check import zmp as zmp_rules
 from armcli.check.context import (
@@ -76,6 +86,7 @@ FAMILIES: tuple[Family, ...] = (
     Family("self-collision", MODEL, _self_collision),
     Family("tipover", DYNAMICS, tipover.check),
     Family("zmp", DYNAMICS, zmp_rules.check),
+    Family("reach", MODEL, reach.check),
 )
 
 

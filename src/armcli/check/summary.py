@@ -21,6 +21,7 @@ from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf, total_dof
 from armcli.urdf.pinocchio import configuration
 from armcli.urdf.tool import tool_point
+from armcli.urdf.workspace import ReachPoint, Workspace
 
 
 @dataclass(frozen=True)
@@ -47,6 +48,8 @@ class Summary:
     notes: tuple[str, ...]
     balance: StaticBalance | None = None  # static balance over the support polygon
     zmp: ZmpReport | None = None  # the --trajectory's zero-moment point
+    reach: Workspace | None = None  # the tool point's reach envelope
+    reach_points: tuple[ReachPoint, ...] = ()  # the --reach-point verdicts
 
 
 def summarise(ctx: Context) -> Summary:
@@ -62,6 +65,8 @@ def summarise(ctx: Context) -> Summary:
         "notes": tuple(ctx.notes),
         "balance": ctx.balance,
         "zmp": ctx.zmp,
+        "reach": ctx.reach,
+        "reach_points": ctx.reach_points,
     }
     if ctx.model is None:
         return Summary(**base, end_effector="", poses=())

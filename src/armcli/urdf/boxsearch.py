@@ -9,11 +9,11 @@ scipy.optimize's ~0.5 s of import.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 Objective = Callable[[NDArray[np.float64]], tuple[float, NDArray[np.float64]]]
 
@@ -34,9 +34,9 @@ class Minimum:
 
 def minimize_box(
     fun: Objective,
-    x0: Sequence[float],
-    lower: Sequence[float],
-    upper: Sequence[float],
+    x0: ArrayLike,
+    lower: ArrayLike,
+    upper: ArrayLike,
     *,
     step: float = 1.0,
     max_iterations: int = MAX_ITERATIONS,

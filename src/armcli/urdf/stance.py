@@ -23,6 +23,11 @@ from armcli.urdf.ground import Ground, MeshVertices, find_ground, has_wheels
 from armcli.urdf.pinocchio import JointRange, configuration, joint_ranges, load_model
 from armcli.urdf.support import SupportPolygon, support_polygon
 
+FIXED_BASE = (
+    "fixed base: no wheel touches the ground (name the contact links to analyse a robot "
+    "standing on feet or skids)"
+)
+
 
 @dataclass(frozen=True)
 class Payload:
@@ -106,9 +111,11 @@ def stance_of(
     `declared`: the contact links, named by the user. Without either, a robot none of
     whose wheels touches the ground has a fixed base (an arm bolted down): no polygon.
     """
+    names = {lk.name for lk in urdf.links}
+    if declared is None and candidates is not None and not names & set(candidates):
+        return NoStance(FIXED_BASE)  # e.g. a spec's standalone arm: none of its base's links
     model = load_model(urdf.source, xml=urdf.text.decode("utf-8"), floating=True).model
     if declared is not None:
-        names = {lk.name for lk in urdf.links}
         unknown = [n for n in declared if n not in names]
         if unknown:
             raise InputError(
@@ -118,8 +125,7 @@ def stance_of(
             )
     ground = find_ground(urdf, model, candidates=candidates, declared=declared, mesh=mesh)
     if ground is None or (declared is None and candidates is None and not has_wheels(ground)):
-        return NoStance("fixed base: no wheel touches the ground (name the contact links to "
-                        "analyse a robot standing on feet or skids)")  # fmt: skip
+        return NoStance(FIXED_BASE)
     polygon = support_polygon(ground.points())
     if polygon is None:
         links = ", ".join(ground.links)
