@@ -222,6 +222,9 @@ class Run:
     q0: np.ndarray
     duration: float  # [s]
     cfg: SimConfig
+    # sample_reference(reference, steps, cfg.dt, cfg.integrator), when the caller already
+    # has it: `armcli tune` samples each case once for all its candidates
+    sampled: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
 
 @dataclass
@@ -245,7 +248,11 @@ def _start(r: Run) -> _Progress:
     params = params_of(r.arm, r.cfg)
     energy = _energy_max(r.arm, r.q0, params)
     plant = ro.Plant(r.arm.model, params, r.cfg.gravity_comp, r.cfg.dt, r.cfg.integrator, energy)
-    ref, q_ref, v_ref = sample_reference(r.reference, steps, r.cfg.dt, r.cfg.integrator)
+    ref, q_ref, v_ref = (
+        r.sampled
+        if r.sampled is not None
+        else sample_reference(r.reference, steps, r.cfg.dt, r.cfg.integrator)
+    )
     q0 = np.array(r.q0, dtype=float)
     return _Progress(plant, params, ref, q_ref, v_ref, steps, q0, np.zeros(len(q0)), [])
 
@@ -261,7 +268,8 @@ def simulate_batch(runs: Sequence[Run]) -> list[SimResult | SimulationError]:
     if not runs or mod is None or any(r.cfg.backend == "python" for r in runs):
         return [_simulate_or_error(r) for r in runs]
     state = [_start(r) for r in runs]
-    compiled = {id(r.arm.model): native.compiled_model(mod, r.arm.model) for r in runs}
+    models = {id(r.arm.model): r.arm.model for r in runs}  # each model compiled once
+    compiled = {key: native.compiled_model(mod, m) for key, m in models.items()}
     chunk = CHUNK_STEPS[native.engine_name(mod)]
     start = time.perf_counter()
     for k0 in range(0, max(s.steps for s in state), chunk):

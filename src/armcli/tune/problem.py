@@ -16,12 +16,14 @@ from typing import Any
 import numpy as np
 
 from armcli.sim.reference import Reference
-from armcli.sim.simulate import Arm, arm_from_model
+from armcli.sim.simulate import Arm, arm_from_model, sample_reference
 from armcli.sim.stability import Linearised
 from armcli.tune.model_gains import linearised, sample_configurations
 from armcli.urdf.pinocchio import load_model
 
 _CACHE: dict[str, tuple[Scored, ...]] = {}
+Sampled = tuple[np.ndarray, np.ndarray, np.ndarray]  # sim.simulate.sample_reference's tables
+_SAMPLED: dict[str, tuple[Sampled, ...]] = {}
 _LOCK = threading.Lock()
 
 
@@ -107,6 +109,25 @@ def scored_models(problem: TuneProblem) -> tuple[Scored, ...]:
             gravity = not problem.gravity_comp
             _CACHE[key] = tuple(Scored(a, qs, linearised(a, qs, gravity=gravity)) for a in built)
         return _CACHE[key]
+
+
+def sampled_cases(problem: TuneProblem) -> tuple[Sampled, ...]:
+    """Each case's reference sampled at the problem's steps, once per process.
+
+    Every candidate of a tuning runs the same cases at the same dt, so the tables the
+    simulator steps along are computed once (`sim.simulate.Run.sampled`), not per rollout.
+    """
+    key = problem.key or problem.with_key().key
+    with _LOCK:
+        if key not in _SAMPLED:
+            _SAMPLED[key] = tuple(
+                sample_reference(
+                    c.reference, max(1, round(c.duration / problem.dt)), problem.dt,
+                    problem.integrator,
+                )
+                for c in problem.cases
+            )  # fmt: skip
+        return _SAMPLED[key]
 
 
 def draw_variants(
