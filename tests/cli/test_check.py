@@ -77,7 +77,11 @@ def test_strict_turns_warnings_into_exit_1_and_ignore_silences(tmp_path: Path) -
     spec = course_gains_spec(tmp_path)
     r = armcli("check", spec.name, "--strict", "--format", "github", cwd=tmp_path)
     assert r.returncode == 1
-    assert r.stdout.startswith("::error file=my_robot.yaml,title=armcli pd-explicit-unstable")
+    gains_line = spec.read_text().splitlines().index("  gains:") + 1
+    assert r.stdout.startswith(
+        f"::error file=my_robot.yaml,line={gains_line},title=armcli pd-explicit-unstable::"
+        "control.gains (my_robot.urdf:"
+    )
     assert "error finding(s)" in r.stderr
     ignored = ("--ignore", "pd-explicit-unstable", "--ignore", "root-inertia")
     r = armcli("check", spec.name, "--strict", *ignored, cwd=tmp_path)

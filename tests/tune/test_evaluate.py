@@ -1,9 +1,9 @@
 """What a candidate costs (issue 24): the work shared by every candidate is done once.
 
-Scoring N candidates samples each case's reference once and linearises each model once
-(M(q) and gravity's stiffness at the samples); per candidate only the rollouts and the
-stability verdict itself (one batched factorisation of A at the samples) remain. The
-pre-sampled tables give the same numbers as sampling per run.
+Scoring N candidates linearises each model once (M(q) and gravity's stiffness at the
+samples) and never samples a reference in Python (the compiled engine evaluates the
+trajectory's polynomials itself); per candidate only the rollouts and the stability
+verdict itself (one batched factorisation of A at the samples) remain.
 """
 
 from __future__ import annotations
@@ -13,13 +13,14 @@ from typing import Any
 import numpy as np
 import pytest
 
-from armcli.sim import simulate as sim
 from armcli.sim import stability as stab
+from armcli.sim.reference import Reference
 from armcli.spec.load import load_spec
 from armcli.tune import evaluate, problem
 from armcli.tune import job as tjob
 from armcli.tune.objective import Weights
 from tests.helpers import ROOT
+from tests.sim import stability_reference as ref
 
 SPEC = ROOT / "specs" / "my_robot.yaml"
 PICK = ROOT / "specs" / "trajectories" / "pick.yaml"
@@ -50,33 +51,27 @@ def _counting(monkeypatch: pytest.MonkeyPatch, module: Any, name: str) -> list[i
     return calls
 
 
-def test_shared_work_is_done_once_per_case_and_model(
+def test_shared_work_is_done_once_per_model(
     job: tjob.TuneJob, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    fresh = job.problem.with_key()  # a new key: the per-process caches start empty
+    fresh = job.problem.with_key()  # a new key: the per-process cache starts empty
     monkeypatch.setattr(problem, "_CACHE", {})
-    monkeypatch.setattr(problem, "_SAMPLED", {})
-    sampled = _counting(monkeypatch, problem, "sample_reference")
-    per_run = _counting(monkeypatch, sim, "sample_reference")
+    sampled = _counting(monkeypatch, Reference, "sample")
     linearised = _counting(monkeypatch, stab, "linearise")
     evs = evaluate.evaluate_candidates(fresh, _batch(job), Weights())
     assert all(ev.feasible for ev in evs)
-    assert sampled[0] == len(fresh.cases)  # once per case, not per candidate or model
-    assert per_run[0] == 0  # no rollout samples its own reference
-    assert linearised[0] == len(fresh.variants)  # once per model
+    assert sampled[0] == 0  # no reference is sampled per candidate (nor at all)
+    assert linearised[0] == len(fresh.variants)  # once per model, not per candidate
 
 
-def test_presampled_reference_gives_the_same_numbers(job: tjob.TuneJob) -> None:
-    """A run given its tables equals one that samples them itself, to the bit."""
+def test_stability_verdict_per_candidate_is_the_bound(job: tjob.TuneJob) -> None:
+    """The batched factorisation judges as the eigenvalues of the step map do."""
     sm = problem.scored_models(job.problem)[0]
-    case, table = job.problem.cases[0], problem.sampled_cases(job.problem)[0]
-    cfg = sim.SimConfig(job.start.kp, job.start.kd, job.problem.dt)
-    own, given = sim.simulate_batch(
-        [
-            sim.Run(sm.arm, case.reference, case.q0, case.duration, cfg),
-            sim.Run(sm.arm, case.reference, case.q0, case.duration, cfg, table),
-        ]
-    )
-    assert isinstance(own, sim.SimResult) and isinstance(given, sim.SimResult)
-    np.testing.assert_array_equal(own.q, given.q)
-    np.testing.assert_array_equal(own.tau, given.tau)
+    n = len(job.problem.joints)
+    Ms, Gs = list(sm.lin.M), list(sm.lin.G)
+    for scale in (1.0, 30.0, 1e3, 1e5):
+        kp = job.start.kp * scale
+        pd = stab.PD.of(range(n), kp, job.start.kd, sm.arm.damping)
+        d = job.start.kd + sm.arm.damping
+        rho = ref.worst_radius(Ms, Gs, range(n), kp, d, job.problem.dt, "implicit")
+        assert stab.stable(sm.lin, pd, job.problem.dt, "implicit") == (rho <= 1 + ref.RADIUS_TOL)

@@ -84,17 +84,22 @@ def _esc_prop(s: str) -> str:
 def to_github(findings: Sequence[Finding]) -> str:
     """GitHub Actions workflow commands: one `::error`/`::warning` line per finding.
 
-    Findings in a URDF built in memory from a spec (`spec.yaml#name.urdf`)
-    point at the spec file without a line: the lines are the generated file's.
+    Findings in a URDF built in memory from a spec (`spec.yaml#name.urdf`) point at the
+    spec's line of the field they came from (check.spec_locate) and name the generated
+    file's line in the message; without a spec field, at the spec file without a line.
     """
     lines = []
     for f in findings:
         path, _, inner = f.file.partition("#")
         props = [f"file={_esc_prop(path)}"]
-        if f.line and not inner:
+        if f.spec is not None and f.spec.line:  # the spec's own line
+            props.append(f"line={f.spec.line}")
+        elif f.line and not inner:
             props.append(f"line={f.line}")
         props.append(f"title={_esc_prop(f'armcli {f.rule}')}")
         where = f"{inner}:{f.line}: " if inner and f.line else ""
+        if f.spec is not None:
+            where = f"{f.spec.field} ({where.rstrip(': ') or inner}): "
         msg = f"{where}{f.message}" + (f" (fix: {f.hint})" if f.hint else "")
         lines.append(f"::{f.severity} {','.join(props)}::{_esc_data(msg)}")
     return "".join(line + "\n" for line in lines)
@@ -154,7 +159,11 @@ def _findings_grid(findings: Sequence[Finding]) -> Any:
     for f in findings:
         style = "red" if f.severity == ERROR else "yellow"
         body = Text(f.rule, style="bold")
-        if f.line:
+        if f.spec is not None:  # the spec field first; the generated URDF's line after it
+            generated = f.file.partition("#")[2]
+            body.append(f"  {f.spec}")
+            body.append(f" ({generated}:{f.line})" if f.line else "", style="dim")
+        elif f.line:
             body.append(f"  line {f.line}")
         body.append(f"\n{f.message}")
         if f.hint:

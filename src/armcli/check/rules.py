@@ -9,7 +9,7 @@ module is the floor they all stand on, so it imports none of them.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -289,6 +289,18 @@ def unknown_rules(ids: Iterable[str]) -> list[str]:
 
 
 @dataclass(frozen=True)
+class SpecPlace:
+    """Where in a spec file a finding in its generated URDF comes from (check.spec_locate)."""
+
+    file: str
+    line: int | None
+    field: str  # dotted field path, e.g. arm.joints.forearm_hand_joint.limit.upper
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line} {self.field}" if self.line else f"{self.file} {self.field}"
+
+
+@dataclass(frozen=True)
 class Finding:
     """One problem: which rule, where, what the numbers are, and how to fix it."""
 
@@ -300,6 +312,7 @@ class Finding:
     values: Mapping[str, Value] = field(default_factory=dict)
     hint: str = ""
     fix: Mapping[str, Value] = field(default_factory=dict)  # the numbers that would pass
+    spec: SpecPlace | None = None  # the spec field behind a generated URDF's element
 
     def to_dict(self) -> dict[str, Any]:
         """The finding as a JSON object in the stable schema of docs/check.md."""
@@ -312,6 +325,7 @@ class Finding:
             "values": dict(self.values),
             "hint": self.hint,
             "fix": dict(self.fix),
+            "spec": None if self.spec is None else vars(self.spec).copy(),
         }
 
 
@@ -395,6 +409,6 @@ def apply_policy(
         if f.rule in skip:
             continue
         if strict and f.severity == WARNING:
-            f = Finding(f.rule, ERROR, f.file, f.line, f.message, f.values, f.hint, f.fix)
+            f = replace(f, severity=ERROR)
         out.append(f)
     return out

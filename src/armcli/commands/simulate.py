@@ -24,13 +24,12 @@ from armcli.io.outdir import check_output_file
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
 from armcli.sim import rosbag, states
-from armcli.sim.options import ENGINES, INTEGRATORS, Engine, Integrator, SimOptions
+from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 from armcli.sim.plot import write_tracking_plot
 from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
-ENGINE_HELP = "auto (default: compiled when available), native (compiled) or python."
 INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
 GRAVITY_HELP = "Add g(q) to the PD torque (default: the spec's control.gravity_compensation)."
 IGNORE_HELP = "Simulate a --urdf despite this `check` rule's error (repeatable)."
@@ -66,7 +65,6 @@ def simulate_cmd(
     ),
     plot: Path = option(None, "--plot", help="Write a tracking plot PNG."),
     rate: float = option(None, "--rate", help="Output rate [Hz] (default: the spec's publisher)."),
-    engine: str = choice("auto", ENGINES, "--engine", help=ENGINE_HELP),
     package_dir: list[str] = package_dir_option(),
     env: list[str] = env_option(),
     trust_xacro: bool = option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
@@ -103,7 +101,6 @@ def simulate_cmd(
         duration=duration,
         clamp=clamp,
         rate=rate,
-        engine=cast(Engine, engine),
         trust_xacro=trust_mode(trust_xacro, unsandboxed),
         xacro=inputs,
     )
@@ -152,9 +149,7 @@ def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
     for w in job.trajectory.warnings:
         err.print(f"warning: {w}", markup=False, highlight=False)
     with _LazyProgress(err) as progress:
-        res = simjob.run(job, progress)
-    if res.notice:
-        err.print(f"note: {res.notice}", markup=False, highlight=False, soft_wrap=True)
+        res = simjob.run(job, progress, plot=plot is not None)
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
     if output is not None and rosbag.is_mcap(output):

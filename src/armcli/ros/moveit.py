@@ -14,6 +14,7 @@ from typing import Any
 import yaml
 
 from armcli.errors import InputError
+from armcli.ros.interfaces import HUMBLE, trajectory_interface
 from armcli.ros.srdf import ARM_GROUP, chain_joints
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf, position_bounds
@@ -102,7 +103,7 @@ def ros2_controllers(spec: RobotSpec, source: str | None = None) -> dict[str, An
     }
     arm: dict[str, Any] = {
         "joints": joints,
-        "command_interfaces": ["position"],
+        "command_interfaces": [trajectory_interface(spec, joints, HUMBLE, source)],
         "state_interfaces": ["position", "velocity"],
         "allow_nonzero_velocity_at_trajectory_end": True,
     }

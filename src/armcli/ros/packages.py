@@ -217,7 +217,7 @@ def description_files(
     `extra` adds xacro files under `urdf/` (the Jazzy top levels).
     """
     note = GENERATED.format(spec=label)
-    xacros = {**xacro_files(spec, label), **(extra or {})}
+    xacros = {**xacro_files(spec, label, hardware=False), **(extra or {})}
     files = {f"urdf/{name}": data for name, data in xacros.items()}
     files["launch/display.launch.py"] = render("display.launch.py.tmpl", _launch_values(n), note)
     files[f"rviz/{DISPLAY_RVIZ}"] = mc.dump_yaml(display_rviz(n.robot_root), note)
@@ -262,9 +262,7 @@ def moveit_files(
     urdf_xacro = f"config/{n.robot}.urdf.xacro"
     files[n.srdf] = srdf_bytes(spec, matrix, note)
     files[urdf_xacro] = moveit_urdf_xacro(n.robot, n.description, n.robot_xacro, note)
-    files[f"config/{n.robot}.ros2_control.xacro"] = ros2_control_xacro(
-        n.robot, chain_joints(spec), mc.passive_joints(spec), note
-    )
+    files[f"config/{n.robot}.ros2_control.xacro"] = ros2_control_xacro(spec, note)
     files["config/moveit.rviz"] = mc.dump_yaml(moveit_rviz(n.robot_root), note)
     files[".setup_assistant"] = mc.dump_yaml(mc.setup_assistant(n.moveit, urdf_xacro, n.srdf), note)
     for launch, (generator, what) in MOVEIT_LAUNCHES.items():

@@ -23,8 +23,7 @@ import numpy as np
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
 from armcli.io.yaml import read_text
-from armcli.sim.job import MAX_STEPS
-from armcli.sim.simulate import SimResult
+from armcli.sim.simulate import MAX_STEPS, SimResult
 
 TIME = "time"
 FIELDS = ("position", "velocity", "effort", "reference")  # per-joint columns, in file order
@@ -39,19 +38,34 @@ def column(joint: str, field: str) -> str:
 # -- writer ----------------------------------------------------------------------------------
 
 
-def sample_states(res: SimResult, rate: float) -> dict[str, np.ndarray]:
-    """Columns `time`, `NAME.position|velocity|effort|reference` at `rate` [Hz]."""
-    steps = len(res.t) - 1
+def sample_steps(steps: int, dt: float, rate: float) -> np.ndarray:
+    """The steps whose states the file holds: one per period 1/`rate` [Hz] from t = 0.
+
+    `simulate` keeps only these (plus what a plot needs), so memory follows the output
+    rate, not the number of steps.
+    """
     period = 1.0 / rate
-    n_samples = int(np.floor(res.t[-1] / period + 1e-9)) + 1
-    idx = np.minimum(np.round(np.arange(n_samples) * period / res.dt).astype(int), steps)
-    tau_idx = np.minimum(idx, steps - 1)
-    cols: dict[str, np.ndarray] = {TIME: res.t[idx]}
+    n_samples = int(np.floor(steps * dt / period + 1e-9)) + 1
+    idx = np.round(np.arange(n_samples) * period / dt).astype(np.int64)
+    return np.unique(np.minimum(idx, steps))
+
+
+def sample_states(res: SimResult, rate: float) -> dict[str, np.ndarray]:
+    """Columns `time`, `NAME.position|velocity|effort|reference` at `rate` [Hz].
+
+    Raises:
+        ValueError: `res` did not keep the states at those steps.
+    """
+    want = sample_steps(res.steps, res.dt, rate)
+    rows = np.minimum(np.searchsorted(res.step, want), len(res.step) - 1)
+    if not np.array_equal(res.step[rows], want):
+        raise ValueError(f"the run did not keep the states at {rate:g} Hz")
+    cols: dict[str, np.ndarray] = {TIME: res.t[rows]}
     for i, name in enumerate(res.joint_names):
-        cols[column(name, "position")] = res.q[idx, i]
-        cols[column(name, "velocity")] = res.v[idx, i]
-        cols[column(name, "effort")] = res.tau[tau_idx, i]
-        cols[column(name, "reference")] = res.q_ref[idx, i]
+        cols[column(name, "position")] = res.q[rows, i]
+        cols[column(name, "velocity")] = res.v[rows, i]
+        cols[column(name, "effort")] = res.tau[rows, i]
+        cols[column(name, "reference")] = res.q_ref[rows, i]
     return cols
 
 

@@ -47,6 +47,7 @@ def semantic_problems(spec: RobotSpec) -> list[Problem]:
     _plugin_problems(spec, all_joints, add)
     _mount_problems(spec, all_joints, add)
     _mimic_problems(spec, add)
+    _control_problems(spec, all_joints, add)
     for jname in spec.control.gains:
         if jname not in spec.arm.joints:
             add(("control", "gains", jname), f"unknown arm joint; known: {_names(spec.arm.joints)}")
@@ -90,6 +91,20 @@ def _mimic_problems(spec: RobotSpec, add: Callable[..., None]) -> None:
                 add(path, f"{j.mimic.joint} is {lead.type}: a lead joint must move")
             elif lead.mimic is not None:
                 add(path, f"{j.mimic.joint} mimics {lead.mimic.joint}: follow that one")
+
+
+def _control_problems(
+    spec: RobotSpec, all_joints: dict[str, Joint], add: Callable[..., None]
+) -> None:
+    """ros2_control joints exist and move."""
+    if spec.ros2_control is None:
+        return
+    for jname in spec.ros2_control.joints:
+        j = all_joints.get(jname)
+        if j is None:
+            add(("ros2_control", "joints", jname), f"unknown joint; known: {_names(all_joints)}")
+        elif j.type == "fixed":
+            add(("ros2_control", "joints", jname), "a fixed joint has no interfaces")
 
 
 def _mount_problems(spec: RobotSpec, all_joints: dict[str, Joint], add: Any) -> None:

@@ -7,7 +7,7 @@ is cut into chunks does not change any result, since every rollout is independen
 
 `rollout_batch` is the single place that runs the simulator: all rollouts of a chunk
 (candidates x models x cases) in one `sim.simulate.simulate_batch` call, which hands them
-to the compiled extension's batch rollout together (GIL released; else the Python loop).
+to the compiled engine together.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from armcli.sim.simulate import Arm, Run, SimConfig, SimResult, simulate_batch
 from armcli.tune import gains as gain_vector
 from armcli.tune.model_gains import loop_stable
 from armcli.tune.objective import METRIC_FIELDS, Weights, run_cost, run_metrics
-from armcli.tune.problem import Case, Sampled, TuneProblem, sampled_cases, scored_models
+from armcli.tune.problem import Case, TuneProblem, scored_models
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,14 +41,11 @@ class RolloutJob:
     arm: Arm
     case: Case
     cfg: SimConfig
-    sampled: Sampled | None = None  # the case's reference tables (problem.sampled_cases)
 
 
 def rollout_batch(jobs: Sequence[RolloutJob]) -> list[SimResult | None]:
     """Run every job through the simulator's batch entry point; None for a diverged run."""
-    runs = [
-        Run(j.arm, j.case.reference, j.case.q0, j.case.duration, j.cfg, j.sampled) for j in jobs
-    ]
+    runs = [Run(j.arm, j.case.reference, j.case.q0, j.case.duration, j.cfg) for j in jobs]
     return [r if isinstance(r, SimResult) else None for r in simulate_batch(runs)]
 
 
@@ -71,20 +68,15 @@ def evaluate_candidates(
     """Score gains [kp_1..kp_n, kd_1..kd_n] of each candidate on every model and case."""
     n = len(problem.joints)
     models = scored_models(problem)
-    tables = sampled_cases(problem)
     shape = (len(models), len(problem.cases))
     cfgs, reasons, jobs = [], [], []
     for gains in chunk:
         kp, kd = gain_vector.split(gains)
-        cfg = SimConfig(kp, kd, problem.dt, problem.integrator, problem.gravity_comp, "auto")
+        cfg = SimConfig(kp, kd, problem.dt, problem.integrator, problem.gravity_comp)
         cfgs.append(cfg)
         reasons.append(_unstable_reason(problem, kp, kd))
         if not reasons[-1]:
-            jobs += [
-                RolloutJob(sm.arm, case, cfg, table)
-                for sm in models
-                for case, table in zip(problem.cases, tables, strict=True)
-            ]
+            jobs += [RolloutJob(sm.arm, case, cfg) for sm in models for case in problem.cases]
     results = iter(rollout_batch(jobs))
     out = []
     for reason in reasons:

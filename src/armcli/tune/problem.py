@@ -15,15 +15,14 @@ from typing import Any
 
 import numpy as np
 
+from armcli.sim.options import Integrator
 from armcli.sim.reference import Reference
-from armcli.sim.simulate import Arm, arm_from_model, sample_reference
+from armcli.sim.simulate import Arm, arm_from_model
 from armcli.sim.stability import Linearised
 from armcli.tune.model_gains import linearised, sample_configurations
 from armcli.urdf.pinocchio import load_model
 
 _CACHE: dict[str, tuple[Scored, ...]] = {}
-Sampled = tuple[np.ndarray, np.ndarray, np.ndarray]  # sim.simulate.sample_reference's tables
-_SAMPLED: dict[str, tuple[Sampled, ...]] = {}
 _LOCK = threading.Lock()
 
 
@@ -63,7 +62,7 @@ class TuneProblem:
     urdf_name: str
     joints: tuple[str, ...]
     dt: float  # [s]
-    integrator: str
+    integrator: Integrator
     gravity_comp: bool
     loop: str  # "implicit" | "explicit": which stability bound makes a candidate infeasible
     stability_margin: float  # nominal model: stable at stability_margin * dt; variants: at dt
@@ -109,25 +108,6 @@ def scored_models(problem: TuneProblem) -> tuple[Scored, ...]:
             gravity = not problem.gravity_comp
             _CACHE[key] = tuple(Scored(a, qs, linearised(a, qs, gravity=gravity)) for a in built)
         return _CACHE[key]
-
-
-def sampled_cases(problem: TuneProblem) -> tuple[Sampled, ...]:
-    """Each case's reference sampled at the problem's steps, once per process.
-
-    Every candidate of a tuning runs the same cases at the same dt, so the tables the
-    simulator steps along are computed once (`sim.simulate.Run.sampled`), not per rollout.
-    """
-    key = problem.key or problem.with_key().key
-    with _LOCK:
-        if key not in _SAMPLED:
-            _SAMPLED[key] = tuple(
-                sample_reference(
-                    c.reference, max(1, round(c.duration / problem.dt)), problem.dt,
-                    problem.integrator,
-                )
-                for c in problem.cases
-            )  # fmt: skip
-        return _SAMPLED[key]
 
 
 def draw_variants(
