@@ -9,7 +9,11 @@ from __future__ import annotations
 
 import copy
 import math
+import os
 import re
+import subprocess
+import sys
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -39,6 +43,34 @@ def course_gains_spec(directory: Path, name: str = "my_robot.yaml") -> Path:
     path = directory / name
     path.write_text(gains_text(DEFAULT_SPEC.read_text(), COURSE_GAINS))
     return path
+
+
+CLI_TIME_LIMIT_S = 120.0  # one CLI run on a loaded 2-core machine
+
+
+def run_cli(
+    args: Sequence[str | Path],
+    cwd: Path | None = None,
+    env: Mapping[str, str] | None = None,
+    *,
+    preexec_fn: Callable[[], Any] | None = None,
+) -> subprocess.CompletedProcess[str]:
+    """`python -m armcli.cli ARGS` as its own process: exit code, stdout, stderr, files.
+
+    `env` adds to (or overrides) this process's environment, without ARMCLI_DEBUG (errors
+    stay one line). For in-process calls that only need the output, tests call
+    `armcli.cli.main` directly instead.
+    """
+    return subprocess.run(
+        [sys.executable, "-m", "armcli.cli", *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=CLI_TIME_LIMIT_S,
+        check=False,
+        cwd=cwd,
+        env={**{k: v for k, v in os.environ.items() if k != "ARMCLI_DEBUG"}, **(env or {})},
+        preexec_fn=preexec_fn,
+    )
 
 
 HOSTILE_SCALARS = st.one_of(

@@ -113,3 +113,18 @@ def test_init_from_a_urdf(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
     )
     assert code == 0, err
     assert load_spec(tmp_path / "proj" / "armcli.yaml").name == "sensor_base"
+
+
+def test_massless_arm_imports_without_start_gains(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    urdf = tmp_path / "frames.urdf"  # no inertia anywhere: no mass matrix to size gains on
+    urdf.write_text(
+        '<robot name="frames"><link name="a"/><link name="b"/>'
+        '<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+        '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>'
+    )
+    code, out, err = run(["import", str(urdf), "-o", str(tmp_path / "s.yaml")], capsys)
+    assert code == 0, err
+    assert "gives back the same URDF" in out
+    assert load_spec(tmp_path / "s.yaml").control.gains == {}

@@ -33,7 +33,7 @@ from armcli.ros.packages import RosPackages, ros_packages
 from armcli.spec.load import load_spec, loads_spec
 from armcli.spec.model import RobotSpec
 from armcli.urdf.read import parse_urdf
-from tests.helpers import ROOT
+from tests.helpers import ROOT, run_cli
 
 GOLDEN = ROOT / "tests" / "ros" / "golden"
 SAMPLES = 300  # as test_ros_package.py
@@ -41,6 +41,7 @@ LABEL = "specs/my_robot.yaml"
 DESC, BRINGUP, MOVEIT = "my_robot_description", "my_robot_bringup", "my_robot_moveit_config"
 GOLDEN_FILES = [
     f"{BRINGUP}/README.md",
+    f"{BRINGUP}/config/my_robot_bridge.yaml",
     f"{BRINGUP}/config/my_robot_controllers.yaml",
     f"{BRINGUP}/launch/my_robot_gz.launch.py",
     f"{BRINGUP}/package.xml",
@@ -192,7 +193,8 @@ def test_bringup_launch_chains_spawners_after_the_spawn(files: Mapping[str, byte
         '"-r " + WORLD',
         'WORLD = "empty.sdf"',
         '"-topic", "robot_description"',
-        '"/clock@rosgraph_msgs/msg/Clock[gz.msgs.Clock"',
+        '"config_file": os.path.join(config, BRIDGE)',
+        'BRIDGE = "my_robot_bridge.yaml"',
         'AppendEnvironmentVariable("GZ_SIM_RESOURCE_PATH"',
         'executable="create"',
         '" controllers_file:="',
@@ -342,25 +344,17 @@ def test_standalone_arm_is_welded_to_the_world(files: Mapping[str, bytes], tmp_p
 
 
 def test_cli_target_choice_and_one_line_error(tmp_path: Path) -> None:
-    import sys
-
     spec = str(ROOT / LABEL)
-    r = subprocess.run(
-        [sys.executable, "-m", "armcli.cli", "ros-package", spec, "-o", str(tmp_path / "a"),
-         "--samples", "10", "--target", "noetic"],
-        capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
+    r = run_cli(
+        ["ros-package", spec, "-o", tmp_path / "a", "--samples", "10", "--target", "noetic"]
+    )
     assert r.returncode == 2 and "humble-classic" in r.stderr and "jazzy" in r.stderr
     assert not (tmp_path / "a").exists()
     bad = tmp_path / "no_gains.yaml"
     bad.write_text(
         (ROOT / LABEL).read_text().replace("    forearm_hand_joint: {kp: 50, kd: 1.5}\n", "")
     )
-    r = subprocess.run(
-        [sys.executable, "-m", "armcli.cli", "ros-package", str(bad), "-o", str(tmp_path / "b"),
-         "--samples", "10", "--target", "jazzy"],
-        capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
+    r = run_cli(["ros-package", bad, "-o", tmp_path / "b", "--samples", "10", "--target", "jazzy"])
     assert r.returncode == 2, r.stderr
     assert len(r.stderr.strip().splitlines()) == 1
     assert "no_gains.yaml" in r.stderr and "control.gains" in r.stderr

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from lxml import etree
 
+from armcli.compiler.sensors import classic_sensor
 from armcli.compiler.xmlfmt import fmt, robot, sub
 from armcli.spec.model import (
     DiffDrive,
@@ -103,6 +104,7 @@ def mobile_base_gazebo(spec: RobotSpec) -> etree._Element:
     link_extensions(root, spec, spec.mobile_base.links)
     if spec.mobile_base.diff_drive is not None:
         root.append(diff_drive_element(spec.mobile_base.diff_drive))
+    _sensors(root, spec, spec.mobile_base.links)
     return root
 
 
@@ -114,4 +116,12 @@ def arm_gazebo(spec: RobotSpec) -> etree._Element:
         root.append(joint_state_publisher_element(spec.arm.joint_state_publisher))
     if spec.arm.joint_pose_trajectory is not None:
         root.append(joint_pose_trajectory_element(spec.arm.joint_pose_trajectory))
+    _sensors(root, spec, spec.arm.links)
     return root
+
+
+def _sensors(root: etree._Element, spec: RobotSpec, links: dict[str, Link]) -> None:
+    """The Gazebo classic sensors fixed on this part's links."""
+    for name, sensor in spec.sensors.items():
+        if sensor.link in links:
+            root.append(classic_sensor(name, sensor))

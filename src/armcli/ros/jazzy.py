@@ -19,6 +19,7 @@ from typing import Any
 from lxml import etree
 
 from armcli.compiler.ros2_control import joint_block
+from armcli.compiler.sensors import bridge_entries, harmonic_sensor, harmonic_systems
 from armcli.compiler.xacro_writer import ARM, COMMON, MOBILE_BASE, joint_element
 from armcli.compiler.xmlfmt import XACRO_NS, fmt, to_bytes
 from armcli.errors import InputError
@@ -27,7 +28,7 @@ from armcli.ros import moveit as mc
 from armcli.ros.interfaces import GAIN_INTERFACES, JAZZY
 from armcli.ros.launch import render
 from armcli.ros.srdf import chain_joints
-from armcli.spec.model import Joint, RobotSpec
+from armcli.spec.model import Joint, RobotSpec, Sensor
 
 X = f"{{{XACRO_NS}}}"
 GZ_SYSTEM = "gz_ros2_control/GazeboSimSystem"
@@ -175,7 +176,47 @@ def top_xacro(spec: RobotSpec, bringup_pkg: str, *, whole: bool, header: str) ->
     _friction(root, spec, whole)
     ros2_control_block(root, spec, mc.passive_joints(spec) if whole else [])
     _gz_plugins(root, spec, whole)
+    _sensors(root, spec, whole)
     return to_bytes(root, header_comment=header)
+
+
+def sensors_on(spec: RobotSpec, whole: bool) -> dict[str, Sensor]:
+    """The sensors of the whole robot, or of the arm alone."""
+    links = spec.all_links() if whole else spec.arm.links
+    return {n: s for n, s in spec.sensors.items() if s.link in links}
+
+
+def _sensors(root: etree._Element, spec: RobotSpec, whole: bool) -> None:
+    """gz-sim sensors and the systems that run them (outside mock mode, like the plugins)."""
+    sensors = sensors_on(spec, whole)
+    if not sensors:
+        return
+    sim = _sub(root, X + "unless", value=f"$(arg {MOCK_ARG})")
+    for el in harmonic_systems(list(sensors.values())):
+        sim.append(el)
+    for name, s in sensors.items():
+        sim.append(harmonic_sensor(name, s))
+
+
+def bridge_file(robot: str) -> str:
+    """File name of the ros_gz_bridge configuration in the bringup's `config/`."""
+    return f"{robot}_bridge.yaml"
+
+
+def bridge(spec: RobotSpec) -> list[dict[str, Any]]:
+    """ros_gz_bridge entries: the simulation clock, then every sensor's topics."""
+    out: list[dict[str, Any]] = [
+        {
+            "ros_topic_name": "clock",
+            "gz_topic_name": "clock",
+            "ros_type_name": "rosgraph_msgs/msg/Clock",
+            "gz_type_name": "gz.msgs.Clock",
+            "direction": "GZ_TO_ROS",
+        }
+    ]
+    for s in spec.sensors.values():
+        out += bridge_entries(s)
+    return out
 
 
 def has_whole_robot(spec: RobotSpec) -> bool:

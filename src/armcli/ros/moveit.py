@@ -27,16 +27,17 @@ IK_TIMEOUT = 0.005  # [s] Setup Assistant default
 SCALING_DEFAULT = 0.1  # Setup Assistant default velocity/acceleration scaling
 
 
-class _Dumper(yaml.SafeDumper):
+class Dumper(yaml.SafeDumper):
     """Block-style YAML, lists indented under their key like ROS 2 examples."""
 
     def increase_indent(self, flow: bool = False, indentless: bool = False) -> Any:
+        """Indent sequences under their key (never "indentless")."""
         return super().increase_indent(flow, False)
 
 
 def dump_yaml(data: dict[str, Any], header: str | None = None) -> bytes:
     """Deterministic YAML text: insertion order, block style, optional `#` header."""
-    body = yaml.dump(data, Dumper=_Dumper, sort_keys=False, default_flow_style=False, width=100)
+    body = yaml.dump(data, Dumper=Dumper, sort_keys=False, default_flow_style=False, width=100)
     head = "".join(f"# {line}\n" for line in header.splitlines()) if header else ""
     return (head + body).encode("utf-8")
 

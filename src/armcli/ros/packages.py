@@ -16,14 +16,18 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import yaml
 from lxml import etree
 
 from armcli.compiler.expand import expand_urdfs
+from armcli.compiler.massprops import MAX_MESH_BYTES
+from armcli.compiler.meshfiles import MeshNames, package_meshes, package_of, spec_mesh_names
 from armcli.compiler.xacro_writer import GENERATED, STANDALONE_ARM, top_level_files, xacro_files
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.io.files import write_tree_atomic
 from armcli.io.outdir import resolve_output_dir
+from armcli.io.userfile import read_regular
 from armcli.ros import jazzy
 from armcli.ros import moveit as mc
 from armcli.ros.collision_matrix import (
@@ -217,12 +221,24 @@ def description_files(
     `extra` adds xacro files under `urdf/` (the Jazzy top levels).
     """
     note = GENERATED.format(spec=label)
-    xacros = {**xacro_files(spec, label, hardware=False), **(extra or {})}
+    names = MeshNames(spec.base_dir, package=n.description)
+    xacros = {**xacro_files(spec, label, names, hardware=False), **(extra or {})}
     files = {f"urdf/{name}": data for name, data in xacros.items()}
+    files.update(mesh_files(spec))
     files["launch/display.launch.py"] = render("display.launch.py.tmpl", _launch_values(n), note)
     files[f"rviz/{DISPLAY_RVIZ}"] = mc.dump_yaml(display_rviz(n.robot_root), note)
     about = f"Robot description (xacro, URDF, RViz) of {n.robot}. {note}"
-    return _package(n.description, about, DESCRIPTION_DEPENDS, files, info)
+    others = sorted({p for m in spec_mesh_names(spec) if (p := package_of(m)) is not None})
+    depends = [*DESCRIPTION_DEPENDS, *(p for p in others if p != n.description)]
+    return _package(n.description, about, depends, files, info)
+
+
+def mesh_files(spec: RobotSpec) -> dict[str, bytes]:
+    """The spec's path-named meshes, copied under `meshes/` (bounded regular files)."""
+    out = {}
+    for rel, path in package_meshes(spec).items():
+        out[rel] = read_regular(path, max_bytes=MAX_MESH_BYTES, what="mesh file")
+    return out
 
 
 def bringup_files(n: Names, note: str, info: PackageInfo) -> dict[str, bytes]:
@@ -325,6 +341,7 @@ def jazzy_files(
         "robot_xacro": whole if whole in tops else jazzy.STANDALONE,
         "standalone_xacro": jazzy.STANDALONE,
         "controllers": jazzy.controllers_file(n.robot),
+        "bridge": jazzy.bridge_file(n.robot),
         "gz_launch": launch,
         "arm_controller": mc.ARM_CONTROLLER,
         "joint_state_broadcaster": mc.JOINT_STATE_BROADCASTER,
@@ -333,6 +350,7 @@ def jazzy_files(
         f"config/{jazzy.controllers_file(n.robot)}": mc.dump_yaml(
             jazzy.controllers(spec, source), note
         ),
+        f"config/{jazzy.bridge_file(n.robot)}": _bridge_yaml(jazzy.bridge(spec), note),
         f"launch/{launch}": jazzy.bringup_launch(values, note),
         "README.md": jazzy_readme(spec, n.bringup, launch, n.moveit, note),
     }
@@ -341,6 +359,12 @@ def jazzy_files(
         **description_files(spec, n, label, info, tops),
         **_package(n.bringup, about, [n.description, *jazzy.BRINGUP_DEPENDS], files, info),
     }
+
+
+def _bridge_yaml(entries: list[dict[str, Any]], note: str) -> bytes:
+    """ros_gz_bridge's config file: a YAML list of topic entries."""
+    body = yaml.dump(entries, Dumper=mc.Dumper, sort_keys=False, default_flow_style=False)
+    return ("".join(f"# {line}\n" for line in note.splitlines()) + body).encode("utf-8")
 
 
 def write_ros_packages(

@@ -24,7 +24,11 @@ STEP_CAP = math.pi / 2  # [rad or m] the largest step the start gains are sized 
 
 
 def spec_start_gains(spec: RobotSpec) -> dict[str, tuple[float, float]]:
-    """{joint: (kp, kd)} for the driven arm joints; {} when there are none or gravity wins."""
+    """{joint: (kp, kd)} for the driven arm joints.
+
+    {} when there are none, gravity beats an effort limit, or the mass matrix is singular
+    (massless links): the import then writes no gains, and `check` says what is wrong.
+    """
     joints = [
         n
         for n in spec.movable_arm_joints()
@@ -44,6 +48,8 @@ def spec_start_gains(spec: RobotSpec) -> dict[str, tuple[float, float]]:
         )
     except InputError:
         return {}  # an effort limit below gravity: no start gains; tune says why
+    except np.linalg.LinAlgError:
+        return {}  # a massless chain (singular mass matrix): nothing to size gains on; check says
     return {
         name: (float(kp), float(kd))
         for name, kp, kd in zip(arm.joint_names, start.kp, start.kd, strict=True)
