@@ -1,4 +1,4 @@
-"""The balance part of `check`'s table report: margins and tipping angles, the trajectory's ZMP.
+"""The balance and reach part of `check`'s table report: margins, tipping angles, ZMP, reach.
 
 One table per robot with a support polygon: a row per named pose and one for the worst
 over the joint range, a column per edge of the polygon (the direction the robot would
@@ -13,6 +13,7 @@ from typing import Any
 from armcli.check.balance import StaticBalance
 from armcli.io.terminal import Column, FitTable
 from armcli.sim.tipping import ZmpReport, summary_line
+from armcli.urdf.workspace import ReachPoint, Workspace
 
 
 def balance_items(balance: StaticBalance | None, zmp: ZmpReport | None) -> list[Any]:
@@ -64,3 +65,31 @@ def _caption(b: StaticBalance) -> str:
         f"centre of mass's margin and the slope that tips it (rigid wheels, flat ground); "
         f"warning below {b.threshold * 1e3:g} mm: {holds}; robot {b.mass:.4g} kg"
     )
+
+
+def reach_items(reach: Workspace | None, points: tuple[ReachPoint, ...]) -> list[Any]:
+    """One line for the tool point's reach envelope and one per --reach-point."""
+    from rich.text import Text
+
+    if reach is None:
+        return []
+    lo, hi = reach.lower, reach.upper
+    box = " ".join(f"{a:.3f}..{b:.3f}" for a, b in zip(lo, hi, strict=True))
+    out: list[Any] = [
+        Text(
+            f"reach of {reach.point} over {', '.join(reach.joints)}: max {reach.max_reach:.3f} m "
+            f"from the shoulder {_xyz(reach.shoulder)}, height {reach.min_height:.3f}.."
+            f"{reach.max_height:.3f} m, horizontal {reach.max_horizontal:.3f} m from the root's "
+            f"z axis; box x y z {box} m ({reach.samples} samples, extremes refined)"
+        )
+    ]
+    for p in points:
+        verdict = "reachable" if p.reachable else f"OUT OF REACH by {p.residual * 1e3:.1f} mm"
+        q = ", ".join(f"{n}={v:.4g}" for n, v in p.q)
+        out.append(Text(f"  point {_xyz(p.target)}: {verdict} (at {q})",
+                        style="" if p.reachable else "red"))  # fmt: skip
+    return out
+
+
+def _xyz(v: tuple[float, float, float]) -> str:
+    return f"({v[0]:.3f}, {v[1]:.3f}, {v[2]:.3f})"
