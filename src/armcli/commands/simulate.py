@@ -13,11 +13,12 @@ from armcli.commands.options import choice, option, spec_argument
 from armcli.errors import InputError
 from armcli.io import terminal
 from armcli.io.outdir import check_output_file
+from armcli.io.together import write_files_together
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
 from armcli.sim import states
 from armcli.sim.options import ENGINES, INTEGRATORS, Engine, Integrator, SimOptions
-from armcli.sim.plot import write_tracking_plot
+from armcli.sim.plot import tracking_png
 from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
@@ -99,10 +100,14 @@ def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
         err.print(f"note: {res.notice}", markup=False, highlight=False, soft_wrap=True)
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
+    files: dict[Path, bytes] = {}  # written together: never a new CSV beside an old plot
     if output is not None:
-        states.write_states(output, res, job.rate)
+        files[output] = states.states_bytes(
+            states.sample_states(res, job.rate), states.output_format(output)
+        )
     if plot is not None:
-        write_tracking_plot(plot, res, job.arm.effort)
+        files[plot] = tracking_png(res, job.arm.effort)
+    write_files_together(files)
     out = terminal.console()
     out.print(simreport.summary_table(metrics, ee, job.tool_label, res), crop=False)
     for path in (output, plot):
