@@ -9,11 +9,17 @@ SPEC ?= specs/my_robot.yaml
 
 # The install builds the compiled rollout (armcli.sim._rollout, CMakeLists.txt) too, so a
 # change to its C++ source or build files reinstalls.
+# pip prints what it collects and builds: a first install downloads ~80 packages and
+# compiles the engine (README, "Set-up": minutes and memory measured here).
 $(STAMP): pyproject.toml CMakeLists.txt src/armcli/sim/_native/rollout.cpp
+	@echo "install [1/3]: virtual environment in $(VENV)"
 	$(PY) -m venv $(VENV)
+	@echo "install [2/3]: pip"
 	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -e '.[dev]'
+	@echo "install [3/3]: armcli and its dependencies, compiling the engine (the longest step)"
+	$(BIN)/python -m pip install --progress-bar off -e '.[dev]'
 	touch $(STAMP)
+	@echo "install: done"
 
 install: $(STAMP)
 
@@ -47,6 +53,7 @@ test: install sysdeps lint native-check
 # Rebuild the compiled rollout after editing its C++ (the editable install does not rebuild
 # on import): incremental, in build/, with the build tools of the dev extra.
 native: install
+	@echo "native: recompiling the engine (armcli.sim._rollout)"
 	$(BIN)/python -m pip install -q --no-build-isolation --no-deps -e .
 	$(BIN)/python -m armcli.sim.native
 

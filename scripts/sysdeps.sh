@@ -6,6 +6,7 @@ command -v check_urdf >/dev/null 2>&1 || need+=(liburdfdom-tools)
 command -v chromium >/dev/null 2>&1 || need+=(chromium)
 command -v chromedriver >/dev/null 2>&1 || need+=(chromium-driver)
 command -v bwrap >/dev/null 2>&1 || need+=(bubblewrap)  # --trust-xacro sandbox (xacro_jail)
+command -v ign >/dev/null 2>&1 || need+=(libsdformat-dev ignition-tools)  # `ign sdf -k`: Gazebo's URDF parser (tests)
 [ ${#need[@]} -eq 0 ] && exit 0
 if [ "$(id -u)" != 0 ] || ! command -v apt-get >/dev/null 2>&1; then
   echo "sysdeps: cannot install ${need[*]} (need root and apt-get); the tests using them will skip" >&2

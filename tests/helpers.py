@@ -92,3 +92,55 @@ def mutated(draw: st.DrawFn, base: Any, max_mutations: int = 3) -> Any:
         elif action == "wrap":
             parent[path[-1]] = [parent[path[-1]]]
     return doc
+
+
+# A ROS 2 workspace fixture (tests/fixtures/ros_ws/src): two packages whose clone
+# directories are not named like the packages, built into an ament install prefix the
+# way `colcon build --symlink-install --merge-install` leaves it.
+ROS_WS_SRC = FIXTURES / "ros_ws" / "src"
+ARM_PACKAGE, GRIPPER_PACKAGE = "demo_arm_description", "demo_gripper_description"
+DEMO_ARM = ROS_WS_SRC / "arm_clone" / "urdf" / "demo_arm.urdf.xacro"
+AMENT_MARKERS = Path("share", "ament_index", "resource_index", "packages")
+
+
+def symlink_install(src: Path, prefix: Path) -> Path:
+    """`prefix`/share/NAME for each package under `src`: real directories, one symlink per
+    file into the source (as ament_cmake's symlink install), plus the ament index marker."""
+    import re
+
+    for xml in sorted(src.glob("*/package.xml")):
+        name = re.search(r"<name>([^<]+)</name>", xml.read_text())
+        assert name is not None, xml
+        share = prefix / "share" / name.group(1)
+        for f in sorted(p for p in xml.parent.rglob("*") if p.is_file()):
+            target = share / f.relative_to(xml.parent)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.symlink_to(f)
+        (prefix / AMENT_MARKERS).mkdir(parents=True, exist_ok=True)
+        (prefix / AMENT_MARKERS / name.group(1)).touch()
+    return prefix
+
+
+def ament_index_shim() -> Any:
+    """A stand-in for ROS 2's `ament_index_python` (not on PyPI) so that xacro itself can
+    resolve `$(find)` as a sourced workspace does: `<prefix>/share/NAME` of the first
+    AMENT_PREFIX_PATH prefix whose ament index registers NAME. Install it with
+    `monkeypatch.setitem(sys.modules, ...)` for both returned modules."""
+    import os
+    import types
+
+    class PackageNotFoundError(KeyError):
+        pass
+
+    def get_package_share_directory(name: str, print_warning: bool = True) -> str:
+        for prefix in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep):
+            if prefix and (Path(prefix) / AMENT_MARKERS / name).is_file():
+                return os.path.join(prefix, "share", name)
+        raise PackageNotFoundError(name)
+
+    top = types.ModuleType("ament_index_python")
+    packages = types.ModuleType("ament_index_python.packages")
+    packages.get_package_share_directory = get_package_share_directory  # type: ignore[attr-defined]
+    packages.PackageNotFoundError = PackageNotFoundError  # type: ignore[attr-defined]
+    top.packages = packages  # type: ignore[attr-defined]
+    return top, packages

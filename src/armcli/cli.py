@@ -10,7 +10,9 @@ numpy or any command's library, and `armcli build` loads only what build needs.
 from __future__ import annotations
 
 import importlib
+import signal
 import sys
+import threading
 from typing import Any
 
 import click
@@ -63,6 +65,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "Print the kinematic tree: links, and joints with their types and limits.",
     ),
     "export": ("armcli.commands.export", "Export the robot to other simulators' formats."),
+    "expand": (
+        "armcli.commands.expand",
+        "Expand a xacro file like `xacro FILE NAME:=VALUE...`, without running its code.",
+    ),
 }
 
 
@@ -156,6 +162,17 @@ def _debug_requested(argv: list[str]) -> bool:
     return False
 
 
+class _Interrupted(BaseException):
+    """Ctrl-C, raised instead of KeyboardInterrupt, which typer turns into a silent exit 130."""
+
+
+INTERRUPTED = "interrupted (Ctrl-C): stopped; no file was left half-written\n"
+
+
+def _raise_interrupted(signum: int, frame: object) -> None:
+    raise _Interrupted
+
+
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry point: run the app and map exceptions to exit codes.
 
@@ -166,16 +183,18 @@ def main(argv: list[str] | None = None) -> None:
     # `--trust-xacro=unsandboxed` is the documented spelling; a bool flag cannot take a value
     args = [UNSANDBOXED_FLAG if a == "--trust-xacro=unsandboxed" else a for a in args]
     debug = _debug_requested(args)
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, _raise_interrupted) if main_thread else None
     try:
         app(args=args, prog_name="armcli")
+    except (_Interrupted, KeyboardInterrupt):
+        sys.stderr.write(INTERRUPTED)
+        raise SystemExit(130) from None
     except ArmcliError as exc:
         if debug:
             raise
         _print_error(exc)
         raise SystemExit(exc.exit_code) from None
-    except KeyboardInterrupt:
-        sys.stderr.write("interrupted\n")
-        raise SystemExit(130) from None
     except Exception as exc:  # a bug: say so in one line unless --debug
         if debug:
             raise
@@ -184,6 +203,9 @@ def main(argv: list[str] | None = None) -> None:
             "(rerun with --debug for a traceback)\n"
         )
         raise SystemExit(EXIT_FAILED) from None
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
 
 
 if __name__ == "__main__":

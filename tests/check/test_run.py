@@ -419,3 +419,19 @@ def test_sampled_range_reaches_the_gravity_worst_case() -> None:
     j1 = next(j for j in result.summary.joints if j.name == "arm_base_forearm_joint")
     assert j1.gravity_max == pytest.approx(0.3 * 9.81 * 0.6, rel=1e-9)
     assert math.isfinite(j1.gravity_max)
+
+
+@pytest.mark.parametrize(
+    ("drop", "role"),
+    [("collision", "visual"), ("visual", "collision"), (None, "visual and collision")],
+)
+def test_inertia_exceeds_geometry_names_the_shape_it_measured(drop: str | None, role: str) -> None:
+    """A link drawn only by its visual gets "visual shape", not "collision shape"."""
+
+    def edit(r: Any) -> None:
+        scale_hand_inertia(4.0)(r)
+        if drop:
+            HAND(r).remove(HAND(r).find(drop))
+
+    (f,) = [f for f in run(edit, None).findings if f.rule == "inertia-exceeds-geometry"]
+    assert f"inside that {role} shape can have" in f.message

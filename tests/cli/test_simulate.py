@@ -19,8 +19,8 @@ TRAJ = ROOT / "specs" / "trajectories"
 J1, J2 = "arm_base_forearm_joint", "forearm_hand_joint"
 SEED = (
     "{header: {frame_id: arm_base_link}, joint_names: [arm_base_forearm_joint, "
-    "forearm_hand_joint], points: [{positions: {0.0, 0.0}}]}"
-)  # the course's `ros2 topic pub /set_joint_trajectory` payload
+    "forearm_hand_joint], points: [{positions: [0.0, 0.0]}]}"
+)  # the course's `ros2 topic pub /set_joint_trajectory` payload, positions as a list
 RATE = 10.0  # [Hz] joint_state_publisher update_rate in specs/my_robot.yaml
 TRACK_TOL = 0.01  # [rad] final tracking: friction 0.05 / Kp 50 and gravity sag 0.6*9.81*0.15/50
 
@@ -48,6 +48,15 @@ def test_seed_message(capsys: pytest.CaptureFixture[str]) -> None:
     # the same frame and numbers `check` and `view` report.
     assert "in base_footprint" in out
     assert "(0.1500, 0.0000, 0.9200) m" in out
+
+
+def test_course_brace_form(capsys: pytest.CaptureFixture[str]) -> None:
+    """`{0.0, 0.0}` is one position in ROS 2 (refused); `{0.5, 0.3}` is two (a warning)."""
+    code, _, err = run(["--message", SEED.replace("[0.0, 0.0]", "{0.0, 0.0}")], capsys)
+    assert code == 2 and "1 value(s) for 2 joint(s)" in err and "[0.0, 0.0]" in err
+    code, _, err = run(["--message", SEED.replace("[0.0, 0.0]", "{0.5, 0.3}")], capsys)
+    assert code == 0, err
+    assert err.count("is a YAML mapping, not a list") == 1 and "[0.5, 0.3]" in err
 
 
 @pytest.mark.parametrize("name", sorted(p.name for p in TRAJ.glob("*.yaml")))

@@ -111,7 +111,7 @@ def test_scheduler_without_dask_says_what_to_install(
     monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
     code, _, err = run([str(spec_copy), *QUICK, "--scheduler", "tcp://127.0.0.1:8786"], capsys)
     assert code == 2
-    assert "pip install 'armcli[dask]'" in err
+    assert "pip install 'dask[distributed]'" in err
 
 
 def test_shared_trajectory_folder_other_spec(capsys: pytest.CaptureFixture[str],

@@ -52,6 +52,17 @@ TRAJECTORY = (
     " - {positions: [0.5, 0.8], time_from_start: 3.5}\n"
     " - {positions: [0.3, 0.3], time_from_start: 5.0}\n"
 )  # specs/trajectories/pick.yaml kept off the joint stops (as in test_sim_mujoco.py)
+# Issue 24's case: to both stops of both joints and back (limits 0 and pi/2).
+LIMIT_TRAJECTORY = (
+    "joint_names: [arm_base_forearm_joint, forearm_hand_joint]\npoints:\n"
+    " - {positions: [0.0, 1.5707963267948966], time_from_start: 1.0}\n"
+    " - {positions: [1.5707963267948966, 0.0], time_from_start: 2.5}\n"
+    " - {positions: [0.0, 1.5707963267948966], time_from_start: 4.0}\n"
+    " - {positions: [0.3, 0.3], time_from_start: 5.0}\n"
+)
+# At the stops MuJoCo's limit is a soft constraint (time constant 2 dt, its floor) and
+# armcli's a hard one: the issue's bound on their difference.
+LIMIT_AGREE = 2e-3  # [rad]
 Q0 = np.array([0.2, 0.2])
 DURATION = 6.0
 
@@ -110,21 +121,31 @@ def test_mass_matrix_and_bias_equal_pinocchio(tmp_path: Path, whole: bool) -> No
         assert np.max(np.abs(d.qfrc_bias[perm] - b_pin)) < RIGID_TOL
 
 
-def _loop(tmp_path: Path, friction: bool) -> tuple[np.ndarray, np.ndarray]:
-    """The same reference through armcli simulate and through the exported actuators."""
+def _loop(
+    tmp_path: Path, friction: bool, trajectory: str = TRAJECTORY, limits: bool = False
+) -> tuple[Any, np.ndarray]:
+    """The same reference through armcli simulate and through the exported actuators.
+
+    `limits`: run both at the spec's own time step with MuJoCo's joint limits on (as
+    exported); otherwise at LOOP_DT with the limits off, where the two steps are equal.
+    """
     spec_path = ROOT / "specs" / "my_robot.yaml"
     _, m, _ = _export(spec_path, tmp_path)
     spec = load_spec(spec_path)
     arm = arm_from_model(load_model(_urdf_file(spec_path, tmp_path)).model)
-    tr = loads_trajectory(TRAJECTORY, dict.fromkeys(arm.joint_names, (0.0, math.pi / 2)))
+    tr = loads_trajectory(trajectory, dict.fromkeys(arm.joint_names, (0.0, math.pi / 2)))
     ref = build_reference(tr, arm.joint_names, Q0)
     plant = arm if friction else replace(arm, friction=np.zeros(2))
     kp = np.array([spec.control.gains[j].kp for j in arm.joint_names])
     kd = np.array([spec.control.gains[j].kd for j in arm.joint_names])
-    res = simulate(plant, ref, Q0, DURATION, SimConfig(kp, kd, dt=LOOP_DT))
-    assert not res.stop_active.any() and not res.saturated.any()
-    m.opt.timestep = LOOP_DT
-    m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT | mujoco.mjtDisableBit.mjDSBL_LIMIT
+    dt = spec.control.dt if limits else LOOP_DT
+    res = simulate(plant, ref, Q0, DURATION, SimConfig(kp, kd, dt=dt))
+    assert not res.saturated.any()
+    m.opt.timestep = dt
+    m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+    if not limits:
+        assert not res.stop_active.any()
+        m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_LIMIT
     if not friction:
         m.dof_frictionloss[:] = 0.0
     d = mujoco.MjData(m)
@@ -135,7 +156,7 @@ def _loop(tmp_path: Path, friction: bool) -> tuple[np.ndarray, np.ndarray]:
         d.ctrl[:] = res.q_ref[k] + kd / kp * res.v_ref[k]  # the documented mapping
         mujoco.mj_step(m, d)
         q_mj[k + 1] = d.qpos
-    return res.q, q_mj
+    return res, q_mj
 
 
 def _urdf_file(spec_path: Path, tmp: Path) -> Path:
@@ -147,13 +168,39 @@ def _urdf_file(spec_path: Path, tmp: Path) -> Path:
 
 
 def test_closed_loop_agrees_with_armcli_simulate(tmp_path: Path) -> None:
-    q, q_mj = _loop(tmp_path, friction=False)
-    assert np.max(np.abs(q - q_mj)) < LOOP_AGREE
+    res, q_mj = _loop(tmp_path, friction=False)
+    assert np.max(np.abs(res.q - q_mj)) < LOOP_AGREE
 
 
 def test_closed_loop_with_friction_differs_by_a_stated_amount(tmp_path: Path) -> None:
-    q, q_mj = _loop(tmp_path, friction=True)
-    assert np.max(np.abs(q - q_mj)) < FRICTION_DIFF
+    res, q_mj = _loop(tmp_path, friction=True)
+    assert np.max(np.abs(res.q - q_mj)) < FRICTION_DIFF
+
+
+@pytest.mark.parametrize("friction", [False, True], ids=["frictionless", "friction"])
+def test_closed_loop_agrees_on_a_trajectory_that_reaches_the_limits(
+    tmp_path: Path, friction: bool
+) -> None:
+    """Issue 24: the mapped control leaves the joint range near a limit and must not be clipped.
+
+    With ctrlrange = joint range the export was 4.5e-2 rad away from `armcli simulate`
+    here; the rest is MuJoCo's soft limit against armcli's hard stop (1.4e-3 rad measured).
+    """
+    res, q_mj = _loop(tmp_path, friction, LIMIT_TRAJECTORY, limits=True)
+    assert res.stop_active.any()  # the arm does reach its stops
+    kp, kd = 50.0, 5.0  # specs/my_robot.yaml control.gains
+    ctrl = res.q_ref + kd / kp * res.v_ref
+    assert ctrl.min() < 0.0 and ctrl.max() > math.pi / 2  # outside the range [0, pi/2]
+    assert np.max(np.abs(res.q - q_mj)) < LIMIT_AGREE
+
+
+def _control_bounds(m: Any) -> tuple[np.ndarray, np.ndarray]:
+    """ctrlrange where the actuator has one (motors), else its joint's range (positions)."""
+    lo, hi = m.actuator_ctrlrange[:, 0].copy(), m.actuator_ctrlrange[:, 1].copy()
+    for a in range(m.nu):
+        if not m.actuator_ctrllimited[a]:
+            lo[a], hi[a] = m.jnt_range[m.actuator_trnid[a, 0]]
+    return lo, hi
 
 
 @pytest.mark.parametrize("base", ["fixed", "free"])
@@ -167,7 +214,7 @@ def test_smoke_every_spec_steps_one_second_finite(
     d = mujoco.MjData(m)
     mujoco.mj_resetDataKeyframe(m, d, m.key("home").id)
     rng = np.random.default_rng(SEED)
-    lo, hi = m.actuator_ctrlrange[:, 0], m.actuator_ctrlrange[:, 1]
+    lo, hi = _control_bounds(m)
     for _ in range(round(SMOKE_SECONDS / m.opt.timestep)):
         d.ctrl[:] = rng.uniform(lo, hi)
         mujoco.mj_step(m, d)
@@ -189,7 +236,7 @@ def test_actuators_keyframes_and_timestep_come_from_the_spec(tmp_path: Path) -> 
         # MuJoCo's position actuator: force = gain * ctrl + bias0 + bias1 q + bias2 v
         assert (a.gainprm[0], a.biasprm[1], a.biasprm[2]) == (g.kp, -g.kp, -g.kd)
         assert tuple(a.forcerange) == (-lim.effort, lim.effort)
-        assert tuple(a.ctrlrange) == (lim.lower, lim.upper)
+        assert not m.actuator_ctrllimited[a.id]  # the mapped control is never clipped
         j = m.joint(name)
         dyn = spec.arm.joints[name].dynamics
         assert dyn is not None
@@ -198,6 +245,7 @@ def test_actuators_keyframes_and_timestep_come_from_the_spec(tmp_path: Path) -> 
             dyn.friction,
         )
         assert tuple(j.range) == (lim.lower, lim.upper)
+        assert tuple(j.solref) == (2 * spec.control.dt, 1.0)  # stiffest stable limit
     assert res.export.keyframes == ("home", *[p for p in spec.poses if p != "home"])
     for pose in spec.poses:
         key = m.key(pose)

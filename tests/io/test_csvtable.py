@@ -29,7 +29,8 @@ SMALL = CsvBounds(max_bytes=10_000, max_columns=4, max_rows=5, max_cells=12)
 def _peak_of_load(path: Path) -> tuple[int, str]:
     """(peak RSS [KiB], error line) of a fresh interpreter running load_replay on `path`."""
     code = (
-        "import sys\nfrom armcli.errors import InputError\nfrom armcli.sim.states import load_replay\n"
+        "import sys\nfrom armcli.errors import InputError\n"
+        "from armcli.sim.states import load_replay\n"
         f"try:\n    load_replay({str(path)!r}, ['j'])\nexcept InputError as e:\n"
         "    sys.stderr.write(str(e))\n"
     )

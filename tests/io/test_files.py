@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 import armcli.io.files as fsio
-from armcli.errors import BuildError
+from armcli.errors import BuildError, OutputRefusedError
 from armcli.io.files import write_file_atomic, write_tree_atomic
 from armcli.io.outdir import MARKER_NAME, MARKER_TEXT
 
@@ -113,7 +113,7 @@ def test_fallback_without_exchange(tmp_path: Path, monkeypatch: pytest.MonkeyPat
 
 def test_refuses_escaping_names_and_directories(tmp_path: Path) -> None:
     for bad in ("../evil.txt", "/etc/passwd", "a/../../b", ""):
-        with pytest.raises(BuildError, match="outside the output directory"):
+        with pytest.raises(OutputRefusedError, match="outside the output directory"):
             write_tree_atomic(tmp_path / "o", {bad: b"x"})
     write_tree_atomic(tmp_path / "o", {"f.txt": b"old"})
     (tmp_path / "o" / "dir").mkdir()

@@ -7,8 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from armcli.errors import ExistingFileError, InputError, OutputRefusedError
+from armcli.errors import ExistingFileError, OutputRefusedError
 from armcli.io import newfiles
+from armcli.io.files import write_tree_atomic
 from armcli.io.newfiles import create_files
 
 FILES = {"a.yaml": b"a\n", "sub/dir/b.yaml": b"b\n", "c.md": b"c\n"}
@@ -67,10 +68,13 @@ def test_a_new_directory_appears_complete(tmp_path: Path) -> None:
     assert _tree(tmp_path) == ["p", "p/a.yaml", "p/c.md", "p/sub", "p/sub/dir", "p/sub/dir/b.yaml"]
 
 
-@pytest.mark.parametrize("rel", ["../x", "/abs", ""])
+@pytest.mark.parametrize("rel", ["../x", "/abs", "", "a/../../b"])
 def test_paths_outside_are_refused(tmp_path: Path, rel: str) -> None:
-    with pytest.raises(InputError, match="outside the target directory"):
+    # the same rule and error as the atomic tree writer (io.outdir.relative_inside)
+    with pytest.raises(OutputRefusedError, match="outside the output directory"):
         create_files(tmp_path, {rel: b""})
+    with pytest.raises(OutputRefusedError, match="outside the output directory"):
+        write_tree_atomic(tmp_path / "o", {rel: b""})
 
 
 def test_a_symlinked_subdirectory_is_not_written_through(tmp_path: Path) -> None:

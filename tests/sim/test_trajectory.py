@@ -30,13 +30,44 @@ def _sample1(ref, t: float) -> tuple[np.ndarray, np.ndarray]:
     return q[0], v[0]
 
 
-def test_seed_payload_flow_quirk_is_a_list() -> None:
-    tr = loads_trajectory(SEED, LIMITS)
+def test_seed_payload_is_refused_as_ros_reads_it() -> None:
+    """The course's `{0.0, 0.0}`: PyYAML keeps one key, so ROS 2 sends one position."""
+    with pytest.raises(SpecError) as exc:
+        loads_trajectory(SEED, LIMITS)
+    msg = str(exc.value)
+    assert "points[0].positions" in msg and "1 value(s) for 2 joint(s)" in msg
+    assert "write a list: [0.0, 0.0]" in msg
+    tr = loads_trajectory(SEED.replace("{0.0, 0.0}", "[0.0, 0.0]"), LIMITS)
     assert tr.joint_names == (J1, J2)
     assert tr.frame_id == "arm_base_link"
     np.testing.assert_array_equal(tr.positions, [[0.0, 0.0]])
     assert tr.times.tolist() == [DEFAULT_SEGMENT_S]  # documented default for a missing time
     assert tr.velocities is None and tr.accelerations is None
+    assert tr.warnings == ()
+
+
+def _ros2_topic_pub_positions(payload: str) -> list[list[float]]:
+    """What `ros2 topic pub` puts in points[k].positions: yaml.safe_load, then
+    rosidl_runtime_py.set_message_fields' `array.array('d', value)` on the sequence field."""
+    import array
+
+    doc = yaml.safe_load(payload)
+    return [list(array.array("d", p["positions"])) for p in doc["points"]]
+
+
+@pytest.mark.parametrize(
+    "positions", ["{0.5, 0.3}", "{0.3, 0.5}", "{0, 1.5}", "{0.0, 0.0}", "{1, 1.0}", "{0.5}"]
+)
+def test_brace_form_reads_as_ros_2_sends_it(positions: str) -> None:
+    payload = f"{{joint_names: [{J1}, {J2}], points: [{{positions: {positions}}}]}}"
+    sent = _ros2_topic_pub_positions(payload)[0]  # the independent reference: ROS's own code
+    if len(sent) == 2:
+        tr = loads_trajectory(payload, LIMITS)
+        assert tr.positions.tolist() == [sent]
+        assert len(tr.warnings) == 1 and "is a YAML mapping, not a list" in tr.warnings[0]
+    else:
+        with pytest.raises(SpecError, match=rf"{len(sent)} value\(s\) for 2 joint\(s\)"):
+            loads_trajectory(payload, LIMITS)
 
 
 @pytest.mark.parametrize("path", sorted((ROOT / "specs" / "trajectories").glob("*.yaml")))

@@ -77,7 +77,12 @@ def test_limits_out_of_order_names_file_line_and_field(text: str) -> None:
         ("mass: 0.5", "mass: heavy", "arm.links.arm_base_link.mass", "only numbers, pi"),
         ("mass: 0.5", "mass: true", "arm.links.arm_base_link.mass", "boolean"),
         ("mass: 0.5", "mass: 0.5\n      colour: red", "arm.links.arm_base_link.colour", "unknown"),
-        ("effort: 100,", "effort: 0,", "arm.joints.arm_base_forearm_joint.limit.effort", "greater"),
+        (
+            "effort: 100,",
+            "effort: -1,",
+            "arm.joints.arm_base_forearm_joint.limit.effort",
+            "greater",
+        ),
         (
             "parent: arm_base_link",
             "parent: nowhere",

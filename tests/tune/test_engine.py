@@ -93,7 +93,7 @@ def _stop(procs: list[subprocess.Popen[bytes]]) -> None:
 def scheduler_address(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
     pytest.importorskip("distributed")
     if not DASK.exists() and shutil.which("dask") is None:
-        pytest.skip("the `dask` command is not installed (pip install 'armcli[dask]')")
+        pytest.skip("the `dask` command is not installed (pip install 'dask[distributed]')")
     exe = str(DASK) if DASK.exists() else "dask"
     port = _free_port()
     address = f"tcp://127.0.0.1:{port}"

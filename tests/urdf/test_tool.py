@@ -8,12 +8,13 @@ import pytest
 
 from armcli.check.rules import CheckOptions
 from armcli.check.run import check_urdf
+from armcli.ros.srdf import arm_chain
 from armcli.sim import job as simjob
 from armcli.sim.options import SimOptions
 from armcli.spec.load import load_spec
 from armcli.urdf.read import parse_urdf, read_urdf
 from armcli.urdf.source import read_robot
-from armcli.urdf.tool import ToolPoint, tool_point
+from armcli.urdf.tool import ToolPoint, spec_tool, tool_point
 from armcli.view.scene import load_robot
 from tests.helpers import DEFAULT_SPEC
 
@@ -77,3 +78,30 @@ def test_check_simulate_and_view_report_the_same_point(arm_file: Path) -> None:
                       kp=(50.0,), kd=(5.0,))  # fmt: skip
     job = simjob.prepare(None, opts)
     assert job.tool_label.startswith("l2 ")
+
+
+def test_label_is_the_link_plus_the_offset_when_there_is_one() -> None:
+    assert ToolPoint("hand").label == "hand"
+    assert ToolPoint("hand", (0.0, 0.0, 0.1)).label == "hand + (0, 0, 0.1)"
+
+
+def test_check_and_simulate_print_the_same_label() -> None:
+    spec = load_spec(DEFAULT_SPEC)
+    assert spec.arm.tool is not None and any(spec.arm.tool.xyz)  # an offset to print
+    robot = read_robot(DEFAULT_SPEC)
+    summary = check_urdf(robot.robot, CheckOptions(spec=spec)).summary
+    message = f"joint_names: [{spec.movable_arm_joints()[0]}]\npoints: [{{positions: [0.1]}}]"
+    job = simjob.prepare(spec, SimOptions(message=message))
+    assert summary is not None and summary.end_effector
+    assert job.tool_label.startswith(summary.end_effector + " in ")
+
+
+def test_a_spec_without_tool_and_moveit_end_at_the_same_link() -> None:
+    spec = load_spec(DEFAULT_SPEC)
+    bare = spec.model_copy(update={"arm": spec.arm.model_copy(update={"tool": None})})
+    robot = read_robot(DEFAULT_SPEC)
+    tip = spec_tool(bare).link
+    assert tip == arm_chain(bare)[1]  # the SRDF's planning chain asks the same rule
+    assert tool_point(robot.robot, bare) == ToolPoint(tip)
+    # the deepest arm link of my_robot.yaml: arm_base_link -> forearm_link -> hand_link
+    assert tip == "hand_link"

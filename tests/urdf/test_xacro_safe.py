@@ -10,16 +10,30 @@ create PWNED).
 from __future__ import annotations
 
 import json
+import math
+import os
 import shutil
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 import xacro
 
 from armcli.errors import InputError, XacroRefusedError
-from armcli.urdf.xacro_safe import MAX_MACRO_CALLS, expand_safe
+from armcli.urdf.packages import PackageLookup
+from armcli.urdf.source import allowed_roots
+from armcli.urdf.xacro_args import Expansion, XacroInputs
+from armcli.urdf.xacro_safe import MAX_MACRO_CALLS, expand_safe, expand_safe_report
+from tests.helpers import (
+    ARM_PACKAGE,
+    DEMO_ARM,
+    GRIPPER_PACKAGE,
+    ROS_WS_SRC,
+    ament_index_shim,
+    symlink_install,
+)
 
 EXAMPLE_ROBOTS = (
     Path(sys.prefix)
@@ -110,11 +124,8 @@ REFUSED = [
     ("${9 ** 9 ** 9}", "integer result larger than"),
     ("${'%999999999d' % 1}", "%-formatting of strings is not allowed"),
     ("${(1).real}", "attribute access .real on int"),
-    ("$(env HOME)", r"\$\(env \.\.\.\) is not allowed"),
-    ("$(optenv HOME x)", r"\$\(optenv \.\.\.\) is not allowed"),
     ("$(cwd)", r"\$\(cwd \.\.\.\) is not allowed"),
     ("$(eval 1 + 1)", r"\$\(eval \.\.\.\) is not allowed"),
-    ("$(find no_such_package)", "no package 'no_such_package'"),
     ("${xacro.load_yaml('/etc/passwd')}", "YAML file '/etc/passwd' is outside the allowed"),
 ]
 
@@ -176,3 +187,149 @@ def test_cli_checks_foreign_xacro_without_trust(root: Path) -> None:
     safe, trusted = (json.loads(r.stdout)["files"][0]["findings"] for r in runs)
     assert runs[0].returncode == runs[1].returncode == 1  # the course's 4x inertias (test_check)
     assert safe == trusted and {f["rule"] for f in safe} >= {"inertia-geometry"}
+
+
+# --- issue 19: what real description files use, through a ROS 2 workspace -------------
+
+
+@pytest.fixture
+def workspace(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """The ros_ws fixture installed as a sourced ROS 2 workspace (AMENT_PREFIX_PATH only),
+    with ament_index_python stood in for, so that xacro itself resolves $(find) too."""
+    prefix = symlink_install(ROS_WS_SRC, tmp_path / "install")
+    monkeypatch.setenv("AMENT_PREFIX_PATH", str(prefix))
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    top, packages = ament_index_shim()
+    monkeypatch.setitem(sys.modules, "ament_index_python", top)
+    monkeypatch.setitem(sys.modules, "ament_index_python.packages", packages)
+    return prefix
+
+
+def safe(path: Path, args: dict[str, str], **kw: Any) -> tuple[bytes, Expansion]:
+    return expand_safe_report(path, allowed_roots(path.parent), XacroInputs(args=args, **kw))
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        {"name": "demo"},
+        {"name": "demo", "prefix": "right_", "arm_type": "long", "with_gripper": "false"},
+    ],
+)
+def test_workspace_fixture_equals_xacro(args: dict[str, str], workspace: Path) -> None:
+    # $(find) across two packages through the ament prefix, !degrees/!radians YAML, dict
+    # keyword calls, string methods, $(optenv), a duplicate YAML key, an argument without a
+    # default (name): the same document as xacro itself.
+    for top in (DEMO_ARM, workspace / "share" / ARM_PACKAGE / "urdf" / DEMO_ARM.name):
+        got, used = safe(top, args)
+        assert _without_banner(got) == _without_banner(reference(top, dict(args))), top
+    assert (b'name="right_finger_link"' in got) is False  # with_gripper:=false exercised
+    assert (b"right_elbow" in got) == ("prefix" in args)
+    assert used.given == tuple(args) and set(used.defaults) == (
+        {"prefix", "arm_type", "with_gripper"} - set(args)
+    )
+
+
+def test_degrees_in_yaml_converted_as_xacro_does(workspace: Path) -> None:
+    got, _ = safe(DEMO_ARM, {"name": "demo"})
+    # joints.yaml: shoulder lower !degrees -170, velocity !radians pi / 2
+    assert f'lower="{-170 * math.pi / 180}"'.encode() in got
+    assert f'velocity="{math.pi / 2}"'.encode() in got
+
+
+def test_duplicate_yaml_key_warned_with_file_and_line(workspace: Path) -> None:
+    _, used = safe(DEMO_ARM, {"name": "demo"})
+    [warning] = [w for w in used.warnings if "duplicate YAML key" in w]
+    assert warning.startswith(
+        f"{workspace / 'share' / ARM_PACKAGE / 'config' / 'inertials.yaml'}:12:"
+    )
+    assert "'upper' (first on line 6)" in warning
+
+
+def test_optenv_default_unless_given_with_env(workspace: Path) -> None:
+    default, used = safe(DEMO_ARM, {"name": "demo"})
+    assert used.optenv_defaults == ("DEMO_ARM_TOOL_LENGTH",)
+    os.environ["DEMO_ARM_TOOL_LENGTH"] = "9"  # armcli's own environment is never read
+    try:
+        again, _ = safe(DEMO_ARM, {"name": "demo"})
+    finally:
+        del os.environ["DEMO_ARM_TOOL_LENGTH"]
+    assert again == default
+    given, used = safe(DEMO_ARM, {"name": "demo"}, env={"DEMO_ARM_TOOL_LENGTH": "0.1"})
+    assert used.optenv_defaults == ()
+    # finger offset = elbow length 0.25 + tool length (0.05 by default, 0.1 given)
+    assert b'xyz="0 0 0.3"' in default and b'xyz="0 0 0.35"' in given
+
+
+def test_env_needs_the_env_option(tmp_path: Path) -> None:
+    top = tmp_path / "env.xacro"
+    top.write_text(f'<robot name="r" {NS}>\n  <link name="$(env ROBOT_LINK)"/>\n</robot>\n')
+    with pytest.raises(InputError, match=r"pass --env ROBOT_LINK=VALUE") as info:
+        safe(top, {})
+    assert not isinstance(info.value, XacroRefusedError) and info.value.line == 2
+    got, _ = safe(top, {}, env={"ROBOT_LINK": "base"})
+    assert b'<link name="base"/>' in got
+
+
+def test_missing_argument_and_unused_ones_reported(workspace: Path) -> None:
+    with pytest.raises(
+        InputError, match=r"undefined xacro argument 'name': pass name:=VALUE"
+    ) as info:
+        safe(DEMO_ARM, {})
+    assert info.value.file == str(DEMO_ARM) and info.value.line == 4
+    _, used = safe(DEMO_ARM, {"name": "demo", "ur_type": "ur5e"})
+    assert used.unused == ("ur_type",)
+    assert any("neither declares nor uses: ur_type" in n for n in used.notes())
+
+
+def test_missing_package_names_it(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("AMENT_PREFIX_PATH", raising=False)
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    with pytest.raises(InputError, match=f"no package '{GRIPPER_PACKAGE}'.*--package-dir") as info:
+        safe(DEMO_ARM, {"name": "demo"})
+    assert info.value.line == 9  # the <xacro:include> of the gripper
+    # --package-dir instead of a sourced workspace; the arm is its enclosing package
+    lookup = PackageLookup({GRIPPER_PACKAGE: ROS_WS_SRC / "gripper_repo"})
+    got, _ = safe(DEMO_ARM, {"name": "demo"}, packages=lookup)
+    assert b'name="finger_link"' in got
+
+
+def test_refusal_inside_a_lazy_property_keeps_its_cause(tmp_path: Path) -> None:
+    # The refusal raised while xacro evaluated `x` for `${x}` was re-wrapped as
+    # "when evaluating expression ..." and its cause lost.
+    top = tmp_path / "lazy.xacro"
+    top.write_text(
+        f'<robot name="r" {NS}>\n'
+        '  <xacro:property name="x" value="${\'%s\'.format(1)}"/>\n'
+        '  <link name="${x}"/>\n</robot>\n'
+    )
+    with pytest.raises(XacroRefusedError, match=r"attribute access \.format on str") as info:
+        safe(top, {})
+    assert info.value.line == 2
+
+
+def test_yaml_errors_name_the_yaml_file_and_line(tmp_path: Path) -> None:
+    (tmp_path / "bad.yaml").write_text("a: 1\nb: [1, 2\n")
+    (tmp_path / "unit.yaml").write_text("a: !degrees __import__('os')\n")
+    for name, cls, line, message in (
+        ("bad.yaml", InputError, 3, "malformed YAML"),
+        ("unit.yaml", XacroRefusedError, 1, "name '__import__' is not allowed"),
+    ):
+        top = tmp_path / f"{name}.xacro"
+        top.write_text(
+            f'<robot name="r" {NS}>\n'
+            f'  <xacro:property name="y" value="${{xacro.load_yaml(\'{name}\')}}"/>\n'
+            '  <link name="${y.a}"/>\n</robot>\n'
+        )
+        with pytest.raises(cls, match=message) as info:
+            safe(top, {})
+        assert (info.value.file, info.value.line) == (str(tmp_path / name), line), name
+
+
+def test_optional_include_of_a_missing_file(tmp_path: Path) -> None:
+    top = tmp_path / "opt.xacro"
+    top.write_text(
+        f'<robot name="r" {NS}>\n  <xacro:include filename="nope.xacro" optional="true"/>\n'
+        '  <link name="a"/>\n</robot>\n'
+    )
+    assert _without_banner(safe(top, {})[0]) == _without_banner(reference(top))

@@ -137,7 +137,14 @@ def test_cli_render_q_and_errors(root: Path, tmp_path: Path) -> None:
     ok = _cli("render", "--q", "pi/4,pi/4", "-o", str(out), cwd=root)
     assert ok.returncode == 0, ok.stderr
     x, _, z = tip(math.pi / 4, math.pi / 4)
-    assert ok.stdout.strip() == f"wrote {out} (1200x600 px) tool at ({x:.3f}, 0.000, {z:.3f}) m"
+    assert ok.stdout.strip() == (
+        f"wrote {out} (1200x600 px) at --q pi/4,pi/4; tool at ({x:.3f}, 0.000, {z:.3f}) m"
+    )
+    default = _cli("render", "-o", str(tmp_path / "d.png"), cwd=root)
+    # no --pose or --q: the message says which configuration was drawn (the spec's home is 0)
+    assert "at q = 0, the pose 'home', as no --pose or --q was given" in default.stdout
+    assert "(others: --pose home|" in default.stdout
+    (tmp_path / "d.png").unlink()
     both = _cli("render", "--pose", "home", "--q", "0,0", "-o", str(tmp_path / "b.png"), cwd=root)
     assert both.returncode == 2
     assert both.stderr.strip() == "error: --pose: give --pose or --q, not both"

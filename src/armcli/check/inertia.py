@@ -265,7 +265,7 @@ def _exceeds(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -> bool:
         "inertia-exceeds-geometry",
         ine.inertia_line,
         f"link {link.name!r}: moments about its {g.kind} {dims} m centre ({moments}) exceed "
-        f"the most {m:g} kg inside that collision shape can have (all mass on its extremes); "
+        f"the most {m:g} kg inside that {_role(link)} shape can have (all mass on its extremes); "
         f"solid {g.kind}: {_fmt(solid)} "
         f"(geometry frame){_diagnosis(np.diag(inr.rotate(J, R_geom_inertial)), solid)}"
         f"{_fix_suffix(fix)}",
@@ -277,6 +277,13 @@ def _exceeds(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -> bool:
         solid=list(ex.solid),
     )
     return True
+
+
+def _role(link: Link) -> str:
+    """Which elements the link's one primitive stands for: both, collision or visual."""
+    if link.collisions and link.visuals:
+        return "visual and collision"
+    return "collision" if link.collisions else "visual"
 
 
 def _diagnosis(got: np.ndarray, want: np.ndarray) -> str:

@@ -18,6 +18,7 @@ from armcli.errors import EXIT_FAILED, EXIT_OK, EXIT_UNUSABLE, InputError
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
 from armcli.urdf.source import Trust, read_robot, read_urdf_file
+from armcli.urdf.xacro_args import XacroInputs
 
 URDF_GLOB = "*.urdf"
 
@@ -44,6 +45,7 @@ class CheckRun:
 
     results: tuple[CheckResult, ...]
     unusable: tuple[Unusable, ...]
+    notes: tuple[tuple[str, str], ...] = ()  # (file, line) of Urdf.notes: xacro arguments used
 
     def exit_code(self, findings: list[Finding]) -> int:
         """2 if nothing was usable or a named file was not; else 1 on error findings, else 0.
@@ -57,11 +59,11 @@ class CheckRun:
 
 
 def _documents(
-    path: Path, trust_xacro: Trust
+    path: Path, trust_xacro: Trust, inputs: XacroInputs | None = None
 ) -> tuple[list[tuple[Urdf, RobotSpec | None]], list[Unusable]]:
     """The URDF documents a PATH stands for, each with its spec (or None); the unusable files."""
     if not path.is_dir():
-        robot = read_robot(path, trust_xacro=trust_xacro)
+        robot = read_robot(path, trust_xacro=trust_xacro, inputs=inputs)
         return [(urdf, robot.spec) for urdf in robot.urdfs], []
     files = sorted(p for p in path.rglob(URDF_GLOB) if p.is_file())
     if not files:
@@ -70,19 +72,29 @@ def _documents(
     bad: list[Unusable] = []
     for p in files:
         try:
-            docs.append((read_urdf_file(p, trust_xacro=trust_xacro), None))
+            docs.append((read_urdf_file(p, trust_xacro=trust_xacro, inputs=inputs), None))
         except InputError as exc:
             bad.append(Unusable(str(p), exc, named=False))
     return docs, bad
 
 
-def run_check(paths: list[Path], base: CheckOptions, *, trust_xacro: Trust = False) -> CheckRun:
-    """Check every usable document under `paths`; collect the unusable ones."""
+def run_check(
+    paths: list[Path],
+    base: CheckOptions,
+    *,
+    trust_xacro: Trust = False,
+    inputs: XacroInputs | None = None,
+) -> CheckRun:
+    """Check every usable document under `paths`; collect the unusable ones.
+
+    `inputs`: xacro arguments, --env values and package lookup for xacro files.
+    """
     results: list[CheckResult] = []
     unusable: list[Unusable] = []
+    notes: list[tuple[str, str]] = []
     for path in paths:
         try:
-            docs, bad = _documents(path, trust_xacro)
+            docs, bad = _documents(path, trust_xacro, inputs)
         except InputError as exc:
             unusable.append(Unusable(str(path), exc, named=True))
             continue
@@ -90,4 +102,5 @@ def run_check(paths: list[Path], base: CheckOptions, *, trust_xacro: Trust = Fal
         for urdf, spec in docs:
             opts = replace(base, spec=spec) if spec is not None else base
             results.append(check_urdf(urdf, opts))
-    return CheckRun(tuple(results), tuple(unusable))
+            notes += [(urdf.source, line) for line in urdf.notes]
+    return CheckRun(tuple(results), tuple(unusable), tuple(notes))

@@ -99,12 +99,13 @@ def _spec_limits(urdf: Urdf, spec: RobotSpec, out: Collector) -> None:
             continue
         uj = by_name[name]
         ul = uj.limit
-        want = {
+        given = {
             "lower": sj.limit.lower,
             "upper": sj.limit.upper,
             "effort": sj.limit.effort,
             "velocity": sj.limit.velocity,
         }
+        want = {k: v for k, v in given.items() if v is not None}  # a continuous joint: no bounds
         got = {k: (getattr(ul, k) if ul is not None else None) for k in want}
         bad = [k for k in want if (g := got[k]) is None or abs(g - want[k]) > SPEC_LIMIT_TOL]
         if bad:

@@ -18,37 +18,91 @@ from armcli.urdf.meshes import MeshSearch
 
 ERROR = "error"
 WARNING = "warning"
+_MODEL = "model"  # see Rule.blocks
+_DYNAMICS = "dynamics"
 
 Value = float | int | str | list[float] | None
 
 
 @dataclass(frozen=True)
 class Rule:
-    """One check rule: stable id (for --ignore and JSON), severity, title and fix hint."""
+    """One check rule: stable id (for --ignore and JSON), severity, title and fix hint.
+
+    `blocks`: while an error of this rule stands, the rule families that need the Pinocchio
+    model ("model") or usable dynamics numbers ("dynamics") are skipped (check/context.py).
+    """
 
     id: str
     severity: str
     title: str
     hint: str
+    blocks: str | None = None
 
 
 _RULES = [
     # structure
-    Rule("duplicate-name", ERROR, "link, joint or material name used twice", "rename one of them"),
-    Rule("unknown-link", ERROR, "joint parent/child is not a link", "fix the link name"),
-    Rule("multiple-parents", ERROR, "link is the child of several joints", "a link has one parent"),
-    Rule("root-count", ERROR, "the tree must have exactly one root", "connect the extra roots"),
-    Rule("disconnected", ERROR, "links not reachable from the root", "add the missing joints"),
-    Rule("joint-type", ERROR, "unknown joint type", "use revolute, continuous, prismatic, fixed"),
+    Rule(
+        "duplicate-name",
+        ERROR,
+        "link, joint or material name used twice",
+        "rename one of them",
+        blocks=_MODEL,
+    ),
+    Rule(
+        "unknown-link",
+        ERROR,
+        "joint parent/child is not a link",
+        "fix the link name",
+        blocks=_MODEL,
+    ),
+    Rule(
+        "multiple-parents",
+        ERROR,
+        "link is the child of several joints",
+        "a link has one parent",
+        blocks=_MODEL,
+    ),
+    Rule(
+        "root-count",
+        ERROR,
+        "the tree must have exactly one root",
+        "connect the extra roots",
+        blocks=_MODEL,
+    ),
+    Rule(
+        "disconnected",
+        ERROR,
+        "links not reachable from the root",
+        "add the missing joints",
+        blocks=_MODEL,
+    ),
+    Rule(
+        "joint-type",
+        ERROR,
+        "unknown joint type",
+        "use revolute, continuous, prismatic, fixed",
+        blocks=_MODEL,
+    ),
     Rule(
         "missing-limit",
         ERROR,
         "revolute/prismatic joint without full <limit>",
         "give lower, upper, effort and velocity",
+        blocks=_MODEL,
     ),
-    Rule("mimic-target", ERROR, "mimic refers to an unknown joint", "fix the mimic joint name"),
     Rule(
-        "robot-name", ERROR, "<robot> without a name", 'give the robot a name: <robot name="...">'
+        "mimic-target",
+        ERROR,
+        "mimic refers to an unknown joint",
+        "fix the mimic joint name",
+        blocks=_MODEL,
+    ),
+    Rule(
+        "robot-name",
+        ERROR,
+        "<robot> without a name",
+        'give the robot a name: <robot name="...">',
+        blocks=_MODEL,
     ),
     Rule(
         "material-conflict",
@@ -63,9 +117,27 @@ _RULES = [
         "define it at top level with <color rgba=...> or <texture>",
     ),
     # numbers
-    Rule("number-syntax", ERROR, "number missing or not parsable", "write plain decimal numbers"),
-    Rule("non-finite", ERROR, "NaN or infinite number", "replace it with a finite value"),
-    Rule("vector-length", ERROR, "vector with the wrong number of values", "give 3 (rgba: 4)"),
+    Rule(
+        "number-syntax",
+        ERROR,
+        "number missing or not parsable",
+        "write plain decimal numbers",
+        blocks=_MODEL,
+    ),
+    Rule(
+        "non-finite",
+        ERROR,
+        "NaN or infinite number",
+        "replace it with a finite value",
+        blocks=_MODEL,
+    ),
+    Rule(
+        "vector-length",
+        ERROR,
+        "vector with the wrong number of values",
+        "give 3 (rgba: 4)",
+        blocks=_MODEL,
+    ),
     Rule("geometry-size", ERROR, "geometry size not > 0", "give positive sizes"),
     Rule(
         "geometry-kind",
@@ -80,18 +152,21 @@ _RULES = [
         ERROR,
         "negative mass, or a moving body without mass",
         "give the link its real mass",
+        blocks=_DYNAMICS,
     ),
     Rule(
         "inertia-not-pd",
         ERROR,
         "inertia of a link with mass not positive definite, or a moving body's singular",
         "use the solid-body formula for the link's shape",
+        blocks=_DYNAMICS,
     ),
     Rule(
         "inertia-triangle",
         ERROR,
         "principal moments violate I1 + I2 >= I3",
         "a real body has I1 + I2 >= I3; recompute the inertia",
+        blocks=_DYNAMICS,
     ),
     Rule(
         "tiny-mass",
@@ -130,14 +205,20 @@ _RULES = [
         "put the inertial origin at the shape's centre",
     ),
     # joints
-    Rule("limit-order", ERROR, "lower limit not below upper limit", "swap or fix the limits"),
+    Rule(
+        "limit-order",
+        ERROR,
+        "lower limit not below upper limit",
+        "swap or fix the limits",
+        blocks=_DYNAMICS,
+    ),
     Rule(
         "limit-effort-velocity",
         ERROR,
         "effort or velocity limit <= 0",
         "give the actuator's real effort and velocity limits",
     ),
-    Rule("axis", ERROR, "joint axis zero", "give a unit axis such as 0 0 1"),
+    Rule("axis", ERROR, "joint axis zero", "give a unit axis such as 0 0 1", blocks=_DYNAMICS),
     Rule("axis-unit", WARNING, "joint axis not unit length", "normalise the axis"),
     Rule(
         "limit-degrees",

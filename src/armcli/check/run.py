@@ -1,13 +1,79 @@
-"""Run every `check` rule family on one parsed URDF, in a fixed order."""
+"""Run every `check` rule family on one parsed URDF, in the fixed order of `FAMILIES`.
+
+The structure rules come first (every other family needs the kinematic tree they
+build); then each family of the registry, in order, once the stage it needs is there
+(check/context.py: the model loads once, lazily, unless a blocking error stands). A new
+rule family is a module with a function of the `Context` and one line in `FAMILIES`.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
-from armcli.check import bodies, inertia, joints, meshes, structure, summary
+from armcli.check import bodies, inertia, interface, joints, meshes, structure, summary
+from armcli.check import dynamics as dyn
+from armcli.check.context import (
+    BLOCKS_DYNAMICS,
+    BLOCKS_MODEL,
+    DYNAMICS,
+    DYNAMICS_SKIPPED,
+    MODEL,
+    MODEL_SKIPPED,
+    URDF,
+    Context,
+    Stage,
+    joint_rows,
+    poses,
+)
 from armcli.check.rules import CheckOptions, Collector, Finding
 from armcli.check.summary import Summary
+from armcli.errors import ModelLoadError
 from armcli.urdf.doc import Urdf
+from armcli.urdf.pinocchio import joint_ranges, load_model, parser_problems
+
+
+@dataclass(frozen=True)
+class Family:
+    """A group of rules run together: a name, the stage it needs, and the function."""
+
+    name: str
+    needs: Stage
+    run: Callable[[Context], None]
+
+
+def _gravity(c: Context) -> None:
+    c.rows = dyn.gravity(c.urdf, c.model, c.data, c.samples, c.rows, c.out)
+
+
+def _servo(c: Context) -> None:
+    c.servo = interface.check(c.urdf.text, c.opts, c.out, c.notes)
+
+
+def _stability(c: Context) -> None:
+    gained = set(c.opts.spec.control.gains) if c.opts.spec is not None else set()
+    if c.servo and gained <= c.servo:  # a position servo is not a PD loop
+        return
+    c.stability = dyn.stability(
+        c.urdf, c.opts, c.model, c.data, c.samples, c.ranges, c.out, c.notes
+    )
+
+
+def _self_collision(c: Context) -> None:
+    if c.opts.spec is not None and c.opts.spec.poses:
+        dyn.self_collision(c.urdf, c.opts, c.model, poses(c), c.out, c.notes)
+
+
+FAMILIES: tuple[Family, ...] = (
+    Family("inertia", URDF, lambda c: inertia.check(c.urdf, c.tree, c.out)),
+    Family("bodies", URDF, lambda c: bodies.check(c.urdf, c.tree, c.out)),
+    Family("joints", URDF, lambda c: joints.check(c.urdf, c.opts.spec, c.out)),
+    Family("meshes", URDF, lambda c: meshes.check(c.urdf, c.opts, c.out)),
+    Family("gravity", DYNAMICS, _gravity),
+    Family("servo", DYNAMICS, _servo),
+    Family("stability", DYNAMICS, _stability),
+    Family("self-collision", MODEL, _self_collision),
+)
 
 
 @dataclass(frozen=True)
@@ -20,13 +86,51 @@ class CheckResult:
 
 
 def check_urdf(urdf: Urdf, options: CheckOptions | None = None) -> CheckResult:
-    """Run every rule on one parsed URDF."""
+    """Run every rule on one parsed URDF: the document's families, then the model's."""
     opts = options or CheckOptions()
     out = Collector(urdf.source)
-    tree = structure.check(urdf, out)
-    inertia.check(urdf, tree, out)
-    bodies.check(urdf, tree, out)
-    joints.check(urdf, opts.spec, out)
-    meshes.check(urdf, opts, out)
-    model = summary.check(urdf, tree, opts, out)
-    return CheckResult(urdf.source, tuple(out.findings), model)
+    ctx = Context(urdf, opts, out, structure.check(urdf, out), rows=joint_rows(urdf))
+    for family in sorted(FAMILIES, key=lambda f: f.needs != URDF):  # the document's first
+        if _ready(ctx, family.needs):
+            family.run(ctx)
+    _ready(ctx, MODEL)  # the summary's poses need the model even without model rules
+    return CheckResult(urdf.source, tuple(out.findings), summary.summarise(ctx))
+
+
+def _ready(ctx: Context, needs: Stage) -> bool:
+    """Whether the stage `needs` is there, reaching it on first demand (see check/context.py)."""
+    if needs == URDF:
+        return True
+    if ctx.stage == "unloaded":
+        _load(ctx)
+    if ctx.stage == MODEL and needs == DYNAMICS:
+        if ctx.out.has_errors(BLOCKS_DYNAMICS):
+            ctx.notes.append(DYNAMICS_SKIPPED)
+            ctx.stage = "no-dynamics"
+        else:
+            ctx.samples = dyn.samples(ctx.model, ctx.ranges)
+            ctx.stage = DYNAMICS
+    if needs == MODEL:
+        return ctx.model is not None
+    return ctx.stage == DYNAMICS
+
+
+def _load(ctx: Context) -> None:
+    """Load the Pinocchio model; parser messages become findings, a refusal `model-load`."""
+    if ctx.out.has_errors(BLOCKS_MODEL):
+        ctx.notes.append(MODEL_SKIPPED)
+        ctx.stage = "refused"
+        return
+    try:
+        loaded = load_model(ctx.urdf.source, xml=ctx.urdf.text.decode("utf-8"))
+    except ModelLoadError as exc:
+        ctx.out.add("model-load", None, exc.message)
+        ctx.stage = "refused"
+        return
+    for msg in parser_problems(loaded.parser_messages):
+        rule = "parser-error" if msg.lower().startswith("error") else "parser-message"
+        ctx.out.add(rule, None, f"Pinocchio/urdfdom: {msg}", text=msg)
+    ctx.model = loaded.model
+    ctx.data = ctx.model.createData()
+    ctx.ranges = joint_ranges(ctx.model)
+    ctx.stage = MODEL

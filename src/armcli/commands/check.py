@@ -14,9 +14,17 @@ from armcli.check.report import counts
 from armcli.check.rules import RULES, CheckOptions, apply_policy
 from armcli.check.sarif import to_sarif
 from armcli.commands.options import choice
+from armcli.commands.xacro_inputs import (
+    env_option,
+    package_dir_option,
+    split_paths,
+    write_notes,
+    xacro_inputs,
+)
 from armcli.errors import (
     EXIT_FAILED,
     EXIT_UNUSABLE,
+    EXPANDED_TAG,
     FindingsError,
     InputError,
     UnusableInputsError,
@@ -24,17 +32,17 @@ from armcli.errors import (
 from armcli.io import terminal
 from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
-from armcli.urdf.meshes import parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 FORMATS = ("table", "json", "github", "sarif")
 
 
 def check_cmd(
-    paths: list[Path] = typer.Argument(
+    paths: list[str] = typer.Argument(
         None,
-        help="URDF files, spec YAMLs (built in memory) or directories (every *.urdf); "
-        "default: ./armcli.yaml, else the spec in specs/.",
+        metavar="[PATHS]... [NAME:=VALUE]...",
+        help="URDF or xacro files, spec YAMLs (built in memory) or directories (every *.urdf); "
+        "default: ./armcli.yaml, else the spec in specs/. NAME:=VALUE: xacro arguments.",
     ),
     spec: Path | None = typer.Option(
         None, "--spec", help="Spec to compare limits with; also gives gains, dt, poses, tool."
@@ -42,9 +50,8 @@ def check_cmd(
     fmt: str = choice("table", FORMATS, "--format", help="Report format (default: table)."),
     strict: bool = typer.Option(False, "--strict", help="Treat warnings as errors."),
     ignore: list[str] = typer.Option([], "--ignore", help="Silence a rule id (repeatable)."),
-    package_dir: list[str] = typer.Option(
-        [], "--package-dir", help="NAME=PATH for package://NAME/ mesh URIs (repeatable)."
-    ),
+    package_dir: list[str] = package_dir_option(),
+    env: list[str] = env_option(),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
@@ -52,11 +59,15 @@ def check_cmd(
     unknown = sorted(set(ignore) - set(RULES))
     if unknown:
         raise InputError(f"unknown rule(s) {unknown}; known: {', '.join(RULES)}", field="--ignore")
-    base = CheckOptions(package_dirs=parse_package_dirs(package_dir))
+    files, args = split_paths(paths or [])
+    inputs = xacro_inputs(args, env, package_dir)
+    base = CheckOptions(package_dirs=inputs.packages.package_dirs)
     if spec is not None:
         base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs)
     trust = trust_mode(trust_xacro, unsandboxed)
-    run = run_check(list(paths or [find_spec(None)]), base, trust_xacro=trust)
+    run = run_check(files or [find_spec(None)], base, trust_xacro=trust, inputs=inputs)
+    for file, note in run.notes:
+        write_notes([note], file.removesuffix(EXPANDED_TAG))
     everything = [f for r in run.results for f in r.findings]
     everything += [u.finding() for u in run.unusable]
     findings = report.by_severity(apply_policy(everything, ignore=ignore, strict=strict))

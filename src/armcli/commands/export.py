@@ -8,12 +8,19 @@ from pathlib import Path
 import typer
 
 from armcli.commands.options import choice
+from armcli.commands.xacro_inputs import (
+    args_argument,
+    env_option,
+    package_dir_option,
+    split_robot,
+    write_notes,
+    xacro_inputs,
+)
 from armcli.compiler.expand import spec_label
 from armcli.export.mjcf import BASES
 from armcli.export.mjcf_files import export_mjcf
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
-from armcli.urdf.meshes import MeshSearch, parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 export_app = typer.Typer(
@@ -29,6 +36,7 @@ def mjcf_cmd(
         help="Robot spec YAML, URDF or xacro file (default: ./armcli.yaml, else the spec in "
         "specs/).",
     ),
+    args: list[str] = args_argument(),
     out: Path = typer.Option(
         Path("robot.xml"),
         "-o",
@@ -47,9 +55,8 @@ def mjcf_cmd(
     ),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
-    package_dir: list[str] = typer.Option(
-        [], "--package-dir", help="NAME=PATH: where package://NAME/ meshes live (repeatable)."
-    ),
+    package_dir: list[str] = package_dir_option(),
+    env: list[str] = env_option(),
 ) -> None:
     """Write a MuJoCo MJCF model of ROBOT to OUT, with scene.xml (floor, light) beside it.
 
@@ -57,6 +64,8 @@ def mjcf_cmd(
     the effort limit); the report lists what MuJoCo cannot represent.
     """
     check_output_file(out, "--out")  # before any work: nothing else is written
+    robot, tokens = split_robot(robot, args)
+    inputs = xacro_inputs(tokens, env, package_dir)
     robot = find_spec(robot)
     res = export_mjcf(
         robot,
@@ -64,9 +73,11 @@ def mjcf_cmd(
         base=base,
         whole_robot=whole_robot,
         trust_xacro=trust_mode(trust_xacro, unsandboxed),
-        search=MeshSearch(parse_package_dirs(package_dir)),
+        search=inputs.packages,
         label=spec_label(robot),
+        inputs=inputs,
     )
+    write_notes(res.notes)
     exp = res.export
     w = sys.stdout.write
     w(f"wrote {len(res.files)} files beside {out} from {res.robot}\n")

@@ -3,15 +3,23 @@
 from __future__ import annotations
 
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 
 import typer
 
 from armcli.commands.options import spec_argument
+from armcli.commands.xacro_inputs import (
+    args_argument,
+    env_option,
+    package_dir_option,
+    split_robot,
+    write_notes,
+    xacro_inputs,
+)
 from armcli.errors import InputError
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
-from armcli.urdf.meshes import MeshSearch, parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 from armcli.view.png import load_urdf, render_png
 from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
@@ -29,6 +37,7 @@ def _size(text: str) -> tuple[int, int]:
 
 def render_cmd(
     robot: Path | None = spec_argument(ROBOT_HELP),
+    args: list[str] = args_argument(),
     pose: str = typer.Option(None, "--pose", help="A named pose of the spec."),
     q: str = typer.Option(
         None,
@@ -48,19 +57,19 @@ def render_cmd(
         show_default=False,
         help="Image size WIDTHxHEIGHT in pixels (default: 1200x600).",
     ),
-    package_dir: list[str] = typer.Option(
-        [], "--package-dir", help="NAME=PATH for package://NAME/ mesh URIs (repeatable)."
-    ),
+    package_dir: list[str] = package_dir_option(),
+    env: list[str] = env_option(),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
     check_output_file(out, "--out")  # before any work: nothing else is written
+    robot, tokens = split_robot(robot, args)
+    inputs = xacro_inputs(tokens, env, package_dir)
     src = load_robot(
-        find_spec(robot),
-        trust_mode(trust_xacro, unsandboxed),
-        MeshSearch(parse_package_dirs(package_dir)),
+        find_spec(robot), trust_mode(trust_xacro, unsandboxed), inputs.packages, inputs
     )
+    write_notes(src.notes)
     values = pose_q(src, pose, q)
     width, height = _size(size)
     urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search)
@@ -78,7 +87,20 @@ def render_cmd(
         if res.tool_position is None
         else " tool at ({:.3f}, {:.3f}, {:.3f}) m".format(*res.tool_position)
     )
-    sys.stdout.write(f"wrote {res.path} ({res.width}x{res.height} px){tip}\n")
+    drawn = _drawn(src.poses, pose, q)
+    sys.stdout.write(f"wrote {res.path} ({res.width}x{res.height} px) at {drawn};{tip}\n")
+
+
+def _drawn(poses: Mapping[str, Mapping[str, float]], pose: str | None, q: str | None) -> str:
+    """Which configuration the picture shows, so a render without options is not a guess."""
+    if pose is not None:
+        return f"pose {pose!r}"
+    if q is not None:
+        return f"--q {q}"
+    zero = [name for name, values in poses.items() if not any(values.values())]
+    same = f", the pose {zero[0]!r}" if zero else ""
+    others = f" (others: --pose {'|'.join(poses)})" if poses else ""
+    return f"q = 0{same}, as no --pose or --q was given{others}"
 
 
 def register(app: typer.Typer) -> None:

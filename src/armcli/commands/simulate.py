@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 import time
 from pathlib import Path
 from typing import Any, cast
@@ -10,13 +11,21 @@ import typer
 
 from armcli.check.gate import refuse_check_errors
 from armcli.commands.options import choice, option, spec_argument
+from armcli.commands.xacro_inputs import (
+    args_argument,
+    env_option,
+    package_dir_option,
+    split_robot,
+    write_notes,
+    xacro_inputs,
+)
 from armcli.errors import InputError
 from armcli.io import terminal
 from armcli.io.outdir import check_output_file
 from armcli.io.together import write_files_together
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
-from armcli.sim import states
+from armcli.sim import rosbag, states
 from armcli.sim.options import ENGINES, INTEGRATORS, Engine, Integrator, SimOptions
 from armcli.sim.plot import tracking_png
 from armcli.spec.discover import find_spec
@@ -41,6 +50,7 @@ def _floats(text: str | None, option: str) -> list[float] | None:
 
 def simulate_cmd(
     spec: Path | None = spec_argument(),
+    args: list[str] = args_argument(),
     trajectory: Path = option(None, "--trajectory", "-t", help=TRAJECTORY_HELP),
     message: str = option(None, "--message", "-m", help="JointTrajectory as YAML text."),
     urdf: Path = option(None, "--urdf", help="Simulate this URDF instead of the spec's arm."),
@@ -52,16 +62,23 @@ def simulate_cmd(
     integrator: str = choice("euler", INTEGRATORS, "--integrator", help=INTEGRATOR_HELP),
     duration: float = option(None, "--duration", help="Simulated time [s] (default: end + 2 s)."),
     clamp: bool = option(False, "--clamp", help="Clamp positions outside the limits (warns)."),
-    output: Path = option(None, "--output", "-o", help="Joint states at --rate: .csv or .json."),
+    output: Path = option(
+        None, "--output", "-o", help="Joint states at --rate: .csv, .json or .mcap (rosbag2)."
+    ),
     plot: Path = option(None, "--plot", help="Write a tracking plot PNG."),
     rate: float = option(None, "--rate", help="Output rate [Hz] (default: the spec's publisher)."),
     engine: str = choice("auto", ENGINES, "--engine", help=ENGINE_HELP),
+    package_dir: list[str] = package_dir_option(),
+    env: list[str] = env_option(),
     trust_xacro: bool = option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
+    spec, tokens = split_robot(spec, args)
+    inputs = xacro_inputs(tokens, env, package_dir)
     if output is not None:
-        states.output_format(output)
+        if not rosbag.is_mcap(output):
+            states.output_format(output)
         check_output_file(output, "--output")
     if plot is not None:
         check_output_file(plot, "--plot")
@@ -82,6 +99,7 @@ def simulate_cmd(
         rate=rate,
         engine=cast(Engine, engine),
         trust_xacro=trust_mode(trust_xacro, unsandboxed),
+        xacro=inputs,
     )
     # a model `check` reports as an error is not simulated (same rule ids)
     _run(simjob.prepare(spec_obj, opts, gate=refuse_check_errors), output, plot)
@@ -89,9 +107,8 @@ def simulate_cmd(
 
 def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
     """Run the prepared job with a progress bar, write the files, print the summary."""
-    from rich.console import Console
-
-    err = Console(stderr=True)
+    err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
+    write_notes(job.notes)
     for w in job.trajectory.warnings:
         err.print(f"warning: {w}", markup=False, highlight=False)
     with _LazyProgress(err) as progress:
@@ -101,7 +118,9 @@ def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
     files: dict[Path, bytes] = {}  # written together: never a new CSV beside an old plot
-    if output is not None:
+    if output is not None and rosbag.is_mcap(output):
+        files[output] = rosbag.run_mcap_bytes(res, job.rate, job.urdf)
+    elif output is not None:
         files[output] = states.states_bytes(
             states.sample_states(res, job.rate), states.output_format(output)
         )

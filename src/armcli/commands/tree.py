@@ -9,6 +9,14 @@ from pathlib import Path
 import typer
 
 from armcli.commands.options import choice, spec_argument
+from armcli.commands.xacro_inputs import (
+    args_argument,
+    env_option,
+    package_dir_option,
+    split_robot,
+    write_notes,
+    xacro_inputs,
+)
 from armcli.errors import InputError
 from armcli.io import terminal
 from armcli.io.files import write_file_atomic
@@ -23,10 +31,13 @@ TREE_FORMATS = ("text", "dot")
 
 def tree_cmd(
     robot: Path | None = spec_argument(ROBOT_HELP),
+    args: list[str] = args_argument(),
     fmt: str = choice(
         "text", TREE_FORMATS, "--format", help="text (a tree, the default) or dot (Graphviz)."
     ),
     out: Path = typer.Option(None, "-o", "--out", help="Write to this file instead of stdout."),
+    package_dir: list[str] = package_dir_option(),
+    env: list[str] = env_option(),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
@@ -35,7 +46,12 @@ def tree_cmd(
         raise InputError(f"unknown format {fmt!r}; known: text, dot", field="--format")
     if out is not None:
         check_output_file(out, "--out")
-    src = load_robot(find_spec(robot), trust_mode(trust_xacro, unsandboxed))
+    robot, tokens = split_robot(robot, args)
+    inputs = xacro_inputs(tokens, env, package_dir)
+    src = load_robot(
+        find_spec(robot), trust_mode(trust_xacro, unsandboxed), inputs.packages, inputs
+    )
+    write_notes(src.notes)
     tree = parse_tree(src.xml, src.source)
     if fmt == "dot":
         text = to_dot(tree)

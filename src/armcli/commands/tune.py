@@ -15,6 +15,7 @@ from armcli.io.files import write_file_atomic
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
+from armcli.tune import gains as gain_vector
 from armcli.tune import job as tjob
 from armcli.tune import report, session
 from armcli.tune.engine import Engine, make_engine
@@ -33,7 +34,7 @@ LOOP_HELP = (
     "stepped explicitly, e.g. Gazebo's effort controller)."
 )
 ROBUST_MODE_HELP = "Aggregate over the perturbed models: worst (default) or quantile."
-SCHEDULER_HELP = "Dask scheduler address, e.g. tcp://HOST:8786 (needs armcli[dask])."
+SCHEDULER_HELP = "Dask scheduler address, e.g. tcp://HOST:8786 (needs dask[distributed])."
 
 
 def _pair(text: str, name: str) -> tuple[float, float]:
@@ -134,12 +135,7 @@ def _run(
         runs = session.tracking_runs(job, outcome, case)
         write_tune_plot(plot, outcome.result.history, runs, job.problem.cases[case].label)
     if write:
-        n = len(job.problem.joints)
-        best = outcome.result.best
-        write_gains(
-            spec_path,
-            {j: (float(best[i]), float(best[n + i])) for i, j in enumerate(job.problem.joints)},
-        )
+        write_gains(spec_path, gain_vector.by_joint(outcome.result.best, job.problem.joints))
     for path in (output, plot, spec_path if write else None):
         if path is not None:
             out.print(f"wrote {path}", markup=False, highlight=False)

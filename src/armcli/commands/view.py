@@ -8,10 +8,18 @@ from pathlib import Path
 import typer
 
 from armcli.commands.options import spec_argument
+from armcli.commands.xacro_inputs import (
+    args_argument,
+    env_option,
+    package_dir_option,
+    split_robot,
+    write_notes,
+    xacro_inputs,
+)
 from armcli.errors import InputError
+from armcli.sim import rosbag
 from armcli.sim.states import load_replay
 from armcli.spec.discover import find_spec
-from armcli.urdf.meshes import MeshSearch, parse_package_dirs
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 from armcli.view.browser import Viewer
 from armcli.view.png import joint_limits, load_urdf
@@ -20,6 +28,7 @@ from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
 
 def view_cmd(
     robot: Path | None = spec_argument(ROBOT_HELP),
+    args: list[str] = args_argument(),
     replay: Path = typer.Option(None, "--replay", help="A CSV written by `armcli simulate`."),
     pose: str = typer.Option(None, "--pose", help="Start at this named pose."),
     host: str = typer.Option(
@@ -31,25 +40,26 @@ def view_cmd(
         show_default=False,
         help="Port to listen on (default: 8080; 0: any free port).",
     ),
-    package_dir: list[str] = typer.Option(
-        [], "--package-dir", help="NAME=PATH for package://NAME/ mesh URIs (repeatable)."
-    ),
+    package_dir: list[str] = package_dir_option(),
+    env: list[str] = env_option(),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Open a browser 3-D viewer with joint sliders, named poses and simulation replay."""
+    robot, tokens = split_robot(robot, args)
+    inputs = xacro_inputs(tokens, env, package_dir)
     src = load_robot(
-        find_spec(robot),
-        trust_mode(trust_xacro, unsandboxed),
-        MeshSearch(parse_package_dirs(package_dir)),
+        find_spec(robot), trust_mode(trust_xacro, unsandboxed), inputs.packages, inputs
     )
+    write_notes(src.notes)
     pose_q(src, pose, None)  # validate before starting the server
     if not 0 <= port <= 65535:
         raise InputError(f"{port} is not a port number", field="--port")
     run = None
     if replay is not None:
         names = list(joint_limits(load_urdf(src.xml, src.source, src.mesh_dir, src.search)))
-        run = load_replay(replay, names)
+        load = rosbag.load_replay if rosbag.is_mcap(replay) else load_replay
+        run = load(replay, names)
     viewer = Viewer(
         src.xml,
         name=src.name,

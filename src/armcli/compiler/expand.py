@@ -14,7 +14,7 @@ import xml.dom.minidom
 from dataclasses import dataclass
 from pathlib import Path
 
-from armcli.compiler.xacro_writer import top_level_files, xacro_files
+from armcli.compiler.xacro_writer import mesh_names, top_level_files, xacro_files
 from armcli.errors import BuildError, StaleBuildError
 from armcli.io.files import write_tree_atomic
 from armcli.io.outdir import resolve_output_dir
@@ -66,9 +66,15 @@ def expand_urdfs(spec: RobotSpec, files: dict[str, bytes] | None = None) -> dict
         return {urdf: expand(tmpdir, top) for urdf, top in top_level_files(spec).items()}
 
 
-def build_files(spec: RobotSpec, spec_label: str) -> dict[str, bytes]:
-    """Every output of `build`: the xacro set plus the expanded URDFs."""
-    xfiles = xacro_files(spec, spec_label)
+def build_files(
+    spec: RobotSpec, spec_label: str, out_dir: str | Path | None = None
+) -> dict[str, bytes]:
+    """Every output of `build`: the xacro set plus the expanded URDFs.
+
+    Relative mesh paths of the spec are written relative to `out_dir` (absolute when None).
+    """
+    names = mesh_names(spec, Path(out_dir) if out_dir is not None else None)
+    xfiles = xacro_files(spec, spec_label, names)
     return {**xfiles, **expand_urdfs(spec, xfiles)}
 
 
@@ -86,7 +92,7 @@ def build(spec_path: str | Path, out_dir: str | Path, *, force: bool = False) ->
     path = Path(spec_path)
     resolve_output_dir(out_dir, force=force)  # refuse before the work, again when writing
     spec = load_spec(path)
-    files = build_files(spec, spec_label(path))
+    files = build_files(spec, spec_label(path), out_dir)
     written = write_tree_atomic(out_dir, files, force=force)
     return BuildResult(spec=spec, out_dir=Path(out_dir), files=tuple(written))
 
@@ -94,7 +100,7 @@ def build(spec_path: str | Path, out_dir: str | Path, *, force: bool = False) ->
 def stale_files(spec_path: str | Path, out_dir: str | Path) -> list[str]:
     """Generated files in `out_dir` that are missing or differ from a fresh build."""
     path = Path(spec_path)
-    files = build_files(load_spec(path), spec_label(path))
+    files = build_files(load_spec(path), spec_label(path), out_dir)
     out = Path(out_dir)
     return [
         str(out / name)

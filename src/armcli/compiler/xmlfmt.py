@@ -56,3 +56,26 @@ def to_bytes(root: etree._Element, *, header_comment: str | None = None) -> byte
     if header_comment:
         out += f"<!-- {comment_text(header_comment)} -->\n"
     return (out + body + "\n").encode("utf-8")
+
+
+_XACRO_SUBST = re.compile(r"(\$+)(?=[({])")
+
+
+def literal(text: str) -> str:
+    """`text` as a xacro literal: `${`/`$(` gain one `$`, which xacro removes again.
+
+    For user text (mesh URIs, material names, copied XML) that must not be read as a
+    xacro expression or substitution.
+    """
+    return _XACRO_SUBST.sub(r"$\1", text)
+
+
+def robot(name: str | None = None) -> etree._Element:
+    """An empty `<robot>` with the xacro namespace (named for top-level files)."""
+    attrs = {"name": name} if name else {}
+    return etree.Element("robot", attrs, nsmap={"xacro": XACRO_NS})
+
+
+def sub(parent: etree._Element, tag: str, **attrs: str) -> etree._Element:
+    """Append `<tag attrs/>` to `parent` and return it."""
+    return etree.SubElement(parent, tag, attrs)

@@ -10,9 +10,12 @@ the primitives; meshes are copied into `meshes/` beside the model.
 Actuators: a joint with spec gains gets a `position` actuator with kp = Kp,
 kv = Kd and forcerange = the effort limit, i.e. the torque
 `Kp (ctrl - q) - Kd v`, clipped. armcli's controller is `Kp (q_ref - q) + Kd (v_ref - v)`;
-both agree with ctrl = q_ref + (Kd / Kp) v_ref. A joint without gains but with an
-effort limit gets a `motor` (ctrl = torque). The integrator is `implicitfast`,
-which, like `armcli simulate`, treats damping and Kd implicitly.
+both agree with ctrl = q_ref + (Kd / Kp) v_ref, which is why the control is not
+clipped to the joint range. A joint without gains but with an effort limit gets a
+`motor` (ctrl = torque). The integrator is `implicitfast`, which, like `armcli
+simulate`, treats damping and Kd implicitly. armcli's joint stops are hard; MuJoCo's
+limits are soft constraints, made as stiff as MuJoCo allows (`solreflimit` time
+constant = 2 time steps, its stability floor).
 """
 
 from __future__ import annotations
@@ -38,6 +41,7 @@ MESH_SUFFIXES = (".stl", ".obj", ".msh")  # what MuJoCo loads
 MESH_DIR = "meshes"
 FREE_JOINT = "root"
 INTEGRATOR = "implicitfast"
+LIMIT_STEPS = 2.0  # solreflimit time constant in time steps: MuJoCo's floor (refsafe)
 CONTACT_FRICTION = ("0.005", "0.0001")  # MuJoCo's default torsional and rolling friction
 _HINGE = {"revolute": "hinge", "continuous": "hinge", "prismatic": "slide"}
 
@@ -226,6 +230,8 @@ def _header(root: etree._Element, name: str, spec: RobotSpec | None) -> None:
         opt = {"timestep": fmt(spec.control.dt), **opt}
     etree.SubElement(root, "option", opt)
     top = etree.SubElement(etree.SubElement(root, "default"), "default", {"class": name})
+    if spec is not None:  # stops as stiff as the time step allows (armcli's are hard)
+        etree.SubElement(top, "joint", solreflimit=vec((LIMIT_STEPS * spec.control.dt, 1.0)))
     vis = etree.SubElement(top, "default", {"class": "visual"})
     etree.SubElement(vis, "geom", contype="0", conaffinity="0", group="2")
     col = etree.SubElement(top, "default", {"class": "collision"})

@@ -1,5 +1,10 @@
 """The parts of the MJCF model after the body tree: actuators, keyframes, equalities, notes.
 
+Position actuators carry no `ctrlrange`: their control is armcli's mapped
+reference ctrl = q_ref + (Kd / Kp) v_ref, which leaves the joint range whenever
+the reference moves near a limit; clipping it there would change the PD law
+(5e-2 rad away from `armcli simulate` on a trajectory that returns to the limits).
+
 Keyframes hold qpos in MuJoCo's joint order (the free joint's position and unit
 quaternion first, when the base is free) and, for position actuators, a ctrl
 equal to the pose so that the key is also a hold command.
@@ -41,9 +46,7 @@ def actuators(
         attrs = {"name": j.name, "joint": j.name}
         if j.name in gains:
             g = gains[j.name]
-            attrs.update(kp=fmt(g.kp), kv=fmt(g.kd))
-            if (r := _range(j)) is not None:
-                attrs["ctrlrange"] = vec(r)
+            attrs.update(kp=fmt(g.kp), kv=fmt(g.kd))  # no ctrlrange: see the module docstring
             if effort is not None:
                 attrs["forcerange"] = vec((-effort, effort))
             etree.SubElement(act, "position", attrs)

@@ -27,6 +27,7 @@ from armcli.io.outdir import (
     carry_entries,
     clean_stale_stages,
     no_links_below,
+    relative_inside,
     remove_entry,
     resolve_output_dir,
 )
@@ -34,14 +35,6 @@ from armcli.io.together import write_files_together
 
 _AT_FDCWD = -100
 _RENAME_EXCHANGE = 2
-
-
-def _safe_relpath(rel: str) -> PurePosixPath:
-    """Reject names that would escape the output directory."""
-    p = PurePosixPath(rel)
-    if p.is_absolute() or not p.parts or any(part in ("..", "", ".") for part in p.parts):
-        raise BuildError(f"refusing to write outside the output directory: {rel!r}")
-    return p
 
 
 def _umask() -> int:
@@ -148,7 +141,7 @@ def write_tree_atomic(
     A rebuild with identical content touches nothing (same bytes, same mtimes).
     """
     given = Path(out_dir)
-    payloads = {str(_safe_relpath(r)): _payload(d) for r, d in sorted(files.items())}
+    payloads = {str(relative_inside(r)): _payload(d) for r, d in sorted(files.items())}
     paths = [given.joinpath(*PurePosixPath(r).parts) for r in payloads]
     payloads[MARKER_NAME] = MARKER_TEXT
     root = resolve_output_dir(given, force=force)

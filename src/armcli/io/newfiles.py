@@ -1,7 +1,7 @@
 """Create a set of new files all-or-nothing, never replacing anything that exists.
 
 `armcli init` writes into a directory the user owns, maybe their current one, so the
-atomic writers in `fsio` (which replace outputs and swap whole directories) do not fit:
+atomic writers in `io.files` (which replace outputs and swap whole directories) do not fit:
 here an existing file is an error and the directory itself must never be swapped (a
 shell sitting in it would be left in a stale copy). Files are written completely into
 a hidden staging directory first; a new directory is then renamed into place in one
@@ -16,19 +16,12 @@ import os
 import shutil
 import tempfile
 from collections.abc import Mapping
-from pathlib import Path, PurePosixPath
+from pathlib import Path
 
-from armcli.errors import BuildError, ExistingFileError, InputError, OutputRefusedError
-from armcli.io.outdir import no_links_below, pid_alive, remove_entry
+from armcli.errors import BuildError, ExistingFileError, OutputRefusedError
+from armcli.io.outdir import no_links_below, pid_alive, relative_inside, remove_entry
 
 _STAGE_PREFIX = ".armcli-new-"  # + PID + "-": a killed run's stage is removed by the next
-
-
-def _relpath(rel: str) -> PurePosixPath:
-    p = PurePosixPath(rel)
-    if p.is_absolute() or not p.parts or ".." in p.parts:
-        raise InputError(f"refusing to write outside the target directory: {rel!r}")
-    return p
 
 
 def _umask() -> int:
@@ -42,7 +35,7 @@ def _stage(parent: Path, files: Mapping[str, bytes]) -> Path:
     stage = Path(tempfile.mkdtemp(dir=parent, prefix=f"{_STAGE_PREFIX}{os.getpid()}-"))
     os.chmod(stage, 0o777 & ~_umask())  # mkdtemp makes 0700; a new project dir is ordinary
     for rel, data in files.items():
-        path = stage / _relpath(rel)
+        path = stage / relative_inside(rel)
         path.parent.mkdir(parents=True, exist_ok=True)
         with open(path, "xb") as fh:
             fh.write(data)
@@ -64,8 +57,8 @@ def _refuse_existing(root: Path, files: Mapping[str, bytes]) -> None:
     if os.path.lexists(root) and not root.is_dir():
         raise ExistingFileError("exists and is not a directory", file=root)
     for rel in files:
-        target = root / _relpath(rel)
-        if not no_links_below(root, _relpath(rel).parent):
+        target = root / relative_inside(rel)
+        if not no_links_below(root, relative_inside(rel).parent):
             raise OutputRefusedError(
                 "a directory on the way is a symlink; armcli does not write new files "
                 "through links (nothing was written)",
@@ -95,7 +88,7 @@ def _link_into(root: Path, stage: Path, files: Mapping[str, bytes]) -> None:
     made_dirs: list[Path] = []
     try:
         for rel in files:
-            target = root / _relpath(rel)
+            target = root / relative_inside(rel)
             for parent in reversed(target.relative_to(root).parents[:-1]):
                 d = root / parent
                 if not d.is_dir():
@@ -148,4 +141,4 @@ def create_files(root: str | Path, files: Mapping[str, bytes]) -> list[Path]:
         ) from None
     except OSError as exc:
         raise BuildError(f"{exc.filename or root}: cannot write: {exc.strerror}") from None
-    return [root / _relpath(rel) for rel in files]
+    return [root / relative_inside(rel) for rel in files]

@@ -21,7 +21,7 @@ import pwd
 import shutil
 import stat
 from collections.abc import Collection
-from pathlib import Path, PurePath
+from pathlib import Path, PurePath, PurePosixPath
 
 from armcli.errors import OutputRefusedError
 
@@ -33,6 +33,17 @@ MARKER_TEXT = (
 STAGE_TAG = ".armcli-stage-"
 MAX_CARRY_DEPTH = 32  # nesting bound of the old tree carried into the new version
 _KINDS = {stat.S_IFCHR: "device", stat.S_IFBLK: "device", stat.S_IFIFO: "FIFO"}
+
+
+def relative_inside(rel: str) -> PurePosixPath:
+    """`rel` as a path that stays inside the directory it is joined to; else refused.
+
+    The one rule for every writer of a file set: relative, not empty, no `..` part.
+    """
+    p = PurePosixPath(rel)
+    if p.is_absolute() or not p.parts or ".." in p.parts:
+        raise OutputRefusedError(f"refusing to write outside the output directory: {rel!r}")
+    return p
 
 
 def _homes() -> set[Path]:

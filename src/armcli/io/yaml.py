@@ -115,6 +115,18 @@ def _scalar(node: yaml.ScalarNode, loader: _Loader, path: Path_, doc: YamlDoc) -
     return str(node.value)
 
 
+class FlowKeys(list[Any]):
+    """`{0.5, 0.3}` read with `flow_sets`: a flow mapping of null values, as its keys in order.
+
+    YAML reads the brace form as a mapping (repeated keys collapse in ROS's reader); the
+    list keeps every key and `text` the keys as written, for the caller to explain.
+    """
+
+    def __init__(self, keys: list[Any], text: str) -> None:
+        super().__init__(keys)
+        self.text = text
+
+
 def _build(
     node: yaml.Node,
     loader: _Loader,
@@ -143,10 +155,11 @@ def _build(
                 for _, v in node.value
             )
         ):
-            # ROS tolerates `{0.0, 0.0}` (a flow mapping of null values) as a list.
-            return [
+            # `{0.5, 0.3}`: the course's brace form; its reader decides (armcli.sim.brace)
+            keys = [
                 _build(k, loader, (*path, i), doc, flow_sets) for i, (k, _) in enumerate(node.value)
             ]
+            return FlowKeys(keys, "{" + ", ".join(str(k.value) for k, _ in node.value) + "}")
         out: dict[Any, Any] = {}
         for key_node, value_node in node.value:
             key = _build(key_node, loader, path, doc, flow_sets)

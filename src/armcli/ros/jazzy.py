@@ -169,8 +169,8 @@ def top_xacro(spec: RobotSpec, bringup_pkg: str, *, whole: bool, header: str) ->
     parts = [COMMON, MOBILE_BASE, ARM] if whole else [COMMON, ARM]
     for inc in parts:
         _sub(root, X + "include", filename=inc)
-    if whole and spec.mount is not None:
-        joint_element(root, spec.mount.joint, spec.mount_joint())
+    if whole and spec.mounted_base() is not None:
+        joint_element(root, spec.mount_joint_name(), spec.mount_joint())
     if not whole:
         _sub(root, "link", name=WORLD)
         anchor = Joint(type="fixed", parent=WORLD, child=spec.arm_root())
@@ -183,7 +183,7 @@ def top_xacro(spec: RobotSpec, bringup_pkg: str, *, whole: bool, header: str) ->
 
 def has_whole_robot(spec: RobotSpec) -> bool:
     """Whether the spec has a mobile base to mount the arm on (a whole-robot xacro)."""
-    return spec.mobile_base is not None and spec.mount is not None
+    return spec.mounted_base() is not None
 
 
 def description_xacros(spec: RobotSpec, bringup_pkg: str, header: str) -> dict[str, bytes]:

@@ -110,8 +110,8 @@ class Names:
             )
         whole = top_level_files(spec).get(f"{spec.name}.urdf", STANDALONE_ARM)
         root = spec.arm_root()
-        if spec.mobile_base is not None and whole != STANDALONE_ARM:
-            base = spec.mobile_base
+        base = spec.mounted_base()
+        if base is not None and whole != STANDALONE_ARM:
             root = root_links(base.links, (j.child for j in base.joints.values()))[0]
         return Names(
             robot=spec.name,

@@ -18,6 +18,7 @@ from lxml import etree
 from armcli.compiler.xmlfmt import fmt, to_bytes
 from armcli.ros.collision_matrix import CollisionMatrix
 from armcli.spec.model import RobotSpec
+from armcli.urdf.tool import spec_tool
 
 ARM_GROUP = "arm"
 HAND_GROUP = "hand"
@@ -25,13 +26,7 @@ HAND_GROUP = "hand"
 
 def arm_chain(spec: RobotSpec) -> tuple[str, str]:
     """(base_link, tip_link) of the planning chain: the arm root to the tool link."""
-    tip = spec.arm.tool.link if spec.arm.tool is not None else _last_link(spec)
-    return spec.arm_root(), tip
-
-
-def _last_link(spec: RobotSpec) -> str:
-    movable = spec.movable_arm_joints()
-    return spec.arm.joints[movable[-1]].child if movable else spec.arm_root()
+    return spec.arm_root(), spec_tool(spec).link
 
 
 def chain_joints(spec: RobotSpec) -> list[str]:

@@ -32,6 +32,7 @@ from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import Trust, checked_model, read_urdf_file
 from armcli.urdf.tool import tool_point
+from armcli.urdf.xacro_args import XacroInputs
 
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
 ARM_URDF = STANDALONE_ARM_URDF
@@ -54,15 +55,24 @@ class SimJob:
     tool_label: str
     rate: float  # [Hz] joint_state_publisher rate
     T_frame_root: np.ndarray  # 4x4 pose of the arm's root link in the reporting frame
+    notes: tuple[str, ...] = ()  # what reading a xacro --urdf reported (Urdf.notes)
+    urdf: Urdf | None = None  # the simulated description (an MCAP's /robot_description, /tf)
 
 
-def arm_urdf(spec: RobotSpec | None, urdf: Path | None, *, trust_xacro: Trust = False) -> Urdf:
+def arm_urdf(
+    spec: RobotSpec | None,
+    urdf: Path | None,
+    *,
+    trust_xacro: Trust = False,
+    inputs: XacroInputs | None = None,
+) -> Urdf:
     """The URDF to simulate: a given file or the spec's standalone arm built in memory.
 
-    A given file goes through the strict reader (a foreign xacro only when trusted).
+    A given file goes through the strict reader (a xacro file in safe mode unless trusted,
+    with `inputs`' arguments).
     """
     if urdf is not None:
-        return read_urdf_file(urdf, trust_xacro=trust_xacro)
+        return read_urdf_file(urdf, trust_xacro=trust_xacro, inputs=inputs)
     if spec is None:
         raise InputError("give a spec or --urdf", field="--urdf")
     return parse_urdf(expand_urdfs(spec)[ARM_URDF], ARM_URDF)
@@ -84,6 +94,25 @@ def load_arm(
     return arm_from_model(
         checked_model(arm_urdf(spec, urdf, trust_xacro=trust_xacro)).model, joints
     )
+
+
+def refuse_mimic(doc: Urdf, joints: Sequence[str] | None) -> None:
+    """Mimic joints are not coupled to their lead here: refuse them rather than drive them alone.
+
+    Locking the followers (`--joints` without them) simulates the rest of the arm.
+    """
+    movable = [j.name for j in doc.joints if j.movable]
+    chosen = list(joints) if joints else movable
+    followers = [j for j in doc.joints if j.mimic is not None and j.name in chosen]
+    if followers:
+        f = followers[0]
+        rest = ",".join(n for n in chosen if n not in {j.name for j in followers})
+        raise InputError(
+            f"joint {f.name!r} mimics {f.mimic!r}: armcli simulate does not couple mimic "
+            f"joints; lock the followers with --joints {rest}",
+            file=doc.source,
+            field="--joints",
+        )
 
 
 def _gains(
@@ -124,9 +153,7 @@ def _tool(arm: Arm, doc: Urdf, spec: RobotSpec | None) -> tuple[int, np.ndarray,
     tool = tool_point(doc, spec)
     if tool is None or not model.existFrame(tool.link):
         raise InputError("this URDF has no link to report as the end effector", file=doc.source)
-    off = np.array(tool.xyz, dtype=float)
-    label = f"{tool.link}+{_fmt(off)}" if np.any(off) else tool.link
-    return model.getFrameId(tool.link), off, label
+    return model.getFrameId(tool.link), np.array(tool.xyz, dtype=float), tool.label
 
 
 def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
@@ -141,7 +168,7 @@ def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
     model = arm.model
     root = next(f.name for f in model.frames if f.parentJoint == 0 and f.name != "universe")
     T = pin.SE3.Identity()
-    if spec is None or spec.mobile_base is None or spec.mount is None:
+    if spec is None or spec.mounted_base() is None:
         return root, T.homogeneous
     by_child = {j.child: j for j in spec.all_joints().values()}
     link = spec.arm_root()
@@ -151,10 +178,6 @@ def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
         T = pin.SE3(rot, np.array(joint.origin.xyz, dtype=float)) * T
         link = joint.parent
     return link, T.homogeneous
-
-
-def _fmt(v: np.ndarray) -> str:
-    return "(" + ",".join(f"{x:g}" for x in v) + ")"
 
 
 def start_state(arm: Arm, spec: RobotSpec | None) -> np.ndarray:
@@ -211,7 +234,8 @@ def prepare(
     dt = dt if dt is not None else (spec.control.dt if spec is not None else DEFAULT_DT)
     if not (np.isfinite(dt) and 0 < dt <= 0.1):
         raise InputError(f"must be in (0, 0.1] s, got {dt:g}", field="--dt")
-    doc = arm_urdf(spec, opts.urdf, trust_xacro=opts.trust_xacro)
+    doc = arm_urdf(spec, opts.urdf, trust_xacro=opts.trust_xacro, inputs=opts.xacro)
+    refuse_mimic(doc, opts.joints)
     arm = arm_from_model(checked_model(doc, gate=gate if opts.urdf else None).model, opts.joints)
     limits = {
         n: (float(lo), float(hi))
@@ -238,7 +262,9 @@ def prepare(
     fid, off, label = _tool(arm, doc, spec)
     frame, T_frame_root = _report_frame(arm, spec)
     label = f"{label} in {frame}"
-    return SimJob(arm, traj, ref, q0, total, cfg, fid, off, label, float(rate), T_frame_root)
+    return SimJob(
+        arm, traj, ref, q0, total, cfg, fid, off, label, float(rate), T_frame_root, doc.notes, doc
+    )
 
 
 def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:

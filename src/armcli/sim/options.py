@@ -14,6 +14,7 @@ from armcli.errors import InputError
 
 if TYPE_CHECKING:
     from armcli.urdf.source import Trust
+    from armcli.urdf.xacro_args import XacroInputs
 
 Integrator = Literal["euler", "rk4"]
 """euler: semi-implicit (symplectic) Euler with implicit damping; rk4: classic Runge-Kutta."""
@@ -43,6 +44,7 @@ class SimOptions:
         rate: joint-state output rate [Hz].
         engine: see `Engine`.
         trust_xacro: expand a foreign xacro file given as `urdf` in the sandbox.
+        xacro: a xacro `urdf`'s NAME:=VALUE arguments, --env values and package lookup.
     """
 
     trajectory: Path | None = None
@@ -59,6 +61,7 @@ class SimOptions:
     rate: float | None = None
     engine: Engine = "auto"
     trust_xacro: Trust = False
+    xacro: XacroInputs | None = None
 
     def __post_init__(self) -> None:
         for value, choices, option in (

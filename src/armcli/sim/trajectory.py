@@ -2,8 +2,8 @@
 
 The YAML mirrors the ROS message (`header.frame_id`, `joint_names`, `points` with
 `positions` and optional `velocities`, `accelerations`, `effort`, `time_from_start`), so
-the payload of `ros2 topic pub /set_joint_trajectory ...` works as is, including ROS's
-`{0.0, 0.0}` flow-mapping quirk.
+the payload of `ros2 topic pub /set_joint_trajectory ...` reads as ROS reads it, including
+the brace form `{0.5, 0.3}` (see armcli.sim.brace).
 
 Interpolation follows ros2_control's joint_trajectory_controller: per segment, linear
 when the points give positions only, cubic when they give velocities, quintic when they
@@ -27,7 +27,8 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import Problem, SpecError
-from armcli.io.yaml import YamlDoc, dotted, load_yaml, loads_yaml
+from armcli.io.yaml import FlowKeys, YamlDoc, dotted, load_yaml, loads_yaml
+from armcli.sim.brace import BraceNotes
 
 DEFAULT_SEGMENT_S = 1.0  # [s] time given to a point without time_from_start
 MIN_SEGMENT_S = 1e-6  # [s] shorter segments make the interpolated reference overflow
@@ -79,6 +80,7 @@ class _Collector:
     def __init__(self, doc: YamlDoc) -> None:
         self.doc = doc
         self.problems: list[Problem] = []
+        self.braces = BraceNotes()
 
     def add(self, path: tuple[str | int, ...], msg: str) -> None:
         self.problems.append(Problem(dotted(path), msg, self.doc.line_of(path)))
@@ -143,7 +145,7 @@ def parse_trajectory(
         accelerations=np.array(acc, dtype=float) if acc[0] is not None else None,
         frame_id=frame_id,
         source=doc.source,
-        warnings=tuple(warnings),
+        warnings=tuple(c.braces.warnings(doc.source) + warnings),
     )
 
 
@@ -179,6 +181,11 @@ def _joint_names(raw: Any, limits: Mapping[str, Any], c: _Collector) -> list[str
 def _vector(
     raw: Any, m: int, path: tuple[str | int, ...], c: _Collector, required: bool
 ) -> list[float] | None:
+    if isinstance(raw, FlowKeys):  # `{0.5, 0.3}`: what ROS 2 would send, or the reason not
+        raw, refusal = c.braces.read(raw, m, dotted(path))
+        if raw is None:
+            c.add(path, refusal)
+            return None
     if raw is None or raw == []:
         if required:
             c.add(path, f"missing: give {m} value(s), one per joint name")

@@ -13,6 +13,7 @@ from armcli.errors import Problem, SpecError
 from armcli.io.yaml import YamlDoc, dotted, load_yaml, loads_yaml
 from armcli.spec.model import RobotSpec
 from armcli.spec.semantics import semantic_problems
+from armcli.spec.suggest import did_you_mean
 
 
 def _pydantic_problems(exc: ValidationError, doc: YamlDoc) -> list[Problem]:
@@ -23,7 +24,7 @@ def _pydantic_problems(exc: ValidationError, doc: YamlDoc) -> list[Problem]:
         if msg.startswith("Value error, "):
             msg = msg[len("Value error, ") :]
         if err["type"] == "extra_forbidden":
-            msg = "unknown key"
+            msg = "unknown key" + did_you_mean(RobotSpec, loc)
         out.append(Problem(dotted(loc), msg, doc.line_of(loc)))
     return out
 
@@ -54,8 +55,8 @@ def _split(field: str) -> tuple[str | int, ...]:
 
 
 def load_spec(path: str | Path) -> RobotSpec:
-    """Read, parse and validate a spec file."""
-    return spec_from_doc(load_yaml(path))
+    """Read, parse and validate a spec file (relative mesh paths start at its directory)."""
+    return spec_from_doc(load_yaml(path)).with_source(Path(path))
 
 
 def loads_spec(text: str, source: str = "<string>") -> RobotSpec:

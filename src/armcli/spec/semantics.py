@@ -7,6 +7,7 @@ problems with dotted field paths; `spec.spec_from_doc` adds file and line.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 from armcli.errors import Problem
@@ -39,21 +40,56 @@ def semantic_problems(spec: RobotSpec) -> list[Problem]:
     for part, links, joints in parts:
         _tree_problems(part, links, joints, add)
         for lname, link in links.items():
-            if link.material is not None and link.material not in spec.materials:
-                add(
-                    (part, "links", lname, "material"),
-                    f"unknown material {link.material!r}; known: {_names(spec.materials)}",
-                )
+            _material_problems(spec, (part, "links", lname), link, add)
 
     arm_movable = set(spec.movable_arm_joints()) if not out else set()
     all_joints = {**base_joints, **spec.arm.joints}
     _plugin_problems(spec, all_joints, add)
     _mount_problems(spec, all_joints, add)
+    _mimic_problems(spec, add)
     for jname in spec.control.gains:
         if jname not in spec.arm.joints:
             add(("control", "gains", jname), f"unknown arm joint; known: {_names(spec.arm.joints)}")
+        elif (m := spec.arm.joints[jname].mimic) is not None:
+            add(("control", "gains", jname), f"mimics {m.joint}: give gains to the lead joint")
     _pose_problems(spec, arm_movable, add)
     return out
+
+
+def _material_problems(
+    spec: RobotSpec, path: tuple[str, ...], link: Link, add: Callable[..., None]
+) -> None:
+    """Material names a link uses exist in `materials`."""
+    known = _names(spec.materials)
+    if isinstance(link.material, str) and link.material not in spec.materials:
+        add((*path, "material"), f"unknown material {link.material!r}; known: {known}")
+    for i, shape in enumerate(link.visual):
+        if isinstance(shape.material, str) and shape.material not in spec.materials:
+            add(
+                (*path, "visual", i, "material"),
+                f"unknown material {shape.material!r}; known: {known}",
+            )
+
+
+def _mimic_problems(spec: RobotSpec, add: Callable[..., None]) -> None:
+    """A mimic joint follows a moving joint of the same part that is no follower itself."""
+    parts = [("arm", spec.arm.joints)]
+    if spec.mobile_base is not None:
+        parts.append(("mobile_base", spec.mobile_base.joints))
+    for part, joints in parts:
+        for jname, j in joints.items():
+            if j.mimic is None:
+                continue
+            lead = joints.get(j.mimic.joint)
+            path = (part, "joints", jname, "mimic", "joint")
+            if lead is None:
+                add(path, f"unknown {part} joint; known: {_names(joints)}")
+            elif j.mimic.joint == jname:
+                add(path, "a joint cannot mimic itself")
+            elif lead.type not in ("revolute", "continuous", "prismatic"):
+                add(path, f"{j.mimic.joint} is {lead.type}: a lead joint must move")
+            elif lead.mimic is not None:
+                add(path, f"{j.mimic.joint} mimics {lead.mimic.joint}: follow that one")
 
 
 def _mount_problems(spec: RobotSpec, all_joints: dict[str, Joint], add: Any) -> None:
@@ -77,15 +113,17 @@ def _pose_problems(spec: RobotSpec, arm_movable: set[str], add: Any) -> None:
             j = spec.arm.joints.get(jname)
             if j is None or (arm_movable and jname not in arm_movable):
                 add(("poses", pname, jname), f"unknown arm joint; known: {_names(spec.arm.joints)}")
+            elif j.mimic is not None:
+                add(("poses", pname, jname), f"mimics {j.mimic.joint}: give the lead joint")
             elif (
-                j.limit is not None
+                (b := j.bounds) is not None
                 and j.type != "continuous"
-                and j.limit.lower <= j.limit.upper
-                and not (j.limit.lower - 1e-12 <= value <= j.limit.upper + 1e-12)
+                and b[0] <= b[1]
+                and not (b[0] - 1e-12 <= value <= b[1] + 1e-12)
             ):
                 add(
                     ("poses", pname, jname),
-                    f"{value:g} is outside the joint limits [{j.limit.lower:g}, {j.limit.upper:g}]",
+                    f"{value:g} is outside the joint limits [{b[0]:g}, {b[1]:g}]",
                 )
 
 
@@ -103,11 +141,8 @@ def _tree_problems(part: str, links: dict[str, Link], joints: dict[str, Joint], 
         children[j.child] = jname
         if j.parent == j.child:
             add((part, "joints", jname, "child"), "a joint cannot connect a link to itself")
-        if j.limit is not None and j.limit.lower > j.limit.upper:
-            add(
-                (part, "joints", jname, "limit", "upper"),
-                f"must be >= lower ({j.limit.lower:g})",
-            )
+        if (b := j.bounds) is not None and b[0] > b[1]:
+            add((part, "joints", jname, "limit", "upper"), f"must be >= lower ({b[0]:g})")
     roots = root_links(links, children)
     if len(roots) != 1:
         add((part, "links"), f"exactly one root link expected, found {len(roots)}: {roots}")

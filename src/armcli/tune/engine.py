@@ -24,7 +24,7 @@ from armcli.tune.objective import Weights
 from armcli.tune.problem import TuneProblem
 
 CONNECT_TIMEOUT_S = 3.0  # [s] to reach a Dask scheduler before giving up
-DASK_HINT = "pip install 'armcli[dask]' (or: pip install 'dask[distributed]')"
+DASK_HINT = "pip install 'dask[distributed]' (what armcli's `dask` extra installs)"
 
 
 class Engine(Protocol):
@@ -66,7 +66,7 @@ class LocalEngine:
     def close(self) -> None:
         """Stop the threads."""
         if self._pool is not None:
-            self._pool.shutdown()
+            self._pool.shutdown(cancel_futures=True)  # Ctrl-C: queued candidates never start
 
 
 class DaskEngine:

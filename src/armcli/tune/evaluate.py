@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from armcli.sim.simulate import Arm, Run, SimConfig, SimResult, simulate_batch
+from armcli.tune import gains as gain_vector
 from armcli.tune.model_gains import loop_stable
 from armcli.tune.objective import METRIC_FIELDS, Weights, run_cost, run_metrics
 from armcli.tune.problem import Case, TuneProblem, scored_models
@@ -70,7 +71,7 @@ def evaluate_candidates(
     shape = (len(models), len(problem.cases))
     cfgs, reasons, jobs = [], [], []
     for gains in chunk:
-        kp, kd = np.asarray(gains[:n], dtype=float), np.asarray(gains[n:], dtype=float)
+        kp, kd = gain_vector.split(gains)
         cfg = SimConfig(kp, kd, problem.dt, problem.integrator, problem.gravity_comp, "auto")
         cfgs.append(cfg)
         reasons.append(_unstable_reason(problem, kp, kd))

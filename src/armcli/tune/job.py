@@ -21,6 +21,7 @@ from armcli.sim.job import ARM_URDF, SETTLE_EXTRA_S, start_state
 from armcli.sim.reference import Reference, build_reference
 from armcli.sim.trajectory import Trajectory, load_trajectory
 from armcli.spec.model import RobotSpec
+from armcli.tune import gains as gain_vector
 from armcli.tune.model_gains import (
     LOOPS,
     STABILITY_MARGIN,
@@ -163,4 +164,4 @@ def _spec_gains(spec: RobotSpec, joints: Sequence[str]) -> np.ndarray | None:
     gains = spec.control.gains
     if not all(j in gains and gains[j].ki == 0.0 for j in joints):
         return None  # missing, or PID: the PD simulator cannot reproduce it
-    return np.array([gains[j].kp for j in joints] + [gains[j].kd for j in joints], dtype=float)
+    return gain_vector.stack([gains[j].kp for j in joints], [gains[j].kd for j in joints])

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from armcli.io.terminal import Column, FitTable
+from armcli.tune import gains as gain_vector
 from armcli.tune.evaluate import CandidateEval
 from armcli.tune.model_gains import StartGains, dt_max
 from armcli.tune.objective import FINAL, MAX, RMS, SATURATED, SETTLE
@@ -124,7 +125,6 @@ def comparison_table(
     problem: TuneProblem, start: StartGains, rows: Sequence[Row], damping: np.ndarray
 ) -> Any:
     """Per joint (a group) and gain set: gains, errors, settle, saturation, margin."""
-    n = len(problem.joints)
     t = FitTable(
         [Column(h, num) for h, num in COMPARISON_COLUMNS],
         title="before / after (nominal model, all trajectories)",
@@ -134,7 +134,7 @@ def comparison_table(
         t.add_group(name)
         for row in rows:
             s = joint_summary(row.nominal, j)
-            kp, kd = float(row.gains[j]), float(row.gains[n + j])
+            kp, kd = gain_vector.of_joint(row.gains, j)
             cells = [_f(s[k]) for k in ("rms", "max", "final", "settle")]
             sat = "-" if s["saturated_pct"] is None else f"{s['saturated_pct']:.1f}"
             t.add_row(
@@ -167,7 +167,7 @@ def to_json(
     damping: np.ndarray,
 ) -> str:
     """The output document (schema in docs/tune.md; stable key order, no timestamps)."""
-    n = len(problem.joints)
+    best_kp, best_kd = gain_vector.split(result.best)
     search = {k: getattr(opts, k) for k in ("trials", "batch", "seed", "span", "robust")}
     doc = {
         "schema_version": SCHEMA_VERSION,
@@ -185,8 +185,8 @@ def to_json(
         "results": {row.label: _row_doc(problem, start, row, damping) for row in rows},
         "best": {
             "cost": _num(result.best_cost),
-            "kp": result.best[:n].tolist(),
-            "kd": result.best[n:].tolist(),
+            "kp": best_kp.tolist(),
+            "kd": best_kd.tolist(),
         },
         "history": [_trial_doc(r) for r in result.history],
     }
@@ -195,12 +195,11 @@ def to_json(
 
 def _row_doc(problem: TuneProblem, start: StartGains, row: Row, damping: np.ndarray
              ) -> dict[str, Any]:  # fmt: skip
-    n = len(problem.joints)
     return {
         "robust_cost": _num(row.robust_cost),
         "feasible": row.nominal.feasible,
         "joints": {
-            name: _joint_doc(start, row, j, n, float(damping[j]))
+            name: _joint_doc(start, row, j, float(damping[j]))
             for j, name in enumerate(problem.joints)
         },
     }
@@ -211,8 +210,8 @@ def _trial_doc(r: TrialRecord) -> dict[str, Any]:
             "reason": r.reason, "gains": r.gains.tolist()}  # fmt: skip
 
 
-def _joint_doc(start: StartGains, row: Row, j: int, n: int, damping: float) -> dict[str, Any]:
-    kp, kd = float(row.gains[j]), float(row.gains[n + j])
+def _joint_doc(start: StartGains, row: Row, j: int, damping: float) -> dict[str, Any]:
+    kp, kd = gain_vector.of_joint(row.gains, j)
     summary = {k: _num(v) for k, v in joint_summary(row.nominal, j).items()}
     return {
         "kp": kp,

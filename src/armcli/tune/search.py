@@ -18,6 +18,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from armcli.errors import InputError
+from armcli.tune import gains as gain_vector
 from armcli.tune.engine import Engine
 from armcli.tune.evaluate import CandidateEval
 from armcli.tune.objective import Weights, aggregate
@@ -98,7 +99,7 @@ def search(
 
     validate(opts)
     optuna.logging.set_verbosity(optuna.logging.WARNING)
-    names = _param_names(problem.joints)
+    names = gain_vector.param_names(problem.joints)
     lo, hi = start / opts.span, start * opts.span
     for g in also_try:  # widen the box to hold the user's gains (when all are > 0)
         if np.all(g > 0):
@@ -132,7 +133,3 @@ def search(
 def nominal(problem: TuneProblem) -> TuneProblem:
     """The same problem on the unperturbed model only (for the before/after report)."""
     return replace(problem, variants=(), key="").with_key()
-
-
-def _param_names(joints: Sequence[str]) -> list[str]:
-    return [f"kp:{j}" for j in joints] + [f"kd:{j}" for j in joints]

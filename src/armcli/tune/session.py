@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from armcli.sim.simulate import SimConfig, SimResult, simulate
+from armcli.tune import gains as gain_vector
 from armcli.tune.engine import Engine
 from armcli.tune.job import TuneJob
 from armcli.tune.problem import nominal_arm
@@ -37,7 +38,7 @@ def run(
     progress: Callable[[int, int], None] | None = None,
 ) -> Outcome:
     """Search from the model-based start, then score spec/start/tuned for the report."""
-    start = np.concatenate([job.start.kp, job.start.kd])
+    start = gain_vector.stack(job.start.kp, job.start.kd)
     extra = [job.spec_gains] if job.spec_gains is not None else []
     result = search(job.problem, start, engine, opts, also_try=extra, progress=progress)
     labelled = ([("spec", job.spec_gains)] if job.spec_gains is not None else []) + [
@@ -72,11 +73,11 @@ def tracking_runs(job: TuneJob, outcome: Outcome, case: int) -> list[tuple[str, 
     p = job.problem
     arm = nominal_arm(p)
     c = p.cases[case]
-    n = len(p.joints)
     out = []
     for row in outcome.rows:
         if not row.nominal.feasible:
             continue
-        cfg = SimConfig(row.gains[:n], row.gains[n:], p.dt, p.integrator, p.gravity_comp)
+        kp, kd = gain_vector.split(row.gains)
+        cfg = SimConfig(kp, kd, p.dt, p.integrator, p.gravity_comp)
         out.append((row.label, simulate(arm, c.reference, c.q0, c.duration, cfg)))
     return out

@@ -175,6 +175,7 @@ class Urdf:
     materials: tuple[Material, ...]
     problems: tuple[NumberProblem, ...] = field(default=())
     line: int | None = None  # the <robot> element's
+    notes: tuple[str, ...] = ()  # `note: ...`/`warning: ...` lines: xacro arguments used, ...
 
     def link(self, name: str) -> Link | None:
         """The link called `name`, or None."""

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
 
@@ -23,9 +23,12 @@ from armcli.errors import EXPANDED_TAG, InputError, XacroRefusedError
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
+from armcli.urdf.packages import inside, real_roots
 from armcli.urdf.pinocchio import LoadedModel, load_model, parser_problems
 from armcli.urdf.read import parse_urdf, read_urdf
-from armcli.urdf.xacro_sandbox import expand_foreign, expand_untrusted
+from armcli.urdf.xacro_args import Expansion, XacroInputs
+from armcli.urdf.xacro_safe import request_json
+from armcli.urdf.xacro_sandbox import expand_untrusted, run_safe
 
 SPEC_SUFFIXES = (".yaml", ".yml")
 XACRO_SUFFIX = ".xacro"
@@ -70,8 +73,13 @@ class RobotFile:
         return self.urdfs[0]
 
 
-def read_robot(path: Path, *, trust_xacro: Trust = False) -> RobotFile:
-    """Spec YAML, URDF or (trusted) xacro -> RobotFile; InputError when unusable."""
+def read_robot(
+    path: Path, *, trust_xacro: Trust = False, inputs: XacroInputs | None = None
+) -> RobotFile:
+    """Spec YAML, URDF or xacro -> RobotFile; InputError when unusable.
+
+    `inputs`: a xacro file's arguments, --env values and package lookup (xacro_args).
+    """
     if path.is_dir():
         raise InputError("is a directory, expected a robot spec, URDF or xacro file", file=path)
     if path.suffix in SPEC_SUFFIXES:
@@ -79,26 +87,53 @@ def read_robot(path: Path, *, trust_xacro: Trust = False) -> RobotFile:
         urdfs = expand_urdfs(spec)
         docs = tuple(parse_urdf(urdfs[n], f"{path}#{n}") for n in sorted(urdfs))
         return RobotFile(path, docs, spec)
-    return RobotFile(path, (read_urdf_file(path, trust_xacro=trust_xacro),))
+    return RobotFile(path, (read_urdf_file(path, trust_xacro=trust_xacro, inputs=inputs),))
 
 
-def read_urdf_file(path: Path, *, trust_xacro: Trust = False) -> Urdf:
-    """A URDF or xacro file -> Urdf; xacro (by suffix or content) only with trust_xacro."""
+def read_urdf_file(
+    path: Path, *, trust_xacro: Trust = False, inputs: XacroInputs | None = None
+) -> Urdf:
+    """A URDF or xacro file -> Urdf (xacro by suffix or content).
+
+    A xacro file is expanded in safe mode (xacro_safe: no code from the file runs), or
+    with xacro itself when trusted; `Urdf.notes` says which arguments it used.
+    """
     if path.suffix != XACRO_SUFFIX:
         try:
             return read_urdf(path)
         except XacroRefusedError:
             pass  # xacro content in a .urdf: expanded like a .xacro file
+    xml, used = expand_xacro(path, trust_xacro=trust_xacro, inputs=inputs)
+    return replace(parse_urdf(xml, f"{path}{EXPANDED_TAG}"), notes=used.notes())
+
+
+def expand_xacro(
+    path: Path, *, trust_xacro: Trust = False, inputs: XacroInputs | None = None
+) -> tuple[bytes, Expansion]:
+    """A xacro file's expansion (the bytes xacro itself writes) and what it used.
+
+    Safe mode (xacro_safe, in a limited child) unless `trust_xacro`: then xacro itself
+    in xacro_sandbox's jail, which reports no argument use.
+    """
+    given = inputs or XacroInputs()
     if trust_xacro:
         unsandboxed = trust_xacro == "unsandboxed"
-        xml = expand_untrusted(path, unsandboxed=unsandboxed, roots=allowed_roots(path.parent))
-        return parse_urdf(xml, f"{path}{EXPANDED_TAG}")
-    xml = expand_foreign(path, allowed_roots(path.parent))  # safe mode: no code runs
-    return parse_urdf(xml, f"{path}{EXPANDED_TAG}")
+        roots = allowed_roots(path.parent)
+        xml = expand_untrusted(
+            path, mappings=dict(given.args), unsandboxed=unsandboxed, roots=roots
+        )
+        return xml, Expansion(args=dict(given.args), given=tuple(given.args))
+    request = request_json(allowed_roots(path.parent), given)
+    xml, report = run_safe(path, request)  # safe mode: no code runs
+    return xml, Expansion.from_dict(report.get("expansion", {}))
 
 
 def load_checked_model(
-    path: Path, *, trust_xacro: Trust = False, gate: Callable[[Urdf], None] | None = None
+    path: Path,
+    *,
+    trust_xacro: Trust = False,
+    gate: Callable[[Urdf], None] | None = None,
+    inputs: XacroInputs | None = None,
 ) -> LoadedModel:
     """A URDF/xacro file -> Pinocchio model, refusing what Pinocchio would silently accept.
 
@@ -106,7 +141,8 @@ def load_checked_model(
     non-finite number (Pinocchio turns mass="nan" into 0) or any error the URDF
     parser prints is an InputError naming the file and line, not a wrong result.
     """
-    return checked_model(read_urdf_file(path, trust_xacro=trust_xacro), gate=gate)
+    urdf = read_urdf_file(path, trust_xacro=trust_xacro, inputs=inputs)
+    return checked_model(urdf, gate=gate)
 
 
 def checked_model(urdf: Urdf, *, gate: Callable[[Urdf], None] | None = None) -> LoadedModel:
@@ -138,19 +174,21 @@ def urdf_text(urdf: Urdf) -> str:
 def allowed_roots(urdf_dir: Path, extra: Iterable[Path] = ()) -> tuple[Path, ...]:
     """Directories mesh files may come from.
 
-    The URDF's directory, the ROS package it sits in (nearest ancestor with a package.xml),
-    `extra` (--package-dir) and ROS_PACKAGE_PATH.
+    The URDF's directory, the ROS package it sits in (nearest ancestor with a package.xml,
+    with its real directories: packages.real_roots), `extra` (--package-dir) and
+    ROS_PACKAGE_PATH.
     """
     here = urdf_dir.resolve()
     roots = [here, *extra]
     roots += [Path(p) for p in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
-    package = next((d for d in (here, *here.parents) if (d / "package.xml").is_file()), None)
-    if package is not None:
-        roots.append(package)
+    lexical = Path(os.path.abspath(urdf_dir))
+    for start in dict.fromkeys((lexical, here)):  # an install tree's own dir or its source's
+        package = next((d for d in (start, *start.parents) if (d / "package.xml").is_file()), None)
+        if package is not None:
+            roots += real_roots(package)
     return tuple(dict.fromkeys(r.resolve() for r in roots))
 
 
 def inside_roots(path: Path, roots: Iterable[Path]) -> bool:
     """Whether `path` (symlinks followed, `..` collapsed) lies inside one of `roots`."""
-    real = path.resolve()
-    return any(real.is_relative_to(r) for r in roots)
+    return inside(path, tuple(roots))

@@ -5,10 +5,13 @@ access, `type`, `vars` and friends remain), which is why a foreign xacro file
 is code. Real description files only compute with numbers and strings, so
 xacro_safe replaces that `eval` with this walker: literals, property names,
 arithmetic, comparisons, boolean logic, conditional expressions, indexing,
-`math` functions and a few pure builtins. Anything else raises
-ExprRefusedError, which xacro_safe turns into an error naming the file and line.
-Sizes are bounded so that `'x' * 4000000000` or `9 ** 9 ** 9` cannot
-exhaust memory or time.
+`math` functions, pure builtins (with keyword arguments: `dict(joint_1=0.0)`) and
+a fixed set of read-only `str` methods plus a few list/dict ones (`xyz.split(' ')`,
+`levels.pop(0)`, `d.get(k)`); nothing that formats (`format`, `%`) or reaches
+attributes. A callable may only be passed to another (`map(float, xs)`) when it is
+itself allowed. Anything else raises ExprRefusedError, which xacro_safe turns into
+an error naming the file and line. Sizes are bounded so that `'x' * 4000000000`,
+`9 ** 9 ** 9` or `s.replace('a', s)` cannot exhaust memory or time.
 """
 
 from __future__ import annotations
@@ -57,7 +60,78 @@ _MATH_NAMES = [
     "isnan",
 ]
 MATH: dict[str, Any] = {name: getattr(math, name) for name in _MATH_NAMES}
-_BUILTINS: tuple[Callable[..., Any], ...] = (abs, min, max, round, int, float, str, bool, len, sum)
+_BUILTINS: tuple[Callable[..., Any], ...] = (
+    abs,
+    all,
+    any,
+    bool,
+    dict,
+    divmod,
+    enumerate,
+    filter,
+    float,
+    frozenset,
+    int,
+    isinstance,
+    len,
+    list,
+    map,
+    max,
+    min,
+    ord,
+    range,
+    reversed,
+    round,
+    set,
+    sorted,
+    str,
+    sum,
+    tuple,
+    zip,
+)
+# Methods an expression may call: read-only for str; list.pop is xacro files' one mutation
+# (husky's pacs.urdf.xacro), on a list the file itself built.
+METHODS: dict[type, frozenset[str]] = {
+    str: frozenset(
+        [
+            "capitalize",
+            "casefold",
+            "count",
+            "endswith",
+            "find",
+            "index",
+            "isalnum",
+            "isalpha",
+            "isdigit",
+            "islower",
+            "isnumeric",
+            "isspace",
+            "isupper",
+            "join",
+            "lower",
+            "lstrip",
+            "partition",
+            "removeprefix",
+            "removesuffix",
+            "replace",
+            "rfind",
+            "rindex",
+            "rpartition",
+            "rsplit",
+            "rstrip",
+            "split",
+            "splitlines",
+            "startswith",
+            "strip",
+            "swapcase",
+            "title",
+            "upper",
+        ]
+    ),
+    list: frozenset(["count", "index", "pop", "copy"]),
+    tuple: frozenset(["count", "index"]),
+    dict: frozenset(["get", "keys", "values", "items", "copy"]),
+}
 _BINOPS: dict[type, Callable[[Any, Any], Any]] = {
     ast.Add: operator.add,
     ast.Sub: operator.sub,
@@ -136,6 +210,11 @@ class Evaluator:
         if node.attr.startswith("_"):
             raise ExprRefusedError(f"attribute {node.attr!r} is not allowed")
         base = self.eval(node.value)
+        kind = next((t for t in METHODS if isinstance(base, t)), None)
+        if kind is not None and hasattr(kind, node.attr):  # a method, as in Python (and xacro)
+            if node.attr not in METHODS[kind]:
+                raise ExprRefusedError(f"attribute access .{node.attr} on {kind.__name__}")
+            return Method(base, node.attr)
         if isinstance(base, dict):  # xacro namespaces (math., xacro., included ns) and YAML maps
             try:
                 return base[node.attr]
@@ -158,6 +237,11 @@ class Evaluator:
 
     def _Tuple(self, node: ast.Tuple) -> tuple[Any, ...]:
         return tuple(self.eval(e) for e in node.elts)
+
+    def _Dict(self, node: ast.Dict) -> dict[Any, Any]:
+        if any(k is None for k in node.keys):
+            raise ExprRefusedError("** unpacking is not allowed")
+        return {self.eval(k): self.eval(v) for k, v in zip(node.keys, node.values, strict=True)}  # type: ignore[arg-type]
 
     def _UnaryOp(self, node: ast.UnaryOp) -> Any:
         value = self.eval(node.operand)
@@ -204,14 +288,54 @@ class Evaluator:
 
     def _Call(self, node: ast.Call) -> Any:
         func = self.eval(node.func)
-        args = [self.eval(a) for a in node.args]
-        if node.keywords:
-            raise ExprRefusedError("keyword arguments are not allowed")
+        if any(isinstance(a, ast.Starred) for a in node.args) or any(
+            k.arg is None for k in node.keywords
+        ):
+            raise ExprRefusedError("* and ** unpacking are not allowed")
+        args = [self._argument(self.eval(a)) for a in node.args]
+        kwargs = {str(k.arg): self._argument(self.eval(k.value)) for k in node.keywords}
         if id(func) in self.calls:
-            return self.calls[id(func)](*args)
-        if id(func) not in self.allowed:
+            return self.calls[id(func)](*args, **kwargs)
+        if not self._allowed(func):
             raise ExprRefusedError(f"calling {getattr(func, '__name__', type(func).__name__)}")
-        return func(*args)
+        if func is range and len(range(*args)) > MAX_SEQUENCE:
+            raise ExprRefusedError(f"range longer than {MAX_SEQUENCE} items")
+        return func(*args, **kwargs)
+
+    def _allowed(self, func: Any) -> bool:
+        return isinstance(func, Method) or id(func) in self.allowed
+
+    def _argument(self, value: Any) -> Any:
+        """An argument value; a callable one must be allowed (map, sorted's key=, ...)."""
+        if callable(value):
+            if id(value) in self.calls:
+                return self.calls[id(value)]
+            if not self._allowed(value):
+                name = getattr(value, "__name__", type(value).__name__)
+                raise ExprRefusedError(f"passing {name} to a call")
+        return value
+
+
+class Method:
+    """A whitelisted method bound to its value (`'a b'.split`), with size bounds."""
+
+    def __init__(self, obj: Any, name: str) -> None:
+        self.obj = obj
+        self.name = name
+        self.__name__ = name
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        """Call the method after checking that its result stays within MAX_SEQUENCE."""
+        if self.name == "replace" and len(args) >= 2 and isinstance(args[1], str):
+            grows = self.obj.count(args[0]) * max(len(args[1]) - len(args[0]), 0)
+            if len(self.obj) + grows > MAX_SEQUENCE:
+                raise ExprRefusedError(f"result longer than {MAX_SEQUENCE} items")
+        if self.name == "join" and args:
+            items = list(args[0])
+            if sum(len(str(i)) + len(self.obj) for i in items) > MAX_SEQUENCE:
+                raise ExprRefusedError(f"result longer than {MAX_SEQUENCE} items")
+            args = (items, *args[1:])
+        return getattr(self.obj, self.name)(*args, **kwargs)
 
 
 def _check_sizes(op: ast.operator, left: Any, right: Any) -> None:

@@ -28,10 +28,13 @@ import sysconfig
 import time
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 from armcli.errors import InputError, XacroRefusedError
 from armcli.io.userfile import check_regular
+from armcli.urdf.xacro_args import XacroInputs
 from armcli.urdf.xacro_jail import jail_argv, sandbox_problem, seccomp_program
+from armcli.urdf.xacro_safe import request_json
 
 XACRO_TIMEOUT = 20.0  # wall clock [s]
 XACRO_CPU_SECONDS = 20
@@ -153,34 +156,42 @@ def _python() -> list[str]:
     return [sys.executable, "-I"]
 
 
-def expand_foreign(path: str | Path, roots: Sequence[Path]) -> bytes:
+def expand_foreign(path: str | Path, roots: Sequence[Path], request: str | None = None) -> bytes:
     """Safe-mode expansion (xacro_safe) of a foreign xacro file in a limited child."""
+    return run_safe(path, request or request_json(roots, XacroInputs()))[0]
+
+
+def run_safe(path: str | Path, request: str) -> tuple[bytes, dict[str, Any]]:
+    """xacro_safe's child on `path` with its JSON `request`: the URDF bytes and its report."""
     p = Path(path)
     check_regular(p, "xacro file")
-    argv = [*_python(), "-c", _SAFE_SCRIPT, str(p.resolve()), *map(str, roots)]
-    env = {"PATH": os.defpath, "LANG": "C.UTF-8"}
-    if "ROS_PACKAGE_PATH" in os.environ:  # $(find pkg) lookups, the ROS convention
-        env["ROS_PACKAGE_PATH"] = os.environ["ROS_PACKAGE_PATH"]
-    res = run_limited(argv, p.resolve().parent, env=env)
+    argv = [*_python(), "-c", _SAFE_SCRIPT, os.path.abspath(p), request]  # as given, like xacro
+    res = run_limited(argv, p.resolve().parent, env={"PATH": os.defpath, "LANG": "C.UTF-8"})
     if res.why is not None:
         raise InputError(f"xacro expansion {res.why}", file=p)
     if res.returncode != 0:
         _raise_report(p, res)
-    return res.out
+    return res.out, _report(res) or {}
+
+
+def _report(res: ChildResult) -> dict[str, Any] | None:
+    """The JSON object on the child's last stderr line (None when there is none)."""
+    lines = [ln for ln in res.err.decode("utf-8", "replace").splitlines() if ln.strip()]
+    try:
+        rep = json.loads(lines[-1]) if lines else None
+    except ValueError:
+        return None
+    return rep if isinstance(rep, dict) else None
 
 
 def _raise_report(p: Path, res: ChildResult) -> None:
-    lines = [ln for ln in res.err.decode("utf-8", "replace").splitlines() if ln.strip()]
-    if lines:
-        try:
-            rep = json.loads(lines[-1])
-        except ValueError:
-            rep = None
-        if isinstance(rep, dict) and "message" in rep:
-            cls = XacroRefusedError if rep.get("kind") == "refused" else InputError
-            file = rep.get("file") or str(p.resolve())
-            shown = p if file == str(p.resolve()) else file  # the path as the user gave it
-            raise cls(str(rep["message"]), file=shown, line=rep.get("line"))
+    rep = _report(res)
+    if rep is not None and "message" in rep:
+        cls = XacroRefusedError if rep.get("kind") == "refused" else InputError
+        file = rep.get("file") or os.path.abspath(p)
+        same = file in (str(p.resolve()), os.path.abspath(p))
+        shown = p if same else file  # the path as the user gave it
+        raise cls(str(rep["message"]), file=shown, line=rep.get("line"))
     why = _last_line(res) or f"exit status {res.returncode}"
     raise InputError(f"xacro expansion failed: {why}", file=p)
 

@@ -16,6 +16,7 @@ from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import Trust, read_robot, urdf_text
 from armcli.urdf.tool import ToolPoint, tool_point
 from armcli.urdf.tree import tree_from_urdf
+from armcli.urdf.xacro_args import XacroInputs
 
 ROBOT_HELP = (
     "Robot spec YAML, URDF file, or xacro file (with --trust-xacro); "
@@ -35,17 +36,22 @@ class RobotSource:
     poses: dict[str, dict[str, float]] = field(default_factory=dict)
     tool: ToolPoint | None = None
     search: MeshSearch = field(default_factory=MeshSearch)  # --package-dir
+    notes: tuple[str, ...] = ()  # what reading a xacro file reported (Urdf.notes)
 
 
 def load_robot(
-    path: Path, trust_xacro: Trust = False, search: MeshSearch | None = None
+    path: Path,
+    trust_xacro: Trust = False,
+    search: MeshSearch | None = None,
+    inputs: XacroInputs | None = None,
 ) -> RobotSource:
     """Spec YAML (built in memory), URDF or trusted xacro file -> RobotSource.
 
     Mesh URIs resolve with armcli.urdf.meshes (honouring `search`, the --package-dir
     options) and must stay inside the allowed roots; the tool point is armcli.urdf.tool's.
+    `inputs`: a xacro file's NAME:=VALUE arguments, --env and package lookup.
     """
-    robot = read_robot(path, trust_xacro=trust_xacro)
+    robot = read_robot(path, trust_xacro=trust_xacro, inputs=inputs)
     spec = robot.spec
     where = search or MeshSearch()
     if spec is not None:
@@ -69,6 +75,7 @@ def load_robot(
         joints=tuple(j.name for j in tree.movable()),
         tool=tool_point(urdf),
         search=where,
+        notes=urdf.notes,
     )
 
 

@@ -1,0 +1,92 @@
+"""What the rule families of `check` share for one file, and the stages they need.
+
+`run.py` builds one `Context` per URDF and hands it to each family of its registry. A
+family declares the stage it needs: `URDF` (the parsed document and its tree), `MODEL`
+(the Pinocchio model, loaded once and only while no error of a rule that `blocks` the
+model stands) or `DYNAMICS` (also no error of a rule that blocks the dynamics, such as a
+negative mass). Families write findings to `out`, notes to `notes`, and what later ones
+or the summary read (the gravity load in `rows`, the servo joints, the PD verdict) here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+from armcli.check.rules import RULES, CheckOptions, Collector, JointRow
+from armcli.check.structure import Tree
+from armcli.sim.stability import StabilityReport
+from armcli.urdf.doc import Urdf, position_bounds
+from armcli.urdf.pinocchio import JointRange
+
+Stage = Literal["urdf", "model", "dynamics"]
+URDF: Stage = "urdf"
+MODEL: Stage = "model"
+DYNAMICS: Stage = "dynamics"
+
+# Errors after which the model is not loaded (urdfdom would only repeat them: a NaN mass
+# came back as two parser errors, a nameless <robot> as model-load), and after which the
+# dynamics rules would compute with unusable numbers. Declared per rule in rules.py.
+BLOCKS_MODEL = frozenset(r.id for r in RULES.values() if r.blocks == MODEL)
+BLOCKS_DYNAMICS = BLOCKS_MODEL | {r.id for r in RULES.values() if r.blocks == DYNAMICS}
+MODEL_SKIPPED = "model checks skipped: fix the structure errors first"
+DYNAMICS_SKIPPED = "dynamics checks skipped: fix the number and inertia errors first"
+
+
+@dataclass
+class Context:
+    """One file under check: inputs, findings so far, and what earlier stages derived."""
+
+    urdf: Urdf
+    opts: CheckOptions
+    out: Collector
+    tree: Tree
+    notes: list[str] = field(default_factory=list)
+    rows: tuple[JointRow, ...] = ()  # the joint table; the gravity rule fills its load
+    model: Any = None  # pinocchio.Model, once loaded
+    data: Any = None  # its pinocchio.Data
+    ranges: list[JointRange] = field(default_factory=list)  # its 1-DoF joints
+    samples: list[tuple[dict[str, float], Any]] = field(default_factory=list)  # dynamics
+    servo: set[str] = field(default_factory=set)  # joints a position servo drives
+    stability: StabilityReport | None = None
+    stage: Stage | Literal["unloaded", "refused", "no-dynamics"] = "unloaded"
+
+
+def joint_rows(urdf: Urdf) -> tuple[JointRow, ...]:
+    """The summary's joint table: every joint that is not fixed, with its URDF numbers."""
+    rows = []
+    for j in urdf.joints:
+        if j.type in ("fixed", ""):
+            continue
+        lim = j.limit
+        lower, upper = position_bounds(j.type, lim) or (None, None)
+        rows.append(
+            JointRow(
+                j.name,
+                j.type,
+                lower,
+                upper,
+                lim.effort if lim else None,
+                lim.velocity if lim else None,
+                j.damping,
+                j.friction,
+            )
+        )
+    return tuple(rows)
+
+
+def poses(ctx: Context) -> list[tuple[str, dict[str, float]]]:
+    """Named poses of the spec (or q = 0), then every joint at its lower and upper limit."""
+    out: list[tuple[str, dict[str, float]]] = []
+    spec = ctx.opts.spec
+    if spec is not None and spec.poses:
+        names = {jr.name for jr in ctx.ranges}
+        for name in spec.poses:
+            out.append((name, {k: v for k, v in spec.pose(name).items() if k in names}))
+    else:
+        out.append(("zero", {jr.name: 0.0 for jr in ctx.ranges}))
+    limited = [jr for jr in ctx.ranges if not jr.continuous]
+    if limited:
+        out.append(("lower", {jr.name: jr.lower for jr in limited}))
+        out.append(("upper", {jr.name: jr.upper for jr in limited}))
+    return out

@@ -1,0 +1,337 @@
+"""`simulate --output run.mcap`: the run as a rosbag2 MCAP file that ROS tools open.
+
+Topics, stamped in simulated time from 0 at the output rate (the CSV's rows, same numbers):
+
+- `/joint_states` (sensor_msgs/msg/JointState): position, velocity, effort of the simulated
+  joints;
+- `/joint_states_reference` (sensor_msgs/msg/JointState): the position being tracked;
+- `/tf` (tf2_msgs/msg/TFMessage): parent -> child of every moving joint;
+- `/tf_static` (tf2_msgs/msg/TFMessage): the fixed joints, once (transient local);
+- `/robot_description` (std_msgs/msg/String): the simulated URDF, once (transient local).
+
+As rosbag2 records them: MCAP profile `ros2`, schema encoding `ros2msg` with the ROS 2
+Jazzy `.msg` texts (armcli/data/ros2_msgs) concatenated the way rosbag2's
+LocalMessageDefinitionSource does, message encoding `cdr`, and each channel's
+`offered_qos_profiles`. Nothing depends on the wall clock: the same run gives the same bytes.
+`load_replay` reads a file back for `view --replay`.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import re
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from armcli.errors import InputError
+from armcli.io.files import write_file_atomic
+from armcli.sim.simulate import SimResult
+from armcli.sim.states import TIME, Replay, column, sample_states
+from armcli.urdf.doc import Joint, Urdf
+
+MCAP_SUFFIX = ".mcap"
+PROFILE = "ros2"
+SCHEMA_ENCODING = "ros2msg"
+MESSAGE_ENCODING = "cdr"
+JOINT_STATE = "sensor_msgs/msg/JointState"
+TF_MESSAGE = "tf2_msgs/msg/TFMessage"
+STRING = "std_msgs/msg/String"
+JOINT_STATES, REFERENCE = "/joint_states", "/joint_states_reference"
+TF, TF_STATIC, DESCRIPTION = "/tf", "/tf_static", "/robot_description"
+MAX_REPLAY_BYTES = 1_000_000_000
+
+
+def is_mcap(path: Path) -> bool:
+    """Whether `path` names an MCAP file (by its extension)."""
+    return path.suffix.lower() == MCAP_SUFFIX
+
+
+# -- message definitions, as rosbag2 writes them ---------------------------------------------
+
+_DELIMITER = "=" * 80 + "\n"
+_PRIMITIVES = {"bool", "byte", "char", "float32", "float64", "int8", "uint8", "int16",
+               "uint16", "int32", "uint32", "int64", "uint64", "string"}  # fmt: skip
+_FIELD_TYPE = re.compile(r"(?:^|\n)\s*([a-zA-Z0-9_/]+)(?:\[[^\]]*\])?\s+")  # rosbag2's regex
+_TYPENAME = re.compile(r"^([a-zA-Z0-9_]+)/(?:msg/)?([a-zA-Z0-9_]+)$")
+
+
+def _msg_text(datatype: str) -> tuple[str, str]:
+    """(package, .msg text) of `pkg/msg/Name` or `pkg/Name` from armcli's copies."""
+    m = _TYPENAME.match(datatype)
+    if m is None:
+        raise ValueError(f"not a message type name: {datatype!r}")
+    pkg, name = m.groups()
+    ref = resources.files("armcli") / "data" / "ros2_msgs" / pkg / "msg" / f"{name}.msg"
+    return pkg, ref.read_text(encoding="utf-8")
+
+
+def _dependencies(text: str, package: str) -> list[str]:
+    """Non-primitive field types, package-qualified, sorted (rosbag2's std::set order)."""
+    deps = set()
+    for m in _FIELD_TYPE.finditer(text):
+        name = m.group(1)
+        if name not in _PRIMITIVES:
+            deps.add(name if "/" in name else f"{package}/{name}")
+    return sorted(deps)
+
+
+def message_definition(datatype: str) -> str:
+    """The full text rosbag2 stores as the schema of `datatype` (dependencies appended)."""
+    seen: set[str] = set()
+
+    def append(name: str) -> str:
+        pkg, text = _msg_text(name)
+        out = text
+        for dep in _dependencies(text, pkg):
+            if dep not in seen:
+                seen.add(dep)
+                out += "\n" + _DELIMITER + "MSG: " + dep + "\n" + append(dep)
+        return out
+
+    return append(datatype)
+
+
+# -- QoS, as rosbag2 records what a publisher offered (integer enums: bag format <= 8) -------
+
+_INFINITE = {"sec": 9223372036, "nsec": 854775807}  # RMW_DURATION_INFINITE
+
+
+def _qos(depth: int, transient_local: bool) -> str:
+    """`offered_qos_profiles` YAML: reliable, keep last `depth`, volatile or transient local."""
+    import yaml
+
+    profile = {
+        "history": 1,  # KEEP_LAST
+        "depth": depth,
+        "reliability": 1,  # RELIABLE
+        "durability": 1 if transient_local else 2,  # TRANSIENT_LOCAL | VOLATILE
+        "deadline": _INFINITE,
+        "lifespan": _INFINITE,
+        "liveliness": 1,  # AUTOMATIC
+        "liveliness_lease_duration": _INFINITE,
+        "avoid_ros_namespace_conventions": False,
+    }
+    return str(yaml.safe_dump([profile], sort_keys=False))
+
+
+# -- transforms of the URDF's joints --------------------------------------------------------
+
+
+def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product of (x, y, z, w) quaternions."""
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return np.array([
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    ])  # fmt: skip
+
+
+def _quat_axis(axis: np.ndarray, angle: float) -> np.ndarray:
+    s = math.sin(angle / 2.0)
+    return np.array([axis[0] * s, axis[1] * s, axis[2] * s, math.cos(angle / 2.0)])
+
+
+def quat_rpy(rpy: Sequence[float]) -> np.ndarray:
+    """URDF's fixed-axis roll, pitch, yaw (R = Rz(y) Ry(p) Rx(r)) as (x, y, z, w)."""
+    r, p, y = rpy
+    qx = _quat_axis(np.array([1.0, 0.0, 0.0]), r)
+    qy = _quat_axis(np.array([0.0, 1.0, 0.0]), p)
+    qz = _quat_axis(np.array([0.0, 0.0, 1.0]), y)
+    return _quat_mul(qz, _quat_mul(qy, qx))
+
+
+def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    u, w = q[:3], q[3]
+    return np.asarray(v + 2.0 * np.cross(u, np.cross(u, v) + w * v), dtype=float)
+
+
+def joint_transform(j: Joint, value: float) -> tuple[np.ndarray, np.ndarray]:
+    """(translation [m], rotation (x, y, z, w)) of the child link in the parent link at `value`."""
+    xyz = np.array(j.origin.xyz, dtype=float)
+    rot = quat_rpy(j.origin.rpy)
+    if j.type == "fixed" or not j.movable:
+        return xyz, rot
+    axis = np.array(j.axis or (1.0, 0.0, 0.0), dtype=float)
+    axis = axis / np.linalg.norm(axis)
+    if j.type == "prismatic":
+        return xyz + _rotate(rot, axis * value), rot
+    return xyz, _quat_mul(rot, _quat_axis(axis, value))
+
+
+# -- messages --------------------------------------------------------------------------------
+
+
+def _stamp(ns: int) -> dict[str, int]:
+    return {"sec": ns // 1_000_000_000, "nanosec": ns % 1_000_000_000}
+
+
+def _transform(j: Joint, value: float, ns: int) -> dict[str, Any]:
+    t, r = joint_transform(j, value)
+    return {
+        "header": {"stamp": _stamp(ns), "frame_id": j.parent},
+        "child_frame_id": j.child,
+        "transform": {
+            "translation": dict(zip("xyz", map(float, t), strict=True)),
+            "rotation": dict(zip("xyzw", map(float, r), strict=True)),
+        },
+    }
+
+
+def _joint_state(ns: int, names: Sequence[str], **arrays: Sequence[float]) -> dict[str, Any]:
+    msg: dict[str, Any] = {"header": {"stamp": _stamp(ns), "frame_id": ""}, "name": list(names)}
+    for key in ("position", "velocity", "effort"):
+        msg[key] = [float(x) for x in arrays.get(key, [])]
+    return msg
+
+
+@dataclass(frozen=True)
+class Channel:
+    """One topic: its type, QoS and the (log time [ns], message) pairs written on it."""
+
+    topic: str
+    datatype: str
+    qos: str
+    messages: list[tuple[int, dict[str, Any]]]
+
+
+def channels(cols: Mapping[str, np.ndarray], names: Sequence[str], urdf: Urdf) -> list[Channel]:
+    """Every topic of the file from the sampled states `cols` (sim.states' columns)."""
+    stamps = [round(float(t) * 1e9) for t in cols[TIME]]
+    state, ref, tf = [], [], []
+    moving = [j for j in urdf.joints if j.type != "fixed" and j.movable]
+    for k, ns in enumerate(stamps):
+        values = {n: float(cols[column(n, "position")][k]) for n in names}
+        state.append((ns, _joint_state(
+            ns, names, **{f: [cols[column(n, f)][k] for n in names]
+                          for f in ("position", "velocity", "effort")},
+        )))  # fmt: skip
+        ref.append((ns, _joint_state(ns, names, position=[cols[column(n, "reference")][k]
+                                                          for n in names])))  # fmt: skip
+        tf.append((ns, {"transforms": [_transform(j, values.get(j.name, 0.0), ns)
+                                       for j in moving]}))  # fmt: skip
+    fixed = [j for j in urdf.joints if j.type == "fixed"]
+    start = stamps[0]
+    text = urdf.text.decode("utf-8")
+    return [
+        Channel(DESCRIPTION, STRING, _qos(1, True), [(start, {"data": text})]),
+        Channel(TF_STATIC, TF_MESSAGE, _qos(1, True),
+                [(start, {"transforms": [_transform(j, 0.0, start) for j in fixed]})]),
+        Channel(JOINT_STATES, JOINT_STATE, _qos(10, False), state),
+        Channel(REFERENCE, JOINT_STATE, _qos(10, False), ref),
+        Channel(TF, TF_MESSAGE, _qos(100, False), tf),
+    ]  # fmt: skip
+
+
+def mcap_bytes(chans: Sequence[Channel]) -> bytes:
+    """The MCAP file: schemas, channels, then the messages in time order (ties: topic order)."""
+    from mcap.writer import CompressionType, Writer
+    from mcap_ros2._dynamic import serialize_dynamic
+
+    from armcli import __version__
+
+    buf = io.BytesIO()
+    writer = Writer(buf, compression=CompressionType.ZSTD)
+    writer.start(profile=PROFILE, library=f"armcli {__version__}")
+    schema_ids: dict[str, int] = {}
+    encoders: dict[str, Any] = {}
+    ids = []
+    for ch in chans:
+        if ch.datatype not in schema_ids:
+            text = message_definition(ch.datatype)
+            schema_ids[ch.datatype] = writer.register_schema(
+                name=ch.datatype, encoding=SCHEMA_ENCODING, data=text.encode("utf-8")
+            )
+            encoders[ch.datatype] = serialize_dynamic(ch.datatype, text)[ch.datatype]
+        ids.append(
+            writer.register_channel(
+                topic=ch.topic,
+                message_encoding=MESSAGE_ENCODING,
+                schema_id=schema_ids[ch.datatype],
+                metadata={"offered_qos_profiles": ch.qos},
+            )
+        )
+    for ns, rank, k, msg in sorted(_messages(chans), key=lambda m: m[:3]):
+        data = encoders[chans[rank].datatype](msg)
+        writer.add_message(ids[rank], log_time=ns, data=data, publish_time=ns, sequence=k)
+    writer.finish()  # type: ignore[no-untyped-call]
+    return buf.getvalue()
+
+
+def _messages(chans: Sequence[Channel]) -> Iterator[tuple[int, int, int, dict[str, Any]]]:
+    for rank, ch in enumerate(chans):
+        for k, (ns, msg) in enumerate(ch.messages):
+            yield ns, rank, k, msg
+
+
+def run_mcap_bytes(res: SimResult, rate: float, urdf: Urdf | None) -> bytes:
+    """The run sampled at `rate` [Hz] as the bytes of a rosbag2 MCAP file."""
+    if urdf is None:
+        raise ValueError("an MCAP file needs the simulated robot description")
+    cols = sample_states(res, rate)
+    return mcap_bytes(channels(cols, res.joint_names, urdf))
+
+
+def write_mcap(path: Path, res: SimResult, rate: float, urdf: Urdf | None) -> None:
+    """Write the run sampled at `rate` [Hz] as a rosbag2 MCAP file, atomically."""
+    write_file_atomic(path, run_mcap_bytes(res, rate, urdf))
+
+
+# -- reader ----------------------------------------------------------------------------------
+
+
+def load_replay(path: str | Path, joints: Sequence[str]) -> Replay:
+    """Joint positions (and the reference) over time from a `simulate` MCAP, for `joints`.
+
+    Reads `/joint_states` (and `/joint_states_reference` when present) of any rosbag2 MCAP;
+    joints not in `joints` are ignored, as robot_state_publisher does.
+    """
+    from mcap.exceptions import McapError
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+
+    source = str(path)
+    rows: dict[str, list[tuple[float, dict[str, float]]]] = {JOINT_STATES: [], REFERENCE: []}
+    try:
+        with open(path, "rb") as fh:
+            reader = make_reader(fh, decoder_factories=[DecoderFactory()])
+            for _, channel, _raw, msg in reader.iter_decoded_messages(
+                topics=[JOINT_STATES, REFERENCE]
+            ):
+                t = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+                known = {n: float(x) for n, x in zip(msg.name, msg.position, strict=False)}
+                rows[channel.topic].append((t, {n: v for n, v in known.items() if n in joints}))
+    except (McapError, OSError, ValueError, KeyError) as exc:
+        raise InputError(f"unreadable MCAP file: {exc}", file=source) from None
+    if not rows[JOINT_STATES]:
+        raise InputError(f"no {JOINT_STATES} messages", file=source)
+    return _replay(source, rows[JOINT_STATES], rows[REFERENCE])
+
+
+def _replay(
+    source: str,
+    states: list[tuple[float, dict[str, float]]],
+    refs: list[tuple[float, dict[str, float]]],
+) -> Replay:
+    time = np.array([t for t, _ in states])
+    if np.any(np.diff(time) <= 0):
+        raise InputError(f"{JOINT_STATES} stamps must increase", file=source)
+    names = sorted({n for _, v in states for n in v})
+    if not names:
+        raise InputError(f"{JOINT_STATES} names none of this robot's joints", file=source)
+    position = {n: np.array([v.get(n, math.nan) for _, v in states]) for n in names}
+    reference: dict[str, np.ndarray] = {}
+    if refs:
+        at = {round(t * 1e9): v for t, v in refs}
+        reference = {
+            n: np.array([at.get(round(t * 1e9), {}).get(n, math.nan) for t in time]) for n in names
+        }
+    return Replay(source=source, time=time, position=position, reference=reference)
