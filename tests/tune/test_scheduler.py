@@ -76,7 +76,7 @@ def test_a_server_that_is_not_dask_is_a_clean_error(not_dask: str) -> None:
 def test_plain_remote_scheduler_needs_trust(address: str) -> None:
     start = time.monotonic()
     with pytest.raises(
-        InputError, match="not encrypted and not on this machine.*--trust-scheduler"
+        InputError, match=r"not encrypted and not on this machine.*--trust-scheduler"
     ):
         make_engine(1, address)
     assert time.monotonic() - start < REFUSE_FAST_S  # refused before connecting
@@ -91,5 +91,5 @@ def test_loopback_and_tls_need_no_trust(address: str) -> None:
 
 
 def test_trusted_remote_scheduler_is_tried() -> None:
-    with pytest.raises(InputError, match="cannot reach the Dask scheduler at tcp://192.0.2.1"):
+    with pytest.raises(InputError, match=r"cannot reach the Dask scheduler at tcp://192\.0\.2\.1"):
         make_engine(1, "tcp://192.0.2.1:8786", trust_scheduler=True)  # TEST-NET-1: unroutable
