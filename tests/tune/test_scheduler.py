@@ -53,19 +53,21 @@ def _server(first_bytes: bytes | None) -> Iterator[str]:
 
 
 @pytest.fixture(params=["ssh-banner", "huge-length", "silent"])
-def not_dask(request: pytest.FixtureRequest) -> Iterator[str]:
-    first = {
-        "ssh-banner": b"SSH-2.0-OpenSSH_9.2p1 Debian-2\r\n",
-        "huge-length": struct.pack("<Q", 3 << 60),
-        "silent": None,
+def not_dask(request: pytest.FixtureRequest) -> Iterator[tuple[str, str]]:
+    first, said = {
+        "ssh-banner": (b"SSH-2.0-OpenSSH_9.2p1 Debian-2\r\n", "does not answer as a Dask"),
+        "huge-length": (struct.pack("<Q", 3 << 60), "does not answer as a Dask"),
+        "silent": (None, "cannot reach the Dask scheduler .* within 3 s"),
     }[request.param]
-    yield from _server(first)
+    for address in _server(first):
+        yield address, said
 
 
-def test_a_server_that_is_not_dask_is_a_clean_error(not_dask: str) -> None:
+def test_a_server_that_is_not_dask_is_a_clean_error(not_dask: tuple[str, str]) -> None:
+    address, said = not_dask
     start = time.monotonic()
-    with pytest.raises(InputError, match="does not answer as a Dask scheduler"):
-        make_engine(1, not_dask)  # before: internal error: MemoryError
+    with pytest.raises(InputError, match=said):
+        make_engine(1, address)  # before: internal error: MemoryError
     assert time.monotonic() - start < CONNECT_TIMEOUT_S + 2.0
 
 

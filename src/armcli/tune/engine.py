@@ -171,7 +171,8 @@ def check_scheduler_address(address: str, trusted: bool) -> None:
 def _raw_probe(host: str, port: int, timeout: float) -> None:
     """Read the first 8 bytes the peer sends: a Dask comm's handshake length, sent unasked.
 
-    A server that stays silent or announces a message of gigabytes is not a Dask scheduler.
+    A server that stays silent is unreachable (TimeoutError); one that announces a message
+    of gigabytes is not a Dask scheduler.
     """
     with socket.create_connection((host, port), timeout=timeout) as sock:
         head = b""
@@ -181,9 +182,9 @@ def _raw_probe(host: str, port: int, timeout: float) -> None:
             try:
                 chunk = sock.recv(8 - len(head))
             except TimeoutError:
-                raise _NotDaskError("it sent nothing") from None
+                raise TimeoutError("no answer") from None  # reported as unreachable
             if not chunk:
-                raise _NotDaskError("it closed the connection")
+                raise ConnectionResetError("the connection was closed before the handshake")
             head += chunk
     (size,) = struct.unpack("<Q", head)
     if size > MAX_HANDSHAKE_BYTES:
