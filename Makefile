@@ -53,7 +53,7 @@ test: install sysdeps lint native-check
 
 # Rebuild the compiled rollout after editing its C++ (the editable install does not rebuild
 # on import): incremental, in build/, with the build tools of the dev extra.
-native: install
+native: | $(STAMP)
 	@echo "native: recompiling the engine (armcli.sim._rollout)"
 	$(BIN)/python -m pip install -q --no-build-isolation --no-deps -e .
 	$(BIN)/python -m armcli.sim.native
@@ -63,7 +63,7 @@ native: install
 native-check: install
 	@if command -v c++ >/dev/null 2>&1 || command -v g++ >/dev/null 2>&1; then \
 	  $(BIN)/python -m armcli.sim.native; \
-	else echo "no C++ compiler: armcli uses its Python engine; compiled-engine tests skip"; fi
+	else echo "no C++ compiler: armcli installs without its simulator; simulator tests skip"; fi
 
 bench: install native-check
 	$(BIN)/python bench/bench_sim.py

@@ -1,20 +1,29 @@
-"""Benchmark: the whole `armcli simulate` process vs the equivalent MuJoCo script.
+"""Benchmark: the whole `armcli simulate --urdf` process vs the equivalent MuJoCo script.
 
-A 120 s pick-like trajectory at dt = 0.5 ms (240,000 steps) on the standalone arm, PD
-gains Kp 50, Kd 5. Each side runs as a fresh process, as a user would run it; the same
-command with a one-step duration measures imports and set-up, which are then cut to give
-the stepping cost alone. Run with `make bench` (or `python bench/bench_process.py
-[--quick]`). Not a test: numbers depend on the machine and its load.
+1. Whole process: a 120 s pick-like trajectory at dt = 0.5 ms (240,000 steps) on the
+   standalone arm, PD gains Kp 50, Kd 5, each side a fresh process as a user runs it, in
+   turn (A B A B ...) so the ratio is taken pair by pair. The same commands for one step
+   give the set-up (imports, model, checks), which is cut to give the stepping alone.
+2. Peak memory (the process's max RSS) of both, and of armcli on 1.8 M steps (900 s at
+   0.5 ms) writing its states at 10 Hz: memory follows the output rate, not the steps.
+3. Start-up: `armcli simulate --help` next to `python -c pass`, and what importing the
+   simulate command costs, by module (`python -X importtime`).
+
+Run with `make bench` (or `python bench/bench_process.py [--quick]`). Not a test: numbers
+depend on the machine and its load.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import re
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -60,58 +69,107 @@ def trajectory(duration: float) -> tuple[str, list[tuple[float, float, float]]]:
     return "\n".join(lines) + "\n", knots
 
 
-def timed(cmd: list[str], repeats: int) -> float:
-    times = []
+def run_once(cmd: list[str]) -> tuple[float, float]:
+    """Wall seconds and peak RSS [MiB] of one process (the kernel's accounting)."""
+    start = time.perf_counter()
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - start
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    if proc.returncode != 0:
+        raise SystemExit(f"failed ({proc.returncode}): {' '.join(cmd)}")
+    return wall, usage.ru_maxrss / 1024.0
+
+
+def paired(a: list[str], b: list[str], repeats: int) -> tuple[list[float], list[float], float]:
+    """A and B in turn; medians of their runs [s], and the median of the pairwise ratios."""
+    ta, tb = [], []
     for _ in range(repeats):
-        t = time.perf_counter()
-        subprocess.run(cmd, check=True, capture_output=True)
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
+        ta.append(run_once(a)[0])
+        tb.append(run_once(b)[0])
+    ratio = statistics.median(x / y for x, y in zip(ta, tb, strict=True))
+    return ta, tb, ratio
+
+
+def whole_process(
+    repeats: int, armcli: Callable[[float], list[str]], mujoco: Callable[[float], list[str]]
+) -> None:
+    duration = 120.0
+    steps = round(duration / DT)
+    ta, tb, ratio = paired(armcli(duration), mujoco(duration), repeats)
+    sa, sb, _ = paired(armcli(DT), mujoco(DT), repeats)
+    med = statistics.median
+    cut = (med(ta) - med(sa)) / (med(tb) - med(sb))
+    print(f"\nwhole process, {duration:g} s trajectory at dt = {DT} s ({steps} steps), "
+          f"median of {repeats} pairs")  # fmt: skip
+    head = ("process", "total [s]", "set-up [s]", "µs/step", "peak [MiB]")
+    print("  ".join(f"{c:>11}" if i else f"{c:<34}" for i, c in enumerate(head)))
+    for name, tot, setup, cmd in (
+        ("MuJoCo script (PD in Python)", tb, sb, mujoco(duration)),
+        ("armcli simulate --urdf", ta, sa, armcli(duration)),
+    ):
+        peak = run_once(cmd)[1]
+        cells = (name, f"{med(tot):.2f}", f"{med(setup):.2f}",
+                 f"{(med(tot) - med(setup)) / steps * 1e6:.2f}", f"{peak:.0f}")  # fmt: skip
+        print("  ".join(f"{c:>11}" if i else f"{c:<34}" for i, c in enumerate(cells)))
+    print(f"armcli / MuJoCo, whole process: {ratio:.3f}x (pairwise median; target <= 0.3x)")
+    print(f"armcli / MuJoCo, stepping alone (set-up cut): {cut:.3f}x")
+
+
+def memory(armcli: Callable[..., list[str]], out: Path) -> None:
+    """Peak RSS of a 1.8 M-step run writing its states at 10 Hz."""
+    steps = 1_800_000
+    wall, peak = run_once(armcli(steps * DT, "--output", str(out), "--rate", "10"))
+    short_wall, short_peak = run_once(armcli(DT))
+    print(f"\n{steps:,} steps (--duration {steps * DT:g} at dt = {DT}), states at 10 Hz:")
+    print(f"  peak {peak:.0f} MiB ({short_peak:.0f} MiB for one step); {wall:.2f} s "
+          f"({(wall - short_wall) / steps * 1e6:.2f} µs/step)")  # fmt: skip
+
+
+def startup(repeats: int) -> None:
+    """`simulate --help` vs `python -c pass`, and the import cost by module."""
+    help_cmd = [str(BIN / "armcli"), "simulate", "--help"]
+    bare = [sys.executable, "-c", "pass"]
+    th, tp, _ = paired(help_cmd, bare, repeats)
+    print(f"\nstart-up: `armcli simulate --help` {statistics.median(th):.3f} s, "
+          f"`python -c pass` {statistics.median(tp):.3f} s")  # fmt: skip
+    for module in ("armcli.commands.simulate", "armcli.check.gate", "pinocchio"):
+        r = subprocess.run([sys.executable, "-X", "importtime", "-c", f"import {module}"],
+                           capture_output=True, text=True, check=True)  # fmt: skip
+        rows = [m.groups() for m in re.finditer(r"\|\s*(\d+) \|\s*(\S.*)$", r.stderr, re.M)]
+        total = max(int(cum) for cum, _ in rows) / 1e6
+        heavy = sorted(((int(c), n.strip()) for c, n in rows if not n.startswith(" ")),
+                       reverse=True)[:4]  # fmt: skip
+        tops = ", ".join(f"{n} {c / 1e6:.3f}" for c, n in heavy)
+        print(f"  import {module}: {total:.3f} s (top level: {tops})")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="one repeat")
     args = ap.parse_args()
-    reps = 1 if args.quick else 3
-    duration = 120.0
+    reps = 1 if args.quick else 5
     urdf = ROOT / "urdf" / "standalone_arm.urdf"
-    text, knots = trajectory(duration)
+    text, knots = trajectory(900.0)
     with tempfile.TemporaryDirectory() as tmp:
         traj = Path(tmp) / "long.yaml"
         traj.write_text(text, encoding="utf-8")
         script = Path(tmp) / "mujoco_pd.py"
         script.write_text(MUJOCO_SCRIPT.format(dt=DT, kp=KP, kd=KD, knots=knots), "utf-8")
 
-        def armcli(engine: str, secs: float) -> list[str]:
+        def armcli(secs: float, *extra: str) -> list[str]:
             return [
                 str(BIN / "armcli"), "simulate", "--urdf", str(urdf), "--trajectory", str(traj),
                 "--dt", str(DT), "--duration", str(secs), "--kp", str(KP), "--kd", str(KD),
-                "--engine", engine,
+                *extra,
             ]  # fmt: skip
 
         def mujoco(secs: float) -> list[str]:
             return [sys.executable, str(script), str(urdf), str(secs)]
 
-        rows = {}
-        for name, make in (
-            ("MuJoCo script (PD in Python)", mujoco),
-            ("armcli simulate, compiled", lambda s: armcli("native", s)),
-            ("armcli simulate, Python engine", lambda s: armcli("python", s)),
-        ):
-            total = timed(make(duration), reps)
-            setup = timed(make(DT), reps)
-            rows[name] = (total, setup)
-    steps = round(duration / DT)
-    mj_total, mj_setup = rows["MuJoCo script (PD in Python)"]
-    print(f"\nwhole process, {duration:g} s trajectory at dt = {DT} s ({steps} steps)")
-    head = ("process", "total [s]", "set-up [s]", "x MuJoCo", "cut x MuJoCo", "µs/step")
-    print("  ".join(f"{c:>12}" if i else f"{c:<32}" for i, c in enumerate(head)))
-    for name, (total, setup) in rows.items():
-        cut = (total - setup) / (mj_total - mj_setup)
-        cells = (name, f"{total:.2f}", f"{setup:.2f}", f"{total / mj_total:.3f}", f"{cut:.3f}",
-                 f"{(total - setup) / steps * 1e6:.2f}")  # fmt: skip
-        print("  ".join(f"{c:>12}" if i else f"{c:<32}" for i, c in enumerate(cells)))
+        whole_process(reps, armcli, mujoco)
+        memory(armcli, Path(tmp) / "states.csv")
+    startup(reps)
 
 
 if __name__ == "__main__":

@@ -1,10 +1,10 @@
-"""Benchmark: armcli's step loop vs MuJoCo driven from Python, same model/trajectory/dt.
+"""Benchmark: armcli's compiled step vs MuJoCo driven from Python, same model/trajectory/dt.
 
 Run with `make bench` (or `python bench/bench_sim.py [--quick]`). Prints µs per step
-(medians of repeats, CPU time of this process) and the ratio to MuJoCo's Python loop for
-each engine, the maximum deviation between armcli and MuJoCo, and the cost per step of a
-batch of independent rollouts on 1 and 2 threads. Not a test: numbers depend on the
-machine and its load.
+(medians of repeats, CPU time of this process) and the ratio to MuJoCo's Python loop,
+the maximum deviation between armcli and MuJoCo, and the cost per step of a batch of
+independent rollouts on 1 and 2 threads. Not a test: numbers depend on the machine and
+its load.
 """
 
 from __future__ import annotations
@@ -26,10 +26,12 @@ from armcli.sim import native  # noqa: E402
 from armcli.sim import rollout as ro  # noqa: E402
 from armcli.sim.reference import build_reference  # noqa: E402
 from armcli.sim.simulate import (  # noqa: E402
+    Run,
     SimConfig,
     arm_from_model,
-    params_of,
+    plant_of,
     simulate,
+    simulate_batch,
 )
 from armcli.sim.trajectory import loads_trajectory  # noqa: E402
 from armcli.urdf.pinocchio import load_model  # noqa: E402
@@ -139,34 +141,34 @@ def timed(fn, repeats: int, clock=time.process_time) -> float:
     return statistics.median(times)
 
 
-def refs(reference, steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    q_ref, v_ref = reference.sample(np.arange(steps + 1) * DT)
-    return q_ref, v_ref, np.ascontiguousarray(np.hstack([q_ref, v_ref]))
+def refs(reference, steps: int) -> tuple[np.ndarray, np.ndarray]:
+    return reference.sample(np.arange(steps + 1) * DT)
 
 
 def row(*cells: object) -> str:
     return "  ".join(f"{c:>14}" if i else f"{c:<38}" for i, c in enumerate(cells))
 
 
-def per_step(args, mod, arm, reference, plant, m, m_c) -> float:
-    """µs per step of each engine on the same 10 s run; returns MuJoCo's loop time."""
+def engine_only(plant, reference, steps: int) -> None:
+    """The compiled rollout alone, keeping only the last state."""
+    ro.run(plant, reference, Q0, np.zeros(2), steps, record=np.array([steps]))
+
+
+def per_step(args, arm, reference, plant, m, m_c) -> float:
+    """µs per step on the same 10 s run; returns MuJoCo's loop time."""
     reps = 3 if args.quick else 5
     steps = 10_000
-    q_ref, v_ref, ref = refs(reference, steps)
+    q_ref, v_ref = refs(reference, steps)
     cfg = SimConfig(np.full(2, KP), np.full(2, KD), dt=DT)
     t_mj = timed(lambda: mujoco_loop(m, q_ref, v_ref, Q0), reps) / steps
     t_mjc = timed(lambda: mujoco_c_rollout(m_c, q_ref, v_ref), reps) / steps
-    rows = [("MuJoCo mj_step, PD in Python", t_mj), ("MuJoCo mujoco.rollout (C)", t_mjc)]
-    if mod is not None:
-        t_nat = timed(lambda: native.rollout(mod, plant, Q0, np.zeros(2), ref), reps) / steps
-        t_sim = timed(lambda: simulate(arm, reference, Q0, steps * DT, cfg), reps) / steps
-        rows += [("armcli compiled rollout", t_nat), ("armcli simulate() compiled, all-in", t_sim)]
-    t_py = timed(lambda: ro.rollout_python(plant, Q0, np.zeros(2), ref), 1 if args.quick else 3)
-    py_cfg = replace(cfg, backend="python")
-    t_sim_py = timed(lambda: simulate(arm, reference, Q0, steps * DT, py_cfg), 1) / steps
-    rows += [
-        ("armcli Python loop (fallback)", t_py / steps),
-        ("armcli simulate() Python, all-in", t_sim_py),
+    t_nat = timed(lambda: engine_only(plant, reference, steps), reps) / steps
+    t_sim = timed(lambda: simulate(arm, reference, Q0, steps * DT, cfg), reps) / steps
+    rows = [
+        ("MuJoCo mj_step, PD in Python", t_mj),
+        ("MuJoCo mujoco.rollout (C)", t_mjc),
+        ("armcli compiled rollout", t_nat),
+        ("armcli simulate(), every step kept", t_sim),
     ]
     print(f"\nsame model (standalone arm), trajectory (5 points, {steps * DT:g} s), dt = {DT} s")
     print("friction off (MuJoCo's frictionloss is a soft constraint; this is the like-for-like)")
@@ -176,25 +178,19 @@ def per_step(args, mod, arm, reference, plant, m, m_c) -> float:
     return t_mj
 
 
-def per_step_friction(args, mod, urdf: Path, reference) -> None:
+def per_step_friction(args, urdf: Path, reference) -> None:
     """The seed arm as its URDF has it: Coulomb friction 0.05 N·m on both joints."""
     reps = 3 if args.quick else 5
     steps = 10_000
-    q_ref, v_ref, ref = refs(reference, steps)
+    q_ref, v_ref = refs(reference, steps)
     arm_f, _ = setup(urdf, friction=True)
-    cfg = SimConfig(np.full(2, KP), np.full(2, KD), dt=DT)
-    plant = ro.Plant(arm_f.model, params_of(arm_f, cfg), False, DT, "euler", math.inf)
+    plant = plant_of(arm_f, SimConfig(np.full(2, KP), np.full(2, KD), dt=DT))
     m_f = mujoco_model(urdf, friction=True)
     t_mj = timed(lambda: mujoco_loop(m_f, q_ref, v_ref, Q0), reps) / steps
-    rows = [("MuJoCo mj_step, PD in Python", t_mj)]
-    if mod is not None:
-        t_nat = timed(lambda: native.rollout(mod, plant, Q0, np.zeros(2), ref), reps) / steps
-        rows.append(("armcli compiled rollout", t_nat))
-    t_py = timed(lambda: ro.rollout_python(plant, Q0, np.zeros(2), ref), 1 if args.quick else 3)
-    rows.append(("armcli Python loop (fallback)", t_py / steps))
+    t_nat = timed(lambda: engine_only(plant, reference, steps), reps) / steps
     print("\nfriction on (URDF: 0.05 N·m per joint; MuJoCo frictionloss)")
     print(row("engine", "µs/step", "x MuJoCo loop"))
-    for name, t in rows:
+    for name, t in (("MuJoCo mj_step, PD in Python", t_mj), ("armcli compiled rollout", t_nat)):
         print(row(name, f"{t * 1e6:.2f}", f"{t / t_mj:.3f}"))
 
 
@@ -212,15 +208,16 @@ def agreement(arm, reference, urdf: Path, m, m_c) -> None:
     print(f"max |q_armcli - q_mujoco.rollout|: {dev_c:.2e} rad friction off")
 
 
-def batch_scaling(args, mod, plant, reference, m_c) -> None:
+def batch_scaling(arm, reference, m_c) -> None:
     """Independent rollouts (different initial states) on 1 and 2 threads, next to
     mujoco.rollout's own thread pool; µs per step per rollout."""
     import mujoco
 
     steps = 2000
-    q_r, v_r, r = refs(reference, steps)
+    q_r, v_r = refs(reference, steps)
     rng = np.random.default_rng(0)
     threads = (1, 2)
+    cfg = SimConfig(np.full(2, KP), np.full(2, KD), dt=DT)
     print(f"\nbatch of independent rollouts, {steps} steps each (µs/step/rollout)")
     print(
         row(
@@ -231,17 +228,11 @@ def batch_scaling(args, mod, plant, reference, m_c) -> None:
     )
     for batch in (1, 10, 100):
         q0s = Q0 + rng.uniform(-0.1, 0.1, size=(batch, 2))
-        jobs = [native.Job(plant, q0, np.zeros(2), r) for q0 in q0s]
+        runs = [Run(arm, reference, q0, steps * DT, cfg) for q0 in q0s]
         cells = []
         for t in threads:
-            if mod is None:
-                cells.append("n/a")
-                continue
-            secs = timed(
-                lambda t=t, jobs=jobs: native.rollout_batch(mod, jobs, threads=t),
-                3,
-                time.perf_counter,
-            )
+            secs = timed(lambda t=t, runs=runs: simulate_batch(runs, threads=t), 3,
+                         time.perf_counter)  # fmt: skip
             cells.append(f"{secs / (batch * steps) * 1e6:.3f}")
         kind = mujoco.mjtState.mjSTATE_FULLPHYSICS
         d = mujoco.MjData(m_c)
@@ -272,18 +263,15 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="fewer repeats and steps")
     args = ap.parse_args()
     urdf = ROOT / "urdf" / "standalone_arm.urdf"
-    mod = native.load()
-    if mod is None:
-        print(f"note: compiled rollout unavailable ({native.why_missing()}); Python loop only")
+    native.require()
     arm, reference = setup(urdf, friction=False)
-    cfg = SimConfig(np.full(2, KP), np.full(2, KD), dt=DT)
-    plant = ro.Plant(arm.model, params_of(arm, cfg), False, DT, "euler", math.inf)
+    plant = plant_of(arm, SimConfig(np.full(2, KP), np.full(2, KD), dt=DT))
     m = mujoco_model(urdf, friction=False)
     m_c = mujoco_actuated(urdf)
-    per_step(args, mod, arm, reference, plant, m, m_c)
-    per_step_friction(args, mod, urdf, reference)
+    per_step(args, arm, reference, plant, m, m_c)
+    per_step_friction(args, urdf, reference)
     agreement(arm, reference, urdf, m, m_c)
-    batch_scaling(args, mod, plant, reference, m_c)
+    batch_scaling(arm, reference, m_c)
 
 
 if __name__ == "__main__":

@@ -78,8 +78,7 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="fewer candidates and repeats")
     args = ap.parse_args()
     count, repeats = (8, 1) if args.quick else (32, 3)
-    if native.load() is None:
-        print("note: compiled rollout not built (make native): timing the Python loop")
+    native.require()
     job = tjob.prepare(load_spec(SPEC), SPEC, [], tjob.TuneSettings())
     batch = candidates(job, count)
     steps = sum(round(c.duration / job.problem.dt) for c in job.problem.cases)

@@ -32,6 +32,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "armcli.commands.init",
         "Write an example spec (armcli.yaml), its trajectories and a README; never overwrites.",
     ),
+    "import": (
+        "armcli.commands.importer",
+        "Import a URDF or xacro file into a spec that builds the same URDF back.",
+    ),
     "build": (
         "armcli.commands.build",
         "Compile SPEC into the course's xacro set and the expanded URDFs.",

@@ -101,6 +101,38 @@ class SpecError(InputError):
         return out
 
 
+class UnstableLoopError(InputError):
+    """The PD gains diverge at the time step (armcli.sim.verdict); carries the one remedy.
+
+    The library names no option: the command layer says where dt and the gains came from
+    (`located`).
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        scheme: str,
+        dt: float,
+        suggestion_dt: float,
+        kp: Sequence[float] | None,
+        kd: Sequence[float] | None,
+        file: str | Path | None = None,
+        field: str | None = None,
+    ) -> None:
+        self.scheme, self.dt, self.suggestion_dt = scheme, dt, suggestion_dt
+        self.kp = tuple(kp) if kp is not None else None
+        self.kd = tuple(kd) if kd is not None else None
+        super().__init__(message, file=file, field=field)
+
+    def located(self, *, file: str | Path | None, field: str | None) -> UnstableLoopError:
+        """The same error, saying which file and field (or option) dt and gains came from."""
+        return UnstableLoopError(
+            self.message, scheme=self.scheme, dt=self.dt, suggestion_dt=self.suggestion_dt,
+            kp=self.kp, kd=self.kd, file=file, field=field,
+        )  # fmt: skip
+
+
 class XacroRefusedError(InputError):
     """A foreign xacro file would run code from the file; refused without --trust-xacro."""
 
@@ -120,19 +152,30 @@ class RuleViolation:
 
 
 class ModelRefusedError(InputError):
-    """`check` reports errors for a model another command was asked to use; one line each."""
+    """`check` reports errors for a model another command was asked to use; one line each.
 
-    def __init__(self, source: str, violations: Sequence[RuleViolation]) -> None:
+    `remedy`, set by the command layer, says how to go on anyway (e.g. which option).
+    """
+
+    def __init__(
+        self, source: str, violations: Sequence[RuleViolation], remedy: str | None = None
+    ) -> None:
         self.source = source
         self.violations = list(violations)
+        self.remedy = remedy
         first = self.violations[0]
         super().__init__(f"[{first.rule}] {first.message}", file=first.file, line=first.line)
 
+    def rules(self) -> list[str]:
+        """The refusing rule ids, each once, in order."""
+        return list(dict.fromkeys(v.rule for v in self.violations))
+
     def lines(self) -> list[str]:
-        """One line per violation, then one saying the model is refused."""
+        """One line per violation, then one saying the model is refused (and the remedy)."""
         out = [f"{_where(v.file, v.line)}: [{v.rule}] {v.message}" for v in self.violations]
         n = len(self.violations)
-        out.append(f"{self.source}: `armcli check` reports {n} error(s); the model is refused")
+        last = f"{self.source}: `armcli check` reports {n} error(s); the model is refused"
+        out.append(f"{last}; {self.remedy}" if self.remedy else last)
         return out
 
 

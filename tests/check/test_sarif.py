@@ -106,11 +106,18 @@ def test_strict_levels_spec_findings_and_remedies() -> None:
     results = doc["runs"][0]["results"]
     assert {r["level"] for r in results} == {"error"}
     pd = next(r for r in results if r["ruleId"] == "pd-explicit-unstable")
-    # A finding in the URDF built in memory points at the spec, without a line.
+    # A finding in the URDF built in memory points at the spec field it comes from (the
+    # gains), with that line; the message names the field and the generated file's line.
     loc = pd["locations"][0]["physicalLocation"]
-    assert loc["artifactLocation"]["uri"] == "specs/my_robot.yaml" and "region" not in loc
-    assert pd["message"]["text"].startswith(("my_robot.urdf", "standalone_arm.urdf"))
-    assert pd["properties"]["fix"] == {"dt": 0.00063, "kd": 3.1}
+    spec_lines = (ROOT / "specs" / "my_robot.yaml").read_text().splitlines()
+    gains_line = spec_lines.index("  gains:") + 1
+    assert loc["artifactLocation"]["uri"] == "specs/my_robot.yaml"
+    assert loc["region"] == {"startLine": gains_line}
+    assert pd["message"]["text"].startswith(
+        ("control.gains (my_robot.urdf:", "control.gains (standalone_arm.urdf:")
+    )
+    # dt, or Kd alone scaled into the stable range (Kp kept), 0.9 inside the bounds
+    assert pd["properties"]["fix"] == {"dt": 0.00063, "kp": [50.0, 50.0], "kd": [3.1, 3.1]}
     fingerprints = [r["partialFingerprints"]["armcliFinding/v1"] for r in results]
     assert len(set(fingerprints)) == len(fingerprints)
 

@@ -65,7 +65,11 @@ def test_spec_json_schema_and_fk() -> None:
 def test_strict_turns_warnings_into_exit_1_and_ignore_silences() -> None:
     r = armcli("check", "specs/my_robot.yaml", "--strict", "--format", "github")
     assert r.returncode == 1
-    assert r.stdout.startswith("::error file=specs/my_robot.yaml,title=armcli pd-explicit-unstable")
+    gains_line = (ROOT / "specs" / "my_robot.yaml").read_text().splitlines().index("  gains:") + 1
+    assert r.stdout.startswith(
+        f"::error file=specs/my_robot.yaml,line={gains_line},title=armcli pd-explicit-unstable::"
+        "control.gains (my_robot.urdf:"
+    )
     assert "error finding(s)" in r.stderr
     ignored = ("--ignore", "pd-explicit-unstable", "--ignore", "root-inertia")
     r = armcli("check", "specs/my_robot.yaml", "--strict", *ignored)

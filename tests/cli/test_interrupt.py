@@ -65,7 +65,7 @@ def test_ctrl_c_in_simulate(tmp_path: Path, output: str) -> None:
     # the brace form's warning is printed just before the run starts: the marker
     message = "{joint_names: [arm_base_forearm_joint], points: [{positions: {0.5}}]}"
     args = ["simulate", str(DEFAULT_SPEC), "-m", message, "--duration", "1500",
-            "--engine", "python", "-o", output, "--plot", "track.png"]  # fmt: skip
+            "-o", output, "--plot", "track.png"]  # fmt: skip
     code, err = _interrupt(args, "is a YAML mapping", on_stderr=True, cwd=tmp_path)
     assert code == 130
     assert err.strip().splitlines()[-1] == INTERRUPTED.strip()

@@ -61,7 +61,10 @@ def test_check_tables_fit(
             keys = ("lower", "upper", "effort", "velocity", "damping", "friction", "gravity_max")
             numbers += [g4(j[k]) for k in keys]
         numbers += [f"{v:.4f}" for p in s["poses"] for v in p["xyz"]]
-        numbers += [str(x["line"]) for x in f["findings"] if x["line"]]
+        for x in f["findings"]:  # spec place first, the generated URDF's line in brackets
+            if x["spec"]:
+                numbers.append(f"{x['spec']['file']}:{x['spec']['line']}")
+                numbers.append(f"({x['file'].partition('#')[2]}:{x['line']})")
     assert_fits(out, width, numbers)
 
 

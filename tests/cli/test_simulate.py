@@ -115,7 +115,9 @@ def test_limits_error_or_clamp(tmp_path: Path, capsys: pytest.CaptureFixture[str
 
 def test_rk4_at_default_dt_is_refused_with_advice(capsys: pytest.CaptureFixture[str]) -> None:
     code, _, err = run(["--message", SEED, "--integrator", "rk4"], capsys)
-    assert code == 2 and "--dt <=" in err
+    assert code == 2 and "stable for dt <=" in err
+    # dt and gains came from the spec: the error names its fields, not an option
+    assert "specs/my_robot.yaml control.dt, control.gains: " in err and "--dt" not in err
     code, _, err = run(["--message", SEED, "--integrator", "rk4", "--dt", "0.0005"], capsys)
     assert code == 0, err
 
@@ -162,20 +164,56 @@ def test_integral_gain_is_refused_not_ignored(tmp_path: Path) -> None:
     assert ok.returncode == 0, ok.stderr
 
 
-def test_engine_is_reported_and_a_missing_extension_is_one_note(
+def test_engine_is_reported_and_a_missing_one_is_one_error(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     from armcli.sim import native
 
     code, out, _ = run(["--trajectory", str(TRAJ / "pick.yaml")], capsys)
-    assert code == 0
-    engine = "compiled (native) engine" if native.load() is not None else "Python engine"
-    assert engine in out
+    assert code == 0 and "compiled engine" in out
     monkeypatch.setenv("ARMCLI_NO_NATIVE", "1")
     monkeypatch.setattr(native, "_state", {})
-    code, out, err = run(["--trajectory", str(TRAJ / "pick.yaml")], capsys)
-    assert code == 0 and "Python engine" in out
-    notes = [ln for ln in err.splitlines() if ln.startswith("note:")]
-    assert len(notes) == 1 and notes[0].endswith("using the Python loop")  # one unwrapped line
-    code, _, err = run(["--trajectory", str(TRAJ / "pick.yaml"), "--engine", "native"], capsys)
-    assert code != 0 and "compiled simulator is unavailable" in err
+    code, _, err = run(["--trajectory", str(TRAJ / "pick.yaml")], capsys)
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert code == 2 and len(lines) == 1 and "simulator is unavailable" in lines[0]
+
+
+PENDULUM = ROOT / "tests" / "fixtures" / "stability" / "pendulum_1cm.urdf"
+HANG = "{joint_names: [swing_joint], points: [{positions: [0.0], time_from_start: 1}]}"
+
+
+def test_the_issues_1cm_pendulum_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 24: accepted before, it banged between the stops at 44 rad/s and exited 0.
+    Hanging, gravity's stiffness m g l = 9.81e-3 N·m/rad against I = 1.016e-5 kg·m²
+    needs dt < 2 sqrt(I / (k + Kp)) = 0.0613 s."""
+    args = ["--urdf", str(PENDULUM), "--kp", "0.001", "--kd", "0", "--dt", "0.1", "-m", HANG]
+    code, _, err = run(args, capsys)
+    assert code == 2
+    assert "--dt, --kp, --kd: armcli simulate (damping implicit) diverges" in err
+    assert "gravity's stiffness up to 0.00981" in err and "stable for dt <= 0.0613 s" in err
+    assert "e.g. dt = 0.055 s" in err
+    code, _, err = run([*args[:-4], "--dt", "0.055", "-m", HANG], capsys)
+    assert code == 0, err
+
+
+def test_ignore_lets_a_true_finding_simulate(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Issue 19: students' arms with a true inertia-exceeds-geometry finding."""
+    arm = (ROOT / "urdf" / "standalone_arm.urdf").read_text()
+    # 20x the forearm's ixx and iyy: more than any mass inside its cylinder can have
+    heavy = arm.replace('ixx="0.00228" ixy="0" ixz="0" iyy="0.00228"',
+                        'ixx="0.0456" ixy="0" ixz="0" iyy="0.0456"', 1)  # fmt: skip
+    assert heavy != arm
+    urdf = tmp_path / "student.urdf"
+    urdf.write_text(heavy)
+    msg = "{joint_names: [forearm_hand_joint], points: [{positions: [0.3], time_from_start: 1}]}"
+    args = ["--urdf", str(urdf), "--kp", "50", "--kd", "5", "-m", msg]
+    code, _, err = run(args, capsys)
+    assert code == 2 and "[inertia-exceeds-geometry]" in err
+    assert "simulate it anyway with --ignore inertia-exceeds-geometry" in err
+    code, out, err = run([*args, "--ignore", "inertia-exceeds-geometry"], capsys)
+    assert code == 0, err
+    assert J2 in out
+    code, _, err = run([*args, "--ignore", "no-such-rule"], capsys)
+    assert code == 2 and "--ignore" in err and "no-such-rule" in err

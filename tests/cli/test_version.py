@@ -25,15 +25,14 @@ def test_version_is_pyprojects() -> None:
 def test_version_lines() -> None:
     lines = version_lines()
     assert lines[0] == f"armcli {armcli.__version__} ({Path(armcli.__file__).parent})"
-    assert lines[1].startswith(("simulator engine: compiled (", "simulator engine: Python ("))
+    assert lines[1].startswith(("simulator engine: compiled (", "simulator engine: unavailable ("))
     assert lines[2:4] == [f"pin {metadata.version('pin')}", f"xacro {metadata.version('xacro')}"]
 
 
-def test_engine_when_the_compiled_rollout_is_missing(monkeypatch: pytest.MonkeyPatch) -> None:
-    # the wheel without the C++ rollout is covered for real by test_install.py
+def test_engine_when_the_compiled_simulator_is_missing(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(native, "load", lambda: None)
     monkeypatch.setattr(native, "why_missing", lambda: "not built")
-    assert version_lines()[1] == "simulator engine: Python (no compiled rollout: not built)"
+    assert version_lines()[1] == "simulator engine: unavailable (not built)"
 
 
 def test_version_option_is_fast() -> None:

@@ -41,6 +41,7 @@ LABEL = "specs/my_robot.yaml"
 DESC, BRINGUP, MOVEIT = "my_robot_description", "my_robot_bringup", "my_robot_moveit_config"
 GOLDEN_FILES = [
     f"{BRINGUP}/README.md",
+    f"{BRINGUP}/config/my_robot_bridge.yaml",
     f"{BRINGUP}/config/my_robot_controllers.yaml",
     f"{BRINGUP}/launch/my_robot_gz.launch.py",
     f"{BRINGUP}/package.xml",
@@ -192,7 +193,8 @@ def test_bringup_launch_chains_spawners_after_the_spawn(files: Mapping[str, byte
         '"-r " + WORLD',
         'WORLD = "empty.sdf"',
         '"-topic", "robot_description"',
-        '"/clock@rosgraph_msgs/msg/Clock[gz.msgs.Clock"',
+        '"config_file": os.path.join(config, BRIDGE)',
+        'BRIDGE = "my_robot_bridge.yaml"',
         'AppendEnvironmentVariable("GZ_SIM_RESOURCE_PATH"',
         'executable="create"',
         '" controllers_file:="',

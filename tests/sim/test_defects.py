@@ -1,4 +1,4 @@
-"""Regression tests for the simulator defects of issue 11, on both engines.
+"""Regression tests for the simulator defects of issue 11.
 
 Each test failed before its fix: unaligned joint axes (the compiled engine aborted),
 effort saturation of the whole-step motor torque, RK4 at joint stops and RK4's order on
@@ -17,20 +17,15 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim.reference import build_reference
-from armcli.sim.simulate import Arm, SimConfig, arm_from_model, params_of, simulate
+from armcli.sim.simulate import Arm, SimConfig, arm_from_model, plant_of, simulate
 from armcli.sim.trajectory import loads_trajectory
 from armcli.urdf.pinocchio import load_model
-from tests.sim.engines import require_native
+from tests.sim.engines import run_held
 
-ROUNDOFF = 1e-12  # the two engines run the same operations in the same order
 ID_TOL = 1e-9  # [N·m] inverse dynamics vs reported torque: round-off of (v' - v) / dt
 EQUILIBRIUM_TOL = 1e-9  # [rad] converged static equilibrium vs brentq on the statics
-ERD = (
-    Path(pin.__file__).resolve().parents[4] / "share" / "example-robot-data" / "robots"
-)  # example-robot-data's URDFs, shipped in the dev extra under cmeel.prefix
 TILTED_URDF = """<robot name="tilted">
   <link name="base"/>
   <link name="a"><inertial><mass value="1.2"/><origin xyz="0.1 0.02 -0.2"/>
@@ -64,24 +59,7 @@ def _arm(model: pin.Model, lower: float = -1e3, upper: float = 1e3, **kw: float)
 
 
 def _plant(arm: Arm, cfg: SimConfig) -> ro.Plant:
-    return ro.Plant(arm.model, params_of(arm, cfg), cfg.gravity_comp, cfg.dt, cfg.integrator, 1e9)
-
-
-def _both(plant: ro.Plant, q0: np.ndarray, ref: np.ndarray) -> tuple[ro.Rollout, ro.Rollout]:
-    """The same rollout on both engines, checked equal to round-off."""
-    v0 = np.zeros_like(q0)
-    a = ro.rollout_python(plant, q0, v0, ref)
-    b = native.rollout(require_native(), plant, q0, v0, ref)
-    for x, y in ((a.q, b.q), (a.v, b.v), (a.tau, b.tau)):
-        np.testing.assert_allclose(x, y, atol=ROUNDOFF, rtol=0)
-    assert (a.flags == b.flags).all() and a.fail_step == b.fail_step
-    return a, b
-
-
-def _hold(q: np.ndarray, steps: int, integrator: str = "euler") -> np.ndarray:
-    ref = np.zeros((ro.rows_per_step(integrator) * steps + 1, 2 * q.shape[0]))
-    ref[:, : q.shape[0]] = q
-    return ref
+    return plant_of(arm, cfg, energy_max=1e9)
 
 
 def pendulum(length: float = 0.5) -> pin.Model:
@@ -97,45 +75,14 @@ def pendulum(length: float = 0.5) -> pin.Model:
 
 
 @pytest.mark.parametrize("integrator", ["euler", "rk4"])
-def test_tilted_axes_engines_agree(integrator: str) -> None:
+def test_tilted_axes_run_into_the_prismatic_stop(integrator: str) -> None:
     arm = arm_from_model(pin.buildModelFromXML(TILTED_URDF))
     kinds = {arm.model.joints[j].shortname() for j in range(1, arm.model.njoints)}
     assert {"JointModelRevoluteUnaligned", "JointModelPrismaticUnaligned"} <= kinds
     cfg = SimConfig(np.full(3, 20.0), np.full(3, 0.5), dt=5e-4, integrator=integrator)
-    ref = _hold(np.array([0.8, 0.04, -0.5]), 1000, integrator)
-    a, _ = _both(_plant(arm, cfg), np.zeros(3), ref)
-    assert a.fail_step == -1 and (a.flags & ro.FLAG_STOP).any()  # the prismatic stop is hit
-
-
-def _erd_urdfs() -> list[Path]:
-    return sorted(ERD.glob("**/*.urdf")) if ERD.is_dir() else []
-
-
-@pytest.mark.skipif(not _erd_urdfs(), reason="example-robot-data not installed (dev extra)")
-def test_every_example_robot_engines_agree() -> None:
-    """Free fall with light damping against the URDF stops, every robot that loads."""
-    compared = unaligned = 0
-    for path in _erd_urdfs():
-        try:
-            model = pin.buildModelFromUrdf(str(path))
-        except (RuntimeError, ValueError):
-            continue  # e.g. ur3.urdf has no robot name
-        simulable = [
-            model.names[j]
-            for j in range(1, model.njoints)
-            if model.joints[j].shortname() in ro.JOINT_TYPES and model.joints[j].nq == 1
-        ]
-        if not simulable:
-            continue
-        arm = arm_from_model(model, simulable)
-        n = arm.model.nv
-        cfg = SimConfig(np.zeros(n), np.full(n, 0.1), dt=1e-3)
-        q0 = np.clip(pin.neutral(arm.model), arm.lower, arm.upper)
-        _both(_plant(arm, cfg), q0, _hold(q0, 40))
-        compared += 1
-        names = {arm.model.joints[j].shortname() for j in range(1, arm.model.njoints)}
-        unaligned += any("Unaligned" in k for k in names)
-    assert compared >= 50 and unaligned >= 10  # example-robot-data 4.x: 60+ URDFs
+    a = run_held(_plant(arm, cfg), np.zeros(3), np.zeros(3), 1000, [0.8, 0.04, -0.5])
+    assert a.fail_step == -1 and a.trace.stop[:, 1].any()  # the prismatic stop at 0.05 m
+    assert np.all(a.trace.q[:, 1] <= 0.05)
 
 
 # (b) effort saturation of the whole step ------------------------------------------------
@@ -148,10 +95,10 @@ def test_effort_limit_holds_for_the_applied_torque(kd: float) -> None:
     effort, dt = 4.0, 1e-3  # before the fix: 1.0035x (Kd 5), 1.031x (Kd 50) the limit
     arm = _arm(pendulum(), effort=effort, damping=0.05)
     cfg = SimConfig(np.array([50.0]), np.array([kd]), dt=dt)
-    a, _ = _both(_plant(arm, cfg), np.array([math.pi / 2]), _hold(np.array([math.pi / 2]), 2000))
+    a = run_held(_plant(arm, cfg), [math.pi / 2], [0.0], 2000, [math.pi / 2]).trace
     assert np.max(np.abs(a.tau)) <= effort * (1 + 1e-15)
     at_limit = np.abs(a.tau[:, 0]) == effort
-    assert at_limit.any() and (((a.flags[:, 0] & ro.FLAG_SATURATED) > 0) == at_limit).all()
+    assert at_limit.any() and (a.saturated[:, 0] == at_limit).all()
     # inverse dynamics (RNEA) of each step: M (v' - v)/dt + C v + g + D v' is the torque
     # the joint received; Euler's ABA solves exactly that, so it must equal the report
     data = arm.model.createData()
@@ -168,10 +115,10 @@ def test_rk4_resting_on_a_stop_has_no_phantom_velocity() -> None:
     # hanging pendulum held at q = 0.3 by its lower stop: gravity presses it on the stop
     arm = _arm(pendulum(), lower=0.3, upper=2.0)
     cfg = SimConfig(np.zeros(1), np.zeros(1), dt=5e-4, integrator="rk4")
-    a, _ = _both(_plant(arm, cfg), np.array([0.3]), _hold(np.array([0.3]), 2000, "rk4"))
+    a = run_held(_plant(arm, cfg), [0.3], [0.0], 2000, [0.3]).trace
     assert np.all(a.q[:, 0] == 0.3)  # on the stop, exactly
     assert np.all(a.v[:, 0] == 0.0)  # and at rest: no dt a / 2 into the stop
-    assert np.all(a.flags[:, 0] & ro.FLAG_STOP)
+    assert np.all(a.stop[:, 0])
 
 
 def test_rk4_coupled_joint_settles_at_its_static_equilibrium(built_dir: Path) -> None:
@@ -179,8 +126,8 @@ def test_rk4_coupled_joint_settles_at_its_static_equilibrium(built_dir: Path) ->
     arm = _arm(model, lower=0.0, upper=math.pi / 2, damping=0.2)
     kp, q2_ref = 50.0, 0.8
     cfg = SimConfig(np.array([0.0, kp]), np.array([0.0, 2.0]), dt=5e-4, integrator="rk4")
-    ref = _hold(np.array([math.pi / 2, q2_ref]), 16_000, "rk4")  # 8 s
-    a, _ = _both(_plant(arm, cfg), np.array([math.pi / 2, 0.5]), ref)
+    a = run_held(_plant(arm, cfg), [math.pi / 2, 0.5], [0.0, 0.0], 16_000,  # 8 s
+                 [math.pi / 2, q2_ref]).trace  # fmt: skip
     # gravity presses joint 1 on its upper stop; joint 2's statics: Kp (q_ref - q2) = g2(q)
     data = model.createData()
 

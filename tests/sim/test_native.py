@@ -1,4 +1,5 @@
-"""The compiled engine as a module: batches on threads, engine choice and its notice."""
+"""The compiled engine as a module: the exact model it receives, batches on threads, chunking
+and recording that change nothing, running statistics, and refusing a missing or stale build."""
 
 from __future__ import annotations
 
@@ -7,17 +8,32 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
-from armcli.errors import InputError
+from armcli.errors import InputError, SimulationError
 from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim.reference import build_reference
-from armcli.sim.simulate import Arm, SimConfig, arm_from_model, params_of, simulate
+from armcli.sim.simulate import (
+    SETTLE_TOL,
+    Arm,
+    Run,
+    SimConfig,
+    arm_from_model,
+    configuration,
+    plant_of,
+    simulate,
+    simulate_batch,
+)
 from armcli.sim.trajectory import loads_trajectory
 from armcli.urdf.pinocchio import load_model
-from tests.sim.engines import require_native
+from tests.sim.engines import require_native, run_held
+from tests.sim.test_defects import TILTED_URDF
 
+ERD = (
+    Path(pin.__file__).resolve().parents[4] / "share" / "example-robot-data" / "robots"
+)  # example-robot-data's URDFs, shipped in the dev extra under cmeel.prefix
 TRAJ = (
     "joint_names: [arm_base_forearm_joint, forearm_hand_joint]\npoints:\n"
     " - {positions: [0.6, 0.4], time_from_start: 0.5}\n"
@@ -30,93 +46,107 @@ def arm(built_dir: Path) -> Arm:
     return arm_from_model(load_model(built_dir / "standalone_arm.urdf").model)
 
 
-def _ref(arm: Arm, steps: int, dt: float) -> np.ndarray:
+def _reference(arm: Arm):  # type: ignore[no-untyped-def]
     tr = loads_trajectory(TRAJ, dict.fromkeys(arm.joint_names, (0.0, math.pi / 2)))
-    q, v = build_reference(tr, arm.joint_names, np.zeros(2)).sample(np.arange(steps + 1) * dt)
-    return np.ascontiguousarray(np.hstack([q, v]))
+    return build_reference(tr, arm.joint_names, np.zeros(2))
 
 
-def test_batch_on_threads_equals_one_by_one(arm: Arm) -> None:
-    """Many gain sets and two models (one with a weaker hand) in one threaded batch."""
-    mod = require_native()
+def _erd_models() -> list[pin.Model]:
+    models = []
+    for path in sorted(ERD.glob("**/*.urdf")) if ERD.is_dir() else []:
+        try:
+            models.append(pin.buildModelFromUrdf(str(path)))
+        except (RuntimeError, ValueError):
+            continue  # e.g. ur3.urdf has no robot name
+    return models
+
+
+def _free_step_equals_python_aba(model: pin.Model) -> bool:
+    """One Euler step of the free arm from a random state, against Pinocchio in Python:
+    v1 = v0 + dt a, q1 = q0 + dt v1 with a = ABA(q0, v0, 0), bit for bit. False when
+    Python's ABA is not finite (massless chains: a singular mass matrix)."""
+    simulable = [model.names[j] for j in range(1, model.njoints) if model.joints[j].nv == 1]
+    arm = arm_from_model(model, simulable)
+    n, dt = arm.model.nv, 1e-3
+    wide = replace(arm, lower=np.full(n, -1e9), upper=np.full(n, 1e9), damping=np.zeros(n),
+                   friction=np.zeros(n), velocity=np.full(n, 1e9))  # fmt: skip
+    rng = np.random.default_rng(n)
+    q0, v0 = rng.uniform(-1, 1, n), rng.uniform(-1, 1, n)
+    a = pin.aba(wide.model, wide.model.createData(), configuration(wide.model, q0), v0, np.zeros(n))
+    if not np.all(np.isfinite(a)):
+        return False
+    r = run_held(plant_of(wide, SimConfig(np.zeros(n), np.zeros(n), dt=dt)), q0, v0, 1).trace
+    v1 = v0 + dt * a
+    np.testing.assert_array_equal(r.v[1], v1)
+    np.testing.assert_array_equal(r.q[1], q0 + dt * v1)
+    return True
+
+
+def test_the_engine_receives_the_model_exactly() -> None:
+    """Pinocchio's own serialisation hands the model over: the first step equals Python's
+    ABA exactly (rebuilding it with appendBodyToJoint moved centres of mass by an ulp,
+    2.3e-13 on some arms). Unaligned axes, prismatic and continuous joints included."""
+    require_native()
+    models = [pin.buildModelFromXML(TILTED_URDF), *_erd_models()]
+    compared = sum(_free_step_equals_python_aba(model) for model in models)
+    # example-robot-data 4.x: 60+ URDFs, a few with massless chains
+    assert compared >= 40 or (not ERD.is_dir() and compared == 1)
+
+
+def test_chunking_and_recording_change_nothing(arm: Arm, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The run continues across chunks (friction's warm start included) and keeping a
+    subset of the states keeps exactly those rows."""
+    require_native()
+    cfg = SimConfig(np.full(2, 50.0), np.full(2, 2.0), dt=1e-3, gravity_comp=True)
+    ref = _reference(arm)
+    whole = simulate(arm, ref, np.zeros(2), 1.5, cfg)
+    monkeypatch.setattr(ro, "CHUNK_STEPS", 7)
+    keep = np.array([0, 3, 500, 501, 1499, 1500])
+    part = simulate(arm, ref, np.zeros(2), 1.5, cfg, record=keep)
+    for name in ("q", "v", "q_ref", "v_ref", "tau", "saturated", "stop_active"):
+        np.testing.assert_array_equal(getattr(part, name), getattr(whole, name)[keep])
+    for f in part.stats.__dataclass_fields__:
+        np.testing.assert_array_equal(getattr(part.stats, f), getattr(whole.stats, f))
+
+
+def test_running_statistics_equal_the_full_trace(arm: Arm) -> None:
+    """Statistics the engine accumulates step by step, against numpy on every state."""
+    require_native()
+    weak = replace(arm, effort=np.array([3.0, 1.0]))  # saturates; the stops are hit
+    cfg = SimConfig(np.full(2, 50.0), np.full(2, 2.0), dt=5e-4)
+    res = simulate(weak, _reference(arm), np.zeros(2), 2.0, cfg)
+    e = res.q - res.q_ref
+    st = res.stats
+    assert st.states == res.steps + 1 == len(res.t)
+    np.testing.assert_allclose(st.sum_e2, np.sum(e**2, axis=0), rtol=1e-12)
+    np.testing.assert_array_equal(st.max_e, np.max(np.abs(e), axis=0))
+    np.testing.assert_array_equal(st.last_e, e[-1])
+    outside = [np.nonzero(np.abs(e[:, i]) > SETTLE_TOL)[0] for i in range(2)]
+    np.testing.assert_array_equal(st.last_out, [o[-1] if o.size else -1 for o in outside])
+    steps_sat, steps_stop = res.saturated[:-1], res.stop_active[:-1]  # one row per step
+    np.testing.assert_array_equal(st.saturated_steps, steps_sat.sum(axis=0))
+    rises = steps_stop[0].astype(int) + (steps_stop[1:] & ~steps_stop[:-1]).sum(axis=0)
+    np.testing.assert_array_equal(st.stop_rises, rises)
+    assert steps_sat.any() and steps_stop.any()
+
+
+def test_batch_on_threads_equals_simulate_run_by_run(arm: Arm) -> None:
+    """The batch entry point (`armcli tune`) gives each run's `simulate` result exactly, on
+    threads too, diverged runs included."""
+    require_native()
+    ref = _reference(arm)
     weak = replace(arm, effort=np.array([3.0, 0.5]))
-    ref = _ref(arm, 1500, 1e-3)
-    jobs = []
-    for k, a in enumerate([arm, weak] * 6):
-        cfg = SimConfig(np.full(2, 20.0 + 10 * k), np.full(2, 1.0 + k), dt=1e-3)
-        plant = ro.Plant(a.model, params_of(a, cfg), k % 2 == 0, 1e-3, "euler", math.inf)
-        jobs.append(native.Job(plant, np.zeros(2), np.zeros(2), ref))
-    together = native.rollout_batch(mod, jobs, threads=4)
-    for job, r in zip(jobs, together, strict=True):
-        alone = ro.rollout_python(job.plant, job.q0, job.v0, job.ref)
-        # the same arithmetic on any thread: equal to the Python reference to round-off
-        np.testing.assert_allclose(r.q, alone.q, atol=1e-12, rtol=0)
-        np.testing.assert_array_equal(r.flags, alone.flags)
-    assert len({float(r.q[-1, 0]) for r in together}) == len(jobs)  # really different runs
-
-
-def test_missing_extension_is_a_notice_not_a_crash(
-    arm: Arm, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    monkeypatch.setenv("ARMCLI_NO_NATIVE", "1")
-    monkeypatch.setattr(native, "_state", {})
-    tr = loads_trajectory(TRAJ, dict.fromkeys(arm.joint_names, (0.0, math.pi / 2)))
-    ref = build_reference(tr, arm.joint_names, np.zeros(2))
-    cfg = SimConfig(np.full(2, 50.0), np.full(2, 5.0), dt=1e-3)
-    res = simulate(arm, ref, np.zeros(2), 0.2, cfg)
-    assert res.backend == "python" and res.notice is not None and "\n" not in res.notice
-    with pytest.raises(InputError, match="compiled simulator is unavailable"):
-        simulate(arm, ref, np.zeros(2), 0.2, replace(cfg, backend="native"))
-
-
-def test_model_arrays_keep_unaligned_axes() -> None:
-    """The generic JointModel has no axis; the flat model must carry the concrete one."""
-    import pinocchio as pin
-
-    model = pin.Model()
-    axis = np.array([0.36, 0.48, 0.8])  # unit, not along x, y or z
-    jid = model.addJoint(0, pin.JointModelRevoluteUnaligned(axis), pin.SE3.Identity(), "r")
-    pin_axis = np.array([0.0, 0.6, -0.8])
-    model.addJoint(jid, pin.JointModelPrismaticUnaligned(pin_axis), pin.SE3.Identity(), "p")
-    arrays = native.model_arrays(model)
-    np.testing.assert_array_equal(arrays["axis"], [axis, pin_axis])
-    assert arrays["jtype"].tolist() == [3, 7]
-
-
-def test_simulate_batch_equals_simulate_run_by_run() -> None:
-    """The batch entry point (used by `armcli tune`) gives each run's `simulate` result exactly,
-    diverged runs included."""
-    from armcli.errors import SimulationError
-    from armcli.sim.job import load_arm
-    from armcli.sim.reference import build_reference
-    from armcli.sim.simulate import Run, SimConfig, simulate, simulate_batch
-    from armcli.sim.trajectory import loads_trajectory
-    from armcli.spec.load import load_spec
-    from tests.helpers import DEFAULT_SPEC
-
-    arm = load_arm(load_spec(DEFAULT_SPEC), None, None)
-    limits = {
-        n: (float(lo), float(hi))
-        for n, lo, hi in zip(arm.joint_names, arm.lower, arm.upper, strict=True)
-    }
-    text = (
-        "joint_names: [arm_base_forearm_joint, forearm_hand_joint]\n"
-        "points: [{positions: [0.8, 0.4]}, {positions: [0.2, 1.2]}]"
-    )
-    traj = loads_trajectory(text, limits)
-    q0 = np.zeros(2)
-    ref = build_reference(traj, arm.joint_names, q0)
+    free = replace(arm, effort=np.full(2, np.inf), lower=np.full(2, -1e3), upper=np.full(2, 1e3))
     runs = [
-        Run(arm, ref, q0, 3.0, SimConfig(kp=np.full(2, kp), kd=np.full(2, kd), integrator=integ))
-        for kp, kd, integ in [
-            (50, 5, "euler"),
-            (200, 2, "euler"),
-            (50, 5, "rk4"),
-            (50, -5, "euler"),
+        Run(a, ref, np.zeros(2), 1.5, SimConfig(np.full(2, kp), np.full(2, kd), 1e-3, integ))
+        for a, kp, kd, integ in [
+            (arm, 50, 5, "euler"),
+            (weak, 200, 2, "euler"),
+            (arm, 50, 1, "rk4"),
+            (free, 1e8, 0, "euler"),  # far beyond the stability bound: diverges
         ]
     ]
-    batch = simulate_batch(runs)
-    # negative Kd pumps energy in: that run diverges
+    batch = simulate_batch(runs, threads=3)
     assert sum(isinstance(r, SimulationError) for r in batch) == 1
     for run, got in zip(runs, batch, strict=True):
         try:
@@ -127,3 +157,26 @@ def test_simulate_batch_equals_simulate_run_by_run() -> None:
         assert not isinstance(got, SimulationError)
         np.testing.assert_array_equal(got.q, want.q)
         np.testing.assert_array_equal(got.tau, want.tau)
+
+
+def test_missing_extension_is_an_error_saying_how_to_get_it(
+    arm: Arm, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("ARMCLI_NO_NATIVE", "1")
+    monkeypatch.setattr(native, "_state", {})
+    cfg = SimConfig(np.full(2, 50.0), np.full(2, 5.0), dt=1e-3)
+    with pytest.raises(InputError, match=r"simulator is unavailable.*C\+\+ compiler") as exc:
+        simulate(arm, _reference(arm), np.zeros(2), 0.2, cfg)
+    assert "\n" not in str(exc.value)
+
+
+def test_an_extension_built_from_other_source_is_refused(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An editable install whose C++ changed without `make native` must not run."""
+    require_native()
+    edited = tmp_path / "rollout.cpp"
+    edited.write_bytes(native.SOURCE.read_bytes() + b"// edited\n")
+    monkeypatch.setattr(native, "SOURCE", edited)
+    monkeypatch.setattr(native, "_state", {})
+    assert native.load() is None and "built from another" in native.why_missing()

@@ -1,82 +1,113 @@
-"""Tracking metrics and joint-state sampling on synthetic runs with known answers."""
+"""Tracking metrics against the closed-form discrete solutions of two one-joint runs, and
+joint-state sampling at the publisher rate."""
 
 from __future__ import annotations
 
 import math
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
-from armcli.sim.report import joint_metrics
-from armcli.sim.simulate import SimResult
-from armcli.sim.states import sample_states, states_bytes
+from armcli.sim import rollout as ro
+from armcli.sim.reference import Reference
+from armcli.sim.report import SETTLE_TOL, joint_metrics
+from armcli.sim.simulate import Arm, SimConfig, SimResult, plant_of, simulate
+from armcli.sim.states import sample_states, sample_steps, states_bytes
+from tests.sim.engines import hold, require_native
 
 DT = 1e-3
+INERTIA = 0.25  # [kg·m²] about the joint axis
 
 
-def synthetic(
-    err: np.ndarray, sat: np.ndarray | None = None, stop: np.ndarray | None = None
-) -> SimResult:
-    steps = err.shape[0] - 1
-    t = np.arange(steps + 1) * DT
-    q_ref = np.zeros((steps + 1, 1))
-    return SimResult(
-        joint_names=("j",),
-        t=t,
-        q=q_ref + err[:, None],
-        v=np.gradient(err, DT)[:, None],
-        q_ref=q_ref,
-        v_ref=np.zeros_like(q_ref),
-        tau=np.arange(steps, dtype=float)[:, None],
-        saturated=(sat if sat is not None else np.zeros(steps, dtype=bool))[:, None],
-        stop_active=(stop if stop is not None else np.zeros(steps, dtype=bool))[:, None],
-        dt=DT,
-        integrator="euler",
-        backend="python",
-        wall_time=0.0,
-    )
+def wheel(damping: float) -> Arm:
+    """A joint about the vertical axis (gravity exerts no torque): inertia INERTIA."""
+    model = pin.Model()
+    jid = model.addJoint(0, pin.JointModelRZ(), pin.SE3.Identity(), "wheel")
+    model.appendBodyToJoint(jid, pin.Inertia(1.0, np.zeros(3), np.diag([1.0, 1.0, INERTIA])),
+                            pin.SE3.Identity())  # fmt: skip
+    one = np.ones(1)
+    return Arm(model, ("wheel",), -1e3 * one, 1e3 * one, np.inf * one, 1e3 * one,
+               damping * one, 0.0 * one)  # fmt: skip
 
 
-def test_rms_and_max_of_a_sine() -> None:
-    t = np.arange(4001) * DT
-    amp = 0.02
-    m = joint_metrics(synthetic(amp * np.sin(2 * math.pi * t)), t_end=0.0)[0]
-    # whole periods of A sin: RMS = A / sqrt(2), max = A (sampled at the crest)
-    assert m.rms_error == pytest.approx(amp / math.sqrt(2), rel=1e-3)
-    assert m.max_error == pytest.approx(amp, rel=1e-6)
-    # settled = inside 0.01 from then on: |A sin(2 pi t)| last exceeds A/2 at t = 4 - 1/12
-    assert m.settle_time == pytest.approx(4.0 - 1.0 / 12.0, abs=2 * DT)
+def _coast(arm: Arm, q0: float, v0: float, steps: int) -> SimResult:
+    """No gains, the reference held at 0, from (q0, v0): the error is the position."""
+    require_native()
+    cfg = SimConfig(np.zeros(1), np.zeros(1), dt=DT)
+    r = ro.run(plant_of(arm, cfg), hold(np.zeros(1)), np.array([q0]), np.array([v0]), steps,
+               settle_tol=SETTLE_TOL)  # fmt: skip
+    tr = r.trace
+    return SimResult(arm.joint_names, steps, DT, "euler", tr.step, tr.step * DT, tr.q, tr.v,
+                     tr.q_ref, tr.v_ref, tr.tau, tr.saturated, tr.stop, r.stats, SETTLE_TOL,
+                     0.0)  # fmt: skip
 
 
-def test_settle_time_of_an_exponential() -> None:
-    t = np.arange(5001) * DT
-    e0, tau, t_end = 0.1, 0.5, 1.0
-    err = np.where(t < t_end, e0, e0 * np.exp(-(t - t_end) / tau))
-    m = joint_metrics(synthetic(err), t_end=t_end, tol=0.01)[0]
-    # e0 exp(-s / tau) = tol  ->  s = tau ln(e0 / tol)
-    assert m.settle_time == pytest.approx(tau * math.log(e0 / 0.01), abs=2 * DT)
-    assert m.final_error == pytest.approx(e0 * math.exp(-4.0 / tau))
-    m_strict = joint_metrics(synthetic(err), t_end=t_end, tol=1e-6)[0]
-    assert m_strict.settle_time is None  # e(5 s) = 3.4e-5 is still outside 1e-6
+def test_ramp_rms_max_final() -> None:
+    """Free rotation at v0 away from a reference held at 0: e_k = v0 k dt exactly."""
+    steps, v0 = 2000, 0.5
+    res = _coast(wheel(0.0), 0.0, v0, steps)
+    np.testing.assert_allclose(res.q[:, 0], v0 * DT * np.arange(steps + 1), rtol=1e-12)
+    m = joint_metrics(res, t_end=0.0)[0]
+    # closed form: sum of k² for k = 0..N is N(N+1)(2N+1)/6, over N + 1 states
+    rms = v0 * DT * math.sqrt(steps * (2 * steps + 1) / 6)
+    assert m.rms_error == pytest.approx(rms, rel=1e-12)
+    assert m.max_error == pytest.approx(v0 * DT * steps, rel=1e-12)
+    assert m.final_error == pytest.approx(v0 * DT * steps, rel=1e-12)
+    assert m.settle_time is None  # outside the band at the end
 
 
-def test_saturation_share_and_stop_contacts() -> None:
-    steps = 1000
-    sat = np.zeros(steps, dtype=bool)
-    sat[100:350] = True  # 250 of 1000 steps
-    stop = np.zeros(steps, dtype=bool)
-    stop[[10, 11, 12, 500, 900, 901]] = True  # three separate contacts
-    m = joint_metrics(synthetic(np.zeros(steps + 1), sat, stop), t_end=0.0)[0]
-    assert m.saturated_pct == pytest.approx(25.0)
-    assert m.limit_contacts == 3
+def test_settle_time_of_a_damped_coast() -> None:
+    """Viscous damping D only: implicit Euler gives v_k = v0 r^k with r = I / (I + dt D);
+    from q0 = -A r, A = dt v0 / (1 - r), the error is e_k = -A r^(k+1). It is outside the
+    band while r^(k+1) > SETTLE_TOL / A: the last such k is ceil(x) - 2, x = log(tol/A)/log r."""
+    D, v0, steps, t_end = 0.5, 2.0, 3000, 0.3
+    r = INERTIA / (INERTIA + DT * D)
+    A = DT * v0 / (1.0 - r)
+    res = _coast(wheel(D), -A * r, v0, steps)
+    k_last = math.ceil(math.log(SETTLE_TOL / A) / math.log(r)) - 2
+    m = joint_metrics(res, t_end=t_end)[0]
+    assert m.settle_time == pytest.approx((k_last + 1) * DT - t_end, abs=1e-12)
+    assert m.final_error == pytest.approx(-A * r ** (steps + 1), rel=1e-9)
+    assert m.max_error == pytest.approx(A * r, rel=1e-12)  # at the start
 
 
-def test_sampling_at_the_publisher_rate() -> None:
-    res = synthetic(np.zeros(2501))  # 2.5 s at 1 ms
-    cols = sample_states(res, rate=10.0)
-    np.testing.assert_allclose(cols["time"], np.arange(26) * 0.1, atol=1e-12)  # 0 .. 2.5 s
-    # effort sampled at step k is the torque applied during step k (here tau[k] = k)
-    np.testing.assert_allclose(cols["j.effort"][:-1], np.arange(25) * 100)
-    text = states_bytes(cols, "csv").decode()
-    assert text.splitlines()[0] == "time,j.position,j.velocity,j.effort,j.reference"
+def test_metrics_from_a_simulate_run() -> None:
+    """joint_metrics reads the run's statistics: a coast from rest never moves (e = q0)."""
+    arm = wheel(0.5)
+    res = simulate(arm, hold(np.zeros(1)), np.array([0.02]), 1.0,
+                   SimConfig(np.zeros(1), np.zeros(1), DT))  # fmt: skip
+    m = joint_metrics(res, t_end=0.4)[0]
+    assert m.rms_error == pytest.approx(0.02) and m.max_error == pytest.approx(0.02)
+    assert m.final_error == pytest.approx(0.02) and m.settle_time is None  # 0.02 > 0.01
+    assert m.saturated_pct == 0.0 and m.limit_contacts == 0
+    cfg = SimConfig(np.zeros(1), np.zeros(1), DT)
+    settled = joint_metrics(simulate(arm, hold(np.zeros(1)), np.array([0.005]), 1.0, cfg), 0.4)[0]
+    assert settled.settle_time == 0.0  # inside the band from the start
+
+
+def test_sample_steps_at_the_publisher_rate() -> None:
+    # 2.5 s at 1 ms, 10 Hz: every 100th step, both ends included
+    np.testing.assert_array_equal(sample_steps(2500, DT, 10.0), np.arange(26) * 100)
+    # 3 Hz: periods of 333.33 steps, rounded to the nearest step
+    np.testing.assert_array_equal(sample_steps(1000, DT, 3.0), [0, 333, 667, 1000])
+
+
+def test_states_file_of_a_run_kept_at_the_output_rate() -> None:
+    """The rows equal those of the same run kept at every step."""
+    arm = wheel(0.5)
+    ref = Reference(np.array([0.0, 1.0]), np.zeros((1, 6, 1)), np.array([0.3]))
+    ref.coeffs[0, 1, 0] = 0.3  # q_ref = 0.3 t over the first second
+    cfg = SimConfig(np.array([5.0]), np.array([1.0]), DT)
+    full = simulate(arm, ref, np.zeros(1), 2.5, cfg)
+    kept = simulate(arm, ref, np.zeros(1), 2.5, cfg, record=sample_steps(2500, DT, 10.0))
+    assert len(kept.t) == 26 and len(full.t) == 2501
+    a, b = sample_states(full, 10.0), sample_states(kept, 10.0)
+    for col in a:
+        np.testing.assert_array_equal(a[col], b[col])
+    np.testing.assert_allclose(a["time"], np.arange(26) * 0.1, atol=1e-12)
+    # the reference column is the polynomial: 0.3 t until 1 s, then held
+    np.testing.assert_allclose(a["wheel.reference"], np.minimum(0.3 * a["time"], 0.3), atol=1e-15)
+    text = states_bytes(a, "csv").decode()
+    assert text.splitlines()[0] == "time,wheel.position,wheel.velocity,wheel.effort,wheel.reference"
     assert len(text.splitlines()) == 27

@@ -10,8 +10,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from armcli.errors import InputError
+from armcli.errors import UnstableLoopError
 from armcli.sim import stability as stab
+from armcli.sim import verdict as verdicts
 from armcli.sim.job import load_arm
 from armcli.sim.simulate import Arm, SimConfig, check_stability
 from armcli.spec.load import load_spec
@@ -72,10 +73,19 @@ def test_jury_condition_matches_iterating_the_scalar_mode(a: float, b: float) ->
     assert stab.explicit_stable(a, b) == (not grows)
 
 
+def _lin(*Ms: np.ndarray) -> stab.Linearised:
+    """Mass matrices without gravity (the textbook arm lies in a horizontal plane)."""
+    return stab.Linearised(np.array(Ms), np.zeros((len(Ms), *Ms[0].shape)))
+
+
+def _pd(kp: float, kd: float, damping: float, n: int = 2) -> stab.PD:
+    return stab.PD.of(range(n), [kp] * n, [kd] * n, [damping] * n)
+
+
 def test_seed_arm_explicit_diverges_implicit_converges() -> None:
     Ms = [two_link_mass_matrix(q2) for q2 in np.linspace(0, math.pi / 2, 5)]
     qs = [[0.0, q2] for q2 in np.linspace(0, math.pi / 2, 5)]
-    rep = stab.analyse(Ms, qs, [0, 1], [KP, KP], [KD, KD], [DAMPING, DAMPING], DT)
+    rep = verdicts.analyse(_lin(*Ms), qs, _pd(KP, KD, DAMPING), DT)
     assert rep.lambda_max == pytest.approx(ISSUE_LAMBDA, rel=LAMBDA_RTOL)
     assert rep.q_worst == (0.0, 0.0)  # lambda_max(M^-1) is largest with the arm stretched
     # b = (Kd + damping) dt lambda = 5.1e-3 * 554 = 2.83 > 2: explicit loop diverges.
@@ -93,8 +103,9 @@ def test_suggested_bounds_are_the_stability_edge() -> None:
     dt_max = stab.explicit_dt_max(KP, d, lam)
     assert simulate(M0, KP, d, 0.98 * dt_max, implicit=False) < 1.0
     assert simulate(M0, KP, d, 1.02 * dt_max, implicit=False) > 1.0
-    rep = stab.analyse([M0], [[0.0, 0.0]], [0, 1], [KP] * 2, [KD] * 2, [DAMPING] * 2, DT)
+    rep = verdicts.analyse(_lin(M0), [[0.0, 0.0]], _pd(KP, KD, DAMPING), DT)
     kd_max = rep.kd_max_explicit
+    assert kd_max is not None and rep.kp_max_implicit is not None
     assert simulate(M0, KP, 0.98 * kd_max + DAMPING, DT, implicit=False) < 1.0
     assert simulate(M0, KP, 1.02 * kd_max + DAMPING, DT, implicit=False) > 1.0
     # With implicit damping only Kp is bounded.
@@ -149,12 +160,14 @@ def test_check_verdict_equals_simulate_acceptance(
     for q in configs:
         M = pin.crba(arm.model, data, q)
         Ms.append(np.triu(M) + np.triu(M, 1).T)
-    rep = stab.analyse(Ms, configs.tolist(), [0, 1], [kp] * 2, [kd] * 2, [damping] * 2, dt)
+    G = [pin.computeGeneralizedGravityDerivatives(arm.model, data, q) for q in configs]
+    lin = stab.Linearised(np.array(Ms), np.array([0.5 * (g + g.T) for g in G]))
+    rep = verdicts.analyse(lin, configs.tolist(), _pd(kp, kd, damping), dt)
     cfg = SimConfig(kp=np.full(2, kp), kd=np.full(2, kd), dt=dt)
     try:
         check_stability(arm, cfg, configs)
         accepted = True
-    except InputError:
+    except UnstableLoopError:
         accepted = False
     assert rep.implicit.stable == accepted
 
@@ -163,9 +176,9 @@ def test_undamped_loop_is_marginal_and_accepted() -> None:
     """No damping: symplectic Euler keeps |eigenvalues| = 1 (a bounded oscillation) below the
     Jury edge a < 4, so both commands accept it, and iterating it neither grows nor decays."""
     M = two_link_mass_matrix(0.0)
-    rep = stab.analyse([M], [[0.0, 0.0]], [0, 1], [KP] * 2, [0.0] * 2, [0.0] * 2, DT)
+    rep = verdicts.analyse(_lin(M), [[0.0, 0.0]], _pd(KP, 0.0, 0.0), DT)
     assert rep.implicit.stable and rep.explicit.stable
-    assert rep.implicit.spectral_radius == pytest.approx(1.0, abs=stab.RADIUS_TOL)
+    assert rep.implicit.spectral_radius == pytest.approx(1.0, abs=1e-6)
     assert simulate(M, KP, 0.0, DT, implicit=True) < 1.5  # bounded: no growth
 
 
@@ -174,6 +187,5 @@ def test_largest_stable_dt_matches_the_closed_form() -> None:
     M = two_link_mass_matrix(0.0)
     lam = float(np.linalg.eigvalsh(np.linalg.inv(M))[-1])
     d = KD + DAMPING
-    kp_v, d_v = np.full(2, KP), np.full(2, d)
-    dt_exp = stab.largest_stable_dt([M], [0, 1], kp_v, d_v, "explicit", DT)
+    dt_exp = stab.largest_stable_dt(_lin(M), _pd(KP, KD, DAMPING), "explicit", DT)
     assert dt_exp == pytest.approx(stab.explicit_dt_max(KP, d, lam), rel=1e-9)

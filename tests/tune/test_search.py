@@ -10,12 +10,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from armcli.sim.stability import analyse
+from armcli.sim import stability as stab
+from armcli.sim.verdict import analyse
 from armcli.spec.load import load_spec
 from armcli.tune import job as tjob
 from armcli.tune import session
 from armcli.tune.engine import LocalEngine
-from armcli.tune.model_gains import mass_matrices, sample_configurations
+from armcli.tune.model_gains import linearised, sample_configurations
 from armcli.tune.objective import INFEASIBLE_COST
 from armcli.tune.problem import nominal_arm
 from armcli.tune.search import SearchOptions, cost_of
@@ -50,8 +51,8 @@ def test_tuned_gains_stable_at_the_spec_dt(job: tjob.TuneJob, outcome: session.O
     qs = sample_configurations(arm)
     n = len(arm.joint_names)
     best = outcome.result.best
-    rep = analyse(mass_matrices(arm, qs), qs.tolist(), list(range(n)), best[:n].tolist(),
-                  best[n:].tolist(), arm.damping.tolist(), load_spec(SPEC).control.dt)  # fmt: skip
+    pd = stab.PD.of(range(n), best[:n], best[n:], arm.damping)
+    rep = analyse(linearised(arm, qs, gravity=True), qs.tolist(), pd, load_spec(SPEC).control.dt)
     assert rep.implicit.stable
     assert rep.implicit.spectral_radius < 1.0
 

@@ -15,7 +15,7 @@ from typing import Any, Literal
 
 from armcli.check.rules import RULES, CheckOptions, Collector, JointRow
 from armcli.check.structure import Tree
-from armcli.sim.stability import StabilityReport
+from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf, position_bounds
 from armcli.urdf.pinocchio import JointRange
 

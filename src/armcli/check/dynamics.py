@@ -14,15 +14,16 @@ from typing import Any
 
 import numpy as np
 
-from armcli.check.rules import CheckOptions, Collector, JointRow
+from armcli.check.rules import CheckOptions, Collector, JointRow, Value
 from armcli.check.structure import finite
 from armcli.errors import InputError
 from armcli.sim import stability as stab
-from armcli.sim.stability import StabilityReport
+from armcli.sim import verdict as verdicts
+from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf
 from armcli.urdf.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
 from armcli.urdf.meshes import mesh_paths
-from armcli.urdf.pinocchio import collision_model, configuration, mass_matrix
+from armcli.urdf.pinocchio import collision_model, configuration
 
 GRID_POINTS = 5  # per joint, when the grid has at most MAX_GRID samples
 MAX_GRID = 125
@@ -32,11 +33,9 @@ SAMPLE_SEED = 0
 # Shapes must overlap by more than this to count as colliding: links that merely
 # touch by construction (e.g. a link resting on the base top) are not a collision.
 PENETRATION_TOL = 1e-4  # [m]
-# Remedies: an effort limit covering the worst gravity torque with this margin (payload,
-# acceleration), and time steps / gains this fraction inside the strict stability bounds,
-# both rounded to 2 significant digits (up for effort, down for dt, Kd and Kp).
+# Remedy: an effort limit covering the worst gravity torque with this margin (payload,
+# acceleration), rounded up to 2 significant digits (stability remedies: sim.stability).
 EFFORT_MARGIN = 1.5
-STABLE_MARGIN = 0.9
 REMEDY_DIGITS = 2
 
 
@@ -46,14 +45,6 @@ def round_up(x: float, digits: int = REMEDY_DIGITS) -> float:
         return x
     step = 10.0 ** (np.floor(np.log10(x)) - digits + 1)
     return float(f"{np.ceil(x / step - 1e-9) * step:.{digits}g}")
-
-
-def round_down(x: float, digits: int = REMEDY_DIGITS) -> float:
-    """X rounded down to `digits` significant digits (a dt or gain still below a bound)."""
-    if x <= 0 or not np.isfinite(x):
-        return x
-    step = 10.0 ** (np.floor(np.log10(x)) - digits + 1)
-    return float(f"{np.floor(x / step + 1e-9) * step:.{digits}g}")
 
 
 def samples(model: Any, ranges: list[Any]) -> list[tuple[dict[str, float], Any]]:
@@ -134,8 +125,9 @@ def stability(
 ) -> StabilityReport | None:
     """Rules `pd-explicit-unstable` and `pd-unstable`: the spec's PD gains at its time step.
 
-    The mass matrix at every sample bounds the gains (armcli.sim.stability). Returns None
-    without a spec that has gains, and adds a note when no controlled joint is in the URDF.
+    M(q) and gravity's stiffness at every sample bound the gains (armcli.sim.stability).
+    Returns None without a spec that has gains, and adds a note when no controlled joint
+    is in the URDF.
     """
     spec = opts.spec
     if spec is None or not spec.control.gains:
@@ -146,72 +138,44 @@ def stability(
     if not names:
         notes.append("stability skipped: no controlled joint found in this URDF")
         return None
-    Ms = [mass_matrix(model, data, q) for _, q in samples]
-    qs = [[p[n] for n in names] for p, _ in samples]
+    gravity = not spec.control.gravity_compensation
+    lin = stab.linearise(model, [q for _, q in samples], gravity=gravity, data=data)
     gains = [spec.control.gains[n] for n in names]
-    rep = stab.analyse(
-        Ms,
-        qs,
+    pd = stab.PD.of(
         [v_of[n] for n in names],
         [g.kp for g in gains],
         [g.kd for g in gains],
         [joints[n].damping for n in names],
-        spec.control.dt,
     )
+    qs = [[p[n] for n in names] for p, _ in samples]
+    rep = verdicts.analyse(lin, qs, pd, spec.control.dt)
     line = next((j.line for j in urdf.joints if j.name == names[0]), None)
-    _report_stability(rep, names, line, out)
+    _report_stability(rep, names, qs, line, out)
     return rep
 
 
 def _report_stability(
-    rep: StabilityReport, names: list[str], line: int | None, out: Collector
+    rep: StabilityReport,
+    names: list[str],
+    qs: list[list[float]],
+    line: int | None,
+    out: Collector,
 ) -> None:
-    """The two PD findings, with the numbers that explain them and a remedy."""
-    q_txt = ", ".join(f"{n} = {v:.3g}" for n, v in zip(names, rep.q_worst, strict=True))
-    common = dict(lambda_max=rep.lambda_max, dt=rep.dt, kp=rep.kp, kd_plus_damping=rep.d)
-    if not rep.explicit.stable:
-        e = rep.explicit
-        fix = {
-            "dt": round_down(STABLE_MARGIN * e.dt_max),
-            "kd": round_down(STABLE_MARGIN * rep.kd_max_explicit),
-        }
-        out.add(
-            "pd-explicit-unstable",
-            line,
-            f"explicit-damping PD at dt = {rep.dt:g} s diverges: "
-            f"lambda_max(M^-1) = {rep.lambda_max:.4g} at {q_txt}; (Kd+damping)*dt*lambda = "
-            f"{e.b:.3g}, Kp*dt^2*lambda = {e.a:.3g}, need a + 2b < 4 (is {e.a + 2 * e.b:.3g}); "
-            f"stable for dt < {e.dt_max:.3g} s or Kd < {rep.kd_max_explicit:.3g}"
-            + (
-                f"; with implicit damping (as `armcli simulate` steps) it is stable for "
-                f"Kp < {rep.kp_max_implicit:.4g}"
-                if rep.implicit.stable
-                else ""
-            )
-            + f"; e.g. dt = {fix['dt']:g} s or Kd = {fix['kd']:g}",
-            fix,
-            **common,
-            a=e.a,
-            b=e.b,
-            dt_max=e.dt_max,
-            kd_max=rep.kd_max_explicit,
-        )
-    if not rep.implicit.stable:
-        fix = {
-            "dt": round_down(STABLE_MARGIN * rep.implicit.dt_max),
-            "kp": round_down(STABLE_MARGIN * rep.kp_max_implicit),
-        }
-        out.add(
-            "pd-unstable",
-            line,
-            f"PD at dt = {rep.dt:g} s diverges even with implicit "
-            f"damping: Kp = {rep.kp:g} > {rep.kp_max_implicit:.4g}; stable for dt < "
-            f"{rep.implicit.dt_max:.3g} s; e.g. dt = {fix['dt']:g} s or Kp = {fix['kp']:g}",
-            fix,
-            **common,
-            kp_max=rep.kp_max_implicit,
-            dt_max=rep.implicit.dt_max,
-        )
+    """One finding per unstable loop, saying which loop, why, where and its one remedy."""
+    common = dict(lambda_max=rep.lambda_max, dt=rep.dt, kp=rep.kp, kd_plus_damping=rep.d,
+                  gravity_stiffness=rep.gravity_stiffness)  # fmt: skip
+    numbers = (rep.kp, rep.d, rep.gravity_stiffness, rep.lambda_max)
+    for rule, v in (("pd-unstable", rep.implicit), ("pd-explicit-unstable", rep.explicit)):
+        if v.stable or v.suggestion is None:
+            continue
+        text = verdicts.message(v, names, qs[v.worst], rep.dt, numbers)
+        if rule == "pd-explicit-unstable" and rep.implicit.stable:
+            text += f"; {rep.implicit.loop} is stable with these gains"
+        fix: dict[str, Value] = {"dt": v.suggestion.dt}
+        if v.suggestion.kp is not None and v.suggestion.kd is not None:
+            fix["kp"], fix["kd"] = list(v.suggestion.kp), list(v.suggestion.kd)
+        out.add(rule, line, text, fix, **common, a=v.a, b=v.b, dt_max=v.dt_max,
+                gain_scale=v.gain_scale)  # fmt: skip
 
 
 def self_collision(

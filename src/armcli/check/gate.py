@@ -9,6 +9,8 @@ first makes the two commands agree on what a usable model is.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 from armcli.check.rules import ERROR, CheckOptions
 from armcli.check.run import check_urdf
 from armcli.errors import ModelRefusedError, RuleViolation
@@ -23,13 +25,21 @@ NOT_SIMULATED = frozenset(
 )  # fmt: skip
 
 
-def refuse_check_errors(urdf: Urdf, options: CheckOptions | None = None) -> None:
-    """Raise ModelRefusedError when a check rule that bears on the dynamics reports an error."""
+def refuse_check_errors(
+    urdf: Urdf, options: CheckOptions | None = None, *, ignore: Iterable[str] = ()
+) -> None:
+    """Raise ModelRefusedError when a check rule that bears on the dynamics reports an error.
+
+    Rules in `ignore` do not refuse (as `check --ignore` silences them): the user has
+    judged the finding, e.g. a true `inertia-exceeds-geometry` on an arm whose inertia is
+    right although its collision shape is smaller.
+    """
+    skip = NOT_SIMULATED | set(ignore)
     result = check_urdf(urdf, options)
     errors = [
         RuleViolation(f.rule, f.file, f.line, f.message)
         for f in result.findings
-        if f.severity == ERROR and f.rule not in NOT_SIMULATED
+        if f.severity == ERROR and f.rule not in skip
     ]
     if errors:
         raise ModelRefusedError(urdf.source, errors)

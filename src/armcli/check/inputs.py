@@ -14,7 +14,9 @@ from pathlib import Path
 
 from armcli.check.rules import ERROR, RULES, CheckOptions, Finding
 from armcli.check.run import CheckResult, check_urdf
+from armcli.check.spec_locate import key_lines, locate
 from armcli.errors import EXIT_FAILED, EXIT_OK, EXIT_UNUSABLE, InputError
+from armcli.io.yaml import load_yaml, read_text
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
 from armcli.urdf.source import Trust, read_robot, read_urdf_file
@@ -99,8 +101,14 @@ def run_check(
             unusable.append(Unusable(str(path), exc, named=True))
             continue
         unusable.extend(bad)
+        spec_doc = load_yaml(path) if any(spec is not None for _, spec in docs) else None
+        keys = key_lines(read_text(path)) if spec_doc is not None else {}
         for urdf, spec in docs:
             opts = replace(base, spec=spec) if spec is not None else base
-            results.append(check_urdf(urdf, opts))
+            result = check_urdf(urdf, opts)
+            if spec_doc is not None and spec is not None:  # point at the spec, not its URDF
+                found = locate(result.findings, urdf.text, spec_doc, keys)
+                result = replace(result, findings=tuple(found))
+            results.append(result)
             notes += [(urdf.source, line) for line in urdf.notes]
     return CheckRun(tuple(results), tuple(unusable), tuple(notes))

@@ -86,17 +86,22 @@ def _esc_prop(s: str) -> str:
 def to_github(findings: Sequence[Finding]) -> str:
     """GitHub Actions workflow commands: one `::error`/`::warning` line per finding.
 
-    Findings in a URDF built in memory from a spec (`spec.yaml#name.urdf`)
-    point at the spec file without a line: the lines are the generated file's.
+    Findings in a URDF built in memory from a spec (`spec.yaml#name.urdf`) point at the
+    spec's line of the field they came from (check.spec_locate) and name the generated
+    file's line in the message; without a spec field, at the spec file without a line.
     """
     lines = []
     for f in findings:
         path, inner = split_source(f.file)
         props = [f"file={_esc_prop(path)}"]
-        if f.line and not inner:
+        if f.spec is not None and f.spec.line:  # the spec's own line
+            props.append(f"line={f.spec.line}")
+        elif f.line and not inner:
             props.append(f"line={f.line}")
         props.append(f"title={_esc_prop(f'armcli {f.rule}')}")
         where = f"{inner}:{f.line}: " if inner and f.line else ""
+        if f.spec is not None:
+            where = f"{f.spec.field} ({where.rstrip(': ') or inner}): "
         msg = f"{where}{f.message}" + (f" (fix: {f.hint})" if f.hint else "")
         lines.append(f"::{f.severity} {','.join(props)}::{_esc_data(msg)}")
     return "".join(line + "\n" for line in lines)
@@ -156,7 +161,11 @@ def _findings_grid(findings: Sequence[Finding]) -> Any:
     for f in findings:
         style = "red" if f.severity == ERROR else "yellow"
         body = Text(f.rule, style="bold")
-        if f.line:
+        if f.spec is not None:  # the spec field first; the generated URDF's line after it
+            generated = f.file.partition("#")[2]
+            body.append(f"  {f.spec}")
+            body.append(f" ({generated}:{f.line})" if f.line else "", style="dim")
+        elif f.line:
             body.append(f"  line {f.line}")
         body.append(f"\n{one_line(f.message)}")
         if f.hint:
@@ -228,18 +237,25 @@ def _summary(r: CheckResult) -> list[Any]:
 def _stability_text(st: Any) -> Any:
     from rich.text import Text
 
-    e, i = st.explicit, st.implicit
     t = Text(
         f"PD stability at dt = {st.dt:g} s: lambda_max(M^-1) = {st.lambda_max:.4g} 1/(kg m^2), "
-        f"Kp = {st.kp:g}, Kd + damping = {st.d:g}\n"
+        f"gravity's stiffness up to {st.gravity_stiffness:.3g} N·m/rad, Kp up to {st.kp:g}, "
+        f"Kd + damping up to {st.d:g}"
     )
-    t.append(
-        f"  explicit damping: b = {e.b:.3g}, a = {e.a:.3g}, a + 2b = {e.a + 2 * e.b:.3g} "
-        f"(< 4 needed): ",
-    )
-    t.append("stable" if e.stable else "UNSTABLE", "green" if e.stable else "red")
-    t.append(f"; stable for dt < {e.dt_max:.3g} s or Kd < {st.kd_max_explicit:.3g}\n")
-    t.append("  implicit damping (the simulator): ")
-    t.append("stable" if i.stable else "UNSTABLE", "green" if i.stable else "red")
-    t.append(f"; Kp < {st.kp_max_implicit:.4g} or dt < {i.dt_max:.3g} s")
+    for v in (st.implicit, st.explicit):
+        t.append(f"\n  {v.loop}: ")
+        t.append("stable" if v.stable else "UNSTABLE", "green" if v.stable else "red")
+        t.append(_loop_bounds(v))
     return t
+
+
+def _loop_bounds(v: Any) -> str:
+    """How far a loop is from its edge: the largest dt, and the gain factor at this dt."""
+    what = v.scaled
+    head = " (up to" if v.stable else " (stable for"
+    edge = "dt = " if v.stable else "dt <= "
+    dt = "any dt" if v.dt_max == float("inf") else f"{edge}{v.dt_max:.3g} s"
+    if v.gain_scale is None:
+        return f"{head} {dt}; at this dt gravity or damping alone is too stiff)"
+    factor = "any factor" if v.gain_scale == float("inf") else f"x {v.gain_scale:.3g}"
+    return f"{head} {dt}, or {what} {factor} at this dt)"

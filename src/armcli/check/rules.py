@@ -9,7 +9,7 @@ module is the floor they all stand on, so it imports none of them.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -238,13 +238,16 @@ _RULES = [
         "raise the effort limit or lighten the links",
     ),
     Rule(
-        "pd-unstable", ERROR, "PD loop unstable at dt even with implicit damping", "lower Kp or dt"
+        "pd-unstable",
+        ERROR,
+        "PD loop unstable at dt in armcli simulate (damping implicit); gravity's stiffness counts",
+        "lower dt or Kp (`armcli tune` picks stable gains)",
     ),
     Rule(
         "pd-explicit-unstable",
         WARNING,
-        "PD loop unstable at dt with explicit damping",
-        "lower Kd or dt, or treat damping implicitly",
+        "PD loop unstable at dt in an explicit torque loop (ros2_control effort controller)",
+        "lower dt or Kd (`armcli tune --loop explicit` picks gains for this loop)",
     ),
     Rule(
         "servo-unstable",
@@ -280,6 +283,23 @@ _RULES = [
 RULES: dict[str, Rule] = {r.id: r for r in _RULES}
 
 
+def unknown_rules(ids: Iterable[str]) -> list[str]:
+    """The ids among `ids` that name no rule, sorted (for `--ignore`)."""
+    return sorted(set(ids) - set(RULES))
+
+
+@dataclass(frozen=True)
+class SpecPlace:
+    """Where in a spec file a finding in its generated URDF comes from (check.spec_locate)."""
+
+    file: str
+    line: int | None
+    field: str  # dotted field path, e.g. arm.joints.forearm_hand_joint.limit.upper
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line} {self.field}" if self.line else f"{self.file} {self.field}"
+
+
 @dataclass(frozen=True)
 class Finding:
     """One problem: which rule, where, what the numbers are, and how to fix it."""
@@ -292,6 +312,7 @@ class Finding:
     values: Mapping[str, Value] = field(default_factory=dict)
     hint: str = ""
     fix: Mapping[str, Value] = field(default_factory=dict)  # the numbers that would pass
+    spec: SpecPlace | None = None  # the spec field behind a generated URDF's element
 
     def to_dict(self) -> dict[str, Any]:
         """The finding as a JSON object in the stable schema of docs/check.md."""
@@ -304,6 +325,7 @@ class Finding:
             "values": dict(self.values),
             "hint": self.hint,
             "fix": dict(self.fix),
+            "spec": None if self.spec is None else vars(self.spec).copy(),
         }
 
 
@@ -387,6 +409,6 @@ def apply_policy(
         if f.rule in skip:
             continue
         if strict and f.severity == WARNING:
-            f = Finding(f.rule, ERROR, f.file, f.line, f.message, f.values, f.hint, f.fix)
+            f = replace(f, severity=ERROR)
         out.append(f)
     return out

@@ -80,6 +80,10 @@ def _location(f: Finding, root: Path) -> tuple[dict[str, Any], str]:
     if f.line and f.line > 0 and not inner:
         physical["region"] = {"startLine": f.line}
     prefix = f"{inner}:{f.line}: " if inner and f.line else (f"{inner}: " if inner else "")
+    if f.spec is not None:  # the spec field's line; the generated URDF's in the message
+        if f.spec.line:
+            physical["region"] = {"startLine": f.spec.line}
+        prefix = f"{f.spec.field} ({prefix.rstrip(': ')}): "
     return {"physicalLocation": physical}, prefix
 
 

@@ -15,7 +15,7 @@ import numpy as np
 from armcli.check.context import Context, poses
 from armcli.check.rules import CheckOptions, JointRow
 from armcli.check.structure import finite
-from armcli.sim.stability import StabilityReport
+from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf, total_dof
 from armcli.urdf.pinocchio import configuration
 from armcli.urdf.tool import tool_point

@@ -11,7 +11,7 @@ import typer
 from armcli.check import report
 from armcli.check.inputs import CheckRun, run_check
 from armcli.check.report import counts
-from armcli.check.rules import RULES, CheckOptions, apply_policy
+from armcli.check.rules import RULES, CheckOptions, apply_policy, unknown_rules
 from armcli.check.sarif import to_sarif
 from armcli.commands.options import choice
 from armcli.commands.xacro_inputs import (
@@ -56,7 +56,7 @@ def check_cmd(
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Check robot descriptions for physical sanity; exit 1 on error findings."""
-    unknown = sorted(set(ignore) - set(RULES))
+    unknown = unknown_rules(ignore)
     if unknown:
         raise InputError(f"unknown rule(s) {unknown}; known: {', '.join(RULES)}", field="--ignore")
     files, args = split_paths(paths or [])

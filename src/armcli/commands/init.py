@@ -9,8 +9,12 @@ from pathlib import Path
 import click
 import typer
 
+from armcli.commands.importer import report
+from armcli.commands.xacro_inputs import write_notes
 from armcli.defaults import SPEC_FILE, TRAJECTORY_DIR
+from armcli.importer.file import import_file
 from armcli.spec.scaffold import DEFAULT_TEMPLATE, TEMPLATES, init_project
+from armcli.tune.spec_start import spec_start_gains
 
 
 def init_cmd(
@@ -24,8 +28,20 @@ def init_cmd(
         show_default=False,
         help="course (default: a 2-axis arm on a mobile base) or tabletop (a 3-axis arm).",
     ),
+    source: Path | None = typer.Option(
+        None,
+        "--from",
+        help="Start from this URDF or xacro file instead (as `armcli import`).",
+    ),
 ) -> None:
     """Write an example spec (armcli.yaml), its trajectories and a README; never overwrites."""
+    if source is not None:
+        directory.mkdir(parents=True, exist_ok=True)
+        out = directory / SPEC_FILE
+        result, notes = import_file(source, out, gains=spec_start_gains)
+        write_notes(notes)
+        sys.stdout.write(report(result, source, out))
+        return
     written = init_project(directory, template)
     where = "." if directory == Path(".") else str(directory)
     sys.stdout.write(f"wrote {len(written)} files into {where}{os.sep}\n")

@@ -9,7 +9,6 @@ from typing import Any, cast
 
 import typer
 
-from armcli.check.gate import refuse_check_errors
 from armcli.commands.options import choice, option, spec_argument
 from armcli.commands.xacro_inputs import (
     args_argument,
@@ -19,22 +18,22 @@ from armcli.commands.xacro_inputs import (
     write_notes,
     xacro_inputs,
 )
-from armcli.errors import InputError
+from armcli.errors import InputError, ModelRefusedError, UnstableLoopError
 from armcli.io import terminal
 from armcli.io.outdir import check_output_file
 from armcli.io.together import write_files_together
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
 from armcli.sim import rosbag, states
-from armcli.sim.options import ENGINES, INTEGRATORS, Engine, Integrator, SimOptions
+from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 from armcli.sim.plot import tracking_png
 from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
-ENGINE_HELP = "auto (default: compiled when available), native (compiled) or python."
 INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
 GRAVITY_HELP = "Add g(q) to the PD torque (default: the spec's control.gravity_compensation)."
+IGNORE_HELP = "Simulate a --urdf despite this `check` rule's error (repeatable)."
 TRAJECTORY_HELP = "JointTrajectory YAML (a point without time_from_start: previous + 1 s)."
 PROGRESS_AFTER_S = 1.0  # show a progress bar when the run is projected to take longer
 
@@ -67,13 +66,18 @@ def simulate_cmd(
     ),
     plot: Path = option(None, "--plot", help="Write a tracking plot PNG."),
     rate: float = option(None, "--rate", help="Output rate [Hz] (default: the spec's publisher)."),
-    engine: str = choice("auto", ENGINES, "--engine", help=ENGINE_HELP),
     package_dir: list[str] = package_dir_option(),
     env: list[str] = env_option(),
     trust_xacro: bool = option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
+    ignore: list[str] = option([], "--ignore", help=IGNORE_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
+    from armcli.check.rules import unknown_rules
+
+    unknown = unknown_rules(ignore)
+    if unknown:
+        raise InputError(f"unknown rule(s) {', '.join(unknown)}", field="--ignore")
     spec, tokens = split_robot(spec, args)
     inputs = xacro_inputs(tokens, env, package_dir)
     if output is not None:
@@ -82,7 +86,8 @@ def simulate_cmd(
         check_output_file(output, "--output")
     if plot is not None:
         check_output_file(plot, "--plot")
-    spec_obj = load_spec(find_spec(spec)) if (spec is not None or urdf is None) else None
+    spec_path = find_spec(spec) if (spec is not None or urdf is None) else None
+    spec_obj = load_spec(spec_path) if spec_path is not None else None
     kp_values, kd_values = _floats(kp, "--kp"), _floats(kd, "--kd")
     opts = SimOptions(
         trajectory=trajectory,
@@ -97,12 +102,45 @@ def simulate_cmd(
         duration=duration,
         clamp=clamp,
         rate=rate,
-        engine=cast(Engine, engine),
         trust_xacro=trust_mode(trust_xacro, unsandboxed),
         xacro=inputs,
     )
-    # a model `check` reports as an error is not simulated (same rule ids)
-    _run(simjob.prepare(spec_obj, opts, gate=refuse_check_errors), output, plot)
+    _run(_prepare(spec_obj, spec_path, opts, tuple(ignore)), output, plot)
+
+
+def _prepare(
+    spec: Any, spec_path: Path | None, opts: SimOptions, ignore: tuple[str, ...]
+) -> simjob.SimJob:
+    """The job, with library refusals told in the command's terms (options, spec fields).
+
+    A model `check` reports as an error is not simulated (same rule ids), unless ignored.
+    """
+    from armcli.check.gate import refuse_check_errors
+
+    def gate(doc: Any) -> None:
+        refuse_check_errors(doc, ignore=ignore)
+
+    try:
+        return simjob.prepare(spec, opts, gate=gate)
+    except ModelRefusedError as exc:
+        flags = " ".join(f"--ignore {r}" for r in exc.rules())
+        raise ModelRefusedError(
+            exc.source, exc.violations, f"simulate it anyway with {flags}"
+        ) from None
+    except UnstableLoopError as exc:
+        raise exc.located(**_sources(spec_path, opts)) from None
+
+
+def _sources(spec_path: Path | None, opts: SimOptions) -> dict[str, Any]:
+    """Where dt and the gains came from: options, or the spec's control fields."""
+    fields = ["--dt" if opts.dt is not None else "control.dt"]
+    fields += [flag for flag, value in (("--kp", opts.kp), ("--kd", opts.kd)) if value is not None]
+    if opts.kp is None or opts.kd is None:
+        fields.append("control.gains")
+    if spec_path is None:  # no spec: the default dt and the given gains
+        fields = [f for f in fields if not f.startswith("control.")]
+    from_spec = any(f.startswith("control.") for f in fields)
+    return {"file": spec_path if from_spec else None, "field": ", ".join(fields) or None}
 
 
 def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
@@ -112,9 +150,7 @@ def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
     for w in job.trajectory.warnings:
         err.print(f"warning: {w}", markup=False, highlight=False)
     with _LazyProgress(err) as progress:
-        res = simjob.run(job, progress)
-    if res.notice:
-        err.print(f"note: {res.notice}", markup=False, highlight=False, soft_wrap=True)
+        res = simjob.run(job, progress, plot=plot is not None)
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
     files: dict[Path, bytes] = {}  # written together: never a new CSV beside an old plot

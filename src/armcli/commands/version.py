@@ -1,7 +1,7 @@
 """What `armcli --version` reports: armcli, the simulator engine, pin and xacro.
 
 A bug report needs to say which installation ran (the path), whether `simulate` uses the
-compiled rollout or the Python loop, and the versions of the two libraries that shape
+compiled simulator (or why it has none), and the versions of the two libraries that shape
 every output (Pinocchio for dynamics and checks, xacro for expansion). Versions come
 from the installed metadata so that no heavy library is imported.
 """
@@ -27,14 +27,14 @@ def _dist_version(name: str) -> str:
 
 
 def engine() -> str:
-    """`compiled` or `Python`: what `simulate --engine auto` runs, and where or why not.
+    """Where the compiled simulator `simulate` runs is, or why there is none.
 
     Asks `native.load()`, the same check the simulator makes, so the answer cannot differ
     from what `simulate` does.
     """
     lib = native.load()
     if lib is None:
-        return f"Python (no compiled rollout: {native.why_missing()})"
+        return f"unavailable ({native.why_missing()})"
     where = getattr(lib, "__file__", None) or getattr(lib, "_name", "")  # module or CDLL
     return f"compiled ({where})"
 

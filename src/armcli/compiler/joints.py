@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from lxml import etree
 
+from armcli.compiler.passthrough import copy_into
 from armcli.compiler.xmlfmt import fmt, sub, vec
 from armcli.spec.model import Joint
 
@@ -60,4 +61,5 @@ def joint_element(parent: etree._Element, name: str, joint: Joint) -> etree._Ele
             k: fmt(v) for k, v in (("rising", c.rising), ("falling", c.falling)) if v is not None
         }
         sub(el, "calibration", **attrs)
+    copy_into(el, joint.passthrough)
     return el

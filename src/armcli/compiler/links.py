@@ -15,6 +15,7 @@ from lxml import etree
 
 from armcli.compiler.massprops import mesh_mass_properties, primitive_mass
 from armcli.compiler.meshfiles import MeshNames
+from armcli.compiler.passthrough import copy_into
 from armcli.compiler.xmlfmt import XACRO_NS, fmt, literal, sub, vec
 from armcli.spec.model import Geometry, InlineMaterial, Link, Origin, Shape
 
@@ -202,3 +203,4 @@ def link_element(
     for shape in link.collisions():
         shape_element(el, "collision", shape, names, r)
     inertial_element(el, link, names, r, field)
+    copy_into(el, link.passthrough)

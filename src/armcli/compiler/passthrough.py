@@ -21,12 +21,17 @@ def _escape(el: etree._Element) -> None:
             node.set(key, literal(str(value)))
 
 
-def passthrough_tree(elements: list[str]) -> etree._Element:
-    """The passthrough.xacro tree: each element copied in order."""
-    root = robot()
+def copy_into(parent: etree._Element, elements: list[str]) -> None:
+    """Append each passthrough element to `parent`, as xacro literals."""
     for text in elements:
         el = parse_element(text)
         _escape(el)
         el.tail = None
-        root.append(el)
+        parent.append(el)
+
+
+def passthrough_tree(elements: list[str]) -> etree._Element:
+    """The passthrough.xacro tree: each element copied in order."""
+    root = robot()
+    copy_into(root, elements)
     return root

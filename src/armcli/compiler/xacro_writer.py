@@ -20,6 +20,7 @@ from armcli.compiler.joints import joint_element
 from armcli.compiler.links import INERTIA_MACROS, link_element, link_properties, stems
 from armcli.compiler.meshfiles import MeshNames
 from armcli.compiler.passthrough import passthrough_tree
+from armcli.compiler.ros2_control import ros2_control_element
 from armcli.compiler.xmlfmt import XACRO_NS, robot, sub, to_bytes, vec
 from armcli.defaults import STANDALONE_ARM as STANDALONE_ARM_NAME
 from armcli.defaults import STANDALONE_ARM_URDF, STANDALONE_ARM_XACRO
@@ -36,6 +37,7 @@ MOBILE_BASE_GAZEBO = "mobile_base_gazebo.xacro"
 ARM = "arm.xacro"
 ARM_GAZEBO = "arm_gazebo.xacro"
 PASSTHROUGH = "passthrough.xacro"
+ROS2_CONTROL = "ros2_control.xacro"
 STANDALONE_ARM = STANDALONE_ARM_XACRO
 TOP = "{name}.urdf.xacro"
 
@@ -101,16 +103,24 @@ def has_base(spec: RobotSpec) -> bool:
 
 
 def xacro_files(
-    spec: RobotSpec, spec_label: str = "the armcli spec", names: MeshNames | None = None
+    spec: RobotSpec,
+    spec_label: str = "the armcli spec",
+    names: MeshNames | None = None,
+    *,
+    hardware: bool = True,
 ) -> dict[str, bytes]:
     """Filename -> bytes of the whole xacro set for `spec`.
 
-    `names` says how mesh files are named (default: absolute paths, for an in-memory build).
+    `names` says how mesh files are named (default: absolute paths, for an in-memory build);
+    `hardware` False leaves out the spec's own `<ros2_control>` block (the ROS packages
+    write theirs, mock or Gazebo, from the same interfaces).
     """
     names = names if names is not None else MeshNames(spec.base_dir)
     header = GENERATED.format(spec=spec_label)
     prefixes = stems(list(spec.all_links()))
-    extra = [PASSTHROUGH] if spec.passthrough else []
+    rc = spec.ros2_control if hardware else None
+    extra = [ROS2_CONTROL] if rc is not None and rc.hardware is not None else []
+    extra += [PASSTHROUGH] if spec.passthrough else []
     arm_top = STANDALONE_ARM_NAME if has_base(spec) else spec.name
     trees: dict[str, etree._Element] = {
         COMMON: common_properties(spec),
@@ -122,6 +132,9 @@ def xacro_files(
     }
     if spec.passthrough:
         trees[PASSTHROUGH] = passthrough_tree(spec.passthrough)
+    if rc is not None and rc.hardware is not None:
+        trees[ROS2_CONTROL] = robot()
+        trees[ROS2_CONTROL].append(ros2_control_element(spec.name, rc))
     base = spec.mounted_base()
     if base is not None:
         trees[MOBILE_BASE] = part(base.links, base.joints, prefixes, names, "mobile_base")

@@ -18,13 +18,17 @@ from typing import Any
 
 from lxml import etree
 
+from armcli.compiler.ros2_control import joint_block
+from armcli.compiler.sensors import bridge_entries, harmonic_sensor, harmonic_systems
 from armcli.compiler.xacro_writer import ARM, COMMON, MOBILE_BASE, joint_element
 from armcli.compiler.xmlfmt import XACRO_NS, fmt, to_bytes
 from armcli.errors import InputError
+from armcli.ros import interfaces
 from armcli.ros import moveit as mc
+from armcli.ros.interfaces import GAIN_INTERFACES, JAZZY
 from armcli.ros.launch import render
 from armcli.ros.srdf import chain_joints
-from armcli.spec.model import Joint, RobotSpec
+from armcli.spec.model import Joint, RobotSpec, Sensor
 
 X = f"{{{XACRO_NS}}}"
 GZ_SYSTEM = "gz_ros2_control/GazeboSimSystem"
@@ -76,8 +80,13 @@ def _sub(parent: etree._Element, tag: str, text: str | None = None, **attrs: str
 
 
 def required_gains(spec: RobotSpec, source: str | None = None) -> dict[str, Any]:
-    """Every commanded joint needs gains: an effort JTC without them applies no torque."""
+    """Every commanded joint needs gains: an effort JTC without them applies no torque.
+
+    A position-commanded arm (the spec's ros2_control says so) needs none: {}.
+    """
     joints = chain_joints(spec)
+    if interfaces.trajectory_interface(spec, joints, JAZZY, source) not in GAIN_INTERFACES:
+        return {}
     missing = [j for j in joints if j not in spec.control.gains]
     if missing:
         raise InputError(
@@ -98,30 +107,19 @@ def _hardware(rc: etree._Element) -> None:
 
 
 def ros2_control_block(parent: etree._Element, spec: RobotSpec, passive: list[str]) -> None:
-    """`<ros2_control>`: effort command + position/velocity/effort state per arm joint.
+    """`<ros2_control>`: the arm joints' interfaces (ros.interfaces), state for `passive`.
 
-    The position state starts at the `home` pose (mc.initial_positions), which
-    gz_ros2_control also uses to place the joints at spawn.
+    Unless the spec says otherwise an arm joint takes effort within its effort limit and
+    reports position, velocity and effort. The position state starts at the `home` pose
+    (mc.initial_positions), which gz_ros2_control also uses to place the joints at spawn.
     """
     rc = _sub(parent, "ros2_control", name=f"{spec.name}_system", type="system")
     _hardware(rc)
     start = mc.initial_positions(spec)["initial_positions"]
-    joints = spec.all_joints()
     for name in chain_joints(spec):
-        el = _sub(rc, "joint", name=name)
-        cmd = _sub(el, "command_interface", name="effort")
-        lim = joints[name].limit
-        if lim is not None:
-            _sub(cmd, "param", fmt(-lim.effort), name="min")
-            _sub(cmd, "param", fmt(lim.effort), name="max")
-        pos = _sub(el, "state_interface", name="position")
-        _sub(pos, "param", fmt(start[name]), name="initial_value")
-        _sub(el, "state_interface", name="velocity")
-        _sub(el, "state_interface", name="effort")
+        joint_block(rc, name, interfaces.commanded(spec, name, JAZZY), fmt(start[name]))
     for name in passive:
-        el = _sub(rc, "joint", name=name)
-        _sub(el, "state_interface", name="position")
-        _sub(el, "state_interface", name="velocity")
+        joint_block(rc, name, interfaces.passive(spec, name))
 
 
 def _gz_plugins(parent: etree._Element, spec: RobotSpec, whole: bool) -> None:
@@ -178,7 +176,47 @@ def top_xacro(spec: RobotSpec, bringup_pkg: str, *, whole: bool, header: str) ->
     _friction(root, spec, whole)
     ros2_control_block(root, spec, mc.passive_joints(spec) if whole else [])
     _gz_plugins(root, spec, whole)
+    _sensors(root, spec, whole)
     return to_bytes(root, header_comment=header)
+
+
+def sensors_on(spec: RobotSpec, whole: bool) -> dict[str, Sensor]:
+    """The sensors of the whole robot, or of the arm alone."""
+    links = spec.all_links() if whole else spec.arm.links
+    return {n: s for n, s in spec.sensors.items() if s.link in links}
+
+
+def _sensors(root: etree._Element, spec: RobotSpec, whole: bool) -> None:
+    """gz-sim sensors and the systems that run them (outside mock mode, like the plugins)."""
+    sensors = sensors_on(spec, whole)
+    if not sensors:
+        return
+    sim = _sub(root, X + "unless", value=f"$(arg {MOCK_ARG})")
+    for el in harmonic_systems(list(sensors.values())):
+        sim.append(el)
+    for name, s in sensors.items():
+        sim.append(harmonic_sensor(name, s))
+
+
+def bridge_file(robot: str) -> str:
+    """File name of the ros_gz_bridge configuration in the bringup's `config/`."""
+    return f"{robot}_bridge.yaml"
+
+
+def bridge(spec: RobotSpec) -> list[dict[str, Any]]:
+    """ros_gz_bridge entries: the simulation clock, then every sensor's topics."""
+    out: list[dict[str, Any]] = [
+        {
+            "ros_topic_name": "clock",
+            "gz_topic_name": "clock",
+            "ros_type_name": "rosgraph_msgs/msg/Clock",
+            "gz_type_name": "gz.msgs.Clock",
+            "direction": "GZ_TO_ROS",
+        }
+    ]
+    for s in spec.sensors.values():
+        out += bridge_entries(s)
+    return out
 
 
 def has_whole_robot(spec: RobotSpec) -> bool:
@@ -203,6 +241,8 @@ def controllers(spec: RobotSpec, source: str | None = None) -> dict[str, Any]:
     i_clamp bounds the integral torque by the effort limit (0 when Ki is 0).
     """
     gains = required_gains(spec, source)
+    chain = chain_joints(spec)
+    command = interfaces.trajectory_interface(spec, chain, JAZZY, source)
     joints = spec.all_joints()
     tol = spec.control.tolerances
     constraints: dict[str, Any] = {
@@ -210,8 +250,9 @@ def controllers(spec: RobotSpec, source: str | None = None) -> dict[str, Any]:
         "goal_time": float(tol.goal_time),
     }
     pid: dict[str, Any] = {}
-    for name, g in gains.items():
+    for name in chain:
         constraints[name] = {"trajectory": float(tol.trajectory), "goal": float(tol.goal)}
+    for name, g in gains.items():
         lim = joints[name].limit
         clamp = float(lim.effort) if (lim is not None and g.ki > 0) else 0.0
         pid[name] = {
@@ -221,14 +262,15 @@ def controllers(spec: RobotSpec, source: str | None = None) -> dict[str, Any]:
             "i_clamp": clamp,
             "ff_velocity_scale": 0.0,
         }
-    arm = {
-        "joints": list(gains),
-        "command_interfaces": ["effort"],
+    arm: dict[str, Any] = {
+        "joints": chain,
+        "command_interfaces": [command],
         "state_interfaces": ["position", "velocity"],
         "allow_nonzero_velocity_at_trajectory_end": False,
         "constraints": constraints,
-        "gains": pid,
     }
+    if pid:
+        arm["gains"] = pid
     return {
         "controller_manager": {
             "ros__parameters": {

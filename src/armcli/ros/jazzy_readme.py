@@ -125,7 +125,8 @@ def readme(spec: RobotSpec, bringup: str, launch: str, moveit: str, note: str) -
         "",
         "The launch starts `gz_sim.launch.py` (ros_gz_sim) with an empty world, "
         "robot_state_publisher on the xacro, `ros_gz_sim create -topic robot_description`, "
-        "the `/clock` bridge, then spawns `joint_state_broadcaster` once the robot exists "
+        f"the ros_gz_bridge of `/clock` and the sensor topics (`config/{spec.name}_bridge.yaml`), "
+        "then spawns `joint_state_broadcaster` once the robot exists "
         f"and `{ARM_CONTROLLER}` once that is active.",
         "",
         *_moving(spec),

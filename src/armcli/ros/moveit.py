@@ -14,6 +14,7 @@ from typing import Any
 import yaml
 
 from armcli.errors import InputError
+from armcli.ros.interfaces import HUMBLE, trajectory_interface
 from armcli.ros.srdf import ARM_GROUP, chain_joints
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf, position_bounds
@@ -26,16 +27,17 @@ IK_TIMEOUT = 0.005  # [s] Setup Assistant default
 SCALING_DEFAULT = 0.1  # Setup Assistant default velocity/acceleration scaling
 
 
-class _Dumper(yaml.SafeDumper):
+class Dumper(yaml.SafeDumper):
     """Block-style YAML, lists indented under their key like ROS 2 examples."""
 
     def increase_indent(self, flow: bool = False, indentless: bool = False) -> Any:
+        """Indent sequences under their key (never "indentless")."""
         return super().increase_indent(flow, False)
 
 
 def dump_yaml(data: dict[str, Any], header: str | None = None) -> bytes:
     """Deterministic YAML text: insertion order, block style, optional `#` header."""
-    body = yaml.dump(data, Dumper=_Dumper, sort_keys=False, default_flow_style=False, width=100)
+    body = yaml.dump(data, Dumper=Dumper, sort_keys=False, default_flow_style=False, width=100)
     head = "".join(f"# {line}\n" for line in header.splitlines()) if header else ""
     return (head + body).encode("utf-8")
 
@@ -102,7 +104,7 @@ def ros2_controllers(spec: RobotSpec, source: str | None = None) -> dict[str, An
     }
     arm: dict[str, Any] = {
         "joints": joints,
-        "command_interfaces": ["position"],
+        "command_interfaces": [trajectory_interface(spec, joints, HUMBLE, source)],
         "state_interfaces": ["position", "velocity"],
         "allow_nonzero_velocity_at_trajectory_end": True,
     }

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import yaml
 from lxml import etree
 
 from armcli.compiler.expand import expand_urdfs
@@ -217,7 +218,7 @@ def description_files(
     `extra` adds xacro files under `urdf/` (the Jazzy top levels).
     """
     note = GENERATED.format(spec=label)
-    xacros = {**xacro_files(spec, label), **(extra or {})}
+    xacros = {**xacro_files(spec, label, hardware=False), **(extra or {})}
     files = {f"urdf/{name}": data for name, data in xacros.items()}
     files["launch/display.launch.py"] = render("display.launch.py.tmpl", _launch_values(n), note)
     files[f"rviz/{DISPLAY_RVIZ}"] = mc.dump_yaml(display_rviz(n.robot_root), note)
@@ -262,9 +263,7 @@ def moveit_files(
     urdf_xacro = f"config/{n.robot}.urdf.xacro"
     files[n.srdf] = srdf_bytes(spec, matrix, note)
     files[urdf_xacro] = moveit_urdf_xacro(n.robot, n.description, n.robot_xacro, note)
-    files[f"config/{n.robot}.ros2_control.xacro"] = ros2_control_xacro(
-        n.robot, chain_joints(spec), mc.passive_joints(spec), note
-    )
+    files[f"config/{n.robot}.ros2_control.xacro"] = ros2_control_xacro(spec, note)
     files["config/moveit.rviz"] = mc.dump_yaml(moveit_rviz(n.robot_root), note)
     files[".setup_assistant"] = mc.dump_yaml(mc.setup_assistant(n.moveit, urdf_xacro, n.srdf), note)
     for launch, (generator, what) in MOVEIT_LAUNCHES.items():
@@ -327,6 +326,7 @@ def jazzy_files(
         "robot_xacro": whole if whole in tops else jazzy.STANDALONE,
         "standalone_xacro": jazzy.STANDALONE,
         "controllers": jazzy.controllers_file(n.robot),
+        "bridge": jazzy.bridge_file(n.robot),
         "gz_launch": launch,
         "arm_controller": mc.ARM_CONTROLLER,
         "joint_state_broadcaster": mc.JOINT_STATE_BROADCASTER,
@@ -335,6 +335,7 @@ def jazzy_files(
         f"config/{jazzy.controllers_file(n.robot)}": mc.dump_yaml(
             jazzy.controllers(spec, source), note
         ),
+        f"config/{jazzy.bridge_file(n.robot)}": _bridge_yaml(jazzy.bridge(spec), note),
         f"launch/{launch}": jazzy.bringup_launch(values, note),
         "README.md": jazzy_readme(spec, n.bringup, launch, n.moveit, note),
     }
@@ -343,6 +344,12 @@ def jazzy_files(
         **description_files(spec, n, label, info, tops),
         **_package(n.bringup, about, [n.description, *jazzy.BRINGUP_DEPENDS], files, info),
     }
+
+
+def _bridge_yaml(entries: list[dict[str, Any]], note: str) -> bytes:
+    """ros_gz_bridge's config file: a YAML list of topic entries."""
+    body = yaml.dump(entries, Dumper=mc.Dumper, sort_keys=False, default_flow_style=False)
+    return ("".join(f"# {line}\n" for line in note.splitlines()) + body).encode("utf-8")
 
 
 def write_ros_packages(

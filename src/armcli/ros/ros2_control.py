@@ -10,7 +10,12 @@ from __future__ import annotations
 
 from lxml import etree
 
+from armcli.compiler.ros2_control import joint_block
 from armcli.compiler.xmlfmt import XACRO_NS, to_bytes
+from armcli.ros.interfaces import HUMBLE, commanded, passive
+from armcli.ros.moveit import passive_joints
+from armcli.ros.srdf import chain_joints
+from armcli.spec.model import RobotSpec
 
 X = f"{{{XACRO_NS}}}"
 MOCK_PLUGIN = "mock_components/GenericSystem"
@@ -27,13 +32,13 @@ def macro_name(robot: str) -> str:
     return f"{robot}_ros2_control"
 
 
-def ros2_control_xacro(
-    robot: str, commanded: list[str], passive: list[str], header: str | None = None
-) -> bytes:
-    """A xacro macro emitting the `<ros2_control>` block.
+def ros2_control_xacro(spec: RobotSpec, header: str | None = None) -> bytes:
+    """A xacro macro emitting the `<ros2_control>` block of the MoveIt demo (mock hardware).
 
-    `commanded` joints take position commands; `passive` ones only report state.
+    Chain joints take commands (position unless the spec's `ros2_control` says otherwise);
+    the others only report state. Positions start at initial_positions.yaml.
     """
+    robot = spec.name
     root = _robot()
     macro = etree.SubElement(
         root, X + "macro", name=macro_name(robot), params="name initial_positions_file"
@@ -47,14 +52,10 @@ def ros2_control_xacro(
     rc = etree.SubElement(macro, "ros2_control", name="${name}", type="system")
     hw = etree.SubElement(rc, "hardware")
     etree.SubElement(hw, "plugin").text = MOCK_PLUGIN
-    for j in [*commanded, *passive]:
-        el = etree.SubElement(rc, "joint", name=j)
-        if j in commanded:
-            etree.SubElement(el, "command_interface", name="position")
-        pos = etree.SubElement(el, "state_interface", name="position")
-        param = etree.SubElement(pos, "param", name="initial_value")
-        param.text = "${initial_positions['" + j + "']}"
-        etree.SubElement(el, "state_interface", name="velocity")
+    blocks = [(j, commanded(spec, j, HUMBLE)) for j in chain_joints(spec)]
+    blocks += [(j, passive(spec, j)) for j in passive_joints(spec)]
+    for j, control in blocks:
+        joint_block(rc, j, control, initial="${initial_positions['" + j + "']}")
     return to_bytes(root, header_comment=header)
 
 

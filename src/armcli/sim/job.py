@@ -16,8 +16,10 @@ from armcli.compiler.expand import expand_urdfs
 from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.sim.options import SimOptions
+from armcli.sim.plot import plot_steps
 from armcli.sim.reference import Reference, build_reference
 from armcli.sim.simulate import (
+    MAX_STEPS,
     Arm,
     SimConfig,
     SimResult,
@@ -25,7 +27,9 @@ from armcli.sim.simulate import (
     check_stability,
     configuration,
     simulate,
+    steps_of,
 )
+from armcli.sim.states import sample_steps
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
@@ -37,7 +41,6 @@ from armcli.urdf.xacro_args import XacroInputs
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
 ARM_URDF = STANDALONE_ARM_URDF
 RATE_SLACK = 1e-9  # relative: --rate 1000 with dt 0.001 is exactly one sample per step
-MAX_STEPS = 2_000_000  # ~200 MB of recorded states for a 2-joint arm
 
 
 @dataclass(frozen=True)
@@ -255,7 +258,7 @@ def prepare(
     kp, kd = _gains(arm, spec, opts.kp, "kp"), _gains(arm, spec, opts.kd, "kd")
     if opts.kp is None or opts.kd is None:
         _refuse_integral_gain(arm, spec)
-    cfg = SimConfig(kp, kd, dt, opts.integrator, gc, opts.engine)
+    cfg = SimConfig(kp, kd, dt, opts.integrator, gc)
     configs = np.vstack([q0[None, :], ref.sample(traj.times)[0]])
     check_stability(arm, cfg, configs)
     total, rate = _duration_and_rate(spec, opts, traj.duration, dt)
@@ -278,6 +281,15 @@ def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
     return out
 
 
-def run(job: SimJob, progress: Callable[[int, int], None] | None = None) -> SimResult:
-    """Run the job; `progress(steps_done, steps_total)` is called between chunks of steps."""
-    return simulate(job.arm, job.reference, job.q0, job.duration, job.config, progress)
+def run(
+    job: SimJob, progress: Callable[[int, int], None] | None = None, *, plot: bool = False
+) -> SimResult:
+    """Run the job, keeping the states at the output rate (and those a plot draws).
+
+    `progress(steps_done, steps_total)` is called between chunks of steps.
+    """
+    steps = steps_of(job.duration, job.config.dt)
+    keep = sample_steps(steps, job.config.dt, job.rate)
+    if plot:
+        keep = np.union1d(keep, plot_steps(steps))
+    return simulate(job.arm, job.reference, job.q0, job.duration, job.config, progress, record=keep)

@@ -1,33 +1,24 @@
-"""The compiled rollout (the `armcli.sim._rollout` extension) and the choice of engine.
+"""The compiled simulator (`armcli.sim._rollout`): loading it and handing it a model.
 
-The extension is built at install time (`pip install .`, `make install`; CMakeLists.txt)
-against the Pinocchio of the `pin` wheel; nothing compiles at run time. Where it is
-missing (an sdist installed without a compiler), `load()` returns None with the reason
-in `why_missing()` and callers use the identical Python loop in `rollout.py`.
-
-The extension releases the GIL for the whole rollout, so `rollout_batch` runs many
-rollouts (gain sets, models, initial states) on threads in parallel.
+The step is defined once, in `_native/rollout.cpp`, built at install time (`pip install .`,
+`make install`; CMakeLists.txt) against the Pinocchio of the `pin` wheel; nothing compiles
+at run time. An install without a C++ compiler has no simulator: `require()` says so and
+how to get one. The extension carries the hash of the source it was built from, so an
+editable install whose C++ changed without `make native` is refused instead of running
+stale physics.
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
-from collections.abc import Sequence
-from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, replace
+from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-import numpy as np
+from armcli.errors import InputError
 
-from armcli.sim import rollout as ro
-
-ABI_VERSION = 3
-_UNALIGNED = (
-    "JointModelRevoluteUnaligned",
-    "JointModelPrismaticUnaligned",
-    "JointModelRevoluteUnboundedUnaligned",
-)
+SOURCE = Path(__file__).parent / "_native" / "rollout.cpp"
 _state: dict[str, Any] = {}
 
 
@@ -36,6 +27,21 @@ def load() -> ModuleType | None:
     if "module" not in _state:
         _state["module"], _state["why"] = _import()
     mod: ModuleType | None = _state["module"]
+    return mod
+
+
+def require() -> ModuleType:
+    """The extension module.
+
+    Raises:
+        InputError: it is not installed, or stale; the message says how to build it.
+    """
+    mod = load()
+    if mod is None:
+        raise InputError(
+            f"the simulator is unavailable: {why_missing()}; it is compiled when armcli is "
+            "installed: install a C++ compiler (e.g. apt-get install g++) and reinstall armcli"
+        )
     return mod
 
 
@@ -48,119 +54,38 @@ def _import() -> tuple[ModuleType | None, str]:
         from armcli.sim import _rollout  # type: ignore[attr-defined]
     except ImportError as exc:
         return None, f"the armcli.sim._rollout extension is not installed ({exc})"
-    if getattr(_rollout, "ABI_VERSION", None) != ABI_VERSION:
-        return None, "the installed armcli.sim._rollout extension is stale: reinstall armcli"
+    if SOURCE.is_file() and _sha256(SOURCE) != _rollout.SOURCE_SHA256:
+        return None, f"armcli.sim._rollout was built from another {SOURCE.name} (run make native)"
     return _rollout, ""
 
 
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
 def why_missing() -> str:
-    """Why `load()` returned None, for the one-line notice."""
+    """Why `load()` returned None, for the one-line message."""
     load()
     why: str = _state["why"]
     return why
 
 
-def engine_name(mod: ModuleType | None) -> str:
-    """The engine `load()`'s result runs: "native" (compiled) or "python"."""
-    return "native" if mod is not None else "python"
-
-
-def model_arrays(model: Any) -> dict[str, np.ndarray]:
-    """The model as flat arrays the C++ side rebuilds it from (one-dof joints only)."""
-    n = model.njoints - 1
-    out = {
-        "jtype": np.zeros(n, dtype=np.int32),
-        "parent": np.zeros(n, dtype=np.int32),
-        "placement": np.zeros((n, 12)),
-        "axis": np.zeros((n, 3)),
-        "inertia": np.zeros((n, 13)),
-        "gravity": np.array(model.gravity.linear, dtype=float),
-    }
-    for i in range(n):
-        jid = i + 1
-        j = model.joints[jid]
-        out["jtype"][i] = ro.JOINT_TYPES[j.shortname()]
-        out["parent"][i] = model.parents[jid]
-        M = model.jointPlacements[jid]
-        out["placement"][i] = np.concatenate([M.rotation.reshape(-1), M.translation])
-        if j.shortname() in _UNALIGNED:  # the generic JointModel has no axis; the concrete one has
-            out["axis"][i] = j.extract().axis
-        Y = model.inertias[jid]
-        out["inertia"][i] = np.concatenate([[Y.mass], Y.lever, Y.inertia.reshape(-1)])
-    return out
-
-
 def compiled_model(mod: ModuleType, model: Any) -> Any:
-    """The extension's copy of a pinocchio.Model (build once, reuse across rollouts)."""
-    a = model_arrays(model)
-    c = np.ascontiguousarray
-    return mod.build_model(
-        a["jtype"], a["parent"], c(a["placement"]), c(a["axis"]), c(a["inertia"]), a["gravity"]
-    )
+    """The extension's copy of a pinocchio.Model, exact: Pinocchio's own binary serialisation.
 
-
-@dataclass(frozen=True)
-class Job:
-    """One rollout of a batch: any plant (model, gains, dt), initial state and reference."""
-
-    plant: ro.Plant
-    q0: np.ndarray
-    v0: np.ndarray
-    ref: np.ndarray
-    compiled: Any = None  # compiled_model(...) of plant.model, built on demand when None
-
-
-def rollout(
-    mod: ModuleType, plant: ro.Plant, q0: np.ndarray, v0: np.ndarray, ref: np.ndarray
-) -> ro.Rollout:
-    """One rollout through the extension; same contract as `rollout.rollout_python`."""
-    return _run(mod, Job(plant, q0, v0, ref))
-
-
-def rollout_batch(
-    mod: ModuleType, jobs: Sequence[Job], threads: int | None = None
-) -> list[ro.Rollout]:
-    """Independent rollouts, in order, on `threads` threads (default: one per CPU).
-
-    The extension releases the GIL, so the rollouts run in parallel.
+    Build once and reuse across rollouts of the same model.
     """
-    models: dict[int, Any] = {}  # each distinct pinocchio.Model is converted once
-    for j in jobs:
-        if j.compiled is None and id(j.plant.model) not in models:
-            models[id(j.plant.model)] = compiled_model(mod, j.plant.model)
-    ready = [
-        j if j.compiled is not None else replace(j, compiled=models[id(j.plant.model)])
-        for j in jobs
-    ]
-    workers = max(1, min(threads or os.cpu_count() or 1, len(jobs)))
-    if workers == 1:
-        return [_run(mod, j) for j in ready]
-    with ThreadPoolExecutor(max_workers=workers) as pool:
-        return list(pool.map(lambda j: _run(mod, j), ready))
+    import pinocchio as pin
+
+    buf = pin.serialization.StreamBuffer()
+    model.saveToBinary(buf)
+    return mod.load_model(buf.tobytes())
 
 
-def _run(mod: ModuleType, job: Job) -> ro.Rollout:
-    plant = job.plant
-    n = plant.model.nv
-    steps = ro.steps_of(plant, job.ref)
-    Q = np.full((steps + 1, n), np.nan)
-    V = np.full((steps + 1, n), np.nan)
-    T = np.full((steps, n), np.nan)
-    F = np.zeros((steps, n), dtype=np.uint8)
-    compiled = job.compiled if job.compiled is not None else compiled_model(mod, plant.model)
-    c = np.ascontiguousarray
-    fail_step, fail_joint, fail_code = mod.rollout(
-        compiled, c(plant.params, dtype=float), plant.gravity_comp, plant.dt, plant.integrator,
-        plant.energy_max, c(job.q0, dtype=float), c(job.v0, dtype=float),
-        c(job.ref, dtype=float), Q, V, T, F,
-    )  # fmt: skip
-    return ro.Rollout(Q, V, T, F, int(fail_step), int(fail_joint), int(fail_code))
-
-
-if __name__ == "__main__":  # `python -m armcli.sim.native`: which engine this install has
+if __name__ == "__main__":  # `python -m armcli.sim.native`: is the simulator installed
     import sys
 
     if load() is None:
-        print(f"armcli: compiled rollout unavailable: {why_missing()}", file=sys.stderr)
+        print(f"armcli: compiled simulator unavailable: {why_missing()}", file=sys.stderr)
         raise SystemExit(1)
-    print(f"armcli: compiled rollout {load()}")
+    print(f"armcli: compiled simulator {load()}")

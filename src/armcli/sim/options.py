@@ -1,7 +1,7 @@
 """What a simulate run is told besides the spec: built once (by the CLI or a caller), passed down.
 
-A frozen dataclass with `Literal` choices, so a typo in an engine or integrator name is a
-type error for library callers and a listed choice in `armcli simulate --help`.
+A frozen dataclass with `Literal` choices, so a typo in an integrator name is a type error
+for library callers and a listed choice in `armcli simulate --help`.
 """
 
 from __future__ import annotations
@@ -17,12 +17,10 @@ if TYPE_CHECKING:
     from armcli.urdf.xacro_args import XacroInputs
 
 Integrator = Literal["euler", "rk4"]
-"""euler: semi-implicit (symplectic) Euler with implicit damping; rk4: classic Runge-Kutta."""
-Engine = Literal["auto", "native", "python"]
-"""auto: the compiled rollout when available, else the Python loop."""
+"""euler: semi-implicit Euler, Kd and damping implicit (first order; symplectic only for a
+constant mass matrix, see sim/simulate.py); rk4: classic Runge-Kutta, split at knots."""
 
 INTEGRATORS: tuple[str, ...] = get_args(Integrator)
-ENGINES: tuple[str, ...] = get_args(Engine)
 
 
 @dataclass(frozen=True)
@@ -42,7 +40,6 @@ class SimOptions:
         duration: simulated time [s] (default: last point + settle time).
         clamp: clamp trajectory positions outside the limits instead of refusing.
         rate: joint-state output rate [Hz].
-        engine: see `Engine`.
         trust_xacro: expand a foreign xacro file given as `urdf` in the sandbox.
         xacro: a xacro `urdf`'s NAME:=VALUE arguments, --env values and package lookup.
     """
@@ -59,16 +56,12 @@ class SimOptions:
     duration: float | None = None
     clamp: bool = False
     rate: float | None = None
-    engine: Engine = "auto"
     trust_xacro: Trust = False
     xacro: XacroInputs | None = None
 
     def __post_init__(self) -> None:
-        for value, choices, option in (
-            (self.integrator, INTEGRATORS, "--integrator"),
-            (self.engine, ENGINES, "--engine"),
-        ):
-            if value not in choices:
-                raise InputError(
-                    f"unknown value {value!r}; valid: {', '.join(choices)}", field=option
-                )
+        if self.integrator not in INTEGRATORS:
+            raise InputError(
+                f"unknown value {self.integrator!r}; valid: {', '.join(INTEGRATORS)}",
+                field="--integrator",
+            )

@@ -14,6 +14,13 @@ import numpy as np
 from armcli.io.files import write_file_atomic
 from armcli.sim.simulate import SimResult
 
+PLOT_POINTS = 4000  # states a tracking plot draws at most: finer than the figure's pixels
+
+
+def plot_steps(steps: int) -> np.ndarray:
+    """The steps whose states a plot of a `steps`-step run needs (evenly spread, both ends)."""
+    return np.unique(np.round(np.linspace(0, steps, min(steps + 1, PLOT_POINTS))).astype(np.int64))
+
 
 def tracking_png(res: SimResult, effort_limits: np.ndarray | None = None) -> bytes:
     """PNG bytes of a rows = (position, velocity, torque), columns = joints figure."""
@@ -24,19 +31,19 @@ def tracking_png(res: SimResult, effort_limits: np.ndarray | None = None) -> byt
 
     n = len(res.joint_names)
     fig, axes = plt.subplots(3, n, figsize=(5.0 * n, 7.5), sharex=True, squeeze=False)
-    t, tt = res.t, res.t[:-1]
+    t = res.t  # the states the run kept (simulate's plot_steps: dense enough to draw)
     for i, name in enumerate(res.joint_names):
         ax_q, ax_v, ax_t = axes[:, i]
         ax_q.plot(t, res.q_ref[:, i], "--", color="0.4", lw=1.5, label="reference")
         ax_q.plot(t, res.q[:, i], color="C0", lw=1.2, label="actual")
         ax_v.plot(t, res.v_ref[:, i], "--", color="0.4", lw=1.5, label="reference")
         ax_v.plot(t, res.v[:, i], color="C1", lw=1.2, label="actual")
-        ax_t.plot(tt, res.tau[:, i], color="C2", lw=1.2, label="motor torque")
+        ax_t.plot(t, res.tau[:, i], color="C2", lw=1.2, label="motor torque")
         sat = res.saturated[:, i]
         if sat.any() and effort_limits is not None:
             for s in (-1, 1):
                 ax_t.axhline(s * effort_limits[i], color="C3", lw=0.8, ls=":", label=None)
-            ax_t.fill_between(tt, 0, 1, where=sat, color="C3", alpha=0.15,
+            ax_t.fill_between(t, 0, 1, where=sat, color="C3", alpha=0.15,
                               transform=ax_t.get_xaxis_transform(), label="saturated")  # fmt: skip
         ax_q.set_title(name, fontsize=11)
         ax_q.set_ylabel("position [rad]")

@@ -9,10 +9,9 @@ from typing import Any
 import numpy as np
 
 from armcli.io.terminal import Column, FitTable
-from armcli.sim.simulate import SimResult
+from armcli.sim.simulate import SETTLE_TOL, SimResult
 
-SETTLE_TOL = 0.01  # [rad or m] |q - q_ref| band for "settled"
-FLOAT_FMT = "{:.9g}"
+__all__ = ["SETTLE_TOL", "JointMetrics", "joint_metrics", "summary_table"]
 
 
 @dataclass(frozen=True)
@@ -28,34 +27,30 @@ class JointMetrics:
     limit_contacts: int  # times a joint stop engaged (rising edges)
 
 
-def joint_metrics(res: SimResult, t_end: float, tol: float = SETTLE_TOL) -> list[JointMetrics]:
-    """Per-joint tracking metrics; `t_end` is the time of the trajectory's last point."""
-    err = res.q - res.q_ref
+def joint_metrics(res: SimResult, t_end: float) -> list[JointMetrics]:
+    """Per-joint tracking metrics over every state of the run, kept or not.
+
+    `t_end` is the time of the trajectory's last point. The engine accumulates the
+    statistics step by step (`res.stats`).
+    """
+    st = res.stats
     out = []
     for i, name in enumerate(res.joint_names):
-        e = err[:, i]
-        stop = res.stop_active[:, i]
-        rises = int(stop[0]) + int(np.count_nonzero(stop[1:] & ~stop[:-1]))
+        last = int(st.last_out[i])  # the last state outside the band; -1: none
+        start = (last + 1) * res.dt if last >= 0 else 0.0
+        settle = None if last == res.steps else max(0.0, start - t_end)
         out.append(
             JointMetrics(
                 name=name,
-                rms_error=float(np.sqrt(np.mean(e**2))),
-                max_error=float(np.max(np.abs(e))),
-                final_error=float(e[-1]),
-                settle_time=_settle(res.t, e, t_end, tol),
-                saturated_pct=float(100.0 * np.mean(res.saturated[:, i])),
-                limit_contacts=rises,
+                rms_error=float(np.sqrt(st.sum_e2[i] / st.states)),
+                max_error=float(st.max_e[i]),
+                final_error=float(st.last_e[i]),
+                settle_time=settle,
+                saturated_pct=float(100.0 * st.saturated_steps[i] / res.steps),
+                limit_contacts=int(st.stop_rises[i]),
             )
         )
     return out
-
-
-def _settle(t: np.ndarray, e: np.ndarray, t_end: float, tol: float) -> float | None:
-    outside = np.nonzero(np.abs(e) > tol)[0]
-    if outside.size and outside[-1] == len(e) - 1:
-        return None
-    start = t[outside[-1] + 1] if outside.size else t[0]
-    return max(0.0, float(start) - t_end)
 
 
 SUMMARY_HEADERS = (
@@ -66,7 +61,6 @@ SUMMARY_HEADERS = (
     "saturated\n[%]",
     "stop\nhits",
 )
-ENGINE_LABEL = {"native": "compiled (native)", "python": "Python"}
 
 
 def summary_table(
@@ -74,14 +68,13 @@ def summary_table(
 ) -> Any:
     """A table (rich renderable, numbers whole at any width); the caller prints it."""
     caption = (
-        f"{res.integrator}, dt = {res.dt:g} s, {len(res.t) - 1} steps, "
-        f"{ENGINE_LABEL.get(res.backend, res.backend)} engine "
-        f"({res.wall_time * 1e6 / max(1, len(res.t) - 1):.2f} µs/step)\n"
+        f"{res.integrator}, dt = {res.dt:g} s, {res.steps} steps, compiled engine "
+        f"({res.wall_time * 1e6 / max(1, res.steps):.2f} µs/step)\n"
         f"errors q - q_ref; settle: time after the last point until |error| stays "
-        f"< {SETTLE_TOL:g}; stop hits: times a joint stop engaged"
+        f"< {res.settle_tol:g}; stop hits: times a joint stop engaged"
     )
     if ee is not None:
-        caption += f"\nend effector {ee_label} at t = {res.t[-1]:g} s:\n  " + _xyz(ee)
+        caption += f"\nend effector {ee_label} at t = {res.steps * res.dt:g} s:\n  " + _xyz(ee)
     table = FitTable(
         [Column("joint", number=False), *(Column(h) for h in SUMMARY_HEADERS)],
         title="armcli simulate: tracking",

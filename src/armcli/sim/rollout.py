@@ -1,81 +1,39 @@
-"""The simulator's rollout: PD motor, implicit damping, friction and joint stops.
+"""One closed-loop run on the compiled step: plant, reference, the states asked for.
 
-One step (semi-implicit Euler, the default) at state (q, v) and reference (q_ref, v_ref):
-
-1. motor torque tau = Kp (q_ref - q) + Kd (v_ref - v) [+ g(q)], saturated at the effort limit;
-2. velocity-proportional torques (Kd of unsaturated joints, viscous damping D) are implicit:
-   (M + dt B)(v* - v)/dt = tau_explicit - B v - nle, with B = diag(Kd + D). ABA adds
-   `model.armature` to the diagonal of M, so armature = dt B gives exactly this, and the
-   step is stable for any non-negative Kd and D;
-3. Coulomb friction and joint stops are solved at velocity level, like MuJoCo's
-   frictionloss and limit constraints: v' = argmin ½|v - v*|²_(M+dtB) + dt Σ F_i |v_i|
-   subject to the stop bounds, by projected Gauss-Seidel. A joint at rest with a small
-   torque stays exactly at rest (no chatter), and since v = 0 is feasible the projection
-   never adds kinetic energy;
-4. the motor torque over the whole step, tau - Kd (v' - v), must respect the effort limit
-   too: a joint whose implicit Kd would push it past the limit is saturated and the step
-   solved again, so the reported torque is the applied torque and never exceeds the limit;
-5. q' = q + dt v', clamped to the limits against round-off.
-
-RK4 integrates the smooth part (PD, gravity, damping) with the classic four stages, all
-explicit, on reference samples from one polynomial piece per step (so a knot between
-steps does not cost the method its order), then applies the same projection.
-
-`stepper.py` holds the step in plain Python floats (the reference and the fallback);
-`_native/rollout.cpp` runs the identical algorithm compiled (`native.py`).
+The physics (PD motor, implicit damping, friction, joint stops, Euler and RK4) is defined
+once, in `_native/rollout.cpp`, whose header describes the step. Here: what a run is given
+(the per-joint parameters, the reference as its polynomial pieces, which steps to keep)
+and what it returns (those states and running statistics over every state), so a long
+run's memory is that of the states kept, not of its steps.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from armcli.sim.fastloop import euler_loop, rk4_loop
-from armcli.sim.stepper import DAMPING as DAMPING
-from armcli.sim.stepper import EFFORT as EFFORT
-from armcli.sim.stepper import ENERGY_EVERY as ENERGY_EVERY
-from armcli.sim.stepper import FAIL_ENERGY as FAIL_ENERGY
-from armcli.sim.stepper import FAIL_NONE as FAIL_NONE
-from armcli.sim.stepper import FAIL_NONFINITE as FAIL_NONFINITE
-from armcli.sim.stepper import FAIL_VELOCITY as FAIL_VELOCITY
-from armcli.sim.stepper import FLAG_SATURATED as FLAG_SATURATED
-from armcli.sim.stepper import FLAG_STOP as FLAG_STOP
-from armcli.sim.stepper import FRICTION as FRICTION
-from armcli.sim.stepper import KD as KD
-from armcli.sim.stepper import KP as KP
-from armcli.sim.stepper import LOWER as LOWER
-from armcli.sim.stepper import PARAM_FIELDS as PARAM_FIELDS
-from armcli.sim.stepper import UPPER as UPPER
-from armcli.sim.stepper import VABORT as VABORT
-from armcli.sim.stepper import Stepper
+from armcli.sim import native
+from armcli.sim.reference import Reference
 
-# Pinocchio joint model -> the joint code both engines use (revolute 0-3, prismatic 4-7,
-# continuous 8-11: a revolute joint without limits, configuration (cos, sin) in Pinocchio).
-JOINT_TYPES = {
-    "JointModelRX": 0,
-    "JointModelRY": 1,
-    "JointModelRZ": 2,
-    "JointModelRevoluteUnaligned": 3,
-    "JointModelPX": 4,
-    "JointModelPY": 5,
-    "JointModelPZ": 6,
-    "JointModelPrismaticUnaligned": 7,
-    "JointModelRUBX": 8,
-    "JointModelRUBY": 9,
-    "JointModelRUBZ": 10,
-    "JointModelRevoluteUnboundedUnaligned": 11,
-}
-RK4_ROWS = 3  # reference rows per RK4 step: t, t + dt/2, t + dt (one polynomial piece)
+CHUNK_STEPS = 10_000  # steps per call into the engine, between progress reports
 
 
 @dataclass(frozen=True)
 class Plant:
-    """Everything a rollout needs besides the initial state and the reference."""
+    """Everything a run needs besides the start state and the reference; arrays per joint."""
 
     model: Any  # pinocchio.Model of one-dof joints (a continuous joint: nq 2, nv 1)
-    params: np.ndarray  # (n, len(PARAM_FIELDS))
+    kp: np.ndarray  # [N·m/rad or N/m]
+    kd: np.ndarray  # [N·m·s/rad or N·s/m]
+    damping: np.ndarray  # viscous [N·m·s/rad or N·s/m]
+    friction: np.ndarray  # Coulomb [N·m or N]
+    lower: np.ndarray  # stops [rad or m]; ±inf: none
+    upper: np.ndarray
+    effort: np.ndarray  # saturation [N·m or N]; inf: none
+    vabort: np.ndarray  # |v| treated as divergence [rad/s or m/s]
     gravity_comp: bool
     dt: float  # [s]
     integrator: str  # "euler" | "rk4"
@@ -83,57 +41,138 @@ class Plant:
 
 
 @dataclass(frozen=True)
-class Rollout:
-    """States at every step; a failed run stops at `fail_step` (rows after it are unset)."""
+class Trace:
+    """The states kept: row j is the state after `step[j]` steps."""
 
-    q: np.ndarray  # (steps + 1, n) [rad or m]
-    v: np.ndarray  # (steps + 1, n)
-    tau: np.ndarray  # (steps, n) motor torque applied during each step [N·m or N]
-    flags: np.ndarray  # (steps, n) uint8: FLAG_SATURATED | FLAG_STOP
+    step: np.ndarray  # (K,) int
+    q: np.ndarray  # (K, n) [rad or m]
+    v: np.ndarray  # (K, n)
+    q_ref: np.ndarray  # (K, n) reference at the state's time
+    v_ref: np.ndarray
+    tau: np.ndarray  # (K, n) motor torque applied from this state on (last state: last step's)
+    saturated: np.ndarray  # (K, n) bool: that torque is at the effort limit
+    stop: np.ndarray  # (K, n) bool: a stop constraint acted in that step
+
+
+@dataclass(frozen=True)
+class Stats:
+    """Running statistics over every state of the run, kept or not; per joint."""
+
+    states: int  # states seen (steps + 1 for a complete run)
+    sum_e2: np.ndarray  # Σ (q - q_ref)² [rad² or m²]
+    max_e: np.ndarray  # max |q - q_ref|
+    last_e: np.ndarray  # q - q_ref of the last state
+    last_out: np.ndarray  # (int) step of the last state outside the settle band; -1: none
+    saturated_steps: np.ndarray  # (int) steps with the motor torque at the effort limit
+    stop_rises: np.ndarray  # (int) times a joint's stop constraint engaged
+
+
+@dataclass(frozen=True)
+class Rollout:
+    """A run's outcome; a failed run stops at `fail_step` (`failure` names why)."""
+
+    trace: Trace
+    stats: Stats
+    q: np.ndarray  # the last state reached
+    v: np.ndarray
     fail_step: int  # -1 when the run completed
     fail_joint: int  # index, -1 when not joint-specific
-    fail_code: int
+    failure: str  # "" | "nonfinite" | "velocity" | "energy"
 
 
-def rows_per_step(integrator: str) -> int:
-    """Reference rows one step consumes.
+def run(
+    plant: Plant,
+    reference: Reference,
+    q0: np.ndarray,
+    v0: np.ndarray,
+    steps: int,
+    *,
+    record: np.ndarray | None = None,
+    settle_tol: float = 0.0,
+    compiled: Any = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> Rollout:
+    """Run `steps` steps from (q0, v0), keeping the states at the `record` steps.
 
-    [q_ref, v_ref] at t (Euler) or at t, t + dt/2, t + dt (RK4). A reference for N steps
-    has N * rows + 1 rows (the last: t = N dt).
+    `record` is strictly increasing (default: every step). `compiled` is
+    `native.compiled_model` of the plant's model, built here when None. The statistics
+    count a state outside the settle band when |q - q_ref| > `settle_tol`. The engine
+    releases the GIL: runs parallelise on threads.
     """
-    return RK4_ROWS if integrator == "rk4" else 1
-
-
-def steps_of(plant: Plant, ref: np.ndarray) -> int:
-    """How many steps the reference table `ref` drives."""
-    return int((ref.shape[0] - 1) // rows_per_step(plant.integrator))
-
-
-def rollout_python(plant: Plant, q0: np.ndarray, v0: np.ndarray, ref: np.ndarray) -> Rollout:
-    """Reference implementation and fallback of `native.rollout` (same contract)."""
-    s = Stepper(plant.model, plant.params, plant.gravity_comp, plant.dt)
-    n = s.n
-    steps = steps_of(plant, ref)
-    table = np.asarray(ref, dtype=float)
-    q, v = [float(x) for x in q0], [float(x) for x in v0]
-    if plant.integrator == "rk4":  # the reference, sampled once, as Python floats
-        rec = rk4_loop(s, q, v, table[: RK4_ROWS * steps].tolist(), plant.energy_max)
-    else:
-        Rq, Rv = table[:steps, :n].tolist(), table[:steps, n:].tolist()
-        rec = euler_loop(s, q, v, Rq, Rv, plant.energy_max)
-    F = np.zeros((steps, n), dtype=np.uint8)
-    for k, row in rec.flagged:
-        F[k] = row
-    Q = np.full((steps + 1) * n, np.nan)
-    V = np.full((steps + 1) * n, np.nan)
-    T = np.full(steps * n, np.nan)
-    Q[: len(rec.q)], V[: len(rec.v)], T[: len(rec.tau)] = rec.q, rec.v, rec.tau
-    return Rollout(
-        Q.reshape(-1, n),
-        V.reshape(-1, n),
-        T.reshape(-1, n),
-        F,
-        rec.fail_step,
-        rec.fail_joint,
-        rec.fail_code,
+    mod = native.require()
+    model = compiled if compiled is not None else native.compiled_model(mod, plant.model)
+    keep = np.arange(steps + 1, dtype=np.int64) if record is None else record
+    r = mod.rollout(
+        _compiled_plant(mod, model, plant),
+        _compiled_reference(mod, reference),
+        _vector(q0),
+        _vector(v0),
+        steps,
+        np.ascontiguousarray(keep, dtype=np.int64),
+        settle_tol,
     )
+    fail_step, fail_joint, code = -1, -1, mod.FAIL_NONE
+    while r.step < steps and code == mod.FAIL_NONE:
+        fail_step, fail_joint, code = r.advance(CHUNK_STEPS)
+        if progress is not None:
+            progress(r.step, steps)
+    failure = {
+        mod.FAIL_NONE: "",
+        mod.FAIL_NONFINITE: "nonfinite",
+        mod.FAIL_VELOCITY: "velocity",
+        mod.FAIL_ENERGY: "energy",
+    }[code]
+    recs, stats = r.records(), r.statistics()
+    trace = Trace(
+        step=recs["step"],
+        q=recs["q"],
+        v=recs["v"],
+        q_ref=recs["q_ref"],
+        v_ref=recs["v_ref"],
+        tau=recs["tau"],
+        saturated=recs["saturated"].astype(bool),
+        stop=recs["stop"].astype(bool),
+    )
+    return Rollout(
+        trace,
+        Stats(
+            states=int(stats["states"]),
+            sum_e2=stats["sum_e2"],
+            max_e=stats["max_e"],
+            last_e=stats["last_e"],
+            last_out=stats["last_out"],
+            saturated_steps=stats["saturated_steps"],
+            stop_rises=stats["stop_rises"],
+        ),
+        r.q,
+        r.v,
+        int(fail_step),
+        int(fail_joint),
+        failure,
+    )
+
+
+def _vector(x: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(x, dtype=float)
+
+
+def _compiled_plant(mod: Any, model: Any, p: Plant) -> Any:
+    return mod.plant(
+        model,
+        kp=_vector(p.kp),
+        kd=_vector(p.kd),
+        damping=_vector(p.damping),
+        friction=_vector(p.friction),
+        lower=_vector(p.lower),
+        upper=_vector(p.upper),
+        effort=_vector(p.effort),
+        vabort=_vector(p.vabort),
+        gravity_comp=p.gravity_comp,
+        dt=p.dt,
+        integrator=p.integrator,
+        energy_max=p.energy_max,
+    )
+
+
+def _compiled_reference(mod: Any, ref: Reference) -> Any:
+    return mod.reference(_vector(ref.knots), _vector(ref.coeffs).reshape(-1), _vector(ref.final))

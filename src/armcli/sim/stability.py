@@ -1,72 +1,117 @@
-"""Sampled-data stability of joint PD control under semi-implicit (symplectic) Euler.
+"""Sampled-data stability of joint PD control: the one bound `check`, `simulate` and `tune` use.
 
-Per mode of the linearised arm, with lambda an eigenvalue of M^-1 [1/(kg·m²)],
-D = Kd + damping and the step
-    v+ = v + dt * (-Kp q - D v) / m_eff,   q+ = q + dt v+
-the update matrix on (q, dt v) is [[1 - a, 1 - b], [-a, 1 - b]] with
-a = Kp dt² lambda and b = D dt lambda. Its trace is 2 - a - b and determinant
-1 - b; the Jury conditions give stability iff a > 0 and a + 2b < 4.
+Linearised at an operating point q*, the arm obeys M dq'' = -K dq - D dq' with
 
-Explicit damping uses m_eff = 1/lambda. The simulator treats D implicitly by
-adding dt*D to the armature (m_eff = 1/lambda + dt D), which turns the
-condition into Kp dt² lambda < 4 + 2 D dt lambda: any Kd is then stable and
-only Kp is bounded. The worst mode is the largest lambda, so the verdict uses
-lambda_max(M^-1) over a sample of the joint range. With unequal gains per
-joint the scalar numbers use the largest gains (conservative); the verdict
-itself comes from the spectral radius of the full linearised update.
+    K = Kp + G,  G = dg/dq (gravity's stiffness: the Hessian of the potential at q*;
+                  zero with gravity compensation, which cancels g(q) at the same q),
+    D = Kd + damping on the controlled joints (free joints: neither).
 
-This is the one stability bound of armcli: `check` reports it and `simulate`
-refuses what it rejects, with the same tolerance (`RADIUS_TOL`) and the same
-"largest stable dt" (bisection on the spectral radius of the real matrices; the
-closed forms below are the scalar-mode reference the tests compare it with).
-RK4 has no implicit damping; its step map is the 4th-order Taylor polynomial.
+One semi-implicit Euler step, v+ = v + dt M_e^-1 (-K q - D v), q+ = q + dt v+, with
+M_e = M (damping explicit, as a torque loop such as a ros2_control effort controller in
+Gazebo) or M_e = M + dt D (damping implicit, as armcli's simulator steps it). Its
+characteristic polynomial z² M_e - z (2 M_e - dt D - dt² K) + (M_e - dt D), under the
+bilinear map z = (1 + s) / (1 - s) (|z| <= 1 iff Re s <= 0), becomes
+
+    s² A + s (2 dt D) + dt² K,   A = 4 M + 2 c dt D - dt² K,   c = +1 implicit, -1 explicit.
+
+All three matrices are symmetric. With K, D >= 0 every eigenpair gives a s² + b s + c = 0
+with a = x*Ax, b, c >= 0, so A >= 0 (positive semidefinite) keeps |z| <= 1; and if A has a
+negative direction, det(A + tau B + tau² C) changes sign on tau > 0, which is a real
+|z| > 1. So **the step is stable iff A >= 0**: one Cholesky factorisation per sample
+instead of a 2n x 2n eigenvalue problem, which keeps the analysis cheap on 128-DoF models.
+For one joint (lambda = 1/m) it is the Jury condition a + 2 c b <= 4 with a = Kp dt² lambda,
+b = D dt lambda. Where gravity tips the arm (K not >= 0) the continuous loop itself is
+statically unstable at that point; A >= 0 then still says the step adds no growth of its
+own, which is what a smaller dt can fix.
+
+A is decreasing in dt (A / dt² = 4 M / dt² + 2 c D / dt - K), so the stable time steps
+are an interval [0, dt_max], found by bisection; A is affine in a common gain scale s, so
+the largest stable scale is a generalised eigenvalue (closed form). `suggest` turns both
+into the remedy that `check` reports and `simulate` prints (armcli.sim.verdict).
+
+RK4 has no implicit damping: its step map is the 4th-order Taylor polynomial p(h mu) of
+the continuous modes mu (eigenvalues of the linearised loop), stable where |p| <= 1.
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
-from typing import Literal
+from functools import partial
+from typing import Any, Literal
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-# The loop counts as stable when its step map does not grow: spectral radius <= 1 + RADIUS_TOL.
-# Undamped symplectic Euler sits exactly on 1 (a bounded oscillation), so the slack absorbs
-# the eigenvalue solver's rounding there.
+from armcli.urdf.pinocchio import mass_matrix
+
+# The loop counts as stable when its step map does not grow: spectral radius <= 1 + RADIUS_TOL
+# (RK4 and reports), or A + PSD_RTOL * 4M positive definite (Euler). Undamped symplectic
+# Euler sits exactly on |z| = 1 (a bounded oscillation); the slack absorbs rounding there.
 RADIUS_TOL = 1e-9
-BISECT_STEPS = 60  # halvings for the largest stable dt / gain scale (relative error 2^-60)
+PSD_RTOL = 1e-10
+BISECT_STEPS = 60  # halvings for the largest stable dt (relative error 2^-60)
+DT_CEILING = 1e6  # [s] a loop stable beyond this is stable for every dt
 
 Scheme = Literal["explicit", "implicit", "rk4"]
 """How the PD loop is stepped: semi-implicit Euler with damping explicit (a torque loop as
 in Gazebo's effort controllers) or implicit (armcli's simulator), or RK4 (explicit)."""
 
-
-@dataclass(frozen=True)
-class LoopVerdict:
-    """One integration scheme's verdict at the worst sampled configuration."""
-
-    stable: bool
-    a: float  # Kp dt² lambda_eff (largest gains)
-    b: float  # D dt lambda_eff
-    spectral_radius: float  # of the linearised update, worst sample
-    dt_max: float  # largest stable dt with these gains [s]
+Array = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
-class StabilityReport:
-    """PD stability at the worst sampled configuration, and the gain bounds at `dt`."""
+class Linearised:
+    """The arm at its operating points: symmetric M(q) and gravity's stiffness G(q)."""
 
-    dt: float  # [s]
-    lambda_max: float  # max over samples of lambda_max(M^-1) [1/(kg·m²)]
-    q_worst: tuple[float, ...]  # controlled joints at that sample [rad or m]
-    kp: float  # largest Kp [N·m/rad]
-    d: float  # largest Kd + damping [N·m·s/rad]
-    explicit: LoopVerdict
-    implicit: LoopVerdict
-    kd_max_explicit: float  # largest Kd stable with explicit damping at dt (may be < 0)
-    kp_max_implicit: float  # largest Kp stable with implicit damping at dt
+    M: Array  # (S, nv, nv) [kg·m²]
+    G: Array  # (S, nv, nv) dg/dq [N·m/rad]; zeros with gravity compensation
+
+    def __len__(self) -> int:
+        return int(self.M.shape[0])
+
+
+@dataclass(frozen=True)
+class PD:
+    """PD gains on the controlled velocity indices `idx` (the others move freely)."""
+
+    idx: tuple[int, ...]
+    kp: Array  # [N·m/rad]
+    kd: Array  # [N·m·s/rad]
+    damping: Array  # joint viscous damping of the controlled joints [N·m·s/rad]
+
+    @staticmethod
+    def of(idx: Sequence[int], kp: ArrayLike, kd: ArrayLike, damping: ArrayLike) -> PD:
+        """Gains as float arrays (one entry per controlled joint)."""
+        arr = [np.asarray(x, dtype=float).reshape(-1) for x in (kp, kd, damping)]
+        return PD(tuple(int(i) for i in idx), arr[0], arr[1], arr[2])
+
+    def scaled(self, kp: float, kd: float) -> PD:
+        """The same joints with Kp and Kd multiplied by `kp` and `kd` (damping is physical)."""
+        return PD(self.idx, self.kp * kp, self.kd * kd, self.damping)
+
+
+@contextlib.contextmanager
+def one_blas_thread() -> Iterator[None]:
+    """Run numpy's linear algebra on one thread inside the block.
+
+    The analysis factors many small matrices; a multi-threaded BLAS spends more on waking
+    its threads than on the work (a 129 x 129 Cholesky: 0.12 ms on one thread, ~10 ms with
+    OpenBLAS's threads on a busy 2-core machine), and under `tune`'s threads it competes
+    with the rollouts. Without threadpoolctl the block runs as is.
+    """
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # pragma: no cover - optional speed-up
+        yield
+        return
+    with threadpool_limits(limits=1, user_api="blas"):
+        yield
+
+
+# -- scalar modes (the closed forms the matrix bound reduces to for one joint) ----------------
 
 
 def explicit_stable(a: float, b: float) -> bool:
@@ -88,173 +133,281 @@ def implicit_dt_max(kp: float, d: float, lam: float) -> float:
     return (d * lam + math.sqrt((d * lam) ** 2 + 4.0 * kp * lam)) / (kp * lam)
 
 
-def update_matrix(
-    Minv: NDArray[np.float64], Kp: NDArray[np.float64], D: NDArray[np.float64], dt: float
-) -> NDArray[np.float64]:
-    """The linear map (q, v) -> (q+, v+) of one semi-implicit Euler step of PD control."""
-    n = Minv.shape[0]
-    eye = np.eye(n)
-    Av = eye - dt * Minv @ np.diag(D)
-    Aq = -dt * Minv @ np.diag(Kp)
-    return np.block([[eye + dt * Aq, dt * Av], [Aq, Av]])
+# -- the operating points -------------------------------------------------------------------
 
 
-def spectral_radius(A: NDArray[np.float64]) -> float:
-    """Largest eigenvalue modulus of A; the discrete loop is stable when it is <= 1."""
-    return float(np.max(np.abs(np.linalg.eigvals(A))))
+def linearise(
+    model: Any, configurations: Sequence[Any], *, gravity: bool = True, data: Any = None
+) -> Linearised:
+    """M(q) (CRBA, symmetric) and G(q) = dg/dq at each Pinocchio configuration.
 
-
-def is_stable(radius: float) -> bool:
-    """The one verdict: the linearised loop does not grow (see RADIUS_TOL)."""
-    return radius <= 1.0 + RADIUS_TOL
-
-
-def step_matrix(
-    M: NDArray[np.float64],
-    controlled: Sequence[int],
-    Kp: NDArray[np.float64],
-    D: NDArray[np.float64],
-    dt: float,
-    scheme: Scheme,
-) -> NDArray[np.float64]:
-    """The linearised step map on the `controlled` velocity indices of mass matrix M.
-
-    Uncontrolled joints move freely, so the controlled joints see the (controlled,
-    controlled) block of M^-1; implicit damping adds dt*D to the controlled diagonal of
-    M before inverting. D = Kd + damping [N·m·s/rad].
+    `gravity=False` for a loop that compensates g(q) (then G = 0).
     """
-    idx = np.asarray(controlled, dtype=int)
-    if scheme == "implicit":
-        arm = np.zeros(M.shape[0])
-        arm[idx] = dt * D
-        M = M + np.diag(arm)
-    Minv = np.linalg.inv(M)[np.ix_(idx, idx)]
-    if scheme != "rk4":
-        return update_matrix(Minv, Kp, D, dt)
-    n = len(idx)
-    eye, eye2 = np.eye(n), np.eye(2 * n)
-    hA = dt * np.block([[np.zeros((n, n)), eye], [-Minv @ np.diag(Kp), -Minv @ np.diag(D)]])
-    out: NDArray[np.float64] = eye2 + hA @ (eye2 + hA / 2 @ (eye2 + hA / 3 @ (eye2 + hA / 4)))
+    import pinocchio as pin
+
+    data = data if data is not None else model.createData()
+    Ms, Gs = [], []
+    for q in configurations:
+        q = np.asarray(q, dtype=float)
+        Ms.append(mass_matrix(model, data, q))
+        if gravity:
+            G = np.array(pin.computeGeneralizedGravityDerivatives(model, data, q), dtype=float)
+            Gs.append(0.5 * (G + G.T))
+        else:
+            Gs.append(np.zeros((model.nv, model.nv)))
+    return Linearised(np.array(Ms, dtype=float), np.array(Gs, dtype=float))
+
+
+# -- Euler: A >= 0 --------------------------------------------------------------------------
+
+
+def _diag(n: int, pd: PD, values: Array) -> Array:
+    out = np.zeros(n)
+    out[list(pd.idx)] = values
     return out
 
 
-def worst_radius(
-    M_samples: Sequence[NDArray[np.float64]],
-    controlled: Sequence[int],
-    Kp: NDArray[np.float64],
-    D: NDArray[np.float64],
-    dt: float,
-    scheme: Scheme,
-) -> tuple[float, int]:
-    """Largest spectral radius over the samples, and the index of that sample."""
-    radii = [spectral_radius(step_matrix(M, controlled, Kp, D, dt, scheme)) for M in M_samples]
-    k = int(np.argmax(radii))
-    return radii[k], k
+def margin_matrix(M: Array, G: Array, pd: PD, dt: float, scheme: Scheme) -> Array:
+    """A = 4 M + 2 c dt D - dt² (Kp + G): the Euler step is stable iff A >= 0."""
+    n = M.shape[0]
+    c = 1.0 if scheme == "implicit" else -1.0
+    d = _diag(n, pd, pd.kd + pd.damping)
+    k = _diag(n, pd, pd.kp)
+    A = 4.0 * M - dt * dt * G
+    A[np.diag_indices(n)] += 2.0 * c * dt * d - dt * dt * k
+    return A
 
 
-def _bisect(ok: Callable[[float], bool], lo: float, hi: float) -> float:
-    """The edge between ok(lo) and not ok(hi), from below, to BISECT_STEPS halvings."""
+def _psd(A: Array, M: Array) -> bool:
+    """A >= 0 up to PSD_RTOL relative to 4M (Cholesky of the slightly lifted matrix)."""
+    try:
+        np.linalg.cholesky(A + (4.0 * PSD_RTOL) * M)
+    except np.linalg.LinAlgError:
+        return False
+    return True
+
+
+def _euler_ok(lin: Linearised, k: int, pd: PD, dt: float, *, scheme: Scheme) -> bool:
+    return _psd(margin_matrix(lin.M[k], lin.G[k], pd, dt, scheme), lin.M[k])
+
+
+def _edge(ok: Callable[[float], bool], start: float) -> float:
+    """Largest x > 0 with ok(x), for ok true below one edge: bracket from `start`, bisect."""
+    lo, hi = 0.0, start
+    if ok(start):
+        lo, hi = start, 2.0 * start
+        while ok(hi):
+            lo, hi = hi, 2.0 * hi
+            if hi > DT_CEILING:
+                return math.inf
+    else:
+        while not ok(hi / 2.0):
+            hi /= 2.0
+            if hi < 1e-300:
+                return 0.0
+        lo = hi / 2.0
     for _ in range(BISECT_STEPS):
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if ok(mid) else (lo, mid)
     return lo
 
 
-def largest_stable_dt(
-    M_samples: Sequence[NDArray[np.float64]],
-    controlled: Sequence[int],
-    Kp: NDArray[np.float64],
-    D: NDArray[np.float64],
-    scheme: Scheme,
-    start: float,
-) -> float:
-    """Largest dt [s] the loop is stable at (inf if every dt is), by bracketing + bisection."""
+def _euler_dt_max(lin: Linearised, pd: PD, scheme: Scheme, start: float) -> tuple[float, int]:
+    """Largest stable dt over all points and the point that sets it.
 
-    def ok(h: float) -> bool:
-        return is_stable(worst_radius(M_samples, controlled, Kp, D, h, scheme)[0])
-
-    lo, hi = 0.0, start
-    while ok(hi):
-        lo, hi = hi, 2.0 * hi
-        if hi > 1e6:
-            return math.inf
-    return _bisect(ok, lo, hi)
+    A point stable at the best dt so far cannot lower it (A decreases with dt), so each
+    point costs one factorisation and only the few that lower the bound are bisected.
+    """
+    best, worst = math.inf, 0
+    for k in range(len(lin)):
+        if math.isfinite(best) and _euler_ok(lin, k, pd, best, scheme=scheme):
+            continue
+        edge = _edge(partial(_euler_ok, lin, k, pd, scheme=scheme), min(start, best))
+        if edge < best:
+            best, worst = edge, k
+    return best, worst
 
 
-def largest_stable_scale(
-    M_samples: Sequence[NDArray[np.float64]],
-    controlled: Sequence[int],
-    Kp: NDArray[np.float64],
-    D: NDArray[np.float64],
-    dt: float,
-    scheme: Scheme,
-) -> float:
-    """Largest factor s in [0, 1] such that gains s*Kp, s*D are stable at dt."""
+def largest_along(lin: Linearised, base: PD, p: Array, dt: float, scheme: Scheme) -> float | None:
+    """Largest s >= 0 with A(base) - s diag(p) >= 0 at every point (inf: any s; None: not 0).
+
+    A is affine in s, so per point s* = 1 / lambda_max(P^1/2 A(base)^-1 P^1/2), a symmetric
+    eigenvalue problem on the controlled joints; a point already >= 0 at the best s so far
+    cannot lower it and costs one factorisation.
+    """
+    idx = list(base.idx)
+    n = lin.M.shape[1]
+    full = _diag(n, base, p)
+    best = math.inf
+    for k in range(len(lin)):
+        M = lin.M[k]
+        A0 = margin_matrix(M, lin.G[k], base, dt, scheme)
+        if math.isfinite(best) and _psd(A0 - best * np.diag(full), M):
+            continue
+        if not _psd(A0, M):
+            return None
+        if not idx:
+            continue
+        sq = np.sqrt(p)
+        W = np.linalg.inv(A0 + (4.0 * PSD_RTOL) * M)[np.ix_(idx, idx)] * np.outer(sq, sq)
+        top = float(np.linalg.eigvalsh(0.5 * (W + W.T))[-1])
+        best = min(best, 1.0 / top if top > 0.0 else math.inf)
+    return best
+
+
+@dataclass(frozen=True)
+class GainScale:
+    """The largest stable factor on some of the gains at dt: which gains, and how far."""
+
+    factor: float  # >= 1 when the gains are stable; inf: any factor
+    kp: bool  # Kp is scaled
+    kd: bool  # Kd is scaled
+
+    @property
+    def label(self) -> str:
+        """The scaled gains, in words."""
+        return "Kp and Kd" if self.kp and self.kd else ("Kp" if self.kp else "Kd")
+
+    def apply(self, pd: PD, s: float) -> PD:
+        """`pd` with the scaled gains multiplied by s."""
+        return pd.scaled(s if self.kp else 1.0, s if self.kd else 1.0)
+
+
+def _euler_scale(lin: Linearised, pd: PD, dt: float, scheme: Scheme) -> GainScale | None:
+    """Largest stable factor at dt on every point, along the gains that matter.
+
+    Implicit damping: Kp alone (Kd makes that loop more stable, never less). Explicit
+    damping: Kd alone when vanishing Kd would be stable (Kp kept), else Kp and Kd together.
+    """
+    if scheme == "implicit":
+        directions = [GainScale(0.0, kp=True, kd=False)]
+    else:
+        directions = [GainScale(0.0, kp=True, kd=True)]
+        if np.any(pd.kd > 0.0):
+            directions.insert(0, GainScale(0.0, kp=False, kd=True))
+    for d in directions:
+        p = (dt * dt * pd.kp if d.kp else 0.0 * pd.kp) + (2.0 * dt * pd.kd if d.kd else 0.0)
+        factor = largest_along(lin, d.apply(pd, 0.0), p, dt, scheme)
+        if factor is not None:
+            return GainScale(factor, d.kp, d.kd)
+    return None
+
+
+# -- RK4: continuous modes through the Taylor polynomial ------------------------------------
+
+
+def continuous_modes(M: Array, G: Array, pd: PD) -> NDArray[np.complex128]:
+    """Eigenvalues mu of the linearised continuous loop M x'' + D x' + (Kp + G) x = 0."""
+    n = M.shape[0]
+    K = G + np.diag(_diag(n, pd, pd.kp))
+    D = np.diag(_diag(n, pd, pd.kd + pd.damping))
+    Minv = np.linalg.inv(M)
+    top = np.hstack([np.zeros((n, n)), np.eye(n)])
+    mu = np.linalg.eigvals(np.vstack([top, np.hstack([-Minv @ K, -Minv @ D])]))
+    return np.asarray(mu, dtype=np.complex128)
+
+
+def _rk4_radius(mu: NDArray[np.complex128], h: float) -> float:
+    """Largest |p(h mu)| over the modes the continuous loop itself keeps bounded."""
+    z = h * mu[mu.real <= RADIUS_TOL * np.maximum(1.0, np.abs(mu))]
+    if z.size == 0:
+        return 1.0
+    p = 1.0 + z * (1.0 + z / 2.0 * (1.0 + z / 3.0 * (1.0 + z / 4.0)))
+    return float(np.max(np.abs(p)))
+
+
+def _rk4_ok(mu: NDArray[np.complex128], h: float) -> bool:
+    return _rk4_radius(mu, h) <= 1.0 + RADIUS_TOL
+
+
+def _rk4_dt_max(modes: Sequence[NDArray[np.complex128]], start: float) -> tuple[float, int]:
+    best, worst = math.inf, 0
+    for k, mu in enumerate(modes):
+        edge = _edge(partial(_rk4_ok, mu), min(start, best))
+        if edge < best:
+            best, worst = edge, k
+    return best, worst
+
+
+def _rk4_scale(lin: Linearised, pd: PD, dt: float, k: int) -> GainScale | None:
+    """Largest common Kp, Kd factor in [0, 1] stable at dt on point k (bisection)."""
 
     def ok(s: float) -> bool:
-        return is_stable(worst_radius(M_samples, controlled, s * Kp, s * D, dt, scheme)[0])
+        mu = continuous_modes(lin.M[k], lin.G[k], pd.scaled(s, s))
+        return _rk4_radius(mu, dt) <= 1.0 + RADIUS_TOL
 
+    if not ok(0.0):
+        return None
+    if ok(1.0):
+        return GainScale(1.0, kp=True, kd=True)
     lo, hi = 0.0, 1.0
-    if ok(hi):
-        return 1.0
-    return _bisect(ok, lo, hi)
+    for _ in range(BISECT_STEPS):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ok(mid) else (lo, mid)
+    return GainScale(lo, kp=True, kd=True)
 
 
-def analyse(
-    M_samples: Sequence[NDArray[np.float64]],
-    q_samples: Sequence[Sequence[float]],
-    controlled: Sequence[int],
-    Kp: Sequence[float],
-    Kd: Sequence[float],
-    damping: Sequence[float],
-    dt: float,
-) -> StabilityReport:
-    """Stability of PD on the `controlled` velocity indices over sampled mass matrices.
+# -- one loop's verdict and remedy ----------------------------------------------------------
 
-    The verdicts and largest stable dt come from the spectral radius of the real step
-    maps (see `step_matrix`); the scalar numbers (a, b, Kd and Kp bounds) use the
-    largest gains and lambda_max, as a conservative explanation of the verdict.
+
+def step_matrix(M: Array, G: Array, pd: PD, dt: float, scheme: Scheme) -> Array:
+    """The linear map (q, v) -> (q+, v+) of one step of the linearised loop (for reports)."""
+    n = M.shape[0]
+    K = G + np.diag(_diag(n, pd, pd.kp))
+    D = np.diag(_diag(n, pd, pd.kd + pd.damping))
+    eye = np.eye(n)
+    if scheme == "rk4":
+        Minv = np.linalg.inv(M)
+        hA = dt * np.block([[np.zeros((n, n)), eye], [-Minv @ K, -Minv @ D]])
+        e2 = np.eye(2 * n)
+        out: Array = e2 + hA @ (e2 + hA / 2 @ (e2 + hA / 3 @ (e2 + hA / 4)))
+        return out
+    Minv = np.linalg.inv(M + dt * D if scheme == "implicit" else M)
+    Av = eye - dt * Minv @ D
+    Aq = -dt * Minv @ K
+    return np.block([[eye + dt * Aq, dt * Av], [Aq, Av]])
+
+
+def spectral_radius(A: Array) -> float:
+    """Largest eigenvalue modulus of A; the discrete loop is stable when it is <= 1."""
+    return float(np.max(np.abs(np.linalg.eigvals(A))))
+
+
+def is_stable(radius: float) -> bool:
+    """A spectral radius that does not grow (see RADIUS_TOL)."""
+    return radius <= 1.0 + RADIUS_TOL
+
+
+def stable(lin: Linearised, pd: PD, dt: float, scheme: Scheme) -> bool:
+    """Whether the loop is stable at dt at every operating point."""
+    if scheme == "rk4":
+        return all(
+            _rk4_radius(continuous_modes(lin.M[k], lin.G[k], pd), dt) <= 1.0 + RADIUS_TOL
+            for k in range(len(lin))
+        )
+    return all(_euler_ok(lin, k, pd, dt, scheme=scheme) for k in range(len(lin)))
+
+
+def largest_stable_dt(lin: Linearised, pd: PD, scheme: Scheme, start: float) -> float:
+    """Largest dt [s] the loop is stable at on every point (inf if every dt is)."""
+    return dt_max_at(lin, pd, scheme, start)[0]
+
+
+def dt_max_at(lin: Linearised, pd: PD, scheme: Scheme, start: float) -> tuple[float, int]:
+    """Largest stable dt [s] over the points, and the index of the point that sets it."""
+    if scheme == "rk4":
+        modes = [continuous_modes(lin.M[k], lin.G[k], pd) for k in range(len(lin))]
+        return _rk4_dt_max(modes, start)
+    return _euler_dt_max(lin, pd, scheme, start)
+
+
+def gain_scale(lin: Linearised, pd: PD, dt: float, scheme: Scheme) -> GainScale | None:
+    """Largest stable factor at dt on every point, and which gains it scales.
+
+    At least 1 when the gains are stable; None when no factor >= 0 is (gravity or
+    damping alone too stiff).
     """
-    idx = np.asarray(controlled, dtype=int)
-    kp_v = np.asarray(Kp, float)
-    d_v = np.asarray(Kd, float) + np.asarray(damping, float)
-    arm = np.zeros(M_samples[0].shape[0])
-    arm[idx] = dt * d_v
-    lam_max, lam_imp, worst = 0.0, 0.0, 0
-    for k, M in enumerate(M_samples):
-        Minv = np.linalg.inv(M)[np.ix_(idx, idx)]
-        Minv_imp = np.linalg.inv(M + np.diag(arm))[np.ix_(idx, idx)]
-        lam = float(np.linalg.eigvalsh(0.5 * (Minv + Minv.T))[-1])
-        if lam > lam_max:
-            lam_max, worst = lam, k
-        lam_imp = max(lam_imp, float(np.linalg.eigvalsh(0.5 * (Minv_imp + Minv_imp.T))[-1]))
-    rho_exp = worst_radius(M_samples, controlled, kp_v, d_v, dt, "explicit")[0]
-    rho_imp = worst_radius(M_samples, controlled, kp_v, d_v, dt, "implicit")[0]
-    kp, d = float(kp_v.max()), float(d_v.max())
-    a, b = kp * dt * dt * lam_max, d * dt * lam_max
-    a_i, b_i = kp * dt * dt * lam_imp, d * dt * lam_imp
-    explicit = LoopVerdict(
-        is_stable(rho_exp),
-        a,
-        b,
-        rho_exp,
-        largest_stable_dt(M_samples, controlled, kp_v, d_v, "explicit", dt),
-    )
-    implicit = LoopVerdict(
-        is_stable(rho_imp),
-        a_i,
-        b_i,
-        rho_imp,
-        largest_stable_dt(M_samples, controlled, kp_v, d_v, "implicit", dt),
-    )
-    return StabilityReport(
-        dt=dt,
-        lambda_max=lam_max,
-        q_worst=tuple(float(x) for x in q_samples[worst]),
-        kp=kp,
-        d=d,
-        explicit=explicit,
-        implicit=implicit,
-        kd_max_explicit=(4.0 - a) / (2.0 * dt * lam_max) - float(np.max(damping)),
-        kp_max_implicit=(4.0 + 2.0 * b) / (dt * dt * lam_max),
-    )
+    if scheme != "rk4":
+        return _euler_scale(lin, pd, dt, scheme)
+    _, k = dt_max_at(lin, pd, scheme, dt)
+    return _rk4_scale(lin, pd, dt, k)

@@ -21,8 +21,7 @@ import numpy as np
 from armcli.errors import InputError
 from armcli.io.csvtable import CsvBounds, read_numeric_csv
 from armcli.io.files import write_file_atomic
-from armcli.sim.job import MAX_STEPS
-from armcli.sim.simulate import SimResult
+from armcli.sim.simulate import MAX_STEPS, SimResult
 
 TIME = "time"
 FIELDS = ("position", "velocity", "effort", "reference")  # per-joint columns, in file order
@@ -37,19 +36,34 @@ def column(joint: str, field: str) -> str:
 # -- writer ----------------------------------------------------------------------------------
 
 
-def sample_states(res: SimResult, rate: float) -> dict[str, np.ndarray]:
-    """Columns `time`, `NAME.position|velocity|effort|reference` at `rate` [Hz]."""
-    steps = len(res.t) - 1
+def sample_steps(steps: int, dt: float, rate: float) -> np.ndarray:
+    """The steps whose states the file holds: one per period 1/`rate` [Hz] from t = 0.
+
+    `simulate` keeps only these (plus what a plot needs), so memory follows the output
+    rate, not the number of steps.
+    """
     period = 1.0 / rate
-    n_samples = int(np.floor(res.t[-1] / period + 1e-9)) + 1
-    idx = np.minimum(np.round(np.arange(n_samples) * period / res.dt).astype(int), steps)
-    tau_idx = np.minimum(idx, steps - 1)
-    cols: dict[str, np.ndarray] = {TIME: res.t[idx]}
+    n_samples = int(np.floor(steps * dt / period + 1e-9)) + 1
+    idx = np.round(np.arange(n_samples) * period / dt).astype(np.int64)
+    return np.unique(np.minimum(idx, steps))
+
+
+def sample_states(res: SimResult, rate: float) -> dict[str, np.ndarray]:
+    """Columns `time`, `NAME.position|velocity|effort|reference` at `rate` [Hz].
+
+    Raises:
+        ValueError: `res` did not keep the states at those steps.
+    """
+    want = sample_steps(res.steps, res.dt, rate)
+    rows = np.minimum(np.searchsorted(res.step, want), len(res.step) - 1)
+    if not np.array_equal(res.step[rows], want):
+        raise ValueError(f"the run did not keep the states at {rate:g} Hz")
+    cols: dict[str, np.ndarray] = {TIME: res.t[rows]}
     for i, name in enumerate(res.joint_names):
-        cols[column(name, "position")] = res.q[idx, i]
-        cols[column(name, "velocity")] = res.v[idx, i]
-        cols[column(name, "effort")] = res.tau[tau_idx, i]
-        cols[column(name, "reference")] = res.q_ref[idx, i]
+        cols[column(name, "position")] = res.q[rows, i]
+        cols[column(name, "velocity")] = res.v[rows, i]
+        cols[column(name, "effort")] = res.tau[rows, i]
+        cols[column(name, "reference")] = res.q_ref[rows, i]
     return cols
 
 
@@ -90,7 +104,7 @@ def write_states(path: Path, res: SimResult, rate: float) -> None:
 MAX_REPLAY_BYTES = 200_000_000
 MAX_REPLAY_ROWS = MAX_STEPS  # the most states `simulate` records
 MAX_REPLAY_COLUMNS = 1024  # time + 4 columns for each of 128 joints, with room to spare
-MAX_REPLAY_CELLS = 25_000_000  # 200 MB as float64: a 198 MB file of 2 rows needed 2.6 GB
+MAX_REPLAY_CELLS = 25_000_000  # 200 MB as float64 (a 198 MB file of 2 rows took 2 GB)
 REPLAY_BOUNDS = CsvBounds(MAX_REPLAY_BYTES, MAX_REPLAY_COLUMNS, MAX_REPLAY_ROWS, MAX_REPLAY_CELLS)
 
 

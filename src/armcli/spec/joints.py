@@ -7,6 +7,7 @@ from typing import Literal
 
 from pydantic import Field, model_validator
 
+from armcli.spec.passthrough import PassthroughElement
 from armcli.spec.shapes import Origin
 from armcli.spec.types import NonNeg, Real, UrdfName, Vec3, _Model
 
@@ -85,6 +86,9 @@ class Joint(_Model):
     mimic: Mimic | None = Field(None, description="follow another joint (e.g. a gripper finger)")
     safety_controller: SafetyController | None = Field(None, description="soft limits")
     calibration: Calibration | None = Field(None, description="reference switch positions")
+    passthrough: list[PassthroughElement] = Field(
+        [], description="elements inside <joint> kept verbatim (non-URDF extensions)"
+    )
 
     @model_validator(mode="after")
     def _limits(self) -> Joint:

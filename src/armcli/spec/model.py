@@ -16,6 +16,7 @@ from pathlib import Path
 from pydantic import Field, PrivateAttr
 
 from armcli.defaults import DEFAULT_DT
+from armcli.spec.control import Hardware, Interface, JointControl, Ros2Control
 from armcli.spec.graph import root_links
 from armcli.spec.joints import (
     Calibration,
@@ -27,6 +28,7 @@ from armcli.spec.joints import (
     SafetyController,
 )
 from armcli.spec.passthrough import PassthroughElement
+from armcli.spec.sensors import Camera, Imu, Lidar, Noise, Sensor
 from armcli.spec.shapes import (
     Box,
     Contact,
@@ -42,14 +44,49 @@ from armcli.spec.shapes import (
     Shape,
     Sphere,
 )
-from armcli.spec.types import Name, NonNeg, Positive, Real, UrdfName, Vec3, _Model
+from armcli.spec.types import Name, NonNeg, Positive, Real, RobotName, UrdfName, Vec3, _Model
 
 __all__ = [
-    "Arm", "Box", "Calibration", "Contact", "Control", "Cylinder", "DiffDrive", "Dynamics",
-    "Gains", "Geometry", "Inertia", "Inertial", "InlineMaterial", "Joint",
-    "JointPoseTrajectory", "JointStatePublisher", "JointType", "Limit", "Link", "Material",
-    "Mesh", "Mimic", "MobileBase", "Mount", "Origin", "RobotSpec", "SafetyController", "Shape",
-    "Sphere", "Tolerances", "Tool",
+    "Arm",
+    "Box",
+    "Calibration",
+    "Camera",
+    "Contact",
+    "Control",
+    "Cylinder",
+    "DiffDrive",
+    "Dynamics",
+    "Gains",
+    "Geometry",
+    "Hardware",
+    "Imu",
+    "Inertia",
+    "Inertial",
+    "InlineMaterial",
+    "Interface",
+    "Joint",
+    "JointControl",
+    "JointPoseTrajectory",
+    "JointStatePublisher",
+    "JointType",
+    "Lidar",
+    "Limit",
+    "Link",
+    "Material",
+    "Mesh",
+    "Mimic",
+    "MobileBase",
+    "Mount",
+    "Noise",
+    "Origin",
+    "RobotSpec",
+    "Ros2Control",
+    "SafetyController",
+    "Sensor",
+    "Shape",
+    "Sphere",
+    "Tolerances",
+    "Tool",
 ]  # fmt: skip
 
 
@@ -181,8 +218,8 @@ class Control(_Model):
 class RobotSpec(_Model):
     """The whole robot: base, arm, how they are mounted, and how the arm is controlled."""
 
-    name: Name = Field(description="robot name; also the ROS package prefix")
-    materials: dict[Name, Material] = Field({}, description="colours by name")
+    name: RobotName = Field(description="robot name; also the ROS package prefix")
+    materials: dict[UrdfName, Material] = Field({}, description="colours by name")
     mobile_base: MobileBase | None = Field(
         None, description="the mobile base, if the arm rides on one"
     )
@@ -191,6 +228,12 @@ class RobotSpec(_Model):
     control: Control = Field(Control(), description="controller gains and time step")
     poses: dict[Name, dict[UrdfName, Real]] = Field(
         {}, description="named poses: joint name -> position [rad or m]"
+    )
+    sensors: dict[Name, Sensor] = Field(
+        {}, description="cameras, lidars and IMUs on links, by name"
+    )
+    ros2_control: Ros2Control | None = Field(
+        None, description="ros2_control interfaces per joint (both ROS targets), hardware"
     )
     passthrough: list[PassthroughElement] = Field(
         [],

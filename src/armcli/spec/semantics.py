@@ -47,6 +47,8 @@ def semantic_problems(spec: RobotSpec) -> list[Problem]:
     _plugin_problems(spec, all_joints, add)
     _mount_problems(spec, all_joints, add)
     _mimic_problems(spec, add)
+    _control_problems(spec, all_joints, add)
+    _sensor_problems(spec, add)
     for jname in spec.control.gains:
         if jname not in spec.arm.joints:
             add(("control", "gains", jname), f"unknown arm joint; known: {_names(spec.arm.joints)}")
@@ -90,6 +92,34 @@ def _mimic_problems(spec: RobotSpec, add: Callable[..., None]) -> None:
                 add(path, f"{j.mimic.joint} is {lead.type}: a lead joint must move")
             elif lead.mimic is not None:
                 add(path, f"{j.mimic.joint} mimics {lead.mimic.joint}: follow that one")
+
+
+def _control_problems(
+    spec: RobotSpec, all_joints: dict[str, Joint], add: Callable[..., None]
+) -> None:
+    """ros2_control joints exist and move."""
+    if spec.ros2_control is None:
+        return
+    for jname in spec.ros2_control.joints:
+        j = all_joints.get(jname)
+        if j is None:
+            add(("ros2_control", "joints", jname), f"unknown joint; known: {_names(all_joints)}")
+        elif j.type == "fixed":
+            add(("ros2_control", "joints", jname), "a fixed joint has no interfaces")
+
+
+def _sensor_problems(spec: RobotSpec, add: Callable[..., None]) -> None:
+    """Sensors sit on known links, stamp known frames and publish distinct topics."""
+    links = spec.all_links()
+    topics: dict[str, str] = {}
+    for name, s in spec.sensors.items():
+        for role in ("link", "frame"):
+            value = getattr(s, role)
+            if value is not None and value not in links:
+                add(("sensors", name, role), f"unknown link {value!r}; known: {_names(links)}")
+        if s.topic in topics:
+            add(("sensors", name, "topic"), f"{s.topic!r} is already sensor {topics[s.topic]}'s")
+        topics[s.topic] = name
 
 
 def _mount_problems(spec: RobotSpec, all_joints: dict[str, Joint], add: Any) -> None:

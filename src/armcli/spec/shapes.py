@@ -16,7 +16,8 @@ from urllib.parse import urlparse
 
 from pydantic import Field, field_validator, model_validator
 
-from armcli.spec.types import Name, NonNeg, Positive, Real, Text, Unit, Vec3, _Model
+from armcli.spec.passthrough import PassthroughElement
+from armcli.spec.types import NonNeg, Positive, Real, Text, Unit, UrdfName, Vec3, _Model
 
 SHAPE_REF = re.compile(r"^(visual|collision)(?:\.(\d+))?$")
 
@@ -143,7 +144,7 @@ class Shape(_Model):
     )
     geometry: Geometry = Field(description="the shape")
     origin: Origin = Field(Origin(), description="pose of the shape in the link frame")
-    material: Name | InlineMaterial | None = Field(
+    material: UrdfName | InlineMaterial | None = Field(
         None, description="visuals: a name from `materials`, or a material written in place"
     )
 
@@ -224,7 +225,9 @@ class Link(_Model):
     origin: Origin = Field(
         Origin(), description="shorthand: pose of the shape and its centre of mass"
     )
-    material: Name | None = Field(None, description="shorthand: name of an entry of `materials`")
+    material: UrdfName | None = Field(
+        None, description="shorthand: name of an entry of `materials`"
+    )
     mass: Positive | None = Field(
         None, description="shorthand: mass [kg]; the inertia tensor follows from the shape"
     )
@@ -232,6 +235,9 @@ class Link(_Model):
     collision: list[Shape] = Field([], description="collision shapes, in order")
     inertial: Inertial | None = Field(None, description="mass properties; none: massless frame")
     contact: Contact | None = Field(None, description="Gazebo surface friction")
+    passthrough: list[PassthroughElement] = Field(
+        [], description="elements inside <link> kept verbatim (non-URDF extensions)"
+    )
 
     @model_validator(mode="after")
     def _solid(self) -> Link:

@@ -36,6 +36,8 @@ Unit = Annotated[Real, Field(ge=0, le=1)]
 Vec3 = tuple[Real, Real, Real]
 # Names that also become xacro properties, file names and ROS names.
 Name = Annotated[str, Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]*$", max_length=64)]
+# A robot name: also file names (`NAME.urdf`) and, where ROS allows it, the package prefix.
+RobotName = Annotated[str, Field(pattern=r"^[A-Za-z0-9_][A-Za-z0-9_-]*$", max_length=64)]
 # Link and joint names as URDFs write them (`joint_0.0`, `LFoot/FSR/Heel_sensor`): no
 # spaces, quotes or `$`, which xacro would read as an expression.
 UrdfName = Annotated[str, Field(pattern=r"^[A-Za-z0-9_][A-Za-z0-9_./-]*$", max_length=128)]

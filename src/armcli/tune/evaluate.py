@@ -7,7 +7,7 @@ is cut into chunks does not change any result, since every rollout is independen
 
 `rollout_batch` is the single place that runs the simulator: all rollouts of a chunk
 (candidates x models x cases) in one `sim.simulate.simulate_batch` call, which hands them
-to the compiled extension's batch rollout together (GIL released; else the Python loop).
+to the compiled engine together.
 """
 
 from __future__ import annotations
@@ -57,7 +57,7 @@ def _unstable_reason(problem: TuneProblem, kp: np.ndarray, kd: np.ndarray) -> st
     """
     margin = 1.0 if problem.variants else problem.stability_margin
     for v, sm in enumerate(scored_models(problem)):
-        if not loop_stable(sm.arm, sm.Ms, kp, kd, problem.loop, margin * problem.dt):
+        if not loop_stable(sm.arm, sm.lin, kp, kd, problem.loop, margin * problem.dt):
             return f"model {v}: {problem.loop} loop unstable at {margin:g} x dt"
     return ""
 
@@ -72,7 +72,7 @@ def evaluate_candidates(
     cfgs, reasons, jobs = [], [], []
     for gains in chunk:
         kp, kd = gain_vector.split(gains)
-        cfg = SimConfig(kp, kd, problem.dt, problem.integrator, problem.gravity_comp, "auto")
+        cfg = SimConfig(kp, kd, problem.dt, problem.integrator, problem.gravity_comp)
         cfgs.append(cfg)
         reasons.append(_unstable_reason(problem, kp, kd))
         if not reasons[-1]:

@@ -153,7 +153,8 @@ def prepare(
         else 2 * math.pi * spec.control.controller_update_rate / TARGET_RATIO
     )
     start = start_gains(arm, dt=spec.control.dt, loop=s.loop, zeta=s.zeta, wn_target=wn,
-                        steps=largest_steps(cases, len(joints)))  # fmt: skip
+                        steps=largest_steps(cases, len(joints)),
+                        gravity=not base.gravity_comp)  # fmt: skip
     variants = draw_variants(arm, s.robust, s.mass_scale, s.friction_scale, s.seed)
     problem = TuneProblem(xml, ARM_URDF, joints, spec.control.dt, "euler", base.gravity_comp,
                           s.loop, STABILITY_MARGIN, tuple(cases), variants).with_key()  # fmt: skip

@@ -31,7 +31,6 @@ import numpy as np
 from armcli.errors import InputError
 from armcli.sim import stability as stab
 from armcli.sim.simulate import Arm, configuration
-from armcli.urdf.pinocchio import mass_matrix
 
 TARGET_RATIO = 10.0  # wn <= 2 pi f_c / TARGET_RATIO for a loop closed at f_c [Hz]
 STABILITY_MARGIN = 2.0  # gains must be stable at this multiple of dt
@@ -40,6 +39,7 @@ MAX_GRID = 125
 RANDOM_SAMPLES = 100
 SAMPLE_SEED = 0
 WN_BRACKET = (1e-6, 1e9)  # [rad/s] search interval for the stability cap
+SCALE_FLOOR = 1e-9  # smallest common kp scale the coupled check tries
 LOOPS = ("implicit", "explicit")
 
 
@@ -88,10 +88,12 @@ def sample_configurations(arm: Arm) -> np.ndarray:
     return np.vstack([np.clip(np.zeros(n), lo, hi), rng.uniform(lo, hi, size=(RANDOM_SAMPLES, n))])
 
 
-def mass_matrices(arm: Arm, qs: np.ndarray) -> list[np.ndarray]:
-    """Symmetric M(q) (CRBA) at every sample."""
-    data = arm.model.createData()
-    return [mass_matrix(arm.model, data, configuration(arm.model, q)) for q in qs]
+def linearised(arm: Arm, qs: np.ndarray, *, gravity: bool) -> stab.Linearised:
+    """M(q) and gravity's stiffness at every sample, as the stability bound needs them.
+
+    `gravity=False` (gravity compensation) gives zero stiffness.
+    """
+    return stab.linearise(arm.model, [configuration(arm.model, q) for q in qs], gravity=gravity)
 
 
 def gravity_max(arm: Arm, qs: np.ndarray) -> np.ndarray:
@@ -129,12 +131,17 @@ def _largest(ok: Callable[[float], bool], lo: float, hi: float) -> float:
     return lo
 
 
-def stability_cap(loop: str, m: float, zeta: float, damping: float, lam: float, dt: float) -> float:
-    """Largest wn whose gains keep the loop stable at STABILITY_MARGIN * dt [rad/s]."""
+def stability_cap(
+    loop: str, m: float, zeta: float, damping: float, lam: float, dt: float, stiffness: float = 0.0
+) -> float:
+    """Largest wn whose gains keep the loop stable at STABILITY_MARGIN * dt [rad/s].
+
+    `stiffness` is gravity's on the joint [N·m/rad], which adds to Kp in the bound.
+    """
 
     def ok(wn: float) -> bool:
         kp, kd = m * wn * wn, 2.0 * zeta * wn * m
-        return dt_max(loop, kp, kd + damping, lam) >= STABILITY_MARGIN * dt
+        return dt_max(loop, kp + stiffness, kd + damping, lam) >= STABILITY_MARGIN * dt
 
     return _largest(ok, *WN_BRACKET)
 
@@ -147,21 +154,26 @@ def start_gains(
     zeta: float,
     wn_target: float,
     steps: np.ndarray,
+    gravity: bool = True,
 ) -> StartGains:
     """Model-based kp, kd per joint (see the module docstring).
 
     Raises InputError when the effort limit cannot even hold the arm against gravity.
     """
     qs = sample_configurations(arm)
-    Ms = mass_matrices(arm, qs)
+    lin = linearised(arm, qs, gravity=gravity)
+    Ms = list(lin.M)
     lam = lambda_max(Ms)
+    g_jj = np.max(np.maximum(np.diagonal(lin.G, axis1=1, axis2=2), 0.0), axis=0)
     lam_j = np.max([np.diag(np.linalg.inv(M)) for M in Ms], axis=0)
     g = gravity_max(arm, qs)
     diag = np.array([np.diag(M) for M in Ms])
     rows = []
     for j, name in enumerate(arm.joint_names):
         m_max = float(diag[:, j].max())
-        wn_s = stability_cap(loop, m_max, zeta, float(arm.damping[j]), float(lam_j[j]), dt)
+        wn_s = stability_cap(
+            loop, m_max, zeta, float(arm.damping[j]), float(lam_j[j]), dt, float(g_jj[j])
+        )
         wn_e = _effort_cap(name, float(arm.effort[j]), float(g[j]), float(steps[j]), m_max)
         caps = {"target": wn_target, "stability": wn_s, "effort": wn_e}
         binding = min(caps, key=lambda k: caps[k])
@@ -175,7 +187,7 @@ def start_gains(
         )  # fmt: skip
     kp = np.array([r.kp for r in rows])
     kd = np.array([r.kd for r in rows])
-    scale = _coupled_scale(arm, Ms, kp, kd, loop, dt)
+    scale = _coupled_scale(arm, lin, kp, kd, loop, dt)
     if scale < 1.0:
         kp, kd = kp * scale, kd * math.sqrt(scale)
         rows = [_scaled(r, scale) for r in rows]
@@ -198,27 +210,38 @@ def _effort_cap(name: str, effort: float, g: float, step: float, m: float) -> fl
 
 
 def loop_stable(
-    arm: Arm, Ms: Sequence[np.ndarray], kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
+    arm: Arm, lin: stab.Linearised, kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
 ) -> bool:
-    """The verdict of `armcli.sim.stability` on the full step maps, for `loop` at dt."""
-    idx = list(range(len(kp)))
-    D = np.asarray(kd, dtype=float) + arm.damping
+    """The verdict of `armcli.sim.stability` at every sample, for `loop` at dt."""
+    pd = stab.PD.of(range(len(kp)), kp, kd, arm.damping)
     scheme: stab.Scheme = "implicit" if loop == "implicit" else "explicit"
-    radius, _ = stab.worst_radius(Ms, idx, np.asarray(kp, dtype=float), D, dt, scheme)
-    return stab.is_stable(radius)
+    return stab.stable(lin, pd, dt, scheme)
 
 
 def _coupled_scale(
-    arm: Arm, Ms: Sequence[np.ndarray], kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
+    arm: Arm, lin: stab.Linearised, kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
 ) -> float:
     """Common kp scale keeping the coupled loop stable at margin * dt (1 when it is).
 
-    kd is scaled by sqrt(s), which keeps zeta.
+    kd is scaled by sqrt(s), which keeps zeta. Raises InputError when even vanishing gains
+    are unstable: gravity's stiffness alone is too much for the time step.
     """
     h = STABILITY_MARGIN * dt
-    if loop_stable(arm, Ms, kp, kd, loop, h):
+    if loop_stable(arm, lin, kp, kd, loop, h):
         return 1.0
-    return _largest(lambda s: loop_stable(arm, Ms, s * kp, math.sqrt(s) * kd, loop, h), 1e-9, 1.0)
+    if not loop_stable(arm, lin, kp * SCALE_FLOOR, kd * math.sqrt(SCALE_FLOOR), loop, h):
+        scheme: stab.Scheme = "implicit" if loop == "implicit" else "explicit"
+        free = stab.PD.of(range(len(kp)), 0.0 * kp, 0.0 * kd, arm.damping)
+        edge = stab.largest_stable_dt(lin, free, scheme, dt)
+        raise InputError(
+            f"= {dt:g} s: gravity's stiffness alone makes the {loop} loop unstable at "
+            f"{STABILITY_MARGIN:g} x dt, whatever the gains; use dt <= "
+            f"{edge / STABILITY_MARGIN:.3g} s",
+            field="control.dt",
+        )
+    return _largest(
+        lambda s: loop_stable(arm, lin, s * kp, math.sqrt(s) * kd, loop, h), SCALE_FLOOR, 1.0
+    )
 
 
 def _scaled(r: JointReasoning, s: float) -> JointReasoning:

@@ -15,9 +15,11 @@ from typing import Any
 
 import numpy as np
 
+from armcli.sim.options import Integrator
 from armcli.sim.reference import Reference
 from armcli.sim.simulate import Arm, arm_from_model
-from armcli.tune.model_gains import mass_matrices, sample_configurations
+from armcli.sim.stability import Linearised
+from armcli.tune.model_gains import linearised, sample_configurations
 from armcli.urdf.pinocchio import load_model
 
 _CACHE: dict[str, tuple[Scored, ...]] = {}
@@ -30,7 +32,7 @@ class Scored:
 
     arm: Arm
     qs: np.ndarray  # (S, n) sampled configurations
-    Ms: tuple[np.ndarray, ...]  # M(q) at each sample
+    lin: Linearised  # M(q) and gravity's stiffness at each sample
 
 
 @dataclass(frozen=True, eq=False)
@@ -60,7 +62,7 @@ class TuneProblem:
     urdf_name: str
     joints: tuple[str, ...]
     dt: float  # [s]
-    integrator: str
+    integrator: Integrator
     gravity_comp: bool
     loop: str  # "implicit" | "explicit": which stability bound makes a candidate infeasible
     stability_margin: float  # nominal model: stable at stability_margin * dt; variants: at dt
@@ -103,7 +105,8 @@ def scored_models(problem: TuneProblem) -> tuple[Scored, ...]:
             arm = nominal_arm(problem)
             qs = sample_configurations(arm)
             built = tuple(perturb(arm, v) for v in problem.variants) or (arm,)
-            _CACHE[key] = tuple(Scored(a, qs, tuple(mass_matrices(a, qs))) for a in built)
+            gravity = not problem.gravity_comp
+            _CACHE[key] = tuple(Scored(a, qs, linearised(a, qs, gravity=gravity)) for a in built)
         return _CACHE[key]
 
 

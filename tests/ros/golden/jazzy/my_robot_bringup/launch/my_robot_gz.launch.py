@@ -32,6 +32,7 @@ STANDALONE_XACRO = "standalone_arm_gz.urdf.xacro"
 ROBOT_ROOT = "base_footprint"
 STANDALONE_ROOT = "arm_base_link"
 CONTROLLERS = "my_robot_controllers.yaml"
+BRIDGE = "my_robot_bridge.yaml"
 RVIZ_CONFIG = "display.rviz"
 ENTITY = "my_robot"
 ARM_CONTROLLER = "arm_controller"
@@ -41,7 +42,8 @@ WORLD = "empty.sdf"
 
 def generate_launch_description():
     share = get_package_share_directory(DESCRIPTION_PKG)
-    controllers = os.path.join(get_package_share_directory(BRINGUP_PKG), "config", CONTROLLERS)
+    config = os.path.join(get_package_share_directory(BRINGUP_PKG), "config")
+    controllers = os.path.join(config, CONTROLLERS)
     ros_gz_sim_share = get_package_share_directory("ros_gz_sim")
     standalone = LaunchConfiguration("standalone")
     xacro_file = PythonExpression(
@@ -100,10 +102,11 @@ def generate_launch_description():
                 parameters=[{"robot_description": robot_description, "use_sim_time": True}],
             ),
             spawn,
+            # /clock and every sensor topic, Gazebo -> ROS (config/<robot>_bridge.yaml)
             Node(
                 package="ros_gz_bridge",
                 executable="parameter_bridge",
-                arguments=["/clock@rosgraph_msgs/msg/Clock[gz.msgs.Clock"],
+                parameters=[{"config_file": os.path.join(config, BRIDGE), "use_sim_time": True}],
             ),
             RegisterEventHandler(
                 OnProcessExit(target_action=spawn, on_exit=[joint_state_broadcaster])

@@ -1,0 +1,53 @@
+"""`armcli import FILE`: read a URDF or xacro file, import it, write the spec atomically."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from armcli.errors import ExistingFileError, InputError
+from armcli.importer.run import GainSource, ImportResult, import_urdf
+from armcli.io.files import write_file_atomic
+from armcli.urdf.source import Trust, read_urdf_file
+from armcli.urdf.xacro_args import XacroInputs
+
+
+def source_label(path: Path, inputs: XacroInputs | None) -> str:
+    """How the spec names its source: the file, with the xacro arguments given."""
+    args = dict(inputs.args) if inputs is not None else {}
+    given = " ".join(f"{k}:={v}" for k, v in args.items())
+    return path.as_posix() + (f" {given}" if given else "")
+
+
+def import_file(
+    path: Path,
+    out: Path,
+    *,
+    inputs: XacroInputs | None = None,
+    trust_xacro: Trust = False,
+    arm_root: str | None = None,
+    force: bool = False,
+    gains: GainSource | None = None,
+) -> tuple[ImportResult, tuple[str, ...]]:
+    """Import `path` and write the spec to `out` (all or nothing; never over a file unless forced).
+
+    Returns the result and the `note:` lines of a xacro expansion (arguments it used).
+
+    Raises:
+        ExistingFileError: `out` exists and `force` is not set (nothing was read or written).
+        InputError: the file is unusable or holds what a spec cannot.
+    """
+    if out.exists() and not force:
+        raise ExistingFileError(f"{out} exists; pass --force to replace it", file=out)
+    if out.is_dir():
+        raise InputError("is a directory; give the spec file to write", file=out, field="--out")
+    urdf = read_urdf_file(path, trust_xacro=trust_xacro, inputs=inputs)
+    result = import_urdf(
+        urdf.text,
+        source_label(path, inputs),
+        out,
+        arm_root=arm_root,
+        source_dir=path.parent,
+        gains=gains,
+    )
+    write_file_atomic(out, result.text)
+    return result, urdf.notes

@@ -1,0 +1,56 @@
+"""Model-based start gains for a spec that has none (an imported robot), without rollouts.
+
+The same start `armcli tune` begins from (`tune.model_gains.start_gains`, implicit loop,
+critically damped, wn a decade under the controller rate), for the arm's moving joints
+that have a motor of their own: mimic followers and continuous joints are left out, as
+the simulator does not drive them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from armcli.compiler.expand import expand_urdfs
+from armcli.defaults import STANDALONE_ARM_URDF
+from armcli.errors import InputError
+from armcli.sim.simulate import arm_from_model
+from armcli.spec.model import RobotSpec
+from armcli.tune.model_gains import TARGET_RATIO, start_gains
+from armcli.urdf.pinocchio import load_model
+
+STEP_CAP = math.pi / 2  # [rad or m] the largest step the start gains are sized for
+
+
+def spec_start_gains(spec: RobotSpec) -> dict[str, tuple[float, float]]:
+    """{joint: (kp, kd)} for the driven arm joints.
+
+    {} when there are none, gravity beats an effort limit, or the mass matrix is singular
+    (massless links): the import then writes no gains, and `check` says what is wrong.
+    """
+    joints = [
+        n
+        for n in spec.movable_arm_joints()
+        if spec.arm.joints[n].mimic is None and spec.arm.joints[n].type in ("revolute", "prismatic")
+    ]
+    if not joints:
+        return {}
+    xml = expand_urdfs(spec)[STANDALONE_ARM_URDF].decode("utf-8")
+    arm = arm_from_model(load_model(STANDALONE_ARM_URDF, xml=xml).model, joints)
+    steps = np.minimum(
+        np.where(np.isfinite(arm.upper - arm.lower), arm.upper - arm.lower, STEP_CAP), STEP_CAP
+    )
+    wn = 2 * math.pi * spec.control.controller_update_rate / TARGET_RATIO
+    try:
+        start = start_gains(
+            arm, dt=spec.control.dt, loop="implicit", zeta=1.0, wn_target=wn, steps=steps
+        )
+    except InputError:
+        return {}  # an effort limit below gravity: no start gains; tune says why
+    except np.linalg.LinAlgError:
+        return {}  # a massless chain (singular mass matrix): nothing to size gains on; check says
+    return {
+        name: (float(kp), float(kd))
+        for name, kp, kd in zip(arm.joint_names, start.kp, start.kd, strict=True)
+    }
