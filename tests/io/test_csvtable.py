@@ -22,7 +22,7 @@ from armcli.sim.states import load_replay
 from tests.helpers import ROOT
 
 WIDE_BYTES = 40_000_000  # a 40 MB hostile file is enough to see a row being built
-PEAK_LIMIT_KB = 150_000  # the interpreter with numpy is ~40 MB; before: ~0.5 GB per 40 MB row
+GROWTH_LIMIT_KB = 30_000  # over reading a 2-row file; before: ~0.4 GB for a 40 MB row
 SMALL = CsvBounds(max_bytes=10_000, max_columns=4, max_rows=5, max_cells=12)
 
 
@@ -57,10 +57,14 @@ def test_wide_file_is_refused_before_allocating(shape: str, tmp_path: Path) -> N
         for _ in range(cells // 1_000_000):
             fh.write(",1" * 1_000_000)
         fh.write("\n")
+    small = tmp_path / "small.csv"
+    small.write_text("time,j.position\n0,1\n0.1,2\n")
+    baseline, said = _peak_of_load(small)  # the interpreter and imports
+    assert said == ""
     peak, said = _peak_of_load(path)
     line = 2 if shape == "wide-row" else 1
     assert f"huge.csv:{line}: " in said and "longer than" in said, said
-    assert peak < PEAK_LIMIT_KB, peak  # before: the row was built, hundreds of MB
+    assert peak - baseline < GROWTH_LIMIT_KB, (peak, baseline)  # before: the row was built
 
 
 def test_cells_rows_and_columns_are_bounded(tmp_path: Path) -> None:
