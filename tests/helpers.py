@@ -9,6 +9,10 @@ from __future__ import annotations
 
 import copy
 import math
+import os
+import subprocess
+import sys
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -19,6 +23,33 @@ SPECS = ROOT / "specs"
 DEFAULT_SPEC = SPECS / "my_robot.yaml"
 FIXTURES = ROOT / "tests" / "fixtures"
 BAD_INPUTS = ROOT / "tests" / "bad_inputs"
+CLI_TIME_LIMIT_S = 120.0  # one CLI run on a loaded 2-core machine
+
+
+def run_cli(
+    args: Sequence[str | Path],
+    cwd: Path | None = None,
+    env: Mapping[str, str] | None = None,
+    *,
+    preexec_fn: Callable[[], Any] | None = None,
+) -> subprocess.CompletedProcess[str]:
+    """`python -m armcli.cli ARGS` as its own process: exit code, stdout, stderr, files.
+
+    `env` adds to (or overrides) this process's environment, without ARMCLI_DEBUG (errors
+    stay one line). For in-process calls that only need the output, tests call
+    `armcli.cli.main` directly instead.
+    """
+    return subprocess.run(
+        [sys.executable, "-m", "armcli.cli", *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=CLI_TIME_LIMIT_S,
+        check=False,
+        cwd=cwd,
+        env={**{k: v for k, v in os.environ.items() if k != "ARMCLI_DEBUG"}, **(env or {})},
+        preexec_fn=preexec_fn,
+    )
+
 
 HOSTILE_SCALARS = st.one_of(
     st.sampled_from(

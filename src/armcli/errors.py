@@ -8,7 +8,8 @@ diverged simulation). Library code raises these and never prints or exits.
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+import re
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -69,9 +70,37 @@ class InputError(ArmcliError):
         self.file = str(file) if file is not None else None
         self.line = line
         self.field = field
-        where = _where(file, line)
-        prefix = " ".join(p for p in (where, field) if p)
-        super().__init__(f"{prefix}: {message}" if prefix else message)
+        super().__init__(_text(self.file, line, field, message))
+
+    def renamed(self, names: Mapping[str, str]) -> InputError:
+        """This error in another vocabulary: the CLI's flags for the library's names.
+
+        Library errors name what a Python caller passed (`SimOptions.dt`); `names` maps
+        such a name to a flag (`--dt`) in the field, the file label and wherever the
+        message quotes it in backticks. Returns self when nothing is renamed.
+        """
+
+        def flag(m: re.Match[str]) -> str:
+            return names.get(m[1], m[0])
+
+        message = _QUOTED_NAME.sub(flag, self.message)
+        field = names.get(self.field, self.field) if self.field else None
+        file = names.get(self.file, self.file) if self.file else None
+        if (message, field, file) == (self.message, self.field, self.file):
+            return self
+        new = type(self).__new__(type(self))  # copy.copy would call a subclass's __init__
+        new.__dict__.update(self.__dict__)
+        new.message, new.field, new.file = message, field, file
+        new.args = (_text(file, self.line, field, message),)
+        return new
+
+
+_QUOTED_NAME = re.compile(r"`([A-Za-z_][A-Za-z0-9_.]*)`")
+
+
+def _text(file: str | None, line: int | None, field: str | None, message: str) -> str:
+    prefix = " ".join(p for p in (_where(file, line), field) if p)
+    return f"{prefix}: {message}" if prefix else message
 
 
 @dataclass(frozen=True)
@@ -269,6 +298,19 @@ class SimulationError(ArmcliError):
         if cause:
             text += f"; likely cause: {cause}"
         super().__init__(text)
+
+
+class ExportRefusedError(ArmcliError):
+    """An export would write a model its target simulator refuses: which part, and why."""
+
+    exit_code = EXIT_FAILED
+
+    def __init__(self, file: str | Path, reason: str, *, link: str | None = None) -> None:
+        self.file = str(file)
+        self.link = link
+        self.reason = reason
+        what = f"link {link!r}: " if link is not None else ""
+        super().__init__(f"{_where(file, None)}: {what}{reason}")
 
 
 class NoSpecError(InputError):

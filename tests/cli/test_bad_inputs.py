@@ -13,17 +13,15 @@ import json
 import os
 import re
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 import yaml
 
-from tests.helpers import BAD_INPUTS
+from tests.helpers import BAD_INPUTS, run_cli
 
 HERE = BAD_INPUTS
 CASES = yaml.safe_load((HERE / "cases.yaml").read_text())
-TIME_LIMIT_S = 60.0  # generous bound on one CLI run on a loaded 2-core machine
 PWNED = Path("/tmp/armcli-pwned")  # the hostile files try to create this
 # A valid trajectory for the standalone arm's first joint, so that `simulate --urdf`
 # fails on the URDF and not on the trajectory ({{ }}: str.format escapes).
@@ -66,17 +64,6 @@ COMMANDS = {
     "tree-trusted": ["tree", "--trust-xacro", "{file}", "-o", "{out}/tree.txt"],
     "render-trusted": ["render", "--trust-xacro", "{file}", "-o", "{out}/robot.png"],
 }
-
-
-def run_cli(args: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "armcli.cli", *args],
-        capture_output=True,
-        text=True,
-        timeout=TIME_LIMIT_S,
-        check=False,
-        cwd=cwd,
-    )
 
 
 def assert_clean_failure(

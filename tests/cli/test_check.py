@@ -3,14 +3,12 @@
 from __future__ import annotations
 
 import json
-import os
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
-from tests.helpers import ROOT
+from tests.helpers import ROOT, run_cli
 
 FIXTURES = ROOT / "tests" / "fixtures" / "check"
 HAND_TIP_HOME = [0.15, 0.0, 0.92]  # the forward-kinematics reference [m]
@@ -18,16 +16,7 @@ FK_ATOL = 1e-9
 
 
 def armcli(*args: str | Path, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "COLUMNS": "200"}
-    env.pop("ARMCLI_DEBUG", None)
-    return subprocess.run(
-        [sys.executable, "-m", "armcli.cli", *map(str, args)],
-        cwd=cwd,
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=120,
-    )
+    return run_cli(args, cwd, {"COLUMNS": "200"})  # wide: one table row per line
 
 
 def broken_copy(tmp_path: Path, old: str, new: str, name: str = "broken.urdf") -> Path:

@@ -3,31 +3,18 @@
 from __future__ import annotations
 
 import csv
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
 from armcli.errors import InputError
 from armcli.sim.states import load_replay
+from tests.helpers import run_cli
 
-TIME_LIMIT_S = 120.0  # one CLI run on a loaded 2-core machine
 CSV_FIELD_LIMIT = csv.field_size_limit()  # 131072: the csv module's default
 TRAJECTORY = (
     "{joint_names: [arm_base_forearm_joint], points: [{positions: [0.2], time_from_start: 0.5}]}"
 )
-
-
-def run_cli(args: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "armcli.cli", *args],
-        capture_output=True,
-        text=True,
-        timeout=TIME_LIMIT_S,
-        check=False,
-        cwd=cwd,
-    )
 
 
 def test_replay_field_over_csv_limit_is_an_input_error(tmp_path: Path) -> None:

@@ -76,7 +76,7 @@ def test_pinocchio_loads_model_and_meshes(built: Path) -> None:
         model, str(built), pin.GeometryType.VISUAL, package_dirs=[str(built.parent)]
     )
     meshes = [g.meshPath for g in visual.geometryObjects if g.meshPath.endswith(".stl")]
-    assert len(meshes) == 3 and all(Path(m).is_file() for m in meshes)
+    assert len(meshes) == 5 and all(Path(m).is_file() for m in meshes)  # 2 from the fingers
 
 
 def test_mujoco_compiles(built: Path) -> None:
@@ -111,6 +111,6 @@ def test_simulate_refuses_mimic_joints_naming_the_way_out(built: Path) -> None:
         refuse_mimic(doc, None)
     message = str(info.value)
     assert "'right_finger_joint' mimics 'left_finger_joint'" in message
-    hint = message.split("lock the followers with --joints ")[1]
+    hint = message.split("lock the followers with `SimOptions.joints` ")[1]
     assert hint.startswith("shoulder_pan_joint,") and "right_finger_joint" not in hint
     refuse_mimic(doc, ["shoulder_pan_joint", "left_finger_joint"])  # followers locked: accepted

@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +14,7 @@ import pytest
 import armcli.compiler.expand as build_mod
 from armcli.compiler.expand import build, stale_files
 from armcli.errors import BuildError
+from tests.helpers import run_cli
 
 ARM_JOINTS = ["arm_base_forearm_joint", "forearm_hand_joint"]
 # Seed: arm 0.5 + 0.3 + 0.3 kg; base 5 kg + 2 wheels x 1 kg + caster 0.5 kg.
@@ -106,30 +106,14 @@ def test_failed_build_leaves_previous_outputs(
 
 
 def test_cli_build_check_and_stale(tmp_path: Path, default_spec_path: Path) -> None:
-    exe = [sys.executable, "-m", "armcli.cli"]
     out = tmp_path / "urdf"
-    ok = subprocess.run(
-        [*exe, "build", str(default_spec_path), "-o", str(out)],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    ok = run_cli(["build", str(default_spec_path), "-o", str(out)])
     assert ok.returncode == 0, ok.stderr
-    fresh = subprocess.run(
-        [*exe, "build", str(default_spec_path), "-o", str(out), "--check"],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    fresh = run_cli(["build", str(default_spec_path), "-o", str(out), "--check"])
     assert fresh.returncode == 0, fresh.stderr
     (out / "arm.xacro").write_text("<robot/>")
     (out / "my_robot.urdf").unlink()
-    stale = subprocess.run(
-        [*exe, "build", str(default_spec_path), "-o", str(out), "--check"],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    stale = run_cli(["build", str(default_spec_path), "-o", str(out), "--check"])
     assert stale.returncode == 1
     assert f"stale: {out / 'arm.xacro'}" in stale.stderr
     assert f"stale: {out / 'my_robot.urdf'}" in stale.stderr
@@ -139,12 +123,7 @@ def test_cli_bad_spec_exit_2_and_writes_nothing(tmp_path: Path, default_spec_pat
     bad = tmp_path / "bad.yaml"
     bad.write_text(default_spec_path.read_text().replace("upper: pi/2", "upper: -1", 1))
     out = tmp_path / "out"
-    proc = subprocess.run(
-        [sys.executable, "-m", "armcli.cli", "build", str(bad), "-o", str(out)],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    proc = run_cli(["build", bad, "-o", out])
     assert proc.returncode == 2
     assert proc.stderr.startswith(f"error: {bad}:")
     assert "limit.upper: must be >= lower (0)" in proc.stderr

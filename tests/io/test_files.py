@@ -15,6 +15,7 @@ import armcli.io.files as fsio
 from armcli.errors import BuildError, OutputRefusedError
 from armcli.io.files import write_file_atomic, write_tree_atomic
 from armcli.io.outdir import MARKER_NAME, MARKER_TEXT
+from tests.helpers import run_cli
 
 KILL_WAIT_S = 60.0  # bound on how long the child may take to reach the injected pause
 
@@ -83,12 +84,7 @@ def test_sigkill_mid_build_keeps_previous_outputs(
     assert _snapshot(out) == before
     # The next build replaces everything in one swap, keeps the user's file, and
     # removes the dead process's staging directory.
-    fsio_build = subprocess.run(
-        [sys.executable, "-m", "armcli.cli", "build", str(default_spec_path), "-o", str(out)],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    fsio_build = run_cli(["build", default_spec_path, "-o", out])
     assert fsio_build.returncode == 0, fsio_build.stderr
     assert (out / "meshes" / "user.stl").read_bytes() == b"solid user"
     assert (out / "my_robot.urdf").is_file()

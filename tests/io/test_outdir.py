@@ -15,7 +15,6 @@ import signal
 import socket
 import stat
 import subprocess
-import sys
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -26,8 +25,8 @@ import armcli.io.together as together
 from armcli.errors import BuildError, OutputRefusedError
 from armcli.io.files import write_tree_atomic
 from armcli.io.outdir import MARKER_NAME
+from tests import helpers
 
-TIME_LIMIT_S = 120.0  # one CLI run on a loaded 2-core machine
 FILE_LIMIT_BYTES = 50_000_000  # far above any armcli output, far below a full disk
 TRAJECTORY = (
     "{joint_names: [arm_base_forearm_joint], points: [{positions: [0.2], time_from_start: 0.5}]}"
@@ -41,16 +40,8 @@ def _limit_files() -> None:
 def run_cli(
     args: list[str], cwd: Path, env: dict[str, str] | None = None
 ) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "armcli.cli", *args],
-        capture_output=True,
-        text=True,
-        timeout=TIME_LIMIT_S,
-        check=False,
-        cwd=cwd,
-        env={**os.environ, **(env or {})},
-        preexec_fn=_limit_files,
-    )
+    """The shared runner, with a cap on the size of any file the command writes."""
+    return helpers.run_cli(args, cwd, env, preexec_fn=_limit_files)
 
 
 def _stages(parent: Path) -> list[str]:

@@ -33,7 +33,7 @@ from armcli.ros.packages import RosPackages, ros_packages
 from armcli.spec.load import load_spec, loads_spec
 from armcli.spec.model import RobotSpec
 from armcli.urdf.read import parse_urdf
-from tests.helpers import ROOT
+from tests.helpers import ROOT, run_cli
 
 GOLDEN = ROOT / "tests" / "ros" / "golden"
 SAMPLES = 300  # as test_ros_package.py
@@ -343,25 +343,17 @@ def test_standalone_arm_is_welded_to_the_world(files: Mapping[str, bytes], tmp_p
 
 
 def test_cli_target_choice_and_one_line_error(tmp_path: Path) -> None:
-    import sys
-
     spec = str(ROOT / LABEL)
-    r = subprocess.run(
-        [sys.executable, "-m", "armcli.cli", "ros-package", spec, "-o", str(tmp_path / "a"),
-         "--samples", "10", "--target", "noetic"],
-        capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
+    r = run_cli(
+        ["ros-package", spec, "-o", tmp_path / "a", "--samples", "10", "--target", "noetic"]
+    )
     assert r.returncode == 2 and "humble-classic" in r.stderr and "jazzy" in r.stderr
     assert not (tmp_path / "a").exists()
     bad = tmp_path / "no_gains.yaml"
     bad.write_text(
         (ROOT / LABEL).read_text().replace("    forearm_hand_joint: {kp: 50, kd: 5}\n", "")
     )
-    r = subprocess.run(
-        [sys.executable, "-m", "armcli.cli", "ros-package", str(bad), "-o", str(tmp_path / "b"),
-         "--samples", "10", "--target", "jazzy"],
-        capture_output=True, text=True, timeout=120,
-    )  # fmt: skip
+    r = run_cli(["ros-package", bad, "-o", tmp_path / "b", "--samples", "10", "--target", "jazzy"])
     assert r.returncode == 2, r.stderr
     assert len(r.stderr.strip().splitlines()) == 1
     assert "no_gains.yaml" in r.stderr and "control.gains" in r.stderr

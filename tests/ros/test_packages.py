@@ -10,8 +10,6 @@ from __future__ import annotations
 import ast
 import py_compile
 import re
-import subprocess
-import sys
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -27,7 +25,7 @@ from armcli.ros.launch import module_constants
 from armcli.ros.packages import RosPackages, ros_packages
 from armcli.spec.load import load_spec, loads_spec
 from armcli.spec.model import RobotSpec
-from tests.helpers import ROOT
+from tests.helpers import ROOT, run_cli
 
 SAMPLES = 300  # enough for the tests; the CLI default is the Setup Assistant's 10000
 LABEL = "specs/my_robot.yaml"
@@ -387,26 +385,16 @@ def test_same_inputs_same_bytes(spec: RobotSpec, pkgs: RosPackages) -> None:
     assert again.files == pkgs.files
 
 
-def _cli(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "armcli.cli", *args],
-        capture_output=True,
-        text=True,
-        cwd=cwd,
-        check=False,
-    )
-
-
 def test_command_writes_the_tree_and_rewrites_identically(root: Path, tmp_path: Path) -> None:
     out = tmp_path / "ros"
     args = ("ros-package", "specs/my_robot.yaml", "-o", str(out), "--samples", "200")
-    first = _cli(*args, cwd=root)
+    first = run_cli(args, root)
     assert first.returncode == 0, first.stderr
     assert "my_robot_moveit_config" in first.stdout
     assert "named pose 'folded'" in first.stderr  # see test_collision_matrix
     snapshot = {p: p.read_bytes() for p in out.rglob("*") if p.is_file()}
     assert len(snapshot) == 34  # 33 package files + the armcli marker
-    second = _cli(*args, cwd=root)
+    second = run_cli(args, root)
     assert second.returncode == 0
     assert {p: p.read_bytes() for p in out.rglob("*") if p.is_file()} == snapshot
 
@@ -416,7 +404,7 @@ def test_bad_spec_gives_one_line_and_no_output(root: Path, tmp_path: Path) -> No
     text = (root / "specs" / "my_robot.yaml").read_text()
     bad.write_text(text.replace("controller_update_rate: 100", "controller_update_rate: 99.5"))
     out = tmp_path / "ros"
-    proc = _cli("ros-package", str(bad), "-o", str(out), cwd=root)
+    proc = run_cli(["ros-package", str(bad), "-o", str(out)], root)
     assert proc.returncode == 2
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and "control.controller_update_rate" in lines[0]

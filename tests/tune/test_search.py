@@ -100,5 +100,5 @@ def test_robust_worst_case_no_worse_than_nominal_tuning(tmp_path: Path) -> None:
 def test_trials_zero_is_refused(job: tjob.TuneJob) -> None:
     from armcli.errors import InputError
 
-    with pytest.raises(InputError, match="--trials"):
+    with pytest.raises(InputError, match=r"SearchOptions\.trials"):
         session.run(job, LocalEngine(1), replace(SearchOptions(), trials=0))

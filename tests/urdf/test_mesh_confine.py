@@ -9,8 +9,6 @@ pairs, trimesh gave up on large shapes, and two links of 5000 boxes hung check.
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -23,20 +21,9 @@ from armcli.check.run import check_urdf
 from armcli.spec.load import load_spec
 from armcli.urdf.mesh_confine import MAX_MESH_BYTES
 from armcli.urdf.read import MAX_URDF_COLLISIONS, read_urdf
+from tests.helpers import run_cli
 
-TIME_LIMIT_S = 120.0  # one CLI run on a loaded 2-core machine
 PACKAGE_XML = "<?xml version='1.0'?>\n<package format='3'><name>{name}</name></package>\n"
-
-
-def run_cli(args: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "armcli.cli", *args],
-        capture_output=True,
-        text=True,
-        timeout=TIME_LIMIT_S,
-        check=False,
-        cwd=cwd,
-    )
 
 
 def _arm(root: Path) -> str:

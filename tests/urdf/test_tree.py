@@ -6,7 +6,6 @@ import io
 import re
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -15,6 +14,7 @@ from armcli.errors import InputError
 from armcli.spec.load import load_spec
 from armcli.urdf.tree import parse_tree, to_dot, to_rich
 from armcli.view.scene import load_robot
+from tests.helpers import run_cli
 
 LIMIT_TOL = 1e-9  # [rad] limits pass through xacro as shortest-repr decimals of the spec value
 CHAIN = ("arm_base_link", "forearm_link", "hand_link")  # the seed's arm, root to tip
@@ -130,25 +130,14 @@ def test_entities_are_refused() -> None:
         parse_tree(xml, "evil.urdf")
 
 
-def _cli(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "armcli.cli", *args],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        check=False,
-        cwd=cwd,
-    )
-
-
 def test_cli_tree_text_dot_and_bad_format(root: Path, tmp_path: Path) -> None:
-    text = _cli("tree", cwd=root)
+    text = run_cli(["tree"], root)
     assert text.returncode == 0, text.stderr
     assert "forearm_link" in text.stdout and "revolute" in text.stdout
     out = tmp_path / "robot.gv"
-    dot = _cli("tree", "urdf/my_robot.urdf", "--format", "dot", "-o", str(out), cwd=root)
+    dot = run_cli(["tree", "urdf/my_robot.urdf", "--format", "dot", "-o", str(out)], root)
     assert dot.returncode == 0, dot.stderr
     assert out.read_text().startswith("digraph G {")
-    bad = _cli("tree", "--format", "svg", cwd=root)
+    bad = run_cli(["tree", "--format", "svg"], root)
     assert bad.returncode == 2
     assert bad.stderr.strip() == "error: --format: unknown value 'svg'; valid: text, dot"

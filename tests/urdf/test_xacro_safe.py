@@ -13,7 +13,6 @@ import json
 import math
 import os
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 from typing import Any
@@ -32,6 +31,7 @@ from tests.helpers import (
     GRIPPER_PACKAGE,
     ROS_WS_SRC,
     ament_index_shim,
+    run_cli,
     symlink_install,
 )
 
@@ -174,14 +174,7 @@ def test_cli_checks_foreign_xacro_without_trust(root: Path) -> None:
     """Safe mode gives `check` the same document, so the same findings, as --trust-xacro."""
     fixture = root / "tests" / "fixtures" / "check" / "course_macros.urdf.xacro"
     runs = [
-        subprocess.run(
-            [sys.executable, "-m", "armcli.cli", "check", *flags, str(fixture), "--format", "json"],
-            capture_output=True,
-            text=True,
-            timeout=120,
-            check=False,
-            cwd=root,
-        )
+        run_cli(["check", *flags, fixture, "--format", "json"], root)
         for flags in ([], ["--trust-xacro"])
     ]
     safe, trusted = (json.loads(r.stdout)["files"][0]["findings"] for r in runs)

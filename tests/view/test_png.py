@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import math
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +12,7 @@ from PIL import Image
 from armcli.errors import InputError
 from armcli.view.png import AMBIENT, load_urdf, render_png
 from armcli.view.scene import load_robot
+from tests.helpers import run_cli
 
 SHADE_TOL = 0.05  # max distance in RGB [0..1] of a pixel from a shade of a material colour
 MIN_PIXELS = 150  # a drawn part covers at least this many pixels at 1200x600
@@ -121,34 +120,23 @@ def test_out_of_limits_is_refused_and_nothing_written(robot, tmp_path: Path) -> 
     assert not out.exists()
 
 
-def _cli(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "armcli.cli", *args],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        check=False,
-        cwd=cwd,
-    )
-
-
 def test_cli_render_q_and_errors(root: Path, tmp_path: Path) -> None:
     out = tmp_path / "r.png"
-    ok = _cli("render", "--q", "pi/4,pi/4", "-o", str(out), cwd=root)
+    ok = run_cli(["render", "--q", "pi/4,pi/4", "-o", str(out)], root)
     assert ok.returncode == 0, ok.stderr
     x, _, z = tip(math.pi / 4, math.pi / 4)
     assert ok.stdout.strip() == (
         f"wrote {out} (1200x600 px) at --q pi/4,pi/4; tool at ({x:.3f}, 0.000, {z:.3f}) m"
     )
-    default = _cli("render", "-o", str(tmp_path / "d.png"), cwd=root)
+    default = run_cli(["render", "-o", str(tmp_path / "d.png")], root)
     # no --pose or --q: the message says which configuration was drawn (the spec's home is 0)
     assert "at q = 0, the pose 'home', as no --pose or --q was given" in default.stdout
     assert "(others: --pose home|" in default.stdout
     (tmp_path / "d.png").unlink()
-    both = _cli("render", "--pose", "home", "--q", "0,0", "-o", str(tmp_path / "b.png"), cwd=root)
+    both = run_cli(["render", "--pose", "home", "--q", "0,0", "-o", str(tmp_path / "b.png")], root)
     assert both.returncode == 2
     assert both.stderr.strip() == "error: --pose: give --pose or --q, not both"
-    count = _cli("render", "--q", "0.1", "-o", str(tmp_path / "c.png"), cwd=root)
+    count = run_cli(["render", "--q", "0.1", "-o", str(tmp_path / "c.png")], root)
     assert count.returncode == 2
     assert "expected 2 values, for: arm_base_forearm_joint, forearm_hand_joint" in count.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.png"]
@@ -184,7 +172,7 @@ def test_foreign_textured_meshes(root: Path, tmp_path: Path) -> None:
     # is only a root when given (a folder's name alone is not a package, issue 15).
     pkg = f"example-robot-data={share / 'example-robot-data'}"
     args = ("--q", "0,-1.2,1.5,0,0,0", "--package-dir", pkg, "-o", str(out))
-    proc = _cli("render", str(urdf), *args, cwd=root)
+    proc = run_cli(["render", str(urdf), *args], root)
     assert proc.returncode == 0, proc.stderr
     img = pixels(out)
     assert img.shape[:2] == (600, 1200)
@@ -194,7 +182,8 @@ def test_foreign_textured_meshes(root: Path, tmp_path: Path) -> None:
 
 
 def test_render_resolves_package_meshes_with_package_dir(tmp_path: Path) -> None:
-    """`render` uses check's mesh resolver: package://NAME needs --package-dir NAME=PATH."""
+    """`render` uses check's mesh resolver: package://NAME needs --package-dir NAME=PATH;
+    without it the mesh is missing, which render warns about and draws the rest."""
     import trimesh
 
     pkg = tmp_path / "meshes_pkg"
@@ -210,13 +199,17 @@ def test_render_resolves_package_meshes_with_package_dir(tmp_path: Path) -> None
         "</robot>"
     )
     out = tmp_path / "meshy.png"
-    res = _cli("render", str(urdf), "-o", str(out), cwd=tmp_path)
-    assert (
-        res.returncode == 2 and "my_meshes/hand.stl" in res.stderr and "--package-dir" in res.stderr
+    # Without it the mesh is missing: render draws the rest and warns (issue 19: it exited 2)
+    res = run_cli(["render", str(urdf), "-o", str(out)], tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert res.stderr == (
+        f"warning: {urdf}: mesh 'package://my_meshes/hand.stl' not found, not drawn "
+        "(--package-dir NAME=PATH points package://NAME at a folder)\n"
     )
-    assert not out.exists()
-    res = _cli(
-        "render", str(urdf), "-o", str(out), "--package-dir", f"my_meshes={pkg}", cwd=tmp_path
+    assert out.is_file()
+    out.unlink()
+    res = run_cli(
+        ["render", str(urdf), "-o", str(out), "--package-dir", f"my_meshes={pkg}"], tmp_path
     )
     assert res.returncode == 0, res.stderr
     with Image.open(out) as img:

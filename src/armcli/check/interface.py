@@ -1,6 +1,6 @@
 """Which loop the URDF's `<ros2_control>` block closes, and its stability bound.
 
-An **effort** command interface is the PD torque loop that `checks_dynamics`
+An **effort** command interface is the PD torque loop that `armcli.check.dynamics`
 bounds. A **position** command interface on gz_ros2_control is not a PD loop at
 all: every controller update, GazeboSimSystem::write() sets the joint velocity to
 

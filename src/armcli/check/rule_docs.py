@@ -1,4 +1,4 @@
-"""The rules table of docs/check.md, generated from the rule registry (`checks.RULES`).
+"""The rules table of docs/check.md, generated from the rule registry (`armcli.check.rules.RULES`).
 
 One source of truth: the ids, severities, descriptions and fix hints that `check`
 reports, SARIF's `tool.driver.rules` and the documentation all come from the registry.

@@ -3,7 +3,7 @@
 Why SARIF next to `--format github`: workflow annotations vanish with the run, while a
 SARIF file uploaded with `github/codeql-action/upload-sarif` becomes code-scanning alerts
 that persist, are tracked across commits (`partialFingerprints`) and are closed when the
-problem is fixed. The document lists every rule of the registry (`checks.RULES`) in
+problem is fixed. The document lists every rule of the registry (`armcli.check.rules.RULES`) in
 `tool.driver.rules`, so a viewer can explain rules that did not fire too.
 
 Locations are repository-relative (`uriBaseId` `%SRCROOT%`, relative to `root`, the

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import typer
 
+from armcli.commands.flags import flag_errors
 from armcli.commands.options import option
 from armcli.commands.xacro_inputs import (
     env_option,
@@ -47,6 +48,7 @@ def report(result: ImportResult, source: Path, out: Path) -> str:
     return "\n".join(lines) + "\n"
 
 
+@flag_errors({"out": "--out", "arm_root": "--arm-root", "force": "--force"})
 def import_cmd(
     file: Path = typer.Argument(..., help="URDF or xacro file to import."),
     args: list[str] = typer.Argument(

@@ -9,6 +9,7 @@ from pathlib import Path
 import click
 import typer
 
+from armcli.commands.flags import flag_errors
 from armcli.commands.importer import report
 from armcli.commands.xacro_inputs import write_notes
 from armcli.defaults import SPEC_FILE, TRAJECTORY_DIR
@@ -17,6 +18,7 @@ from armcli.spec.scaffold import DEFAULT_TEMPLATE, TEMPLATES, init_project
 from armcli.tune.spec_start import spec_start_gains
 
 
+@flag_errors({"template": "--template"})
 def init_cmd(
     directory: Path = typer.Argument(
         Path("."), show_default=False, help="Where to write (created if missing; default: here)."

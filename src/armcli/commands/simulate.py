@@ -9,6 +9,7 @@ from typing import Any, cast
 
 import typer
 
+from armcli.commands.flags import flag_errors, option_flags
 from armcli.commands.options import choice, option, spec_argument
 from armcli.commands.xacro_inputs import (
     args_argument,
@@ -27,8 +28,6 @@ from armcli.sim import report as simreport
 from armcli.sim import rosbag, states
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 from armcli.sim.plot import tracking_png
-from armcli.spec.discover import find_spec
-from armcli.spec.load import load_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
@@ -36,6 +35,13 @@ GRAVITY_HELP = "Add g(q) to the PD torque (default: the spec's control.gravity_c
 IGNORE_HELP = "Simulate a --urdf despite this `check` rule's error (repeatable)."
 TRAJECTORY_HELP = "JointTrajectory YAML (a point without time_from_start: previous + 1 s)."
 PROGRESS_AFTER_S = 1.0  # show a progress bar when the run is projected to take longer
+# The library's names for what these flags set (errors name them; commands.flags maps back).
+FLAGS = {
+    **option_flags(SimOptions),
+    "SimConfig.dt": "--dt",
+    "joints": "--joints",
+    "output": "--output",
+}
 
 
 def _floats(text: str | None, option: str) -> list[float] | None:
@@ -47,6 +53,7 @@ def _floats(text: str | None, option: str) -> list[float] | None:
         raise InputError(f"expected comma-separated numbers, got {text!r}", field=option) from None
 
 
+@flag_errors(FLAGS)
 def simulate_cmd(
     spec: Path | None = spec_argument(),
     args: list[str] = args_argument(),
@@ -86,8 +93,13 @@ def simulate_cmd(
         check_output_file(output, "--output")
     if plot is not None:
         check_output_file(plot, "--plot")
-    spec_path = find_spec(spec) if (spec is not None or urdf is None) else None
-    spec_obj = load_spec(spec_path) if spec_path is not None else None
+    spec_path, spec_obj = None, None
+    if spec is not None or urdf is None:  # the spec layers are imported only for a spec
+        from armcli.spec.discover import find_spec
+        from armcli.spec.load import load_spec
+
+        spec_path = find_spec(spec)
+        spec_obj = load_spec(spec_path)
     kp_values, kd_values = _floats(kp, "--kp"), _floats(kd, "--kd")
     opts = SimOptions(
         trajectory=trajectory,

@@ -8,6 +8,7 @@ from typing import Any
 
 import typer
 
+from armcli.commands.flags import flag_errors, option_flags
 from armcli.commands.options import choice, option, spec_argument
 from armcli.errors import InputError
 from armcli.io import terminal
@@ -39,6 +40,15 @@ TRUST_SCHEDULER_HELP = (
     "Allow a plain tcp:// scheduler on another host: the Dask client unpickles what the "
     "cluster sends, so it runs code in armcli (docs/security.md)."
 )
+# The library's names for what these flags set (errors name them; commands.flags maps back).
+FLAGS = {
+    **option_flags(SearchOptions, robust="--robust-mode"),
+    **option_flags(tjob.TuneSettings),
+    "jobs": "--jobs",
+    "scheduler": "--scheduler",
+    "joints": "--joints",
+    "trajectories": "--trajectory",
+}
 
 
 def _pair(text: str, name: str) -> tuple[float, float]:
@@ -50,6 +60,7 @@ def _pair(text: str, name: str) -> tuple[float, float]:
     return a, b
 
 
+@flag_errors(FLAGS)
 def tune_cmd(
     spec: Path | None = spec_argument(),
     trajectory: list[Path] = option(None, "--trajectory", "-t", help=TRAJECTORY_HELP),

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import typer
 
+from armcli.commands.flags import flag_errors
 from armcli.commands.options import spec_argument
 from armcli.commands.xacro_inputs import (
     args_argument,
@@ -26,6 +27,7 @@ from armcli.view.png import joint_limits, load_urdf
 from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
 
 
+@flag_errors({"pose": "--pose", "q": "--q", "port": "--port", "replay": "--replay"})
 def view_cmd(
     robot: Path | None = spec_argument(ROBOT_HELP),
     args: list[str] = args_argument(),

@@ -37,9 +37,9 @@ def import_file(
         InputError: the file is unusable or holds what a spec cannot.
     """
     if out.exists() and not force:
-        raise ExistingFileError(f"{out} exists; pass --force to replace it", file=out)
+        raise ExistingFileError(f"{out} exists; pass `force` to replace it", file=out)
     if out.is_dir():
-        raise InputError("is a directory; give the spec file to write", file=out, field="--out")
+        raise InputError("is a directory; give the spec file to write", file=out, field="out")
     urdf = read_urdf_file(path, trust_xacro=trust_xacro, inputs=inputs)
     result = import_urdf(
         urdf.text,

@@ -49,7 +49,7 @@ def split_robot(links: list[str], joints: list[JointEdge], arm_root: str | None 
     by_child = {j.child: j for j in joints}
     if arm_root is not None:
         if arm_root not in links:
-            raise InputError(f"unknown link {arm_root!r}", field="--arm-root")
+            raise InputError(f"unknown link {arm_root!r}", field="arm_root")
         mount = by_child.get(arm_root)
         if mount is None:
             return Split(frozenset(links), None)
@@ -57,7 +57,7 @@ def split_robot(links: list[str], joints: list[JointEdge], arm_root: str | None 
             raise InputError(
                 f"{arm_root!r} hangs on {mount.type} joint {mount.name!r}; the arm is mounted by "
                 "a fixed joint",
-                field="--arm-root",
+                field="arm_root",
             )
         return Split(frozenset(_subtree(arm_root, joints)), mount.name)
     moving = {j.child for j in joints if j.type in ("revolute", "prismatic")}

@@ -1,6 +1,6 @@
 """Guarded output paths: where armcli may write, checked before anything is written.
 
-`build -o` and `ros-package -o` replace a whole directory (fsio's staged swap).
+`build -o` and `ros-package -o` replace a whole directory (io.files' staged swap).
 A mistyped `-o "$UNSET/"` must not turn that into a copy of `/` (devices
 included), so an output directory is refused when it is a filesystem root, a
 mount point or the home directory, and when it already holds files but no

@@ -9,10 +9,10 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from armcli.compiler.expand import expand_urdfs
 from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.sim.options import SimOptions
@@ -29,14 +29,16 @@ from armcli.sim.simulate import (
     simulate,
     steps_of,
 )
-from armcli.sim.states import sample_steps
+from armcli.sim.states import distinct, sample_steps
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
-from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import Trust, checked_model, read_urdf_file
 from armcli.urdf.tool import tool_point
 from armcli.urdf.xacro_args import XacroInputs
+
+if TYPE_CHECKING:
+    from armcli.spec.model import RobotSpec
 
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
 ARM_URDF = STANDALONE_ARM_URDF
@@ -77,7 +79,9 @@ def arm_urdf(
     if urdf is not None:
         return read_urdf_file(urdf, trust_xacro=trust_xacro, inputs=inputs)
     if spec is None:
-        raise InputError("give a spec or --urdf", field="--urdf")
+        raise InputError("give a spec or `SimOptions.urdf`", field="SimOptions.urdf")
+    from armcli.compiler.expand import expand_urdfs  # the spec compiler: only for a spec
+
     return parse_urdf(expand_urdfs(spec)[ARM_URDF], ARM_URDF)
 
 
@@ -102,7 +106,7 @@ def load_arm(
 def refuse_mimic(doc: Urdf, joints: Sequence[str] | None) -> None:
     """Mimic joints are not coupled to their lead here: refuse them rather than drive them alone.
 
-    Locking the followers (`--joints` without them) simulates the rest of the arm.
+    Locking the followers (`joints` without them) simulates the rest of the arm.
     """
     movable = [j.name for j in doc.joints if j.movable]
     chosen = list(joints) if joints else movable
@@ -112,9 +116,9 @@ def refuse_mimic(doc: Urdf, joints: Sequence[str] | None) -> None:
         rest = ",".join(n for n in chosen if n not in {j.name for j in followers})
         raise InputError(
             f"joint {f.name!r} mimics {f.mimic!r}: armcli simulate does not couple mimic "
-            f"joints; lock the followers with --joints {rest}",
+            f"joints; lock the followers with `SimOptions.joints` {rest}",
             file=doc.source,
-            field="--joints",
+            field="SimOptions.joints",
         )
 
 
@@ -124,16 +128,20 @@ def _gains(
     n = len(arm.joint_names)
     if override:
         if len(override) not in (1, n):
-            raise InputError(f"give 1 or {n} value(s), got {len(override)}", field=f"--{which}")
+            raise InputError(
+                f"give 1 or {n} value(s), got {len(override)}", field=f"SimOptions.{which}"
+            )
         vals = np.array(list(override) * (n if len(override) == 1 else 1), dtype=np.float64)
         if not np.all(np.isfinite(vals)) or np.any(vals < 0.0):
-            raise InputError("gains must be finite and >= 0", field=f"--{which}")
+            raise InputError("gains must be finite and >= 0", field=f"SimOptions.{which}")
         return vals
     gains = spec.control.gains if spec is not None else {}
     missing = [j for j in arm.joint_names if j not in gains]
     if missing:
         raise InputError(
-            f"no {which} for {', '.join(missing)} in the spec; give --{which}", field=f"--{which}"
+            f"no {which} for {', '.join(missing)} in the spec's control.gains; "
+            f"give `SimOptions.{which}`",
+            field=f"SimOptions.{which}",
         )
     return np.array([getattr(gains[j], which) for j in arm.joint_names], dtype=float)
 
@@ -199,12 +207,12 @@ def _duration_and_rate(
     rate = opts.rate
     total = opts.duration if opts.duration is not None else t_last + SETTLE_EXTRA_S
     if not (np.isfinite(total) and 0 < total <= 3600):
-        raise InputError(f"must be in (0, 3600] s, got {total:g}", field="--duration")
+        raise InputError(f"must be in (0, 3600] s, got {total:g}", field="SimOptions.duration")
     if total / dt > MAX_STEPS:
         raise InputError(
             f"{total:g} s at dt = {dt:g} s is {total / dt:.3g} steps, more than {MAX_STEPS:,}; "
-            "shorten --duration or raise --dt",
-            field="--duration",
+            "shorten `SimOptions.duration` or raise `SimOptions.dt`",
+            field="SimOptions.duration",
         )
     jsp = spec.arm.joint_state_publisher if spec is not None else None
     rate = (
@@ -216,7 +224,7 @@ def _duration_and_rate(
         raise InputError(
             f"must be in (0, 1/dt = {1.0 / dt:g}] Hz (one state per time step at most), "
             f"got {rate:g}",
-            field="--rate",
+            field="SimOptions.rate",
         )
     return float(total), float(rate)
 
@@ -232,11 +240,13 @@ def prepare(
     trajectory, message, dt = opts.trajectory, opts.message, opts.dt
     if (trajectory is None) == (message is None):
         raise InputError(
-            "give exactly one of --trajectory FILE or --message '...'", field="--trajectory"
+            "give exactly one of `SimOptions.trajectory` (a file) or `SimOptions.message`",
+            field="SimOptions.trajectory",
         )
+    dt_field = "SimOptions.dt" if dt is not None else "control.dt"  # else the spec's, checked
     dt = dt if dt is not None else (spec.control.dt if spec is not None else DEFAULT_DT)
     if not (np.isfinite(dt) and 0 < dt <= 0.1):
-        raise InputError(f"must be in (0, 0.1] s, got {dt:g}", field="--dt")
+        raise InputError(f"must be in (0, 0.1] s, got {dt:g}", field=dt_field)
     doc = arm_urdf(spec, opts.urdf, trust_xacro=opts.trust_xacro, inputs=opts.xacro)
     refuse_mimic(doc, opts.joints)
     arm = arm_from_model(checked_model(doc, gate=gate if opts.urdf else None).model, opts.joints)
@@ -247,7 +257,7 @@ def prepare(
     if trajectory is not None:
         traj = load_trajectory(trajectory, limits, clamp=opts.clamp)
     else:
-        traj = loads_trajectory(str(message), limits, clamp=opts.clamp)
+        traj = loads_trajectory(str(message), limits, source="SimOptions.message", clamp=opts.clamp)
     q0 = start_state(arm, spec)
     ref = build_reference(traj, arm.joint_names, q0)
     gc = (
@@ -289,7 +299,9 @@ def run(
     `progress(steps_done, steps_total)` is called between chunks of steps.
     """
     steps = steps_of(job.duration, job.config.dt)
-    keep = sample_steps(steps, job.config.dt, job.rate)
+    # the output rate's states, the final one (the end effector is reported there), a plot's
+    keep = np.concatenate([sample_steps(steps, job.config.dt, job.rate), [steps]])
     if plot:
-        keep = np.union1d(keep, plot_steps(steps))
+        keep = np.concatenate([keep, plot_steps(steps)])
+    keep = distinct(keep)
     return simulate(job.arm, job.reference, job.q0, job.duration, job.config, progress, record=keep)

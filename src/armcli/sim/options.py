@@ -63,5 +63,5 @@ class SimOptions:
         if self.integrator not in INTEGRATORS:
             raise InputError(
                 f"unknown value {self.integrator!r}; valid: {', '.join(INTEGRATORS)}",
-                field="--integrator",
+                field="SimOptions.integrator",
             )

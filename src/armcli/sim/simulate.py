@@ -146,9 +146,9 @@ def arm_from_model(model: Any, joints: Sequence[str] | None = None) -> Arm:
     chosen = list(joints) if joints else names
     for name in chosen:
         if name not in names:
-            raise InputError(f"unknown joint {name!r}; valid: {', '.join(names)}", field="--joints")
+            raise InputError(f"unknown joint {name!r}; valid: {', '.join(names)}", field="joints")
     if len(set(chosen)) != len(chosen):
-        raise InputError("a joint is listed twice", field="--joints")
+        raise InputError("a joint is listed twice", field="joints")
     lock = [model.getJointId(nm) for nm in names if nm not in chosen]
     if lock:
         model = pin.buildReducedModel(model, lock, pin.neutral(model))
@@ -157,8 +157,9 @@ def arm_from_model(model: Any, joints: Sequence[str] | None = None) -> Arm:
         if j.nv != 1 or j.nq not in (1, 2):
             raise InputError(
                 f"joint {model.names[jid]!r} ({j.shortname()}) cannot be simulated: only "
-                "revolute, continuous and prismatic joints are supported (lock it with --joints)",
-                field="--joints",
+                "revolute, continuous and prismatic joints are supported (leave it out of `joints` "
+                "to lock it)",
+                field="joints",
             )
     order = list(model.names)[1:]  # simulated in model (tree) order whatever --joints says
     iq = [model.idx_qs[j] for j in range(1, model.njoints)]

@@ -69,7 +69,7 @@ def loads_trajectory(
     text: str,
     limits: Mapping[str, tuple[float, float]],
     *,
-    source: str = "--message",
+    source: str = "<message>",
     clamp: bool = False,
 ) -> Trajectory:
     """Validate a trajectory given as text, e.g. the `ros2 topic pub` payload."""

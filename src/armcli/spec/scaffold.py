@@ -51,7 +51,7 @@ DEFAULT_TEMPLATE = "course"
 def _template(name: str) -> ExampleTemplate:
     if name not in TEMPLATES:
         known = ", ".join(TEMPLATES)
-        raise InputError(f"unknown template {name!r}; known: {known}", field="--template")
+        raise InputError(f"unknown template {name!r}; known: {known}", field="template")
     return TEMPLATES[name]
 
 

@@ -69,7 +69,7 @@ class LocalEngine:
 
     def __init__(self, jobs: int) -> None:
         if jobs < 1:
-            raise InputError(f"must be >= 1, got {jobs}", field="--jobs")
+            raise InputError(f"must be >= 1, got {jobs}", field="jobs")
         self.jobs = jobs
         self.name = f"local ({jobs} thread{'s' if jobs > 1 else ''})"
         self._pool = ThreadPoolExecutor(jobs) if jobs > 1 else None
@@ -100,7 +100,7 @@ class DaskEngine:
         try:
             from distributed import Client
         except ImportError:
-            raise InputError(f"needs dask.distributed: {DASK_HINT}", field="--scheduler") from None
+            raise InputError(f"needs dask.distributed: {DASK_HINT}", field="scheduler") from None
         self.address = address
         try:
             _probe(address, timeout)
@@ -108,13 +108,13 @@ class DaskEngine:
                 address, timeout=f"{timeout}s", set_as_default=False
             )
         except ValueError as exc:
-            raise InputError(f"not a Dask address: {exc}", field="--scheduler") from None
+            raise InputError(f"not a Dask address: {exc}", field="scheduler") from None
         except (OSError, TimeoutError) as exc:
             raise InputError(
                 f"cannot reach the Dask scheduler at {address} within {timeout:g} s "
                 f"({str(exc) or 'no answer'}); start one with `dask scheduler` and "
                 "`dask worker ADDRESS`",
-                field="--scheduler",
+                field="scheduler",
             ) from None
         workers = self.client.scheduler_info().get("workers", {})
         self.name = f"dask {address} ({len(workers)} worker{'s' if len(workers) != 1 else ''})"

@@ -80,18 +80,21 @@ def default_trajectories(spec_path: Path, joints: Sequence[str]) -> list[Path]:
 
 def _validate(s: TuneSettings) -> None:
     if s.loop not in LOOPS:
-        raise InputError(f"unknown loop {s.loop!r}; valid: {', '.join(LOOPS)}", field="--loop")
+        valid = ", ".join(LOOPS)
+        raise InputError(f"unknown loop {s.loop!r}; valid: {valid}", field="TuneSettings.loop")
     if not (math.isfinite(s.zeta) and s.zeta > 0):
-        raise InputError(f"must be > 0, got {s.zeta:g}", field="--zeta")
+        raise InputError(f"must be > 0, got {s.zeta:g}", field="TuneSettings.zeta")
     if s.wn is not None and not (math.isfinite(s.wn) and s.wn > 0):
-        raise InputError(f"must be > 0 rad/s, got {s.wn:g}", field="--wn")
+        raise InputError(f"must be > 0 rad/s, got {s.wn:g}", field="TuneSettings.wn")
     if not (math.isfinite(s.settle) and 0 < s.settle <= 60):
-        raise InputError(f"must be in (0, 60] s, got {s.settle:g}", field="--settle")
+        raise InputError(f"must be in (0, 60] s, got {s.settle:g}", field="TuneSettings.settle")
     if not 0 <= s.robust <= MAX_ROBUST:
-        raise InputError(f"must be in [0, {MAX_ROBUST}], got {s.robust}", field="--robust")
-    for field, (a, b) in (("--mass-scale", s.mass_scale), ("--friction-scale", s.friction_scale)):
+        raise InputError(
+            f"must be in [0, {MAX_ROBUST}], got {s.robust}", field="TuneSettings.robust"
+        )
+    for field, (a, b) in (("mass_scale", s.mass_scale), ("friction_scale", s.friction_scale)):
         if not (math.isfinite(a) and math.isfinite(b) and 0 < a <= b):
-            raise InputError(f"need 0 < a <= b, got {a:g},{b:g}", field=field)
+            raise InputError(f"need 0 < a <= b, got {a:g},{b:g}", field=f"TuneSettings.{field}")
 
 
 def _pose_cases(
@@ -143,9 +146,9 @@ def prepare(
         cases = _pose_cases(spec, joints, q0, s.settle)
     if not cases:
         raise InputError(
-            "nothing to track: give --trajectory FILE, or add trajectories/*.yaml next to "
-            "the spec or named poses other than the start",
-            field="--trajectory",
+            "nothing to track: give a trajectory file (`trajectories`), or add "
+            "trajectories/*.yaml next to the spec or named poses other than the start",
+            field="trajectories",
         )
     wn = (
         s.wn

@@ -116,7 +116,7 @@ def lambda_max(Ms: Sequence[np.ndarray]) -> float:
 
 
 def dt_max(loop: str, kp: float, d: float, lam: float) -> float:
-    """Largest stable dt for one mode, from `armcli.stability` [s]."""
+    """Largest stable dt for one mode, from `armcli.sim.stability` [s]."""
     bound = stab.implicit_dt_max if loop == "implicit" else stab.explicit_dt_max
     return float(bound(kp, d, lam))
 

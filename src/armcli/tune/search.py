@@ -64,15 +64,19 @@ class SearchResult:
 def validate(opts: SearchOptions) -> None:
     """InputError for options no search can run with."""
     if opts.trials < 1:
-        raise InputError(f"must be >= 1, got {opts.trials}", field="--trials")
+        raise InputError(f"must be >= 1, got {opts.trials}", field="SearchOptions.trials")
     if opts.batch < 1:
-        raise InputError(f"must be >= 1, got {opts.batch}", field="--batch")
+        raise InputError(f"must be >= 1, got {opts.batch}", field="SearchOptions.batch")
     if not (math.isfinite(opts.span) and opts.span > 1.0):
-        raise InputError(f"must be > 1, got {opts.span:g}", field="--span")
+        raise InputError(f"must be > 1, got {opts.span:g}", field="SearchOptions.span")
     if opts.robust not in ROBUST_MODES:
-        raise InputError(f"unknown {opts.robust!r}; valid: worst, quantile", field="--robust-mode")
+        raise InputError(
+            f"unknown {opts.robust!r}; valid: worst, quantile", field="SearchOptions.robust"
+        )
     if not 0.0 <= opts.quantile <= 1.0:
-        raise InputError(f"must be in [0, 1], got {opts.quantile:g}", field="--quantile")
+        raise InputError(
+            f"must be in [0, 1], got {opts.quantile:g}", field="SearchOptions.quantile"
+        )
 
 
 def round_sig(x: np.ndarray, digits: int = ROUND_DIGITS) -> np.ndarray:

@@ -94,7 +94,7 @@ def tree_from_urdf(urdf: Urdf) -> KinematicTree:
 
 
 def parse_tree(xml: str | bytes, source: str = "<urdf>") -> KinematicTree:
-    """Parse URDF text safely (see urdfxml) into its KinematicTree."""
+    """Parse URDF text safely (see armcli.urdf.read) into its KinematicTree."""
     data = xml.encode("utf-8") if isinstance(xml, str) else xml
     return tree_from_urdf(parse_urdf(data, source))
 

@@ -52,8 +52,8 @@ def check_port_free(host: str, port: int) -> None:
         except OSError as exc:
             raise InputError(
                 f"cannot listen on {host}:{port}: {exc.strerror}; "
-                "choose another with --port (or --port 0 for any free port)",
-                field="--port",
+                "choose another `port` (0: any free port)",
+                field="port",
             ) from None
 
 
@@ -184,7 +184,7 @@ class Viewer:
     def seek(self, t: float) -> None:
         """Show the replay at time t [s] from the start of the record."""
         if self._replay is None:
-            raise InputError("no replay loaded", field="--replay")
+            raise InputError("no replay loaded", field="replay")
         self._time_slider.value = float(np.clip(t, 0.0, self._replay.duration))
 
     def play(self, playing: bool = True) -> None:

@@ -91,21 +91,21 @@ def parse_q(text: str, robot: RobotSource) -> dict[str, float]:
             return out
         if len(items) != len(robot.joints):
             order = ", ".join(robot.joints) or "(none)"
-            raise InputError(f"expected {len(robot.joints)} values, for: {order}", field="--q")
+            raise InputError(f"expected {len(robot.joints)} values, for: {order}", field="q")
         return {j: float(eval_expr(s)) for j, s in zip(robot.joints, items, strict=True)}
     except InputError as exc:
-        raise InputError(exc.message, field="--q") from None
+        raise InputError(exc.message, field="q") from None
     except (ValueError, ArithmeticError) as exc:
-        raise InputError(f"{text!r}: {exc}", field="--q") from None
+        raise InputError(f"{text!r}: {exc}", field="q") from None
 
 
 def pose_q(robot: RobotSource, pose: str | None, q: str | None) -> dict[str, float]:
     """The joint values a `--pose NAME` or `--q VALUES` option stands for."""
     if pose is not None and q is not None:
-        raise InputError("give --pose or --q, not both", field="--pose")
+        raise InputError("give `pose` or `q`, not both", field="pose")
     if pose is not None:
         if pose not in robot.poses:
             known = ", ".join(robot.poses) or "(none: a URDF has no named poses)"
-            raise InputError(f"unknown pose {pose!r}; known: {known}", field="--pose")
+            raise InputError(f"unknown pose {pose!r}; known: {known}", field="pose")
         return dict(robot.poses[pose])
     return parse_q(q, robot) if q is not None else {}
