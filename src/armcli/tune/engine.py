@@ -150,7 +150,7 @@ def _split(address: str) -> tuple[str, str, int | None]:
     try:
         port = parsed.port
     except ValueError:
-        raise InputError(f"bad port in {address!r}", field="--scheduler") from None
+        raise InputError(f"bad port in {address!r}", field="scheduler") from None
     return scheme.lower(), (parsed.hostname or "").lower(), port
 
 
@@ -169,7 +169,7 @@ def check_scheduler_address(address: str, trusted: bool) -> None:
     scheme, host, _ = _split(address)
     if scheme in PLAIN_SCHEMES and not is_loopback(host) and not trusted:
         raise InputError(f"{address} is not encrypted and not on this machine: {TRUST_HINT}",
-                         field="--scheduler")  # fmt: skip
+                         field="scheduler")  # fmt: skip
 
 
 def _raw_probe(host: str, port: int, timeout: float) -> None:
@@ -222,7 +222,7 @@ def _probe(address: str, timeout: float) -> None:
     except (_NotDaskError, MemoryError, OverflowError, struct.error) as exc:
         why = str(exc) or type(exc).__name__
         raise InputError(f"{address} does not answer as a Dask scheduler ({why})",
-                         field="--scheduler") from None  # fmt: skip
+                         field="scheduler") from None  # fmt: skip
 
 
 def make_engine(jobs: int, scheduler: str | None, *, trust_scheduler: bool = False) -> Engine:
