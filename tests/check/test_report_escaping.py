@@ -83,3 +83,27 @@ def test_one_line_escapes_every_line_break_and_control() -> None:
     text = "a\nb\rc\x1b[31md\x85e\u2028f\u2029g\x00h\x7f"
     assert one_line(text) == "a\\nb\\rc\\x1b[31md\\x85e\\u2028f\\u2029g\\x00h\\x7f"
     assert one_line("plain: ü, 1e-3 kg·m²") == "plain: ü, 1e-3 kg·m²"
+
+
+XACRO_NOTE = (
+    '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+    '<xacro:arg name="x" default="v&#10;::add-mask::ARG&#13;::error::bad"/>'
+    '<link name="base"><inertial><mass value="1"/>'
+    '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link></robot>'
+)
+
+
+@pytest.mark.parametrize("fmt", ["github", "table"])
+def test_notes_on_stderr_cannot_inject_workflow_commands(fmt: str, tmp_path: Path) -> None:
+    """The `note:` line of a xacro file names the file and its argument defaults, both
+    the author's: a newline in either started a `::add-mask::` line on stderr."""
+    evil = tmp_path / "a\n::add-mask::FILE\nb.urdf.xacro"
+    evil.write_text(XACRO_NOTE)
+    other = tmp_path / "c.urdf.xacro"  # two files: the note names its file
+    other.write_text(XACRO_NOTE)
+    r = armcli("check", "--format", fmt, evil, other)
+    assert r.returncode in (0, 1), r.stderr
+    assert "defaults taken x:=v\\n::add-mask::ARG\\r::error::bad" in r.stderr
+    for stream in (r.stdout, r.stderr):
+        for line in commands(stream):
+            assert ANNOTATION.match(line), line  # before: "::add-mask::ARG", "::error::bad"

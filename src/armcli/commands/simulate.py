@@ -21,6 +21,7 @@ from armcli.commands.xacro_inputs import (
 )
 from armcli.errors import InputError, ModelRefusedError, UnstableLoopError
 from armcli.io import terminal
+from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
 from armcli.io.together import write_files_together
 from armcli.sim import job as simjob
@@ -160,7 +161,7 @@ def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
     err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
     write_notes(job.notes)
     for w in job.trajectory.warnings:
-        err.print(f"warning: {w}", markup=False, highlight=False)
+        err.print(one_line(f"warning: {w}"), markup=False, highlight=False)
     with _LazyProgress(err) as progress:
         res = simjob.run(job, progress, plot=plot is not None)
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
