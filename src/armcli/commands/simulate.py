@@ -21,12 +21,14 @@ from armcli.commands.xacro_inputs import (
 )
 from armcli.errors import InputError, ModelRefusedError, UnstableLoopError
 from armcli.io import terminal
+from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
+from armcli.io.together import write_files_together
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
 from armcli.sim import rosbag, states, tipping
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
-from armcli.sim.plot import write_tracking_plot
+from armcli.sim.plot import tracking_png
 from armcli.sim.tipping import TipOptions
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
@@ -188,21 +190,25 @@ def _run(
     err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
     write_notes([*job.notes, *(notes or [])])
     for w in job.trajectory.warnings:
-        err.print(f"warning: {w}", markup=False, highlight=False)
+        err.print(one_line(f"warning: {w}"), markup=False, highlight=False)
     extra = None if tip is None else (lambda steps: tip.steps(job, steps))
     with _LazyProgress(err) as progress:
         res = simjob.run(job, progress, plot=plot is not None, extra=extra)
     series = tip.series(job, res) if tip is not None else None
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
+    files: dict[Path, bytes] = {}  # written together: never a new CSV beside an old plot
     if output is not None and rosbag.is_mcap(output):
-        rosbag.write_mcap(output, res, job.rate, job.urdf)
+        files[output] = rosbag.run_mcap_bytes(res, job.rate, job.urdf)
     elif output is not None:
-        cols = tipping.columns(series, res, job.rate) if series is not None else None
-        states.write_states(output, res, job.rate, cols)
+        cols = states.sample_states(res, job.rate)
+        if series is not None:
+            cols = {**cols, **tipping.columns(series, res, job.rate)}
+        files[output] = states.states_bytes(cols, states.output_format(output))
     if plot is not None:
         row = tipping.plot_row(series) if series is not None else None
-        write_tracking_plot(plot, res, job.arm.effort, row)
+        files[plot] = tracking_png(res, job.arm.effort, row)
+    write_files_together(files)
     out = terminal.console()
     out.print(simreport.summary_table(metrics, ee, job.tool_label, res), crop=False)
     balance = tipping.report(tip, series) if tip is not None and series is not None else None

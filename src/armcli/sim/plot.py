@@ -75,10 +75,7 @@ def tracking_png(
 
 
 def write_tracking_plot(
-    path: Path,
-    res: SimResult,
-    effort_limits: np.ndarray | None = None,
-    extra_row: Callable[[Sequence[Any]], None] | None = None,
+    path: Path, res: SimResult, effort_limits: np.ndarray | None = None
 ) -> None:
     """Write the tracking plot PNG atomically; `effort_limits` [N·m] mark saturation."""
-    write_file_atomic(path, tracking_png(res, effort_limits, extra_row))
+    write_file_atomic(path, tracking_png(res, effort_limits))
