@@ -24,7 +24,7 @@ from armcli.io import terminal
 from armcli.io.outdir import check_output_file
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
-from armcli.sim import rosbag, states
+from armcli.sim import states
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 from armcli.sim.plot import write_tracking_plot
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
@@ -87,6 +87,8 @@ def simulate_cmd(
     spec, tokens = split_robot(spec, args)
     inputs = xacro_inputs(tokens, env, package_dir)
     if output is not None:
+        from armcli.sim import rosbag  # the MCAP writer: imported by runs that write a file
+
         if not rosbag.is_mcap(output):
             states.output_format(output)
         check_output_file(output, "--output")
@@ -164,10 +166,13 @@ def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
         res = simjob.run(job, progress, plot=plot is not None)
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
-    if output is not None and rosbag.is_mcap(output):
-        rosbag.write_mcap(output, res, job.rate, job.urdf)
-    elif output is not None:
-        states.write_states(output, res, job.rate)
+    if output is not None:
+        from armcli.sim import rosbag
+
+        if rosbag.is_mcap(output):
+            rosbag.write_mcap(output, res, job.rate, job.urdf)
+        else:
+            states.write_states(output, res, job.rate)
     if plot is not None:
         write_tracking_plot(plot, res, job.arm.effort)
     out = terminal.console()
