@@ -26,7 +26,7 @@ from armcli.io.outdir import check_output_file
 from armcli.io.together import write_files_together
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
-from armcli.sim import rosbag, states
+from armcli.sim import states
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 from armcli.sim.plot import tracking_png
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
@@ -89,6 +89,8 @@ def simulate_cmd(
     spec, tokens = split_robot(spec, args)
     inputs = xacro_inputs(tokens, env, package_dir)
     if output is not None:
+        from armcli.sim import rosbag  # the MCAP writer: imported by runs that write a file
+
         if not rosbag.is_mcap(output):
             states.output_format(output)
         check_output_file(output, "--output")
@@ -167,12 +169,15 @@ def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
     files: dict[Path, bytes] = {}  # written together: never a new CSV beside an old plot
-    if output is not None and rosbag.is_mcap(output):
-        files[output] = rosbag.run_mcap_bytes(res, job.rate, job.urdf)
-    elif output is not None:
-        files[output] = states.states_bytes(
-            states.sample_states(res, job.rate), states.output_format(output)
-        )
+    if output is not None:
+        from armcli.sim import rosbag
+
+        if rosbag.is_mcap(output):
+            files[output] = rosbag.run_mcap_bytes(res, job.rate, job.urdf)
+        else:
+            files[output] = states.states_bytes(
+                states.sample_states(res, job.rate), states.output_format(output)
+            )
     if plot is not None:
         files[plot] = tracking_png(res, job.arm.effort)
     write_files_together(files)
