@@ -15,8 +15,11 @@ from pathlib import Path
 import pytest
 from lxml import etree
 
+from armcli.compiler.xacro_writer import xacro_files
 from armcli.compiler.xmlfmt import comment_text, to_bytes
-from tests.helpers import DEFAULT_SPEC
+from armcli.spec.load import load_spec
+from tests.helpers import DEFAULT_SPEC, FIXTURES
+from tests.meshes import house_triangles, prism_triangles, write_stl
 
 HOSTILE = [
     "my--robot.yaml",
@@ -62,3 +65,30 @@ def test_build_a_spec_whose_file_name_has_hyphens(name: str, tmp_path: Path) -> 
     for path in sorted((tmp_path / "out").glob("*.xacro")):
         tree = etree.parse(str(path), etree.XMLParser(resolve_entities=False, load_dtd=False))
         assert tree.docinfo.doctype == "", path
+
+
+@pytest.mark.parametrize(
+    ("mesh", "shown"), [("x---y-.stl", "x- - -y-.stl"), ("a-->b.stl", "a- ->b.stl")]
+)
+def test_mesh_name_in_the_mass_comment_stays_a_comment(
+    mesh: str, shown: str, tmp_path: Path
+) -> None:
+    """The comment naming the mesh a link's inertia came from: `---` kept a `--` after
+    `replace("--", "- -")`, and `build` died with an internal ValueError."""
+    text = (FIXTURES / "spec" / "rich_arm.yaml").read_text()
+    hull = "        - name: hull\n          geometry: {mesh: {filename: meshes/link.stl"
+    assert hull in text
+    (tmp_path / "armcli.yaml").write_text(text.replace(hull, hull.replace("link.stl", mesh)))
+    write_stl(tmp_path / "meshes" / "base.stl", prism_triangles(0.08, 0.1, 32))
+    for name in ("link.stl", mesh):
+        write_stl(tmp_path / "meshes" / name, house_triangles())
+    files = xacro_files(load_spec(tmp_path / "armcli.yaml"))
+    parser = etree.XMLParser(resolve_entities=False, load_dtd=False, no_network=True)
+    about = [
+        c.text
+        for data in files.values()
+        for c in etree.fromstring(data, parser).iter(etree.Comment)
+        if "computed from" in (c.text or "")
+    ]
+    assert f" mass properties computed from meshes/{shown} " in about, about
+    assert all("--" not in (a or "") for a in about)

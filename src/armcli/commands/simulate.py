@@ -26,7 +26,7 @@ from armcli.io.outdir import check_output_file
 from armcli.io.together import write_files_together
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
-from armcli.sim import rosbag, states, tipping
+from armcli.sim import states, tipping
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 from armcli.sim.plot import tracking_png
 from armcli.sim.tipping import TipOptions
@@ -100,6 +100,8 @@ def simulate_cmd(
     spec, tokens = split_robot(spec, args)
     inputs = xacro_inputs(tokens, env, package_dir)
     if output is not None:
+        from armcli.sim import rosbag  # the MCAP writer: imported by runs that write a file
+
         if not rosbag.is_mcap(output):
             states.output_format(output)
         check_output_file(output, "--output")
@@ -198,13 +200,16 @@ def _run(
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
     files: dict[Path, bytes] = {}  # written together: never a new CSV beside an old plot
-    if output is not None and rosbag.is_mcap(output):
-        files[output] = rosbag.run_mcap_bytes(res, job.rate, job.urdf)
-    elif output is not None:
-        cols = states.sample_states(res, job.rate)
-        if series is not None:
-            cols = {**cols, **tipping.columns(series, res, job.rate)}
-        files[output] = states.states_bytes(cols, states.output_format(output))
+    if output is not None:
+        from armcli.sim import rosbag
+
+        if rosbag.is_mcap(output):
+            files[output] = rosbag.run_mcap_bytes(res, job.rate, job.urdf)
+        else:
+            cols = states.sample_states(res, job.rate)
+            if series is not None:
+                cols = {**cols, **tipping.columns(series, res, job.rate)}
+            files[output] = states.states_bytes(cols, states.output_format(output))
     if plot is not None:
         row = tipping.plot_row(series) if series is not None else None
         files[plot] = tracking_png(res, job.arm.effort, row)
