@@ -154,7 +154,8 @@ def _gains(
     for follower, leader in (leaders or {}).items():  # a mimic joint without its own gains
         if follower not in gains and leader in gains:  # is driven like its leader
             gains[follower] = gains[leader]
-    missing = [j for j in arm.joint_names if j not in gains]
+    followers = leaders or {}  # given through their leaders, never on their own
+    missing = [j for j in arm.joint_names if j not in gains and j not in followers]
     if missing:
         raise InputError(
             f"no {which} for {', '.join(missing)} in the spec's control.gains; "
