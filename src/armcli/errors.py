@@ -286,6 +286,19 @@ class SimulationError(ArmcliError):
         super().__init__(text)
 
 
+class ExportRefusedError(ArmcliError):
+    """An export would write a model its target simulator refuses: which part, and why."""
+
+    exit_code = EXIT_FAILED
+
+    def __init__(self, file: str | Path, reason: str, *, link: str | None = None) -> None:
+        self.file = str(file)
+        self.link = link
+        self.reason = reason
+        what = f"link {link!r}: " if link is not None else ""
+        super().__init__(f"{_where(file, None)}: {what}{reason}")
+
+
 class NoSpecError(InputError):
     """No spec argument and none found in the current directory; says what to run."""
 

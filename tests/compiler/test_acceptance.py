@@ -76,7 +76,7 @@ def test_pinocchio_loads_model_and_meshes(built: Path) -> None:
         model, str(built), pin.GeometryType.VISUAL, package_dirs=[str(built.parent)]
     )
     meshes = [g.meshPath for g in visual.geometryObjects if g.meshPath.endswith(".stl")]
-    assert len(meshes) == 3 and all(Path(m).is_file() for m in meshes)
+    assert len(meshes) == 5 and all(Path(m).is_file() for m in meshes)  # 2 from the fingers
 
 
 def test_mujoco_compiles(built: Path) -> None:

@@ -17,15 +17,16 @@ import numpy as np
 import pytest
 from lxml import etree
 
-from armcli.export.mjcf import quat, rotation
+from armcli.export.mjcf import quat
 from armcli.export.mjcf_files import export_mjcf
 from armcli.sim.reference import build_reference
 from armcli.sim.simulate import SimConfig, arm_from_model, simulate
 from armcli.sim.trajectory import loads_trajectory
 from armcli.spec.load import load_spec
+from armcli.urdf.inertia import rpy_matrix
 from armcli.urdf.pinocchio import load_model
 from armcli.urdf.source import read_robot
-from tests.helpers import ROOT
+from tests.helpers import COURSE_GAINS, ROOT, course_gains_spec
 
 mujoco = pytest.importorskip("mujoco")
 pin = pytest.importorskip("pinocchio")
@@ -128,8 +129,10 @@ def _loop(
 
     `limits`: run both at the spec's own time step with MuJoCo's joint limits on (as
     exported); otherwise at LOOP_DT with the limits off, where the two steps are equal.
+    The gains are the course's (Kp 50, Kd 5), fixed here whatever the example spec holds.
     """
-    spec_path = ROOT / "specs" / "my_robot.yaml"
+    (tmp_path / "spec").mkdir()
+    spec_path = course_gains_spec(tmp_path / "spec")
     _, m, _ = _export(spec_path, tmp_path)
     spec = load_spec(spec_path)
     arm = arm_from_model(load_model(_urdf_file(spec_path, tmp_path)).model)
@@ -188,7 +191,7 @@ def test_closed_loop_agrees_on_a_trajectory_that_reaches_the_limits(
     """
     res, q_mj = _loop(tmp_path, friction, LIMIT_TRAJECTORY, limits=True)
     assert res.stop_active.any()  # the arm does reach its stops
-    kp, kd = 50.0, 5.0  # specs/my_robot.yaml control.gains
+    kp, kd = COURSE_GAINS["forearm_hand_joint"]  # the gains _loop runs with
     ctrl = res.q_ref + kd / kp * res.v_ref
     assert ctrl.min() < 0.0 and ctrl.max() > math.pi / 2  # outside the range [0, pi/2]
     assert np.max(np.abs(res.q - q_mj)) < LIMIT_AGREE
@@ -256,13 +259,13 @@ def test_actuators_keyframes_and_timestep_come_from_the_spec(tmp_path: Path) -> 
 
 
 def test_quaternion_matches_the_urdf_rotation() -> None:
-    # reference: MuJoCo's own quaternion -> matrix conversion against rotation()
+    # reference: MuJoCo's own quaternion -> matrix conversion against the URDF rpy matrix
     rng = np.random.default_rng(SEED)
     for _ in range(20):
         rpy = tuple(float(x) for x in rng.uniform(-math.pi, math.pi, 3))
         mat = np.zeros(9)
         mujoco.mju_quat2Mat(mat, np.array(quat(rpy)))  # type: ignore[arg-type]
-        assert np.allclose(mat.reshape(3, 3), rotation(rpy), atol=1e-15)  # type: ignore[arg-type]
+        assert np.allclose(mat.reshape(3, 3), rpy_matrix(rpy), atol=1e-15)
 
 
 def test_export_is_deterministic_and_rewrites_identically(tmp_path: Path) -> None:
@@ -339,6 +342,7 @@ def test_urdf_with_meshes_mimic_and_gazebo_tags(tmp_path: Path) -> None:
         "name": "tet",
         "file": "meshes/tet.stl",
         "scale": "2 2 2",
+        "inertia": "convex",  # MuJoCo's default refuses misoriented meshes (mjcf_meshes)
     }
     m = mujoco.MjModel.from_xml_path(str(out.parent / "scene.xml"))
     assert m.nmesh == 1 and m.neq == 1 and m.nu == 1  # the mimic follower has no actuator
@@ -392,6 +396,7 @@ def test_cli_writes_model_and_scene_and_prints_the_report(
         main(["export", "mjcf", str(ROOT / "specs" / "my_robot.yaml"), "-o", str(out)])
     assert exc.value.code == 0
     text = capsys.readouterr().out
+    assert f"wrote {out} and {tmp_path / 'scene.xml'} from " in text  # names what it wrote
     assert "2 joints, 2 actuators, keyframes: home, reach, folded" in text
     assert "velocity limits" in text
     scene = etree.parse(str(tmp_path / "scene.xml"))

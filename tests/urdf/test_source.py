@@ -8,14 +8,19 @@ from pathlib import Path
 import pytest
 
 from armcli.errors import InputError, XacroRefusedError
+from armcli.urdf.packages import PackageLookup
 from armcli.urdf.source import (
+    Trust,
     allowed_roots,
+    expand_xacro,
     inside_roots,
     load_checked_model,
     read_robot,
     read_urdf_file,
 )
-from tests.helpers import ROOT
+from armcli.urdf.xacro_args import XacroInputs
+from armcli.urdf.xacro_jail import sandbox_problem
+from tests.helpers import ARM_PACKAGE, DEMO_ARM, ROOT, ROS_WS_SRC, symlink_install
 
 COURSE_XACRO = ROOT / "tests" / "fixtures" / "check" / "course_macros.urdf.xacro"
 BAD = ROOT / "tests" / "bad_inputs"
@@ -113,3 +118,46 @@ def test_every_robot_file_command_offers_trust_xacro(command: str) -> None:
     result = CliRunner().invoke(app, [command, "--help"])
     assert result.exit_code == 0, result.output
     assert "--trust-xacro" in result.output
+
+
+# --- issue 19: --trust-xacro resolves $(find) and takes arguments ------------------------
+
+TRUST_MODES = [
+    pytest.param("unsandboxed", id="unsandboxed"),
+    pytest.param(
+        True,
+        id="bubblewrap",
+        marks=pytest.mark.skipif(sandbox_problem() is not None, reason=str(sandbox_problem())),
+    ),
+]
+
+
+@pytest.mark.parametrize("trust", TRUST_MODES)
+def test_trusted_xacro_finds_packages_through_the_ament_prefix(
+    trust: Trust, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Was: "ModuleNotFoundError: No module named 'ament_index_python'" for every $(find).
+    prefix = symlink_install(ROS_WS_SRC, tmp_path / "install")
+    monkeypatch.setenv("AMENT_PREFIX_PATH", str(prefix))
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    inputs = XacroInputs(args={"name": "demo", "nope": "1"}, env={"DEMO_ARM_TOOL_LENGTH": "0.1"})
+    top = prefix / "share" / ARM_PACKAGE / "urdf" / DEMO_ARM.name
+    trusted, used = expand_xacro(top, trust_xacro=trust, inputs=inputs)
+    safe, _ = expand_xacro(top, inputs=inputs)
+    assert trusted == safe and b'xyz="0 0 0.35"' in trusted  # --env reached $(optenv)
+    assert used.given == ("name", "nope") and used.unused == ("nope",)
+    assert set(used.defaults) == {"prefix", "arm_type", "with_gripper"}
+
+
+def test_trusted_xacro_unknown_package_and_refused_env(tmp_path: Path) -> None:
+    top = tmp_path / "find.xacro"
+    top.write_text(
+        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<link name="$(find no_such_pkg)"/></robot>'
+    )
+    lookup = PackageLookup(ament_prefixes=(), ros_package_path=())
+    with pytest.raises(InputError, match="package 'no_such_pkg' not found by armcli"):
+        expand_xacro(top, trust_xacro="unsandboxed", inputs=XacroInputs(packages=lookup))
+    env = XacroInputs(env={"LD_PRELOAD": "/tmp/x.so"})
+    with pytest.raises(InputError, match="--env: LD_PRELOAD may not be set"):
+        expand_xacro(top, trust_xacro="unsandboxed", inputs=env)

@@ -12,6 +12,7 @@ an oracle.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -98,6 +99,25 @@ def _finite_inertial(link: Link) -> bool:
     )
 
 
+def _massless_consequences(urdf: Urdf, links: Sequence[str]) -> str:
+    """What simulators make of a massless moving body, as measured with each.
+
+    MuJoCo's URDF import gives a body whose links have no <inertial> at all a mass from
+    its collision geometry (density 1000 kg/m³) and loads it; with an explicit zero mass,
+    or nothing to take a mass from, it refuses ("mass and inertia of moving bodies must be
+    larger than mjMINVAL").
+    """
+    found = [urdf.link(n) for n in links]
+    parts = [lk for lk in found if lk is not None]
+    no_inertial = all(lk.inertial is None for lk in parts)
+    if no_inertial and any(lk.collisions for lk in parts):
+        return (
+            "no <inertial>; MuJoCo's URDF import loads it with a mass made up from its "
+            "collision geometry at 1000 kg/m³, Gazebo drops or destabilises it"
+        )
+    return "MuJoCo refuses it (a moving body needs mass), Gazebo drops or destabilises it"
+
+
 def moving_bodies(urdf: Urdf, tree: Tree) -> list[Body]:
     """One lumped body per movable joint whose child link exists, in document order."""
     names = {lk.name for lk in urdf.links}
@@ -123,7 +143,7 @@ def check(urdf: Urdf, tree: Tree, out: Collector) -> None:
             out.add(
                 "mass-nonpositive",
                 lines.get(b.link),
-                f"{where} has no mass: MuJoCo rejects it, Gazebo drops or destabilises it",
+                f"{where} has no mass: {_massless_consequences(urdf, b.links)}",
                 joint=b.joint,
                 link=b.link,
                 mass=b.mass,

@@ -109,6 +109,8 @@ def _materials(urdf: Urdf, out: Collector) -> None:
                 f"material {m.name!r}: rgba {list(m.rgba)} outside [0, 1]",
                 rgba=list(m.rgba),
             )
+        if not m.name:  # an unnamed material is a visual's own colour: nothing to conflict
+            continue
         prev = first.setdefault(m.name, m.rgba)
         if prev != m.rgba:
             out.add(

@@ -19,6 +19,8 @@ from armcli.commands.xacro_inputs import (
 from armcli.compiler.expand import spec_label
 from armcli.export.mjcf import BASES
 from armcli.export.mjcf_files import export_mjcf
+from armcli.export.mjcf_meshes import MESH_DIR
+from armcli.export.mjcf_scene import SCENE
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
@@ -80,12 +82,22 @@ def mjcf_cmd(
     write_notes(res.notes)
     exp = res.export
     w = sys.stdout.write
-    w(f"wrote {len(res.files)} files beside {out} from {res.robot}\n")
+    w(f"{wrote_line(out, len(res.export.meshes))} from {res.robot}\n")
     w(
         f"{len(exp.joints)} joints, {len(exp.actuators)} actuators, "
         f"keyframes: {', '.join(exp.keyframes)}\n"
     )
     w(res.report)
+    w(f"{res.verdict.text}\n")
+
+
+def wrote_line(out: Path, meshes: int) -> str:
+    """Which files the export wrote, by name: the model, its scene, and the mesh count."""
+    scene = out.parent / SCENE
+    if not meshes:
+        return f"wrote {out} and {scene}"
+    noun = "mesh" if meshes == 1 else "meshes"
+    return f"wrote {out}, {scene} and {meshes} {noun} in {out.parent / MESH_DIR}/"
 
 
 def register(app: typer.Typer) -> None:

@@ -22,7 +22,7 @@ from armcli.errors import InputError
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
-from armcli.view.png import load_urdf, render_png
+from armcli.view.png import MESH_HINT, load_urdf, render_png
 from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
 
 
@@ -74,7 +74,8 @@ def render_cmd(
     write_notes(src.notes)
     values = pose_q(src, pose, q)
     width, height = _size(size)
-    urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search)
+    missing: list[str] = []
+    urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search, missing)
     res = render_png(
         urdf,
         values,
@@ -89,6 +90,10 @@ def render_cmd(
         if res.tool_position is None
         else " tool at ({:.3f}, {:.3f}, {:.3f}) m".format(*res.tool_position)
     )
+    for uri in missing:  # drawn without them: a picture of the rest beats none
+        sys.stderr.write(
+            f"warning: {src.source}: mesh {uri!r} not found, not drawn ({MESH_HINT})\n"
+        )
     drawn = _drawn(src.poses, pose, q)
     sys.stdout.write(f"wrote {res.path} ({res.width}x{res.height} px) at {drawn};{tip}\n")
 

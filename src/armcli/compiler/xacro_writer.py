@@ -19,12 +19,13 @@ from armcli.compiler.gazebo import arm_gazebo, mobile_base_gazebo
 from armcli.compiler.joints import joint_element
 from armcli.compiler.links import INERTIA_MACROS, link_element, link_properties, stems
 from armcli.compiler.meshfiles import MeshNames
+from armcli.compiler.parts import macros_xml, placed, placements_xml
 from armcli.compiler.passthrough import passthrough_tree
 from armcli.compiler.ros2_control import ros2_control_element
 from armcli.compiler.xmlfmt import XACRO_NS, robot, sub, to_bytes, vec
 from armcli.defaults import STANDALONE_ARM as STANDALONE_ARM_NAME
 from armcli.defaults import STANDALONE_ARM_URDF, STANDALONE_ARM_XACRO
-from armcli.spec.model import Joint, Link, RobotSpec
+from armcli.spec.model import Arm, MobileBase, RobotSpec
 
 __all__ = ["joint_element", "xacro_files"]
 
@@ -74,19 +75,27 @@ def common_properties(spec: RobotSpec) -> etree._Element:
 
 
 def part(
-    links: dict[str, Link],
-    joints: dict[str, Joint],
+    spec: RobotSpec,
+    holder: Arm | MobileBase,
     prefixes: dict[str, str],
     names: MeshNames,
     field: str,
 ) -> etree._Element:
-    """One part (mobile base or arm): shorthand properties, then links, then joints."""
+    """One part file (mobile base or arm).
+
+    Shorthand properties, the reusable parts' macros, links, joints, then placements.
+    """
     root = robot()
+    skip_links, skip_joints = placed(spec, holder.parts)
+    links = {n: lk for n, lk in holder.links.items() if n not in skip_links}
     refs = {n: link_properties(root, prefixes[n], lk) for n, lk in links.items() if lk.shorthand}
+    macros_xml(root, spec, holder.parts, names)
     for name, link in links.items():
         link_element(root, name, link, refs.get(name, {}), names, f"{field}.links.{name}")
-    for name, joint in joints.items():
-        joint_element(root, name, joint)
+    for name, joint in holder.joints.items():
+        if name not in skip_joints:
+            joint_element(root, name, joint)
+    placements_xml(root, spec, holder.parts)
     return root
 
 
@@ -124,7 +133,7 @@ def xacro_files(
     arm_top = STANDALONE_ARM_NAME if has_base(spec) else spec.name
     trees: dict[str, etree._Element] = {
         COMMON: common_properties(spec),
-        ARM: part(spec.arm.links, spec.arm.joints, prefixes, names, "arm"),
+        ARM: part(spec, spec.arm, prefixes, names, "arm"),
         ARM_GAZEBO: arm_gazebo(spec),
         STANDALONE_ARM: _top(
             arm_top, [COMMON, ARM, ARM_GAZEBO, *([] if has_base(spec) else extra)]
@@ -137,7 +146,7 @@ def xacro_files(
         trees[ROS2_CONTROL].append(ros2_control_element(spec.name, rc))
     base = spec.mounted_base()
     if base is not None:
-        trees[MOBILE_BASE] = part(base.links, base.joints, prefixes, names, "mobile_base")
+        trees[MOBILE_BASE] = part(spec, base, prefixes, names, "mobile_base")
         trees[MOBILE_BASE_GAZEBO] = mobile_base_gazebo(spec)
         top = _top(spec.name, [COMMON, MOBILE_BASE, MOBILE_BASE_GAZEBO, ARM, ARM_GAZEBO, *extra])
         joint_element(top, spec.mount_joint_name(), spec.mount_joint())

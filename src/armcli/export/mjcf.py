@@ -23,22 +23,21 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path, PurePosixPath
+from pathlib import Path
 
-import numpy as np
 from lxml import etree
 
 from armcli.compiler.xmlfmt import fmt, to_bytes, vec
 from armcli.errors import InputError
 from armcli.export import mjcf_parts as parts
+from armcli.export.mjcf_mass import FromGeometry, Node, Plan, plan_masses, write_inertial
+from armcli.export.mjcf_meshes import mesh_assets
 from armcli.export.mjcf_report import Extras, Note, scan, text
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Joint, Link, Pose, Shape, Urdf, position_bounds
 from armcli.urdf.read import parse_root
 
 BASES = ("fixed", "free")
-MESH_SUFFIXES = (".stl", ".obj", ".msh")  # what MuJoCo loads
-MESH_DIR = "meshes"
 FREE_JOINT = "root"
 INTEGRATOR = "implicitfast"
 LIMIT_STEPS = 2.0  # solreflimit time constant in time steps: MuJoCo's floor (refsafe)
@@ -77,16 +76,6 @@ def quat(rpy: tuple[float, float, float]) -> tuple[float, float, float, float]:
     )
 
 
-def rotation(rpy: tuple[float, float, float]) -> np.ndarray:
-    """The 3x3 matrix of URDF's roll-pitch-yaw (to rotate inertias into the body frame)."""
-    r, p, y = rpy
-    Rx = np.array([[1, 0, 0], [0, math.cos(r), -math.sin(r)], [0, math.sin(r), math.cos(r)]])
-    Ry = np.array([[math.cos(p), 0, math.sin(p)], [0, 1, 0], [-math.sin(p), 0, math.cos(p)]])
-    Rz = np.array([[math.cos(y), -math.sin(y), 0], [math.sin(y), math.cos(y), 0], [0, 0, 1]])
-    out: np.ndarray = Rz @ Ry @ Rx
-    return out
-
-
 def _place(attrs: dict[str, str], pose: Pose) -> dict[str, str]:
     """pos/quat attributes of a URDF origin; identity parts are left out."""
     if any(pose.xyz):
@@ -108,9 +97,10 @@ class _Builder:
         self.rgba = {m.name: m.rgba for m in reversed(urdf.materials) if m.rgba is not None}
         self.joints: list[Joint] = []
         self.mesh_names: dict[str, str] = {}  # URI -> asset name
-        self.meshes: dict[str, bytes] = {}
+        self.flat: frozenset[str] = frozenset()  # mesh URIs without volume: display only
         self.notes: list[Note] = []
-        self.skipped_meshes: list[str] = []
+        self.plan: dict[str, Plan] = {}
+        self.infer = False  # some body's inertia comes from its geoms (inertiafromgeom auto)
 
     def root_link(self) -> str:
         children = {j.child for j in self.urdf.joints}
@@ -147,20 +137,45 @@ class _Builder:
             self.body(body, str(child.child), child, False)
 
     def inertial(self, body: etree._Element, link: Link) -> None:
-        ine = link.inertial
-        if ine is None or ine.mass is None or ine.mass <= 0 or ine.inertia is None:
-            return
-        ixx, ixy, ixz, iyy, iyz, izz = ine.inertia
-        inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-        R = rotation(ine.origin.rpy)
-        Ib = R @ inertia @ R.T if any(ine.origin.rpy) else inertia  # in the body frame
-        attrs = {"pos": vec(ine.origin.xyz), "mass": fmt(ine.mass)}
-        if Ib[0, 1] == 0.0 and Ib[0, 2] == 0.0 and Ib[1, 2] == 0.0:
-            attrs["diaginertia"] = vec((Ib[0, 0], Ib[1, 1], Ib[2, 2]))
+        collisions = self.collisions(link)
+        write_inertial(body, self.plan.get(link.name), self.infer and collisions > 0)
+
+    def collisions(self, link: Link) -> int:
+        """How many collision geoms the export writes for `link`."""
+        return sum(self.geom_attrs(s, True) is not None for s in link.collisions)
+
+    def tree(self, free: bool) -> list[Node]:
+        """The bodies as `_worldbody` and `body` emit them, parents first."""
+        root = self.root_link()
+        out: list[Node] = []
+        if self.world_is_worldbody(root):
+            for j in self.children.get(root, []):
+                self.walk(out, str(j.child), None, j, free and j.type == "floating")
         else:
-            full = (Ib[0, 0], Ib[1, 1], Ib[2, 2], Ib[0, 1], Ib[0, 2], Ib[1, 2])
-            attrs["fullinertia"] = vec(full)
-        etree.SubElement(body, "inertial", attrs)
+            self.walk(out, root, None, None, free)
+        return out
+
+    def walk(
+        self, out: list[Node], name: str, parent: str | None, j: Joint | None, free: bool
+    ) -> None:
+        pose = j.origin if j is not None else Pose()
+        moving = free or (j is not None and j.type in _HINGE)
+        jname = j.name if j is not None else None
+        link = self.links[name]
+        ncol = self.collisions(link)
+        lost = tuple(
+            str(s.geometry.filename)
+            for s in link.collisions
+            if s.geometry is not None and self.geom_attrs(s, True) is None
+        )
+        out.append(Node(name, parent, pose.xyz, pose.rpy, jname, moving, ncol, lost))
+        for child in self.children.get(name, []):
+            self.walk(out, str(child.child), name, child, False)
+
+    def world_is_worldbody(self, root: str) -> bool:
+        """A massless, shapeless root link named `world` is MJCF's worldbody itself."""
+        link = self.links[root]
+        return root == "world" and link.inertial is None and not (link.visuals or link.collisions)
 
     def joint(self, body: etree._Element, j: Joint) -> None:
         attrs = {"name": j.name, "type": _HINGE[j.type], "axis": vec(j.axis or (1.0, 0.0, 0.0))}
@@ -171,11 +186,17 @@ class _Builder:
         etree.SubElement(body, "joint", attrs)
         self.joints.append(j)
 
-    def geom(self, body: etree._Element, shape: Shape, cls: str, link: str) -> None:
+    def geom_attrs(self, shape: Shape, collision: bool) -> dict[str, str] | None:
+        """Type, size and pose of the geom for `shape`; None when the export has none.
+
+        A flat mesh has no convex hull, which MuJoCo needs for collision: display only.
+        """
         g = shape.geometry
         if g is None or (g.dims is None and g.kind != "mesh"):
-            return
-        attrs = {"class": cls}
+            return None
+        if collision and g.kind == "mesh" and g.filename in self.flat:
+            return None
+        attrs: dict[str, str] = {}
         if g.kind == "box":
             attrs.update(type="box", size=vec(d / 2 for d in g.dims or ()))
         elif g.kind == "cylinder":
@@ -186,45 +207,33 @@ class _Builder:
         elif g.kind == "mesh" and g.filename in self.mesh_names:
             attrs.update(type="mesh", mesh=self.mesh_names[g.filename])
         else:
+            return None
+        return _place(attrs, shape.origin)
+
+    def geom(self, body: etree._Element, shape: Shape, cls: str, link: str) -> None:
+        geo = self.geom_attrs(shape, cls == "collision")
+        if geo is None:
             return
-        _place(attrs, shape.origin)
+        attrs = {"class": cls, **geo}
         if cls == "visual" and shape.material in self.rgba:
             attrs["rgba"] = vec(self.rgba[shape.material] or ())
         if cls == "collision" and link in self.extras.mu1:
             attrs["friction"] = " ".join((fmt(self.extras.mu1[link]), *CONTACT_FRICTION))
+        plan = self.plan.get(link)
+        if cls == "collision" and isinstance(plan, FromGeometry) and plan.geom_mass is not None:
+            attrs["mass"] = fmt(plan.geom_mass)
         etree.SubElement(body, "geom", attrs)
 
-    def assets(self, root: etree._Element, meshes: Mapping[str, Path | None]) -> None:
-        """Mesh assets for every resolvable mesh MuJoCo can read, copied under meshes/."""
-        asset = etree.SubElement(root, "asset")
-        scales = {
-            s.geometry.filename: s.geometry.scale
-            for lk in self.urdf.links
-            for s in (*lk.visuals, *lk.collisions)
-            if s.geometry is not None and s.geometry.filename
-        }
-        for uri in sorted(meshes):
-            path = meshes[uri]
-            if path is None or not path.is_file() or path.suffix.lower() not in MESH_SUFFIXES:
-                self.skipped_meshes.append(uri)
-                continue
-            stem, k = path.stem, 1
-            while stem in self.mesh_names.values():
-                k += 1
-                stem = f"{path.stem}_{k}"
-            self.mesh_names[uri] = stem
-            rel = str(PurePosixPath(MESH_DIR) / f"{stem}{path.suffix.lower()}")
-            self.meshes[rel] = path.read_bytes()
-            attrs = {"name": stem, "file": rel}
-            if scales.get(uri, (1.0, 1.0, 1.0)) != (1.0, 1.0, 1.0):
-                attrs["scale"] = vec(scales[uri])
-            etree.SubElement(asset, "mesh", attrs)
-        if not len(asset):
-            root.remove(asset)
 
-
-def _header(root: etree._Element, name: str, spec: RobotSpec | None) -> None:
-    etree.SubElement(root, "compiler", angle="radian", autolimits="true", inertiafromgeom="false")
+def _header(root: etree._Element, name: str, spec: RobotSpec | None, infer: bool) -> None:
+    """compiler, option, defaults; `infer`: some body takes its inertia from its geoms."""
+    etree.SubElement(
+        root,
+        "compiler",
+        angle="radian",
+        autolimits="true",
+        inertiafromgeom="auto" if infer else "false",
+    )
     opt = {"integrator": INTEGRATOR}
     if spec is not None:
         opt = {"timestep": fmt(spec.control.dt), **opt}
@@ -233,7 +242,10 @@ def _header(root: etree._Element, name: str, spec: RobotSpec | None) -> None:
     if spec is not None:  # stops as stiff as the time step allows (armcli's are hard)
         etree.SubElement(top, "joint", solreflimit=vec((LIMIT_STEPS * spec.control.dt, 1.0)))
     vis = etree.SubElement(top, "default", {"class": "visual"})
-    etree.SubElement(vis, "geom", contype="0", conaffinity="0", group="2")
+    visual = {"contype": "0", "conaffinity": "0", "group": "2"}
+    if infer:  # as in MuJoCo's URDF import, visual geoms weigh nothing
+        visual["density"] = "0"
+    etree.SubElement(vis, "geom", visual)
     col = etree.SubElement(top, "default", {"class": "collision"})
     etree.SubElement(col, "geom", group="3")
 
@@ -241,8 +253,7 @@ def _header(root: etree._Element, name: str, spec: RobotSpec | None) -> None:
 def _worldbody(world: etree._Element, b: _Builder, name: str, free: bool) -> None:
     """The root link's body; a massless, shapeless `world` root link is MJCF's worldbody."""
     root = b.root_link()
-    link = b.links[root]
-    if root == "world" and link.inertial is None and not (link.visuals or link.collisions):
+    if b.world_is_worldbody(root):
         for j in b.children.get(root, []):
             b.body(world, str(j.child), j, free and j.type == "floating")
         if free:
@@ -272,19 +283,24 @@ def build_mjcf(
     b = _Builder(urdf, spec, scan(parse_root(urdf.text, urdf.source)))
     name = urdf.name or "robot"
     root = etree.Element("mujoco", model=name)
-    _header(root, name, spec)
-    b.assets(root, meshes or {})
+    assets = mesh_assets(urdf, meshes or {})  # first: the mesh geoms decide the masses
+    b.mesh_names, b.flat = assets.names, assets.flat
+    b.plan, mass_notes = plan_masses(b.tree(base == "free"), b.links, urdf.source)
+    b.infer = any(isinstance(p, FromGeometry) for p in b.plan.values())
+    _header(root, name, spec, b.infer)
+    if len(assets.element):
+        root.append(assets.element)
     _worldbody(etree.SubElement(root, "worldbody"), b, name, base == "free")
     parts.excludes(root, urdf, {str(el.get("name")) for el in root.iter("body")})
     parts.equalities(root, b.extras, {j.name for j in b.joints})
     actuators = parts.actuators(root, b.joints, spec, b.extras, b.notes)
     keys = parts.keyframes(root, b.joints, actuators, spec, base == "free")
-    b.notes[:0] = parts.notes(urdf, b.joints, b.extras, spec, b.skipped_meshes)
+    b.notes[:0] = [*mass_notes, *assets.notes, *parts.notes(urdf, b.joints, b.extras, spec)]
     if header is not None:  # the report travels with the model
         header = f"{header}\n\n{text(b.notes)}".replace("--", "- -")
     return MjcfExport(
         model=to_bytes(root, header_comment=header),
-        meshes=dict(sorted(b.meshes.items())),
+        meshes=dict(sorted(assets.files.items())),
         notes=tuple(b.notes),
         joints=tuple(j.name for j in b.joints),
         actuators=tuple(a for a, _ in actuators),

@@ -15,6 +15,7 @@ from armcli.errors import InputError
 from armcli.export.mjcf import MjcfExport, build_mjcf
 from armcli.export.mjcf_report import text
 from armcli.export.mjcf_scene import SCENE, scene_xml
+from armcli.export.mjcf_verify import Verdict, compile_check
 from armcli.io.files import write_file_atomic
 from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import MeshSearch, mesh_paths
@@ -32,6 +33,7 @@ class Written:
     files: tuple[Path, ...]
     robot: str  # which URDF document was exported
     report: str
+    verdict: Verdict  # MuJoCo's compile of the files, where it is installed
     notes: tuple[str, ...] = ()  # what reading a xacro file reported (Urdf.notes)
 
 
@@ -71,7 +73,8 @@ def export_mjcf(
     exp = build_mjcf(urdf, robot.spec, base=base, meshes=meshes, header=header)
     report = text(exp.notes)
     files = mjcf_files(exp, out.name, urdf.name or "robot", header)
+    verdict = compile_check(files, SCENE, urdf.source)  # before anything is written
     written = []
     for rel, data in files.items():  # meshes, scene, then the model
         written.append(write_file_atomic(out.parent / rel, data))
-    return Written(exp, tuple(written), urdf.source, report, urdf.notes)
+    return Written(exp, tuple(written), urdf.source, report, verdict, urdf.notes)

@@ -134,7 +134,6 @@ def notes(
     joints: list[Joint],
     extras: Extras,
     spec: RobotSpec | None,
-    skipped_meshes: list[str],
 ) -> list[Note]:
     """Everything URDF (or the spec) says that the MJCF model does not carry as such."""
     out = []
@@ -172,14 +171,6 @@ def notes(
                 f"{counts} ({'/'.join(EXTRA_TAGS)} are simulator-specific)",
                 "dropped: plugins, Gazebo materials, transmissions and ros2_control have no "
                 f"MJCF meaning; actuators come from the spec's gains{mu}",
-            )
-        )
-    if skipped_meshes:
-        out.append(
-            Note(
-                "meshes",
-                f"{', '.join(skipped_meshes)} missing or not STL/OBJ/MSH",
-                "left out of the model (convert them to STL or OBJ)",
             )
         )
     if spec is not None:

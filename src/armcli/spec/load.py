@@ -11,6 +11,7 @@ from pydantic import ValidationError
 
 from armcli.errors import Problem, SpecError
 from armcli.io.yaml import YamlDoc, dotted, load_yaml, loads_yaml
+from armcli.spec.expand import expand_parts
 from armcli.spec.model import RobotSpec
 from armcli.spec.semantics import semantic_problems
 from armcli.spec.suggest import did_you_mean
@@ -37,7 +38,9 @@ def spec_from_doc(doc: YamlDoc) -> RobotSpec:
         spec = RobotSpec.model_validate(doc.data)
     except ValidationError as exc:
         raise SpecError(doc.source, _pydantic_problems(exc, doc)) from None
-    problems = semantic_problems(spec)
+    spec, problems = expand_parts(spec)
+    if not problems:
+        problems = semantic_problems(spec)
     if problems:
         lines = [Problem(p.field, p.message, doc.line_of(_split(p.field))) for p in problems]
         raise SpecError(doc.source, lines)

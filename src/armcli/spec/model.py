@@ -27,6 +27,7 @@ from armcli.spec.joints import (
     Mimic,
     SafetyController,
 )
+from armcli.spec.parts import Part, Placement
 from armcli.spec.passthrough import PassthroughElement
 from armcli.spec.sensors import Camera, Imu, Lidar, Noise, Sensor
 from armcli.spec.shapes import (
@@ -79,6 +80,8 @@ __all__ = [
     "Mount",
     "Noise",
     "Origin",
+    "Part",
+    "Placement",
     "RobotSpec",
     "Ros2Control",
     "SafetyController",
@@ -135,6 +138,7 @@ class MobileBase(_Model):
     links: dict[UrdfName, Link] = Field(description="links by name")
     joints: dict[UrdfName, Joint] = Field({}, description="joints by name (one tree)")
     diff_drive: DiffDrive | None = Field(None, description="differential-drive plugin")
+    parts: list[Placement] = Field([], description="copies of reusable parts on the base")
 
 
 class Arm(_Model):
@@ -151,6 +155,7 @@ class Arm(_Model):
     tool: Tool | None = Field(
         None, description="end-effector point reported by check, simulate, view and render"
     )
+    parts: list[Placement] = Field([], description="copies of reusable parts on the arm")
 
 
 class Mount(_Model):
@@ -229,6 +234,9 @@ class RobotSpec(_Model):
     poses: dict[Name, dict[UrdfName, Real]] = Field(
         {}, description="named poses: joint name -> position [rad or m]"
     )
+    parts: dict[Name, Part] = Field(
+        {}, description="reusable groups of links and joints, placed under mobile_base/arm"
+    )
     sensors: dict[Name, Sensor] = Field(
         {}, description="cameras, lidars and IMUs on links, by name"
     )
@@ -257,6 +265,11 @@ class RobotSpec(_Model):
         out = dict(self.mobile_base.links) if self.mobile_base else {}
         out.update(self.arm.links)
         return out
+
+    def parts_placements(self) -> list[Placement]:
+        """Every placement of a reusable part, arm and base."""
+        base = self.mobile_base.parts if self.mobile_base is not None else []
+        return [*self.arm.parts, *base]
 
     def all_joints(self) -> dict[str, Joint]:
         """Joints of the base and the arm by name, plus the mount joint with a base."""

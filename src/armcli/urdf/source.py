@@ -15,20 +15,20 @@ import os
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
-from armcli.compiler.expand import expand_urdfs
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import EXPANDED_TAG, InputError, XacroRefusedError
-from armcli.spec.load import load_spec
-from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
 from armcli.urdf.packages import inside, real_roots
 from armcli.urdf.pinocchio import LoadedModel, load_model, parser_problems
 from armcli.urdf.read import parse_urdf, read_urdf
 from armcli.urdf.xacro_args import Expansion, XacroInputs
 from armcli.urdf.xacro_safe import request_json
-from armcli.urdf.xacro_sandbox import expand_untrusted, run_safe
+from armcli.urdf.xacro_sandbox import run_safe, run_trusted
+
+if TYPE_CHECKING:
+    from armcli.spec.model import RobotSpec
 
 SPEC_SUFFIXES = (".yaml", ".yml")
 XACRO_SUFFIX = ".xacro"
@@ -38,6 +38,7 @@ TRUST_XACRO_HELP = (
     "xacro files are expanded in safe mode, where no code from the file runs."
 )
 UNSANDBOXED_HELP = "Same as --trust-xacro=unsandboxed: xacro itself with resource limits only."
+TRUSTED_ENV_REFUSED = ("LD_", "PYTHON")  # --env names that would change how the child runs
 Trust = bool | Literal["unsandboxed"]  # --trust-xacro: False, True (sandboxed), "unsandboxed"
 
 
@@ -83,6 +84,10 @@ def read_robot(
     if path.is_dir():
         raise InputError("is a directory, expected a robot spec, URDF or xacro file", file=path)
     if path.suffix in SPEC_SUFFIXES:
+        # the spec layers (pydantic models, ~0.3 s to import) only when a spec is read
+        from armcli.compiler.expand import expand_urdfs
+        from armcli.spec.load import load_spec
+
         spec = load_spec(path)
         urdfs = expand_urdfs(spec)
         docs = tuple(parse_urdf(urdfs[n], f"{path}#{n}") for n in sorted(urdfs))
@@ -117,14 +122,39 @@ def expand_xacro(
     """
     given = inputs or XacroInputs()
     if trust_xacro:
-        unsandboxed = trust_xacro == "unsandboxed"
-        roots = allowed_roots(path.parent)
-        xml = expand_untrusted(
-            path, mappings=dict(given.args), unsandboxed=unsandboxed, roots=roots
-        )
-        return xml, Expansion(args=dict(given.args), given=tuple(given.args))
+        return _expand_trusted(path, given, unsandboxed=trust_xacro == "unsandboxed")
     request = request_json(allowed_roots(path.parent), given)
     xml, report = run_safe(path, request)  # safe mode: no code runs
+    return xml, Expansion.from_dict(report.get("expansion", {}))
+
+
+def _expand_trusted(
+    path: Path, given: XacroInputs, *, unsandboxed: bool
+) -> tuple[bytes, Expansion]:
+    """Xacro itself in xacro_sandbox's jail, `$(find)` answered by armcli's package lookup.
+
+    Every package the lookup knows is passed in with its directories bound read-only
+    (the install prefixes' share/ and each package's real roots: a symlink-install tree
+    points into the sources).
+    """
+    refused = sorted(k for k in given.env if k.startswith(TRUSTED_ENV_REFUSED) or k == "PATH")
+    if refused:
+        raise InputError(
+            f"{refused[0]} may not be set for the xacro child (it would change how Python "
+            "or the loader runs)",
+            field="--env",
+        )
+    known = given.packages.known(near=path)
+    roots = [*allowed_roots(path.parent), *(p / "share" for p in given.packages.prefixes())]
+    roots += [r for root in known.values() for r in real_roots(root)]
+    xml, report = run_trusted(
+        path,
+        mappings=given.args,
+        packages=known,
+        environ=given.env,
+        unsandboxed=unsandboxed,
+        roots=roots,
+    )
     return xml, Expansion.from_dict(report.get("expansion", {}))
 
 

@@ -45,9 +45,39 @@ XACRO_MAX_FILES = 64
 _CHUNK = 65536
 
 _SCRIPT = """
-import sys, xacro
+import json, sys, types
+
+# $(find NAME) asks ament_index_python (ROS 2, not on PyPI): armcli's own lookup answers,
+# from the package map in argv[2] (armcli.urdf.packages, resolved before the jail).
+_packages = json.loads(sys.argv[2])
+class PackageNotFoundError(KeyError):
+    pass
+def get_package_share_directory(name, print_warning=True):
+    if name not in _packages:
+        raise PackageNotFoundError(
+            f"package {name!r} not found by armcli (--package-dir, AMENT_PREFIX_PATH, "
+            "ROS_PACKAGE_PATH, the packages enclosing the file)")
+    return _packages[name]
+_index = types.ModuleType("ament_index_python")
+_index.packages = types.ModuleType("ament_index_python.packages")
+_index.packages.get_package_share_directory = get_package_share_directory
+_index.packages.PackageNotFoundError = PackageNotFoundError
+sys.modules["ament_index_python"] = _index
+sys.modules["ament_index_python.packages"] = _index.packages
+
+class _Args(dict):
+    seen = set()
+    def __contains__(self, key):
+        self.seen.add(key)
+        return dict.__contains__(self, key)
+    def __getitem__(self, key):
+        self.seen.add(key)
+        return dict.__getitem__(self, key)
+
+import xacro
 try:
-    args = dict(a.split(":=", 1) for a in sys.argv[2:])
+    given = dict(a.split(":=", 1) for a in sys.argv[3:])
+    args = _Args(given)
     doc = xacro.process_file(sys.argv[1], mappings=args)
 except BaseException as exc:
     inner = exc
@@ -59,6 +89,9 @@ except BaseException as exc:
     sys.stderr.write(text.strip()[:400] + "\\n")
     sys.exit(1)
 sys.stdout.buffer.write(doc.toprettyxml(indent="  ", encoding="utf-8"))
+unused = [n for n in given if n not in args.seen]
+used = {"args": dict(args), "given": list(given), "unused": unused}
+sys.stderr.write("\\n" + json.dumps({"kind": "ok", "expansion": used}) + "\\n")
 """
 _SAFE_SCRIPT = """
 import sys
@@ -218,13 +251,33 @@ def expand_untrusted(
     `roots` (package roots); where the sandbox cannot run, the expansion is refused
     unless `unsandboxed` (`--trust-xacro=unsandboxed`: the resource limits only).
     """
+    opts = {"mappings": mappings, "timeout": timeout, "unsandboxed": unsandboxed}
+    return run_trusted(path, roots=roots, **opts)[0]  # type: ignore[arg-type]
+
+
+def run_trusted(
+    path: str | Path,
+    *,
+    mappings: Mapping[str, str] | None = None,
+    packages: Mapping[str, Path] | None = None,
+    environ: Mapping[str, str] | None = None,
+    timeout: float = XACRO_TIMEOUT,
+    unsandboxed: bool = False,
+    roots: Sequence[Path] = (),
+) -> tuple[bytes, dict[str, Any]]:
+    """The trusted file through xacro itself (see expand_untrusted): URDF and report.
+
+    `packages` answers `$(find NAME)` (an ament_index_python stand-in in the child);
+    `environ` are the user's --env values, the only variables besides PATH and LANG.
+    """
     p = Path(path)
     check_regular(p, "xacro file")
     args = [f"{k}:={v}" for k, v in (mappings or {}).items()]
-    env = {"PATH": os.defpath, "LANG": "C.UTF-8"}
+    env = {**(environ or {}), "PATH": os.defpath, "LANG": "C.UTF-8"}
     if "ROS_PACKAGE_PATH" in os.environ:
         env["ROS_PACKAGE_PATH"] = os.environ["ROS_PACKAGE_PATH"]
-    argv = [*_python(), "-c", _SCRIPT, str(p.resolve()), *args]
+    found = json.dumps({k: str(v) for k, v in (packages or {}).items()})
+    argv = [*_python(), "-c", _SCRIPT, os.path.abspath(p), found, *args]
     if unsandboxed:
         res = run_limited(argv, p.resolve().parent, timeout=timeout, env=env)
     else:
@@ -233,7 +286,7 @@ def expand_untrusted(
         raise InputError(f"xacro expansion {res.why}", file=p)
     if res.returncode != 0:
         raise InputError(f"xacro expansion failed: {_last_line(res)}", file=p)
-    return res.out
+    return res.out, _report(res) or {}
 
 
 def _interpreter_dirs() -> list[Path]:

@@ -50,6 +50,7 @@ class RenderResult:
     tool_position: tuple[float, float, float] | None
 
 
+MESH_HINT = "--package-dir NAME=PATH points package://NAME at a folder"
 FALLBACK_RGBA = (0.6, 0.6, 0.6, 1.0)  # meshes whose colour cannot be read
 TITLE_WIDTH = 110  # [characters] per title line, so many joints do not run off the figure
 
@@ -70,7 +71,7 @@ def _mesh_handler(
             )
         if path is None or not path.is_file():
             missing.append(fname)
-            return fname
+            return ""  # nothing: yourdfpy skips it (the URI itself could name a file in cwd)
         real = bounded_mesh_file(path, source)  # trimesh opens the checked real path
         loaded.add(real)
         check_total(loaded, source)
@@ -84,6 +85,7 @@ def load_urdf(
     source: str = "<urdf>",
     mesh_dir: str | Path | None = None,
     search: MeshSearch | None = None,
+    missing: list[str] | None = None,
 ) -> Any:
     """URDF text -> yourdfpy.URDF with its visual scene.
 
@@ -91,7 +93,9 @@ def load_urdf(
     `check`, honouring `--package-dir` through `search`. The text first passes the strict
     URDF reader (no DTDs or entities, bounded size and depth), since yourdfpy's own lxml
     parser would resolve entities. A mesh file that cannot be found is an InputError,
-    where yourdfpy would log and draw nothing.
+    where yourdfpy would log and draw nothing, unless the caller passes a `missing` list:
+    then its URI is appended there and the rest is drawn (render warns). A mesh outside
+    the allowed directories is an InputError either way.
     """
     import logging
 
@@ -99,8 +103,8 @@ def load_urdf(
 
     parse_root(xml.encode("utf-8"), source)
     base = Path(mesh_dir or ".")
-    missing: list[str] = []
-    resolve_mesh = _mesh_handler(base, search or MeshSearch(), source, missing)
+    absent: list[str] = []
+    resolve_mesh = _mesh_handler(base, search or MeshSearch(), source, absent)
 
     log = logging.getLogger("yourdfpy")
     level, log.level = log.level, logging.CRITICAL  # its warnings become our error below
@@ -117,10 +121,11 @@ def load_urdf(
         raise InputError(f"cannot load this URDF: {exc}", file=source) from None
     finally:
         log.level = level
-    if missing:
+    if missing is not None:
+        missing += dict.fromkeys(absent)
+    elif absent:
         raise InputError(
-            f"mesh file not found: {missing[0]} (searched from {base}; --package-dir "
-            "NAME=PATH points package://NAME at a folder)",
+            f"mesh file not found: {absent[0]} (searched from {base}; {MESH_HINT})",
             file=source,
         )
     return urdf
