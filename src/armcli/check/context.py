@@ -13,11 +13,16 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
+from armcli.check.balance import StaticBalance
 from armcli.check.rules import RULES, CheckOptions, Collector, JointRow
 from armcli.check.structure import Tree
+from armcli.sim.tipping import ZmpReport
 from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf, position_bounds
+from armcli.urdf.mimic import follow, mimics
 from armcli.urdf.pinocchio import JointRange
+from armcli.urdf.stance import Stance
+from armcli.urdf.workspace import ReachPoint, Workspace
 
 Stage = Literal["urdf", "model", "dynamics"]
 URDF: Stage = "urdf"
@@ -49,6 +54,11 @@ class Context:
     samples: list[tuple[dict[str, float], Any]] = field(default_factory=list)  # dynamics
     servo: set[str] = field(default_factory=set)  # joints a position servo drives
     stability: StabilityReport | None = None
+    balance: StaticBalance | None = None  # check/tipover.py
+    stance: Stance | None = None  # the robot on its support polygon (check/tipover.py)
+    zmp: ZmpReport | None = None  # check/zmp.py: the trajectory's zero-moment point
+    reach: Workspace | None = None  # check/reach.py: the tool point's envelope
+    reach_points: tuple[ReachPoint, ...] = ()  # --reach-point verdicts
     stage: Stage | Literal["unloaded", "refused", "no-dynamics"] = "unloaded"
 
 
@@ -85,8 +95,10 @@ def poses(ctx: Context) -> list[tuple[str, dict[str, float]]]:
             out.append((name, {k: v for k, v in spec.pose(name).items() if k in names}))
     else:
         out.append(("zero", {jr.name: 0.0 for jr in ctx.ranges}))
-    limited = [jr for jr in ctx.ranges if not jr.continuous]
+    coupled = mimics(ctx.urdf.joints)  # a mimic joint follows its leader in every pose
+    followers = {m.follower for m in coupled}
+    limited = [jr for jr in ctx.ranges if not jr.continuous and jr.name not in followers]
     if limited:
         out.append(("lower", {jr.name: jr.lower for jr in limited}))
         out.append(("upper", {jr.name: jr.upper for jr in limited}))
-    return out
+    return [(name, follow(coupled, values)) for name, values in out]

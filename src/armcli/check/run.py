@@ -11,8 +11,19 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from armcli.check import bodies, inertia, interface, joints, meshes, structure, summary
+from armcli.check import (
+    bodies,
+    inertia,
+    interface,
+    joints,
+    meshes,
+    reach,
+    structure,
+    summary,
+    tipover,
+)
 from armcli.check import dynamics as dyn
+from armcli.check import zmp as zmp_rules
 from armcli.check.context import (
     BLOCKS_DYNAMICS,
     BLOCKS_MODEL,
@@ -30,6 +41,7 @@ from armcli.check.rules import CheckOptions, Collector, Finding
 from armcli.check.summary import Summary
 from armcli.errors import ModelLoadError
 from armcli.urdf.doc import Urdf
+from armcli.urdf.mimic import mimics
 from armcli.urdf.pinocchio import joint_ranges, load_model, parser_problems
 
 
@@ -73,6 +85,9 @@ FAMILIES: tuple[Family, ...] = (
     Family("servo", DYNAMICS, _servo),
     Family("stability", DYNAMICS, _stability),
     Family("self-collision", MODEL, _self_collision),
+    Family("tipover", DYNAMICS, tipover.check),
+    Family("zmp", DYNAMICS, zmp_rules.check),
+    Family("reach", MODEL, reach.check),
 )
 
 
@@ -108,7 +123,7 @@ def _ready(ctx: Context, needs: Stage) -> bool:
             ctx.notes.append(DYNAMICS_SKIPPED)
             ctx.stage = "no-dynamics"
         else:
-            ctx.samples = dyn.samples(ctx.model, ctx.ranges)
+            ctx.samples = dyn.samples(ctx.model, ctx.ranges, mimics(ctx.urdf.joints))
             ctx.stage = DYNAMICS
     if needs == MODEL:
         return ctx.model is not None
