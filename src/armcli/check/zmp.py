@@ -45,7 +45,9 @@ def check(c: Context) -> None:
             f"{r.direction} at t = {r.time:.3f} s ({r.when}); ")  # fmt: skip
     if holds > 0 and math.isfinite(holds):
         text += f"a base acceleration up to {holds:.3g} m/s² holds"
-        fix["base_accel"] = round_down(holds)
+        # the spec's diff_drive field when the limit came from the plugin, else the option
+        key = "base_accel" if opts.base_accel is not None else "max_wheel_acceleration"
+        fix[key] = round_down(holds)
     elif math.isinf(holds):
         text += "the base's acceleration does not move it toward that edge"
     else:
