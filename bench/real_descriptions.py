@@ -338,7 +338,9 @@ def summary(rows: list[Row]) -> dict[str, Any]:
         "simulate ran": sum(r.simulate == "ran" for r in rows),
         "export loads in MuJoCo": sum(r.export == "loads in MuJoCo" for r in rows),
         "export exit 0, MuJoCo refuses": sum("MuJoCo refuses" in r.export for r in rows),
-        "export exit != 0": sum(r.export.startswith("exit ") for r in rows),
+        "export exit != 0": sum(
+            r.export.startswith("exit ") and not r.export.startswith("exit 0") for r in rows
+        ),
         "render exit 0": sum(r.render.startswith("ok") for r in rows),
     }
 
@@ -373,10 +375,13 @@ def print_rows(rows: list[Row]) -> None:
 
 
 def compare(before: dict[str, Any], after: dict[str, Any]) -> str:
-    """The summaries of two runs side by side."""
+    """The summaries of two runs side by side, over the entries both ran."""
+    common = {r["label"] for r in before["rows"]} & {r["label"] for r in after["rows"]}
+    sums = [
+        summary([Row(**r) for r in run["rows"] if r["label"] in common]) for run in (before, after)
+    ]
     lines = ["| | before | after |", "|---|---:|---:|"]
-    for key in after["summary"]:
-        lines.append(f"| {key} | {before['summary'].get(key, '-')} | {after['summary'][key]} |")
+    lines += [f"| {key} | {sums[0][key]} | {sums[1][key]} |" for key in sums[1]]
     return "\n".join(lines) + "\n"
 
 
