@@ -96,10 +96,6 @@ ENTRIES = [
     Entry("Motoman SIA20D", "motoman/motoman_sia20d_support/urdf/sia20d.xacro"),
     Entry("Husky", "husky/husky_description/urdf/husky.urdf.xacro"),
     Entry("Jackal", "jackal/jackal_description/urdf/jackal.urdf.xacro"),
-    Entry(
-        "Clearpath A200",
-        "clearpath_common/clearpath_platform_description/urdf/a200/a200.urdf.xacro",
-    ),
     Entry("rrbot (demo 1)", DEMOS + "example_1/description/urdf/rrbot.urdf.xacro"),
     Entry("r6bot (demo 7)", DEMOS + "example_7/description/urdf/r6bot.urdf.xacro"),
     Entry("diffbot (demo 2)", DEMOS + "example_2/description/urdf/diffbot.urdf.xacro"),
