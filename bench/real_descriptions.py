@@ -371,8 +371,9 @@ def print_rows(rows: list[Row]) -> None:
 
 
 def compare(before: dict[str, Any], after: dict[str, Any]) -> str:
-    """The summaries of two runs side by side, over the entries both ran."""
+    """The summaries of two runs side by side, over the current entries both ran."""
     common = {r["label"] for r in before["rows"]} & {r["label"] for r in after["rows"]}
+    common &= {e.label for e in ENTRIES}
     sums = [
         summary([Row(**r) for r in run["rows"] if r["label"] in common]) for run in (before, after)
     ]
