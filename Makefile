@@ -51,8 +51,10 @@ test: install sysdeps lint native-check
 	$(BIN)/python -m pytest -q
 
 # Rebuild the compiled rollout after editing its C++ (the editable install does not rebuild
-# on import): incremental, in build/, with the build tools of the dev extra.
-native: | $(STAMP)
+# on import): incremental, in build/, with the build tools of the dev extra. Not through the
+# install stamp, which a C++ edit outdates: that would recreate the whole venv.
+native:
+	@test -x $(BIN)/python || $(MAKE) install
 	@echo "native: recompiling the engine (armcli.sim._rollout)"
 	$(BIN)/python -m pip install -q --no-build-isolation --no-deps -e .
 	$(BIN)/python -m armcli.sim.native

@@ -69,8 +69,9 @@ def trajectory(duration: float) -> tuple[str, list[tuple[float, float, float]]]:
     return "\n".join(lines) + "\n", knots
 
 
-def run_once(cmd: list[str]) -> tuple[float, float]:
-    """Wall seconds and peak RSS [MiB] of one process (the kernel's accounting)."""
+def run_once(cmd: list[str]) -> tuple[float, float, float]:
+    """Wall seconds, CPU seconds (user + system) and peak RSS [MiB] of one process, from the
+    kernel's accounting. CPU time is what a busy machine disturbs least."""
     start = time.perf_counter()
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     _, status, usage = os.wait4(proc.pid, 0)
@@ -78,15 +79,15 @@ def run_once(cmd: list[str]) -> tuple[float, float]:
     proc.returncode = os.waitstatus_to_exitcode(status)
     if proc.returncode != 0:
         raise SystemExit(f"failed ({proc.returncode}): {' '.join(cmd)}")
-    return wall, usage.ru_maxrss / 1024.0
+    return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024.0
 
 
 def paired(a: list[str], b: list[str], repeats: int) -> tuple[list[float], list[float], float]:
-    """A and B in turn; medians of their runs [s], and the median of the pairwise ratios."""
+    """A and B in turn; their CPU seconds, and the median of the pairwise ratios."""
     ta, tb = [], []
     for _ in range(repeats):
-        ta.append(run_once(a)[0])
-        tb.append(run_once(b)[0])
+        ta.append(run_once(a)[1])
+        tb.append(run_once(b)[1])
     ratio = statistics.median(x / y for x, y in zip(ta, tb, strict=True))
     return ta, tb, ratio
 
@@ -101,14 +102,14 @@ def whole_process(
     med = statistics.median
     cut = (med(ta) - med(sa)) / (med(tb) - med(sb))
     print(f"\nwhole process, {duration:g} s trajectory at dt = {DT} s ({steps} steps), "
-          f"median of {repeats} pairs")  # fmt: skip
+          f"CPU seconds, median of {repeats} pairs")  # fmt: skip
     head = ("process", "total [s]", "set-up [s]", "µs/step", "peak [MiB]")
     print("  ".join(f"{c:>11}" if i else f"{c:<34}" for i, c in enumerate(head)))
     for name, tot, setup, cmd in (
         ("MuJoCo script (PD in Python)", tb, sb, mujoco(duration)),
         ("armcli simulate --urdf", ta, sa, armcli(duration)),
     ):
-        peak = run_once(cmd)[1]
+        peak = run_once(cmd)[2]
         cells = (name, f"{med(tot):.2f}", f"{med(setup):.2f}",
                  f"{(med(tot) - med(setup)) / steps * 1e6:.2f}", f"{peak:.0f}")  # fmt: skip
         print("  ".join(f"{c:>11}" if i else f"{c:<34}" for i, c in enumerate(cells)))
@@ -119,11 +120,11 @@ def whole_process(
 def memory(armcli: Callable[..., list[str]], out: Path) -> None:
     """Peak RSS of a 1.8 M-step run writing its states at 10 Hz."""
     steps = 1_800_000
-    wall, peak = run_once(armcli(steps * DT, "--output", str(out), "--rate", "10"))
-    short_wall, short_peak = run_once(armcli(DT))
+    _, cpu, peak = run_once(armcli(steps * DT, "--output", str(out), "--rate", "10"))
+    _, short_cpu, short_peak = run_once(armcli(DT))
     print(f"\n{steps:,} steps (--duration {steps * DT:g} at dt = {DT}), states at 10 Hz:")
-    print(f"  peak {peak:.0f} MiB ({short_peak:.0f} MiB for one step); {wall:.2f} s "
-          f"({(wall - short_wall) / steps * 1e6:.2f} µs/step)")  # fmt: skip
+    print(f"  peak {peak:.0f} MiB ({short_peak:.0f} MiB for one step); {cpu:.2f} CPU s "
+          f"({(cpu - short_cpu) / steps * 1e6:.2f} µs/step)")  # fmt: skip
 
 
 def startup(repeats: int) -> None:
@@ -131,17 +132,20 @@ def startup(repeats: int) -> None:
     help_cmd = [str(BIN / "armcli"), "simulate", "--help"]
     bare = [sys.executable, "-c", "pass"]
     th, tp, _ = paired(help_cmd, bare, repeats)
-    print(f"\nstart-up: `armcli simulate --help` {statistics.median(th):.3f} s, "
-          f"`python -c pass` {statistics.median(tp):.3f} s")  # fmt: skip
+    print(f"\nstart-up: `armcli simulate --help` {statistics.median(th):.3f} CPU s, "
+          f"`python -c pass` {statistics.median(tp):.3f} CPU s")  # fmt: skip
     for module in ("armcli.commands.simulate", "armcli.check.gate", "pinocchio"):
         r = subprocess.run([sys.executable, "-X", "importtime", "-c", f"import {module}"],
                            capture_output=True, text=True, check=True)  # fmt: skip
-        rows = [m.groups() for m in re.finditer(r"\|\s*(\d+) \|\s*(\S.*)$", r.stderr, re.M)]
-        total = max(int(cum) for cum, _ in rows) / 1e6
-        heavy = sorted(((int(c), n.strip()) for c, n in rows if not n.startswith(" ")),
-                       reverse=True)[:4]  # fmt: skip
-        tops = ", ".join(f"{n} {c / 1e6:.3f}" for c, n in heavy)
-        print(f"  import {module}: {total:.3f} s (top level: {tops})")
+        # "import time: self | cumulative | name", nested names indented by two spaces
+        rows = re.findall(r"\|\s*(\d+) \| ( *)(\S+)$", r.stderr, re.M)
+        end = next(i for i, (_, ind, n) in enumerate(rows) if not ind and n == module)
+        start = max((i for i, (_, ind, _) in enumerate(rows[:end]) if not ind), default=-1)
+        total = int(rows[end][0]) / 1e6
+        children = [(int(c), n) for c, ind, n in rows[start + 1 : end] if len(ind) == 2]
+        inner = sorted(children, reverse=True)[:4]
+        tops = ", ".join(f"{n} {c / 1e6:.3f}" for c, n in inner)
+        print(f"  import {module}: {total:.3f} s (largest: {tops})")
 
 
 def main() -> None:

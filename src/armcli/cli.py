@@ -10,9 +10,7 @@ numpy or any command's library, and `armcli build` loads only what build needs.
 from __future__ import annotations
 
 import importlib
-import signal
 import sys
-import threading
 from typing import Any
 
 import click
@@ -161,15 +159,8 @@ def _debug_requested(argv: list[str]) -> bool:
     return False
 
 
-class _Interrupted(BaseException):
-    """Ctrl-C, raised instead of KeyboardInterrupt, which typer turns into a silent exit 130."""
-
-
 INTERRUPTED = "interrupted (Ctrl-C): stopped; no file was left half-written\n"
-
-
-def _raise_interrupted(signum: int, frame: object) -> None:
-    raise _Interrupted
+EXIT_INTERRUPTED = 130  # 128 + SIGINT; typer's exit for a KeyboardInterrupt it caught
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -182,13 +173,15 @@ def main(argv: list[str] | None = None) -> None:
     # `--trust-xacro=unsandboxed` is the documented spelling; a bool flag cannot take a value
     args = [UNSANDBOXED_FLAG if a == "--trust-xacro=unsandboxed" else a for a in args]
     debug = _debug_requested(args)
-    main_thread = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGINT, _raise_interrupted) if main_thread else None
     try:
         app(args=args, prog_name="armcli")
-    except (_Interrupted, KeyboardInterrupt):
+    except SystemExit as exc:  # typer turns Ctrl-C into a silent exit 130: say it once
+        if exc.code == EXIT_INTERRUPTED:
+            sys.stderr.write(INTERRUPTED)
+        raise
+    except KeyboardInterrupt:
         sys.stderr.write(INTERRUPTED)
-        raise SystemExit(130) from None
+        raise SystemExit(EXIT_INTERRUPTED) from None
     except ArmcliError as exc:
         if debug:
             raise
@@ -201,9 +194,6 @@ def main(argv: list[str] | None = None) -> None:
             f"internal error: {type(exc).__name__}: {exc} (rerun with --debug for a traceback)\n"
         )
         raise SystemExit(EXIT_FAILED) from None
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGINT, previous)
 
 
 if __name__ == "__main__":

@@ -5,6 +5,8 @@ from __future__ import annotations
 import csv
 import json
 import math
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -204,3 +206,34 @@ def test_ignore_lets_a_true_finding_simulate(
     assert J2 in out
     code, _, err = run([*args, "--ignore", "no-such-rule"], capsys)
     assert code == 2 and "--ignore" in err and "no-such-rule" in err
+
+
+HEAVY = {"pinocchio", "scipy", "matplotlib", "mujoco", "yourdfpy", "trimesh", "xacro",
+         "armcli.check.gate", "armcli.spec.model", "numpy.ma"}  # fmt: skip
+
+
+def _modules_after(args: list[str]) -> set[str]:
+    """The modules a fresh interpreter holds after `armcli ARGS` (run in it)."""
+    code = (
+        "import sys\nfrom armcli.cli import main\n"
+        f"try:\n    main({args!r})\nexcept SystemExit as e:\n    assert e.code in (0, None), e\n"
+        "print('@@modules@@', *sys.modules)\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       check=False, cwd=ROOT)  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    return set(r.stdout.split("@@modules@@")[-1].split())
+
+
+def test_help_imports_nothing_heavy() -> None:
+    """`simulate --help` is instant: no dynamics, plotting, check rules or spec models."""
+    assert not HEAVY & _modules_after(["simulate", "--help"])
+
+
+def test_simulating_a_urdf_needs_no_spec_layers() -> None:
+    """A --urdf run reads no spec: the pydantic spec models (~0.3 s) are not imported."""
+    msg = "{joint_names: [forearm_hand_joint], points: [{positions: [0.3], time_from_start: 0.1}]}"
+    loaded = _modules_after(["simulate", "--urdf", "urdf/standalone_arm.urdf", "--kp", "50",
+                             "--kd", "5", "-m", msg, "--duration", "0.2"])  # fmt: skip
+    assert "pinocchio" in loaded and "armcli.spec.model" not in loaded
+    assert not {"matplotlib", "scipy", "mujoco", "numpy.ma"} & loaded

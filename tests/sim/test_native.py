@@ -72,7 +72,8 @@ def _free_step_equals_python_aba(model: pin.Model) -> bool:
                    friction=np.zeros(n), velocity=np.full(n, 1e9))  # fmt: skip
     rng = np.random.default_rng(n)
     q0, v0 = rng.uniform(-1, 1, n), rng.uniform(-1, 1, n)
-    a = pin.aba(wide.model, wide.model.createData(), configuration(wide.model, q0), v0, np.zeros(n))
+    a = pin.aba(wide.model, wide.model.createData(), configuration(wide.model, q0), v0,
+                np.zeros(n), pin.Convention.WORLD)  # fmt: skip
     if not np.all(np.isfinite(a)):
         return False
     r = run_held(plant_of(wide, SimConfig(np.zeros(n), np.zeros(n), dt=dt)), q0, v0, 1).trace

@@ -156,3 +156,15 @@ def test_a_file_that_is_not_mcap_is_an_input_error(tmp_path: Path) -> None:
     bad.write_bytes(b"not an mcap file")
     with pytest.raises(InputError, match="unreadable MCAP file"):
         rosbag.load_replay(bad, ["arm_base_forearm_joint"])
+
+
+def test_view_replay_takes_an_mcap(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """`view --replay X.mcap` goes to the MCAP reader (checked before any server starts)."""
+    from armcli.cli import main
+
+    bad = tmp_path / "bad.mcap"
+    bad.write_bytes(b"\x89MCAP0\r\n truncated")
+    with pytest.raises(SystemExit) as exc:
+        main(["view", str(DEFAULT_SPEC), "--replay", str(bad), "--port", "0"])
+    assert exc.value.code == 2
+    assert f"{bad}: unreadable MCAP file" in capsys.readouterr().err

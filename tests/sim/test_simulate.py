@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 import pytest
 
-from armcli.errors import SimulationError, UnstableLoopError
+from armcli.errors import InputError, SimulationError, UnstableLoopError
 from armcli.sim import rollout as ro
 from armcli.sim.reference import build_reference
 from armcli.sim.simulate import (
@@ -208,3 +209,37 @@ def test_reported_effort_balances_gravity_at_rest(arm: Arm) -> None:
     # static equilibrium: the motor torque (the `effort` output) holds the arm against g(q)
     np.testing.assert_allclose(r.tau[-1], g, atol=1e-6)
     np.testing.assert_allclose(50.0 * ([0.7, 0.9] - q_end), g, atol=1e-6)  # the P term alone
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "message"),
+    [
+        ("friction", math.nan, "friction nan"),  # would freeze the joint
+        ("friction", -0.1, "friction -0.1"),
+        ("damping", math.inf, "damping inf"),
+        ("lower", math.nan, "lower nan"),  # would mean "no stop"
+        ("upper", math.nan, "upper nan"),
+        ("effort", 0.0, "effort 0"),
+        ("velocity", math.nan, "velocity nan"),
+    ],
+)
+def test_arm_refuses_values_that_are_not_numbers_or_out_of_order(
+    arm: Arm, field: str, value: float, message: str
+) -> None:
+    bad = getattr(arm, field).copy()
+    bad[1] = value
+    with pytest.raises(InputError, match=rf"joint 'forearm_hand_joint': {message} "):
+        replace(arm, **{field: bad})
+
+
+def test_arm_refuses_limits_out_of_order(arm: Arm) -> None:
+    with pytest.raises(InputError, match=r"lower limit 1 is above upper 0\.5"):
+        replace(arm, lower=np.array([0.0, 1.0]), upper=np.array([1.0, 0.5]))
+
+
+@pytest.mark.parametrize(
+    ("kp", "kd", "dt"), [(math.nan, 1.0, 1e-3), (1.0, -1.0, 1e-3), (1.0, 1.0, math.nan)]
+)
+def test_sim_config_refuses_bad_gains_and_step(kp: float, kd: float, dt: float) -> None:
+    with pytest.raises(InputError, match="must be finite"):
+        SimConfig(np.full(2, kp), np.full(2, kd), dt=dt)

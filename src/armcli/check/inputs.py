@@ -11,16 +11,19 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from armcli.check.rules import ERROR, RULES, CheckOptions, Finding
 from armcli.check.run import CheckResult, check_urdf
 from armcli.check.spec_locate import key_lines, locate
 from armcli.errors import EXIT_FAILED, EXIT_OK, EXIT_UNUSABLE, InputError
 from armcli.io.yaml import load_yaml, read_text
-from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
 from armcli.urdf.source import Trust, read_robot, read_urdf_file
 from armcli.urdf.xacro_args import XacroInputs
+
+if TYPE_CHECKING:
+    from armcli.spec.model import RobotSpec
 
 URDF_GLOB = "*.urdf"
 

@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 from armcli.check.rules import Collector
 from armcli.check.structure import finite
-from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import ONE_DOF_TYPES, Joint, Urdf
+
+if TYPE_CHECKING:
+    from armcli.spec.model import RobotSpec
 
 AXIS_UNIT_TOL = 1e-6
 # A revolute limit that is a whole multiple of 5 from 15 to 720 (45, 90, 180, 360...)

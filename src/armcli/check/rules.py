@@ -11,10 +11,12 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from armcli.spec.model import RobotSpec
 from armcli.urdf.meshes import MeshSearch
+
+if TYPE_CHECKING:
+    from armcli.spec.model import RobotSpec
 
 ERROR = "error"
 WARNING = "warning"

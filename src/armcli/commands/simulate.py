@@ -27,8 +27,6 @@ from armcli.sim import report as simreport
 from armcli.sim import rosbag, states
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 from armcli.sim.plot import write_tracking_plot
-from armcli.spec.discover import find_spec
-from armcli.spec.load import load_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
@@ -94,8 +92,13 @@ def simulate_cmd(
         check_output_file(output, "--output")
     if plot is not None:
         check_output_file(plot, "--plot")
-    spec_path = find_spec(spec) if (spec is not None or urdf is None) else None
-    spec_obj = load_spec(spec_path) if spec_path is not None else None
+    spec_path, spec_obj = None, None
+    if spec is not None or urdf is None:  # the spec layers are imported only for a spec
+        from armcli.spec.discover import find_spec
+        from armcli.spec.load import load_spec
+
+        spec_path = find_spec(spec)
+        spec_obj = load_spec(spec_path)
     kp_values, kd_values = _floats(kp, "--kp"), _floats(kd, "--kd")
     opts = SimOptions(
         trajectory=trajectory,

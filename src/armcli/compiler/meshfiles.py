@@ -20,6 +20,7 @@ from pathlib import Path
 from urllib.parse import unquote, urlparse
 
 from armcli.errors import InputError
+from armcli.spec.model import RobotSpec
 
 MESH_DIR = "meshes"  # where ros-package puts copied meshes in the description package
 _PACKAGE_NAME = re.compile(rb"<name>\s*([^<\s]+)\s*</name>")
@@ -111,3 +112,50 @@ def package_path(filename: str) -> str:
     parent = p.parent.name
     sub = f"{parent}/" if parent and parent not in (MESH_DIR, ".", "..") else ""
     return f"{MESH_DIR}/{sub}{p.name}"
+
+
+def spec_mesh_names(spec: RobotSpec) -> list[str]:
+    """Every mesh and texture file name the spec uses, in order, once each."""
+    out: list[str] = []
+    links = [
+        *spec.all_links().values(),
+        *(lk for p in spec.parts.values() for lk in p.links.values()),
+    ]
+    for link in links:
+        for shape in (*link.visuals(), *link.collisions()):
+            if shape.geometry.mesh is not None:
+                out.append(shape.geometry.mesh.filename)
+            m = shape.material
+            if m is not None and not isinstance(m, str) and m.texture is not None:
+                out.append(m.texture)
+    out += [m.texture for m in spec.materials.values() if m.texture is not None]
+    return list(dict.fromkeys(out))
+
+
+def package_of(filename: str) -> str | None:
+    """The ROS package a `package://NAME/...` file name points into, else None."""
+    parsed = urlparse(filename)
+    if parsed.scheme != "package":
+        return None
+    return parsed.netloc or unquote(parsed.path).lstrip("/").partition("/")[0]
+
+
+def package_meshes(spec: RobotSpec) -> dict[str, Path]:
+    """Path in the description package -> the file, for every path-named mesh of the spec.
+
+    Raises:
+        InputError: a file is missing, or two different files would land on one path.
+    """
+    out: dict[str, Path] = {}
+    for name in spec_mesh_names(spec):
+        if not is_path(name):
+            continue
+        path = locate(name, spec.base_dir)
+        rel = package_path(name)
+        if rel in out and os.path.realpath(out[rel]) != os.path.realpath(path):
+            raise InputError(
+                f"meshes {out[rel]} and {path} would both be copied to {rel}: rename one",
+                field="meshes",
+            )
+        out[rel] = path
+    return out

@@ -20,11 +20,14 @@ import yaml
 from lxml import etree
 
 from armcli.compiler.expand import expand_urdfs
+from armcli.compiler.massprops import MAX_MESH_BYTES
+from armcli.compiler.meshfiles import MeshNames, package_meshes, package_of, spec_mesh_names
 from armcli.compiler.xacro_writer import GENERATED, STANDALONE_ARM, top_level_files, xacro_files
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.io.files import write_tree_atomic
 from armcli.io.outdir import resolve_output_dir
+from armcli.io.userfile import read_regular
 from armcli.ros import jazzy
 from armcli.ros import moveit as mc
 from armcli.ros.collision_matrix import (
@@ -218,12 +221,24 @@ def description_files(
     `extra` adds xacro files under `urdf/` (the Jazzy top levels).
     """
     note = GENERATED.format(spec=label)
-    xacros = {**xacro_files(spec, label, hardware=False), **(extra or {})}
+    names = MeshNames(spec.base_dir, package=n.description)
+    xacros = {**xacro_files(spec, label, names, hardware=False), **(extra or {})}
     files = {f"urdf/{name}": data for name, data in xacros.items()}
+    files.update(mesh_files(spec))
     files["launch/display.launch.py"] = render("display.launch.py.tmpl", _launch_values(n), note)
     files[f"rviz/{DISPLAY_RVIZ}"] = mc.dump_yaml(display_rviz(n.robot_root), note)
     about = f"Robot description (xacro, URDF, RViz) of {n.robot}. {note}"
-    return _package(n.description, about, DESCRIPTION_DEPENDS, files, info)
+    others = sorted({p for m in spec_mesh_names(spec) if (p := package_of(m)) is not None})
+    depends = [*DESCRIPTION_DEPENDS, *(p for p in others if p != n.description)]
+    return _package(n.description, about, depends, files, info)
+
+
+def mesh_files(spec: RobotSpec) -> dict[str, bytes]:
+    """The spec's path-named meshes, copied under `meshes/` (bounded regular files)."""
+    out = {}
+    for rel, path in package_meshes(spec).items():
+        out[rel] = read_regular(path, max_bytes=MAX_MESH_BYTES, what="mesh file")
+    return out
 
 
 def bringup_files(n: Names, note: str, info: PackageInfo) -> dict[str, bytes]:

@@ -9,10 +9,10 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from armcli.compiler.expand import expand_urdfs
 from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.sim.options import SimOptions
@@ -29,14 +29,16 @@ from armcli.sim.simulate import (
     simulate,
     steps_of,
 )
-from armcli.sim.states import sample_steps
+from armcli.sim.states import distinct, sample_steps
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
-from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import Trust, checked_model, read_urdf_file
 from armcli.urdf.tool import tool_point
 from armcli.urdf.xacro_args import XacroInputs
+
+if TYPE_CHECKING:
+    from armcli.spec.model import RobotSpec
 
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
 ARM_URDF = STANDALONE_ARM_URDF
@@ -78,6 +80,8 @@ def arm_urdf(
         return read_urdf_file(urdf, trust_xacro=trust_xacro, inputs=inputs)
     if spec is None:
         raise InputError("give a spec or `SimOptions.urdf`", field="SimOptions.urdf")
+    from armcli.compiler.expand import expand_urdfs  # the spec compiler: only for a spec
+
     return parse_urdf(expand_urdfs(spec)[ARM_URDF], ARM_URDF)
 
 
@@ -295,7 +299,9 @@ def run(
     `progress(steps_done, steps_total)` is called between chunks of steps.
     """
     steps = steps_of(job.duration, job.config.dt)
-    keep = sample_steps(steps, job.config.dt, job.rate)
+    # the output rate's states, the final one (the end effector is reported there), a plot's
+    keep = np.concatenate([sample_steps(steps, job.config.dt, job.rate), [steps]])
     if plot:
-        keep = np.union1d(keep, plot_steps(steps))
+        keep = np.concatenate([keep, plot_steps(steps)])
+    keep = distinct(keep)
     return simulate(job.arm, job.reference, job.q0, job.duration, job.config, progress, record=keep)

@@ -46,8 +46,14 @@ def sample_steps(steps: int, dt: float, rate: float) -> np.ndarray:
     """
     period = 1.0 / rate
     n_samples = int(np.floor(steps * dt / period + 1e-9)) + 1
-    idx = np.round(np.arange(n_samples) * period / dt).astype(np.int64)
-    return np.unique(np.minimum(idx, steps))
+    idx = np.minimum(np.round(np.arange(n_samples) * period / dt).astype(np.int64), steps)
+    return distinct(idx)
+
+
+def distinct(steps: np.ndarray) -> np.ndarray:
+    """Sorted step numbers without repeats (np.unique would import numpy.ma: 20 ms)."""
+    s = np.sort(np.asarray(steps, dtype=np.int64))
+    return s[np.concatenate(([True], s[1:] != s[:-1]))] if s.size else s
 
 
 def sample_states(res: SimResult, rate: float) -> dict[str, np.ndarray]:

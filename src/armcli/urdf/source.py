@@ -15,13 +15,10 @@ import os
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
-from armcli.compiler.expand import expand_urdfs
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import EXPANDED_TAG, InputError, XacroRefusedError
-from armcli.spec.load import load_spec
-from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
 from armcli.urdf.packages import inside, real_roots
 from armcli.urdf.pinocchio import LoadedModel, load_model, parser_problems
@@ -29,6 +26,9 @@ from armcli.urdf.read import parse_urdf, read_urdf
 from armcli.urdf.xacro_args import Expansion, XacroInputs
 from armcli.urdf.xacro_safe import request_json
 from armcli.urdf.xacro_sandbox import run_safe, run_trusted
+
+if TYPE_CHECKING:
+    from armcli.spec.model import RobotSpec
 
 SPEC_SUFFIXES = (".yaml", ".yml")
 XACRO_SUFFIX = ".xacro"
@@ -84,6 +84,10 @@ def read_robot(
     if path.is_dir():
         raise InputError("is a directory, expected a robot spec, URDF or xacro file", file=path)
     if path.suffix in SPEC_SUFFIXES:
+        # the spec layers (pydantic models, ~0.3 s to import) only when a spec is read
+        from armcli.compiler.expand import expand_urdfs
+        from armcli.spec.load import load_spec
+
         spec = load_spec(path)
         urdfs = expand_urdfs(spec)
         docs = tuple(parse_urdf(urdfs[n], f"{path}#{n}") for n in sorted(urdfs))

@@ -12,9 +12,12 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
+
+if TYPE_CHECKING:
+    from armcli.spec.model import RobotSpec
 
 
 @dataclass(frozen=True)

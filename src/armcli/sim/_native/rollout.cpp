@@ -200,7 +200,7 @@ struct Stepper {
   bool any_friction = false;
   Vec qa, va, ta;
   Eigen::MatrixXd A, Ah;
-  Doubles tau, lo, hi, fdt, lam, dv, tpd;
+  Doubles tau, lo, hi, fdt, lam, dv, tpd, ab, vs, qp;  // ab, vs, qp: step scratch
   std::vector<char> sat, stop;
   std::vector<int> locked;  // RK4: joints held by their stops during the stages
   Doubles force;            // their stop forces (M^-1 units), for the sign test
@@ -212,7 +212,7 @@ struct Stepper {
   explicit Stepper(const Plant& plant)
       : model(plant.model), data(plant.model), P(plant), n(plant.n), dt(plant.dt),
         qa(plant.model.nq), va(n), ta(n), A(n, n), Ah(n, n), tau(n), lo(n), hi(n), fdt(n),
-        lam(n), dv(n), tpd(n), sat(n), stop(n), iq(n), unbounded(n) {
+        lam(n), dv(n), tpd(n), ab(n), vs(n), qp(n), sat(n), stop(n), iq(n), unbounded(n) {
     for (int i = 0; i < n; ++i) {
       any_friction = any_friction || P.friction[i] > 0.0;
       fdt[i] = dt * P.friction[i];
@@ -240,10 +240,11 @@ struct Stepper {
     arm_set = true;
   }
 
+  // The WORLD convention leaves the factorisation that computeMinverse(model, data) reuses.
   const Vec& aba(const double* q, const double* v, const double* t) {
     setq(q);
     for (int i = 0; i < n; ++i) va[i] = v[i], ta[i] = t[i];
-    return pin::aba(model, data, CRef(qa), CRef(va), CRef(ta), pin::Convention::LOCAL);
+    return pin::aba(model, data, CRef(qa), CRef(va), CRef(ta), pin::Convention::WORLD);
   }
 
   double kinetic_energy(const double* q, const double* v) {
@@ -298,8 +299,10 @@ struct Stepper {
   // it ends on the stop with no velocity into it. Other joints move by pos_gain dt dv: the
   // whole impulse for Euler, half of it for RK4, whose positions already integrate the
   // acceleration over the step (a constant constraint force moves a joint by dt dv / 2).
+  // `after_aba`: the last ABA was at q with the current armature, so M^-1 comes from its
+  // factorisation instead of a pass of its own.
   void project(const double* q, const double* vs, const double* qp, double pos_gain, double* qn,
-               double* vn) {
+               double* vn, bool after_aba) {
     bool any = any_friction;
     for (int i = 0; i < n; ++i) {
       lo[i] = -INF, hi[i] = INF;
@@ -312,8 +315,12 @@ struct Stepper {
       for (int i = 0; i < n; ++i) qn[i] = qp[i], vn[i] = vs[i];
       return;
     }
-    setq(q);
-    A = pin::computeMinverse(model, data, CRef(qa));
+    if (after_aba) {
+      A = pin::computeMinverse(model, data);
+    } else {
+      setq(q);
+      A = pin::computeMinverse(model, data, CRef(qa));
+    }
     A.triangularView<Eigen::StrictlyLower>() = A.transpose();
     pgs(vs);
     for (int i = 0; i < n; ++i) {
@@ -330,7 +337,6 @@ struct Stepper {
   // saturated and the step solved again.
   void euler(const double* q, const double* v, const double* qr, const double* vr, double* qn,
              double* vn) {
-    Doubles ab(n), vs(n), qp(n);
     motor(q, v, qr, vr, tpd.data());
     while (true) {
       set_armature(&sat);
@@ -338,7 +344,7 @@ struct Stepper {
       const Vec& a = aba(q, v, ab.data());
       for (int i = 0; i < n; ++i) vs[i] = v[i] + dt * a[i];
       for (int i = 0; i < n; ++i) qp[i] = q[i] + dt * vs[i];
-      project(q, vs.data(), qp.data(), 1.0, qn, vn);
+      project(q, vs.data(), qp.data(), 1.0, qn, vn, true);
       bool over = false;
       for (int i = 0; i < n; ++i) tau[i] = sat[i] ? tpd[i] : tpd[i] - P.kd[i] * (vn[i] - v[i]);
       for (int i = 0; i < n; ++i) {
@@ -357,7 +363,6 @@ struct Stepper {
   // `locked` are held (zero acceleration) by their stops.
   void accel(const double* q, const double* v, const double* qr, const double* vr, double* t,
              double* a) {
-    Doubles ab(n);
     motor(q, v, qr, vr, t);
     for (int i = 0; i < n; ++i) ab[i] = t[i] - P.damping[i] * v[i];
     const Vec& acc = aba(q, v, ab.data());
@@ -599,7 +604,7 @@ struct Rollout {
     st.sat = sat1;
     std::copy(t1.begin(), t1.end(), st.tau.begin());
     st.locked.clear();
-    st.project(q.data(), yv.data(), yq.data(), 0.5, qn.data(), vn.data());
+    st.project(q.data(), yv.data(), yq.data(), 0.5, qn.data(), vn.data(), false);
     for (int i : held) st.stop[i] = 1;
     st.clamp(qn.data());
   }

@@ -1,0 +1,98 @@
+"""`ros-package` copies the spec's meshes into the description package and names them
+`package://`; meshes already in other packages keep their URIs and become dependencies."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pinocchio as pin
+import pytest
+from catkin_pkg.package import parse_package_string
+from lxml import etree
+
+from armcli.errors import InputError
+from armcli.ros.packages import ros_packages
+from armcli.spec.load import load_spec
+from tests.compiler.test_acceptance import SPEC, write_meshes
+
+DESC = "rich_arm_description"
+
+
+@pytest.fixture(scope="module")
+def project(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    project = tmp_path_factory.mktemp("pkgmeshes")
+    shutil.copy(SPEC, project / "armcli.yaml")
+    write_meshes(project)
+    return project
+
+
+@pytest.fixture(scope="module")
+def files(project: Path) -> dict[str, bytes]:
+    return dict(ros_packages(load_spec(project / "armcli.yaml"), samples=50).files)
+
+
+def test_meshes_are_copied_byte_for_byte(project: Path, files: dict[str, bytes]) -> None:
+    for name in ("base.stl", "link.stl"):
+        assert files[f"{DESC}/meshes/{name}"] == (project / "meshes" / name).read_bytes()
+    assert "DIRECTORY launch meshes rviz urdf" in files[f"{DESC}/CMakeLists.txt"].decode()
+
+
+def test_xacro_names_them_by_package(files: dict[str, bytes]) -> None:
+    arm = etree.fromstring(files[f"{DESC}/urdf/arm.xacro"])
+    uris = {m.get("filename") for m in arm.iter("mesh")}
+    assert uris == {f"package://{DESC}/meshes/base.stl", f"package://{DESC}/meshes/link.stl"}
+
+
+def test_the_installed_description_loads_in_pinocchio(
+    files: dict[str, bytes], tmp_path: Path
+) -> None:
+    import xacro
+
+    share = tmp_path / "share"
+    for rel, data in files.items():
+        if rel.startswith(DESC + "/"):
+            (share / rel).parent.mkdir(parents=True, exist_ok=True)
+            (share / rel).write_bytes(data)
+    doc = xacro.process_file(str(share / DESC / "urdf" / "standalone_arm.urdf.xacro"))
+    xml = doc.toprettyxml()
+    model = pin.buildModelFromXML(xml)
+    geom = pin.buildGeomFromUrdfString(
+        model, xml, pin.GeometryType.VISUAL, package_dirs=[str(share)]
+    )
+    meshes = [g.meshPath for g in geom.geometryObjects if g.meshPath.endswith(".stl")]
+    assert meshes and all(m.startswith(str(share / DESC / "meshes")) for m in meshes)
+
+
+def test_packaged_meshes_are_deterministic(project: Path, files: dict[str, bytes]) -> None:
+    again = dict(ros_packages(load_spec(project / "armcli.yaml"), samples=50).files)
+    assert again == files
+
+
+def test_other_packages_meshes_stay_and_become_dependencies(project: Path, tmp_path: Path) -> None:
+    text = (
+        (project / "armcli.yaml")
+        .read_text()
+        .replace("filename: meshes/base.stl", "filename: package://vendor_meshes/meshes/base.dae")
+    )
+    (tmp_path / "armcli.yaml").write_text(text)
+    write_meshes(tmp_path)
+    got = ros_packages(load_spec(tmp_path / "armcli.yaml"), samples=50).files
+    manifest = parse_package_string(got[f"{DESC}/package.xml"].decode())
+    assert "vendor_meshes" in {d.name for d in manifest.exec_depends}
+    assert f"{DESC}/meshes/base.stl" not in got
+    arm = got[f"{DESC}/urdf/arm.xacro"].decode()
+    assert "package://vendor_meshes/meshes/base.dae" in arm
+
+
+def test_two_files_on_one_package_path_are_refused(project: Path, tmp_path: Path) -> None:
+    write_meshes(tmp_path)
+    (tmp_path / "other" / "meshes").mkdir(parents=True)
+    shutil.copy(project / "meshes" / "link.stl", tmp_path / "other" / "meshes" / "base.stl")
+    shoulder = "geometry: {mesh: {filename: meshes/link.stl, scale: [1, 1, 0.8]}}"
+    text = (project / "armcli.yaml").read_text()
+    text = text.replace("filename: meshes/base.stl", "filename: other/meshes/base.stl", 1)
+    text = text.replace(shoulder, "geometry: {mesh: {filename: meshes/base.stl}}", 1)
+    (tmp_path / "armcli.yaml").write_text(text)
+    with pytest.raises(InputError, match=r"would both be copied to meshes/base\.stl"):
+        ros_packages(load_spec(tmp_path / "armcli.yaml"), samples=50)

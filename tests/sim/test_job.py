@@ -1,0 +1,35 @@
+"""What a simulate job keeps: the output rate's states and the final one, not every step."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from armcli.sim import job as simjob
+from armcli.sim.options import SimOptions
+from armcli.sim.plot import PLOT_POINTS
+from armcli.sim.states import sample_states
+from armcli.spec.load import load_spec
+from tests.helpers import DEFAULT_SPEC
+
+MSG = "{joint_names: [forearm_hand_joint], points: [{positions: [0.8], time_from_start: 1}]}"
+
+
+def _job(duration: float, rate: float) -> simjob.SimJob:
+    opts = SimOptions(message=MSG, duration=duration, rate=rate)
+    return simjob.prepare(load_spec(DEFAULT_SPEC), opts)
+
+
+def test_a_run_keeps_the_output_states_and_the_last() -> None:
+    """7.05 s at 1 ms and 10 Hz: 71 samples (0 .. 7.0 s) and the final state at 7.05 s."""
+    res = simjob.run(_job(7.05, 10.0))
+    assert res.steps == 7050 and len(res.t) == 72
+    np.testing.assert_array_equal(res.step, [*range(0, 7001, 100), 7050])
+    cols = sample_states(res, 10.0)  # the file holds the rate's samples only
+    assert len(cols["time"]) == 71 and cols["time"][-1] == 7.0
+    assert res.stats.states == 7051  # the metrics saw every state
+
+
+def test_a_plot_adds_an_even_spread_of_states() -> None:
+    res = simjob.run(_job(7.05, 10.0), plot=True)
+    assert PLOT_POINTS <= len(res.t) <= PLOT_POINTS + 72
+    assert np.all(np.diff(res.step) > 0) and res.step[-1] == 7050
