@@ -70,6 +70,7 @@ bench: install native-check
 	$(BIN)/python bench/bench_sim.py
 	$(BIN)/python bench/bench_process.py
 	$(BIN)/python bench/bench_tune.py
+	$(BIN)/python bench/bench_check_dof.py
 
 fuzz: install
 	HYPOTHESIS_PROFILE=fuzz $(BIN)/python -m pytest -q tests -k fuzz

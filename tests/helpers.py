@@ -10,6 +10,7 @@ from __future__ import annotations
 import copy
 import math
 import os
+import re
 import subprocess
 import sys
 from collections.abc import Callable, Mapping, Sequence
@@ -23,6 +24,27 @@ SPECS = ROOT / "specs"
 DEFAULT_SPEC = SPECS / "my_robot.yaml"
 FIXTURES = ROOT / "tests" / "fixtures"
 BAD_INPUTS = ROOT / "tests" / "bad_inputs"
+# The course's PD gains (the MoveIt tutorial's Kp 50, Kd 5): stable in armcli simulate's
+# loop, not in an explicit torque loop at 1 ms. The example spec keeps Kp and lowers Kd.
+COURSE_GAINS = {"arm_base_forearm_joint": (50.0, 5.0), "forearm_hand_joint": (50.0, 5.0)}
+
+
+def gains_text(text: str, gains: dict[str, tuple[float, float]]) -> str:
+    """Spec YAML text with `joint: {kp: .., kd: ..}` lines set to `gains` (one line each)."""
+    for joint, (kp, kd) in gains.items():
+        line = rf"\g<1>{{kp: {kp:g}, kd: {kd:g}}}"
+        text, n = re.subn(rf"(\n    {joint}: )\{{kp: [^}}\n]*\}}", line, text)
+        assert n == 1, joint
+    return text
+
+
+def course_gains_spec(directory: Path, name: str = "my_robot.yaml") -> Path:
+    """specs/my_robot.yaml with the course's gains (COURSE_GAINS), written into `directory`."""
+    path = directory / name
+    path.write_text(gains_text(DEFAULT_SPEC.read_text(), COURSE_GAINS))
+    return path
+
+
 CLI_TIME_LIMIT_S = 120.0  # one CLI run on a loaded 2-core machine
 
 

@@ -271,7 +271,7 @@ CASES: dict[str, tuple[Callable[[Any], None], RobotSpec | None, set[str]]] = {
     "gravity-effort": (set_attr(J1, "limit", "effort", "1"), None, {"gravity-effort"}),
     # An implicit-damping divergence is always an explicit one too (Kp bound is looser).
     "pd-unstable": (lambda r: None, with_gains(1e6, 5.0), {"pd-unstable", "pd-explicit-unstable"}),
-    "pd-explicit-unstable": (lambda r: None, SPEC, {"pd-explicit-unstable"}),
+    "pd-explicit-unstable": (lambda r: None, with_gains(50.0, 5.0), {"pd-explicit-unstable"}),
     # gz_ros2_control position servo: the error is multiplied by (1 - gain) per period
     "servo-unstable": (gz_position_servo(2.5), None, {"servo-unstable"}),
     "servo-oscillates": (gz_position_servo(1.5), None, {"servo-oscillates"}),
@@ -331,11 +331,13 @@ def test_summary_of_the_default_robot(root: Path) -> None:
     j1 = next(j for j in s.joints if j.name == "arm_base_forearm_joint")
     # Worst gravity torque on joint 1: both links horizontal, 0.3 kg at 0.15 m and 0.45 m.
     assert j1.gravity_max == pytest.approx(0.3 * 9.81 * (0.15 + 0.45), rel=1e-9)
-    assert s.stability is not None and not s.stability.explicit.stable
+    # the example's gains are stable in both loops (the course's Kd 5 is not: below)
+    assert s.stability is not None and s.stability.explicit.stable and s.stability.implicit.stable
 
 
 def test_issue_stability_verdict_for_the_seed_gains(root: Path) -> None:
-    result = check_urdf(read_urdf(root / "urdf" / "standalone_arm.urdf"), CheckOptions(spec=SPEC))
+    course = with_gains(50.0, 5.0)  # the course's Kp 50, Kd 5
+    result = check_urdf(read_urdf(root / "urdf" / "standalone_arm.urdf"), CheckOptions(spec=course))
     (f,) = [f for f in result.findings if f.rule == "pd-explicit-unstable"]
     assert f.values["lambda_max"] == pytest.approx(554.0, rel=1e-3)  # the issue's number
     assert "pd-unstable" not in {x.rule for x in result.findings}  # implicit damping is fine

@@ -12,7 +12,7 @@ import pytest
 
 from armcli.check.rules import RULES
 from tests.cli.test_check import armcli
-from tests.helpers import FIXTURES, ROOT
+from tests.helpers import FIXTURES, ROOT, course_gains_spec
 
 # The OASIS TC's schema, verbatim: github.com/oasis-tcs/sarif-spec,
 # sarif-2.1/schema/sarif-schema-2.1.0.json at commit e0583813964e (its "id" is the
@@ -99,8 +99,9 @@ def test_fingerprints_are_stable_across_runs_and_line_moves(tmp_path: Path) -> N
     assert a["partialFingerprints"] == b["partialFingerprints"]
 
 
-def test_strict_levels_spec_findings_and_remedies() -> None:
-    code, doc = sarif("specs/my_robot.yaml", "--strict")
+def test_strict_levels_spec_findings_and_remedies(tmp_path: Path) -> None:
+    spec = course_gains_spec(tmp_path)  # the course's Kd 5: the explicit loop diverges
+    code, doc = sarif(spec.name, "--strict", cwd=tmp_path)
     assert code == 1
     validate(doc)
     results = doc["runs"][0]["results"]
@@ -109,9 +110,8 @@ def test_strict_levels_spec_findings_and_remedies() -> None:
     # A finding in the URDF built in memory points at the spec field it comes from (the
     # gains), with that line; the message names the field and the generated file's line.
     loc = pd["locations"][0]["physicalLocation"]
-    spec_lines = (ROOT / "specs" / "my_robot.yaml").read_text().splitlines()
-    gains_line = spec_lines.index("  gains:") + 1
-    assert loc["artifactLocation"]["uri"] == "specs/my_robot.yaml"
+    gains_line = spec.read_text().splitlines().index("  gains:") + 1
+    assert loc["artifactLocation"]["uri"] == "my_robot.yaml"
     assert loc["region"] == {"startLine": gains_line}
     assert pd["message"]["text"].startswith(
         ("control.gains (my_robot.urdf:", "control.gains (standalone_arm.urdf:")

@@ -16,7 +16,7 @@ from armcli.check.run import check_urdf
 from armcli.sim.verdict import round_down
 from armcli.spec.load import load_spec
 from armcli.urdf.read import parse_urdf
-from tests.helpers import ROOT
+from tests.helpers import ROOT, course_gains_spec
 
 BASE = (ROOT / "urdf" / "my_robot.urdf").read_bytes()
 SPEC = load_spec(ROOT / "specs" / "my_robot.yaml")
@@ -181,10 +181,11 @@ def test_gravity_effort_remedy_covers_the_torque() -> None:
     assert f'effort="{f.fix["effort"]:g}"' in f.message
 
 
-def test_pd_remedy_is_stable() -> None:
+def test_pd_remedy_is_stable(tmp_path: Path) -> None:
     """The suggested dt and Kd for the course gains must each make the explicit loop stable
     (docs/check.md: stable for dt <= 0.705 ms, or Kd x 0.697 with Kp kept)."""
-    (f,) = [f for f in findings(lambda r: None, SPEC) if f.rule == "pd-explicit-unstable"]
+    course = load_spec(course_gains_spec(tmp_path))  # the course's Kp 50, Kd 5
+    (f,) = [f for f in findings(lambda r: None, course) if f.rule == "pd-explicit-unstable"]
     # 0.9 x the bounds, rounded down to 2 digits; Kp kept
     assert f.fix == {"dt": 0.00063, "kp": [50.0, 50.0], "kd": [3.1, 3.1]}
     lam = float(f.values["lambda_max"])  # type: ignore[arg-type]

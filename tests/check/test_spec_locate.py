@@ -12,15 +12,16 @@ from armcli.check.inputs import run_check
 from armcli.check.report import to_github, to_json
 from armcli.check.rules import CheckOptions, Finding
 from armcli.check.sarif import to_sarif
-from tests.helpers import DEFAULT_SPEC, SPECS
+from tests.helpers import COURSE_GAINS, DEFAULT_SPEC, SPECS, gains_text
 
-# The seed spec with a feather-light forearm and a motor too weak to hold the arm up.
+# The seed spec with a feather-light forearm, a motor too weak to hold the arm up and the
+# course's Kd 5 (which an explicit loop does not hold at 1 ms).
 EDITS = (("      mass: 0.3\n", "      mass: 0.00001\n"), ("effort: 100,", "effort: 0.01,"))
 
 
 @pytest.fixture(scope="module")
 def broken(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    text = DEFAULT_SPEC.read_text()
+    text = gains_text(DEFAULT_SPEC.read_text(), COURSE_GAINS)
     for old, new in EDITS:
         assert old in text
         text = text.replace(old, new, 1)

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.helpers import ROOT, run_cli
+from tests.helpers import ROOT, course_gains_spec, run_cli
 
 FIXTURES = ROOT / "tests" / "fixtures" / "check"
 HAND_TIP_HOME = [0.15, 0.0, 0.92]  # the issue's forward-kinematics reference [m]
@@ -43,25 +43,37 @@ def test_spec_json_schema_and_fk() -> None:
     robot = files["specs/my_robot.yaml#my_robot.urdf"]
     home = next(p for p in robot["summary"]["poses"] if p["name"] == "home")
     assert home["xyz"] == pytest.approx(HAND_TIP_HOME, abs=FK_ATOL)
-    rules = {f["rule"] for f in robot["findings"]}
-    assert rules == {"pd-explicit-unstable"}  # the issue: Kp 50, Kd 5 at 1 ms is not stable
+    assert {f["rule"] for f in robot["findings"]} == set()  # the example's gains: both loops
     st = robot["summary"]["stability"]
-    assert st["explicit"]["stable"] is False and st["implicit"]["stable"] is True
+    assert st["explicit"]["stable"] is True and st["implicit"]["stable"] is True
+    assert st["explicit"]["loop"].startswith("explicit torque loop")
     assert st["lambda_max"] == pytest.approx(554.0, rel=1e-3)
     assert set(doc["counts"]) == {"error", "warning"}
 
 
-def test_strict_turns_warnings_into_exit_1_and_ignore_silences() -> None:
-    r = armcli("check", "specs/my_robot.yaml", "--strict", "--format", "github")
+def test_course_gains_warn_for_the_explicit_loop(tmp_path: Path) -> None:
+    """The issue: Kp 50, Kd 5 at 1 ms is stable in armcli simulate, not in an explicit loop."""
+    r = armcli("check", course_gains_spec(tmp_path), "--format", "json")
+    assert r.returncode == 0, r.stderr
+    robot = next(f for f in json.loads(r.stdout)["files"] if f["file"].endswith("my_robot.urdf"))
+    assert {f["rule"] for f in robot["findings"]} == {"pd-explicit-unstable"}
+    st = robot["summary"]["stability"]
+    assert st["explicit"]["stable"] is False and st["implicit"]["stable"] is True
+    assert st["explicit"]["suggestion"]["dt"] == 0.00063  # 0.9 x 0.705 ms, rounded down
+
+
+def test_strict_turns_warnings_into_exit_1_and_ignore_silences(tmp_path: Path) -> None:
+    spec = course_gains_spec(tmp_path)
+    r = armcli("check", spec.name, "--strict", "--format", "github", cwd=tmp_path)
     assert r.returncode == 1
-    gains_line = (ROOT / "specs" / "my_robot.yaml").read_text().splitlines().index("  gains:") + 1
+    gains_line = spec.read_text().splitlines().index("  gains:") + 1
     assert r.stdout.startswith(
-        f"::error file=specs/my_robot.yaml,line={gains_line},title=armcli pd-explicit-unstable::"
+        f"::error file=my_robot.yaml,line={gains_line},title=armcli pd-explicit-unstable::"
         "control.gains (my_robot.urdf:"
     )
     assert "error finding(s)" in r.stderr
     ignored = ("--ignore", "pd-explicit-unstable", "--ignore", "root-inertia")
-    r = armcli("check", "specs/my_robot.yaml", "--strict", *ignored)
+    r = armcli("check", spec.name, "--strict", *ignored, cwd=tmp_path)
     assert r.returncode == 0, r.stdout
 
 

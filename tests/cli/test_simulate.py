@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -13,7 +14,7 @@ import numpy as np
 import pytest
 
 from armcli.cli import main
-from tests.helpers import ROOT, run_cli
+from tests.helpers import ROOT, course_gains_spec, run_cli
 
 TRAJ = ROOT / "specs" / "trajectories"
 J1, J2 = "arm_base_forearm_joint", "forearm_hand_joint"
@@ -113,12 +114,15 @@ def test_limits_error_or_clamp(tmp_path: Path, capsys: pytest.CaptureFixture[str
     assert code == 0 and "warning" in err and "clamped" in err
 
 
-def test_rk4_at_default_dt_is_refused_with_advice(capsys: pytest.CaptureFixture[str]) -> None:
-    code, _, err = run(["--message", SEED, "--integrator", "rk4"], capsys)
-    assert code == 2 and "stable for dt <=" in err
+def test_rk4_at_default_dt_is_refused_with_advice(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    spec = str(course_gains_spec(tmp_path))  # Kd 5: dt (Kd + damping) lambda_max = 2.8 at 1 ms
+    code, _, err = run([spec, "--message", SEED, "--integrator", "rk4"], capsys)
+    assert code == 2 and "stable for dt <=" in err and "default euler integrator" in err
     # dt and gains came from the spec: the error names its fields, not an option
-    assert "specs/my_robot.yaml control.dt, control.gains: " in err and "--dt" not in err
-    code, _, err = run(["--message", SEED, "--integrator", "rk4", "--dt", "0.0005"], capsys)
+    assert f"{spec} control.dt, control.gains: " in err and "--dt" not in err
+    code, _, err = run([spec, "--message", SEED, "--integrator", "rk4", "--dt", "0.0005"], capsys)
     assert code == 0, err
 
 
@@ -142,9 +146,8 @@ def test_bad_output_extension_fails_before_running(
 def test_integral_gain_is_refused_not_ignored(tmp_path: Path) -> None:
     """The simulator is PD: a spec ki > 0 is an error naming the field, unless --kp/--kd given."""
     text = (ROOT / "specs" / "my_robot.yaml").read_text()
-    assert "kd: 5" in text
     spec = tmp_path / "ki.yaml"
-    spec.write_text(text.replace("kd: 5", "kd: 5, ki: 0.5", 1))
+    spec.write_text(re.sub(r"(kd: [0-9.]+)\}", r"\1, ki: 0.5}", text, count=1))
     traj = str(ROOT / "specs" / "trajectories" / "pick.yaml")
     res = run_cli(["simulate", spec, "-t", traj, "--duration", "0.5"])
     assert res.returncode == 2

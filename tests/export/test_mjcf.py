@@ -26,7 +26,7 @@ from armcli.spec.load import load_spec
 from armcli.urdf.inertia import rpy_matrix
 from armcli.urdf.pinocchio import load_model
 from armcli.urdf.source import read_robot
-from tests.helpers import ROOT
+from tests.helpers import COURSE_GAINS, ROOT, course_gains_spec
 
 mujoco = pytest.importorskip("mujoco")
 pin = pytest.importorskip("pinocchio")
@@ -129,8 +129,10 @@ def _loop(
 
     `limits`: run both at the spec's own time step with MuJoCo's joint limits on (as
     exported); otherwise at LOOP_DT with the limits off, where the two steps are equal.
+    The gains are the course's (Kp 50, Kd 5), fixed here whatever the example spec holds.
     """
-    spec_path = ROOT / "specs" / "my_robot.yaml"
+    (tmp_path / "spec").mkdir()
+    spec_path = course_gains_spec(tmp_path / "spec")
     _, m, _ = _export(spec_path, tmp_path)
     spec = load_spec(spec_path)
     arm = arm_from_model(load_model(_urdf_file(spec_path, tmp_path)).model)
@@ -189,7 +191,7 @@ def test_closed_loop_agrees_on_a_trajectory_that_reaches_the_limits(
     """
     res, q_mj = _loop(tmp_path, friction, LIMIT_TRAJECTORY, limits=True)
     assert res.stop_active.any()  # the arm does reach its stops
-    kp, kd = 50.0, 5.0  # specs/my_robot.yaml control.gains
+    kp, kd = COURSE_GAINS["forearm_hand_joint"]  # the gains _loop runs with
     ctrl = res.q_ref + kd / kp * res.v_ref
     assert ctrl.min() < 0.0 and ctrl.max() > math.pi / 2  # outside the range [0, pi/2]
     assert np.max(np.abs(res.q - q_mj)) < LIMIT_AGREE

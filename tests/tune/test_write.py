@@ -10,7 +10,7 @@ import pytest
 from armcli.errors import InputError
 from armcli.spec.load import load_spec
 from armcli.tune.write import fmt_gain, updated_text, write_gains
-from tests.helpers import ROOT
+from tests.helpers import COURSE_GAINS, ROOT, gains_text
 
 SPEC = ROOT / "specs" / "my_robot.yaml"
 
@@ -34,7 +34,7 @@ def test_only_the_values_change(tmp_path: Path) -> None:
 
 def test_block_style_entries_and_a_new_joint(tmp_path: Path) -> None:
     text = (
-        SPEC.read_text(encoding="utf-8")
+        gains_text(SPEC.read_text(encoding="utf-8"), COURSE_GAINS)
         .replace(
             "    arm_base_forearm_joint: {kp: 50, kd: 5}\n",
             "    arm_base_forearm_joint:\n      kp: 50   # hand-tuned\n      kd: 5\n",

@@ -237,8 +237,12 @@ def _stability_text(st: Any) -> Any:
 
     t = Text(
         f"PD stability at dt = {st.dt:g} s: lambda_max(M^-1) = {st.lambda_max:.4g} 1/(kg m^2), "
-        f"gravity's stiffness up to {st.gravity_stiffness:.3g} N·m/rad, Kp up to {st.kp:g}, "
-        f"Kd + damping up to {st.d:g}"
+        + (
+            f"gravity's stiffness up to {st.gravity_stiffness:.3g} N·m/rad, "
+            if st.gravity_stiffness > 0
+            else ""
+        )
+        + f"Kp up to {st.kp:g}, Kd + damping up to {st.d:g}"
     )
     for v in (st.implicit, st.explicit):
         t.append(f"\n  {v.loop}: ")

@@ -73,7 +73,7 @@ class StabilityReport:
     q_worst: tuple[float, ...]  # controlled joints at the worst sample [rad or m]
     kp: float  # largest Kp [N·m/rad]
     d: float  # largest Kd + damping [N·m·s/rad]
-    gravity_stiffness: float  # largest eigenvalue of dg/dq over the samples [N·m/rad]
+    gravity_stiffness: float  # largest eigenvalue of dg/dq over the samples, >= 0 [N·m/rad]
     explicit: LoopVerdict
     implicit: LoopVerdict
     kd_max_explicit: float | None  # largest common Kd stable explicitly at dt (None: none)
@@ -130,7 +130,7 @@ def analyse(
     kp = _largest(pd.kp)
     with stab.one_blas_thread():
         lam = max(_lambda_max(M, pd) for M in lin.M)
-        g = max(float(np.linalg.eigvalsh(G)[-1]) for G in lin.G)
+        g = max(0.0, float(np.max(np.linalg.eigvalsh(lin.G)[:, -1]))) if len(lin) else 0.0
         kd_max = _common_kd_max(lin, pd, dt)
     return StabilityReport(
         dt=dt,
@@ -194,7 +194,7 @@ def refuse_unstable(lin: Linearised, pd: PD, dt: float, scheme: Scheme,
             return
         euler_ok = scheme == "rk4" and stab.stable(lin, pd, dt, "implicit")
     v = verdict(lin, pd, dt, scheme)
-    g = float(np.linalg.eigvalsh(lin.G[v.worst])[-1])
+    g = max(0.0, _top(lin.G[v.worst]))
     numbers = (_largest(pd.kp), _largest(pd.kd + pd.damping), g, _lambda_max(lin.M[v.worst], pd))
     text = message(v, names, qs[v.worst], dt, numbers)
     if euler_ok:
@@ -208,13 +208,20 @@ def _largest(x: np.ndarray) -> float:
     return float(np.max(x)) if x.size else 0.0
 
 
+def _top(S: np.ndarray) -> float:
+    """The largest eigenvalue of a symmetric matrix."""
+    return float(np.linalg.eigvalsh(S)[-1]) if S.size else 0.0
+
+
 def _lambda_max(M: np.ndarray, pd: PD) -> float:
     """lambda_max of the controlled block of M^-1 [1/(kg·m²)]."""
     idx = list(pd.idx)
     if not idx:
         return 0.0
+    if len(idx) == M.shape[0]:  # every joint controlled: 1 / lambda_min(M), no inverse
+        return 1.0 / float(np.linalg.eigvalsh(M)[0])
     Minv = np.linalg.inv(M)[np.ix_(idx, idx)]
-    return float(np.linalg.eigvalsh(0.5 * (Minv + Minv.T))[-1])
+    return _top(0.5 * (Minv + Minv.T))
 
 
 def _common_kd_max(lin: Linearised, pd: PD, dt: float) -> float | None:

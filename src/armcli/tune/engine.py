@@ -3,7 +3,7 @@
 The work is `evaluate.evaluate_candidates` on chunks of the batch; backends only decide
 where the chunks run, and results come back in batch order:
 
-- `LocalEngine(jobs)`: a thread pool with one chunk per thread. The compiled rollout
+- `LocalEngine(jobs)`: a thread pool, one candidate per task. The compiled rollout
   (the armcli.sim._rollout extension) releases the GIL, so threads run rollouts on separate cores;
 - `DaskEngine(address)`: an existing `dask.distributed` scheduler (`dask scheduler` /
   `dask worker`, or dask-jobqueue / dask-kubernetes clusters, which expose the same
@@ -24,6 +24,7 @@ from armcli.tune.objective import Weights
 from armcli.tune.problem import TuneProblem
 
 CONNECT_TIMEOUT_S = 3.0  # [s] to reach a Dask scheduler before giving up
+TASK_CANDIDATES = 1  # candidates per thread-pool task
 DASK_HINT = "pip install 'dask[distributed]' (what armcli's `dask` extra installs)"
 
 
@@ -59,9 +60,12 @@ class LocalEngine:
         """Score `batch` on the threads, results in batch order."""
         if self._pool is None:
             return evaluate_candidates(problem, batch, weights)
-        chunks = [list(batch[i :: self.jobs]) for i in range(self.jobs)]  # round robin
-        done = list(self._pool.map(lambda c: evaluate_candidates(problem, c, weights), chunks))
-        return [done[k % self.jobs][k // self.jobs] for k in range(len(batch))]
+        # One candidate per task: while one thread runs a rollout in C++ (GIL released),
+        # another does a candidate's Python set-up and scoring, instead of every thread
+        # contending for the GIL at the same moments of one big chunk each.
+        tasks = [batch[k : k + TASK_CANDIDATES] for k in range(0, len(batch), TASK_CANDIDATES)]
+        done = self._pool.map(lambda c: evaluate_candidates(problem, c, weights), tasks)
+        return [ev for chunk in done for ev in chunk]
 
     def close(self) -> None:
         """Stop the threads."""

@@ -1,0 +1,77 @@
+"""What a candidate costs (issue 24): the work shared by every candidate is done once.
+
+Scoring N candidates linearises each model once (M(q) and gravity's stiffness at the
+samples) and never samples a reference in Python (the compiled engine evaluates the
+trajectory's polynomials itself); per candidate only the rollouts and the stability
+verdict itself (one batched factorisation of A at the samples) remain.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+
+from armcli.sim import stability as stab
+from armcli.sim.reference import Reference
+from armcli.spec.load import load_spec
+from armcli.tune import evaluate, problem
+from armcli.tune import job as tjob
+from armcli.tune.objective import Weights
+from tests.helpers import ROOT
+from tests.sim import stability_reference as ref
+
+SPEC = ROOT / "specs" / "my_robot.yaml"
+PICK = ROOT / "specs" / "trajectories" / "pick.yaml"
+WAVE = ROOT / "specs" / "trajectories" / "wave.yaml"
+CANDIDATES = 5
+
+
+@pytest.fixture(scope="module")
+def job() -> tjob.TuneJob:
+    settings = tjob.TuneSettings(settle=0.3, robust=2, seed=1)
+    return tjob.prepare(load_spec(SPEC), SPEC, [PICK, WAVE], settings)
+
+
+def _batch(job: tjob.TuneJob) -> list[np.ndarray]:
+    start = np.concatenate([job.start.kp, job.start.kd])
+    return [start * (1.0 + 0.05 * k) for k in range(CANDIDATES)]
+
+
+def _counting(monkeypatch: pytest.MonkeyPatch, module: Any, name: str) -> list[int]:
+    calls = [0]
+    real = getattr(module, name)
+
+    def counted(*args: Any, **kwargs: Any) -> Any:
+        calls[0] += 1
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(module, name, counted)
+    return calls
+
+
+def test_shared_work_is_done_once_per_model(
+    job: tjob.TuneJob, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    fresh = job.problem.with_key()  # a new key: the per-process cache starts empty
+    monkeypatch.setattr(problem, "_CACHE", {})
+    sampled = _counting(monkeypatch, Reference, "sample")
+    linearised = _counting(monkeypatch, stab, "linearise")
+    evs = evaluate.evaluate_candidates(fresh, _batch(job), Weights())
+    assert all(ev.feasible for ev in evs)
+    assert sampled[0] == 0  # no reference is sampled per candidate (nor at all)
+    assert linearised[0] == len(fresh.variants)  # once per model, not per candidate
+
+
+def test_stability_verdict_per_candidate_is_the_bound(job: tjob.TuneJob) -> None:
+    """The batched factorisation judges as the eigenvalues of the step map do."""
+    sm = problem.scored_models(job.problem)[0]
+    n = len(job.problem.joints)
+    Ms, Gs = list(sm.lin.M), list(sm.lin.G)
+    for scale in (1.0, 30.0, 1e3, 1e5):
+        kp = job.start.kp * scale
+        pd = stab.PD.of(range(n), kp, job.start.kd, sm.arm.damping)
+        d = job.start.kd + sm.arm.damping
+        rho = ref.worst_radius(Ms, Gs, range(n), kp, d, job.problem.dt, "implicit")
+        assert stab.stable(sm.lin, pd, job.problem.dt, "implicit") == (rho <= 1 + ref.RADIUS_TOL)
