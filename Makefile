@@ -35,6 +35,7 @@ DEMO := out/demo
 demo: install
 	$(BIN)/armcli build $(SPEC)
 	$(BIN)/armcli check $(SPEC)
+	mkdir -p $(DEMO)
 	$(BIN)/armcli simulate $(SPEC) --trajectory specs/trajectories/pick.yaml \
 	  --output $(DEMO)/states.csv --plot $(DEMO)/tracking.png
 	$(BIN)/armcli render $(SPEC) --pose reach -o $(DEMO)/robot.png

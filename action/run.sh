@@ -9,8 +9,15 @@
 # whitespace). GITHUB_OUTPUT, when set, receives exit-code= and sarif-file=.
 set -uo pipefail
 
+# A workflow command's message: %, CR and LF escaped, so a value cannot start a command line.
+esc() {
+  local s=${1//'%'/%25}
+  s=${s//$'\r'/%0D}
+  printf '%s' "${s//$'\n'/%0A}"
+}
+
 die() {
-  echo "::error title=armcli action::$1"
+  echo "::error title=armcli action::$(esc "$1")"
   exit 2
 }
 

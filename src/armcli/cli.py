@@ -19,6 +19,7 @@ import typer.core
 import typer.main
 
 from armcli.errors import EXIT_FAILED, ArmcliError
+from armcli.io.oneline import one_line
 
 UNSANDBOXED_FLAG = "--trust-xacro-unsandboxed"  # what `--trust-xacro=unsandboxed` becomes
 
@@ -144,8 +145,12 @@ def _root(
 
 
 def _print_error(exc: ArmcliError) -> None:
-    """One line per problem, labelled by the error's class (never by sniffing its text)."""
-    for line in exc.lines():
+    """One line per problem, labelled by the error's class (never by sniffing its text).
+
+    A newline in a file name or value is escaped (`one_line`): a line of its own could be
+    a workflow command such as `::add-mask::` to GitHub Actions, which reads stderr too.
+    """
+    for line in map(one_line, exc.lines()):
         sys.stderr.write(f"{exc.label}: {line}\n" if exc.label else f"{line}\n")
 
 
@@ -191,7 +196,8 @@ def main(argv: list[str] | None = None) -> None:
         if debug:
             raise
         sys.stderr.write(
-            f"internal error: {type(exc).__name__}: {exc} (rerun with --debug for a traceback)\n"
+            f"internal error: {type(exc).__name__}: {one_line(str(exc))} "
+            "(rerun with --debug for a traceback)\n"
         )
         raise SystemExit(EXIT_FAILED) from None
 

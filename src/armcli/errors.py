@@ -7,6 +7,7 @@ diverged simulation). Library code raises these and never prints or exits.
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -18,6 +19,19 @@ EXIT_UNUSABLE = 2
 
 
 EXPANDED_TAG = "#expanded"  # source suffix of a xacro file's expansion (robot_source)
+
+
+def split_source(source: str) -> tuple[str, str]:
+    """(file, part) of a document's source name; part is "" for a whole file.
+
+    `robot.yaml#arm.urdf` (a URDF built in memory from a spec) and `x.xacro#expanded`
+    name a part of a file; any other `#` belongs to the file name (`a#b.urdf` is a file).
+    """
+    path, sep, part = source.rpartition("#")
+    spec_part = path.endswith((".yaml", ".yml")) and part.endswith(".urdf") and "/" not in part
+    if sep and (f"#{part}" == EXPANDED_TAG or spec_part) and not os.path.lexists(source):
+        return path, part
+    return source, ""
 
 
 def _where(file: str | Path | None, line: int | None) -> str:

@@ -124,3 +124,14 @@ def test_shell_metacharacters_in_paths_are_not_run(tmp_path: Path) -> None:
     r, _ = run_action(repo, paths=f"robots/clean.urdf;touch${{IFS}}{marker}", args="$(touch x)")
     assert r.returncode == 2  # no such file / unknown option, not a shell command
     assert not marker.exists() and not (repo / "x").exists()
+
+
+def test_input_values_cannot_inject_workflow_commands(tmp_path: Path) -> None:
+    """Issue 20: the action's own error line printed the input raw."""
+    r, _ = run_action(consumer_repo(tmp_path), strict="no\n::add-mask::armcli\r::x::y")
+    assert r.returncode == 2
+    lines = [ln.strip() for ln in re.split(r"\r\n|\r|\n", r.stdout + r.stderr)]
+    assert [ln for ln in lines if ln.startswith("::")] == [
+        "::error title=armcli action::input 'strict' must be true or false, "
+        "got 'no%0A::add-mask::armcli%0D::x::y'"
+    ]

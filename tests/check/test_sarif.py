@@ -151,3 +151,13 @@ def test_files_outside_the_root_get_absolute_file_uris(tmp_path: Path) -> None:
     assert artifact_uri(str(inside), tmp_path / "repo") == ("robots/a%20b.urdf", True)
     uri, relative = artifact_uri(str(outside), tmp_path / "repo")
     assert not relative and uri == outside.resolve().as_uri()
+
+
+def test_hash_in_a_file_name_stays_in_the_uri(tmp_path: Path) -> None:
+    """Issue 20: `a#b.urdf` was split at the `#` into file `a` and part `b.urdf`."""
+    _broken(tmp_path).rename(tmp_path / "repo" / "a#b.urdf")
+    _, doc = sarif("a#b.urdf", cwd=tmp_path / "repo")
+    validate(doc)
+    location = doc["runs"][0]["results"][0]["locations"][0]["physicalLocation"]
+    assert location["artifactLocation"]["uri"] == "a%23b.urdf"  # before: "a"
+    assert location["region"]["startLine"] > 0  # before: no line (taken for an in-memory part)

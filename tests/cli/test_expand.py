@@ -97,7 +97,7 @@ def test_missing_argument_is_one_line_naming_file_and_option(prefix: Path) -> No
         ["tree"],
         ["check"],
         ["render", "--size", "300x200", "-o", "{tmp}/arm.png"],
-        ["export", "mjcf", "-o", "{tmp}/mjcf/arm.xml"],
+        ["export", "mjcf", "-o", "{tmp}/arm.xml"],
         ["simulate", "-m", TRAJECTORY, "--kp", "50", "--kd", "5", "--duration", "1.2", "--urdf"],
     ],
     ids=lambda c: c[0],

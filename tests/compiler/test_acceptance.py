@@ -8,7 +8,9 @@ from __future__ import annotations
 import shutil
 import subprocess
 from pathlib import Path
+from typing import Any
 
+import numpy as np
 import pytest
 from lxml import etree
 
@@ -101,16 +103,61 @@ def test_check_does_not_flag_the_mimic_gripper(built: Path) -> None:
     assert about_fingers == []
 
 
-def test_simulate_refuses_mimic_joints_naming_the_way_out(built: Path) -> None:
-    from armcli.errors import InputError
-    from armcli.sim.job import refuse_mimic
-    from armcli.urdf.read import read_urdf
+FINGERS = ["left_finger_joint", "right_finger_joint"]
 
-    doc = read_urdf(built)
-    with pytest.raises(InputError) as info:
-        refuse_mimic(doc, None)
-    message = str(info.value)
-    assert "'right_finger_joint' mimics 'left_finger_joint'" in message
-    hint = message.split("lock the followers with `SimOptions.joints` ")[1]
-    assert hint.startswith("shoulder_pan_joint,") and "right_finger_joint" not in hint
-    refuse_mimic(doc, ["shoulder_pan_joint", "left_finger_joint"])  # followers locked: accepted
+
+def _finger_job(built: Path, msg: str, joints: list[str] = FINGERS) -> Any:
+    from armcli.sim import job as simjob
+    from armcli.sim.options import SimOptions
+    from armcli.spec.load import load_spec
+
+    spec = load_spec(built.parent.parent / "armcli.yaml")
+    opts = SimOptions(message=msg, joints=joints, kp=[200.0], kd=[2.0], duration=1.5)
+    return simjob.prepare(spec, opts)
+
+
+def test_simulate_drives_the_mimic_finger_through_its_leader(built: Path) -> None:
+    """right_finger mimics left_finger (multiplier 1, offset 0): commanding the leader alone
+    moves both, and the follower tracks the leader as gazebo_ros2_control makes it."""
+    from armcli.sim import job as simjob
+
+    msg = "{joint_names: [left_finger_joint], points: [{positions: [0.02], time_from_start: 0.5}]}"
+    job = _finger_job(built, msg)
+    assert list(job.arm.joint_names) == FINGERS
+    q_ref, v_ref = job.reference.sample(np.array([0.0, 0.25, 0.5, 1.0]))
+    np.testing.assert_array_equal(q_ref[:, 1], q_ref[:, 0])  # exactly: 1 * leader + 0
+    np.testing.assert_array_equal(v_ref[:, 1], v_ref[:, 0])
+    assert q_ref[-1, 0] == 0.02
+    res = simjob.run(job)
+    assert abs(res.q[-1, 0] - 0.02) < 1e-3 and abs(res.q[-1, 1] - 0.02) < 1e-3
+    assert np.max(np.abs(res.q[:, 1] - res.q[:, 0])) < 1e-3  # twin fingers, twin motion
+
+
+def test_simulate_refuses_commanding_a_follower_or_locking_its_leader(built: Path) -> None:
+    from armcli.errors import InputError
+
+    msg = "{joint_names: [right_finger_joint], points: [{positions: [0.02], time_from_start: 1}]}"
+    with pytest.raises(InputError, match="command 'left_finger_joint' and 'right_finger_joint'"):
+        _finger_job(built, msg)
+    msg = "{joint_names: [wrist_3_joint], points: [{positions: [0.2], time_from_start: 1}]}"
+    with pytest.raises(InputError, match="which is locked: lock 'right_finger_joint' too"):
+        _finger_job(built, msg, ["wrist_3_joint", "right_finger_joint"])
+
+
+def test_coupled_reference_adds_multiplier_and_offset() -> None:
+    """q_f(t) = m q_l(t) + o, v_f = m v_l on every polynomial piece, chains leaders first."""
+    from armcli.sim.reference import build_reference, coupled
+    from armcli.sim.trajectory import loads_trajectory
+    from armcli.urdf.mimic import Mimic
+
+    limits = {n: (-5.0, 5.0) for n in ("a", "b", "c")}
+    msg = (
+        "{joint_names: [a], points: [{positions: [1.0], time_from_start: 1},"
+        " {positions: [-0.5], time_from_start: 2}]}"
+    )
+    ref = build_reference(loads_trajectory(msg, limits, source="t"), ["a", "b", "c"], np.zeros(3))
+    pairs = [(1, 0, Mimic("b", "a", -2.0, 0.1)), (2, 1, Mimic("c", "b", 0.5, 0.0))]
+    q, v = coupled(ref, pairs).sample(np.linspace(0.0, 3.0, 31))
+    np.testing.assert_allclose(q[:, 1], -2.0 * q[:, 0] + 0.1, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(q[:, 2], 0.5 * q[:, 1], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(v[:, 1], -2.0 * v[:, 0], rtol=0, atol=1e-14)

@@ -200,9 +200,10 @@ def test_cli_exits_1_naming_the_link_and_writes_nothing(
     src = tmp_path / "r.urdf"
     src.write_text(_robot(_link("base", GOOD), _link("tip"), _joint("j", "base", "tip")))
     out = tmp_path / "mj" / "robot.xml"
+    out.parent.mkdir()  # output files need an existing directory (issue 20)
     with pytest.raises(SystemExit) as exc:
         main(["export", "mjcf", str(src), "-o", str(out)])
     assert exc.value.code == 1
     err = capsys.readouterr().err
     assert "link 'tip'" in err and "<inertial>" in err
-    assert not out.parent.exists()
+    assert list(out.parent.iterdir()) == []

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -74,3 +75,30 @@ def test_paths_outside_are_refused(tmp_path: Path, rel: str) -> None:
         create_files(tmp_path, {rel: b""})
     with pytest.raises(OutputRefusedError, match="outside the output directory"):
         write_tree_atomic(tmp_path / "o", {rel: b""})
+
+
+def test_a_symlinked_subdirectory_is_not_written_through(tmp_path: Path) -> None:
+    """Issue 20: `init` wrote trajectories/*.yaml into wherever `trajectories` pointed."""
+    project, elsewhere = tmp_path / "project", tmp_path / "elsewhere"
+    project.mkdir()
+    elsewhere.mkdir()
+    (project / "trajectories").symlink_to(elsewhere)
+    with pytest.raises(OutputRefusedError, match="symlink"):
+        create_files(project, {"armcli.yaml": b"a", "trajectories/pick.yaml": b"b"})
+    assert list(elsewhere.iterdir()) == []
+    assert sorted(p.name for p in project.iterdir()) == ["trajectories"]
+
+
+def test_a_killed_runs_stage_is_removed(tmp_path: Path) -> None:
+    stale = tmp_path / f".armcli-new-{_dead_pid()}-abc"
+    stale.mkdir()
+    (stale / "armcli.yaml").write_bytes(b"half")
+    create_files(tmp_path, {"armcli.yaml": b"a"})
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["armcli.yaml"]
+
+
+def _dead_pid() -> int:
+    """The PID of a process that has exited (its stage would be a killed run's)."""
+    proc = subprocess.Popen(["true"])
+    proc.wait()
+    return proc.pid

@@ -21,6 +21,7 @@ from pathlib import Path
 import pytest
 
 import armcli.io.files as fsio
+import armcli.io.together as together
 from armcli.errors import BuildError, OutputRefusedError
 from armcli.io.files import write_tree_atomic
 from armcli.io.outdir import MARKER_NAME
@@ -203,6 +204,7 @@ def test_out_of_space_error_has_no_none(tmp_path: Path, monkeypatch: pytest.Monk
     with pytest.raises(BuildError) as info:
         write_tree_atomic(tmp_path / "o", {"a.txt": b"1"})
     assert str(info.value).endswith("cannot write: No space left on device"), str(info.value)
+    monkeypatch.setattr(together, "_stage", full)  # single files: the one staging writer
     with pytest.raises(BuildError) as single:
         fsio.write_file_atomic(tmp_path / "f.txt", b"1")
     assert str(single.value).endswith("cannot write: No space left on device"), str(single.value)

@@ -65,3 +65,17 @@ def test_read_only_spec_is_refused_untouched(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="read-only"):
         write_gains(path, {"arm_base_forearm_joint": (1, 1)})
     assert path.read_bytes() == before
+
+
+def test_private_symlinked_spec_stays_private_and_linked(tmp_path: Path) -> None:
+    """Issue 20: `--write` made a 0600 spec 0644 and replaced a symlinked spec with a copy."""
+    real = tmp_path / "configs" / "robot.yaml"
+    real.parent.mkdir()
+    real.write_text(SPEC.read_text(encoding="utf-8"), encoding="utf-8")
+    real.chmod(0o600)
+    link = tmp_path / "robot.yaml"
+    link.symlink_to(real)
+    write_gains(link, {"arm_base_forearm_joint": (163.71, 6.8696)})
+    assert link.is_symlink()  # before: a plain file with the new gains; the real spec unchanged
+    assert load_spec(real).control.gains["arm_base_forearm_joint"].kp == 163.7
+    assert stat.S_IMODE(real.stat().st_mode) == 0o600  # before: 0644

@@ -335,3 +335,19 @@ def test_package_of_the_file_is_readable(tmp_path: Path) -> None:
     )
     doc = read_urdf_file(main, trust_xacro=True)
     assert b'<link name="from_common"/>' in doc.text
+
+
+@pytest.mark.parametrize("unsandboxed", [False, True], ids=["sandbox", "unsandboxed"])
+def test_timeout_holds_when_the_file_closes_its_output(unsandboxed: bool, tmp_path: Path) -> None:
+    """Issue 20: closing stdout and stderr, then sleeping, made armcli wait 91 s."""
+    code = "import os, time\nos.close(1)\nos.close(2)\ntime.sleep(60)"
+    start = time.monotonic()
+    with pytest.raises(InputError, match="took longer than 2 s"):
+        expand_untrusted(hostile(tmp_path, code), timeout=2.0, unsandboxed=unsandboxed)
+    assert time.monotonic() - start < FAST_S  # before: "failed: None" after the sleep
+
+
+def test_silent_failure_says_its_exit_status(tmp_path: Path) -> None:
+    code = "import os\nos.close(2)\nraise SystemExit(3)"
+    with pytest.raises(InputError, match=r"failed: exit status \d+, no message"):
+        expand_untrusted(hostile(tmp_path, code), unsandboxed=True)  # before: "failed: None"

@@ -17,6 +17,7 @@ from armcli.check.rules import RULES, CheckOptions, Collector, JointRow
 from armcli.check.structure import Tree
 from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf, position_bounds
+from armcli.urdf.mimic import follow, mimics
 from armcli.urdf.pinocchio import JointRange
 
 Stage = Literal["urdf", "model", "dynamics"]
@@ -85,8 +86,10 @@ def poses(ctx: Context) -> list[tuple[str, dict[str, float]]]:
             out.append((name, {k: v for k, v in spec.pose(name).items() if k in names}))
     else:
         out.append(("zero", {jr.name: 0.0 for jr in ctx.ranges}))
-    limited = [jr for jr in ctx.ranges if not jr.continuous]
+    coupled = mimics(ctx.urdf.joints)  # a mimic joint follows its leader in every pose
+    followers = {m.follower for m in coupled}
+    limited = [jr for jr in ctx.ranges if not jr.continuous and jr.name not in followers]
     if limited:
         out.append(("lower", {jr.name: jr.lower for jr in limited}))
         out.append(("upper", {jr.name: jr.upper for jr in limited}))
-    return out
+    return [(name, follow(coupled, values)) for name, values in out]

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import itertools
 import random
+from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any
 
@@ -23,6 +24,7 @@ from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf
 from armcli.urdf.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
 from armcli.urdf.meshes import mesh_paths
+from armcli.urdf.mimic import Mimic, follow
 from armcli.urdf.pinocchio import collision_model, configuration
 
 GRID_POINTS = 5  # per joint, when the grid has at most MAX_GRID samples
@@ -47,13 +49,18 @@ def round_up(x: float, digits: int = REMEDY_DIGITS) -> float:
     return float(f"{np.ceil(x / step - 1e-9) * step:.{digits}g}")
 
 
-def samples(model: Any, ranges: list[Any]) -> list[tuple[dict[str, float], Any]]:
+def samples(
+    model: Any, ranges: list[Any], coupled: Sequence[Mimic] = ()
+) -> list[tuple[dict[str, float], Any]]:
     """Joint-space sample as (joint values by name, Pinocchio configuration) pairs.
 
     A full grid for few joints; else the zero pose clamped into range, every corner of the
     range box (where gravity torques peak for serial arms) when there are few, and seeded
-    draws, so the same URDF always gives the same sample.
+    draws, so the same URDF always gives the same sample. Mimic joints (`coupled`) are not
+    sampled: they follow their leaders.
     """
+    followers = {m.follower for m in coupled}
+    ranges = [jr for jr in ranges if jr.name not in followers]
     n = len(ranges)
     names = [jr.name for jr in ranges]
     if n and GRID_POINTS**n <= MAX_GRID:
@@ -66,6 +73,7 @@ def samples(model: Any, ranges: list[Any]) -> list[tuple[dict[str, float], Any]]
             rows += [list(c) for c in itertools.product(*[(jr.lower, jr.upper) for jr in ranges])]
         rows += [[rng.uniform(jr.lower, jr.upper) for jr in ranges] for _ in range(RANDOM_SAMPLES)]
         points = [dict(zip(names, r, strict=True)) for r in rows]
+    points = [follow(coupled, p) for p in points]
     return [(p, configuration(model, p)) for p in points]
 
 

@@ -13,6 +13,8 @@ from typing import Any
 
 from armcli.check.rules import ERROR, WARNING, Finding
 from armcli.check.run import CheckResult
+from armcli.errors import split_source
+from armcli.io.oneline import one_line
 from armcli.io.terminal import Column, FitTable, Hanging
 
 JSON_SCHEMA = "armcli.check/1"
@@ -90,7 +92,7 @@ def to_github(findings: Sequence[Finding]) -> str:
     """
     lines = []
     for f in findings:
-        path, _, inner = f.file.partition("#")
+        path, inner = split_source(f.file)
         props = [f"file={_esc_prop(path)}"]
         if f.spec is not None and f.spec.line:  # the spec's own line
             props.append(f"line={f.spec.line}")
@@ -134,7 +136,7 @@ def to_rich(
     files = [(r.file, r) for r in results] + [(u, None) for u in unusable]
     for file, r in files:
         mine = by_severity([f for f in findings if f.file == file])
-        out.append(Text(f"\n{file}", style="bold"))
+        out.append(Text(f"\n{one_line(file)}", style="bold"))  # a name's newline is no line
         out.append(_findings_grid(mine) if mine else Text("no findings", style="green"))
         if r is not None:
             out.extend(_summary(r))
@@ -165,9 +167,9 @@ def _findings_grid(findings: Sequence[Finding]) -> Any:
             body.append(f" ({generated}:{f.line})" if f.line else "", style="dim")
         elif f.line:
             body.append(f"  line {f.line}")
-        body.append(f"\n{f.message}")
+        body.append(f"\n{one_line(f.message)}")
         if f.hint:
-            body.append(f"\nfix: {f.hint}", style="dim")
+            body.append(f"\nfix: {one_line(f.hint)}", style="dim")
         if f.fix:
             body.append(f"\nwrite: {_fix_text(f.fix)}", style="dim")
         items.append(Hanging(Text(f.severity, style=style), body, SEVERITY_WIDTH))

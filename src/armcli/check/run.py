@@ -30,6 +30,7 @@ from armcli.check.rules import CheckOptions, Collector, Finding
 from armcli.check.summary import Summary
 from armcli.errors import ModelLoadError
 from armcli.urdf.doc import Urdf
+from armcli.urdf.mimic import mimics
 from armcli.urdf.pinocchio import joint_ranges, load_model, parser_problems
 
 
@@ -108,7 +109,7 @@ def _ready(ctx: Context, needs: Stage) -> bool:
             ctx.notes.append(DYNAMICS_SKIPPED)
             ctx.stage = "no-dynamics"
         else:
-            ctx.samples = dyn.samples(ctx.model, ctx.ranges)
+            ctx.samples = dyn.samples(ctx.model, ctx.ranges, mimics(ctx.urdf.joints))
             ctx.stage = DYNAMICS
     if needs == MODEL:
         return ctx.model is not None

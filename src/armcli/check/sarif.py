@@ -28,6 +28,7 @@ from urllib.parse import quote
 
 from armcli import __version__
 from armcli.check.rules import RULES, Finding, Rule
+from armcli.errors import split_source
 
 SARIF_VERSION = "2.1.0"
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -70,7 +71,7 @@ def _subject(f: Finding) -> str:
 
 
 def _location(f: Finding, root: Path) -> tuple[dict[str, Any], str]:
-    path, _, inner = f.file.partition("#")
+    path, inner = split_source(f.file)
     uri, relative = artifact_uri(path, root)
     artifact: dict[str, Any] = {"uri": uri}
     if relative:
@@ -106,7 +107,7 @@ def to_sarif(findings: Sequence[Finding], root: Path | None = None) -> str:
     for f in findings:
         location, prefix = _location(f, base)
         uri = location["physicalLocation"]["artifactLocation"]["uri"]
-        key = f"{f.rule}|{uri}|{f.file.partition('#')[2]}|{_subject(f)}"
+        key = f"{f.rule}|{uri}|{split_source(f.file)[1]}|{_subject(f)}"
         seen[key] += 1  # the n-th finding with the same subject in the same file
         digest = hashlib.sha256(f"{key}|{seen[key]}".encode()).hexdigest()
         result: dict[str, Any] = {

@@ -19,6 +19,7 @@ from armcli.commands.xacro_inputs import (
     xacro_inputs,
 )
 from armcli.errors import InputError
+from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
@@ -92,7 +93,9 @@ def render_cmd(
     )
     for uri, why in skipped.items():  # drawn without them: a picture of the rest beats none
         hint = f" ({MESH_HINT})" if why == "not found" else ""
-        sys.stderr.write(f"warning: {src.source}: mesh {uri!r} {why}, not drawn{hint}\n")
+        sys.stderr.write(
+            one_line(f"warning: {src.source}: mesh {uri!r} {why}, not drawn{hint}") + "\n"
+        )
     drawn = _drawn(src.poses, pose, q)
     sys.stdout.write(f"wrote {res.path} ({res.width}x{res.height} px) at {drawn};{tip}\n")
 

@@ -21,12 +21,14 @@ from armcli.commands.xacro_inputs import (
 )
 from armcli.errors import InputError, ModelRefusedError, UnstableLoopError
 from armcli.io import terminal
+from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
+from armcli.io.together import write_files_together
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
 from armcli.sim import rosbag, states
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
-from armcli.sim.plot import write_tracking_plot
+from armcli.sim.plot import tracking_png
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
@@ -159,17 +161,21 @@ def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
     err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
     write_notes(job.notes)
     for w in job.trajectory.warnings:
-        err.print(f"warning: {w}", markup=False, highlight=False)
+        err.print(one_line(f"warning: {w}"), markup=False, highlight=False)
     with _LazyProgress(err) as progress:
         res = simjob.run(job, progress, plot=plot is not None)
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
+    files: dict[Path, bytes] = {}  # written together: never a new CSV beside an old plot
     if output is not None and rosbag.is_mcap(output):
-        rosbag.write_mcap(output, res, job.rate, job.urdf)
+        files[output] = rosbag.run_mcap_bytes(res, job.rate, job.urdf)
     elif output is not None:
-        states.write_states(output, res, job.rate)
+        files[output] = states.states_bytes(
+            states.sample_states(res, job.rate), states.output_format(output)
+        )
     if plot is not None:
-        write_tracking_plot(plot, res, job.arm.effort)
+        files[plot] = tracking_png(res, job.arm.effort)
+    write_files_together(files)
     out = terminal.console()
     out.print(simreport.summary_table(metrics, ee, job.tool_label, res), crop=False)
     for path in (output, plot):

@@ -12,8 +12,8 @@ from armcli.commands.flags import flag_errors, option_flags
 from armcli.commands.options import choice, option, spec_argument
 from armcli.errors import InputError
 from armcli.io import terminal
-from armcli.io.files import write_file_atomic
 from armcli.io.outdir import check_output_file
+from armcli.io.together import write_files_together
 from armcli.spec.discover import find_spec
 from armcli.spec.load import load_spec
 from armcli.tune import gains as gain_vector
@@ -21,10 +21,10 @@ from armcli.tune import job as tjob
 from armcli.tune import report, session
 from armcli.tune.engine import Engine, make_engine
 from armcli.tune.model_gains import LOOPS
-from armcli.tune.plot import write_tune_plot
+from armcli.tune.plot import tune_png
 from armcli.tune.problem import nominal_arm
 from armcli.tune.search import ROBUST_MODES, SearchOptions, validate
-from armcli.tune.write import check_writable, write_gains
+from armcli.tune.write import check_writable, edited_spec
 
 TRAJECTORY_HELP = (
     "JointTrajectory YAML (repeatable; default: trajectories/*.yaml next to the spec, "
@@ -36,6 +36,10 @@ LOOP_HELP = (
 )
 ROBUST_MODE_HELP = "Aggregate over the perturbed models: worst (default) or quantile."
 SCHEDULER_HELP = "Dask scheduler address, e.g. tcp://HOST:8786 (needs dask[distributed])."
+TRUST_SCHEDULER_HELP = (
+    "Allow a plain tcp:// scheduler on another host: the Dask client unpickles what the "
+    "cluster sends, so it runs code in armcli (docs/security.md)."
+)
 # The library's names for what these flags set (errors name them; commands.flags maps back).
 FLAGS = {
     **option_flags(SearchOptions, robust="--robust-mode"),
@@ -78,6 +82,7 @@ def tune_cmd(
     quantile: float = option(0.9, "--quantile", help="Quantile for --robust-mode quantile"),
     jobs: int = option(None, "--jobs", "-j", help="Local threads (default: every core)."),
     scheduler: str = option(None, "--scheduler", help=SCHEDULER_HELP),
+    trust_scheduler: bool = option(False, "--trust-scheduler", help=TRUST_SCHEDULER_HELP),
     output: Path = option(None, "--output", "-o", help="Write the results as JSON."),
     plot: Path = option(None, "--plot", help="Write history + before/after tracking PNG."),
     write: bool = option(False, "--write", help="Update control.gains in the spec in place."),
@@ -105,7 +110,11 @@ def tune_cmd(
         seed,
     )
     job = tjob.prepare(load_spec(spec_path), spec_path, trajectory or [], settings)
-    engine = make_engine(jobs if jobs is not None else (os.cpu_count() or 1), scheduler)
+    engine = make_engine(
+        jobs if jobs is not None else (os.cpu_count() or 1),
+        scheduler,
+        trust_scheduler=trust_scheduler,
+    )
     try:
         _run(job, engine, opts, output, plot, write, spec_path)
     finally:
@@ -134,19 +143,19 @@ def _run(
         report.comparison_table(job.problem, job.start, outcome.rows, arm_damping), crop=False
     )
     _summary(out, outcome)
+    files: dict[Path, bytes] = {}  # written together: all new or all as before
     if output is not None:
-        write_file_atomic(
-            output,
-            report.to_json(
-                job.problem, job.start, outcome.rows, outcome.result, opts, engine.name, arm_damping
-            ),
-        )
+        files[output] = report.to_json(
+            job.problem, job.start, outcome.rows, outcome.result, opts, engine.name, arm_damping
+        ).encode("utf-8")
     if plot is not None:
         case = session.showcase_case(job, outcome)
         runs = session.tracking_runs(job, outcome, case)
-        write_tune_plot(plot, outcome.result.history, runs, job.problem.cases[case].label)
+        files[plot] = tune_png(outcome.result.history, runs, job.problem.cases[case].label)
     if write:
-        write_gains(spec_path, gain_vector.by_joint(outcome.result.best, job.problem.joints))
+        best = gain_vector.by_joint(outcome.result.best, job.problem.joints)
+        files[spec_path] = edited_spec(spec_path, best)
+    write_files_together(files)
     for path in (output, plot, spec_path if write else None):
         if path is not None:
             out.print(f"wrote {path}", markup=False, highlight=False)

@@ -18,6 +18,7 @@ from typing import Any
 import typer
 
 from armcli.errors import InputError
+from armcli.io.oneline import one_line
 from armcli.urdf.packages import PackageLookup, parse_package_dirs
 from armcli.urdf.xacro_args import ARGS_HELP, ENV_HELP, XacroInputs, is_arg, parse_args, parse_env
 
@@ -84,8 +85,12 @@ def split_paths(tokens: Iterable[str]) -> tuple[list[Path], list[str]]:
 def write_notes(notes: Iterable[str], file: str | None = None) -> None:
     """Print what reading a robot file reported (`note: ...`, `warning: ...`) to stderr.
 
-    `file` names the robot file when several are read (check).
+    `file` names the robot file when several are read (check). File names and the
+    values in notes (xacro argument defaults) come from the input: a newline or carriage
+    return in them would start a line of its own, a workflow command to GitHub Actions
+    (`one_line`), so each note stays one line.
     """
     for line in notes:
         label, _, text = line.partition(": ")
-        sys.stderr.write(f"{label}: {file}: {text}\n" if file else f"{line}\n")
+        shown = f"{label}: {file}: {text}" if file else line
+        sys.stderr.write(one_line(shown) + "\n")

@@ -16,7 +16,7 @@ from lxml import etree
 from armcli.compiler.massprops import mesh_mass_properties, primitive_mass
 from armcli.compiler.meshfiles import MeshNames
 from armcli.compiler.passthrough import copy_into
-from armcli.compiler.xmlfmt import XACRO_NS, fmt, literal, sub, vec
+from armcli.compiler.xmlfmt import XACRO_NS, comment_text, fmt, literal, sub, vec
 from armcli.spec.model import Geometry, InlineMaterial, Link, Origin, Shape
 
 X = f"{{{XACRO_NS}}}"
@@ -187,7 +187,7 @@ def inertial_element(
         _macro_call(parent, shape, mass, refs)
         return
     props = mesh_mass_properties(shape, source, names.base_dir, f"{field}.inertial.shape")
-    about = shape.geometry.mesh.filename.replace("--", "- -")
+    about = comment_text(shape.geometry.mesh.filename)  # "---" kept a "--" with replace
     parent.append(etree.Comment(f" mass properties computed from {about} "))
     _explicit(parent, Origin(xyz=props.com, rpy=props.rpy), props.mass, props.inertia)
 

@@ -29,13 +29,32 @@ def vec(values: Iterable[float]) -> str:
     return " ".join(fmt(v) for v in values)
 
 
+# Characters XML 1.0 does not allow anywhere, not even in a comment.
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff\ud800-\udfff]")
+
+
+def comment_text(text: str) -> str:
+    """`text` made safe inside `<!-- ... -->`, whatever names it holds.
+
+    A space goes between consecutive hyphens (a comment may not hold `--`, so a name
+    with `-->` cannot end the comment and inject markup); characters XML forbids are
+    written as backslash-x escapes.
+    """
+    text = _NOT_XML.sub(lambda m: f"\\x{ord(m.group()):02x}", text)
+    return re.sub(r"-(?=-)", "- ", text)
+
+
 def to_bytes(root: etree._Element, *, header_comment: str | None = None) -> bytes:
-    """Serialise with an XML declaration, two-space indentation and a trailing newline."""
+    """Serialise with an XML declaration, two-space indentation and a trailing newline.
+
+    The header comment goes through `comment_text`; " -->" closes it, so it never ends
+    in "-" either.
+    """
     etree.indent(root, space="  ")
     body = etree.tostring(root, encoding="unicode")
     out = '<?xml version="1.0"?>\n'
     if header_comment:
-        out += f"<!-- {header_comment} -->\n"
+        out += f"<!-- {comment_text(header_comment)} -->\n"
     return (out + body + "\n").encode("utf-8")
 
 

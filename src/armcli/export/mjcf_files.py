@@ -1,22 +1,26 @@
 """`armcli export mjcf`: robot file -> model, scene.xml and meshes/ beside it.
 
-Everything is built in memory first (a bad input raises before any file is
-touched); each file is then replaced atomically, the model last, so a reader
-never sees a half-written file and the model never names a mesh that is not
-there yet.
+Everything is built in memory first and compiled by MuJoCo (a bad input or a model
+MuJoCo refuses raises before any file is touched); the files are then replaced
+together (io.together: all staged and synced before any target changes, so a full
+disk or a kill leaves the previous export whole, and a killed run's staging is
+cleaned by the next). As `build` does with its output directory, a symlinked output
+directory is written through, and a symlink inside it (`meshes/`) is refused.
 """
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from armcli.errors import InputError
+from armcli.errors import InputError, OutputRefusedError
 from armcli.export.mjcf import MjcfExport, build_mjcf
+from armcli.export.mjcf_meshes import MESH_DIR
 from armcli.export.mjcf_report import text
 from armcli.export.mjcf_scene import SCENE, scene_xml
 from armcli.export.mjcf_verify import Verdict, compile_check
-from armcli.io.files import write_file_atomic
+from armcli.io.together import write_files_together
 from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import MeshSearch, mesh_paths
 from armcli.urdf.source import RobotFile, Trust, read_robot
@@ -66,6 +70,7 @@ def export_mjcf(
     """
     if out.suffix != ".xml" or out.name == SCENE:
         raise InputError(f"the model file must end in .xml and not be {SCENE}", file=out)
+    check_targets(out)
     robot = read_robot(path, trust_xacro=trust_xacro, inputs=inputs)
     urdf = pick(robot, whole_robot)
     meshes = mesh_paths(urdf, search or MeshSearch())
@@ -74,7 +79,20 @@ def export_mjcf(
     report = text(exp.notes)
     files = mjcf_files(exp, out.name, urdf.name or "robot", header)
     verdict = compile_check(files, SCENE, urdf.source)  # before anything is written
-    written = []
-    for rel, data in files.items():  # meshes, scene, then the model
-        written.append(write_file_atomic(out.parent / rel, data))
+    written = write_files_together(
+        {out.parent / rel: data for rel, data in files.items()}, parents=True
+    )
     return Written(exp, tuple(written), urdf.source, report, verdict, urdf.notes)
+
+
+def check_targets(out: Path) -> None:
+    """Refuse, before any work, a set of outputs that cannot be written as one."""
+    scene, meshes = out.parent / SCENE, out.parent / MESH_DIR
+    if os.path.isdir(scene):
+        raise OutputRefusedError("is a directory, where the export writes its scene", file=scene)
+    if os.path.islink(meshes):
+        raise OutputRefusedError(
+            "is a symlink; armcli does not write through links inside the output directory "
+            "(a symlinked output directory itself is written through)",
+            file=meshes,
+        )

@@ -31,6 +31,7 @@ from armcli.io.outdir import (
     remove_entry,
     resolve_output_dir,
 )
+from armcli.io.together import write_files_together
 
 _AT_FDCWD = -100
 _RENAME_EXCHANGE = 2
@@ -62,22 +63,13 @@ def _payload(data: bytes | str) -> bytes:
 
 
 def write_file_atomic(path: str | Path, data: bytes | str) -> Path:
-    """Write `data` to `path` atomically (temp file in the same directory + rename)."""
-    target = Path(path)
-    try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        if target.is_dir():
-            raise BuildError(f"{target}: is a directory, cannot write a file there")
-        tmp = _write_temp(target.parent, target.name, _payload(data))
-        try:
-            os.replace(tmp, target)
-        except BaseException:
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
-            raise
-    except OSError as exc:
-        raise BuildError(f"{target}: cannot write: {_why(exc)}") from None
-    return target
+    """Write `data` to `path` atomically (temp file in the same directory + rename).
+
+    Missing parent directories are created (commands check their output paths first,
+    `outdir.check_output_file`); a symlink is written through and an existing file keeps
+    its permission bits (`together.write_files_together`, the one staging writer).
+    """
+    return write_files_together({Path(path): _payload(data)}, parents=True)[0]
 
 
 def _exchange(a: Path, b: Path) -> bool:

@@ -18,10 +18,10 @@ import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
-from armcli.errors import BuildError, ExistingFileError
-from armcli.io.outdir import relative_inside
+from armcli.errors import BuildError, ExistingFileError, OutputRefusedError
+from armcli.io.outdir import no_links_below, pid_alive, relative_inside, remove_entry
 
-_STAGE_PREFIX = ".armcli-new-"
+_STAGE_PREFIX = ".armcli-new-"  # + PID + "-": a killed run's stage is removed by the next
 
 
 def _umask() -> int:
@@ -32,7 +32,7 @@ def _umask() -> int:
 
 def _stage(parent: Path, files: Mapping[str, bytes]) -> Path:
     """A hidden directory in `parent` holding every file, flushed to disk."""
-    stage = Path(tempfile.mkdtemp(dir=parent, prefix=_STAGE_PREFIX))
+    stage = Path(tempfile.mkdtemp(dir=parent, prefix=f"{_STAGE_PREFIX}{os.getpid()}-"))
     os.chmod(stage, 0o777 & ~_umask())  # mkdtemp makes 0700; a new project dir is ordinary
     for rel, data in files.items():
         path = stage / relative_inside(rel)
@@ -44,11 +44,26 @@ def _stage(parent: Path, files: Mapping[str, bytes]) -> Path:
     return stage
 
 
+def _clean_stale(parent: Path) -> None:
+    """Remove the stages of killed runs (their PID is not alive)."""
+    with contextlib.suppress(OSError):
+        for entry in os.scandir(parent):
+            pid = entry.name[len(_STAGE_PREFIX) :].split("-", 1)[0]
+            if entry.name.startswith(_STAGE_PREFIX) and pid.isdigit() and not pid_alive(int(pid)):
+                remove_entry(Path(entry.path))
+
+
 def _refuse_existing(root: Path, files: Mapping[str, bytes]) -> None:
     if os.path.lexists(root) and not root.is_dir():
         raise ExistingFileError("exists and is not a directory", file=root)
     for rel in files:
         target = root / relative_inside(rel)
+        if not no_links_below(root, relative_inside(rel).parent):
+            raise OutputRefusedError(
+                "a directory on the way is a symlink; armcli does not write new files "
+                "through links (nothing was written)",
+                file=target,
+            )
         if os.path.lexists(target):
             raise ExistingFileError(
                 "already exists; nothing was written (never overwritten)", file=target
@@ -106,6 +121,7 @@ def create_files(root: str | Path, files: Mapping[str, bytes]) -> list[Path]:
     try:
         if not os.path.lexists(root):
             root.parent.mkdir(parents=True, exist_ok=True)
+            _clean_stale(root.parent)
             stage = _stage(root.parent, files)
             try:
                 os.rename(stage, root)  # fails if root appeared meanwhile with content
@@ -113,6 +129,7 @@ def create_files(root: str | Path, files: Mapping[str, bytes]) -> list[Path]:
                 shutil.rmtree(stage, ignore_errors=True)
                 raise
         else:
+            _clean_stale(root)
             stage = _stage(root, files)
             try:
                 _link_into(root, stage, files)

@@ -111,7 +111,11 @@ def check_output_file(path: str | Path, field: str) -> None:
         raise OutputRefusedError(
             "exists and is not a regular file (device, FIFO or socket)", file=p, field=field
         )
-    _check_parent(real, field)
+    if not real.parent.is_dir():  # a typo must not create directories (issue 20)
+        _check_parent(real, field)
+        raise OutputRefusedError(
+            f"directory {real.parent} does not exist; create it first", file=p, field=field
+        )
 
 
 def clean_stale_stages(parent: Path, name: str) -> None:
@@ -122,12 +126,13 @@ def clean_stale_stages(parent: Path, name: str) -> None:
             if not entry.name.startswith(prefix):
                 continue
             pid = entry.name[len(prefix) :].split("-", 1)[0]
-            if pid.isdigit() and _pid_alive(int(pid)):
+            if pid.isdigit() and pid_alive(int(pid)):
                 continue
             remove_entry(Path(entry.path))
 
 
-def _pid_alive(pid: int) -> bool:
+def pid_alive(pid: int) -> bool:
+    """Whether process `pid` exists: a staging entry of a live run is left alone."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:

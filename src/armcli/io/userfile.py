@@ -11,6 +11,7 @@ from __future__ import annotations
 import os
 import stat
 from pathlib import Path
+from typing import BinaryIO
 
 from armcli.errors import InputError
 
@@ -42,19 +43,33 @@ def check_regular(path: str | Path, what: str = "file") -> int:
     return st.st_size
 
 
-def read_regular(path: str | Path, *, max_bytes: int, what: str = "file") -> bytes:
-    """The bytes of a regular file of at most `max_bytes`; InputError otherwise."""
+def open_regular(path: str | Path, *, max_bytes: int, what: str = "file") -> BinaryIO:
+    """A binary stream of a regular file of at most `max_bytes` (checked before opening)."""
     p = Path(path)
     size = check_regular(p, what)
     if size > max_bytes:
         raise InputError(f"{what} is {size} bytes, larger than the {max_bytes}-byte cap", file=p)
     try:
         fd = os.open(p, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
-        with os.fdopen(fd, "rb") as fh:
-            _refuse_special(os.fstat(fd).st_mode, p, what)  # replaced since the stat
-            raw = fh.read(max_bytes + 1)
     except OSError as exc:
         raise InputError(f"cannot read {what}: {exc.strerror}", file=p) from None
+    fh = os.fdopen(fd, "rb")
+    try:
+        _refuse_special(os.fstat(fd).st_mode, p, what)  # replaced since the stat
+    except BaseException:
+        fh.close()
+        raise
+    return fh
+
+
+def read_regular(path: str | Path, *, max_bytes: int, what: str = "file") -> bytes:
+    """The bytes of a regular file of at most `max_bytes`; InputError otherwise."""
+    p = Path(path)
+    with open_regular(p, max_bytes=max_bytes, what=what) as fh:
+        try:
+            raw = fh.read(max_bytes + 1)
+        except OSError as exc:
+            raise InputError(f"cannot read {what}: {exc.strerror}", file=p) from None
     if len(raw) > max_bytes:
         raise InputError(f"{what} is larger than the {max_bytes}-byte cap", file=p)
     return raw

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,6 +22,7 @@ import numpy as np
 
 from armcli.errors import BuildError, InputError
 from armcli.urdf.doc import Urdf
+from armcli.urdf.mimic import Mimic, follow, mimics
 from armcli.urdf.pinocchio import load_model
 from armcli.urdf.read import parse_urdf
 
@@ -90,44 +91,54 @@ def adjacent_pairs(urdf: Urdf) -> set[tuple[str, str]]:
 
 
 class _Sampler:
-    """Joint configurations for a Pinocchio model: default state and uniform random states."""
+    """Joint configurations for a Pinocchio model: default state and uniform random states.
 
-    def __init__(self, model: Any) -> None:
+    Mimic joints (`coupled`) are not drawn: they follow their leaders, as in MoveIt's
+    RobotState.
+    """
+
+    def __init__(self, model: Any, coupled: Sequence[Mimic] = ()) -> None:
         self.model = model
-        self.joints = []  # (idx_q, nq, lower, upper) per actuated joint
-        for jm in list(model.joints)[1:]:
+        self.coupled = list(coupled)
+        followers = {m.follower for m in coupled}
+        self.joints = []  # (name, idx_q, nq, lower, upper) per actuated joint
+        for jid, jm in enumerate(list(model.joints)[1:], start=1):
             lo = float(model.lowerPositionLimit[jm.idx_q])
             hi = float(model.upperPositionLimit[jm.idx_q])
             if jm.nq == 2 and jm.nv == 1:  # continuous revolute joint stored as (cos, sin)
                 lo, hi = -math.pi, math.pi
             elif jm.nq != 1 or not (math.isfinite(lo) and math.isfinite(hi)):
                 raise BuildError(f"collision matrix: unsupported joint {jm.shortname()}")
-            self.joints.append((jm.idx_q, jm.nq, lo, hi))
+            self.joints.append((str(model.names[jid]), jm.idx_q, jm.nq, lo, hi))
+        self.free = [j for j in self.joints if j[0] not in followers]
 
     def _q(self, angles: Iterable[float]) -> np.ndarray:
+        values = follow(self.coupled, {j[0]: x for j, x in zip(self.free, angles, strict=True)})
         q = np.zeros(self.model.nq)
-        for (iq, nq, _, _), x in zip(self.joints, angles, strict=True):
+        for name, iq, nq, _, _ in self.joints:
+            x = values.get(name, 0.0)
             if nq == 2:
                 q[iq], q[iq + 1] = math.cos(x), math.sin(x)
             else:
                 q[iq] = x
         return q
 
+    def _defaults(self) -> dict[str, float]:
+        return {n: 0.0 if lo <= 0.0 <= hi else 0.5 * (lo + hi) for n, _, _, lo, hi in self.free}
+
     def default(self) -> np.ndarray:
         """MoveIt's default state: 0 where the limits allow it, else the middle of the range."""
-        return self._q(0.0 if lo <= 0.0 <= hi else 0.5 * (lo + hi) for _, _, lo, hi in self.joints)
+        return self._q(self._defaults().values())
 
     def named(self, values: dict[str, float]) -> np.ndarray:
-        """The default state with the named joints set (revolute/prismatic only)."""
-        q = self.default()
-        for name, x in values.items():
-            jm = self.model.joints[self.model.getJointId(name)]
-            if jm.nq == 1:
-                q[jm.idx_q] = x
-        return q
+        """The default state with the named 1-DoF joints set, and their followers."""
+        base = self._defaults()
+        one_dof = {n for n, _, nq, _, _ in self.free if nq == 1}
+        base.update((k, v) for k, v in values.items() if k in one_dof)
+        return self._q(base[n] for n, *_ in self.free)
 
     def random(self, rng: np.random.Generator) -> np.ndarray:
-        return self._q(rng.uniform(lo, hi) for _, _, lo, hi in self.joints)
+        return self._q(rng.uniform(lo, hi) for _, _, _, lo, hi in self.free)
 
 
 class _Checker:
@@ -203,7 +214,7 @@ def compute_collision_matrix(
     adjacent = adjacent_pairs(urdf)
     candidates = [p for p in itertools.combinations(links, 2) if p not in adjacent]
     checker = _Checker(data.decode("utf-8"), source, candidates)
-    sampler = _Sampler(checker.model)
+    sampler = _Sampler(checker.model, mimics(urdf.joints))
     all_k = range(len(checker.pair_links))
     default_hits = checker.colliding(sampler.default(), all_k)
 

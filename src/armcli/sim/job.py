@@ -17,7 +17,7 @@ from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_UR
 from armcli.errors import InputError
 from armcli.sim.options import SimOptions
 from armcli.sim.plot import plot_steps
-from armcli.sim.reference import Reference, build_reference
+from armcli.sim.reference import Reference, build_reference, coupled
 from armcli.sim.simulate import (
     MAX_STEPS,
     Arm,
@@ -32,6 +32,7 @@ from armcli.sim.simulate import (
 from armcli.sim.states import distinct, sample_steps
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.urdf.doc import Urdf
+from armcli.urdf.mimic import Mimic, mimics
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import Trust, checked_model, read_urdf_file
 from armcli.urdf.tool import tool_point
@@ -103,27 +104,41 @@ def load_arm(
     )
 
 
-def refuse_mimic(doc: Urdf, joints: Sequence[str] | None) -> None:
-    """Mimic joints are not coupled to their lead here: refuse them rather than drive them alone.
+def mimic_pairs(doc: Urdf, arm: Arm, traj: Trajectory, source: str) -> list[tuple[int, int, Mimic]]:
+    """(follower, leader) model indices of the simulated mimic joints, leaders first.
 
-    Locking the followers (`joints` without them) simulates the rest of the arm.
+    A follower is commanded through its leader (multiplier * leader + offset), as
+    gazebo_ros2_control and MoveIt do; naming it in the trajectory, or locking its leader
+    while it moves, is refused.
     """
-    movable = [j.name for j in doc.joints if j.movable]
-    chosen = list(joints) if joints else movable
-    followers = [j for j in doc.joints if j.mimic is not None and j.name in chosen]
-    if followers:
-        f = followers[0]
-        rest = ",".join(n for n in chosen if n not in {j.name for j in followers})
-        raise InputError(
-            f"joint {f.name!r} mimics {f.mimic!r}: armcli simulate does not couple mimic "
-            f"joints; lock the followers with `SimOptions.joints` {rest}",
-            file=doc.source,
-            field="SimOptions.joints",
-        )
+    names = list(arm.joint_names)
+    out = []
+    for m in mimics(doc.joints):
+        if m.follower not in names:
+            continue  # locked
+        if m.follower in traj.joint_names:
+            raise InputError(
+                f"joint {m.follower!r} mimics {m.leader!r}: command {m.leader!r} and "
+                f"{m.follower!r} follows it (multiplier {m.multiplier:g}, offset {m.offset:g})",
+                file=source,
+                field="joint_names",
+            )
+        if m.leader not in names:
+            raise InputError(
+                f"joint {m.follower!r} mimics {m.leader!r}, which is locked: lock "
+                f"{m.follower!r} too",
+                field="SimOptions.joints",
+            )
+        out.append((names.index(m.follower), names.index(m.leader), m))
+    return out
 
 
 def _gains(
-    arm: Arm, spec: RobotSpec | None, override: Sequence[float] | None, which: str
+    arm: Arm,
+    spec: RobotSpec | None,
+    override: Sequence[float] | None,
+    which: str,
+    leaders: dict[str, str] | None = None,
 ) -> np.ndarray:
     n = len(arm.joint_names)
     if override:
@@ -135,7 +150,10 @@ def _gains(
         if not np.all(np.isfinite(vals)) or np.any(vals < 0.0):
             raise InputError("gains must be finite and >= 0", field=f"SimOptions.{which}")
         return vals
-    gains = spec.control.gains if spec is not None else {}
+    gains = dict(spec.control.gains) if spec is not None else {}
+    for follower, leader in (leaders or {}).items():  # a mimic joint without its own gains
+        if follower not in gains and leader in gains:  # is driven like its leader
+            gains[follower] = gains[leader]
     missing = [j for j in arm.joint_names if j not in gains]
     if missing:
         raise InputError(
@@ -248,7 +266,6 @@ def prepare(
     if not (np.isfinite(dt) and 0 < dt <= 0.1):
         raise InputError(f"must be in (0, 0.1] s, got {dt:g}", field=dt_field)
     doc = arm_urdf(spec, opts.urdf, trust_xacro=opts.trust_xacro, inputs=opts.xacro)
-    refuse_mimic(doc, opts.joints)
     arm = arm_from_model(checked_model(doc, gate=gate if opts.urdf else None).model, opts.joints)
     limits = {
         n: (float(lo), float(hi))
@@ -258,14 +275,19 @@ def prepare(
         traj = load_trajectory(trajectory, limits, clamp=opts.clamp)
     else:
         traj = loads_trajectory(str(message), limits, source="SimOptions.message", clamp=opts.clamp)
+    pairs = mimic_pairs(doc, arm, traj, str(trajectory) if trajectory else "SimOptions.message")
     q0 = start_state(arm, spec)
-    ref = build_reference(traj, arm.joint_names, q0)
+    for f, lead, m in pairs:
+        q0[f] = np.clip(m.position(q0[lead]), arm.lower[f], arm.upper[f])
+    ref = coupled(build_reference(traj, arm.joint_names, q0), pairs)
     gc = (
         opts.gravity_comp
         if opts.gravity_comp is not None
         else bool(spec and spec.control.gravity_compensation)
     )
-    kp, kd = _gains(arm, spec, opts.kp, "kp"), _gains(arm, spec, opts.kd, "kd")
+    leaders = {m.follower: m.leader for _, _, m in pairs}
+    kp = _gains(arm, spec, opts.kp, "kp", leaders)
+    kd = _gains(arm, spec, opts.kd, "kd", leaders)
     if opts.kp is None or opts.kd is None:
         _refuse_integral_gain(arm, spec)
     cfg = SimConfig(kp, kd, dt, opts.integrator, gc)

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from armcli.sim.trajectory import Trajectory
+from armcli.urdf.mimic import Mimic
 
 
 @dataclass(frozen=True)
@@ -51,6 +52,18 @@ class Reference:
                 vi = vi * tau + k * c[:, k]
         q[inside], v[inside] = qi, vi
         return q, v
+
+
+def coupled(ref: Reference, pairs: Sequence[tuple[int, int, Mimic]]) -> Reference:
+    """`ref` with each follower column set to multiplier * leader + offset (leaders first)."""
+    if not pairs:
+        return ref
+    coeffs, final = ref.coeffs.copy(), ref.final.copy()
+    for f, lead, m in pairs:
+        coeffs[:, :, f] = m.multiplier * coeffs[:, :, lead]
+        coeffs[:, 0, f] += m.offset
+        final[f] = m.position(final[lead])
+    return Reference(knots=ref.knots, coeffs=coeffs, final=final)
 
 
 def segment_coeffs(

@@ -123,27 +123,11 @@ def run(
         mod.FAIL_ENERGY: "energy",
     }[code]
     recs, stats = r.records(), r.statistics()
-    trace = Trace(
-        step=recs["step"],
-        q=recs["q"],
-        v=recs["v"],
-        q_ref=recs["q_ref"],
-        v_ref=recs["v_ref"],
-        tau=recs["tau"],
-        saturated=recs["saturated"].astype(bool),
-        stop=recs["stop"].astype(bool),
-    )
+    flags = {"saturated": recs.pop("saturated").astype(bool), "stop": recs.pop("stop").astype(bool)}
+    fields = Stats.__dataclass_fields__
     return Rollout(
-        trace,
-        Stats(
-            states=int(stats["states"]),
-            sum_e2=stats["sum_e2"],
-            max_e=stats["max_e"],
-            last_e=stats["last_e"],
-            last_out=stats["last_out"],
-            saturated_steps=stats["saturated_steps"],
-            stop_rises=stats["stop_rises"],
-        ),
+        Trace(**recs, **flags),
+        Stats(**{k: v for k, v in stats.items() if k in fields}),
         r.q,
         r.v,
         int(fail_step),

@@ -31,8 +31,9 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
+from armcli.io.userfile import open_regular
 from armcli.sim.simulate import SimResult
-from armcli.sim.states import TIME, Replay, column, sample_states
+from armcli.sim.states import MAX_REPLAY_ROWS, TIME, Replay, column, sample_states
 from armcli.urdf.doc import Joint, Urdf
 
 MCAP_SUFFIX = ".mcap"
@@ -272,12 +273,17 @@ def _messages(chans: Sequence[Channel]) -> Iterator[tuple[int, int, int, dict[st
             yield ns, rank, k, msg
 
 
-def write_mcap(path: Path, res: SimResult, rate: float, urdf: Urdf | None) -> None:
-    """Write the run sampled at `rate` [Hz] as a rosbag2 MCAP file, atomically."""
+def run_mcap_bytes(res: SimResult, rate: float, urdf: Urdf | None) -> bytes:
+    """The run sampled at `rate` [Hz] as the bytes of a rosbag2 MCAP file."""
     if urdf is None:
         raise ValueError("an MCAP file needs the simulated robot description")
     cols = sample_states(res, rate)
-    write_file_atomic(path, mcap_bytes(channels(cols, res.joint_names, urdf)))
+    return mcap_bytes(channels(cols, res.joint_names, urdf))
+
+
+def write_mcap(path: Path, res: SimResult, rate: float, urdf: Urdf | None) -> None:
+    """Write the run sampled at `rate` [Hz] as a rosbag2 MCAP file, atomically."""
+    write_file_atomic(path, run_mcap_bytes(res, rate, urdf))
 
 
 # -- reader ----------------------------------------------------------------------------------
@@ -295,15 +301,24 @@ def load_replay(path: str | Path, joints: Sequence[str]) -> Replay:
 
     source = str(path)
     rows: dict[str, list[tuple[float, dict[str, float]]]] = {JOINT_STATES: [], REFERENCE: []}
-    try:
-        with open(path, "rb") as fh:
+    count = 0
+    try:  # a regular file of bounded size (a FIFO blocked open() forever), bounded messages
+        with open_regular(path, max_bytes=MAX_REPLAY_BYTES, what="MCAP file") as fh:
             reader = make_reader(fh, decoder_factories=[DecoderFactory()])
             for _, channel, _raw, msg in reader.iter_decoded_messages(
                 topics=[JOINT_STATES, REFERENCE]
             ):
+                count += 1
+                if count > 2 * MAX_REPLAY_ROWS:
+                    raise InputError(f"more than {MAX_REPLAY_ROWS:,} states", file=source)
                 t = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
                 known = {n: float(x) for n, x in zip(msg.name, msg.position, strict=False)}
-                rows[channel.topic].append((t, {n: v for n, v in known.items() if n in joints}))
+                mine = {n: v for n, v in known.items() if n in joints}
+                bad = [n for n, v in mine.items() if not math.isfinite(v)]
+                if bad:
+                    raise InputError(f"{channel.topic} at t = {t:g} s: {bad[0]} is not finite",
+                                     file=source)  # fmt: skip
+                rows[channel.topic].append((t, mine))
     except (McapError, OSError, ValueError, KeyError) as exc:
         raise InputError(f"unreadable MCAP file: {exc}", file=source) from None
     if not rows[JOINT_STATES]:

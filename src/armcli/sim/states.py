@@ -10,8 +10,6 @@ the file, line and column.
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 from collections.abc import Sequence
@@ -21,8 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from armcli.errors import InputError
+from armcli.io.csvtable import CsvBounds, read_numeric_csv
 from armcli.io.files import write_file_atomic
-from armcli.io.yaml import read_text
 from armcli.sim.simulate import MAX_STEPS, SimResult
 
 TIME = "time"
@@ -111,6 +109,9 @@ def write_states(path: Path, res: SimResult, rate: float) -> None:
 
 MAX_REPLAY_BYTES = 200_000_000
 MAX_REPLAY_ROWS = MAX_STEPS  # the most states `simulate` records
+MAX_REPLAY_COLUMNS = 1024  # time + 4 columns for each of 128 joints, with room to spare
+MAX_REPLAY_CELLS = 25_000_000  # 200 MB as float64 (a 198 MB file of 2 rows took 2 GB)
+REPLAY_BOUNDS = CsvBounds(MAX_REPLAY_BYTES, MAX_REPLAY_COLUMNS, MAX_REPLAY_ROWS, MAX_REPLAY_CELLS)
 
 
 @dataclass(frozen=True)
@@ -140,41 +141,15 @@ class Replay:
         return ref if all(math.isfinite(v) for v in ref.values()) else None
 
 
-def _parse_cell(text: str, col: str, line: int, source: str, blank_ok: bool) -> float:
-    if blank_ok and text.strip().lower() in ("", "nan"):
-        return math.nan
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not math.isfinite(value):
-        raise InputError(
-            f"expected a finite number, got {text!r}", file=source, line=line, field=col
-        )
-    return value
-
-
-def _rows(text: str, source: str) -> list[list[str]]:
-    """CSV rows, at most MAX_REPLAY_ROWS; csv's own limits become InputErrors with a line."""
-    reader = csv.reader(io.StringIO(text))
-    rows: list[list[str]] = []
-    try:
-        for row in reader:
-            rows.append(row)
-            if len(rows) > MAX_REPLAY_ROWS + 1:
-                raise InputError(f"more than {MAX_REPLAY_ROWS:,} data rows", file=source)
-    except csv.Error as exc:  # e.g. a field over csv.field_size_limit() characters
-        raise InputError(f"unreadable CSV: {exc}", file=source, line=reader.line_num) from None
-    return rows
-
-
 def load_replay(path: str | Path, joints: Sequence[str]) -> Replay:
     """Read a `simulate` CSV (time, NAME.position/.velocity/.effort/.reference) for `joints`."""
     source = str(path)
-    rows = _rows(read_text(path, max_bytes=MAX_REPLAY_BYTES, what="CSV"), source)
-    if not rows or not rows[0] or rows[0][0].strip() != TIME:
+    table = read_numeric_csv(
+        path, REPLAY_BOUNDS, lambda h: h.endswith((".reference", ".velocity", ".effort"))
+    )  # bounded before allocating; duplicate columns refused
+    header = table.header
+    if not header or header[0] != TIME:
         raise InputError("first column must be 'time'", file=source, line=1)
-    header = [h.strip() for h in rows[0]]
     pos_cols = {h[: -len(".position")]: i for i, h in enumerate(header) if h.endswith(".position")}
     ref_cols = {
         h[: -len(".reference")]: i for i, h in enumerate(header) if h.endswith(".reference")
@@ -185,24 +160,16 @@ def load_replay(path: str | Path, joints: Sequence[str]) -> Replay:
             raise InputError(f"unknown joint {name!r}; known: {known}", file=source, line=1)
     if not pos_cols:
         raise InputError("no NAME.position columns", file=source, line=1)
-    data = [r for r in rows[1:] if r]
-    if not data:
+    if not len(table.values):
         raise InputError("no data rows", file=source, line=2)
-    table = np.empty((len(data), len(header)))
-    for k, row in enumerate(data):
-        line = k + 2
-        if len(row) != len(header):
-            raise InputError(f"{len(row)} cells, header has {len(header)}", file=source, line=line)
-        for i, cell in enumerate(row):
-            blank_ok = header[i].endswith((".reference", ".velocity", ".effort"))
-            table[k, i] = _parse_cell(cell, header[i], line, source, blank_ok)
-    t = table[:, 0]
+    t = table.values[:, 0]
     bad = np.nonzero(np.diff(t) <= 0)[0]
     if len(bad):
-        raise InputError("time must increase", file=source, line=int(bad[0]) + 3, field="time")
+        line = int(table.lines[bad[0] + 1])
+        raise InputError("time must increase", file=source, line=line, field="time")
     return Replay(
         source=source,
         time=t,
-        position={j: table[:, i] for j, i in pos_cols.items()},
-        reference={j: table[:, i] for j, i in ref_cols.items()},
+        position={j: table.values[:, i] for j, i in pos_cols.items()},
+        reference={j: table.values[:, i] for j, i in ref_cols.items()},
     )

@@ -8,13 +8,26 @@ where the chunks run, and results come back in batch order:
 - `DaskEngine(address)`: an existing `dask.distributed` scheduler (`dask scheduler` /
   `dask worker`, or dask-jobqueue / dask-kubernetes clusters, which expose the same
   address). The problem is broadcast once; each candidate is one task.
+
+Trust: the Dask client unpickles what the scheduler and workers send, so whoever runs
+the cluster, or can speak in its place on the network, runs code inside armcli. The
+trust boundary is the cluster: a plain `tcp://` address on another host is refused
+unless the user says it is trusted (`--trust-scheduler`); `tls://` (with Dask's TLS
+configuration) or a loopback address is accepted. Before Dask's own handshake, a
+raw probe checks that the address answers like a Dask comm (a non-Dask server gave
+`MemoryError` for a 3 EiB frame length).
 """
 
 from __future__ import annotations
 
+import ipaddress
+import socket
+import struct
+import time
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Protocol
+from urllib.parse import urlsplit
 
 import numpy as np
 
@@ -24,6 +37,14 @@ from armcli.tune.objective import Weights
 from armcli.tune.problem import TuneProblem
 
 CONNECT_TIMEOUT_S = 3.0  # [s] to reach a Dask scheduler before giving up
+MAX_HANDSHAKE_BYTES = 1 << 20  # a Dask handshake is a few hundred bytes
+PLAIN_SCHEMES = ("tcp", "ws", "ucx")  # unencrypted, unauthenticated transports
+TRUST_HINT = (
+    "the Dask client unpickles what the cluster sends, so a scheduler reached over plain "
+    "tcp:// on another host can run code in armcli: use tls:// (Dask's TLS settings), an SSH "
+    "tunnel to a loopback address, or pass --trust-scheduler if you trust the network and "
+    "the cluster"
+)
 TASK_CANDIDATES = 1  # candidates per thread-pool task
 DASK_HINT = "pip install 'dask[distributed]' (what armcli's `dask` extra installs)"
 
@@ -76,7 +97,10 @@ class LocalEngine:
 class DaskEngine:
     """Candidates as tasks on an existing dask.distributed scheduler."""
 
-    def __init__(self, address: str, timeout: float = CONNECT_TIMEOUT_S) -> None:
+    def __init__(
+        self, address: str, timeout: float = CONNECT_TIMEOUT_S, *, trusted: bool = False
+    ) -> None:
+        check_scheduler_address(address, trusted)
         try:
             from distributed import Client
         except ImportError:
@@ -117,24 +141,92 @@ class DaskEngine:
         self.client.close()
 
 
-def _probe(address: str, timeout: float) -> None:
-    """Connect and handshake with a hard deadline.
+def _split(address: str) -> tuple[str, str, int | None]:
+    """(scheme, host, port) of a Dask address; `HOST:PORT` alone means tcp://."""
+    scheme, sep, rest = address.partition("://")
+    if not sep:
+        scheme, rest = "tcp", address
+    parsed = urlsplit(f"//{rest}")
+    try:
+        port = parsed.port
+    except ValueError:
+        raise InputError(f"bad port in {address!r}", field="scheduler") from None
+    return scheme.lower(), (parsed.hostname or "").lower(), port
 
-    `Client` alone can wait forever on a port that accepts TCP but never speaks Dask.
+
+def is_loopback(host: str) -> bool:
+    """Whether `host` names this machine without asking DNS (localhost or a loopback IP)."""
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+def check_scheduler_address(address: str, trusted: bool) -> None:
+    """Refuse a plain-text scheduler on another host unless `trusted` (see the docstring)."""
+    scheme, host, _ = _split(address)
+    if scheme in PLAIN_SCHEMES and not is_loopback(host) and not trusted:
+        raise InputError(f"{address} is not encrypted and not on this machine: {TRUST_HINT}",
+                         field="scheduler")  # fmt: skip
+
+
+def _raw_probe(host: str, port: int, timeout: float) -> None:
+    """Read the first 8 bytes the peer sends: a Dask comm's handshake length, sent unasked.
+
+    A server that stays silent is unreachable (TimeoutError); one that announces a message
+    of gigabytes is not a Dask scheduler.
+    """
+    with socket.create_connection((host, port), timeout=timeout) as sock:
+        head = b""
+        deadline = time.monotonic() + timeout
+        while len(head) < 8:
+            sock.settimeout(max(deadline - time.monotonic(), 0.001))
+            try:
+                chunk = sock.recv(8 - len(head))
+            except TimeoutError:
+                raise TimeoutError("no answer") from None  # reported as unreachable
+            if not chunk:
+                raise ConnectionResetError("the connection was closed before the handshake")
+            head += chunk
+    (size,) = struct.unpack("<Q", head)
+    if size > MAX_HANDSHAKE_BYTES:
+        raise _NotDaskError(f"its first message claims {size} bytes")
+
+
+class _NotDaskError(Exception):
+    """The address answers, but not as a Dask scheduler."""
+
+
+def _probe(address: str, timeout: float) -> None:
+    """Check the peer, then connect and handshake with a hard deadline.
+
+    `Client` alone can wait forever on a port that accepts TCP but never speaks Dask, and
+    Dask's reader allocates whatever length a stranger's first 8 bytes claim.
     """
     import asyncio
 
     from distributed.comm.core import connect
 
-    async def once() -> None:
-        comm = await asyncio.wait_for(connect(address, timeout=timeout), timeout)  # type: ignore[no-untyped-call]
-        await comm.close()
+    scheme, host, port = _split(address)
+    try:
+        if scheme == "tcp" and port is not None:
+            _raw_probe(host, port, timeout)
 
-    asyncio.run(once())
+        async def once() -> None:
+            comm = await asyncio.wait_for(connect(address, timeout=timeout), timeout)  # type: ignore[no-untyped-call]
+            await comm.close()
+
+        asyncio.run(once())
+    except (_NotDaskError, MemoryError, OverflowError, struct.error) as exc:
+        why = str(exc) or type(exc).__name__
+        raise InputError(f"{address} does not answer as a Dask scheduler ({why})",
+                         field="scheduler") from None  # fmt: skip
 
 
-def make_engine(jobs: int, scheduler: str | None) -> Engine:
+def make_engine(jobs: int, scheduler: str | None, *, trust_scheduler: bool = False) -> Engine:
     """The local thread pool, or Dask when a scheduler address is given."""
     if scheduler:
-        return DaskEngine(scheduler)
+        return DaskEngine(scheduler, trusted=trust_scheduler)
     return LocalEngine(jobs)

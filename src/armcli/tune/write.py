@@ -117,6 +117,11 @@ def _last_line(block: Any, key: str, lines: list[str]) -> int:
 
 def write_gains(path: Path, gains: Mapping[str, tuple[float, float]]) -> None:
     """Update `control.gains` in the spec at `path` atomically (see the module docstring)."""
+    write_file_atomic(path, edited_spec(path, gains))
+
+
+def edited_spec(path: Path, gains: Mapping[str, tuple[float, float]]) -> bytes:
+    """The spec at `path` with `control.gains` updated, checked to read back; not written."""
     check_writable(path)
     text = read_text(path, what="spec")
     new = updated_text(text, path, gains)
@@ -128,4 +133,4 @@ def write_gains(path: Path, gains: Mapping[str, tuple[float, float]]) -> None:
                 f"the edited spec does not read back {joint}'s gains; nothing written",
                 file=path, field="control.gains",
             )  # fmt: skip
-    write_file_atomic(path, new)
+    return new.encode("utf-8")

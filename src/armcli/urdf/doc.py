@@ -145,6 +145,8 @@ class Joint:
     friction: float
     mimic: str | None = None
     mimic_line: int | None = None
+    mimic_multiplier: float = 1.0  # q = multiplier * q_mimic + offset
+    mimic_offset: float = 0.0
 
     @property
     def movable(self) -> bool:

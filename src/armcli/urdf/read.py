@@ -211,7 +211,13 @@ def _joint(num: _Numbers, el: etree._Element) -> Joint:
         friction=num.one(dyn_el, "friction", f"{where}dynamics", 0.0) or 0.0,
         mimic=mimic_el.get("joint") if mimic_el is not None else None,
         mimic_line=_ln(mimic_el) if mimic_el is not None else None,
+        mimic_multiplier=_or(num.one(mimic_el, "multiplier", f"{where}mimic", 1.0), 1.0),
+        mimic_offset=_or(num.one(mimic_el, "offset", f"{where}mimic", 0.0), 0.0),
     )
+
+
+def _or(value: float | None, default: float) -> float:
+    return default if value is None else value
 
 
 def _optional(num: _Numbers, el: etree._Element, attr: str, where: str) -> float | None:

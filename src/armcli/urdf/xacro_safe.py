@@ -24,6 +24,7 @@ is bounded too (`child_main` is that child's entry point).
 from __future__ import annotations
 
 import contextlib
+import glob
 import json
 import os
 import re
@@ -112,13 +113,45 @@ class _State:
             )
         return real
 
-    def read(self, path: str, what: str) -> bytes:
+    def read(self, path: str, what: str) -> str:
+        """The text of a confined file: UTF-8 only, no DOCTYPE or entity declarations.
+
+        In UTF-16 a DOCTYPE hides from a byte search and the XML parser follows the file's
+        own encoding, so the text is decoded strictly and handed on as str (issue 20).
+        """
         real = self.confine(path, what)
         data = read_regular(real, max_bytes=MAX_XACRO_FILE_BYTES, what=what)
-        if b"<!DOCTYPE" in data or b"<!ENTITY" in data:
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError:
+            raise _ProblemError(f"{what} {path!r} is not UTF-8 text", path) from None
+        if "\x00" in text:  # UTF-16 without a byte-order mark is valid UTF-8 full of NULs
+            raise _ProblemError(f"{what} {path!r} holds NUL characters", path)
+        if "<!DOCTYPE" in text or "<!ENTITY" in text:
             raise _ProblemError(f"{what} {path!r} declares a DOCTYPE/entities", path)
-        self.files[str(real)] = data.decode("utf-8", "replace")
-        return data
+        self.files[str(real)] = text
+        return text
+
+    def include_files(self, spec: str) -> list[str]:
+        """The files an include names, a glob matched only inside the allowed roots.
+
+        The pattern's literal directory must be inside a root, and matches outside the
+        roots (through symlinks) are dropped without a word: an error naming them told
+        the file's author which files exist elsewhere (`/root/.*rc` -> `/root/.bashrc`).
+        """
+        if not glob.has_magic(spec):
+            return [spec]
+        literal = spec[: min(spec.find(c) for c in "*?[" if c in spec)]
+        self.confine(os.path.dirname(literal) or ".", "include pattern")
+        inside = [f for f in sorted(glob.glob(spec)) if self.inside(f)]
+        if not inside:
+            self.warnings.append(f"include pattern {spec!r} matches no file")
+        return inside
+
+    def inside(self, path: str) -> bool:
+        """Whether `path` (symlinks resolved) lies in one of the allowed roots."""
+        real = Path(os.path.realpath(path))
+        return any(real.is_relative_to(r) for r in self.roots)
 
     def expansion(self) -> Expansion:
         given = tuple(self.inputs.args)
@@ -243,7 +276,7 @@ def _patches(state: _State, xacro: Any) -> dict[str, Any]:
 
     def load_yaml(filename: str) -> Any:
         path = xacro.abs_filename_spec(filename)
-        data = state.read(path, "YAML file").decode("utf-8", "replace")
+        data = state.read(path, "YAML file")
         xacro.filestack.append(path)
         try:
             doc = read_yaml(
@@ -277,8 +310,14 @@ def _patches(state: _State, xacro: Any) -> dict[str, Any]:
                 xacro.filestack.pop()
                 err = FileNotFoundError(2, "No such file or directory", path)
                 raise xacro.XacroException(f"No such file or directory: {path}", exc=err)
-            return xml.dom.minidom.parseString(state.read(path, "included file"))
+            return xml.dom.minidom.parseString(state.read(path, "included file"))  # str: UTF-8
         return xml.dom.minidom.parseString(inp) if isinstance(inp, str | bytes) else inp
+
+    def get_include_files(filename_spec: str, symbols: Any) -> Iterator[str]:
+        spec = xacro.abs_filename_spec(xacro.eval_text(filename_spec, symbols))
+        for filename in state.include_files(spec):
+            xacro.all_includes.append(filename)
+            yield filename
 
     def handle_macro_call(node: Any, macros: Any, symbols: Any) -> Any:
         state.calls += 1
@@ -295,6 +334,7 @@ def _patches(state: _State, xacro: Any) -> dict[str, Any]:
         "safe_eval": evaluate,
         "eval_extension": lambda s: _extension(state, xacro, s),
         "parse": parse,
+        "get_include_files": get_include_files,
         "handle_macro_call": handle_macro_call,
         "load_yaml": load_yaml,
         "warning": warning,

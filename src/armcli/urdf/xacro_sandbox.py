@@ -144,7 +144,13 @@ def run_limited(
     assert proc.stdout is not None and proc.stderr is not None
     caps: dict[object, int] = {proc.stdout: XACRO_MAX_OUTPUT, proc.stderr: XACRO_MAX_STDERR}
     bufs: dict[object, bytearray] = {proc.stdout: bytearray(), proc.stderr: bytearray()}
-    why = _pump(proc, caps, bufs, time.monotonic() + timeout, timeout)
+    deadline = time.monotonic() + timeout
+    why = _pump(proc, caps, bufs, deadline, timeout)
+    if why is None:  # both streams closed: the child may still run (closed them and slept)
+        try:
+            proc.wait(timeout=max(deadline - time.monotonic(), 0.0))
+        except subprocess.TimeoutExpired:
+            why = f"took longer than {timeout:g} s"
     if why is not None:
         _kill_group(proc.pid)
     proc.wait()
@@ -285,7 +291,8 @@ def run_trusted(
     if res.why is not None:
         raise InputError(f"xacro expansion {res.why}", file=p)
     if res.returncode != 0:
-        raise InputError(f"xacro expansion failed: {_last_line(res)}", file=p)
+        why = _last_line(res) or f"exit status {res.returncode}, no message"
+        raise InputError(f"xacro expansion failed: {why}", file=p)
     return res.out, _report(res) or {}
 
 
