@@ -1,9 +1,10 @@
 """Benchmark: the whole `armcli simulate --urdf` process vs the equivalent MuJoCo script.
 
-1. Whole process: a 120 s pick-like trajectory at dt = 0.5 ms (240,000 steps) on the
-   standalone arm, PD gains Kp 50, Kd 5, each side a fresh process as a user runs it, in
-   turn (A B A B ...) so the ratio is taken pair by pair. The same commands for one step
-   give the set-up (imports, model, checks), which is cut to give the stepping alone.
+1. Whole process: a 120 s pick-like trajectory (121 points, each side reading all of them)
+   at dt = 0.5 ms (240,000 steps) on the standalone arm, PD gains Kp 50, Kd 5, each side a
+   fresh process as a user runs it, in turn (A B A B ...) so the ratio is taken pair by
+   pair. The same commands for one step give the set-up (imports, model, checks), which is
+   cut to give the stepping alone.
 2. Peak memory (the process's max RSS) of both, and of armcli on 1.8 M steps (900 s at
    0.5 ms) writing its states at 10 Hz: memory follows the output rate, not the steps.
 3. Start-up: `armcli simulate --help` next to `python -c pass`, and what importing the
@@ -30,6 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
 DT = 5e-4  # [s]
 KP, KD = 50.0, 5.0
+WHOLE_S, MEMORY_S = 120.0, 900.0  # [s] trajectories of the two comparisons
 CYCLE = [(0.6, 0.4, 1.0), (0.9, 1.2, 2.0), (0.9, 1.2, 2.5), (0.5, 0.8, 3.5), (0.3, 0.3, 5.0)]
 MUJOCO_SCRIPT = """
 import sys
@@ -95,7 +97,7 @@ def paired(a: list[str], b: list[str], repeats: int) -> tuple[list[float], list[
 def whole_process(
     repeats: int, armcli: Callable[[float], list[str]], mujoco: Callable[[float], list[str]]
 ) -> None:
-    duration = 120.0
+    duration = WHOLE_S
     steps = round(duration / DT)
     ta, tb, ratio = paired(armcli(duration), mujoco(duration), repeats)
     sa, sb, _ = paired(armcli(DT), mujoco(DT), repeats)
@@ -119,8 +121,8 @@ def whole_process(
 
 def memory(armcli: Callable[..., list[str]], out: Path) -> None:
     """Peak RSS of a 1.8 M-step run writing its states at 10 Hz."""
-    steps = 1_800_000
-    _, cpu, peak = run_once(armcli(steps * DT, "--output", str(out), "--rate", "10"))
+    steps = round(MEMORY_S / DT)
+    _, cpu, peak = run_once(armcli(MEMORY_S, "--output", str(out), "--rate", "10", traj=MEMORY_S))
     _, short_cpu, short_peak = run_once(armcli(DT))
     print(f"\n{steps:,} steps (--duration {steps * DT:g} at dt = {DT}), states at 10 Hz:")
     print(f"  peak {peak:.0f} MiB ({short_peak:.0f} MiB for one step); {cpu:.2f} CPU s "
@@ -154,18 +156,23 @@ def main() -> None:
     args = ap.parse_args()
     reps = 1 if args.quick else 5
     urdf = ROOT / "urdf" / "standalone_arm.urdf"
-    text, knots = trajectory(900.0)
+    print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory() as tmp:
-        traj = Path(tmp) / "long.yaml"
-        traj.write_text(text, encoding="utf-8")
+        # each side reads the trajectory of the run it times: 120 s (121 points) for the
+        # whole-process comparison, 900 s (901 points) for the memory run
+        files = {}
+        for secs in (WHOLE_S, MEMORY_S):
+            files[secs] = Path(tmp) / f"pick_{secs:g}s.yaml"
+            files[secs].write_text(trajectory(secs)[0], encoding="utf-8")
+        knots = trajectory(WHOLE_S)[1]
         script = Path(tmp) / "mujoco_pd.py"
         script.write_text(MUJOCO_SCRIPT.format(dt=DT, kp=KP, kd=KD, knots=knots), "utf-8")
 
-        def armcli(secs: float, *extra: str) -> list[str]:
+        def armcli(secs: float, *extra: str, traj: float = WHOLE_S) -> list[str]:
             return [
-                str(BIN / "armcli"), "simulate", "--urdf", str(urdf), "--trajectory", str(traj),
-                "--dt", str(DT), "--duration", str(secs), "--kp", str(KP), "--kd", str(KD),
-                *extra,
+                str(BIN / "armcli"), "simulate", "--urdf", str(urdf),
+                "--trajectory", str(files[traj]), "--dt", str(DT), "--duration", str(secs),
+                "--kp", str(KP), "--kd", str(KD), *extra,
             ]  # fmt: skip
 
         def mujoco(secs: float) -> list[str]:
@@ -174,6 +181,7 @@ def main() -> None:
         whole_process(reps, armcli, mujoco)
         memory(armcli, Path(tmp) / "states.csv")
     startup(reps)
+    print(f"load average after: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
 
 
 if __name__ == "__main__":

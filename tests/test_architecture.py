@@ -21,6 +21,7 @@ RANK = {  # layer of each top-level module or subpackage (docs/ARCHITECTURE.md)
 SIBLING_EXCEPTIONS = {
     ("check", "armcli.sim.stability"),
     ("check", "armcli.sim.verdict"),
+    ("check", "armcli.sim.tipping"),
     ("view", "armcli.sim.states"),
 }
 

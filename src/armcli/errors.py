@@ -300,6 +300,21 @@ class SimulationError(ArmcliError):
         super().__init__(text)
 
 
+class TipOverError(ArmcliError):
+    """The simulated motion tips the robot over: its zero-moment point left the support polygon.
+
+    Raised after the run's files and summary are written; carries the evidence.
+    """
+
+    exit_code = EXIT_FAILED
+
+    def __init__(self, message: str, *, time: float, margin: float, case: str) -> None:
+        self.time = time
+        self.margin = margin  # [m] negative: how far outside
+        self.case = case
+        super().__init__(message)
+
+
 class ExportRefusedError(ArmcliError):
     """An export would write a model its target simulator refuses: which part, and why."""
 

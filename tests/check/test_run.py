@@ -11,12 +11,13 @@ from typing import Any
 import pytest
 from lxml import etree
 
-from armcli.check.rules import RULES, CheckOptions, apply_policy
+from armcli.check.rules import RULES, CheckOptions, TipoverOptions, apply_policy
 from armcli.check.run import check_urdf
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
 from armcli.urdf.read import parse_urdf, read_urdf
 from armcli.urdf.xacro_sandbox import expand_untrusted
+from tests.helpers import FIXTURES as ALL_FIXTURES
 from tests.helpers import ROOT
 
 FIXTURES = ROOT / "tests" / "fixtures" / "check"
@@ -157,6 +158,12 @@ def tool_without_inertial(r: Any) -> None:
 
 
 SAFE_SPEC = with_gains(50.0, 2.0)  # Kd = 2 keeps even the explicit loop stable at 1 ms
+SWING = ALL_FIXTURES / "tipover" / "swing.yaml"
+
+
+def tipover(spec: RobotSpec | None = None, **kw: Any) -> CheckOptions:
+    """Options with balance/reach settings (payload at the tool point, trajectory, ...)."""
+    return CheckOptions(spec=spec, tipover=TipoverOptions(**kw))
 
 
 # (edit of urdf/my_robot.urdf, spec or None, the exact set of rules expected)
@@ -181,7 +188,7 @@ def gz_position_servo(gain: float) -> Callable[[Any], None]:
     return edit
 
 
-CASES: dict[str, tuple[Callable[[Any], None], RobotSpec | None, set[str]]] = {
+CASES: dict[str, tuple[Callable[[Any], None], RobotSpec | CheckOptions | None, set[str]]] = {
     "duplicate-name": (append('<link name="hand_link"/>'), None, {"duplicate-name"}),
     "unknown-link": (set_attr(J2, "parent", "link", "no_such_link"), None, {"unknown-link"}),
     "multiple-parents": (
@@ -282,14 +289,31 @@ CASES: dict[str, tuple[Callable[[Any], None], RobotSpec | None, set[str]]] = {
         {"self-collision"},
     ),
     "mesh-missing": (hand_mesh, None, {"mesh-missing"}),
+    # The arm held out front-right, 20 mm threshold: 4.38 kg at the hand holds (test_balance)
+    "support-margin": (lambda r: None, tipover(payload=6.0), {"support-margin"}),
+    "com-outside-support": (lambda r: None, tipover(payload=10.0), {"com-outside-support"}),
+    # The arm is 0.6 m long: a point 1 m out is out of reach from everywhere
+    "reach-point": (lambda r: None, tipover(reach_points=((1.0, 0.0, 0.5),)), {"reach-point"}),
+    # The fast swing alone keeps > 20 mm; braking/accelerating the base on top of it does not
+    "zmp-margin": (
+        lambda r: None,
+        tipover(SAFE_SPEC, trajectory=SWING, base_accel=3.5),
+        {"zmp-margin"},
+    ),
+    "zmp-outside-support": (
+        lambda r: None,
+        tipover(SAFE_SPEC, trajectory=SWING, base_accel=5.0),
+        {"zmp-outside-support"},
+    ),
 }
 
 
-def run(edit: Callable[[Any], None], spec: RobotSpec | None) -> Any:
+def run(edit: Callable[[Any], None], spec: RobotSpec | CheckOptions | None) -> Any:
     root = etree.fromstring(BASE)
     edit(root)
     data = etree.tostring(root, xml_declaration=True, encoding="utf-8")
-    return check_urdf(parse_urdf(data, "broken.urdf"), CheckOptions(spec=spec))
+    opts = spec if isinstance(spec, CheckOptions) else CheckOptions(spec=spec)
+    return check_urdf(parse_urdf(data, "broken.urdf"), opts)
 
 
 def test_every_rule_has_a_case() -> None:

@@ -71,7 +71,9 @@ def test_example_trajectories_csv(
         rows = list(csv.reader(fh))
     header, body = rows[0], np.array(rows[1:], dtype=float)
     cols = [f"{j}.{f}" for j in (J1, J2) for f in ("position", "velocity", "effort", "reference")]
-    assert header == ["time", *cols]
+    # the robot stands on its wheels: the zero-moment point's columns follow (sim.tipping)
+    assert header == ["time", *cols, "zmp.x", "zmp.y", "zmp.margin", "zmp.margin_base"]
+    assert np.all(body[:, 11:] > 0.02)  # the seed never comes near its polygon's edge
     np.testing.assert_allclose(np.diff(body[:, 0]), 1.0 / RATE, atol=1e-9)
     q = body[:, [1, 5]]
     assert np.all(q >= 0.0) and np.all(q <= math.pi / 2)  # the seed's joint limits

@@ -161,3 +161,17 @@ def test_coupled_reference_adds_multiplier_and_offset() -> None:
     np.testing.assert_allclose(q[:, 1], -2.0 * q[:, 0] + 0.1, rtol=0, atol=1e-15)
     np.testing.assert_allclose(q[:, 2], 0.5 * q[:, 1], rtol=0, atol=1e-15)
     np.testing.assert_allclose(v[:, 1], -2.0 * v[:, 0], rtol=0, atol=1e-14)
+
+
+def test_simulate_asks_for_the_leaders_gains_only(built: Path) -> None:
+    """The spec refuses gains on a follower, so a missing one is never asked for."""
+    from armcli.errors import InputError
+    from armcli.sim import job as simjob
+    from armcli.sim.options import SimOptions
+    from armcli.spec.load import load_spec
+
+    spec = load_spec(built.parent.parent / "armcli.yaml")
+    msg = "{joint_names: [left_finger_joint], points: [{positions: [0.02], time_from_start: 1}]}"
+    with pytest.raises(InputError, match=r"no kp for left_finger_joint in the spec") as info:
+        simjob.prepare(spec, SimOptions(message=msg, joints=FINGERS))
+    assert "right_finger_joint" not in str(info.value)

@@ -102,3 +102,54 @@ def test_yaml_of_the_controllers_is_plain(spec) -> None:  # type: ignore[no-unty
         "arm_base_forearm_joint",
         "forearm_hand_joint",
     ]
+
+
+def _mjcf_actuators(text: str) -> tuple[dict[str, etree._Element], list[str]]:
+    from armcli.export.mjcf import build_mjcf
+    from armcli.urdf.read import parse_urdf
+
+    spec = loads_spec(text, "specs/my_robot.yaml")
+    urdf = parse_urdf(expand_urdfs(spec)["standalone_arm.urdf"], "standalone_arm.urdf")
+    out = build_mjcf(urdf, spec)
+    root = etree.fromstring(out.model)
+    acts = {a.get("joint"): a for a in root.find("actuator")}  # type: ignore[union-attr]
+    mujoco = pytest.importorskip("mujoco")
+    mujoco.MjModel.from_xml_string(out.model.decode())  # MuJoCo accepts what it is given
+    return acts, [f"{n.what}: {n.done}" for n in out.notes]
+
+
+def test_mjcf_export_follows_the_ros2_control_interfaces() -> None:
+    """mujoco_ros2_control's mapping: the PD loop with the effort interface's force range,
+    a velocity-only joint as a velocity actuator with the interface's range."""
+    control = """
+ros2_control:
+  joints:
+    arm_base_forearm_joint:
+      command_interfaces: {effort: {min: -30, max: 30}}
+      state_interfaces: {position: {}, velocity: {}}
+    forearm_hand_joint:
+      command_interfaces: {velocity: {min: -2, max: 2}}
+      state_interfaces: {position: {}, velocity: {}}
+"""
+    acts, _ = _mjcf_actuators(DEFAULT_SPEC.read_text() + control)
+    shoulder, hand = acts["arm_base_forearm_joint"], acts["forearm_hand_joint"]
+    assert shoulder.tag == "position" and shoulder.get("forcerange") == "-30 30"
+    assert (hand.tag, hand.get("ctrlrange")) == ("velocity", "-2 2")
+    assert hand.get("kv") == "1.5"  # the spec's Kd
+    default, _ = _mjcf_actuators(DEFAULT_SPEC.read_text())
+    assert default["arm_base_forearm_joint"].get("forcerange") == "-100 100"  # effort limit
+
+
+def test_mjcf_export_leaves_read_only_joints_unactuated() -> None:
+    control = """
+ros2_control:
+  joints:
+    arm_base_forearm_joint:
+      command_interfaces: {position: {}}
+      state_interfaces: {position: {}}
+    forearm_hand_joint:
+      state_interfaces: {position: {}}
+"""
+    acts, notes = _mjcf_actuators(DEFAULT_SPEC.read_text() + control)
+    assert set(acts) == {"arm_base_forearm_joint"}
+    assert any("ros2_control only reads forearm_hand_joint" in n for n in notes)

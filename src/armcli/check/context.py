@@ -13,12 +13,16 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
+from armcli.check.balance import StaticBalance
 from armcli.check.rules import RULES, CheckOptions, Collector, JointRow
 from armcli.check.structure import Tree
+from armcli.sim.tipping import ZmpReport
 from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf, position_bounds
 from armcli.urdf.mimic import follow, mimics
 from armcli.urdf.pinocchio import JointRange
+from armcli.urdf.stance import Stance
+from armcli.urdf.workspace import ReachPoint, Workspace
 
 Stage = Literal["urdf", "model", "dynamics"]
 URDF: Stage = "urdf"
@@ -50,6 +54,11 @@ class Context:
     samples: list[tuple[dict[str, float], Any]] = field(default_factory=list)  # dynamics
     servo: set[str] = field(default_factory=set)  # joints a position servo drives
     stability: StabilityReport | None = None
+    balance: StaticBalance | None = None  # check/tipover.py
+    stance: Stance | None = None  # the robot on its support polygon (check/tipover.py)
+    zmp: ZmpReport | None = None  # check/zmp.py: the trajectory's zero-moment point
+    reach: Workspace | None = None  # check/reach.py: the tool point's envelope
+    reach_points: tuple[ReachPoint, ...] = ()  # --reach-point verdicts
     stage: Stage | Literal["unloaded", "refused", "no-dynamics"] = "unloaded"
 
 

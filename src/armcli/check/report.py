@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from dataclasses import asdict
 from typing import Any
 
+from armcli.check.balance_report import balance_items, reach_items
 from armcli.check.rules import ERROR, WARNING, Finding
 from armcli.check.run import CheckResult
 from armcli.errors import split_source
@@ -230,6 +231,8 @@ def _summary(r: CheckResult) -> list[Any]:
         out.append(t)
     if s.stability is not None:
         out.append(_stability_text(s.stability))
+    out.extend(balance_items(s.balance, s.zmp))
+    out.extend(reach_items(s.reach, s.reach_points))
     out.extend(Text(n, style="dim") for n in s.notes)
     return out
 

@@ -274,6 +274,38 @@ _RULES = [
         "self-collision", ERROR, "links collide at a named pose", "change the pose or the geometry"
     ),
     Rule("mesh-missing", ERROR, "mesh file not found", "fix the path or pass --package-dir"),
+    # balance and reach (check/tipover.py, check/zmp.py, check/reach.py)
+    Rule(
+        "com-outside-support",
+        ERROR,
+        "centre of mass outside the support polygon at a pose or somewhere in the joint range",
+        "lighten the payload (the message says how much holds), keep out of that pose, "
+        "or widen the base",
+    ),
+    Rule(
+        "support-margin",
+        WARNING,
+        "centre of mass closer to the support polygon's edge than the threshold",
+        "lighten the payload or keep the arm closer to the base's centre",
+    ),
+    Rule(
+        "zmp-outside-support",
+        ERROR,
+        "zero-moment point leaves the support polygon along --trajectory: the robot tips",
+        "slow the arm down or lower the base's acceleration (the message says how much holds)",
+    ),
+    Rule(
+        "zmp-margin",
+        WARNING,
+        "zero-moment point closer to the support polygon's edge than the threshold",
+        "slow the arm down or lower the base's acceleration",
+    ),
+    Rule(
+        "reach-point",
+        ERROR,
+        "a --reach-point the tool point cannot reach within the joint limits",
+        "move the point or the arm's mount (the message says how close the arm gets)",
+    ),
     # inputs
     Rule(
         "input-unusable",
@@ -389,12 +421,26 @@ class JointRow:
 
 
 @dataclass(frozen=True)
+class TipoverOptions:
+    """Balance and reach options (check/tipover.py, check/zmp.py, check/reach.py)."""
+
+    payload: float = 0.0  # [kg] point mass at the payload point
+    payload_link: str | None = None  # its link (at the origin); default: the tool point
+    contact_links: tuple[str, ...] | None = None  # default: found from the geometry
+    min_margin: float = 0.02  # [m] margin below which `support-margin` warns
+    trajectory: Path | None = None  # simulate it and report the zero-moment point
+    base_accel: float | None = None  # [m/s²] default: the diff-drive plugin's
+    reach_points: tuple[tuple[float, float, float], ...] = ()  # [m] in the root frame
+
+
+@dataclass(frozen=True)
 class CheckOptions:
     """What the rules may use beyond the URDF itself."""
 
     spec: RobotSpec | None = None
     package_dirs: Mapping[str, Path] = field(default_factory=dict)
     search_paths: tuple[Path, ...] = ()
+    tipover: TipoverOptions = field(default_factory=TipoverOptions)
 
     def mesh_search(self) -> MeshSearch:
         """The mesh-resolver view of these options (shared with view and render)."""

@@ -11,8 +11,19 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from armcli.check import bodies, inertia, interface, joints, meshes, structure, summary
+from armcli.check import (
+    bodies,
+    inertia,
+    interface,
+    joints,
+    meshes,
+    reach,
+    structure,
+    summary,
+    tipover,
+)
 from armcli.check import dynamics as dyn
+from armcli.check import zmp as zmp_rules
 from armcli.check.context import (
     BLOCKS_DYNAMICS,
     BLOCKS_MODEL,
@@ -74,6 +85,9 @@ FAMILIES: tuple[Family, ...] = (
     Family("servo", DYNAMICS, _servo),
     Family("stability", DYNAMICS, _stability),
     Family("self-collision", MODEL, _self_collision),
+    Family("tipover", DYNAMICS, tipover.check),
+    Family("zmp", DYNAMICS, zmp_rules.check),
+    Family("reach", MODEL, reach.check),
 )
 
 

@@ -12,13 +12,16 @@ from typing import Any
 
 import numpy as np
 
+from armcli.check.balance import StaticBalance
 from armcli.check.context import Context, poses
 from armcli.check.rules import CheckOptions, JointRow
 from armcli.check.structure import finite
+from armcli.sim.tipping import ZmpReport
 from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf, total_dof
 from armcli.urdf.pinocchio import configuration
 from armcli.urdf.tool import tool_point
+from armcli.urdf.workspace import ReachPoint, Workspace
 
 
 @dataclass(frozen=True)
@@ -43,6 +46,10 @@ class Summary:
     poses: tuple[PoseRow, ...]
     stability: StabilityReport | None
     notes: tuple[str, ...]
+    balance: StaticBalance | None = None  # static balance over the support polygon
+    zmp: ZmpReport | None = None  # the --trajectory's zero-moment point
+    reach: Workspace | None = None  # the tool point's reach envelope
+    reach_points: tuple[ReachPoint, ...] = ()  # the --reach-point verdicts
 
 
 def summarise(ctx: Context) -> Summary:
@@ -56,6 +63,10 @@ def summarise(ctx: Context) -> Summary:
         "joints": ctx.rows,
         "stability": ctx.stability,
         "notes": tuple(ctx.notes),
+        "balance": ctx.balance,
+        "zmp": ctx.zmp,
+        "reach": ctx.reach,
+        "reach_points": ctx.reach_points,
     }
     if ctx.model is None:
         return Summary(**base, end_effector="", poses=())

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -11,7 +12,7 @@ import typer
 from armcli.check import report
 from armcli.check.inputs import CheckRun, run_check
 from armcli.check.report import counts
-from armcli.check.rules import RULES, CheckOptions, apply_policy, unknown_rules
+from armcli.check.rules import RULES, CheckOptions, TipoverOptions, apply_policy, unknown_rules
 from armcli.check.sarif import to_sarif
 from armcli.commands.options import choice
 from armcli.commands.xacro_inputs import (
@@ -35,6 +36,55 @@ from armcli.spec.load import load_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 FORMATS = ("table", "json", "github", "sarif")
+PAYLOAD_LINK_HELP = "Link carrying --payload at its origin (default: the tool point)."
+CONTACT_LINKS_HELP = "Comma-separated links touching the ground (default: from the geometry)."
+TRAJECTORY_HELP = "Simulate this JointTrajectory and report the zero-moment point (needs gains)."
+BASE_ACCEL_HELP = (
+    "Base acceleration and braking [m/s²] with --trajectory "
+    "(default: the diff-drive plugin's max_wheel_acceleration)."
+)
+REACH_POINT_HELP = "x,y,z [m] in the root frame: is it reachable? (repeatable)"
+
+
+def tipover_options(
+    payload: float,
+    payload_link: str | None,
+    contact_links: str | None,
+    min_margin: float,
+    trajectory: Path | None,
+    base_accel: float | None,
+    reach_points: list[str],
+) -> TipoverOptions:
+    """The balance and reach options, refused here when they are not usable numbers."""
+    for flag, x in (("--payload", payload), ("--min-margin", min_margin),
+                    ("--base-accel", 0.0 if base_accel is None else base_accel)):  # fmt: skip
+        if not (math.isfinite(x) and x >= 0):
+            raise InputError(f"must be a finite number >= 0, got {x:g}", field=flag)
+    if trajectory is not None and not trajectory.is_file():
+        raise InputError("no such file", file=trajectory, field="--trajectory")
+    names = None
+    if contact_links is not None:
+        names = tuple(n.strip() for n in contact_links.split(",") if n.strip())
+    return TipoverOptions(
+        payload=payload,
+        payload_link=payload_link,
+        contact_links=names,
+        min_margin=min_margin,
+        trajectory=trajectory,
+        base_accel=base_accel,
+        reach_points=tuple(point_option(p, "--reach-point") for p in reach_points),
+    )
+
+
+def point_option(text: str, flag: str) -> tuple[float, float, float]:
+    """The point "x,y,z" [m] as three finite numbers."""
+    try:
+        xyz = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        xyz = ()
+    if len(xyz) != 3 or not all(math.isfinite(v) for v in xyz):
+        raise InputError(f"expected x,y,z in metres, got {text!r}", field=flag)
+    return (xyz[0], xyz[1], xyz[2])
 
 
 def check_cmd(
@@ -54,6 +104,15 @@ def check_cmd(
     env: list[str] = env_option(),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
+    payload: float = typer.Option(0.0, "--payload", help="Payload [kg] at the tool point."),
+    payload_link: str = typer.Option(None, "--payload-link", help=PAYLOAD_LINK_HELP),
+    contact_links: str = typer.Option(None, "--contact-links", help=CONTACT_LINKS_HELP),
+    min_margin: float = typer.Option(
+        0.02, "--min-margin", help="Balance margin [m] below which to warn (default 0.02)."
+    ),
+    trajectory: Path = typer.Option(None, "--trajectory", "-t", help=TRAJECTORY_HELP),
+    base_accel: float = typer.Option(None, "--base-accel", help=BASE_ACCEL_HELP),
+    reach_point: list[str] = typer.Option([], "--reach-point", help=REACH_POINT_HELP),
 ) -> None:
     """Check robot descriptions for physical sanity; exit 1 on error findings."""
     unknown = unknown_rules(ignore)
@@ -61,9 +120,12 @@ def check_cmd(
         raise InputError(f"unknown rule(s) {unknown}; known: {', '.join(RULES)}", field="--ignore")
     files, args = split_paths(paths or [])
     inputs = xacro_inputs(args, env, package_dir)
-    base = CheckOptions(package_dirs=inputs.packages.package_dirs)
+    tip = tipover_options(
+        payload, payload_link, contact_links, min_margin, trajectory, base_accel, reach_point
+    )
+    base = CheckOptions(package_dirs=inputs.packages.package_dirs, tipover=tip)
     if spec is not None:
-        base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs)
+        base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs, tipover=tip)
     trust = trust_mode(trust_xacro, unsandboxed)
     run = run_check(files or [find_spec(None)], base, trust_xacro=trust, inputs=inputs)
     for file, note in run.notes:

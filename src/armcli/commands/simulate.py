@@ -26,15 +26,22 @@ from armcli.io.outdir import check_output_file
 from armcli.io.together import write_files_together
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
-from armcli.sim import rosbag, states
+from armcli.sim import states, tipping
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 from armcli.sim.plot import tracking_png
+from armcli.sim.tipping import TipOptions
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
 GRAVITY_HELP = "Add g(q) to the PD torque (default: the spec's control.gravity_compensation)."
 IGNORE_HELP = "Simulate a --urdf despite this `check` rule's error (repeatable)."
 TRAJECTORY_HELP = "JointTrajectory YAML (a point without time_from_start: previous + 1 s)."
+BASE_ACCEL_HELP = (
+    "Base acceleration and braking [m/s²] for the zero-moment point "
+    "(default: the diff-drive plugin's max_wheel_acceleration)."
+)
+PAYLOAD_LINK_HELP = "Link carrying --payload at its origin (default: the tool point)."
+CONTACT_LINKS_HELP = "Comma-separated links touching the ground (default: from the geometry)."
 PROGRESS_AFTER_S = 1.0  # show a progress bar when the run is projected to take longer
 # The library's names for what these flags set (errors name them; commands.flags maps back).
 FLAGS = {
@@ -79,6 +86,10 @@ def simulate_cmd(
     trust_xacro: bool = option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
     ignore: list[str] = option([], "--ignore", help=IGNORE_HELP),
+    base_accel: float = option(None, "--base-accel", help=BASE_ACCEL_HELP),
+    payload: float = option(0.0, "--payload", help="Payload [kg] at the tool point (ZMP)."),
+    payload_link: str = option(None, "--payload-link", help=PAYLOAD_LINK_HELP),
+    contact_links: str = option(None, "--contact-links", help=CONTACT_LINKS_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
     from armcli.check.rules import unknown_rules
@@ -89,6 +100,8 @@ def simulate_cmd(
     spec, tokens = split_robot(spec, args)
     inputs = xacro_inputs(tokens, env, package_dir)
     if output is not None:
+        from armcli.sim import rosbag  # the MCAP writer: imported by runs that write a file
+
         if not rosbag.is_mcap(output):
             states.output_format(output)
         check_output_file(output, "--output")
@@ -118,7 +131,11 @@ def simulate_cmd(
         trust_xacro=trust_mode(trust_xacro, unsandboxed),
         xacro=inputs,
     )
-    _run(_prepare(spec_obj, spec_path, opts, tuple(ignore)), output, plot)
+    tip_opts = TipOptions(base_accel, payload, payload_link, _names(contact_links))
+    job = _prepare(spec_obj, spec_path, opts, tuple(ignore))
+    notes: list[str] = []
+    tip = tipping.prepare(spec_obj, job, tip_opts, inputs.packages, notes)
+    _run(job, output, plot, tip, notes)
 
 
 def _prepare(
@@ -156,31 +173,58 @@ def _sources(spec_path: Path | None, opts: SimOptions) -> dict[str, Any]:
     return {"file": spec_path if from_spec else None, "field": ", ".join(fields) or None}
 
 
-def _run(job: simjob.SimJob, output: Path | None, plot: Path | None) -> None:
-    """Run the prepared job with a progress bar, write the files, print the summary."""
+def _names(text: str | None) -> tuple[str, ...] | None:
+    return None if text is None else tuple(n.strip() for n in text.split(",") if n.strip())
+
+
+def _run(
+    job: simjob.SimJob,
+    output: Path | None,
+    plot: Path | None,
+    tip: tipping.Tipping | None = None,
+    notes: list[str] | None = None,
+) -> None:
+    """Run the prepared job with a progress bar, write the files, print the summary.
+
+    With a robot standing on a base (`tip`), also its zero-moment point: in the states
+    file, the plot's fourth row and the summary; a run that tips it over exits 1.
+    """
     err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
-    write_notes(job.notes)
+    write_notes([*job.notes, *(notes or [])])
     for w in job.trajectory.warnings:
         err.print(one_line(f"warning: {w}"), markup=False, highlight=False)
+    extra = None if tip is None else (lambda steps: tip.steps(job, steps))
     with _LazyProgress(err) as progress:
-        res = simjob.run(job, progress, plot=plot is not None)
+        res = simjob.run(job, progress, plot=plot is not None, extra=extra)
+    series = tip.series(job, res) if tip is not None else None
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
     files: dict[Path, bytes] = {}  # written together: never a new CSV beside an old plot
-    if output is not None and rosbag.is_mcap(output):
-        files[output] = rosbag.run_mcap_bytes(res, job.rate, job.urdf)
-    elif output is not None:
-        files[output] = states.states_bytes(
-            states.sample_states(res, job.rate), states.output_format(output)
-        )
+    if output is not None:
+        from armcli.sim import rosbag
+
+        if rosbag.is_mcap(output):
+            files[output] = rosbag.run_mcap_bytes(res, job.rate, job.urdf)
+        else:
+            cols = states.sample_states(res, job.rate)
+            if series is not None:
+                cols = {**cols, **tipping.columns(series, res, job.rate)}
+            files[output] = states.states_bytes(cols, states.output_format(output))
     if plot is not None:
-        files[plot] = tracking_png(res, job.arm.effort)
+        row = tipping.plot_row(series) if series is not None else None
+        files[plot] = tracking_png(res, job.arm.effort, row)
     write_files_together(files)
     out = terminal.console()
     out.print(simreport.summary_table(metrics, ee, job.tool_label, res), crop=False)
+    balance = tipping.report(tip, series) if tip is not None and series is not None else None
+    if balance is not None:
+        line = tipping.summary_line(balance)
+        out.print(line, style="red" if balance.tips else None, markup=False, highlight=False)
     for path in (output, plot):
         if path is not None:
             out.print(f"wrote {path}", markup=False, highlight=False)
+    if balance is not None and balance.tips:
+        raise tipping.tip_error(balance)
 
 
 class _LazyProgress:

@@ -16,6 +16,7 @@ from lxml import etree
 
 from armcli.compiler.xmlfmt import fmt, vec
 from armcli.export.mjcf_report import EXTRA_TAGS, Extras, Note
+from armcli.spec.control import command_interfaces
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Joint, Urdf, position_bounds
 
@@ -27,6 +28,14 @@ def _range(j: Joint) -> tuple[float, float] | None:
     return position_bounds(j.type, j.limit)
 
 
+def _command_range(spec: RobotSpec | None, joint: str, name: str) -> tuple[float, float] | None:
+    """[min, max] of the spec's ros2_control command interface `name` of `joint`, if given."""
+    rc = spec.ros2_control if spec is not None else None
+    jc = rc.joints.get(joint) if rc is not None else None
+    i = jc.command_interfaces.get(name) if jc is not None else None
+    return (i.min, i.max) if i is not None and i.min is not None and i.max is not None else None
+
+
 def actuators(
     root: etree._Element,
     joints: list[Joint],
@@ -34,25 +43,51 @@ def actuators(
     extras: Extras,
     notes: list[Note],
 ) -> list[tuple[str, str]]:
-    """One actuator per driven joint, named like it; returns (name, kind) in order."""
+    """One actuator per driven joint, named like it; returns (name, kind) in order.
+
+    The spec's ros2_control interfaces choose it as mujoco_ros2_control maps them: a joint
+    with gains and a position or effort command is the PD loop (`position`, force range
+    from the effort interface's min/max, else the effort limit); a velocity-only joint a
+    `velocity` actuator (kv = Kd, ctrl range from the interface, else the velocity limit);
+    an effort command without gains a `motor`; a joint ros2_control only reads, none.
+    """
     act = etree.SubElement(root, "actuator")
     gains = spec.control.gains if spec is not None else {}
+    rc = spec.ros2_control if spec is not None else None
     out: list[tuple[str, str]] = []
-    undriven = []
+    undriven, state_only = [], []
     for j in joints:
         effort = j.limit.effort if j.limit is not None else None
         if j.name in extras.mimic:
             continue
+        commands = command_interfaces(rc, j.name)
+        if rc is not None and j.name in rc.joints and not commands:
+            state_only.append(j.name)
+            continue
+        force = _command_range(spec, j.name, "effort")
+        force = force or ((-effort, effort) if effort is not None else None)
         attrs = {"name": j.name, "joint": j.name}
-        if j.name in gains:
+        velocity_only = commands and all(c == "velocity" for c in commands)
+        if j.name in gains and velocity_only:
+            speed = _command_range(spec, j.name, "velocity")
+            vmax = j.limit.velocity if j.limit is not None else None
+            speed = speed or ((-vmax, vmax) if vmax is not None else None)
+            attrs["kv"] = fmt(gains[j.name].kd)
+            if speed is not None:
+                attrs["ctrlrange"] = vec(speed)
+            if force is not None:
+                attrs["forcerange"] = vec(force)
+            etree.SubElement(act, "velocity", attrs)
+            out.append((j.name, "velocity"))
+        elif j.name in gains and not velocity_only:
             g = gains[j.name]
             attrs.update(kp=fmt(g.kp), kv=fmt(g.kd))  # no ctrlrange: see the module docstring
-            if effort is not None:
-                attrs["forcerange"] = vec((-effort, effort))
+            if force is not None:
+                attrs["forcerange"] = vec(force)
             etree.SubElement(act, "position", attrs)
             out.append((j.name, "position"))
-        elif effort is not None:
-            attrs["ctrlrange"] = vec((-effort, effort))
+        elif force is not None and (not commands or "effort" in commands):
+            attrs["ctrlrange"] = vec(force)
             etree.SubElement(act, "motor", attrs)
             out.append((j.name, "motor"))
         else:
@@ -61,8 +96,16 @@ def actuators(
         notes.append(
             Note(
                 "actuators",
-                f"no gains and no effort limit for {', '.join(undriven)}",
+                f"no gains and no effort command or limit for {', '.join(undriven)}",
                 "left without an actuator (passive joints)",
+            )
+        )
+    if state_only:
+        notes.append(
+            Note(
+                "actuators",
+                f"ros2_control only reads {', '.join(state_only)}",
+                "left without an actuator (no command interface)",
             )
         )
     if not len(act):

@@ -154,7 +154,8 @@ def _gains(
     for follower, leader in (leaders or {}).items():  # a mimic joint without its own gains
         if follower not in gains and leader in gains:  # is driven like its leader
             gains[follower] = gains[leader]
-    missing = [j for j in arm.joint_names if j not in gains]
+    followers = leaders or {}  # given through their leaders, never on their own
+    missing = [j for j in arm.joint_names if j not in gains and j not in followers]
     if missing:
         raise InputError(
             f"no {which} for {', '.join(missing)} in the spec's control.gains; "
@@ -314,16 +315,23 @@ def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
 
 
 def run(
-    job: SimJob, progress: Callable[[int, int], None] | None = None, *, plot: bool = False
+    job: SimJob,
+    progress: Callable[[int, int], None] | None = None,
+    *,
+    plot: bool = False,
+    extra: Callable[[int], np.ndarray] | None = None,
 ) -> SimResult:
     """Run the job, keeping the states at the output rate (and those a plot draws).
 
-    `progress(steps_done, steps_total)` is called between chunks of steps.
+    `progress(steps_done, steps_total)` is called between chunks of steps; `extra(steps)`
+    names more steps to keep (the zero-moment point's, sim.tipping).
     """
     steps = steps_of(job.duration, job.config.dt)
     # the output rate's states, the final one (the end effector is reported there), a plot's
     keep = np.concatenate([sample_steps(steps, job.config.dt, job.rate), [steps]])
     if plot:
         keep = np.concatenate([keep, plot_steps(steps)])
+    if extra is not None:
+        keep = np.concatenate([keep, extra(steps)])
     keep = distinct(keep)
     return simulate(job.arm, job.reference, job.q0, job.duration, job.config, progress, record=keep)

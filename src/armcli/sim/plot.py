@@ -7,7 +7,9 @@ stays cheap.
 from __future__ import annotations
 
 import io
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -23,18 +25,26 @@ def plot_steps(steps: int) -> np.ndarray:
     return picks[np.concatenate(([True], picks[1:] != picks[:-1]))]  # increasing already
 
 
-def tracking_png(res: SimResult, effort_limits: np.ndarray | None = None) -> bytes:
-    """PNG bytes of a rows = (position, velocity, torque), columns = joints figure."""
+def tracking_png(
+    res: SimResult,
+    effort_limits: np.ndarray | None = None,
+    extra_row: Callable[[Sequence[Any]], None] | None = None,
+) -> bytes:
+    """PNG bytes of a rows = (position, velocity, torque), columns = joints figure.
+
+    `extra_row` draws a fourth row of time plots (the zero-moment point's, sim.tipping).
+    """
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     n = len(res.joint_names)
-    fig, axes = plt.subplots(3, n, figsize=(5.0 * n, 7.5), sharex=True, squeeze=False)
+    rows = 3 if extra_row is None else 4
+    fig, axes = plt.subplots(rows, n, figsize=(5.0 * n, 2.5 * rows), sharex=True, squeeze=False)
     t = res.t  # the states the run kept (simulate's plot_steps: dense enough to draw)
     for i, name in enumerate(res.joint_names):
-        ax_q, ax_v, ax_t = axes[:, i]
+        ax_q, ax_v, ax_t = axes[:3, i]
         ax_q.plot(t, res.q_ref[:, i], "--", color="0.4", lw=1.5, label="reference")
         ax_q.plot(t, res.q[:, i], color="C0", lw=1.2, label="actual")
         ax_v.plot(t, res.v_ref[:, i], "--", color="0.4", lw=1.5, label="reference")
@@ -54,6 +64,8 @@ def tracking_png(res: SimResult, effort_limits: np.ndarray | None = None) -> byt
         for ax in (ax_q, ax_v, ax_t):
             ax.grid(True, alpha=0.3)
             ax.legend(loc="best", fontsize=8)
+    if extra_row is not None:
+        extra_row(axes[3])
     fig.suptitle(f"armcli simulate ({res.integrator}, dt = {res.dt:g} s)", fontsize=12)
     fig.tight_layout()
     buf = io.BytesIO()

@@ -65,14 +65,19 @@ def parser_problems(lines: list[str]) -> list[str]:
     return out
 
 
-def load_model(path: str | Path, *, xml: str | None = None) -> LoadedModel:
-    """Build a fixed-base Pinocchio model from a URDF file (or from `xml` text)."""
+def load_model(path: str | Path, *, xml: str | None = None, floating: bool = False) -> LoadedModel:
+    """Build a fixed-base Pinocchio model from a URDF file (or from `xml` text).
+
+    `floating`: the root link on a free-flyer joint instead (joint 1, nq = 7, nv = 6), so
+    that the root's inertia counts and inverse dynamics gives the wrench holding the base.
+    """
     import pinocchio as pin
 
     source = str(path)
     text = xml if xml is not None else Path(path).read_text(encoding="utf-8")
+    args = (pin.JointModelFreeFlyer(),) if floating else ()
     try:
-        model, messages = _capture_stderr(lambda: pin.buildModelFromXML(text))
+        model, messages = _capture_stderr(lambda: pin.buildModelFromXML(text, *args))
     except (RuntimeError, ValueError) as exc:
         said = parser_problems(getattr(exc, "parser_messages", []))
         detail = f" ({'; '.join(said)})" if said else ""

@@ -24,8 +24,6 @@ from armcli.urdf.packages import inside, real_roots
 from armcli.urdf.pinocchio import LoadedModel, load_model, parser_problems
 from armcli.urdf.read import parse_urdf, read_urdf
 from armcli.urdf.xacro_args import Expansion, XacroInputs
-from armcli.urdf.xacro_safe import request_json
-from armcli.urdf.xacro_sandbox import run_safe, run_trusted
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -120,6 +118,10 @@ def expand_xacro(
     Safe mode (xacro_safe, in a limited child) unless `trust_xacro`: then xacro itself
     in xacro_sandbox's jail, which reports no argument use.
     """
+    # imported here: reading a plain URDF (e.g. simulate --urdf) never loads the xacro stack
+    from armcli.urdf.xacro_safe import request_json
+    from armcli.urdf.xacro_sandbox import run_safe
+
     given = inputs or XacroInputs()
     if trust_xacro:
         return _expand_trusted(path, given, unsandboxed=trust_xacro == "unsandboxed")
@@ -144,6 +146,8 @@ def _expand_trusted(
             "or the loader runs)",
             field="--env",
         )
+    from armcli.urdf.xacro_sandbox import run_trusted
+
     known = given.packages.known(near=path)
     roots = [*allowed_roots(path.parent), *(p / "share" for p in given.packages.prefixes())]
     roots += [r for root in known.values() for r in real_roots(root)]

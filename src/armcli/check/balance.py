@@ -1,0 +1,313 @@
+"""Static balance: the whole robot's centre of mass over its support polygon.
+
+Model: rigid bodies on rigid, flat, level ground, contacts that neither slip nor lift,
+and no motion (velocities and accelerations are `simulate`'s zero-moment point). The
+centre of mass (Pinocchio, payload included as a point mass) projects vertically onto
+the ground; its margin toward an edge of the support polygon (`urdf.support`) is its
+distance to that edge's line, positive inside. On a slope rising at theta toward an edge,
+gravity leans by theta in the robot's frame and the projection moves h tan(theta)
+toward that edge (h: the centre of mass's height above the ground), so the robot tips
+at the slope angle atan(d / h): the tipping angle of that direction.
+
+The worst over the joint range is found by search, per edge and per measure (margin,
+tipping angle): every seed (the zero pose, the named poses, every corner of the range
+box when there are at most 64, and seeded uniform draws) is evaluated, and a projected
+gradient descent (`urdf.boxsearch`, with Pinocchio's centre-of-mass Jacobian as the
+gradient) runs from the best three within the joint limits.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import random
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from armcli.urdf.boxsearch import minimize_box
+from armcli.urdf.stance import Stance
+
+SEEDS_DESCENDED = 3  # local searches per edge and measure, from the best seeds
+RANDOM_SEEDS = 32
+SEARCH_SEED = 0
+MAX_CORNERS = 64
+PAYLOAD_ROUNDS = 8  # fixed-point rounds for the largest payload over the range
+PAYLOAD_TOL = 1e-6  # [m] slack below which a payload still counts as holding
+MAX_PAYLOAD = 1e4  # [kg] beyond this the payload "holds" anything: reported as inf
+WORST = "worst over the joint range"
+
+
+@dataclass(frozen=True)
+class PoseBalance:
+    """The centre of mass at one configuration, against every edge of the polygon."""
+
+    name: str  # a named pose, or WORST (toward one direction)
+    q: tuple[tuple[str, float], ...]  # [rad or m]
+    com: tuple[float, float, float]  # [m] root frame, payload included
+    margins: tuple[float, ...]  # [m] signed distance to each edge's line (+ inside)
+    tip_angles: tuple[float, ...]  # [rad] slope that tips it over each edge
+    margin: float  # [m] signed distance to the polygon (negative: that far outside)
+    payload_max: float | None  # [kg] at the payload point with margin >= the threshold
+
+    @property
+    def edge(self) -> int:
+        """The edge with the least margin."""
+        return int(np.argmin(self.margins))
+
+
+@dataclass(frozen=True)
+class StaticBalance:
+    """The static balance of one robot: polygon, named poses, worst over the joint range."""
+
+    contacts: tuple[str, ...]
+    polygon: tuple[tuple[float, float], ...]  # [m] counter-clockwise, root x-y plane
+    directions: tuple[str, ...]  # each edge's outward compass direction
+    headings: tuple[float, ...]  # [rad] each edge's outward normal
+    ground: float  # [m] the ground plane's height in the root frame
+    mass: float  # [kg] robot without payload
+    payload: str | None  # "2 kg at hand_link + (0, 0, 0.3)"
+    payload_point: str  # where the payload (or a suggested one) hangs
+    threshold: float  # [m] margin below which `support-margin` warns
+    poses: tuple[PoseBalance, ...]
+    worst: tuple[PoseBalance, ...]  # per edge: the configuration closest to tipping over it
+    worst_tip_angles: tuple[float, ...]  # [rad] per edge: smallest tipping angle over the range
+    payload_max: float | None  # [kg] the most that holds at every named pose and over the range
+
+    @property
+    def worst_overall(self) -> PoseBalance:
+        """The configuration of the joint range with the least margin."""
+        return min(self.worst, key=lambda p: p.margins[p.edge])
+
+
+class _Mass:
+    """Centre of mass and its Jacobian over the searched joints, with a payload of mass m."""
+
+    def __init__(self, stance: Stance) -> None:
+        import pinocchio as pin
+
+        self.s = stance
+        self.model = stance.model
+        self.data = self.model.createData()
+        self.M = stance.mass
+        self.q0 = np.asarray(pin.neutral(self.model), dtype=float)
+        self.iq = [(jr.idx_q, jr.continuous) for jr in stance.joints]
+        self.iv = [jr.idx_v for jr in stance.joints]
+        p = stance.payload
+        self.frame = self.model.getFrameId(p.link) if p is not None else None
+        self.xyz = np.asarray(p.xyz if p is not None else (0.0, 0.0, 0.0), dtype=float)
+
+    def q(self, x: ArrayLike) -> NDArray[np.float64]:
+        q = self.q0.copy()
+        for (i, cont), v in zip(self.iq, np.asarray(x, dtype=float), strict=True):
+            if cont:
+                q[i], q[i + 1] = math.cos(v), math.sin(v)
+            else:
+                q[i] = v
+        return q
+
+    def parts(self, x: ArrayLike) -> tuple[NDArray[Any], NDArray[Any]]:
+        """(unloaded centre of mass, payload point) [m] at joint values x."""
+        import pinocchio as pin
+
+        q = self.q(x)
+        c0 = np.array(pin.centerOfMass(self.model, self.data, q))
+        if self.frame is None:
+            return c0, c0
+        pin.updateFramePlacement(self.model, self.data, self.frame)
+        return c0, np.asarray(self.data.oMf[self.frame].act(self.xyz), dtype=float)
+
+    def com(self, x: ArrayLike, m: float) -> NDArray[Any]:
+        c0, p = self.parts(x)
+        return (self.M * c0 + m * p) / (self.M + m)
+
+    def com_jac(self, x: ArrayLike, m: float) -> tuple[NDArray[Any], NDArray[Any]]:
+        """Centre of mass [m] and d com / dx (3, n)."""
+        import pinocchio as pin
+
+        q = self.q(x)
+        J0 = np.array(pin.jacobianCenterOfMass(self.model, self.data, q)).reshape(3, -1)
+        J0 = J0[:, self.iv]  # nv = 1 comes back 1-D
+        c0 = np.array(self.data.com[0])
+        if self.frame is None or m <= 0:
+            return c0, J0
+        J6 = pin.computeFrameJacobian(self.model, self.data, q, self.frame,
+                                      pin.LOCAL_WORLD_ALIGNED)  # fmt: skip
+        J = np.asarray(J6, dtype=float).reshape(6, -1)[:, self.iv]
+        T = self.data.oMf[self.frame]
+        r = np.asarray(T.rotation, dtype=float) @ self.xyz
+        p = np.asarray(T.translation, dtype=float) + r
+        Jp = J[:3] - _skew(r) @ J[3:]
+        return (self.M * c0 + m * p) / (self.M + m), (self.M * J0 + m * Jp) / (self.M + m)
+
+
+def _skew(r: NDArray[Any]) -> NDArray[Any]:
+    return np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
+
+
+def analyse(
+    stance: Stance, poses: Sequence[tuple[str, dict[str, float]]], threshold: float
+) -> StaticBalance:
+    """Margins and tipping angles at `poses` and over the joint range, largest payload."""
+    ev = _Mass(stance)
+    m = stance.payload.mass if stance.payload is not None else 0.0
+    poly = stance.polygon
+    named = tuple(_at(ev, name, _values(stance, v), m, threshold) for name, v in poses)
+    seeds = _seeds(stance, [_values(stance, v) for _, v in poses])
+    worst, tips = _search(ev, seeds, m, threshold)
+    best = [p.payload_max for p in named]
+    best.append(_payload_over_range(ev, seeds, m, threshold))
+    known = [b for b in best if b is not None]
+    edges = poly.edges
+    return StaticBalance(
+        contacts=stance.ground.links,
+        polygon=poly.vertices,
+        directions=tuple(e.direction for e in edges),
+        headings=tuple(e.angle for e in edges),
+        ground=stance.ground.height,
+        mass=stance.mass,
+        payload=stance.payload.label if stance.payload is not None and m > 0 else None,
+        payload_point=_point_label(stance),
+        threshold=threshold,
+        poses=named,
+        worst=worst,
+        worst_tip_angles=tips,
+        payload_max=min(known) if len(known) == len(best) else None,
+    )
+
+
+def _point_label(stance: Stance) -> str:
+    p = stance.payload
+    return "" if p is None else p.label.split(" at ", 1)[1]
+
+
+def _values(stance: Stance, values: dict[str, float]) -> list[float]:
+    """The searched joints' values of a pose (0 clamped into range where it gives none)."""
+    return [float(np.clip(values.get(jr.name, 0.0), jr.lower, jr.upper)) for jr in stance.joints]
+
+
+def _at(
+    ev: _Mass, name: str, x: Sequence[float], m: float, threshold: float, *, payload: bool = True
+) -> PoseBalance:
+    """The balance at joint values x with payload m (and the largest payload there)."""
+    c0, p = ev.parts(x)
+    c = (ev.M * c0 + m * p) / (ev.M + m)
+    poly = ev.s.polygon
+    d = poly.edge_distances(c)
+    h = ev.s.height(c)
+    return PoseBalance(
+        name=name,
+        q=tuple((jr.name, float(v)) for jr, v in zip(ev.s.joints, x, strict=True)),
+        com=(float(c[0]), float(c[1]), float(c[2])),
+        margins=tuple(float(v) for v in d),
+        tip_angles=tuple(math.atan2(float(v), h) for v in d),
+        margin=poly.margin(c),
+        payload_max=_payload_max(ev, c0, p, threshold) if payload and ev.frame else None,
+    )
+
+
+def _payload_max(ev: _Mass, c0: NDArray[Any], p: NDArray[Any], threshold: float) -> float | None:
+    """The largest mass [kg] at point p keeping every edge margin >= threshold; None: not even 0.
+
+    The centre of mass with m at p is (M c0 + m p) / (M + m), so each edge's margin is
+    (M d(c0) + m d(p)) / (M + m): linear-fractional in m, with the bound in closed form.
+    """
+    poly = ev.s.polygon
+    d0, dp = poly.edge_distances(c0), poly.edge_distances(p)
+    if np.any(d0 < threshold - PAYLOAD_TOL):
+        return None
+    limits = [ev.M * (a - threshold) / (threshold - b) for a, b in zip(d0, dp, strict=True)
+              if b < threshold]  # fmt: skip
+    return max(0.0, min(limits)) if limits else math.inf
+
+
+def _seeds(stance: Stance, named: list[list[float]]) -> list[list[float]]:
+    joints = stance.joints
+    rows = [[float(np.clip(0.0, jr.lower, jr.upper)) for jr in joints], *named]
+    if 2 ** len(joints) <= MAX_CORNERS:
+        rows += [list(c) for c in itertools.product(*[(jr.lower, jr.upper) for jr in joints])]
+    rng = random.Random(SEARCH_SEED)  # stdlib: numpy.random costs 20 ms of start-up
+    rows += [[rng.uniform(jr.lower, jr.upper) for jr in joints] for _ in range(RANDOM_SEEDS)]
+    return rows
+
+
+def _search(
+    ev: _Mass, seeds: list[list[float]], m: float, threshold: float, *, tips: bool = True
+) -> tuple[tuple[PoseBalance, ...], tuple[float, ...]]:
+    """Per edge: the configuration of least margin, and the least tipping angle."""
+    poly = ev.s.polygon
+    coms = np.array([ev.com(x, m) for x in seeds])
+    h = coms[:, 2] - ev.s.ground.height
+    d_all = poly.offsets[None, :] - coms[:, :2] @ poly.normals.T  # (seeds, edges)
+    worst: list[PoseBalance] = []
+    angles: list[float] = []
+    for e, edge in enumerate(poly.edges):
+        n = np.asarray(edge.normal)
+
+        def margin(x: NDArray[Any], n: NDArray[Any] = n, off: float = edge.offset) -> Any:
+            c, J = ev.com_jac(x, m)
+            return off - n @ c[:2], -(n @ J[:2])
+
+        def tip(x: NDArray[Any], n: NDArray[Any] = n, off: float = edge.offset) -> Any:
+            c, J = ev.com_jac(x, m)
+            d, hh = off - n @ c[:2], ev.s.height(c)
+            grad = (hh * -(n @ J[:2]) - d * J[2]) / (d * d + hh * hh)
+            return math.atan2(d, hh), grad
+
+        x_m = _descend(margin, seeds, d_all[:, e], ev.s)
+        worst.append(_at(ev, WORST, x_m, m, threshold, payload=False))
+        if tips:
+            x_t = _descend(tip, seeds, np.arctan2(d_all[:, e], h), ev.s)
+            at_t = _at(ev, WORST, x_t, m, threshold, payload=False)
+            angles.append(min(at_t.tip_angles[e], worst[-1].tip_angles[e]))
+    return tuple(worst), tuple(angles)
+
+
+def _descend(
+    fun: Any, seeds: list[list[float]], values: NDArray[Any], stance: Stance
+) -> list[float]:
+    """Projected gradient descent within the joint limits from the best seeds; the best point."""
+    if not stance.joints:
+        return []
+    lower = [jr.lower for jr in stance.joints]
+    upper = [jr.upper for jr in stance.joints]
+    best_x, best_f = seeds[int(np.argmin(values))], float(np.min(values))
+    for k in np.argsort(values)[:SEEDS_DESCENDED]:
+        res = minimize_box(fun, seeds[k], lower, upper)
+        if res.f < best_f:
+            best_x, best_f = [float(v) for v in res.x], res.f
+    return list(best_x)
+
+
+def _payload_over_range(
+    ev: _Mass, seeds: list[list[float]], m: float, threshold: float
+) -> float | None:
+    """The largest payload [kg] keeping the margin >= threshold over the whole joint range.
+
+    Every closed-form bound at a real configuration is an upper bound of the answer; the
+    search's worst configuration for the current guess gives the next one, until the
+    guess repeats. None when the robot fails unloaded.
+    """
+    if ev.frame is None:
+        return None
+    guess, bounds = (m if m > 0 else 1.0), [math.inf]
+    for _ in range(PAYLOAD_ROUNDS):
+        worst, _ = _search(ev, seeds, guess, threshold, tips=False)
+        low = min(worst, key=lambda p: p.margins[p.edge])
+        c0, p = ev.parts([v for _, v in low.q])
+        bound = _payload_max(ev, c0, p, threshold)
+        if bound is None:
+            return None
+        if not math.isfinite(bound):  # no edge threatened here: try heavier
+            guess *= 10.0
+            if guess > MAX_PAYLOAD:
+                break
+            continue
+        bounds.append(bound)
+        if abs(bound - guess) <= 1e-6 * max(1.0, guess):
+            break
+        guess = bound
+    return min(bounds)

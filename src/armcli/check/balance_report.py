@@ -1,0 +1,95 @@
+"""The balance and reach part of `check`'s table report: margins, tipping angles, ZMP, reach.
+
+One table per robot with a support polygon: a row per named pose and one for the worst
+over the joint range, a column per edge of the polygon (the direction the robot would
+tip) with the centre of mass's margin and the slope that tips it that way.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from armcli.check.balance import StaticBalance
+from armcli.io.terminal import Column, FitTable
+from armcli.sim.tipping import ZmpReport, summary_line
+from armcli.urdf.workspace import ReachPoint, Workspace
+
+
+def balance_items(balance: StaticBalance | None, zmp: ZmpReport | None) -> list[Any]:
+    """Rich renderables for the summary (none without a support polygon)."""
+    from rich.text import Text
+
+    out: list[Any] = []
+    if balance is not None:
+        out.append(_table(balance))
+    if zmp is not None:
+        out.append(Text(summary_line(zmp), style="red" if zmp.tips else ""))
+    return out
+
+
+def _table(b: StaticBalance) -> Any:
+    heads = [f"{d}\n[mm | deg]" for d in b.directions]
+    cols = [Column("pose", False), Column("COM x\n[m]"), Column("COM z\n[m]"),
+            Column("margin\n[mm]"), *(Column(h) for h in heads)]  # fmt: skip
+    table = FitTable(cols, title=_title(b), caption=_caption(b))
+    for p in b.poses:
+        cells = [_cell(m, a) for m, a in zip(p.margins, p.tip_angles, strict=True)]
+        table.add_row(p.name, f"{p.com[0]:.4f}", f"{p.com[2]:.4f}", f"{p.margin * 1e3:.1f}", *cells)
+    w = b.worst_overall
+    worst = [_cell(p.margins[e], b.worst_tip_angles[e]) for e, p in enumerate(b.worst)]
+    table.add_row("worst in range", f"{w.com[0]:.4f}", f"{w.com[2]:.4f}",
+                  f"{w.margin * 1e3:.1f}", *worst)  # fmt: skip
+    return table
+
+
+def _cell(margin: float, angle: float) -> str:
+    return f"{margin * 1e3:.1f} | {math.degrees(angle):.1f}"
+
+
+def _title(b: StaticBalance) -> str:
+    load = f", {b.payload}" if b.payload else ""
+    return f"static balance on {', '.join(b.contacts)}{load}"
+
+
+def _caption(b: StaticBalance) -> str:
+    corners = " ".join(f"({x:.3f}, {y:.3f})" for x, y in b.polygon)
+    if b.payload_max is None:
+        holds = "no payload keeps the margin everywhere"
+    elif math.isinf(b.payload_max):
+        holds = f"any payload at {b.payload_point} keeps the margin everywhere"
+    else:
+        holds = f"up to {b.payload_max:.3g} kg at {b.payload_point} keeps it everywhere"
+    return (
+        f"support polygon {corners} m, ground at z = {b.ground:.3f} m; per edge: the "
+        f"centre of mass's margin and the slope that tips it (rigid wheels, flat ground); "
+        f"warning below {b.threshold * 1e3:g} mm: {holds}; robot {b.mass:.4g} kg"
+    )
+
+
+def reach_items(reach: Workspace | None, points: tuple[ReachPoint, ...]) -> list[Any]:
+    """One line for the tool point's reach envelope and one per --reach-point."""
+    from rich.text import Text
+
+    if reach is None:
+        return []
+    lo, hi = reach.lower, reach.upper
+    box = " ".join(f"{a:.3f}..{b:.3f}" for a, b in zip(lo, hi, strict=True))
+    out: list[Any] = [
+        Text(
+            f"reach of {reach.point} over {', '.join(reach.joints)}: max {reach.max_reach:.3f} m "
+            f"from the shoulder {_xyz(reach.shoulder)}, height {reach.min_height:.3f}.."
+            f"{reach.max_height:.3f} m, horizontal {reach.max_horizontal:.3f} m from the root's "
+            f"z axis; box x y z {box} m ({reach.samples} samples, extremes refined)"
+        )
+    ]
+    for p in points:
+        verdict = "reachable" if p.reachable else f"OUT OF REACH by {p.residual * 1e3:.1f} mm"
+        q = ", ".join(f"{n}={v:.4g}" for n, v in p.q)
+        out.append(Text(f"  point {_xyz(p.target)}: {verdict} (at {q})",
+                        style="" if p.reachable else "red"))  # fmt: skip
+    return out
+
+
+def _xyz(v: tuple[float, float, float]) -> str:
+    return f"({v[0]:.3f}, {v[1]:.3f}, {v[2]:.3f})"

@@ -1,0 +1,58 @@
+"""Rules `zmp-outside-support` and `zmp-margin`: does a trajectory tip the robot over?
+
+With `--trajectory` and a spec's gains, the spec's arm is simulated along the file as
+`armcli simulate` does (sim.tipping), and the whole robot's zero-moment point, with the
+base also accelerating and braking at the diff-drive plugin's limit, is measured against
+the support polygon (`check/tipover.py` builds the stance). One finding for the run's
+worst moment, naming the time, the case and the base acceleration that still holds.
+"""
+
+from __future__ import annotations
+
+import math
+
+from armcli.check.context import Context
+from armcli.check.rules import Value
+from armcli.check.tipover import round_down
+from armcli.errors import ArmcliError
+from armcli.sim import tipping
+
+
+def check(c: Context) -> None:
+    """Simulate the trajectory (when asked) and report its worst zero-moment point."""
+    opts, spec = c.opts.tipover, c.opts.spec
+    if opts.trajectory is None or c.stance is None:
+        return
+    if spec is None or not spec.control.gains:
+        c.notes.append("zero-moment point skipped: the trajectory needs a spec's PD gains "
+                       "to be simulated (give --spec)")  # fmt: skip
+        return
+    try:
+        r = tipping.trajectory_zmp(spec, c.urdf, c.stance, opts.trajectory,
+                                   opts.base_accel, opts.min_margin)  # fmt: skip
+    except ArmcliError as exc:
+        c.notes.append(f"zero-moment point skipped: {exc}")
+        return
+    c.zmp = r
+    if r.min_margin >= opts.min_margin:
+        return
+    what = (f"{-r.min_margin * 1e3:.1f} mm outside the support polygon: the robot tips"
+            if r.tips else f"only {r.min_margin * 1e3:.1f} mm inside the support polygon "
+            f"(threshold {opts.min_margin * 1e3:g} mm)")  # fmt: skip
+    holds = r.max_base_accel if r.tips else r.max_base_accel_margin
+    fix: dict[str, Value] = {}
+    text = (f"trajectory {opts.trajectory.name}: zero-moment point {what}, toward "
+            f"{r.direction} at t = {r.time:.3f} s ({r.when}); ")  # fmt: skip
+    if holds > 0 and math.isfinite(holds):
+        text += f"a base acceleration up to {holds:.3g} m/s² holds"
+        # the spec's diff_drive field when the limit came from the plugin, else the option
+        key = "base_accel" if opts.base_accel is not None else "max_wheel_acceleration"
+        fix[key] = round_down(holds)
+    elif math.isinf(holds):
+        text += "the base's acceleration does not move it toward that edge"
+    else:
+        text += "the arm motion alone is too fast: slow the trajectory down"
+    rule = "zmp-outside-support" if r.tips else "zmp-margin"
+    c.out.add(rule, c.urdf.line, text, fix, time=r.time, margin=r.min_margin, case=r.case,
+              base_accel=r.base_accel, direction=r.direction, zmp=list(r.zmp),
+              trajectory=str(opts.trajectory))  # fmt: skip

@@ -1,0 +1,279 @@
+"""Will the robot tip over while its arm runs a trajectory? `simulate`'s balance report.
+
+From a prepared simulation (`sim.job`): the whole robot standing on its contacts
+(`urdf.stance`: the spec's full URDF, or a given URDF whose wheels touch the ground),
+the steps the run must keep for the zero-moment point (`sim.zmp`), and after the run
+the series, its worst moment, the states-file columns and the summary line.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from armcli.errors import InputError, TipOverError
+from armcli.sim import job as simjob
+from armcli.sim import zmp as zmps
+from armcli.sim.job import SimJob
+from armcli.sim.options import SimOptions
+from armcli.sim.simulate import SimResult
+from armcli.sim.states import sample_steps
+from armcli.urdf.doc import Urdf
+from armcli.urdf.ground import mesh_loader
+from armcli.urdf.meshes import MeshSearch
+from armcli.urdf.read import parse_urdf
+from armcli.urdf.stance import NoStance, Payload, Stance, stance_of
+from armcli.urdf.tool import tool_point
+
+if TYPE_CHECKING:
+    from armcli.spec.model import RobotSpec
+
+DEFAULT_MIN_MARGIN = 0.02  # [m] as `check`'s support-margin threshold
+COLUMNS = ("zmp.x", "zmp.y", "zmp.margin", "zmp.margin_base")
+
+
+@dataclass(frozen=True)
+class TipOptions:
+    """Balance options of a run (None: from the spec, the URDF or the default)."""
+
+    base_accel: float | None = None  # [m/s²] the base's acceleration and braking
+    payload: float = 0.0  # [kg]
+    payload_link: str | None = None  # default: the tool point
+    contact_links: tuple[str, ...] | None = None
+    min_margin: float = DEFAULT_MIN_MARGIN  # [m]
+
+    def __post_init__(self) -> None:
+        for name in ("payload", "min_margin"):
+            x = getattr(self, name)
+            if not (math.isfinite(x) and x >= 0):
+                raise InputError(f"must be finite and >= 0, got {x:g}", field=f"TipOptions.{name}")
+        if self.base_accel is not None and not (
+            math.isfinite(self.base_accel) and self.base_accel >= 0
+        ):
+            raise InputError(f"must be finite and >= 0, got {self.base_accel:g}",
+                             field="TipOptions.base_accel")  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Tipping:
+    """What a run needs to report its zero-moment point: the stance and the base's acceleration."""
+
+    stance: Stance
+    base_accel: float  # [m/s²]
+    accel_source: str  # where it came from, for the summary
+    threshold: float  # [m]
+
+    def steps(self, job: SimJob, steps: int) -> NDArray[np.int64]:
+        """The steps to keep: pairs for the acceleration, the output rate's among them."""
+        return zmps.zmp_steps(steps, sample_steps(steps, job.config.dt, job.rate))
+
+    def series(self, job: SimJob, res: SimResult) -> zmps.ZmpSeries:
+        """The zero-moment point at every kept state of the run."""
+        return zmps.zmp_series(self.stance, res.joint_names, res.t, res.step, res.q, res.v,
+                               res.dt, self.base_accel, self.threshold,
+                               zmps.impacts(res.stop_active, res.v))  # fmt: skip
+
+
+def robot_urdf(spec: RobotSpec | None, job: SimJob) -> Urdf | None:
+    """The whole robot: the spec's full URDF (arm on its base), or the simulated URDF."""
+    if (
+        spec is not None
+        and job.urdf is not None
+        and job.urdf.source.endswith(".urdf")
+        and (spec.mounted_base() is not None)
+    ):
+        from armcli.compiler.expand import expand_urdfs  # the spec compiler: only for a spec
+
+        name = f"{spec.name}.urdf"
+        return parse_urdf(expand_urdfs(spec)[name], name)
+    return job.urdf
+
+
+def prepare(
+    spec: RobotSpec | None, job: SimJob, opts: TipOptions, search: MeshSearch, notes: list[str]
+) -> Tipping | None:
+    """The run's balance set-up, or None (with a note) for a robot on a fixed base."""
+    urdf = robot_urdf(spec, job)
+    if urdf is None:
+        return None
+    base = spec.mounted_base() if spec is not None else None
+    candidates = set(base.links) if base is not None and opts.contact_links is None else None
+    point = tool_point(urdf, spec)
+    if opts.payload_link is not None:
+        payload = Payload(opts.payload, opts.payload_link)
+    elif point is not None:
+        payload = Payload(opts.payload, point.link, point.xyz)
+    else:
+        return None
+    missing: list[str] = []
+    found = stance_of(urdf, candidates=candidates, declared=opts.contact_links,
+                      mesh=mesh_loader(urdf, search, missing), payload=payload)  # fmt: skip
+    if isinstance(found, NoStance):
+        notes.append(f"no zero-moment point: {found.reason}")
+        return None
+    missing_joints = [n for n in job.arm.joint_names if not found.model.existJointName(n)]
+    if missing_joints:
+        notes.append(f"no zero-moment point: {', '.join(missing_joints)} not in {urdf.source}")
+        return None
+    accel, source = _base_accel(opts, urdf)
+    return Tipping(found, accel, source, opts.min_margin)
+
+
+def trajectory_zmp(
+    spec: RobotSpec,
+    urdf: Urdf,
+    stance: Stance,
+    trajectory: Path,
+    base_accel: float | None,
+    threshold: float,
+) -> ZmpReport:
+    """Simulate the spec's arm along a trajectory file; the whole robot's zero-moment point.
+
+    What `simulate` reports, for `check --trajectory`. Raises what `sim.job.prepare` raises
+    (bad trajectory, gains the integrator refuses) and SimulationError.
+    """
+    job = simjob.prepare(spec, SimOptions(trajectory=trajectory))
+    accel, source = _base_accel(TipOptions(base_accel=base_accel), urdf)
+    tip = Tipping(stance, accel, source, threshold)
+    res = simjob.run(job, extra=lambda steps: tip.steps(job, steps))
+    return report(tip, tip.series(job, res))
+
+
+def _base_accel(opts: TipOptions, urdf: Urdf) -> tuple[float, str]:
+    if opts.base_accel is not None:
+        return opts.base_accel, "--base-accel"
+    limit = zmps.drive_acceleration(urdf)
+    if limit is not None:
+        return limit, "the diff-drive plugin's max_wheel_acceleration"
+    return 0.0, "no diff-drive acceleration limit in the URDF (give --base-accel)"
+
+
+def columns(series: zmps.ZmpSeries, res: SimResult, rate: float) -> dict[str, NDArray[Any]]:
+    """States-file columns at the output rate: the point, its margin, the worst with the base."""
+    want = sample_steps(res.steps, res.dt, rate)
+    rows = np.searchsorted(series.step, want)
+    rows = np.minimum(rows, len(series.step) - 1)
+    if not np.array_equal(series.step[rows], want):
+        raise ValueError("the zero-moment point was not computed at the output rate")
+    return {
+        COLUMNS[0]: series.zmp[rows, 0, 0],
+        COLUMNS[1]: series.zmp[rows, 0, 1],
+        COLUMNS[2]: series.margin[rows, 0],
+        COLUMNS[3]: np.min(series.margin[rows, 1:], axis=1),
+    }
+
+
+@dataclass(frozen=True)
+class ZmpReport:
+    """A run's zero-moment point in numbers: its worst moment and what still holds."""
+
+    base_accel: float  # [m/s²] of the accelerating and braking cases
+    accel_source: str
+    payload: str | None
+    threshold: float  # [m]
+    min_margin: float  # [m] over the run and the cases (negative: it tips)
+    time: float  # [s] when
+    case: str  # one of sim.zmp.CASES
+    direction: str  # toward which edge
+    zmp: tuple[float, float]  # [m] the point then
+    arm_margin: float  # [m] least margin of the arm motion alone (base at rest)
+    max_base_accel: float  # [m/s²] the largest that keeps the margin >= 0 at every state
+    max_base_accel_margin: float  # [m/s²] the largest that keeps it >= threshold
+    impacts: int  # states left out: joint-stop impacts
+
+    @property
+    def tips(self) -> bool:
+        """Whether the point leaves the polygon."""
+        return self.min_margin < 0
+
+    @property
+    def when(self) -> str:
+        """The worst moment's case, with the base's acceleration when it counts."""
+        return self.case + (f" at {self.base_accel:g} m/s²" if self.case != zmps.CASES[0] else "")
+
+
+def report(tip: Tipping, series: zmps.ZmpSeries) -> ZmpReport:
+    """The numbers of a run's zero-moment point."""
+    k, c = series.worst()
+    poly = tip.stance.polygon
+    p = series.zmp[k, c]
+    finite = bool(np.all(np.isfinite(p)))
+    payload = tip.stance.payload
+    return ZmpReport(
+        base_accel=tip.base_accel,
+        accel_source=tip.accel_source,
+        payload=payload.label if payload is not None and payload.mass > 0 else None,
+        threshold=tip.threshold,
+        min_margin=float(series.margin[k, c]),
+        time=float(series.t[k]),
+        case=zmps.CASES[c],
+        direction=poly.edges[poly.nearest_edge(p)].direction if finite else "-",
+        zmp=(float(p[0]), float(p[1])),
+        arm_margin=float(np.min(series.margin[:, 0])),
+        max_base_accel=zmps.max_base_accel(series, poly, 0.0),
+        max_base_accel_margin=zmps.max_base_accel(series, poly, tip.threshold),
+        impacts=series.impacts,
+    )
+
+
+def summary_line(r: ZmpReport) -> str:
+    """The summary's line: where the point came closest to the edge, and whether it tips."""
+    load = f", {r.payload}" if r.payload else ""
+    head = (f"zero-moment point (base held on its wheels{load}; base accel {r.base_accel:g} "
+            f"m/s² from {r.accel_source}): ")  # fmt: skip
+    if r.tips:
+        what = (
+            f"TIPS: {-r.min_margin * 1e3:.1f} mm outside the support polygon toward {r.direction}"
+        )
+    else:
+        what = f"least margin {r.min_margin * 1e3:.1f} mm toward {r.direction}"
+    left = f"; {r.impacts} joint-stop impact(s) left out" if r.impacts else ""
+    holds = "any" if math.isinf(r.max_base_accel) else f"{r.max_base_accel:.3g} m/s²"
+    return (
+        f"{head}{what} at t = {r.time:.3f} s ({r.when}); arm motion alone: "
+        f"{r.arm_margin * 1e3:.1f} mm; base acceleration that holds: {holds}{left}"
+    )
+
+
+def tip_error(r: ZmpReport) -> TipOverError:
+    """The error a run that tips the robot over ends with (after its files are written)."""
+    return TipOverError(
+        f"the robot tips over: its zero-moment point is {-r.min_margin * 1e3:.1f} mm outside "
+        f"the support polygon toward {r.direction} at t = {r.time:.3f} s ({r.when})",
+        time=r.time,
+        margin=r.min_margin,
+        case=r.case,
+    )
+
+
+def plot_row(series: zmps.ZmpSeries) -> Any:
+    """A drawer of the tracking plot's fourth row: margins per case, and the point itself."""
+
+    def draw(axes: Any) -> None:
+        ax = axes[0]
+        for c, name in enumerate(zmps.CASES):
+            if c and series.base_accel == 0:
+                continue
+            label = name + (f" ({series.base_accel:g} m/s²)" if c else "")
+            ax.plot(series.t, series.margin[:, c] * 1e3, lw=1.2, label=label)
+        ax.axhline(series.threshold * 1e3, color="C3", lw=0.8, ls=":", label="warning")
+        ax.axhline(0.0, color="k", lw=0.8, label="tips")
+        ax.set_ylabel("ZMP margin [mm]")
+        ax.set_title("zero-moment point in the support polygon", fontsize=11)
+        if len(axes) > 1:
+            axes[1].plot(series.t, series.zmp[:, 0, 0] * 1e3, color="C0", lw=1.2, label="x")
+            axes[1].plot(series.t, series.zmp[:, 0, 1] * 1e3, color="C1", lw=1.2, label="y")
+            axes[1].set_ylabel("ZMP, arm motion [mm]")
+        for a in axes[2:]:
+            a.set_visible(False)
+        for a in axes[:2]:
+            a.set_xlabel("time [s]")
+            a.grid(True, alpha=0.3)
+            a.legend(loc="best", fontsize=8)
+
+    return draw

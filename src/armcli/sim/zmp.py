@@ -1,0 +1,228 @@
+"""The zero-moment point of the whole robot while its arm moves and its base drives.
+
+Model: rigid bodies on rigid, flat, level ground; the base is held still on its
+wheels (braked, no slip) while the arm follows the simulated motion, and optionally
+the whole robot accelerates or brakes along the base's x axis at a_b (a diff-drive
+base cannot accelerate sideways; turning and the wheels' own spin-up are left out).
+Whole-body inverse dynamics (Pinocchio RNEA on the free-flyer model, payload
+included) gives the wrench (f, n) the ground must apply at the root's origin to hold
+the base: the root's acceleration is a_b x, the arm's joints move at (q, v, a). The
+zero-moment point is the point on the ground plane (height z0) about which that
+wrench has no horizontal moment:
+
+    n' = n - (0, 0, z0) x f,    p_x = -n'_y / f_z,    p_y = n'_x / f_z
+
+It is the centre of pressure of the contact forces whenever they can hold the base,
+so it must stay inside the support polygon; outside, the robot tips about the nearest
+edge. The wrench is affine in a_b (the root's column of the mass matrix is
+m (x, c x x) for a pure translation), so accelerating and braking cost one RNEA.
+
+The joint accelerations are those of the simulator's own steps: a_k = (v_{k+1} - v_k)/dt,
+exactly what semi-implicit Euler applied in step k.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from armcli.urdf.doc import Urdf
+from armcli.urdf.read import parse_root
+from armcli.urdf.stance import Stance
+from armcli.urdf.support import SupportPolygon
+
+MAX_SAMPLES = 20_000  # states whose zero-moment point is computed, at most (pairs of steps)
+CASES = ("arm motion", "accelerating", "braking")
+# gazebo_ros_diff_drive limits the change of each wheel's rim speed by this [m/s²]
+# (its code multiplies the joint velocity by the radius before comparing): the base's
+# linear acceleration. gz-sim's DiffDrive names it max_linear_acceleration [m/s²].
+DRIVE_ACCEL_TAGS = ("max_wheel_acceleration", "max_linear_acceleration", "max_acceleration")
+
+
+@dataclass(frozen=True)
+class ZmpSeries:
+    """The zero-moment point over a run: per kept state, and the worst moment."""
+
+    t: NDArray[np.float64]  # (K,) [s]
+    step: NDArray[np.int64]  # (K,) simulator steps
+    zmp: NDArray[np.float64]  # (K, 3, 2) [m] root x-y per case (CASES)
+    margin: NDArray[np.float64]  # (K, 3) [m] signed margin per case (CASES)
+    base_accel: float  # [m/s²] |a_b| of the accelerating and braking cases
+    threshold: float  # [m] margin below which the report warns
+    impacts: int = 0  # kept states left out: a joint hit its hard stop in that step
+    shift: NDArray[np.float64] | None = None  # (K,) [m per m/s²] backward x shift per a_b
+
+    def worst(self) -> tuple[int, int]:
+        """(state index, case index) of the least margin."""
+        k, c = np.unravel_index(int(np.argmin(self.margin)), self.margin.shape)
+        return int(k), int(c)
+
+    @property
+    def min_margin(self) -> float:
+        """[m] least margin over the run and the cases."""
+        return float(np.min(self.margin))
+
+
+def drive_acceleration(urdf: Urdf) -> float | None:
+    """The diff-drive plugin's acceleration limit [m/s²] in the URDF's <gazebo>, if any."""
+    root = parse_root(urdf.text, urdf.source)
+    for plugin in root.iter("plugin"):
+        for tag in DRIVE_ACCEL_TAGS:
+            text = plugin.findtext(tag)
+            if text is not None:
+                try:
+                    value = float(text)
+                except ValueError:
+                    continue
+                if math.isfinite(value) and value > 0:
+                    return value
+    return None
+
+
+def zmp_steps(steps: int, also: ArrayLike = ()) -> NDArray[np.int64]:
+    """The steps a run must keep for the zero-moment point: pairs (k, k + 1).
+
+    Every step when there are at most MAX_SAMPLES, else evenly spread ones; plus the
+    steps in `also` (the states file's), each with its successor.
+    """
+    k = np.round(np.linspace(0, steps - 1, min(steps, MAX_SAMPLES))).astype(np.int64)
+    k = np.concatenate([k, np.asarray(also, dtype=np.int64)])
+    k = k[(k >= 0) & (k <= steps)]
+    return np.sort(np.concatenate([k, np.minimum(k + 1, steps)]))
+
+
+def accelerations(
+    step: NDArray[Any], v: NDArray[Any], dt: float, impact: NDArray[Any] | None = None
+) -> tuple[NDArray[Any], NDArray[Any]]:
+    """(rows, a): the kept states with a known acceleration and that acceleration.
+
+    Forward difference where the next step was kept, else backward where the previous
+    was (the run's last state); states with neither are left out, and so are the steps
+    marked in `impact` (a joint running into its hard stop: an impulse, not a force).
+    """
+    nxt = np.concatenate([np.diff(step) == 1, [False]])
+    prv = np.concatenate([[False], np.diff(step) == 1])
+    usable = nxt | prv
+    if impact is not None:
+        hit = np.asarray(impact, dtype=bool)
+        usable &= ~np.where(nxt, hit, np.concatenate([[False], hit[:-1]]))
+    rows = np.nonzero(usable)[0]
+    a = np.empty((len(rows), v.shape[1]))
+    for i, r in enumerate(rows):
+        a[i] = (v[r + 1] - v[r]) / dt if nxt[r] else (v[r] - v[r - 1]) / dt
+    return rows, a
+
+
+def impacts(stop: NDArray[Any], v: NDArray[Any]) -> NDArray[np.bool_]:
+    """Per kept state: a joint stop acted in its step while that joint was moving."""
+    return np.asarray(np.any(np.asarray(stop, dtype=bool) & (np.asarray(v) != 0.0), axis=1))
+
+
+def zmp_series(
+    stance: Stance,
+    joint_names: Sequence[str],
+    t: NDArray[Any],
+    step: NDArray[Any],
+    q: NDArray[Any],
+    v: NDArray[Any],
+    dt: float,
+    base_accel: float,
+    threshold: float,
+    impact: NDArray[Any] | None = None,
+) -> ZmpSeries:
+    """The zero-moment point at every kept state of a run whose acceleration is known.
+
+    `q`, `v` are the simulated joints' positions and velocities at the kept `step`s,
+    `joint_names` their names in the whole robot (a joint missing there is an error);
+    states flagged in `impact` (joint-stop impacts, `impacts`) are left out.
+    """
+    import pinocchio as pin
+
+    model = stance.loaded()
+    data = model.createData()
+    rows, a = accelerations(np.asarray(step), np.asarray(v), dt, impact)
+    skipped = 0 if impact is None else int(np.sum(np.asarray(impact, dtype=bool)))
+    cols = _columns(model, joint_names)
+    q_full = np.asarray(pin.neutral(model), dtype=float)
+    mass = float(sum(inertia.mass for inertia in model.inertias))
+    z0 = stance.ground.height
+    zmp = np.empty((len(rows), 3, 2))
+    margin = np.empty((len(rows), 3))
+    shift = np.empty(len(rows))
+    for i, r in enumerate(rows):
+        qk, vk, ak = _state(model, cols, q_full, q[r], v[r], a[i])
+        w = np.asarray(pin.rnea(model, data, qk, vk, ak)[:6], dtype=float)
+        c = np.asarray(pin.centerOfMass(model, data, qk, False), dtype=float)
+        dw = mass * np.array([1.0, 0.0, 0.0, 0.0, c[2], -c[1]])  # d wrench / d a_b
+        shift[i] = mass * (c[2] - z0) / w[2] if w[2] > 0 else math.inf
+        for j, sign in enumerate((0.0, 1.0, -1.0)):
+            p = zero_moment_point(w + sign * base_accel * dw, z0)
+            zmp[i, j] = p
+            margin[i, j] = stance.polygon.margin(p) if np.all(np.isfinite(p)) else -math.inf
+    return ZmpSeries(np.asarray(t)[rows], np.asarray(step)[rows], zmp, margin,
+                     float(base_accel), float(threshold), skipped, shift)  # fmt: skip
+
+
+def max_base_accel(series: ZmpSeries, polygon: SupportPolygon, threshold: float) -> float:
+    """The largest |a_b| [m/s²] for which the point keeps `threshold` margin at every state.
+
+    The base's acceleration moves the point along x only, by -a_b m h / f_z (`shift`):
+    f_z does not change and the moment about the y axis grows by m h a_b. So each edge
+    bounds a_b in closed form; 0 when the arm motion alone leaves too little margin.
+    """
+    assert series.shift is not None
+    best = math.inf
+    for p, s in zip(series.zmp[:, 0], series.shift, strict=True):
+        d = polygon.edge_distances(p) - threshold
+        if np.any(d < 0):
+            return 0.0
+        for n_x, slack in zip(polygon.normals[:, 0], d, strict=True):
+            if abs(n_x) > 1e-12 and s > 0:  # both signs of a_b: either side's edges
+                best = min(best, slack / (s * abs(n_x)))
+    return best
+
+
+def zero_moment_point(wrench: NDArray[Any], ground: float = 0.0) -> NDArray[np.float64]:
+    """The point [m] on the ground plane z = `ground` where the wrench has no horizontal moment.
+
+    `wrench` = (f, n): force [N] and moment [N·m] about the root's origin, root frame.
+    NaN when f_z <= 0: nothing presses the robot on the ground (it lifts off).
+    """
+    f, n = wrench[:3], wrench[3:6]
+    if f[2] <= 0.0:
+        return np.array([math.nan, math.nan])
+    nx = n[0] + ground * f[1]
+    ny = n[1] - ground * f[0]
+    return np.array([-ny / f[2], nx / f[2]])
+
+
+def _columns(model: Any, names: Sequence[str]) -> list[tuple[int, int, bool]]:
+    """(idx_q, idx_v, continuous) in the whole robot of each simulated joint."""
+    out = []
+    for name in names:
+        if not model.existJointName(name):
+            raise ValueError(f"joint {name!r} is not in the whole robot")
+        j = model.joints[model.getJointId(name)]
+        out.append((j.idx_q, j.idx_v, j.nq == 2))
+    return out
+
+
+def _state(
+    model: Any, cols: list[tuple[int, int, bool]], q0: NDArray[Any], q: NDArray[Any],
+    v: NDArray[Any], a: NDArray[Any],
+) -> tuple[NDArray[Any], NDArray[Any], NDArray[Any]]:  # fmt: skip
+    qk = q0.copy()
+    vk = np.zeros(model.nv)
+    ak = np.zeros(model.nv)
+    for (iq, iv, cont), x, xd, xdd in zip(cols, q, v, a, strict=True):
+        if cont:
+            qk[iq], qk[iq + 1] = math.cos(x), math.sin(x)
+        else:
+            qk[iq] = x
+        vk[iv], ak[iv] = xd, xdd
+    return qk, vk, ak
