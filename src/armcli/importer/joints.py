@@ -10,8 +10,6 @@ from armcli.importer.compare import JOINT_TAGS
 from armcli.importer.values import Reader, nums, origin_data, xml_text
 from armcli.importer.yamltext import Block, Num
 
-SPEC_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
-
 
 def _limit(el: etree._Element, jtype: str, reader: Reader) -> dict[str, Any]:
     out: dict[str, Any] = {}
