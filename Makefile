@@ -47,9 +47,12 @@ lint: install
 	$(BIN)/ruff format --check src tests bench
 	$(BIN)/mypy src
 
+# The suite in two timed runs: everything but the `slow` tests (installs into fresh
+# virtualenvs, pre-commit), then those; each prints its own time and slowest tests.
 test: install sysdeps lint native-check
 	$(BIN)/armcli build --check $(SPEC)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -m "not slow" --durations=10
+	$(BIN)/python -m pytest -q -m slow --durations=10
 
 # Rebuild the compiled rollout after editing its C++ (the editable install does not rebuild
 # on import): incremental, in build/, with the build tools of the dev extra. Not through the

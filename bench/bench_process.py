@@ -10,6 +10,11 @@
 3. Start-up: `armcli simulate --help` next to `python -c pass`, and what importing the
    simulate command costs, by module (`python -X importtime`).
 
+Every process runs with Python's bytecode cache on (in a temporary PYTHONPYCACHEPREFIX,
+warmed by an untimed first run), as an installed package has it: an environment with
+PYTHONDONTWRITEBYTECODE=1 would otherwise recompile armcli's modules at every start
+(~0.1 CPU s) while numpy, Pinocchio and MuJoCo load their installed caches.
+
 Run with `make bench` (or `python bench/bench_process.py [--quick]`). Not a test: numbers
 depend on the machine and its load.
 """
@@ -32,6 +37,7 @@ BIN = Path(sys.executable).parent
 DT = 5e-4  # [s]
 KP, KD = 50.0, 5.0
 WHOLE_S, MEMORY_S = 120.0, 900.0  # [s] trajectories of the two comparisons
+ENV = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
 CYCLE = [(0.6, 0.4, 1.0), (0.9, 1.2, 2.0), (0.9, 1.2, 2.5), (0.5, 0.8, 3.5), (0.3, 0.3, 5.0)]
 MUJOCO_SCRIPT = """
 import sys
@@ -75,7 +81,7 @@ def run_once(cmd: list[str]) -> tuple[float, float, float]:
     """Wall seconds, CPU seconds (user + system) and peak RSS [MiB] of one process, from the
     kernel's accounting. CPU time is what a busy machine disturbs least."""
     start = time.perf_counter()
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=ENV)
     _, status, usage = os.wait4(proc.pid, 0)
     wall = time.perf_counter() - start
     proc.returncode = os.waitstatus_to_exitcode(status)
@@ -86,6 +92,7 @@ def run_once(cmd: list[str]) -> tuple[float, float, float]:
 
 def paired(a: list[str], b: list[str], repeats: int) -> tuple[list[float], list[float], float]:
     """A and B in turn; their CPU seconds, and the median of the pairwise ratios."""
+    run_once(a), run_once(b)  # untimed: fills the bytecode cache
     ta, tb = [], []
     for _ in range(repeats):
         ta.append(run_once(a)[1])
@@ -138,7 +145,7 @@ def startup(repeats: int) -> None:
           f"`python -c pass` {statistics.median(tp):.3f} CPU s")  # fmt: skip
     for module in ("armcli.commands.simulate", "armcli.check.gate", "pinocchio"):
         r = subprocess.run([sys.executable, "-X", "importtime", "-c", f"import {module}"],
-                           capture_output=True, text=True, check=True)  # fmt: skip
+                           capture_output=True, text=True, check=True, env=ENV)  # fmt: skip
         # "import time: self | cumulative | name", nested names indented by two spaces
         rows = re.findall(r"\|\s*(\d+) \| ( *)(\S+)$", r.stderr, re.M)
         end = next(i for i, (_, ind, n) in enumerate(rows) if not ind and n == module)
@@ -158,6 +165,7 @@ def main() -> None:
     urdf = ROOT / "urdf" / "standalone_arm.urdf"
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory() as tmp:
+        ENV["PYTHONPYCACHEPREFIX"] = str(Path(tmp) / "pycache")
         # each side reads the trajectory of the run it times: 120 s (121 points) for the
         # whole-process comparison, 900 s (901 points) for the memory run
         files = {}
@@ -180,7 +188,7 @@ def main() -> None:
 
         whole_process(reps, armcli, mujoco)
         memory(armcli, Path(tmp) / "states.csv")
-    startup(reps)
+        startup(reps)
     print(f"load average after: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
 
 

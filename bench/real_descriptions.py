@@ -12,12 +12,16 @@ Each entry of ENTRIES (a robot's top-level description file and the xacro argume
 it needs) is run through the real CLI as a user with a sourced ROS 2 workspace runs
 it: only AMENT_PREFIX_PATH set (no ROS_PACKAGE_PATH). Per entry:
 
-- expansion: `armcli expand FILE ARGS` (an armcli without `expand`: `armcli tree`);
+- expansion: `armcli expand FILE ARGS` (an armcli without `expand`: `armcli tree`),
+  also without the arguments, with only ROS_PACKAGE_PATH (the source tree) instead of
+  the ament prefix, and with `--trust-xacro` (the sandboxed real xacro);
+- tree: `armcli tree FILE ARGS` exits 0;
 - the reference: the real xacro, unsandboxed, with an `ament_index_python` stand-in
   (`<prefix>/share/NAME` from the ament index, as ROS 2's) so that `$(find)` works,
   and whether armcli's expansion equals it (the banner comment naming the file aside);
 - check: exit code, error findings by rule, and false ones: `mesh-missing` for a mesh
   the ROS 2 resolution finds (package:// through the ament index, file://, relative);
+  and the error findings that name an unknown package;
 - simulate --urdf along a small move of every joint (gains 100/10), export mjcf (and
   whether MuJoCo then loads the written model), render: exit codes and first lines.
 
@@ -96,10 +100,6 @@ ENTRIES = [
     Entry("Motoman SIA20D", "motoman/motoman_sia20d_support/urdf/sia20d.xacro"),
     Entry("Husky", "husky/husky_description/urdf/husky.urdf.xacro"),
     Entry("Jackal", "jackal/jackal_description/urdf/jackal.urdf.xacro"),
-    Entry(
-        "Clearpath A200",
-        "clearpath_common/clearpath_platform_description/urdf/a200/a200.urdf.xacro",
-    ),
     Entry("rrbot (demo 1)", DEMOS + "example_1/description/urdf/rrbot.urdf.xacro"),
     Entry("r6bot (demo 7)", DEMOS + "example_7/description/urdf/r6bot.urdf.xacro"),
     Entry("diffbot (demo 2)", DEMOS + "example_2/description/urdf/diffbot.urdf.xacro"),
@@ -151,6 +151,12 @@ class Row:
     reference: str = ""  # "ok" or the reference's error
     expanded: bool = False
     expand_error: str = ""
+    expanded_no_args: bool | None = None  # None: the entry takes no arguments
+    expanded_ros: bool | None = None  # ROS_PACKAGE_PATH only; None: not run
+    trusted: str = ""  # --trust-xacro: "equal", "differs" or its error
+    tree: str = ""
+    unknown_package: int = 0
+    continuous: int = 0  # continuous joints of the model
     equal: bool | None = None  # None: no reference or no expansion to compare
     check_exit: int | None = None
     errors: dict[str, int] = field(default_factory=dict)
@@ -172,11 +178,15 @@ class Runner:
         (tmp / "shim" / "ament_index_python" / "packages.py").write_text(SHIM)
         env = {k: v for k, v in os.environ.items() if k not in ("ROS_PACKAGE_PATH", "PYTHONPATH")}
         self.env = {**env, "AMENT_PREFIX_PATH": str(prefix), "COLUMNS": "200"}
+        no_ament = {k: v for k, v in self.env.items() if k != "AMENT_PREFIX_PATH"}
+        self.ros_env = {**no_ament, "ROS_PACKAGE_PATH": str(self.src)}
         self.python = python
         self.has_expand = self.cli("expand", "--help").returncode == 0
 
-    def cli(self, *args: str) -> subprocess.CompletedProcess[bytes]:
-        return self._run([self.python, "-m", "armcli.cli", *args], self.env)
+    def cli(
+        self, *args: str, env: dict[str, str] | None = None
+    ) -> subprocess.CompletedProcess[bytes]:
+        return self._run([self.python, "-m", "armcli.cli", *args], env or self.env)
 
     def reference(self, path: Path, args: tuple[str, ...]) -> subprocess.CompletedProcess[bytes]:
         env = {**self.env, "PYTHONPATH": str(self.tmp / "shim")}
@@ -212,6 +222,15 @@ def ros_resolves(uri: str, base: Path, prefix: Path) -> bool:
     return not parsed.scheme and (base / uri).is_file()
 
 
+def continuous_joints(xml: bytes) -> int:
+    """How many continuous joints (unbounded angle) the model has."""
+    root = etree.fromstring(xml, etree.XMLParser(resolve_entities=False))
+    return sum(j.get("type") == "continuous" for j in root.findall("joint"))
+
+
+UNKNOWN_PACKAGE = ("unknown package", "no package")
+
+
 def movable_joints(xml: bytes) -> list[tuple[str, float]]:
     """(joint, target) for every moving non-mimic joint: a quarter range from the middle."""
     root = etree.fromstring(xml, etree.XMLParser(resolve_entities=False))
@@ -241,8 +260,13 @@ def run_entry(r: Runner, e: Entry) -> Row:
     xml = _expansion(r, e, path, row)
     if ref_xml is not None and xml is not None:
         row.equal = _without_banner(xml) == _without_banner(ref_xml)
+    if row.xacro:
+        _other_expansions(r, e, path, row, ref_xml)
+    proc = r.cli("tree", str(path), *e.args)
+    row.tree = "ok" if proc.returncode == 0 else f"exit {proc.returncode}: {_first_error(proc)}"
     _check(r, e, path, row)
     model = xml if xml is not None else (ref_xml if row.xacro else path.read_bytes())
+    row.continuous = continuous_joints(model) if model else 0
     _simulate(r, e, path, row, model)
     _export(r, e, path, row)
     out = r.tmp / "render.png"
@@ -265,6 +289,26 @@ def _expansion(r: Runner, e: Entry, path: Path, row: Row) -> bytes | None:
     return proc.stdout if row.expanded and r.has_expand else None
 
 
+def _other_expansions(r: Runner, e: Entry, path: Path, row: Row, ref_xml: bytes | None) -> None:
+    """Without the arguments, with ROS_PACKAGE_PATH only, and with --trust-xacro."""
+    command = "expand" if r.has_expand else "tree"
+    if e.args:
+        row.expanded_no_args = r.cli(command, str(path)).returncode == 0
+    row.expanded_ros = r.cli(command, str(path), *e.args, env=r.ros_env).returncode == 0
+    if not r.has_expand:  # an older CLI: only `tree` reads the file, and without arguments
+        proc = r.cli("tree", "--trust-xacro", str(path))
+        row.trusted = "expanded" if proc.returncode == 0 else _first_error(proc)
+        return
+    proc = r.cli("expand", "--trust-xacro", str(path), *e.args)
+    if proc.returncode != 0:
+        row.trusted = _first_error(proc)
+    elif ref_xml is None:
+        row.trusted = "expanded"
+    else:
+        same = _without_banner(proc.stdout) == _without_banner(ref_xml)
+        row.trusted = "equal" if same else "differs"
+
+
 def _check(r: Runner, e: Entry, path: Path, row: Row) -> None:
     proc = r.cli("check", str(path), *e.args, "--format", "json")
     row.check_exit = proc.returncode
@@ -275,6 +319,9 @@ def _check(r: Runner, e: Entry, path: Path, row: Row) -> None:
     findings = [f for file in doc.get("files", []) for f in file.get("findings", [])]
     errors = [f for f in findings if f.get("severity") == "error"]
     row.errors = dict(Counter(f["rule"] for f in errors))
+    row.unknown_package = sum(
+        any(text in f.get("message", "") for text in UNKNOWN_PACKAGE) for f in errors
+    )
     row.material_conflicts = sum(f["rule"] == "material-conflict" for f in findings)
     for f in errors:
         uri = (f.get("values") or {}).get("uri")
@@ -305,6 +352,7 @@ def _simulate(r: Runner, e: Entry, path: Path, row: Row, model: bytes | None) ->
 
 def _export(r: Runner, e: Entry, path: Path, row: Row) -> None:
     out = r.tmp / "mjcf" / "robot.xml"
+    out.parent.mkdir(exist_ok=True)  # export writes into an existing directory
     proc = r.cli("export", "mjcf", str(path), *e.args, "-o", str(out))
     if proc.returncode != 0:
         row.export = f"exit {proc.returncode}: {_first_error(proc)}"
@@ -328,40 +376,69 @@ def summary(rows: list[Row]) -> dict[str, Any]:
         "entries": len(rows),
         "xacro entries": len(xacro),
         "expanded (xacro)": sum(r.expanded for r in xacro),
+        "expanded without the arguments (xacro)": sum(
+            r.expanded if r.expanded_no_args is None else r.expanded_no_args for r in xacro
+        ),
+        "expanded with ROS_PACKAGE_PATH only (xacro)": sum(bool(r.expanded_ros) for r in xacro),
+        "--trust-xacro expands (xacro)": sum(
+            r.trusted in ("equal", "differs", "expanded") for r in xacro
+        ),
+        "--trust-xacro equal to real xacro": sum(r.trusted == "equal" for r in xacro),
         "real xacro expands (xacro)": len(referenced),
         "expanded where real xacro does": sum(r.expanded for r in referenced),
         "equal to real xacro": sum(r.equal is True for r in referenced),
+        "tree exit 0": sum(r.tree == "ok" for r in rows),
         "check usable (exit 0/1)": sum(r.check_exit in (0, 1) for r in rows),
+        "files with unknown-package errors": sum(
+            r.unknown_package > 0 or any(t in r.expand_error for t in UNKNOWN_PACKAGE) for r in rows
+        ),
+        "unknown-package error findings": sum(r.unknown_package for r in rows),
         "false error findings": sum(r.false_errors for r in rows),
         "error findings": sum(sum(r.errors.values()) for r in rows),
         "material-conflict warnings": sum(r.material_conflicts for r in rows),
         "simulate ran": sum(r.simulate == "ran" for r in rows),
+        "models with continuous joints": sum(r.continuous > 0 for r in rows),
+        "simulate ran, continuous joints": sum(
+            r.simulate == "ran" and r.continuous > 0 for r in rows
+        ),
+        "simulate refuses continuous joints": sum("RUBY" in r.simulate for r in rows),
         "export loads in MuJoCo": sum(r.export == "loads in MuJoCo" for r in rows),
         "export exit 0, MuJoCo refuses": sum("MuJoCo refuses" in r.export for r in rows),
-        "export exit != 0": sum(r.export.startswith("exit ") for r in rows),
+        "export exit != 0": sum(
+            r.export.startswith("exit ") and not r.export.startswith("exit 0") for r in rows
+        ),
         "render exit 0": sum(r.render.startswith("ok") for r in rows),
     }
 
 
 def print_rows(rows: list[Row]) -> None:
     """One line per entry, then the details of what failed."""
-    print("| robot | expand | = xacro | check | false err | simulate | export | render |")
-    print("|---|---|---|---|---:|---|---|---|")
+    print(
+        "| robot | expand | = xacro | trusted | tree | check | false err | simulate | export "
+        "| render |"
+    )
+    print("|---|---|---|---|---|---|---:|---|---|---|")
     for r in rows:
         exp = "-" if not r.xacro else ("ok" if r.expanded else "FAIL")
         eq = {True: "yes", False: "NO", None: "-"}[r.equal]
         sim = "ran" if r.simulate == "ran" else r.simulate.split(":")[0]
         exp_ = r.export if r.export == "loads in MuJoCo" else r.export.split(":")[0]
         ren = r.render if r.render.startswith("ok") else "FAIL"
+        trusted = "-" if not r.xacro else r.trusted if r.trusted in ("equal", "differs") else "FAIL"
+        tree = "ok" if r.tree == "ok" else "FAIL"
         print(
-            f"| {r.label} | {exp} | {eq} | exit {r.check_exit} | {r.false_errors} | {sim} | "
-            f"{exp_} | {ren} |"
+            f"| {r.label} | {exp} | {eq} | {trusted} | {tree} | exit {r.check_exit} | "
+            f"{r.false_errors} | {sim} | {exp_} | {ren} |"
         )
     print()
     for r in rows:
         notes = [
             f"reference: {r.reference}" if r.reference != "ok" else "",
             f"expand: {r.expand_error}" if r.expand_error else "",
+            f"--trust-xacro: {r.trusted}"
+            if r.xacro and r.trusted not in ("equal", "expanded")
+            else "",
+            f"tree: {r.tree}" if r.tree != "ok" else "",
             f"check errors: {r.errors}" if r.errors else "",
             f"simulate: {r.simulate}" if r.simulate != "ran" else "",
             f"export: {r.export}" if r.export != "loads in MuJoCo" else "",
@@ -373,10 +450,14 @@ def print_rows(rows: list[Row]) -> None:
 
 
 def compare(before: dict[str, Any], after: dict[str, Any]) -> str:
-    """The summaries of two runs side by side."""
+    """The summaries of two runs side by side, over the current entries both ran."""
+    common = {r["label"] for r in before["rows"]} & {r["label"] for r in after["rows"]}
+    common &= {e.label for e in ENTRIES}
+    sums = [
+        summary([Row(**r) for r in run["rows"] if r["label"] in common]) for run in (before, after)
+    ]
     lines = ["| | before | after |", "|---|---:|---:|"]
-    for key in after["summary"]:
-        lines.append(f"| {key} | {before['summary'].get(key, '-')} | {after['summary'][key]} |")
+    lines += [f"| {key} | {sums[0][key]} | {sums[1][key]} |" for key in sums[1]]
     return "\n".join(lines) + "\n"
 
 

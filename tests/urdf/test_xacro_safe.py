@@ -275,6 +275,29 @@ def test_missing_argument_and_unused_ones_reported(workspace: Path) -> None:
     assert any("neither declares nor uses: ur_type" in n for n in used.notes())
 
 
+def test_default_declared_after_its_use_is_explained(tmp_path: Path) -> None:
+    # UR's ur.urdf.xacro: <robot name="$(arg name)"> above <xacro:arg name="name" default="ur"/>
+    top = tmp_path / "late.urdf.xacro"
+    top.write_text(
+        f'<robot {NS} name="$(arg name)">\n'
+        '  <!-- <xacro:arg name="name" default="commented"/> -->\n'
+        "  <xacro:arg name='name' default='ur'/>\n"
+        '  <link name="base"/>\n</robot>\n'
+    )
+    with pytest.raises(InputError) as info:
+        safe(top, {})
+    assert info.value.line == 1
+    assert str(info.value).endswith(
+        "undefined xacro argument 'name': pass name:=VALUE after the file (its default 'ur', "
+        "line 3, is declared after this use; xacro applies a default only from its "
+        "declaration on)"
+    )
+    with pytest.raises(Exception, match="Undefined substitution argument name"):
+        xacro.process_file(str(top))  # real xacro refuses it too
+    got, _ = safe(top, {"name": "ur5e"})
+    assert b'name="ur5e"' in got
+
+
 def test_missing_package_names_it(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.delenv("AMENT_PREFIX_PATH", raising=False)
     monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)

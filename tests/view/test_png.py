@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -214,3 +215,37 @@ def test_render_resolves_package_meshes_with_package_dir(tmp_path: Path) -> None
     assert res.returncode == 0, res.stderr
     with Image.open(out) as img:
         assert img.size == (1200, 600)
+
+
+@pytest.mark.parametrize(
+    "name", ["mesh_file_uri.urdf", "mesh_relative_escape.urdf", "mesh_absolute.urdf"]
+)
+def test_render_leaves_out_meshes_outside_the_allowed_directories(
+    name: str, tmp_path: Path, root: Path
+) -> None:
+    """Such a mesh is never read: render draws the rest and says why it is missing (issue 19:
+    a URDF written with its author's absolute paths, kortex's gen3_2f85.urdf, exited 2)."""
+    out = tmp_path / "robot.png"
+    res = run_cli(
+        ["render", str(root / "tests" / "bad_inputs" / "urdf" / name), "-o", str(out)], root
+    )
+    assert res.returncode == 0, res.stderr
+    assert "outside the allowed directories" in res.stderr and ", not drawn" in res.stderr
+    assert res.stderr.startswith("warning: ") and out.is_file()
+
+
+def test_render_never_opens_a_mesh_outside_the_roots(tmp_path: Path) -> None:
+    # A FIFO blocks whoever opens it: the render finishing proves it was never opened.
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    os.mkfifo(outside / "trap.stl")
+    urdf = tmp_path / "robot" / "arm.urdf"
+    urdf.parent.mkdir()
+    urdf.write_text(
+        f'<robot name="r"><link name="a"><visual><geometry><mesh filename="file://{outside}'
+        '/trap.stl"/></geometry></visual><visual><geometry><box size="0.1 0.1 0.1"/>'
+        "</geometry></visual></link></robot>"
+    )
+    res = run_cli(["render", str(urdf), "-o", str(tmp_path / "r.png")], tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert f"mesh 'file://{outside}/trap.stl' resolves to" in res.stderr

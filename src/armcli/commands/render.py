@@ -85,8 +85,8 @@ def render_cmd(
     write_notes(src.notes)
     values = pose_q(src, pose, q)
     width, height = _size(size)
-    missing: list[str] = []
-    urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search, missing)
+    skipped: dict[str, str] = {}
+    urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search, skipped)
     field = "--pose" if pose else "--q"
     lines: list[str] = []
     if reach or targets:
@@ -107,10 +107,10 @@ def render_cmd(
         if res.tool_position is None
         else " tool at ({:.3f}, {:.3f}, {:.3f}) m".format(*res.tool_position)
     )
-    for uri in missing:  # drawn without them: a picture of the rest beats none
+    for uri, why in skipped.items():  # drawn without them: a picture of the rest beats none
+        hint = f" ({MESH_HINT})" if why == "not found" else ""
         sys.stderr.write(
-            one_line(f"warning: {src.source}: mesh {uri!r} not found, not drawn ({MESH_HINT})")
-            + "\n"
+            one_line(f"warning: {src.source}: mesh {uri!r} {why}, not drawn{hint}") + "\n"
         )
     drawn = _drawn(src.poses, pose, q)
     sys.stdout.write(f"wrote {res.path} ({res.width}x{res.height} px) at {drawn};{tip}\n")

@@ -201,13 +201,32 @@ def _env(state: _State, args: list[str], text: str, optional: bool) -> str:
     )
 
 
+def _declared_later(state: _State, xacro: Any, name: str) -> str:
+    """Why a default the file declares does not apply: its <xacro:arg> comes after the use.
+
+    UR's ur.urdf.xacro reads `name` in its <robot> tag, a line above `default="ur"`;
+    xacro takes arguments in document order, so real xacro refuses it the same way.
+    """
+    code = _COMMENT.sub(_blank, state.files.get(os.path.realpath(_current(xacro, state)), ""))
+    quoted = "[\"']" + re.escape(name) + "[\"']"
+    found = re.search(r"<xacro:arg\s+name=" + quoted + r"\s+default=([\"'])(.*?)\1", code)
+    if found is None:
+        return ""
+    line = code.count("\n", 0, found.start()) + 1
+    return (
+        f" (its default {found.group(2)!r}, line {line}, is declared after this use; "
+        "xacro applies a default only from its declaration on)"
+    )
+
+
 def _extension(state: _State, xacro: Any, text: str) -> str:
     inner = text[2:-1].split()
     cmd, args = (inner[0], inner[1:]) if inner else ("", [])
     if cmd == "arg" and len(args) == 1:
         if args[0] not in state.args:
             raise _ProblemError(
-                f"undefined xacro argument {args[0]!r}: pass {args[0]}:=VALUE after the file",
+                f"undefined xacro argument {args[0]!r}: pass {args[0]}:=VALUE after the file"
+                + _declared_later(state, xacro, args[0]),
                 text,
                 refused=False,
             )

@@ -20,7 +20,7 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
-from armcli.urdf.doc import position_bounds
+from armcli.spec.joint_types import position_bounds
 from armcli.urdf.mesh_confine import bounded_mesh_file, check_total
 from armcli.urdf.meshes import MeshSearch, confined, resolve
 from armcli.urdf.read import parse_root
@@ -56,21 +56,30 @@ TITLE_WIDTH = 110  # [characters] per title line, so many joints do not run off 
 
 
 def _mesh_handler(
-    base: Path, where: MeshSearch, source: str, missing: list[str]
+    base: Path, where: MeshSearch, source: str, skipped: dict[str, str] | None
 ) -> Callable[[str], str]:
-    """Yourdfpy's filename handler: armcli's resolver, confinement and size caps."""
+    """Yourdfpy's filename handler: armcli's resolver, confinement and size caps.
+
+    A mesh that is missing, or outside the allowed roots (never read), is recorded in
+    `skipped` (URI -> why) when given, else an InputError.
+    """
     loaded: set[Path] = set()
 
     def resolve_mesh(fname: str) -> str:
         path = resolve(fname, base, where)
-        if path is not None and not confined(fname, path, base, where):
-            raise InputError(  # never read files outside the roots
-                f"mesh {fname!r} resolves to {path}, outside the allowed directories "
-                "(the URDF's directory and ROS package, --package-dir, ROS_PACKAGE_PATH)",
-                file=source,
+        why = None
+        if path is not None and not confined(fname, path, base, where):  # never read
+            why = (
+                f"resolves to {path}, outside the allowed directories (the URDF's directory "
+                "and ROS package, --package-dir, ROS_PACKAGE_PATH, packages found)"
             )
-        if path is None or not path.is_file():
-            missing.append(fname)
+        elif path is None or not path.is_file():
+            why = "not found"
+        if why is not None or path is None:
+            why = why or "not found"
+            if skipped is None:
+                raise InputError(f"mesh {fname!r} {why}", file=source)
+            skipped[fname] = why
             return ""  # nothing: yourdfpy skips it (the URI itself could name a file in cwd)
         real = bounded_mesh_file(path, source)  # trimesh opens the checked real path
         loaded.add(real)
@@ -85,17 +94,17 @@ def load_urdf(
     source: str = "<urdf>",
     mesh_dir: str | Path | None = None,
     search: MeshSearch | None = None,
-    missing: list[str] | None = None,
+    skipped: dict[str, str] | None = None,
 ) -> Any:
     """URDF text -> yourdfpy.URDF with its visual scene.
 
     Meshes resolve with armcli.urdf.meshes from `mesh_dir` (the URDF's directory), as in
     `check`, honouring `--package-dir` through `search`. The text first passes the strict
     URDF reader (no DTDs or entities, bounded size and depth), since yourdfpy's own lxml
-    parser would resolve entities. A mesh file that cannot be found is an InputError,
-    where yourdfpy would log and draw nothing, unless the caller passes a `missing` list:
-    then its URI is appended there and the rest is drawn (render warns). A mesh outside
-    the allowed directories is an InputError either way.
+    parser would resolve entities. A mesh file that cannot be found, or lies outside the
+    allowed directories (never read), is an InputError where yourdfpy would log and draw
+    nothing, unless the caller passes a `skipped` dict: then URI -> why is recorded there
+    and the rest is drawn (render warns).
     """
     import logging
 
@@ -103,7 +112,7 @@ def load_urdf(
 
     parse_root(xml.encode("utf-8"), source)
     base = Path(mesh_dir or ".")
-    absent: list[str] = []
+    absent: dict[str, str] = {}
     resolve_mesh = _mesh_handler(base, search or MeshSearch(), source, absent)
 
     log = logging.getLogger("yourdfpy")
@@ -121,12 +130,14 @@ def load_urdf(
         raise InputError(f"cannot load this URDF: {exc}", file=source) from None
     finally:
         log.level = level
-    if missing is not None:
-        missing += dict.fromkeys(absent)
+    if skipped is not None:
+        skipped.update(absent)
     elif absent:
+        uri, why = next(iter(absent.items()))
+        if why != "not found":
+            raise InputError(f"mesh {uri!r} {why}", file=source)
         raise InputError(
-            f"mesh file not found: {absent[0]} (searched from {base}; {MESH_HINT})",
-            file=source,
+            f"mesh file not found: {uri} (searched from {base}; {MESH_HINT})", file=source
         )
     return urdf
 

@@ -1,8 +1,8 @@
 """The robot a viewer shows: URDF text, named poses, tool point and the joints `--q` sets.
 
 Shared by `view`, `render` and `tree`: a spec is built in memory (xacro
-expansion, nothing written); a URDF is read strictly; a foreign xacro file only
-with --trust-xacro (see armcli.urdf.source).
+expansion, nothing written); a URDF is read strictly; a foreign xacro file is expanded
+in safe mode, or by xacro itself with --trust-xacro (see armcli.urdf.source).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from armcli.urdf.tree import tree_from_urdf
 from armcli.urdf.xacro_args import XacroInputs
 
 ROBOT_HELP = (
-    "Robot spec YAML, URDF file, or xacro file (with --trust-xacro); "
+    "Robot spec YAML, URDF file, or xacro file (expanded in safe mode); "
     "default: ./armcli.yaml, else the spec in specs/."
 )
 
@@ -45,7 +45,7 @@ def load_robot(
     search: MeshSearch | None = None,
     inputs: XacroInputs | None = None,
 ) -> RobotSource:
-    """Spec YAML (built in memory), URDF or trusted xacro file -> RobotSource.
+    """Spec YAML (built in memory), URDF or xacro file -> RobotSource.
 
     Mesh URIs resolve with armcli.urdf.meshes (honouring `search`, the --package-dir
     options) and must stay inside the allowed roots; the tool point is armcli.urdf.tool's.
