@@ -18,7 +18,8 @@ from armcli.check.rules import RULES, CheckOptions, Collector, JointRow
 from armcli.check.structure import Tree
 from armcli.sim.tipping import ZmpReport
 from armcli.sim.verdict import StabilityReport
-from armcli.urdf.doc import Urdf, position_bounds
+from armcli.spec.joint_types import position_bounds
+from armcli.urdf.doc import Urdf
 from armcli.urdf.mimic import follow, mimics
 from armcli.urdf.pinocchio import JointRange
 from armcli.urdf.stance import Stance

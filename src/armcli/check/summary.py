@@ -18,7 +18,8 @@ from armcli.check.rules import CheckOptions, JointRow
 from armcli.check.structure import finite
 from armcli.sim.tipping import ZmpReport
 from armcli.sim.verdict import StabilityReport
-from armcli.urdf.doc import Urdf, total_dof
+from armcli.spec.joint_types import total_dof
+from armcli.urdf.doc import Urdf
 from armcli.urdf.pinocchio import configuration
 from armcli.urdf.tool import tool_point
 from armcli.urdf.workspace import ReachPoint, Workspace

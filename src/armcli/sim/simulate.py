@@ -123,7 +123,7 @@ class SimResult:
     joint_names: tuple[str, ...]
     steps: int  # steps of the run (states 0..steps)
     dt: float
-    integrator: str
+    integrator: Integrator
     step: np.ndarray  # (K,) int: the states kept, by step
     t: np.ndarray  # (K,) their times [s]
     q: np.ndarray  # (K, n)
