@@ -6,7 +6,8 @@
    pair. The same commands for one step give the set-up (imports, model, checks), which is
    cut to give the stepping alone.
 2. Peak memory (the process's max RSS) of both, and of armcli on 1.8 M steps (900 s at
-   0.5 ms) writing its states at 10 Hz: memory follows the output rate, not the steps.
+   0.5 ms) writing its states at 10 Hz: memory follows the output rate, not the steps; next
+   to it the same run through the library keeping every step's state.
 3. Start-up: `armcli simulate --help` next to `python -c pass`, and what importing the
    simulate command costs, by module (`python -X importtime`).
 
@@ -63,6 +64,19 @@ for k in range(steps):
     d.qfrc_applied[:] = kp * (q_ref[k] - d.qpos) + kd * v_ref[k]
     mujoco.mj_step(m, d)
     out[k + 1] = d.qpos
+"""
+
+KEEP_EVERY_STEP = """
+import sys
+from pathlib import Path
+from armcli.sim import job as simjob
+from armcli.sim.options import SimOptions
+from armcli.sim.simulate import simulate
+traj, urdf = Path(sys.argv[1]), Path(sys.argv[2])
+duration, dt = float(sys.argv[3]), float(sys.argv[4])
+opts = SimOptions(trajectory=traj, urdf=urdf, kp=(50.0,), kd=(5.0,), dt=dt, duration=duration)
+job = simjob.prepare(None, opts)
+simulate(job.arm, job.reference, job.q0, job.duration, job.config)
 """
 
 
@@ -126,14 +140,18 @@ def whole_process(
     print(f"armcli / MuJoCo, stepping alone (set-up cut): {cut:.3f}x")
 
 
-def memory(armcli: Callable[..., list[str]], out: Path) -> None:
-    """Peak RSS of a 1.8 M-step run writing its states at 10 Hz."""
+def memory(armcli: Callable[..., list[str]], out: Path, traj: Path, urdf: Path) -> None:
+    """Peak RSS of a 1.8 M-step run writing its states at 10 Hz, and of the same run
+    through the library keeping every step's state (what `simulate` did before)."""
     steps = round(MEMORY_S / DT)
     _, cpu, peak = run_once(armcli(MEMORY_S, "--output", str(out), "--rate", "10", traj=MEMORY_S))
     _, short_cpu, short_peak = run_once(armcli(DT))
+    every = [sys.executable, "-c", KEEP_EVERY_STEP, str(traj), str(urdf), str(MEMORY_S), str(DT)]
+    _, _, every_peak = run_once(every)
     print(f"\n{steps:,} steps (--duration {steps * DT:g} at dt = {DT}), states at 10 Hz:")
     print(f"  peak {peak:.0f} MiB ({short_peak:.0f} MiB for one step); {cpu:.2f} CPU s "
           f"({(cpu - short_cpu) / steps * 1e6:.2f} µs/step)")  # fmt: skip
+    print(f"  the same run keeping every step's state (library, record=None): {every_peak:.0f} MiB")
 
 
 def startup(repeats: int) -> None:
@@ -187,7 +205,7 @@ def main() -> None:
             return [sys.executable, str(script), str(urdf), str(secs)]
 
         whole_process(reps, armcli, mujoco)
-        memory(armcli, Path(tmp) / "states.csv")
+        memory(armcli, Path(tmp) / "states.csv", files[MEMORY_S], urdf)
         startup(reps)
     print(f"load average after: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
 
