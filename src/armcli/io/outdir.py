@@ -68,7 +68,7 @@ def _check_parent(path: Path, field: str) -> None:
         raise OutputRefusedError(f"{anchor} is not a directory", file=path, field=field)
 
 
-def resolve_output_dir(path: str | Path, *, force: bool = False, field: str = "--out") -> Path:
+def resolve_output_dir(path: str | Path, *, force: bool = False, field: str = "out_dir") -> Path:
     """The real directory to write for `-o path`, or OutputRefusedError saying why not.
 
     Symlinks are resolved so that a linked output directory is updated through
