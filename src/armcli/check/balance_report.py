@@ -58,7 +58,9 @@ def _title(b: StaticBalance) -> str:
 
 def _caption(b: StaticBalance) -> str:
     corners = " ".join(f"({x:.3f}, {y:.3f})" for x, y in b.polygon)
-    if b.payload_max is None:
+    if not b.payload_point:
+        holds = "no payload point (no arm)"
+    elif b.payload_max is None:
         holds = "no payload keeps the margin everywhere"
     elif math.isinf(b.payload_max):
         holds = f"any payload at {b.payload_point} keeps the margin everywhere"
