@@ -16,7 +16,7 @@ from armcli.spec.load import load_spec
 from tests.helpers import DEFAULT_SPEC, ROOT
 
 LIBRARY = ROOT / "src" / "armcli"
-FLAG_FIELD = re.compile(r"""field=f?["']--""")
+FLAG_FIELD = re.compile(r"""field(?:: str)?\s*=\s*f?["']--""")  # a keyword or a default
 # Still naming flags: parsers of CLI-format values (NAME=PATH, VAR=VALUE) and the --env
 # values they produce (urdf/source.py); a library caller passes dicts instead.
 LEFT = {"urdf/packages.py", "urdf/xacro_args.py", "urdf/source.py"}

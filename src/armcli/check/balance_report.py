@@ -8,12 +8,14 @@ tip) with the centre of mass's margin and the slope that tips it that way.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from armcli.check.balance import StaticBalance
 from armcli.io.terminal import Column, FitTable
-from armcli.sim.tipping import ZmpReport, summary_line
 from armcli.urdf.workspace import ReachPoint, Workspace, describe, verdict
+
+if TYPE_CHECKING:
+    from armcli.sim.tipping import ZmpReport
 
 
 def balance_items(balance: StaticBalance | None, zmp: ZmpReport | None) -> list[Any]:
@@ -24,6 +26,8 @@ def balance_items(balance: StaticBalance | None, zmp: ZmpReport | None) -> list[
     if balance is not None:
         out.append(_table(balance))
     if zmp is not None:
+        from armcli.sim.tipping import summary_line  # loaded by the --trajectory run already
+
         out.append(Text(summary_line(zmp), style="red" if zmp.tips else ""))
     return out
 

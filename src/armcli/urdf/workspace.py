@@ -32,7 +32,7 @@ from armcli.urdf.boxsearch import minimize_box
 from armcli.urdf.pinocchio import JointRange, configuration, joint_ranges
 from armcli.urdf.tool import ToolPoint
 
-SAMPLES = 2000  # `check`'s cloud (extremes are refined); `render --reach` draws more
+SAMPLES = 500  # `check`'s cloud: IK seeds and starts (extremes are refined); render draws more
 SAMPLE_SEED = 0
 MAX_CORNERS = 64
 REFINE_FROM = 3  # local searches per extreme, from the best samples
