@@ -6,9 +6,15 @@
    pair. The same commands for one step give the set-up (imports, model, checks), which is
    cut to give the stepping alone.
 2. Peak memory (the process's max RSS) of both, and of armcli on 1.8 M steps (900 s at
-   0.5 ms) writing its states at 10 Hz: memory follows the output rate, not the steps.
+   0.5 ms) writing its states at 10 Hz: memory follows the output rate, not the steps; next
+   to it the same run through the library keeping every step's state.
 3. Start-up: `armcli simulate --help` next to `python -c pass`, and what importing the
    simulate command costs, by module (`python -X importtime`).
+
+Every process runs with Python's bytecode cache on (in a temporary PYTHONPYCACHEPREFIX,
+warmed by an untimed first run), as an installed package has it: an environment with
+PYTHONDONTWRITEBYTECODE=1 would otherwise recompile armcli's modules at every start
+(~0.1 CPU s) while numpy, Pinocchio and MuJoCo load their installed caches.
 
 Run with `make bench` (or `python bench/bench_process.py [--quick]`). Not a test: numbers
 depend on the machine and its load.
@@ -32,6 +38,7 @@ BIN = Path(sys.executable).parent
 DT = 5e-4  # [s]
 KP, KD = 50.0, 5.0
 WHOLE_S, MEMORY_S = 120.0, 900.0  # [s] trajectories of the two comparisons
+ENV = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
 CYCLE = [(0.6, 0.4, 1.0), (0.9, 1.2, 2.0), (0.9, 1.2, 2.5), (0.5, 0.8, 3.5), (0.3, 0.3, 5.0)]
 MUJOCO_SCRIPT = """
 import sys
@@ -59,6 +66,19 @@ for k in range(steps):
     out[k + 1] = d.qpos
 """
 
+KEEP_EVERY_STEP = """
+import sys
+from pathlib import Path
+from armcli.sim import job as simjob
+from armcli.sim.options import SimOptions
+from armcli.sim.simulate import simulate
+traj, urdf = Path(sys.argv[1]), Path(sys.argv[2])
+duration, dt = float(sys.argv[3]), float(sys.argv[4])
+opts = SimOptions(trajectory=traj, urdf=urdf, kp=(50.0,), kd=(5.0,), dt=dt, duration=duration)
+job = simjob.prepare(None, opts)
+simulate(job.arm, job.reference, job.q0, job.duration, job.config)
+"""
+
 
 def trajectory(duration: float) -> tuple[str, list[tuple[float, float, float]]]:
     """YAML text and knots (q1, q2, t) of `duration` s of pick cycles from (0.2, 0.2)."""
@@ -75,7 +95,7 @@ def run_once(cmd: list[str]) -> tuple[float, float, float]:
     """Wall seconds, CPU seconds (user + system) and peak RSS [MiB] of one process, from the
     kernel's accounting. CPU time is what a busy machine disturbs least."""
     start = time.perf_counter()
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=ENV)
     _, status, usage = os.wait4(proc.pid, 0)
     wall = time.perf_counter() - start
     proc.returncode = os.waitstatus_to_exitcode(status)
@@ -86,6 +106,7 @@ def run_once(cmd: list[str]) -> tuple[float, float, float]:
 
 def paired(a: list[str], b: list[str], repeats: int) -> tuple[list[float], list[float], float]:
     """A and B in turn; their CPU seconds, and the median of the pairwise ratios."""
+    run_once(a), run_once(b)  # untimed: fills the bytecode cache
     ta, tb = [], []
     for _ in range(repeats):
         ta.append(run_once(a)[1])
@@ -119,14 +140,18 @@ def whole_process(
     print(f"armcli / MuJoCo, stepping alone (set-up cut): {cut:.3f}x")
 
 
-def memory(armcli: Callable[..., list[str]], out: Path) -> None:
-    """Peak RSS of a 1.8 M-step run writing its states at 10 Hz."""
+def memory(armcli: Callable[..., list[str]], out: Path, traj: Path, urdf: Path) -> None:
+    """Peak RSS of a 1.8 M-step run writing its states at 10 Hz, and of the same run
+    through the library keeping every step's state (what `simulate` did before)."""
     steps = round(MEMORY_S / DT)
     _, cpu, peak = run_once(armcli(MEMORY_S, "--output", str(out), "--rate", "10", traj=MEMORY_S))
     _, short_cpu, short_peak = run_once(armcli(DT))
+    every = [sys.executable, "-c", KEEP_EVERY_STEP, str(traj), str(urdf), str(MEMORY_S), str(DT)]
+    _, _, every_peak = run_once(every)
     print(f"\n{steps:,} steps (--duration {steps * DT:g} at dt = {DT}), states at 10 Hz:")
     print(f"  peak {peak:.0f} MiB ({short_peak:.0f} MiB for one step); {cpu:.2f} CPU s "
           f"({(cpu - short_cpu) / steps * 1e6:.2f} µs/step)")  # fmt: skip
+    print(f"  the same run keeping every step's state (library, record=None): {every_peak:.0f} MiB")
 
 
 def startup(repeats: int) -> None:
@@ -138,7 +163,7 @@ def startup(repeats: int) -> None:
           f"`python -c pass` {statistics.median(tp):.3f} CPU s")  # fmt: skip
     for module in ("armcli.commands.simulate", "armcli.check.gate", "pinocchio"):
         r = subprocess.run([sys.executable, "-X", "importtime", "-c", f"import {module}"],
-                           capture_output=True, text=True, check=True)  # fmt: skip
+                           capture_output=True, text=True, check=True, env=ENV)  # fmt: skip
         # "import time: self | cumulative | name", nested names indented by two spaces
         rows = re.findall(r"\|\s*(\d+) \| ( *)(\S+)$", r.stderr, re.M)
         end = next(i for i, (_, ind, n) in enumerate(rows) if not ind and n == module)
@@ -158,6 +183,7 @@ def main() -> None:
     urdf = ROOT / "urdf" / "standalone_arm.urdf"
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory() as tmp:
+        ENV["PYTHONPYCACHEPREFIX"] = str(Path(tmp) / "pycache")
         # each side reads the trajectory of the run it times: 120 s (121 points) for the
         # whole-process comparison, 900 s (901 points) for the memory run
         files = {}
@@ -179,8 +205,8 @@ def main() -> None:
             return [sys.executable, str(script), str(urdf), str(secs)]
 
         whole_process(reps, armcli, mujoco)
-        memory(armcli, Path(tmp) / "states.csv")
-    startup(reps)
+        memory(armcli, Path(tmp) / "states.csv", files[MEMORY_S], urdf)
+        startup(reps)
     print(f"load average after: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
 
 

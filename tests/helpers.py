@@ -17,6 +17,7 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+import pytest
 from hypothesis import strategies as st
 
 ROOT = Path(__file__).resolve().parents[1]  # the repository checkout
@@ -54,23 +55,41 @@ def run_cli(
     env: Mapping[str, str] | None = None,
     *,
     preexec_fn: Callable[[], Any] | None = None,
+    unset: Sequence[str] = (),
+    timeout: float = CLI_TIME_LIMIT_S,
 ) -> subprocess.CompletedProcess[str]:
     """`python -m armcli.cli ARGS` as its own process: exit code, stdout, stderr, files.
 
     `env` adds to (or overrides) this process's environment, without ARMCLI_DEBUG (errors
-    stay one line). For in-process calls that only need the output, tests call
-    `armcli.cli.main` directly instead.
+    stay one line) and the variables in `unset`. For in-process calls that only need the
+    output, tests call `armcli.cli.main` directly instead.
     """
+    drop = {"ARMCLI_DEBUG", *unset}
     return subprocess.run(
         [sys.executable, "-m", "armcli.cli", *map(str, args)],
         capture_output=True,
         text=True,
-        timeout=CLI_TIME_LIMIT_S,
+        timeout=timeout,
         check=False,
         cwd=cwd,
-        env={**{k: v for k, v in os.environ.items() if k != "ARMCLI_DEBUG"}, **(env or {})},
+        env={**{k: v for k, v in os.environ.items() if k not in drop}, **(env or {})},
         preexec_fn=preexec_fn,
     )
+
+
+def run_main(
+    args: Sequence[str | Path], capsys: pytest.CaptureFixture[str]
+) -> tuple[int, str, str]:
+    """`armcli ARGS` in this process (`armcli.cli.main`): exit code, stdout, stderr."""
+    from armcli.cli import main
+
+    try:
+        main([str(a) for a in args])
+        code = 0
+    except SystemExit as exc:
+        code = int(exc.code or 0)
+    out = capsys.readouterr()
+    return code, out.out, out.err
 
 
 HOSTILE_SCALARS = st.one_of(

@@ -161,3 +161,30 @@ def test_course_robot_agrees_with_urdf_validator(course: Stance) -> None:
         theirs = math.degrees(math.atan2(width / 2, mine.com[2] - course.ground.height))
         assert theirs == pytest.approx(report.stability.tipping_angle_deg, abs=UV_DEG)
         assert math.degrees(min(mine.tip_angles)) < report.stability.tipping_angle_deg - 10
+
+
+def test_base_without_arm_has_no_payload_point_and_no_workspace() -> None:
+    """The course base alone (as ros2_control_demos' diffbot): its deepest link is a wheel.
+
+    The balance stands (the polygon and margins do not need an arm); a payload at a
+    wheel and the reach of a wheel mean nothing, so both are left out with notes.
+    """
+    from lxml import etree
+
+    root = etree.fromstring((DEFAULT_SPEC.parent.parent / "urdf" / "my_robot.urdf").read_bytes())
+    arm = {"arm_base_link", "forearm_link", "hand_link"}
+    for el in list(root):
+        child = el.find("child")
+        if el.get("name") in arm or (child is not None and child.get("link") in arm):
+            root.remove(el)
+    base = parse_urdf(etree.tostring(root), "base_only.urdf")
+    res = check_urdf(base, CheckOptions(tipover=TipoverOptions(payload=2.0)))
+    s = res.summary
+    assert s is not None and s.balance is not None and s.reach is None
+    assert s.balance.payload is None and s.balance.payload_point == ""
+    # base 5 kg at x 0, wheels 2 x 1 kg at x -0.15, caster 0.5 kg at x 0.2 (tests above)
+    x = (-0.3 + 0.1) / 7.5
+    assert s.balance.poses[0].com[0] == pytest.approx(x, abs=EXACT)
+    notes = " ".join(s.notes)
+    assert "payload left out" in notes and "workspace skipped" in notes
+    assert not res.findings

@@ -8,7 +8,6 @@ every command is run through the real CLI.
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -16,7 +15,15 @@ from pathlib import Path
 import pytest
 import xacro
 
-from tests.helpers import ARM_PACKAGE, DEMO_ARM, ROOT, ROS_WS_SRC, ament_index_shim, symlink_install
+from tests.helpers import (
+    ARM_PACKAGE,
+    DEMO_ARM,
+    ROOT,
+    ROS_WS_SRC,
+    ament_index_shim,
+    run_cli,
+    symlink_install,
+)
 
 TRAJECTORY = (
     "{joint_names: [l_shoulder, l_elbow], "
@@ -31,17 +38,8 @@ def prefix(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def armcli(prefix: Path, *args: str | Path, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:
     """The CLI with only AMENT_PREFIX_PATH set, as a sourced ROS 2 workspace leaves it."""
-    env = {k: v for k, v in os.environ.items() if k != "ROS_PACKAGE_PATH"}
-    env.update(AMENT_PREFIX_PATH=str(prefix), COLUMNS="200")
-    return subprocess.run(
-        [sys.executable, "-m", "armcli.cli", *map(str, args)],
-        cwd=cwd,
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=180,
-        check=False,
-    )
+    env = {"AMENT_PREFIX_PATH": str(prefix), "COLUMNS": "200"}
+    return run_cli(args, cwd, env, unset=("ROS_PACKAGE_PATH",), timeout=180)
 
 
 def reference(

@@ -16,9 +16,10 @@ from armcli.spec.load import load_spec
 from tests.helpers import DEFAULT_SPEC, ROOT
 
 LIBRARY = ROOT / "src" / "armcli"
-FLAG_FIELD = re.compile(r"""field=f?["']--""")
-# Still naming flags: CLI-format parsers and files other sessions own (issue 24 notes).
-LEFT = {"urdf/packages.py", "urdf/xacro_args.py", "urdf/source.py", "tune/write.py"}
+FLAG_FIELD = re.compile(r"""field(?:: str)?\s*=\s*f?["']--""")  # a keyword or a default
+# Still naming flags: parsers of CLI-format values (NAME=PATH, VAR=VALUE) and the --env
+# values they produce (urdf/source.py); a library caller passes dicts instead.
+LEFT = {"urdf/packages.py", "urdf/xacro_args.py", "urdf/source.py"}
 MESSAGE = "joint_names: [arm_base_forearm_joint]\npoints: [{positions: [0.1]}]"
 
 

@@ -8,22 +8,15 @@ from pathlib import Path
 
 import pytest
 
-from armcli.cli import main
 from armcli.spec.load import load_spec
-from tests.helpers import FIXTURES, ROOT
+from tests.helpers import FIXTURES, ROOT, run_main
 
 STUDENT = FIXTURES / "import" / "course_student" / "urdf" / "my_robot.urdf.xacro"
 PICK = ROOT / "specs" / "trajectories" / "pick.yaml"
 
 
 def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    try:
-        main(args)
-        code = 0
-    except SystemExit as exc:
-        code = int(exc.code or 0)
-    out = capsys.readouterr()
-    return code, out.out, out.err
+    return run_main(args, capsys)
 
 
 @pytest.fixture

@@ -14,8 +14,7 @@ from typing import Any
 
 import pytest
 
-from armcli.cli import main
-from tests.helpers import ROOT
+from tests.helpers import ROOT, run_main
 
 SPEC = ROOT / "specs" / "my_robot.yaml"
 PICK = ROOT / "specs" / "trajectories" / "pick.yaml"
@@ -24,12 +23,8 @@ QUICK_TUNE = ["--trials", "4", "--batch", "2", "--settle", "0.5", "-t", str(PICK
 
 
 def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
-    try:
-        main(args)
-        code = 0
-    except SystemExit as exc:
-        code = int(exc.code or 0)
-    return code, capsys.readouterr().out
+    code, out, _ = run_main(args, capsys)
+    return code, out
 
 
 def g4(x: float | None) -> str:

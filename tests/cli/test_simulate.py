@@ -13,8 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from armcli.cli import main
-from tests.helpers import ROOT, course_gains_spec, run_cli
+from tests.helpers import ROOT, course_gains_spec, run_cli, run_main
 
 TRAJ = ROOT / "specs" / "trajectories"
 J1, J2 = "arm_base_forearm_joint", "forearm_hand_joint"
@@ -27,13 +26,7 @@ TRACK_TOL = 0.01  # [rad] final tracking: friction 0.05 / Kp 50 and gravity sag 
 
 
 def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    try:
-        main(["simulate", *args])
-        code = 0
-    except SystemExit as exc:
-        code = int(exc.code or 0)
-    out = capsys.readouterr()
-    return code, out.out, out.err
+    return run_main(["simulate", *args], capsys)
 
 
 @pytest.fixture(autouse=True)

@@ -18,8 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from armcli.cli import main
-from tests.helpers import DEFAULT_SPEC, FIXTURES
+from tests.helpers import DEFAULT_SPEC, FIXTURES, run_main
 
 SWING = FIXTURES / "tipover" / "swing.yaml"
 TIPPING_ACCEL = 5.0  # [m/s²] > 3.46 m/s², the largest that holds along the swing
@@ -37,13 +36,7 @@ def braking_spec(tmp_path: Path) -> Path:
 
 
 def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    try:
-        main([str(a) for a in args])
-        code = 0
-    except SystemExit as exc:
-        code = int(exc.code or 0)
-    out = capsys.readouterr()
-    return code, out.out, out.err
+    return run_main(args, capsys)
 
 
 def test_simulate_flags_the_variant_and_passes_the_seed(

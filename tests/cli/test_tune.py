@@ -12,9 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from armcli.cli import main
 from armcli.spec.load import load_spec
-from tests.helpers import ROOT
+from tests.helpers import ROOT, run_main
 
 SPEC = ROOT / "specs" / "my_robot.yaml"
 PICK = ROOT / "specs" / "trajectories" / "pick.yaml"
@@ -24,13 +23,7 @@ PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 
 def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    try:
-        main(["tune", *args])
-        code = 0
-    except SystemExit as exc:
-        code = int(exc.code or 0)
-    out = capsys.readouterr()
-    return code, out.out, out.err
+    return run_main(["tune", *args], capsys)
 
 
 @pytest.fixture

@@ -8,8 +8,6 @@ a name holding `-->` closed the comment and could add a DOCTYPE with an external
 from __future__ import annotations
 
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -18,7 +16,7 @@ from lxml import etree
 from armcli.compiler.xacro_writer import xacro_files
 from armcli.compiler.xmlfmt import comment_text, to_bytes
 from armcli.spec.load import load_spec
-from tests.helpers import DEFAULT_SPEC, FIXTURES
+from tests.helpers import DEFAULT_SPEC, FIXTURES, run_cli
 from tests.meshes import house_triangles, prism_triangles, write_stl
 
 HOSTILE = [
@@ -53,14 +51,7 @@ def test_comment_text_keeps_ordinary_text() -> None:
 def test_build_a_spec_whose_file_name_has_hyphens(name: str, tmp_path: Path) -> None:
     spec = tmp_path / name
     shutil.copy(DEFAULT_SPEC, spec)
-    proc = subprocess.run(
-        [sys.executable, "-m", "armcli.cli", "build", spec.name, "-o", "out"],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-        timeout=300,
-        check=False,
-    )
+    proc = run_cli(["build", spec.name, "-o", "out"], tmp_path, timeout=300)
     assert proc.returncode == 0, proc.stderr  # before: "xacro failed ... not well-formed"
     for path in sorted((tmp_path / "out").glob("*.xacro")):
         tree = etree.parse(str(path), etree.XMLParser(resolve_entities=False, load_dtd=False))

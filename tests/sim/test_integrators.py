@@ -153,6 +153,7 @@ def test_euler_energy_drift_on_the_arm(arm: Arm) -> None:
     assert 0.0 < drift_05ms < drift_1ms
 
 
+@pytest.mark.slow  # ~8 s: DOP853 at rtol 1e-12 through 3 s of quintic segments
 def test_euler_is_first_order_against_dop853(arm: Arm) -> None:
     """Quintic segments (a smooth reference): Euler's error is O(dt) and halves with dt."""
     q0, t_end, kd = np.array([0.1, 0.1]), 3.0, 5.0

@@ -53,6 +53,29 @@ def test_template_is_consistent(template: str) -> None:
         assert set(yaml.safe_load(f.read_text())["joint_names"]) <= arm_joints, f.name
 
 
+# The course's standalone arm keeps the course's layout: its root arm_base_link has 0.5 kg,
+# which KDL ignores (root-inertia, a warning that --strict makes an error). Issue 23.
+COURSE_ROOT_INERTIA = pytest.mark.xfail(strict=True, reason="root-inertia on standalone_arm")
+
+
+@pytest.mark.parametrize(
+    "template",
+    [pytest.param(t, marks=COURSE_ROOT_INERTIA) if t == "course" else t for t in sorted(TEMPLATES)],
+)
+def test_a_new_project_checks_clean_under_strict(
+    template: str,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert _main(["init", "--template", template]) == 0
+    capsys.readouterr()
+    code = _main(["check", "--strict"])
+    out = capsys.readouterr().out
+    assert code == 0 and "no findings" in out, out
+
+
 def test_init_here_then_every_command_finds_the_spec(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

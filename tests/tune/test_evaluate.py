@@ -75,3 +75,21 @@ def test_stability_verdict_per_candidate_is_the_bound(job: tjob.TuneJob) -> None
         d = job.start.kd + sm.arm.damping
         rho = ref.worst_radius(Ms, Gs, range(n), kp, d, job.problem.dt, "implicit")
         assert stab.stable(sm.lin, pd, job.problem.dt, "implicit") == (rho <= 1 + ref.RADIUS_TOL)
+
+
+def test_a_rollout_keeps_only_the_states_its_metrics_read(job: tjob.TuneJob) -> None:
+    """Tune's rollouts keep the states from the last trajectory point on (the copy out of
+    the engine holds the GIL); their metrics equal those of the whole trace, bit for bit."""
+    from armcli.sim.simulate import SimConfig, simulate
+    from armcli.tune.objective import run_metrics
+
+    sm = problem.scored_models(job.problem)[0]
+    kp, kd = np.split(_batch(job)[2], 2)
+    cfg = SimConfig(kp, kd, job.problem.dt, job.problem.integrator, job.problem.gravity_comp)
+    for case in job.problem.cases:
+        (kept,) = evaluate.rollout_batch([evaluate.RolloutJob(sm.arm, case, cfg)])
+        whole = simulate(sm.arm, case.reference, case.q0, case.duration, cfg)
+        assert kept is not None
+        assert kept.step[0] == round(case.t_end / cfg.dt) and kept.step[-1] == whole.steps
+        assert kept.q.shape[0] < whole.q.shape[0] / 2
+        assert np.array_equal(run_metrics(kept, case.t_end), run_metrics(whole, case.t_end))

@@ -37,7 +37,7 @@ from armcli.errors import InputError, XacroRefusedError
 from armcli.urdf.source import read_urdf_file
 from armcli.urdf.xacro_jail import readable_binds, sandbox_problem
 from armcli.urdf.xacro_sandbox import XACRO_MAX_OUTPUT, XACRO_TIMEOUT, expand_untrusted
-from tests.helpers import ROOT
+from tests.helpers import ROOT, run_cli
 from tests.urdf.ordinary_user import ordinary_user
 
 pytestmark = pytest.mark.skipif(
@@ -155,15 +155,7 @@ def test_refused_without_sandbox_unless_unsandboxed(
 def test_cli_spelling_trust_xacro_unsandboxed(tmp_path: Path, root: Path) -> None:
     path = hostile(tmp_path, "out = 'ok'")
     for flag in ("--trust-xacro", "--trust-xacro=unsandboxed"):
-        proc = subprocess.run(
-            [sys.executable, "-m", "armcli.cli", "tree", flag, str(path)],
-            capture_output=True,
-            text=True,
-            timeout=120,
-            check=False,
-            cwd=root,
-            env={**os.environ, "SECRET_TOKEN": "x"},
-        )
+        proc = run_cli(["tree", flag, path], root, {"SECRET_TOKEN": "x"})
         assert proc.returncode == 0, proc.stderr
         assert "ok" in proc.stdout
 

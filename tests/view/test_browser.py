@@ -33,6 +33,7 @@ from armcli.errors import InputError
 from armcli.sim.states import load_replay
 from armcli.view.browser import Viewer, moving_parts
 from armcli.view.scene import load_robot
+from tests.helpers import run_cli
 
 TIP_TOL = 1e-6  # [m] forward kinematics vs closed form
 INTERP_TOL = 1e-12  # [rad] linear interpolation of a linear record is exact
@@ -182,14 +183,7 @@ def test_cli_view_port_taken_exits_2(root: Path) -> None:
         s.bind(("127.0.0.1", 0))
         s.listen()
         port = s.getsockname()[1]
-        proc = subprocess.run(
-            [sys.executable, "-m", "armcli.cli", "view", "--port", str(port)],
-            cwd=root,
-            capture_output=True,
-            text=True,
-            timeout=120,
-            check=False,
-        )
+        proc = run_cli(["view", "--port", str(port)], root)
     assert proc.returncode == 2
     assert proc.stderr.startswith(f"error: --port: cannot listen on 127.0.0.1:{port}: ")
     assert proc.stdout == ""

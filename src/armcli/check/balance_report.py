@@ -8,12 +8,14 @@ tip) with the centre of mass's margin and the slope that tips it that way.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from armcli.check.balance import StaticBalance
 from armcli.io.terminal import Column, FitTable
-from armcli.sim.tipping import ZmpReport, summary_line
-from armcli.urdf.workspace import ReachPoint, Workspace
+from armcli.urdf.workspace import ReachPoint, Workspace, describe, verdict
+
+if TYPE_CHECKING:
+    from armcli.sim.tipping import ZmpReport
 
 
 def balance_items(balance: StaticBalance | None, zmp: ZmpReport | None) -> list[Any]:
@@ -24,6 +26,8 @@ def balance_items(balance: StaticBalance | None, zmp: ZmpReport | None) -> list[
     if balance is not None:
         out.append(_table(balance))
     if zmp is not None:
+        from armcli.sim.tipping import summary_line  # loaded by the --trajectory run already
+
         out.append(Text(summary_line(zmp), style="red" if zmp.tips else ""))
     return out
 
@@ -54,7 +58,9 @@ def _title(b: StaticBalance) -> str:
 
 def _caption(b: StaticBalance) -> str:
     corners = " ".join(f"({x:.3f}, {y:.3f})" for x, y in b.polygon)
-    if b.payload_max is None:
+    if not b.payload_point:
+        holds = "no payload point (no arm)"
+    elif b.payload_max is None:
         holds = "no payload keeps the margin everywhere"
     elif math.isinf(b.payload_max):
         holds = f"any payload at {b.payload_point} keeps the margin everywhere"
@@ -73,23 +79,6 @@ def reach_items(reach: Workspace | None, points: tuple[ReachPoint, ...]) -> list
 
     if reach is None:
         return []
-    lo, hi = reach.lower, reach.upper
-    box = " ".join(f"{a:.3f}..{b:.3f}" for a, b in zip(lo, hi, strict=True))
-    out: list[Any] = [
-        Text(
-            f"reach of {reach.point} over {', '.join(reach.joints)}: max {reach.max_reach:.3f} m "
-            f"from the shoulder {_xyz(reach.shoulder)}, height {reach.min_height:.3f}.."
-            f"{reach.max_height:.3f} m, horizontal {reach.max_horizontal:.3f} m from the root's "
-            f"z axis; box x y z {box} m ({reach.samples} samples, extremes refined)"
-        )
-    ]
-    for p in points:
-        verdict = "reachable" if p.reachable else f"OUT OF REACH by {p.residual * 1e3:.1f} mm"
-        q = ", ".join(f"{n}={v:.4g}" for n, v in p.q)
-        out.append(Text(f"  point {_xyz(p.target)}: {verdict} (at {q})",
-                        style="" if p.reachable else "red"))  # fmt: skip
+    out: list[Any] = [Text(describe(reach))]
+    out += [Text(f"  {verdict(p)}", style="" if p.reachable else "red") for p in points]
     return out
-
-
-def _xyz(v: tuple[float, float, float]) -> str:
-    return f"({v[0]:.3f}, {v[1]:.3f}, {v[2]:.3f})"

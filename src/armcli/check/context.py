@@ -11,18 +11,21 @@ or the summary read (the gravity load in `rows`, the servo joints, the PD verdic
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
-from armcli.check.balance import StaticBalance
 from armcli.check.rules import RULES, CheckOptions, Collector, JointRow
 from armcli.check.structure import Tree
-from armcli.sim.tipping import ZmpReport
 from armcli.sim.verdict import StabilityReport
-from armcli.urdf.doc import Urdf, position_bounds
+from armcli.spec.joint_types import position_bounds
+from armcli.urdf.doc import Urdf
 from armcli.urdf.mimic import follow, mimics
 from armcli.urdf.pinocchio import JointRange
-from armcli.urdf.stance import Stance
-from armcli.urdf.workspace import ReachPoint, Workspace
+
+if TYPE_CHECKING:  # the balance and reach results: imported by their own families
+    from armcli.check.balance import StaticBalance
+    from armcli.sim.tipping import ZmpReport
+    from armcli.urdf.stance import Stance
+    from armcli.urdf.workspace import ReachPoint, Workspace
 
 Stage = Literal["urdf", "model", "dynamics"]
 URDF: Stage = "urdf"

@@ -34,7 +34,7 @@ ZERO_RTOL = 1e-9
 
 
 def check(urdf: Urdf, tree: Tree, out: Collector) -> None:
-    """Per-link rules; the bodies the joints move are checked in checks_bodies."""
+    """Per-link rules; the bodies the joints move are checked in check/bodies.py."""
     for link in urdf.links:
         ine = link.inertial
         if ine is None:
@@ -84,7 +84,7 @@ def _tensor_ok(link: Link, ine: Inertial, out: Collector) -> np.ndarray | None:
     moments = inr.principal_moments(J)
     vals = dict(zip(("ixx", "ixy", "ixz", "iyy", "iyz", "izz"), ine.inertia, strict=True))
     if all(x == 0.0 for x in ine.inertia):
-        return None  # a point mass: fine on its own; checks_bodies checks what joints move
+        return None  # a point mass: fine on its own; check/bodies.py checks what joints move
     noise = max(MIN_MOMENT, ZERO_RTOL * float(ine.mass or 0.0) * _size(link) ** 2)
     if max(abs(moments[0]), abs(moments[-1])) <= noise:
         out.add(

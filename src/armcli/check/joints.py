@@ -7,7 +7,8 @@ from typing import TYPE_CHECKING
 
 from armcli.check.rules import Collector
 from armcli.check.structure import finite
-from armcli.urdf.doc import ONE_DOF_TYPES, Joint, Urdf
+from armcli.spec.joint_types import LIMITED_TYPES, ONE_DOF_TYPES
+from armcli.urdf.doc import Joint, Urdf
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -28,7 +29,7 @@ def check(urdf: Urdf, spec: RobotSpec | None, out: Collector) -> None:
     for j in urdf.joints:
         if j.type in ONE_DOF_TYPES:
             _axis(j, out)
-        if j.limit is not None and j.type in ("revolute", "prismatic"):
+        if j.limit is not None and j.type in LIMITED_TYPES:
             _limits(j, out)
     if spec is not None:
         _spec_limits(urdf, spec, out)

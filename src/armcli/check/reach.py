@@ -18,6 +18,10 @@ def check(c: Context) -> None:
     tool = tool_point(c.urdf, c.opts.spec)
     if tool is None or not c.model.existFrame(tool.link):
         return
+    if c.stance is not None and tool.link in c.stance.ground.links:
+        c.notes.append(f"workspace skipped: the tool point {tool.label} touches the ground "
+                       "(a base without an arm)")  # fmt: skip
+        return
     chain = Chain(c.model, tool)
     if not chain.joints:
         c.notes.append("workspace skipped: no moving joint between the root and the tool point")

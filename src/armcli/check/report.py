@@ -5,8 +5,6 @@ Functions return renderables or strings; the command prints them.
 
 from __future__ import annotations
 
-import json
-import math
 from collections.abc import Sequence
 from dataclasses import asdict
 from typing import Any
@@ -15,6 +13,7 @@ from armcli.check.balance_report import balance_items, reach_items
 from armcli.check.rules import ERROR, WARNING, Finding
 from armcli.check.run import CheckResult
 from armcli.errors import split_source
+from armcli.io.jsondoc import dumps
 from armcli.io.oneline import one_line
 from armcli.io.terminal import Column, FitTable, Hanging
 
@@ -27,17 +26,6 @@ def counts(findings: Sequence[Finding]) -> dict[str, int]:
         ERROR: sum(f.severity == ERROR for f in findings),
         WARNING: sum(f.severity == WARNING for f in findings),
     }
-
-
-def _clean(x: Any) -> Any:
-    """JSON has no NaN/inf: write them as strings; tuples become lists."""
-    if isinstance(x, float) and not math.isfinite(x):
-        return str(x)
-    if isinstance(x, dict):
-        return {k: _clean(v) for k, v in x.items()}
-    if isinstance(x, list | tuple):
-        return [_clean(v) for v in x]
-    return x
 
 
 def _summary_dict(r: CheckResult) -> dict[str, Any] | None:
@@ -73,7 +61,7 @@ def to_json(
         "counts": counts(findings),
         "exit_code": exit_code,
     }
-    return json.dumps(_clean(doc), indent=2, sort_keys=False, allow_nan=False) + "\n"
+    return dumps(doc)
 
 
 def _esc_data(s: str) -> str:

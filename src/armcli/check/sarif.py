@@ -16,8 +16,6 @@ files under `root`, stable key order.
 from __future__ import annotations
 
 import hashlib
-import json
-import math
 import os
 import re
 from collections import Counter
@@ -29,6 +27,7 @@ from urllib.parse import quote
 from armcli import __version__
 from armcli.check.rules import RULES, Finding, Rule
 from armcli.errors import split_source
+from armcli.io.jsondoc import dumps
 
 SARIF_VERSION = "2.1.0"
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -87,17 +86,6 @@ def _location(f: Finding, root: Path) -> tuple[dict[str, Any], str]:
     return {"physicalLocation": physical}, prefix
 
 
-def _clean(x: Any) -> Any:
-    """JSON has no NaN/inf: write them as strings (as the JSON format does)."""
-    if isinstance(x, float) and not math.isfinite(x):
-        return str(x)
-    if isinstance(x, dict):
-        return {k: _clean(v) for k, v in x.items()}
-    if isinstance(x, list | tuple):
-        return [_clean(v) for v in x]
-    return x
-
-
 def to_sarif(findings: Sequence[Finding], root: Path | None = None) -> str:
     """The SARIF 2.1.0 log of one `check` run (findings after --ignore/--strict)."""
     base = root if root is not None else Path.cwd()
@@ -138,4 +126,4 @@ def to_sarif(findings: Sequence[Finding], root: Path | None = None) -> str:
             }
         ],
     }
-    return json.dumps(_clean(doc), indent=2, allow_nan=False) + "\n"
+    return dumps(doc)

@@ -12,7 +12,8 @@ from dataclasses import dataclass
 
 from armcli.check.rules import Collector
 from armcli.spec.graph import root_links
-from armcli.urdf.doc import JOINT_TYPES, Joint, Link, Urdf
+from armcli.spec.joint_types import JOINT_TYPES, LIMITED_TYPES
+from armcli.urdf.doc import Joint, Link, Urdf
 
 NUMBER_RULES = {
     "missing": "number-syntax",
@@ -181,7 +182,7 @@ def _joint_shape(j: Joint, links: set[str], joints: set[str], out: Collector) ->
             )
     if j.type not in JOINT_TYPES:
         out.add("joint-type", j.line, f"joint {j.name!r}: unknown type {j.type!r}", type=j.type)
-    if j.type in ("revolute", "prismatic"):
+    if j.type in LIMITED_TYPES:
         lim = j.limit
         missing = (
             ["limit"]

@@ -8,20 +8,23 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from armcli.check.balance import StaticBalance
 from armcli.check.context import Context, poses
 from armcli.check.rules import CheckOptions, JointRow
 from armcli.check.structure import finite
-from armcli.sim.tipping import ZmpReport
 from armcli.sim.verdict import StabilityReport
-from armcli.urdf.doc import Urdf, total_dof
+from armcli.spec.joint_types import total_dof
+from armcli.urdf.doc import Urdf
 from armcli.urdf.pinocchio import configuration
 from armcli.urdf.tool import tool_point
-from armcli.urdf.workspace import ReachPoint, Workspace
+
+if TYPE_CHECKING:  # the balance and reach results: imported by their own families
+    from armcli.check.balance import StaticBalance
+    from armcli.sim.tipping import ZmpReport
+    from armcli.urdf.workspace import ReachPoint, Workspace
 
 
 @dataclass(frozen=True)

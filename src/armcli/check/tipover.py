@@ -10,6 +10,7 @@ named. Each finding names the pose and the payload that still holds there.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 from armcli.check import balance
 from armcli.check.balance import PoseBalance, StaticBalance
@@ -24,9 +25,10 @@ NEAR_NAMED = 1e-3  # [m] a range's worst within this of a named pose's is that p
 
 def check(c: Context) -> None:
     """Build the stance, analyse it, report findings; the result goes to the summary."""
-    stance = c.stance = stance_for(c)
+    stance = stance_for(c)
     if stance is None:
         return
+    stance = c.stance = _without_wheel_payload(c, stance)
     named = [(name, v) for name, v in poses(c) if name not in ("lower", "upper")]
     c.balance = balance.analyse(stance, named, c.opts.tipover.min_margin)
     _report(c.balance, c.out, c.urdf.line)
@@ -60,6 +62,17 @@ def stance_for(c: Context) -> Stance | None:
         c.notes.append(f"static balance skipped: {found.reason}")
         return None
     return found
+
+
+def _without_wheel_payload(c: Context, stance: Stance) -> Stance:
+    """A base without an arm: its deepest link is a wheel, no place for a payload."""
+    p = stance.payload
+    if p is None or c.opts.tipover.payload_link is not None or p.link not in stance.ground.links:
+        return stance
+    if p.mass > 0:
+        c.notes.append(f"payload left out: the tool point {p.link} touches the ground (no arm); "
+                       "name its link with --payload-link")  # fmt: skip
+    return replace(stance, payload=None)
 
 
 def _report(b: StaticBalance, out: Collector, line: int | None) -> None:
@@ -98,7 +111,9 @@ def _add(
                 f"(threshold {b.threshold * 1e3:g} mm)")  # fmt: skip
     text = f"{where}: {what}, toward {direction}{load}; "
     fix: dict[str, Value] = {}
-    if holds is None:
+    if not b.payload_point:  # no payload point: a base without an arm
+        text = text[:-2]
+    elif holds is None:
         text += "it does not hold even unloaded there"
     elif math.isinf(holds):
         text += f"any payload at {b.payload_point} holds there"

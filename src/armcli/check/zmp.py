@@ -15,7 +15,6 @@ from armcli.check.context import Context
 from armcli.check.rules import Value
 from armcli.check.tipover import round_down
 from armcli.errors import ArmcliError
-from armcli.sim import tipping
 
 
 def check(c: Context) -> None:
@@ -27,6 +26,8 @@ def check(c: Context) -> None:
         c.notes.append("zero-moment point skipped: the trajectory needs a spec's PD gains "
                        "to be simulated (give --spec)")  # fmt: skip
         return
+    from armcli.sim import tipping  # the simulator's stack: only with --trajectory (~60 ms)
+
     try:
         r = tipping.trajectory_zmp(spec, c.urdf, c.stance, opts.trajectory,
                                    opts.base_accel, opts.min_margin)  # fmt: skip

@@ -7,11 +7,13 @@ from pathlib import Path
 
 import typer
 
+from armcli.commands.flags import flag_errors
 from armcli.commands.options import spec_argument
 from armcli.compiler.expand import build, check_fresh
 from armcli.spec.discover import find_spec
 
 
+@flag_errors({"out_dir": "--out"})  # the library names its parameter
 def build_cmd(
     spec: Path | None = spec_argument(),
     out: Path = typer.Option(

@@ -15,6 +15,7 @@ from armcli.check.report import counts
 from armcli.check.rules import RULES, CheckOptions, TipoverOptions, apply_policy, unknown_rules
 from armcli.check.sarif import to_sarif
 from armcli.commands.options import choice
+from armcli.commands.points import REACH_POINT_HELP, point_option
 from armcli.commands.xacro_inputs import (
     env_option,
     package_dir_option,
@@ -43,7 +44,6 @@ BASE_ACCEL_HELP = (
     "Base acceleration and braking [m/s²] with --trajectory "
     "(default: the diff-drive plugin's max_wheel_acceleration)."
 )
-REACH_POINT_HELP = "x,y,z [m] in the root frame: is it reachable? (repeatable)"
 
 
 def tipover_options(
@@ -74,17 +74,6 @@ def tipover_options(
         base_accel=base_accel,
         reach_points=tuple(point_option(p, "--reach-point") for p in reach_points),
     )
-
-
-def point_option(text: str, flag: str) -> tuple[float, float, float]:
-    """The point "x,y,z" [m] as three finite numbers."""
-    try:
-        xyz = tuple(float(v) for v in text.split(","))
-    except ValueError:
-        xyz = ()
-    if len(xyz) != 3 or not all(math.isfinite(v) for v in xyz):
-        raise InputError(f"expected x,y,z in metres, got {text!r}", field=flag)
-    return (xyz[0], xyz[1], xyz[2])
 
 
 def check_cmd(

@@ -31,7 +31,7 @@ def report(result: ImportResult, source: Path, out: Path) -> str:
     lines = [
         f"imported {source} into {out}: robot {spec.name!r}, {len(links)} links "
         f"({derived} inertials derived from shapes), {len(joints)} joints"
-        + (f", arm from {spec.arm_root()!r} on a mobile base" if spec.mount else ""),
+        + (f", arm from {spec.arm_root()!r} on a mobile base" if spec.mounted_base() else ""),
     ]
     if result.passthrough:
         lines.append(f"kept verbatim ({len(result.passthrough)}, spec field `passthrough`):")

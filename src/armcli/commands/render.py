@@ -10,6 +10,7 @@ import typer
 
 from armcli.commands.flags import flag_errors
 from armcli.commands.options import spec_argument
+from armcli.commands.points import REACH_POINT_HELP, point_option
 from armcli.commands.xacro_inputs import (
     args_argument,
     env_option,
@@ -23,8 +24,14 @@ from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
 from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.urdf.workspace import describe, verdict
 from armcli.view.png import MESH_HINT, load_urdf, render_png
 from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
+
+REACH_HELP = (
+    "Also draw where the tool point can reach within the joint limits (sampled forward "
+    "kinematics; joints off the arm stay at the pose) and print the envelope."
+)
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -64,9 +71,12 @@ def render_cmd(
     env: list[str] = env_option(),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
+    reach: bool = typer.Option(False, "--reach", help=REACH_HELP),
+    reach_point: list[str] = typer.Option([], "--reach-point", help=REACH_POINT_HELP),
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
     check_output_file(out, "--out")  # before any work: nothing else is written
+    targets = [point_option(p, "--reach-point") for p in reach_point]
     robot, tokens = split_robot(robot, args)
     inputs = xacro_inputs(tokens, env, package_dir)
     src = load_robot(
@@ -77,15 +87,21 @@ def render_cmd(
     width, height = _size(size)
     skipped: dict[str, str] = {}
     urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search, skipped)
-    res = render_png(
-        urdf,
-        values,
-        out,
-        tool=src.tool,
-        name=src.name,
-        size=(width, height),
-        field="--pose" if pose else "--q",
-    )
+    field = "--pose" if pose else "--q"
+    lines: list[str] = []
+    if reach or targets:
+        if src.tool is None:
+            raise InputError("the robot has no links: no tool point to reach with", field="--reach")
+        from armcli.view.reach import render_reach_png  # Pinocchio: only for --reach
+
+        pic = render_reach_png(urdf, src.xml, src.source, values, out, tool=src.tool,
+                               name=src.name, size=(width, height), targets=targets,
+                               field=field)  # fmt: skip
+        res = pic.render
+        lines = [describe(pic.workspace), *(verdict(p) for p in pic.points)]
+    else:
+        res = render_png(urdf, values, out, tool=src.tool, name=src.name,
+                         size=(width, height), field=field)  # fmt: skip
     tip = (
         ""
         if res.tool_position is None
@@ -98,6 +114,8 @@ def render_cmd(
         )
     drawn = _drawn(src.poses, pose, q)
     sys.stdout.write(f"wrote {res.path} ({res.width}x{res.height} px) at {drawn};{tip}\n")
+    for line in lines:
+        sys.stdout.write(f"{line}\n")
 
 
 def _drawn(poses: Mapping[str, Mapping[str, float]], pose: str | None, q: str | None) -> str:

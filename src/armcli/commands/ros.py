@@ -7,8 +7,10 @@ from pathlib import Path
 
 import typer
 
+from armcli.commands.flags import flag_errors
 from armcli.commands.options import choice, option, out_option, spec_argument
 from armcli.compiler.expand import spec_label
+from armcli.ros.collision_matrix import DEFAULT_SAMPLES
 from armcli.ros.packages import DEFAULT_TARGET, TARGETS, PackageInfo, write_ros_packages
 from armcli.spec.discover import find_spec
 
@@ -16,10 +18,10 @@ TARGET_HELP = (
     "humble-classic: the course's ROS 2 Humble + Gazebo classic (default); jazzy: ROS 2 Jazzy "
     "+ Gazebo Harmonic with ros2_control (effort, the spec's gains)."
 )
-DEFAULT_SAMPLES = 10_000  # keep equal to armcli.ros.collision_matrix.DEFAULT_SAMPLES (lazy import)
 MAX_SAMPLES = 1_000_000  # ~100x the default: minutes of coal queries, not days
 
 
+@flag_errors({"out_dir": "--out"})  # the library names its parameter
 def ros_package_cmd(
     spec: Path | None = spec_argument(),
     out: Path = out_option(Path("ros"), "Output directory"),

@@ -135,7 +135,8 @@ def simulate_cmd(
     job = _prepare(spec_obj, spec_path, opts, tuple(ignore))
     notes: list[str] = []
     tip = tipping.prepare(spec_obj, job, tip_opts, inputs.packages, notes)
-    _run(job, output, plot, tip, notes)
+    asked = tip_opts != TipOptions()  # an arm on a fixed base is news only when asked about
+    _run(job, output, plot, tip, notes if asked else [])
 
 
 def _prepare(

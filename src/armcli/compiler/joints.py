@@ -6,6 +6,7 @@ from lxml import etree
 
 from armcli.compiler.passthrough import copy_into
 from armcli.compiler.xmlfmt import fmt, sub, vec
+from armcli.spec.joint_types import AXIS_TYPES
 from armcli.spec.model import Joint
 
 
@@ -32,7 +33,7 @@ def joint_element(parent: etree._Element, name: str, joint: Joint) -> etree._Ele
     sub(el, "parent", link=joint.parent)
     sub(el, "child", link=joint.child)
     sub(el, "origin", xyz=vec(joint.origin.xyz), rpy=vec(joint.origin.rpy))
-    if joint.type not in ("fixed", "floating"):
+    if joint.type in AXIS_TYPES:
         sub(el, "axis", xyz=vec(joint.axis))
     _limit(el, joint)
     if joint.dynamics is not None:

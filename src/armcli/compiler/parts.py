@@ -16,8 +16,9 @@ from armcli.compiler.joints import joint_element
 from armcli.compiler.links import link_element
 from armcli.compiler.meshfiles import MeshNames
 from armcli.compiler.xmlfmt import XACRO_NS, sub
+from armcli.spec.joint_types import ROTARY_TYPES
 from armcli.spec.model import Part, Placement, RobotSpec
-from armcli.spec.parts import AXIAL, part_root, placed_joints
+from armcli.spec.parts import part_root, placed_joints
 
 X = f"{{{XACRO_NS}}}"
 # Which components of a vector attribute flip under the x-z reflection.
@@ -49,7 +50,7 @@ def _mirror(macro: etree._Element) -> None:
         elif el.tag == "joint":
             axis = el.find("axis")
             if axis is not None:
-                comps = (0, 2) if el.get("type") in AXIAL else (1,)
+                comps = (0, 2) if el.get("type") in ROTARY_TYPES else (1,)
                 axis.set("xyz", _reflect(str(axis.get("xyz")), comps))
 
 

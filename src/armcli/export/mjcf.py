@@ -33,8 +33,9 @@ from armcli.export import mjcf_parts as parts
 from armcli.export.mjcf_mass import FromGeometry, Node, Plan, plan_masses, write_inertial
 from armcli.export.mjcf_meshes import mesh_assets
 from armcli.export.mjcf_report import Extras, Note, scan, text
+from armcli.spec.joint_types import position_bounds
 from armcli.spec.model import RobotSpec
-from armcli.urdf.doc import Joint, Link, Pose, Shape, Urdf, position_bounds
+from armcli.urdf.doc import Joint, Link, Pose, Shape, Urdf
 from armcli.urdf.read import parse_root
 
 BASES = ("fixed", "free")

@@ -17,8 +17,9 @@ from lxml import etree
 from armcli.compiler.xmlfmt import fmt, vec
 from armcli.export.mjcf_report import EXTRA_TAGS, Extras, Note
 from armcli.spec.control import command_interfaces
+from armcli.spec.joint_types import position_bounds
 from armcli.spec.model import RobotSpec
-from armcli.urdf.doc import Joint, Urdf, position_bounds
+from armcli.urdf.doc import Joint, Urdf
 
 HOME = "home"
 FREE_QPOS = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)  # origin, identity quaternion (w x y z)

@@ -9,13 +9,14 @@ from lxml import etree
 from armcli.importer.compare import JOINT_TAGS
 from armcli.importer.values import Reader, nums, origin_data, xml_text
 from armcli.importer.yamltext import Block, Num
+from armcli.spec.joint_types import AXIS_TYPES, LIMITED_TYPES
 
 
 def _limit(el: etree._Element, jtype: str, reader: Reader) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for key in ("lower", "upper"):
         v = reader.one(el, key)
-        if v is not None or jtype in ("revolute", "prismatic"):  # URDF reads a missing bound as 0
+        if v is not None or jtype in LIMITED_TYPES:  # URDF reads a missing bound as 0
             out[key] = Num(v or 0.0)
     for key in ("effort", "velocity"):
         out[key] = Num(reader.one(el, key, 0.0) or 0.0)
@@ -47,7 +48,7 @@ def read_joint(el: etree._Element, reader: Reader, notes: list[str]) -> tuple[st
     origin = origin_data(*reader.pose(el))
     if origin:
         out["origin"] = origin
-    if jtype not in ("fixed", "floating"):
+    if jtype in AXIS_TYPES:
         axis_el = el.find("axis")
         axis = reader.floats(axis_el, "xyz", 3, (1.0, 0.0, 0.0)) if axis_el is not None else None
         out["axis"] = nums(axis or (1.0, 0.0, 0.0))  # URDF's default axis is x, the spec's z

@@ -30,9 +30,9 @@ from armcli.importer.links import LinkIn, Materials, read_link
 from armcli.importer.split import JointEdge, Split, split_robot
 from armcli.importer.values import Reader, xml_text
 from armcli.importer.yamltext import Block, BlockMap, Num, document
+from armcli.spec.joint_types import ONE_DOF_TYPES
 from armcli.spec.load import loads_spec
 from armcli.spec.model import RobotSpec
-from armcli.urdf.doc import ONE_DOF_TYPES
 from armcli.urdf.read import parse_root
 
 _GAZEBO_NAME = re.compile(r"^[A-Za-z0-9_/]{1,64}$")
@@ -130,7 +130,7 @@ def _read(root: etree._Element, reader: Reader, notes: list[str]) -> tuple[_Part
         lead = data.get("mimic", {}).get("joint")
         if "mimic" not in data:
             continue
-        if data["type"] in ("fixed", "floating", "planar"):
+        if data["type"] not in ONE_DOF_TYPES:
             notes.append(f"joint {name}: mimic left out (a {data['type']} joint does not move)")
             del data["mimic"]
         elif lead not in joints or joints[lead]["type"] not in ONE_DOF_TYPES:

@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from armcli.errors import InputError
+from armcli.spec.joint_types import LIMITED_TYPES
 
 
 @dataclass(frozen=True)
@@ -60,7 +61,7 @@ def split_robot(links: list[str], joints: list[JointEdge], arm_root: str | None 
                 field="arm_root",
             )
         return Split(frozenset(_subtree(arm_root, joints)), mount.name)
-    moving = {j.child for j in joints if j.type in ("revolute", "prismatic")}
+    moving = {j.child for j in joints if j.type in LIMITED_TYPES}
     wheels = {j.child for j in joints if j.type == "continuous"}
     if not moving or not wheels:
         return Split(frozenset(links), None)

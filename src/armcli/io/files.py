@@ -30,6 +30,7 @@ from armcli.io.outdir import (
     relative_inside,
     remove_entry,
     resolve_output_dir,
+    umask,
 )
 from armcli.io.together import write_files_together
 
@@ -37,16 +38,10 @@ _AT_FDCWD = -100
 _RENAME_EXCHANGE = 2
 
 
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 def _write_temp(directory: Path, name: str, data: bytes) -> Path:
     fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{name}.", suffix=".tmp")
     try:
-        os.fchmod(fd, 0o666 & ~_umask())  # mkstemp makes 0600; outputs are ordinary files
+        os.fchmod(fd, 0o666 & ~umask())  # mkstemp makes 0600; outputs are ordinary files
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
             fh.flush()
@@ -113,7 +108,7 @@ def _populate(stage: Path, root: Path, files: Mapping[str, bytes]) -> None:
         os.replace(_write_temp(target.parent, target.name, data), target)
     for path, mode in modes:  # innermost first: read-only directories receive files first
         os.chmod(path, mode)
-    keep = stat.S_IMODE(os.stat(root).st_mode) if root.is_dir() else 0o777 & ~_umask()
+    keep = stat.S_IMODE(os.stat(root).st_mode) if root.is_dir() else 0o777 & ~umask()
     os.chmod(stage, keep)
 
 

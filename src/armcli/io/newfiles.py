@@ -19,21 +19,15 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from armcli.errors import BuildError, ExistingFileError, OutputRefusedError
-from armcli.io.outdir import no_links_below, pid_alive, relative_inside, remove_entry
+from armcli.io.outdir import no_links_below, pid_alive, relative_inside, remove_entry, umask
 
 _STAGE_PREFIX = ".armcli-new-"  # + PID + "-": a killed run's stage is removed by the next
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
 
 
 def _stage(parent: Path, files: Mapping[str, bytes]) -> Path:
     """A hidden directory in `parent` holding every file, flushed to disk."""
     stage = Path(tempfile.mkdtemp(dir=parent, prefix=f"{_STAGE_PREFIX}{os.getpid()}-"))
-    os.chmod(stage, 0o777 & ~_umask())  # mkdtemp makes 0700; a new project dir is ordinary
+    os.chmod(stage, 0o777 & ~umask())  # mkdtemp makes 0700; a new project dir is ordinary
     for rel, data in files.items():
         path = stage / relative_inside(rel)
         path.parent.mkdir(parents=True, exist_ok=True)

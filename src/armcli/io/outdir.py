@@ -35,6 +35,13 @@ MAX_CARRY_DEPTH = 32  # nesting bound of the old tree carried into the new versi
 _KINDS = {stat.S_IFCHR: "device", stat.S_IFBLK: "device", stat.S_IFIFO: "FIFO"}
 
 
+def umask() -> int:
+    """The process's file-creation mask (reading it means setting it; it is set back at once)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 def relative_inside(rel: str) -> PurePosixPath:
     """`rel` as a path that stays inside the directory it is joined to; else refused.
 
@@ -68,7 +75,7 @@ def _check_parent(path: Path, field: str) -> None:
         raise OutputRefusedError(f"{anchor} is not a directory", file=path, field=field)
 
 
-def resolve_output_dir(path: str | Path, *, force: bool = False, field: str = "--out") -> Path:
+def resolve_output_dir(path: str | Path, *, force: bool = False, field: str = "out_dir") -> Path:
     """The real directory to write for `-o path`, or OutputRefusedError saying why not.
 
     Symlinks are resolved so that a linked output directory is updated through

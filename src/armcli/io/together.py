@@ -33,16 +33,10 @@ from collections.abc import Iterator, Mapping
 from pathlib import Path
 
 from armcli.errors import BuildError, OutputRefusedError
-from armcli.io.outdir import pid_alive
+from armcli.io.outdir import pid_alive, umask
 
 TAG = ".armcli-set-"  # staged files `.NAME.armcli-set-PID-X.tmp`, journals `.armcli-set-PID-X.json`
 _BLOCKED = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGQUIT}
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
 
 
 def _owner_pid(name: str, prefix: str) -> int | None:
@@ -63,7 +57,7 @@ def _stage(target: Path, data: bytes, token: str) -> Path:
         try:
             mode = os.stat(target).st_mode & 0o7777  # keep an existing file's permission bits
         except FileNotFoundError:
-            mode = 0o666 & ~_umask()  # mkstemp makes 0600; a new output is an ordinary file
+            mode = 0o666 & ~umask()  # mkstemp makes 0600; a new output is an ordinary file
         os.fchmod(fd, mode)
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)

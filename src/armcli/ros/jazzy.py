@@ -20,7 +20,7 @@ from lxml import etree
 
 from armcli.compiler.ros2_control import joint_block
 from armcli.compiler.sensors import bridge_entries, harmonic_sensor, harmonic_systems
-from armcli.compiler.xacro_writer import ARM, COMMON, MOBILE_BASE, joint_element
+from armcli.compiler.xacro_writer import ARM, COMMON, MOBILE_BASE, has_base, joint_element
 from armcli.compiler.xmlfmt import XACRO_NS, fmt, to_bytes
 from armcli.errors import InputError
 from armcli.ros import interfaces
@@ -219,15 +219,10 @@ def bridge(spec: RobotSpec) -> list[dict[str, Any]]:
     return out
 
 
-def has_whole_robot(spec: RobotSpec) -> bool:
-    """Whether the spec has a mobile base to mount the arm on (a whole-robot xacro)."""
-    return spec.mounted_base() is not None
-
-
 def description_xacros(spec: RobotSpec, bringup_pkg: str, header: str) -> dict[str, bytes]:
     """urdf/ name -> bytes of the Jazzy top-level xacro files."""
     out = {STANDALONE: top_xacro(spec, bringup_pkg, whole=False, header=header)}
-    if has_whole_robot(spec):
+    if has_base(spec):
         out[TOP.format(name=spec.name)] = top_xacro(spec, bringup_pkg, whole=True, header=header)
     return out
 

@@ -16,8 +16,9 @@ import yaml
 from armcli.errors import InputError
 from armcli.ros.interfaces import HUMBLE, trajectory_interface
 from armcli.ros.srdf import ARM_GROUP, chain_joints
+from armcli.spec.joint_types import position_bounds
 from armcli.spec.model import RobotSpec
-from armcli.urdf.doc import Urdf, position_bounds
+from armcli.urdf.doc import Urdf
 
 ARM_CONTROLLER = "arm_controller"
 JOINT_STATE_BROADCASTER = "joint_state_broadcaster"

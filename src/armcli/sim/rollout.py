@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from armcli.sim import native
+from armcli.sim.options import Integrator
 from armcli.sim.reference import Reference
 
 CHUNK_STEPS = 10_000  # steps per call into the engine, between progress reports
@@ -36,7 +37,7 @@ class Plant:
     vabort: np.ndarray  # |v| treated as divergence [rad/s or m/s]
     gravity_comp: bool
     dt: float  # [s]
-    integrator: str  # "euler" | "rk4"
+    integrator: Integrator
     energy_max: float  # [J] kinetic energy treated as a blow-up
 
 

@@ -123,7 +123,7 @@ class SimResult:
     joint_names: tuple[str, ...]
     steps: int  # steps of the run (states 0..steps)
     dt: float
-    integrator: str
+    integrator: Integrator
     step: np.ndarray  # (K,) int: the states kept, by step
     t: np.ndarray  # (K,) their times [s]
     q: np.ndarray  # (K, n)
@@ -246,6 +246,7 @@ class Run:
     q0: np.ndarray
     duration: float  # [s]
     cfg: SimConfig
+    record: np.ndarray | None = None  # the steps whose states are kept (None: every step)
 
 
 def simulate(
@@ -263,11 +264,11 @@ def simulate(
     Keeps the states at the strictly increasing steps `record` (default: every step);
     `progress(steps_done, steps_total)` is called between chunks of steps.
     """
-    return _run(Run(arm, reference, q0, duration, cfg), None, progress, record)
+    return _run(Run(arm, reference, q0, duration, cfg, record), None, progress)
 
 
 def simulate_batch(runs: Sequence[Run], threads: int = 1) -> list[SimResult | SimulationError]:
-    """Many independent runs, every step kept; each equals `simulate`'s result or error.
+    """Many independent runs (each keeping its `record` steps): `simulate`'s results or errors.
 
     The engine releases the GIL, so `threads` > 1 runs them in parallel; each distinct
     model is handed to the engine once.
@@ -280,7 +281,7 @@ def simulate_batch(runs: Sequence[Run], threads: int = 1) -> list[SimResult | Si
 
     def one(r: Run) -> SimResult | SimulationError:
         try:
-            return _run(r, compiled[id(r.arm.model)], None, None)
+            return _run(r, compiled[id(r.arm.model)], None)
         except SimulationError as exc:
             return exc
 
@@ -295,18 +296,13 @@ def steps_of(duration: float, dt: float) -> int:
     return max(1, round(duration / dt))
 
 
-def _run(
-    r: Run,
-    compiled: Any,
-    progress: Callable[[int, int], None] | None,
-    record: np.ndarray | None,
-) -> SimResult:
+def _run(r: Run, compiled: Any, progress: Callable[[int, int], None] | None) -> SimResult:
     steps = steps_of(r.duration, r.cfg.dt)
     plant = plant_of(r.arm, r.cfg)
     plant = replace(plant, energy_max=_energy_max(r.arm, r.q0, plant.vabort))
     start = time.perf_counter()
     out = ro.run(plant, r.reference, np.asarray(r.q0, dtype=float), np.zeros(len(r.q0)), steps,
-                 record=record, settle_tol=SETTLE_TOL, compiled=compiled,
+                 record=r.record, settle_tol=SETTLE_TOL, compiled=compiled,
                  progress=progress)  # fmt: skip
     wall = time.perf_counter() - start
     if out.failure:

@@ -154,17 +154,27 @@ def _base_accel(opts: TipOptions, urdf: Urdf) -> tuple[float, str]:
 
 
 def columns(series: zmps.ZmpSeries, res: SimResult, rate: float) -> dict[str, NDArray[Any]]:
-    """States-file columns at the output rate: the point, its margin, the worst with the base."""
+    """States-file columns at the output rate: the point, its margin, the worst with the base.
+
+    A state the series left out (a joint-stop impact: an impulse, no finite acceleration)
+    gets NaN in these columns rather than a made-up point.
+    """
     want = sample_steps(res.steps, res.dt, rate)
-    rows = np.searchsorted(series.step, want)
-    rows = np.minimum(rows, len(series.step) - 1)
-    if not np.array_equal(series.step[rows], want):
-        raise ValueError("the zero-moment point was not computed at the output rate")
+    rows = np.minimum(np.searchsorted(series.step, want), max(len(series.step) - 1, 0))
+    known = series.step[rows] == want if len(series.step) else np.zeros(len(want), dtype=bool)
+
+    def pick(values: NDArray[Any]) -> NDArray[Any]:
+        return (
+            np.where(known, values[rows], np.nan)
+            if len(series.step)
+            else np.full(len(want), np.nan)
+        )
+
     return {
-        COLUMNS[0]: series.zmp[rows, 0, 0],
-        COLUMNS[1]: series.zmp[rows, 0, 1],
-        COLUMNS[2]: series.margin[rows, 0],
-        COLUMNS[3]: np.min(series.margin[rows, 1:], axis=1),
+        COLUMNS[0]: pick(series.zmp[:, 0, 0]),
+        COLUMNS[1]: pick(series.zmp[:, 0, 1]),
+        COLUMNS[2]: pick(series.margin[:, 0]),
+        COLUMNS[3]: pick(np.min(series.margin[:, 1:], axis=1)),
     }
 
 
@@ -263,6 +273,15 @@ def plot_row(series: zmps.ZmpSeries) -> Any:
             ax.plot(series.t, series.margin[:, c] * 1e3, lw=1.2, label=label)
         ax.axhline(series.threshold * 1e3, color="C3", lw=0.8, ls=":", label="warning")
         ax.axhline(0.0, color="k", lw=0.8, label="tips")
+        cases = 1 if series.base_accel == 0 else len(zmps.CASES)
+        k = int(np.argmin(np.min(series.margin[:, :cases], axis=1)))  # the least moment
+        low = float(np.min(series.margin[k, :cases])) * 1e3
+        ax.plot(series.t[k], low, "o", color="C3", ms=5, zorder=5)
+        ax.annotate(f"least {low:.1f} mm at {series.t[k]:.3f} s", (series.t[k], low),
+                    xytext=(8, -4), textcoords="offset points", fontsize=8, color="C3")  # fmt: skip
+        top = float(np.max(series.margin[:, :cases])) * 1e3
+        span = top - min(low, 0.0)
+        ax.set_ylim(min(low, 0.0) - 0.15 * span, top + 0.6 * span)  # the legend goes on top
         ax.set_ylabel("ZMP margin [mm]")
         ax.set_title("zero-moment point in the support polygon", fontsize=11)
         if len(axes) > 1:
@@ -274,6 +293,8 @@ def plot_row(series: zmps.ZmpSeries) -> Any:
         for a in axes[:2]:
             a.set_xlabel("time [s]")
             a.grid(True, alpha=0.3)
-            a.legend(loc="best", fontsize=8)
+        ax.legend(loc="upper center", ncol=3, fontsize=7)
+        if len(axes) > 1:
+            axes[1].legend(loc="best", fontsize=8)
 
     return draw

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import math
-from typing import Literal
 
 from pydantic import Field, model_validator
 
+from armcli.spec.joint_types import LIMITED_TYPES, ONE_DOF_TYPES, JointType, position_bounds
 from armcli.spec.passthrough import PassthroughElement
 from armcli.spec.shapes import Origin
 from armcli.spec.types import NonNeg, Real, UrdfName, Vec3, _Model
@@ -59,9 +59,6 @@ class Calibration(_Model):
     falling: Real | None = Field(None, description="falling edge position [rad or m]")
 
 
-JointType = Literal["revolute", "continuous", "prismatic", "fixed", "floating", "planar"]
-
-
 class Joint(_Model):
     """A URDF joint from `parent` to `child`; revolute and prismatic joints need a `limit`.
 
@@ -92,21 +89,18 @@ class Joint(_Model):
 
     @model_validator(mode="after")
     def _limits(self) -> Joint:
-        if self.type in ("revolute", "prismatic"):
+        if self.type in LIMITED_TYPES:
             if self.limit is None:
                 raise ValueError(f"a {self.type} joint needs a limit")
             if self.limit.lower is None or self.limit.upper is None:
                 raise ValueError(f"a {self.type} joint's limit needs lower and upper")
         if self.type != "fixed" and math.fsum(a * a for a in self.axis) < 1e-12:
             raise ValueError("axis must be non-zero")
-        if self.mimic is not None and self.type in ("fixed", "floating", "planar"):
+        if self.mimic is not None and self.type not in ONE_DOF_TYPES:
             raise ValueError(f"a {self.type} joint cannot mimic another")
         return self
 
     @property
     def bounds(self) -> tuple[float, float] | None:
-        """(lower, upper) of a joint with both position limits, else None."""
-        lim = self.limit
-        if lim is None or lim.lower is None or lim.upper is None:
-            return None
-        return lim.lower, lim.upper
+        """(lower, upper) [rad or m] of a bounded joint, else None (continuous: always None)."""
+        return position_bounds(self.type, self.limit)

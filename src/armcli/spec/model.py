@@ -18,11 +18,11 @@ from pydantic import Field, PrivateAttr
 from armcli.defaults import DEFAULT_DT
 from armcli.spec.control import Hardware, Interface, JointControl, Ros2Control
 from armcli.spec.graph import root_links
+from armcli.spec.joint_types import JointType
 from armcli.spec.joints import (
     Calibration,
     Dynamics,
     Joint,
-    JointType,
     Limit,
     Mimic,
     SafetyController,

@@ -19,12 +19,12 @@ from typing import Annotated
 from pydantic import Field
 
 from armcli.spec.graph import root_links
-from armcli.spec.joints import Dynamics, Joint, JointType, Limit, Mimic
+from armcli.spec.joint_types import ROTARY_TYPES, JointType
+from armcli.spec.joints import Dynamics, Joint, Limit, Mimic
 from armcli.spec.shapes import Geometry, Inertia, Link, Mesh, Origin, Shape
 from armcli.spec.types import Name, UrdfName, Vec3, _Model
 
 Prefix = Annotated[str, Field(pattern=r"^[A-Za-z0-9_./-]*$", max_length=64)]
-AXIAL = ("revolute", "continuous")  # rotation axes mirror as axial vectors
 
 
 class Part(_Model):
@@ -99,7 +99,7 @@ def mirror_link(link: Link) -> Link:
 def mirror_axis(joint_type: str, axis: tuple[float, float, float]) -> tuple[float, float, float]:
     """A joint axis reflected through the x-z plane: axial for rotations, polar otherwise."""
     x, y, z = axis
-    return (-x, y, -z) if joint_type in AXIAL else (x, -y, z)
+    return (-x, y, -z) if joint_type in ROTARY_TYPES else (x, -y, z)
 
 
 def _prefixed(p: Placement, name: str) -> str:

@@ -13,6 +13,7 @@ from typing import Any
 from armcli.errors import Problem
 from armcli.io.yaml import dotted
 from armcli.spec.graph import root_links
+from armcli.spec.joint_types import ONE_DOF_TYPES
 from armcli.spec.model import Joint, Link, RobotSpec
 
 
@@ -88,7 +89,7 @@ def _mimic_problems(spec: RobotSpec, add: Callable[..., None]) -> None:
                 add(path, f"unknown {part} joint; known: {_names(joints)}")
             elif j.mimic.joint == jname:
                 add(path, "a joint cannot mimic itself")
-            elif lead.type not in ("revolute", "continuous", "prismatic"):
+            elif lead.type not in ONE_DOF_TYPES:
                 add(path, f"{j.mimic.joint} is {lead.type}: a lead joint must move")
             elif lead.mimic is not None:
                 add(path, f"{j.mimic.joint} mimics {lead.mimic.joint}: follow that one")
@@ -147,7 +148,6 @@ def _pose_problems(spec: RobotSpec, arm_movable: set[str], add: Any) -> None:
                 add(("poses", pname, jname), f"mimics {j.mimic.joint}: give the lead joint")
             elif (
                 (b := j.bounds) is not None
-                and j.type != "continuous"
                 and b[0] <= b[1]
                 and not (b[0] - 1e-12 <= value <= b[1] + 1e-12)
             ):
@@ -171,8 +171,9 @@ def _tree_problems(part: str, links: dict[str, Link], joints: dict[str, Joint], 
         children[j.child] = jname
         if j.parent == j.child:
             add((part, "joints", jname, "child"), "a joint cannot connect a link to itself")
-        if (b := j.bounds) is not None and b[0] > b[1]:
-            add((part, "joints", jname, "limit", "upper"), f"must be >= lower ({b[0]:g})")
+        lim = j.limit  # written limits in order, even a continuous joint's (URDF keeps them)
+        if lim and lim.lower is not None and lim.upper is not None and lim.lower > lim.upper:
+            add((part, "joints", jname, "limit", "upper"), f"must be >= lower ({lim.lower:g})")
     roots = root_links(links, children)
     if len(roots) != 1:
         add((part, "links"), f"exactly one root link expected, found {len(roots)}: {roots}")

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from armcli.sim.simulate import Arm, Run, SimConfig, SimResult, simulate_batch
+from armcli.sim.simulate import Arm, Run, SimConfig, SimResult, simulate_batch, steps_of
 from armcli.tune import gains as gain_vector
 from armcli.tune.model_gains import loop_stable
 from armcli.tune.objective import METRIC_FIELDS, Weights, run_cost, run_metrics
@@ -44,9 +44,23 @@ class RolloutJob:
 
 
 def rollout_batch(jobs: Sequence[RolloutJob]) -> list[SimResult | None]:
-    """Run every job through the simulator's batch entry point; None for a diverged run."""
-    runs = [Run(j.arm, j.case.reference, j.case.q0, j.case.duration, j.cfg) for j in jobs]
+    """Run every job through the simulator's batch entry point; None for a diverged run.
+
+    Each run keeps the states from its last trajectory point on (what `run_metrics` reads
+    beyond the engine's statistics), not every step: the copy out of the engine holds
+    the GIL, which the threads of `--jobs` share.
+    """
+    runs = [
+        Run(j.arm, j.case.reference, j.case.q0, j.case.duration, j.cfg, _tail(j.case, j.cfg.dt))
+        for j in jobs
+    ]
     return [r if isinstance(r, SimResult) else None for r in simulate_batch(runs)]
+
+
+def _tail(case: Case, dt: float) -> np.ndarray:
+    """The steps from the case's last trajectory point to its end."""
+    steps = steps_of(case.duration, dt)
+    return np.arange(min(round(case.t_end / dt), steps), steps + 1, dtype=np.int64)
 
 
 def _unstable_reason(problem: TuneProblem, kp: np.ndarray, kd: np.ndarray) -> str:

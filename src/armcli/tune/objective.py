@@ -46,12 +46,14 @@ class Weights:
 def overshoot(res: SimResult, t_end: float) -> np.ndarray:
     """Per joint: how far q went past the final reference [fraction of the step].
 
-    The step is the gap left at the last point; zero when it is within SETTLE_TOL.
+    The step is the gap left at the last point; zero when it is within SETTLE_TOL. Reads
+    the kept states from the last point's step on (`res` may keep only those).
     """
-    k = min(round(t_end / res.dt), res.q.shape[0] - 1)
+    after = res.step >= min(round(t_end / res.dt), res.steps)
     q_f = res.q_ref[-1]
-    gap = q_f - res.q[k]
-    past = np.sign(gap) * (res.q[k:] - q_f)  # > 0 beyond the target, in the approach direction
+    q_after = res.q[after]
+    gap = q_f - q_after[0]
+    past = np.sign(gap) * (q_after - q_f)  # > 0 beyond the target, in the approach direction
     peak = np.max(past, axis=0)
     scale = np.where(np.abs(gap) > SETTLE_TOL, np.abs(gap), np.inf)
     return np.where(np.abs(gap) > SETTLE_TOL, np.maximum(peak, 0.0) / scale, 0.0)

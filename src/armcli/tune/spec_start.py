@@ -16,6 +16,7 @@ from armcli.compiler.expand import expand_urdfs
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.sim.simulate import arm_from_model
+from armcli.spec.joint_types import LIMITED_TYPES
 from armcli.spec.model import RobotSpec
 from armcli.tune.model_gains import TARGET_RATIO, start_gains
 from armcli.urdf.pinocchio import load_model
@@ -32,7 +33,7 @@ def spec_start_gains(spec: RobotSpec) -> dict[str, tuple[float, float]]:
     joints = [
         n
         for n in spec.movable_arm_joints()
-        if spec.arm.joints[n].mimic is None and spec.arm.joints[n].type in ("revolute", "prismatic")
+        if spec.arm.joints[n].mimic is None and spec.arm.joints[n].type in LIMITED_TYPES
     ]
     if not joints:
         return {}

@@ -33,10 +33,12 @@ def check_writable(path: Path) -> None:
     write it anyway: `chmod a-w` says the user does not want it changed.
     """
     if not path.is_file():
-        raise InputError("spec file not found", file=path, field="--write")
+        raise InputError("spec file not found", file=path, field="control.gains")
     no_write_bit = not path.stat().st_mode & (stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH)
     if no_write_bit or not os.access(path, os.W_OK) or not os.access(path.parent, os.W_OK):
-        raise InputError("spec file is read-only; nothing written", file=path, field="--write")
+        raise InputError(
+            "spec file is read-only; nothing written", file=path, field="control.gains"
+        )
 
 
 def fmt_gain(x: float) -> str:

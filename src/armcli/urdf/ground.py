@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from armcli.spec.joint_types import ROTARY_TYPES
 from armcli.urdf.doc import Shape, Urdf, Vec3
 from armcli.urdf.inertia import rpy_matrix
 from armcli.urdf.mesh_confine import bounded_mesh_file
@@ -131,7 +132,7 @@ def _rolling_links(urdf: Urdf, poses: dict[str, NDArray[np.float64]]) -> set[str
     """Links turned by a revolute or continuous joint about a horizontal axis (wheels)."""
     out = set()
     for j in urdf.joints:
-        if j.type in ("revolute", "continuous") and j.child in poses and j.axis is not None:
+        if j.type in ROTARY_TYPES and j.child in poses and j.axis is not None:
             axis = poses[j.child][:3, :3] @ np.asarray(j.axis, dtype=float)
             n = float(np.linalg.norm(axis))
             if n > 0 and abs(axis[2]) / n < HORIZONTAL_TOL:

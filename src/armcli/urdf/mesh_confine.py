@@ -3,7 +3,7 @@
 Pinocchio resolves `package://` URIs itself by appending the URI path to every
 search directory it is given, which reaches paths armcli never checked (a
 symlink `pkg/etc/pkg -> /` turns `package://pkg/etc/passwd` into /etc/passwd).
-So armcli resolves each mesh URI itself (checks_meshes.resolve), follows
+So armcli resolves each mesh URI itself (urdf/meshes.py `resolve`), follows
 symlinks, requires the real path to be inside the allowed roots, and then
 rewrites the URDF so that every mesh filename is that absolute real path;
 Pinocchio gets no search directories at all. A package root found by walking

@@ -16,6 +16,7 @@ from lxml import etree
 
 from armcli.errors import InputError, XacroRefusedError
 from armcli.io.userfile import read_regular
+from armcli.spec.joint_types import total_dof
 from armcli.urdf.doc import (
     ZERO3,
     Geometry,
@@ -28,7 +29,6 @@ from armcli.urdf.doc import (
     Pose,
     Shape,
     Urdf,
-    total_dof,
 )
 
 MAX_URDF_BYTES = 10_000_000

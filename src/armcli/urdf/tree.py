@@ -15,7 +15,8 @@ from typing import Any
 from armcli.errors import InputError
 from armcli.io.terminal import wrap_parts
 from armcli.spec.graph import root_links
-from armcli.urdf.doc import JOINT_TYPES, MOVABLE_TYPES, Joint, Urdf, position_bounds
+from armcli.spec.joint_types import JOINT_TYPES, MOVABLE_TYPES, position_bounds
+from armcli.urdf.doc import Joint, Urdf
 from armcli.urdf.read import parse_urdf
 
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 import itertools
 import math
 import random
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -29,10 +29,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from armcli.urdf.boxsearch import minimize_box
-from armcli.urdf.pinocchio import JointRange, joint_ranges
+from armcli.urdf.pinocchio import JointRange, configuration, joint_ranges
 from armcli.urdf.tool import ToolPoint
 
-SAMPLES = 2000  # `check`'s cloud (extremes are refined); `render --reach` draws more
+SAMPLES = 500  # `check`'s cloud: IK seeds and starts (extremes are refined); render draws more
 SAMPLE_SEED = 0
 MAX_CORNERS = 64
 REFINE_FROM = 3  # local searches per extreme, from the best samples
@@ -73,9 +73,10 @@ class ReachPoint:
 class Chain:
     """Forward kinematics of the tool point over the chain's joints, and its Jacobian."""
 
-    def __init__(self, model: Any, tool: ToolPoint) -> None:
-        import pinocchio as pin
-
+    def __init__(
+        self, model: Any, tool: ToolPoint, others: Mapping[str, float] | None = None
+    ) -> None:
+        """`others`: values [rad or m] of joints off the chain (neutral where silent)."""
         if not model.existFrame(tool.link):
             raise ValueError(f"no link {tool.link!r} in the model")
         self.model = model
@@ -93,7 +94,7 @@ class Chain:
             jr for jr in joint_ranges(model) if model.getJointId(jr.name) in ids
         )
         self.iv = [jr.idx_v for jr in self.joints]
-        self.q0 = np.asarray(pin.neutral(model), dtype=float)
+        self.q0 = np.asarray(configuration(model, others or {}), dtype=float)
         self.lower = np.array([jr.lower for jr in self.joints])
         self.upper = np.array([jr.upper for jr in self.joints])
 
@@ -253,3 +254,22 @@ def _ik(chain: Chain, x0: NDArray[np.float64], target: NDArray[np.float64]) -> t
         step = J.T @ np.linalg.solve(J @ J.T + IK_DAMPING**2 * np.eye(3), e)
         x = np.clip(x + step, chain.lower, chain.upper)
     return best_x, best_r
+
+
+def describe(ws: Workspace) -> str:
+    """The envelope in one line, as `check` and `render --reach` print it."""
+    box = " ".join(f"{a:.3f}..{b:.3f}" for a, b in zip(ws.lower, ws.upper, strict=True))
+    return (
+        f"reach of {ws.point} over {', '.join(ws.joints)}: max {ws.max_reach:.3f} m from the "
+        f"shoulder ({', '.join(f'{v:.3f}' for v in ws.shoulder)}), height {ws.min_height:.3f}.."
+        f"{ws.max_height:.3f} m, horizontal {ws.max_horizontal:.3f} m from the root's z axis; "
+        f"box x y z {box} m ({ws.samples} samples, extremes refined)"
+    )
+
+
+def verdict(p: ReachPoint) -> str:
+    """One point's verdict: reachable, or by how much it is missed, and the joints there."""
+    xyz = ", ".join(f"{v:.3f}" for v in p.target)
+    what = "reachable" if p.reachable else f"OUT OF REACH by {p.residual * 1e3:.1f} mm"
+    q = ", ".join(f"{n}={v:.4g}" for n, v in p.q)
+    return f"point ({xyz}): {what} (at {q})"

@@ -20,7 +20,7 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
-from armcli.urdf.doc import position_bounds
+from armcli.spec.joint_types import position_bounds
 from armcli.urdf.mesh_confine import bounded_mesh_file, check_total
 from armcli.urdf.meshes import MeshSearch, confined, resolve
 from armcli.urdf.read import parse_root
@@ -238,11 +238,14 @@ def posed_triangles(urdf: Any, q: Mapping[str, float]) -> tuple[np.ndarray, np.n
     return np.concatenate(tris), np.concatenate(cols)
 
 
-def _draw_view(ax: Any, tris: np.ndarray, cols: np.ndarray, tip: np.ndarray | None) -> None:
+def _draw_view(
+    ax: Any, tris: np.ndarray, cols: np.ndarray, tip: np.ndarray | None, extent: np.ndarray
+) -> None:
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     ax.add_collection3d(Poly3DCollection(tris, facecolors=cols, edgecolors=cols, linewidths=0.3))
-    pts = tris.reshape(-1, 3) if len(tris) else np.zeros((1, 3))
+    pts = np.concatenate([tris.reshape(-1, 3), extent])
+    pts = pts if len(pts) else np.zeros((1, 3))
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     centre, half = (lo + hi) / 2, max(float((hi - lo).max()) / 2, 0.05) * 1.05
     ax.set_xlim(centre[0] - half, centre[0] + half)
@@ -279,8 +282,14 @@ def render_figure(
     tool: ToolPoint | None = None,
     name: str = "robot",
     size: Sequence[int] = DEFAULT_SIZE,
+    overlay: Callable[[Any], None] | None = None,
+    extent: np.ndarray | None = None,
 ) -> Any:
-    """A matplotlib Figure (Agg, not pyplot) of the robot at `q` from the two VIEWS."""
+    """A matplotlib Figure (Agg, not pyplot) of the robot at `q` from the two VIEWS.
+
+    `overlay(ax)` draws more on each view (view.reach: the reachable region); `extent`
+    (n, 3) [m] are more points the views' limits must include.
+    """
     from matplotlib.figure import Figure
 
     tris, cols = posed_triangles(urdf, q)
@@ -289,7 +298,9 @@ def render_figure(
     for i, (title, elev, azim) in enumerate(VIEWS):
         ax = fig.add_subplot(1, len(VIEWS), i + 1, projection="3d", proj_type="ortho")
         ax.view_init(elev=elev, azim=azim)
-        _draw_view(ax, tris, cols, tip)
+        _draw_view(ax, tris, cols, tip, np.zeros((0, 3)) if extent is None else extent)
+        if overlay is not None:
+            overlay(ax)
         if elev == 0.0:  # looking along y: its ticks would collapse onto one spot
             ax.set_yticks([])
             ax.set_ylabel("")
