@@ -154,17 +154,27 @@ def _base_accel(opts: TipOptions, urdf: Urdf) -> tuple[float, str]:
 
 
 def columns(series: zmps.ZmpSeries, res: SimResult, rate: float) -> dict[str, NDArray[Any]]:
-    """States-file columns at the output rate: the point, its margin, the worst with the base."""
+    """States-file columns at the output rate: the point, its margin, the worst with the base.
+
+    A state the series left out (a joint-stop impact: an impulse, no finite acceleration)
+    gets NaN in these columns rather than a made-up point.
+    """
     want = sample_steps(res.steps, res.dt, rate)
-    rows = np.searchsorted(series.step, want)
-    rows = np.minimum(rows, len(series.step) - 1)
-    if not np.array_equal(series.step[rows], want):
-        raise ValueError("the zero-moment point was not computed at the output rate")
+    rows = np.minimum(np.searchsorted(series.step, want), max(len(series.step) - 1, 0))
+    known = series.step[rows] == want if len(series.step) else np.zeros(len(want), dtype=bool)
+
+    def pick(values: NDArray[Any]) -> NDArray[Any]:
+        return (
+            np.where(known, values[rows], np.nan)
+            if len(series.step)
+            else np.full(len(want), np.nan)
+        )
+
     return {
-        COLUMNS[0]: series.zmp[rows, 0, 0],
-        COLUMNS[1]: series.zmp[rows, 0, 1],
-        COLUMNS[2]: series.margin[rows, 0],
-        COLUMNS[3]: np.min(series.margin[rows, 1:], axis=1),
+        COLUMNS[0]: pick(series.zmp[:, 0, 0]),
+        COLUMNS[1]: pick(series.zmp[:, 0, 1]),
+        COLUMNS[2]: pick(series.margin[:, 0]),
+        COLUMNS[3]: pick(np.min(series.margin[:, 1:], axis=1)),
     }
 
 
