@@ -18,3 +18,10 @@ STANDALONE_ARM_URDF = f"{STANDALONE_ARM}.urdf"
 
 DEFAULT_DT = 0.001  # [s] control and simulation step when the spec gives none
 DEFAULT_STATE_RATE_HZ = 10.0  # [Hz] joint-state output without a joint_state_publisher
+
+# Choices and defaults of command options whose `--help` must not import their library.
+ROS_TARGETS = ("humble-classic", "jazzy")  # the course's ROS 2 Humble + Gazebo classic; Jazzy + gz
+COLLISION_SAMPLES = 10_000  # the MoveIt Setup Assistant's default "sampling density"
+MJCF_BASES = ("fixed", "free")  # `export mjcf --base`: root welded to the world, or free
+PD_LOOPS = ("implicit", "explicit")  # `tune --loop`: armcli's simulator, or an explicit torque loop
+ROBUST_MODES = ("worst", "quantile")  # `tune --robust-mode` over the perturbed models

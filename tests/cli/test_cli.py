@@ -31,6 +31,40 @@ def test_help_imports_no_command_module() -> None:
     assert res.stdout.strip().splitlines()[-1] == "LOADED:"
 
 
+HEAVY = ("numpy", "pinocchio", "lxml", "mujoco", "yourdfpy", "matplotlib", "trimesh", "scipy")
+
+
+def test_command_help_imports_nothing_heavy() -> None:
+    """`armcli CMD --help` builds every command's help from typer and help text alone.
+
+    One interpreter per command (a module one command loads would hide another's), all
+    started together: ~0.1 s each.
+    """
+    code = (
+        "import sys\nfrom armcli.cli import main\n"
+        "try:\n    main(sys.argv[1:])\nexcept SystemExit as e:\n    assert e.code in (0, None), e\n"
+        f"heavy = {HEAVY!r}\n"
+        "print('LOADED:' + ','.join(sorted(m for m in sys.modules if m.split('.')[0] in heavy)))"
+    )
+    argvs = [[name, "--help"] for name in COMMANDS] + [["export", "mjcf", "--help"]]
+    procs = {
+        " ".join(argv): subprocess.Popen(
+            [sys.executable, "-c", code, *argv],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        for argv in argvs
+    }
+    loaded = {}
+    for cmd, proc in procs.items():
+        out, err = proc.communicate(timeout=60)
+        assert proc.returncode == 0, (cmd, err)
+        assert "Usage:" in out, cmd
+        loaded[cmd] = out.strip().splitlines()[-1]
+    assert loaded == {cmd: "LOADED:" for cmd in procs}
+
+
 def test_version_and_module_entry_point() -> None:
     from importlib.metadata import version
 

@@ -9,7 +9,6 @@ import typer
 
 from armcli.commands.flags import flag_errors
 from armcli.commands.options import spec_argument
-from armcli.compiler.expand import build, check_fresh
 from armcli.spec.discover import find_spec
 
 
@@ -27,6 +26,8 @@ def build_cmd(
     ),
 ) -> None:
     """Compile SPEC into the course's xacro set and the expanded URDFs."""
+    from armcli.compiler.expand import build, check_fresh  # on use: `--help` stays light
+
     spec = find_spec(spec)
     if check:
         check_fresh(spec, out)

@@ -5,15 +5,10 @@ from __future__ import annotations
 import math
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
-from armcli.check import report
-from armcli.check.inputs import CheckRun, run_check
-from armcli.check.report import counts
-from armcli.check.rules import RULES, CheckOptions, TipoverOptions, apply_policy, unknown_rules
-from armcli.check.sarif import to_sarif
 from armcli.commands.options import choice
 from armcli.commands.points import REACH_POINT_HELP, point_option
 from armcli.commands.xacro_inputs import (
@@ -33,8 +28,11 @@ from armcli.errors import (
 )
 from armcli.io import terminal
 from armcli.spec.discover import find_spec
-from armcli.spec.load import load_spec
-from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+
+if TYPE_CHECKING:  # the checker is imported when the command runs: `--help` stays light
+    from armcli.check.inputs import CheckRun
+    from armcli.check.rules import TipoverOptions
 
 FORMATS = ("table", "json", "github", "sarif")
 PAYLOAD_LINK_HELP = "Link carrying --payload at its origin (default: the tool point)."
@@ -56,6 +54,8 @@ def tipover_options(
     reach_points: list[str],
 ) -> TipoverOptions:
     """The balance and reach options, refused here when they are not usable numbers."""
+    from armcli.check.rules import TipoverOptions
+
     for flag, x in (("--payload", payload), ("--min-margin", min_margin),
                     ("--base-accel", 0.0 if base_accel is None else base_accel)):  # fmt: skip
         if not (math.isfinite(x) and x >= 0):
@@ -104,6 +104,12 @@ def check_cmd(
     reach_point: list[str] = typer.Option([], "--reach-point", help=REACH_POINT_HELP),
 ) -> None:
     """Check robot descriptions for physical sanity; exit 1 on error findings."""
+    from armcli.check import report
+    from armcli.check.inputs import run_check
+    from armcli.check.report import counts
+    from armcli.check.rules import RULES, CheckOptions, apply_policy, unknown_rules
+    from armcli.spec.load import load_spec
+
     unknown = unknown_rules(ignore)
     if unknown:
         raise InputError(f"unknown rule(s) {unknown}; known: {', '.join(RULES)}", field="--ignore")
@@ -135,6 +141,9 @@ def check_cmd(
 
 
 def _print(run: CheckRun, findings: list[Any], fmt: str, code: int) -> None:
+    from armcli.check import report
+    from armcli.check.sarif import to_sarif
+
     unusable = [(u.file, u.error.message) for u in run.unusable]
     if fmt == "json":
         sys.stdout.write(report.to_json(run.results, findings, code, unusable))

@@ -18,7 +18,7 @@ from armcli.commands.xacro_inputs import (
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
 from armcli.io.outdir import check_output_file
-from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, expand_xacro, trust_mode
+from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 
 def expand_cmd(
@@ -36,6 +36,8 @@ def expand_cmd(
 
     The arguments used and the defaults taken are reported on stderr.
     """
+    from armcli.urdf.source import expand_xacro  # on use: `--help` imports no numpy or lxml
+
     robot, tokens = split_robot(file, args)
     if robot is None:
         raise InputError("give the xacro file before its NAME:=VALUE arguments", field="FILE")

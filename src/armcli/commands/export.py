@@ -16,14 +16,10 @@ from armcli.commands.xacro_inputs import (
     write_notes,
     xacro_inputs,
 )
-from armcli.compiler.expand import spec_label
-from armcli.export.mjcf import BASES
-from armcli.export.mjcf_files import export_mjcf
-from armcli.export.mjcf_meshes import MESH_DIR
-from armcli.export.mjcf_scene import SCENE
+from armcli.defaults import MJCF_BASES
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
-from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 export_app = typer.Typer(
     help="Export the robot to other simulators' formats.", no_args_is_help=True
@@ -48,7 +44,7 @@ def mjcf_cmd(
     ),
     base: str = choice(
         "fixed",
-        BASES,
+        MJCF_BASES,
         "--base",
         help="fixed (default): the root link is welded to the world; free: on a free joint.",
     ),
@@ -65,6 +61,9 @@ def mjcf_cmd(
     Joints with spec gains get `position` actuators (kp = Kp, kv = Kd, force range =
     the effort limit); the report lists what MuJoCo cannot represent.
     """
+    from armcli.compiler.expand import spec_label  # on use: `--help` stays light
+    from armcli.export.mjcf_files import export_mjcf
+
     check_output_file(out, "--out")  # before any work: nothing else is written
     robot, tokens = split_robot(robot, args)
     inputs = xacro_inputs(tokens, env, package_dir)
@@ -93,6 +92,9 @@ def mjcf_cmd(
 
 def wrote_line(out: Path, meshes: int) -> str:
     """Which files the export wrote, by name: the model, its scene, and the mesh count."""
+    from armcli.export.mjcf_meshes import MESH_DIR
+    from armcli.export.mjcf_scene import SCENE
+
     scene = out.parent / SCENE
     if not meshes:
         return f"wrote {out} and {scene}"

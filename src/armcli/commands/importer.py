@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
@@ -17,10 +18,10 @@ from armcli.commands.xacro_inputs import (
 )
 from armcli.defaults import SPEC_FILE
 from armcli.errors import InputError
-from armcli.importer.file import import_file
-from armcli.importer.run import ImportResult
-from armcli.tune.spec_start import spec_start_gains
-from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+
+if TYPE_CHECKING:  # the importer is imported when the command runs: `--help` stays light
+    from armcli.importer.run import ImportResult
 
 
 def report(result: ImportResult, source: Path, out: Path) -> str:
@@ -68,6 +69,9 @@ def import_cmd(
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Import a URDF or xacro file into a spec that builds the same URDF back."""
+    from armcli.importer.file import import_file
+    from armcli.tune.spec_start import spec_start_gains
+
     stray = [a for a in args or [] if ":=" not in a]
     if stray:
         raise InputError(f"unexpected argument {stray[0]!r}: expected NAME:=VALUE", field="ARGS")

@@ -13,9 +13,7 @@ from armcli.commands.flags import flag_errors
 from armcli.commands.importer import report
 from armcli.commands.xacro_inputs import write_notes
 from armcli.defaults import SPEC_FILE, TRAJECTORY_DIR
-from armcli.importer.file import import_file
 from armcli.spec.scaffold import DEFAULT_TEMPLATE, TEMPLATES, init_project
-from armcli.tune.spec_start import spec_start_gains
 
 
 @flag_errors({"template": "--template"})
@@ -38,6 +36,9 @@ def init_cmd(
 ) -> None:
     """Write an example spec (armcli.yaml), its trajectories and a README; never overwrites."""
     if source is not None:
+        from armcli.importer.file import import_file  # on use: `--help` stays light
+        from armcli.tune.spec_start import spec_start_gains
+
         directory.mkdir(parents=True, exist_ok=True)
         out = directory / SPEC_FILE
         result, notes = import_file(source, out, gains=spec_start_gains)

@@ -9,6 +9,7 @@ from pathlib import Path
 import typer
 
 from armcli.commands.flags import flag_errors
+from armcli.commands.help_text import ROBOT_HELP
 from armcli.commands.options import spec_argument
 from armcli.commands.points import REACH_POINT_HELP, point_option
 from armcli.commands.xacro_inputs import (
@@ -23,10 +24,7 @@ from armcli.errors import InputError
 from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
-from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
-from armcli.urdf.workspace import describe, verdict
-from armcli.view.png import MESH_HINT, load_urdf, render_png
-from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
+from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 REACH_HELP = (
     "Also draw where the tool point can reach within the joint limits (sampled forward "
@@ -75,6 +73,10 @@ def render_cmd(
     reach_point: list[str] = typer.Option([], "--reach-point", help=REACH_POINT_HELP),
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
+    from armcli.urdf.workspace import describe, verdict  # on use: `--help` stays light
+    from armcli.view.png import MESH_HINT, load_urdf, render_png
+    from armcli.view.scene import load_robot, pose_q
+
     check_output_file(out, "--out")  # before any work: nothing else is written
     targets = [point_option(p, "--reach-point") for p in reach_point]
     robot, tokens = split_robot(robot, args)

@@ -9,9 +9,7 @@ import typer
 
 from armcli.commands.flags import flag_errors
 from armcli.commands.options import choice, option, out_option, spec_argument
-from armcli.compiler.expand import spec_label
-from armcli.ros.collision_matrix import DEFAULT_SAMPLES
-from armcli.ros.packages import DEFAULT_TARGET, TARGETS, PackageInfo, write_ros_packages
+from armcli.defaults import COLLISION_SAMPLES, ROS_TARGETS
 from armcli.spec.discover import find_spec
 
 TARGET_HELP = (
@@ -26,7 +24,7 @@ def ros_package_cmd(
     spec: Path | None = spec_argument(),
     out: Path = out_option(Path("ros"), "Output directory"),
     samples: int = option(
-        DEFAULT_SAMPLES,
+        COLLISION_SAMPLES,
         "--samples",
         min=1,
         max=MAX_SAMPLES,
@@ -38,12 +36,15 @@ def ros_package_cmd(
     maintainer: str = option("armcli", "--maintainer", help="package.xml maintainer"),
     email: str = option("armcli@example.com", "--email", help="Maintainer e-mail"),
     license_: str = option("TODO", "--license", help="package.xml license"),
-    target: str = choice(DEFAULT_TARGET, TARGETS, "--target", help=TARGET_HELP),
+    target: str = choice(ROS_TARGETS[0], ROS_TARGETS, "--target", help=TARGET_HELP),
     force: bool = option(
         False, "--force", help="Write into an existing non-empty directory armcli did not create."
     ),
 ) -> None:
     """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
+    from armcli.compiler.expand import spec_label  # on use: `--help` stays light
+    from armcli.ros.packages import PackageInfo, write_ros_packages
+
     spec = find_spec(spec)
     info = PackageInfo(maintainer=maintainer, email=email, license=license_)
     pkgs, written = write_ros_packages(

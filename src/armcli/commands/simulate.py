@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 import time
 from pathlib import Path
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import typer
 
@@ -24,13 +24,12 @@ from armcli.io import terminal
 from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
 from armcli.io.together import write_files_together
-from armcli.sim import job as simjob
-from armcli.sim import report as simreport
-from armcli.sim import states, tipping
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
-from armcli.sim.plot import tracking_png
-from armcli.sim.tipping import TipOptions
-from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+
+if TYPE_CHECKING:  # the simulator is imported when the command runs: `--help` stays light
+    from armcli.sim import job as simjob
+    from armcli.sim import tipping
 
 INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
 GRAVITY_HELP = "Add g(q) to the PD torque (default: the spec's control.gravity_compensation)."
@@ -93,6 +92,8 @@ def simulate_cmd(
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
     from armcli.check.rules import unknown_rules
+    from armcli.sim import states, tipping
+    from armcli.sim.tipping import TipOptions
 
     unknown = unknown_rules(ignore)
     if unknown:
@@ -147,6 +148,7 @@ def _prepare(
     A model `check` reports as an error is not simulated (same rule ids), unless ignored.
     """
     from armcli.check.gate import refuse_check_errors
+    from armcli.sim import job as simjob
 
     def gate(doc: Any) -> None:
         refuse_check_errors(doc, ignore=ignore)
@@ -190,6 +192,11 @@ def _run(
     With a robot standing on a base (`tip`), also its zero-moment point: in the states
     file, the plot's fourth row and the summary; a run that tips it over exits 1.
     """
+    from armcli.sim import job as simjob
+    from armcli.sim import report as simreport
+    from armcli.sim import states, tipping
+    from armcli.sim.plot import tracking_png
+
     err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
     write_notes([*job.notes, *(notes or [])])
     for w in job.trajectory.warnings:

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import typer
 
+from armcli.commands.help_text import ROBOT_HELP
 from armcli.commands.options import choice, spec_argument
 from armcli.commands.xacro_inputs import (
     args_argument,
@@ -22,9 +23,7 @@ from armcli.io import terminal
 from armcli.io.files import write_file_atomic
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
-from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
-from armcli.urdf.tree import parse_tree, to_dot, to_rich
-from armcli.view.scene import ROBOT_HELP, load_robot
+from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 TREE_FORMATS = ("text", "dot")
 
@@ -42,6 +41,9 @@ def tree_cmd(
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Print the kinematic tree: links, and joints with their types and limits."""
+    from armcli.urdf.tree import parse_tree, to_dot, to_rich  # on use: `--help` stays light
+    from armcli.view.scene import load_robot
+
     if fmt not in TREE_FORMATS:
         raise InputError(f"unknown format {fmt!r}; known: text, dot", field="--format")
     if out is not None:

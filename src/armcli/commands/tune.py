@@ -4,27 +4,24 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
 from armcli.commands.flags import flag_errors, option_flags
 from armcli.commands.options import choice, option, spec_argument
+from armcli.defaults import PD_LOOPS, ROBUST_MODES
 from armcli.errors import InputError
 from armcli.io import terminal
 from armcli.io.outdir import check_output_file
-from armcli.io.together import write_files_together
 from armcli.spec.discover import find_spec
-from armcli.spec.load import load_spec
-from armcli.tune import gains as gain_vector
-from armcli.tune import job as tjob
-from armcli.tune import report, session
-from armcli.tune.engine import Engine, make_engine
-from armcli.tune.model_gains import LOOPS
-from armcli.tune.plot import tune_png
-from armcli.tune.problem import nominal_arm
-from armcli.tune.search import ROBUST_MODES, SearchOptions, validate
-from armcli.tune.write import check_writable, edited_spec
+
+if TYPE_CHECKING:  # the tuner is imported when the command runs: `--help` stays light
+    from armcli.tune import job as tjob
+    from armcli.tune import session
+    from armcli.tune.engine import Engine
+    from armcli.tune.search import SearchOptions
+
 
 TRAJECTORY_HELP = (
     "JointTrajectory YAML (repeatable; default: trajectories/*.yaml next to the spec, "
@@ -40,15 +37,21 @@ TRUST_SCHEDULER_HELP = (
     "Allow a plain tcp:// scheduler on another host: the Dask client unpickles what the "
     "cluster sends, so it runs code in armcli (docs/security.md)."
 )
-# The library's names for what these flags set (errors name them; commands.flags maps back).
-FLAGS = {
-    **option_flags(SearchOptions, robust="--robust-mode"),
-    **option_flags(tjob.TuneSettings),
-    "jobs": "--jobs",
-    "scheduler": "--scheduler",
-    "joints": "--joints",
-    "trajectories": "--trajectory",
-}
+
+
+def flags() -> dict[str, str]:
+    """The library's names for what these flags set (errors name them; commands.flags maps back)."""
+    from armcli.tune import job as tjob
+    from armcli.tune.search import SearchOptions
+
+    return {
+        **option_flags(SearchOptions, robust="--robust-mode"),
+        **option_flags(tjob.TuneSettings),
+        "jobs": "--jobs",
+        "scheduler": "--scheduler",
+        "joints": "--joints",
+        "trajectories": "--trajectory",
+    }
 
 
 def _pair(text: str, name: str) -> tuple[float, float]:
@@ -60,12 +63,11 @@ def _pair(text: str, name: str) -> tuple[float, float]:
     return a, b
 
 
-@flag_errors(FLAGS)
 def tune_cmd(
     spec: Path | None = spec_argument(),
     trajectory: list[Path] = option(None, "--trajectory", "-t", help=TRAJECTORY_HELP),
     joints: str = option(None, "--joints", help="Comma-separated joints; others locked."),
-    loop: str = choice("implicit", LOOPS, "--loop", help=LOOP_HELP),
+    loop: str = choice("implicit", PD_LOOPS, "--loop", help=LOOP_HELP),
     zeta: float = option(1.0, "--zeta", help="Damping ratio of the start gains"),
     wn: float = option(
         None, "--wn", help="Target natural frequency [rad/s] (default: 2π·rate/10)."
@@ -88,37 +90,44 @@ def tune_cmd(
     write: bool = option(False, "--write", help="Update control.gains in the spec in place."),
 ) -> None:
     """Tune PD gains: model-based start, then a seeded search over simulated rollouts."""
-    spec_path = find_spec(spec)
-    opts = SearchOptions(trials, batch, seed, span, robust_mode, quantile)
-    validate(opts)
-    if output is not None and output.suffix.lower() != ".json":
-        raise InputError("the output file must end in .json", field="--output")
-    for path, name in ((output, "--output"), (plot, "--plot")):
-        if path is not None:
-            check_output_file(path, name)  # before the search: no partial outputs
-    if write:
-        check_writable(spec_path)
-    settings = tjob.TuneSettings(
-        tuple(j.strip() for j in joints.split(",") if j.strip()) if joints else None,
-        loop,
-        zeta,
-        wn,
-        settle,
-        robust,
-        _pair(mass_scale, "--mass-scale"),
-        _pair(friction_scale, "--friction-scale"),
-        seed,
-    )
-    job = tjob.prepare(load_spec(spec_path), spec_path, trajectory or [], settings)
-    engine = make_engine(
-        jobs if jobs is not None else (os.cpu_count() or 1),
-        scheduler,
-        trust_scheduler=trust_scheduler,
-    )
-    try:
-        _run(job, engine, opts, output, plot, write, spec_path)
-    finally:
-        engine.close()
+    from armcli.spec.load import load_spec  # on use: `--help` stays light
+    from armcli.tune import job as tjob
+    from armcli.tune.engine import make_engine
+    from armcli.tune.search import SearchOptions, validate
+    from armcli.tune.write import check_writable
+
+    with flag_errors(flags()):
+        spec_path = find_spec(spec)
+        opts = SearchOptions(trials, batch, seed, span, robust_mode, quantile)
+        validate(opts)
+        if output is not None and output.suffix.lower() != ".json":
+            raise InputError("the output file must end in .json", field="--output")
+        for path, name in ((output, "--output"), (plot, "--plot")):
+            if path is not None:
+                check_output_file(path, name)  # before the search: no partial outputs
+        if write:
+            check_writable(spec_path)
+        settings = tjob.TuneSettings(
+            tuple(j.strip() for j in joints.split(",") if j.strip()) if joints else None,
+            loop,
+            zeta,
+            wn,
+            settle,
+            robust,
+            _pair(mass_scale, "--mass-scale"),
+            _pair(friction_scale, "--friction-scale"),
+            seed,
+        )
+        job = tjob.prepare(load_spec(spec_path), spec_path, trajectory or [], settings)
+        engine = make_engine(
+            jobs if jobs is not None else (os.cpu_count() or 1),
+            scheduler,
+            trust_scheduler=trust_scheduler,
+        )
+        try:
+            _run(job, engine, opts, output, plot, write, spec_path)
+        finally:
+            engine.close()
 
 
 def _run(
@@ -132,6 +141,13 @@ def _run(
 ) -> None:
     from rich.console import Console
     from rich.progress import Progress
+
+    from armcli.io.together import write_files_together
+    from armcli.tune import gains as gain_vector
+    from armcli.tune import report, session
+    from armcli.tune.plot import tune_png
+    from armcli.tune.problem import nominal_arm
+    from armcli.tune.write import edited_spec
 
     out = terminal.console()
     out.print(report.reasoning_table(job.start), crop=False)
@@ -162,6 +178,7 @@ def _run(
 
 
 def _summary(out: Any, outcome: session.Outcome) -> None:
+    from armcli.tune import session
 
     tuned = outcome.row("tuned")
     parts = []

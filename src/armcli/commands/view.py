@@ -8,6 +8,7 @@ from pathlib import Path
 import typer
 
 from armcli.commands.flags import flag_errors
+from armcli.commands.help_text import ROBOT_HELP
 from armcli.commands.options import spec_argument
 from armcli.commands.xacro_inputs import (
     args_argument,
@@ -18,13 +19,8 @@ from armcli.commands.xacro_inputs import (
     xacro_inputs,
 )
 from armcli.errors import InputError
-from armcli.sim import rosbag
-from armcli.sim.states import load_replay
 from armcli.spec.discover import find_spec
-from armcli.urdf.source import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
-from armcli.view.browser import Viewer
-from armcli.view.png import joint_limits, load_urdf
-from armcli.view.scene import ROBOT_HELP, load_robot, pose_q
+from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 
 @flag_errors({"pose": "--pose", "q": "--q", "port": "--port", "replay": "--replay"})
@@ -48,6 +44,12 @@ def view_cmd(
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Open a browser 3-D viewer with joint sliders, named poses and simulation replay."""
+    from armcli.sim import rosbag  # on use: `--help` stays light
+    from armcli.sim.states import load_replay
+    from armcli.view.browser import Viewer
+    from armcli.view.png import joint_limits, load_urdf
+    from armcli.view.scene import load_robot, pose_q
+
     robot, tokens = split_robot(robot, args)
     inputs = xacro_inputs(tokens, env, package_dir)
     src = load_robot(

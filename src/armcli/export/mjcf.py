@@ -28,6 +28,7 @@ from pathlib import Path
 from lxml import etree
 
 from armcli.compiler.xmlfmt import fmt, to_bytes, vec
+from armcli.defaults import MJCF_BASES
 from armcli.errors import InputError
 from armcli.export import mjcf_parts as parts
 from armcli.export.mjcf_mass import FromGeometry, Node, Plan, plan_masses, write_inertial
@@ -38,7 +39,7 @@ from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Joint, Link, Pose, Shape, Urdf
 from armcli.urdf.read import parse_root
 
-BASES = ("fixed", "free")
+BASES = MJCF_BASES
 FREE_JOINT = "root"
 INTEGRATOR = "implicitfast"
 LIMIT_STEPS = 2.0  # solreflimit time constant in time steps: MuJoCo's floor (refsafe)

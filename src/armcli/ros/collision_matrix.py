@@ -20,13 +20,14 @@ from typing import Any
 
 import numpy as np
 
+from armcli.defaults import COLLISION_SAMPLES
 from armcli.errors import BuildError, InputError
 from armcli.urdf.doc import Urdf
 from armcli.urdf.mimic import Mimic, follow, mimics
 from armcli.urdf.pinocchio import load_model
 from armcli.urdf.read import parse_urdf
 
-DEFAULT_SAMPLES = 10_000  # the Setup Assistant's default "sampling density"
+DEFAULT_SAMPLES = COLLISION_SAMPLES
 DEFAULT_SEED = 0
 REASONS = ("Adjacent", "Default", "Never")
 

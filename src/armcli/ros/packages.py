@@ -23,7 +23,7 @@ from armcli.compiler.expand import expand_urdfs
 from armcli.compiler.massprops import MAX_MESH_BYTES
 from armcli.compiler.meshfiles import MeshNames, package_meshes, package_of, spec_mesh_names
 from armcli.compiler.xacro_writer import GENERATED, STANDALONE_ARM, top_level_files, xacro_files
-from armcli.defaults import STANDALONE_ARM_URDF
+from armcli.defaults import ROS_TARGETS, STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.io.files import write_tree_atomic
 from armcli.io.outdir import resolve_output_dir
@@ -63,7 +63,7 @@ MOVEIT_DEPENDS = [
     "moveit_planners", "moveit_ros_move_group", "moveit_ros_visualization",
     "moveit_simple_controller_manager", "robot_state_publisher", "rviz2", "tf2_ros", "xacro",
 ]  # fmt: skip
-TARGETS = ("humble-classic", "jazzy")  # the course's ROS 2 Humble + Gazebo classic; Jazzy + gz
+TARGETS = ROS_TARGETS
 DEFAULT_TARGET = TARGETS[0]
 MOVEIT_LAUNCHES = {  # launch file -> (moveit_configs_utils generator, what it starts)
     "demo.launch.py": ("generate_demo_launch", "MoveIt demo on mock hardware with RViz."),

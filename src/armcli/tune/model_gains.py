@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from armcli.defaults import PD_LOOPS
 from armcli.errors import InputError
 from armcli.sim import stability as stab
 from armcli.sim.simulate import Arm, configuration
@@ -40,7 +41,7 @@ RANDOM_SAMPLES = 100
 SAMPLE_SEED = 0
 WN_BRACKET = (1e-6, 1e9)  # [rad/s] search interval for the stability cap
 SCALE_FLOOR = 1e-9  # smallest common kp scale the coupled check tries
-LOOPS = ("implicit", "explicit")
+LOOPS = PD_LOOPS
 
 
 @dataclass(frozen=True)

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from armcli.defaults import ROBUST_MODES
 from armcli.errors import InputError
 from armcli.tune import gains as gain_vector
 from armcli.tune.engine import Engine
@@ -25,7 +26,6 @@ from armcli.tune.objective import Weights, aggregate
 from armcli.tune.problem import TuneProblem
 
 ROUND_DIGITS = 4  # significant digits of the reported (and written) gains
-ROBUST_MODES = ("worst", "quantile")
 
 
 @dataclass(frozen=True)

@@ -17,8 +17,7 @@ from __future__ import annotations
 import os
 from collections.abc import Iterable, Mapping
 from pathlib import Path
-
-from lxml import etree
+from typing import TYPE_CHECKING
 
 from armcli.errors import InputError
 from armcli.io.userfile import check_regular, read_regular
@@ -26,9 +25,19 @@ from armcli.io.userfile import check_regular, read_regular
 MAX_MESH_BYTES = 20_000_000  # one mesh file; a 50 MB STL took 51 s and 1.6 GB to render
 MAX_MESH_TOTAL_BYTES = 100_000_000  # all mesh files of one robot
 MAX_PACKAGE_XML_BYTES = 1_000_000
-_SAFE_XML = etree.XMLParser(
-    resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False
-)
+
+if TYPE_CHECKING:
+    from lxml import etree
+
+
+def _safe_xml() -> etree.XMLParser:
+    """A parser without entities, DTDs or network access.
+
+    lxml is imported on use: package lookup sits on every command's path, `--help` included.
+    """
+    from lxml import etree
+
+    return etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False)
 
 
 def package_xml_name(directory: Path) -> str | None:
@@ -36,8 +45,10 @@ def package_xml_name(directory: Path) -> str | None:
     path = directory / "package.xml"
     if not path.is_file():
         return None
+    from lxml import etree
+
     try:
-        root = etree.fromstring(read_regular(path, max_bytes=MAX_PACKAGE_XML_BYTES), _SAFE_XML)
+        root = etree.fromstring(read_regular(path, max_bytes=MAX_PACKAGE_XML_BYTES), _safe_xml())
     except (InputError, etree.XMLSyntaxError):
         return None
     name = root.findtext("name") if root is not None else None
@@ -87,7 +98,9 @@ def with_real_mesh_paths(xml: bytes, real: Mapping[str, Path]) -> str:
     `real` maps every mesh URI of the document to its confined real path; a URI
     missing from it is an error rather than something a parser may resolve.
     """
-    root = etree.fromstring(xml, _SAFE_XML)
+    from lxml import etree
+
+    root = etree.fromstring(xml, _safe_xml())
     for mesh in root.iter("mesh"):
         uri = mesh.get("filename", "")
         if uri not in real:

@@ -15,7 +15,7 @@ import os
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING
 
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import EXPANDED_TAG, InputError, XacroRefusedError
@@ -23,6 +23,7 @@ from armcli.urdf.doc import Urdf
 from armcli.urdf.packages import inside, real_roots
 from armcli.urdf.pinocchio import LoadedModel, load_model, parser_problems
 from armcli.urdf.read import parse_urdf, read_urdf
+from armcli.urdf.trust import Trust as Trust  # re-exported: read_robot and callers share it
 from armcli.urdf.xacro_args import Expansion, XacroInputs
 
 if TYPE_CHECKING:
@@ -30,19 +31,7 @@ if TYPE_CHECKING:
 
 SPEC_SUFFIXES = (".yaml", ".yml")
 XACRO_SUFFIX = ".xacro"
-TRUST_XACRO_HELP = (
-    "Expand a foreign xacro file with xacro itself, which runs Python from the file, inside "
-    "a bubblewrap sandbox (--trust-xacro=unsandboxed: resource limits only). Without it, "
-    "xacro files are expanded in safe mode, where no code from the file runs."
-)
-UNSANDBOXED_HELP = "Same as --trust-xacro=unsandboxed: xacro itself with resource limits only."
 TRUSTED_ENV_REFUSED = ("LD_", "PYTHON")  # --env names that would change how the child runs
-Trust = bool | Literal["unsandboxed"]  # --trust-xacro: False, True (sandboxed), "unsandboxed"
-
-
-def trust_mode(trust_xacro: bool, unsandboxed: bool) -> Trust:
-    """The --trust-xacro / --trust-xacro=unsandboxed options as one value."""
-    return "unsandboxed" if unsandboxed else trust_xacro
 
 
 _PROBLEM = {

@@ -18,11 +18,6 @@ from armcli.urdf.tool import ToolPoint, tool_point
 from armcli.urdf.tree import tree_from_urdf
 from armcli.urdf.xacro_args import XacroInputs
 
-ROBOT_HELP = (
-    "Robot spec YAML, URDF file, or xacro file (expanded in safe mode); "
-    "default: ./armcli.yaml, else the spec in specs/."
-)
-
 
 @dataclass(frozen=True)
 class RobotSource:
