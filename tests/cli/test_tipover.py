@@ -78,6 +78,7 @@ def test_check_trajectory_flags_the_variant_and_passes_the_seed(
     (f,) = robot["findings"]
     assert f["rule"] == "zmp-outside-support" and f["severity"] == "error"
     assert f["values"]["margin"] < 0 and f["values"]["direction"] == "rear"
+    assert f["spec"]["field"] == "mobile_base.diff_drive.max_wheel_acceleration"  # the line added
     holds = f["fix"]["max_wheel_acceleration"]
     assert SEED_ACCEL < holds < TIPPING_ACCEL  # the fix: an acceleration that holds
     assert robot["summary"]["zmp"]["max_base_accel"] >= holds

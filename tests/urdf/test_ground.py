@@ -88,3 +88,22 @@ def test_an_arm_on_a_table_has_no_wheels() -> None:
     assert g is not None and not has_wheels(g)
     (base,) = g.contacts  # the upright cylinder's bottom rim
     assert base.link == "base" and len(base.points) == 32
+
+
+def test_a_wrist_hanging_below_a_bolted_arm_is_no_wheel() -> None:
+    """example-robot-data's UR5 at zero: its wrist links hang below the base's bottom and
+    turn about horizontal axes, behind the arm's joints; the arm is still bolted down."""
+    xml = """<robot name="arm"><link name="base"><collision><origin xyz="0 0 0.05"/>
+      <geometry><cylinder radius="0.1" length="0.1"/></geometry></collision></link>
+      <link name="upper"><collision><origin xyz="0.2 0 0"/><geometry><box size="0.4 0.05 0.05"/>
+      </geometry></collision></link><joint name="shoulder" type="revolute"><parent link="base"/>
+      <child link="upper"/><origin xyz="0 0 0.1"/><axis xyz="0 0 1"/>
+      <limit lower="-3" upper="3" effort="10" velocity="1"/></joint>
+      <link name="wrist"><collision><origin rpy="1.5707963 0 0"/><geometry>
+      <cylinder radius="0.05" length="0.05"/></geometry></collision></link>
+      <joint name="wrist_joint" type="revolute"><parent link="upper"/><child link="wrist"/>
+      <origin xyz="0.4 0 -0.06"/><axis xyz="0 1 0"/>
+      <limit lower="-3" upper="3" effort="10" velocity="1"/></joint></robot>"""
+    g = ground_of(xml)
+    assert g is not None and {c.link for c in g.contacts} == {"wrist"}  # lowest: 1 cm below
+    assert not has_wheels(g)

@@ -47,6 +47,9 @@ _CHILD_KEYS: dict[str, tuple[str, ...]] = {
     "calibration": ("calibration",),
 }
 _PD_RULE_PREFIX = "pd-"
+# check/tipover.py and check/zmp.py: about a pose or the base's drive, not a URDF element
+_BALANCE_RULES = frozenset({"com-outside-support", "support-margin", "zmp-outside-support",
+                            "zmp-margin"})  # fmt: skip
 
 
 def _element_at(root: Any, line: int) -> Any:
@@ -113,6 +116,16 @@ def _refine(path: Path_, f: Finding, doc: YamlDoc) -> Path_:
     return path
 
 
+def _balance_path(f: Finding, doc: YamlDoc) -> Path_ | None:
+    """Balance findings are about the pose named, or the diff drive's acceleration limit."""
+    pose = f.values.get("pose")
+    paths: list[Path_] = [("poses", str(pose))] if pose is not None else []
+    drive = ("mobile_base", "diff_drive")
+    if "max_wheel_acceleration" in f.fix:
+        paths += [(*drive, "max_wheel_acceleration"), drive]
+    return next((p for p in paths if p in doc.lines), None)
+
+
 def _pd_path(f: Finding, doc: YamlDoc) -> Path_ | None:
     """PD findings are about the gains (of the joint named, if one is) or the time step."""
     joint = f.values.get("joint")
@@ -125,6 +138,8 @@ def spec_path(f: Finding, root: Any, doc: YamlDoc) -> Path_ | None:
     """The spec field a finding in the URDF `root` (lxml tree of the generated text) is about."""
     if f.rule.startswith(_PD_RULE_PREFIX):
         return _pd_path(f, doc)
+    if f.rule in _BALANCE_RULES:
+        return _balance_path(f, doc)
     el = _element_at(root, f.line) if f.line else None
     if el is None:
         return None

@@ -52,7 +52,7 @@ def report(result: ImportResult, source: Path, out: Path) -> str:
 def import_cmd(
     file: Path = typer.Argument(..., help="URDF or xacro file to import."),
     args: list[str] = typer.Argument(
-        None, help="xacro arguments NAME:=VALUE (with --trust-xacro)."
+        None, help="xacro arguments NAME:=VALUE (safe mode or --trust-xacro)."
     ),
     out: Path = option(SPEC_FILE, "-o", "--out", help="Spec file to write"),
     arm_root: str | None = option(

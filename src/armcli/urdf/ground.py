@@ -129,10 +129,27 @@ def link_poses(model: Any, names: Collection[str]) -> dict[str, NDArray[np.float
 
 
 def _rolling_links(urdf: Urdf, poses: dict[str, NDArray[np.float64]]) -> set[str]:
-    """Links turned by a revolute or continuous joint about a horizontal axis (wheels)."""
+    """Links turned by a revolute or continuous joint about a horizontal axis (wheels).
+
+    The joint's parent must be the base: joined to the root by fixed joints only. A wrist
+    that hangs below a bolted arm's base at the neutral pose (example-robot-data's UR5)
+    turns about a horizontal axis too, but behind moving joints: it is not a wheel.
+    """
+    by_child = {j.child: j for j in urdf.joints if j.child is not None}
+
+    def on_base(link: str | None) -> bool:
+        seen: set[str] = set()
+        while link is not None and link in by_child and link not in seen:
+            seen.add(link)
+            up = by_child[link]
+            if up.type != "fixed":
+                return False
+            link = up.parent
+        return True
+
     out = set()
     for j in urdf.joints:
-        if j.type in ROTARY_TYPES and j.child in poses and j.axis is not None:
+        if j.type in ROTARY_TYPES and j.child in poses and j.axis is not None and on_base(j.parent):
             axis = poses[j.child][:3, :3] @ np.asarray(j.axis, dtype=float)
             n = float(np.linalg.norm(axis))
             if n > 0 and abs(axis[2]) / n < HORIZONTAL_TOL:
