@@ -6,7 +6,6 @@ from __future__ import annotations
 import json
 import os
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -98,7 +97,13 @@ def test_clean_file_passes(tmp_path: Path) -> None:
 
 def test_strict_and_extra_args(tmp_path: Path) -> None:
     repo = consumer_repo(tmp_path)
-    shutil.copy(ROOT / "urdf" / "standalone_arm.urdf", repo / "arm.urdf")  # root-inertia warning
+    # the standalone arm without its massless `world` root: a root-inertia warning
+    text = (ROOT / "urdf" / "standalone_arm.urdf").read_text()
+    text, n = re.subn(
+        r'  <link name="world"/>\n  <joint name="world_joint".*?</joint>\n', "", text, flags=re.S
+    )
+    assert n == 1
+    (repo / "arm.urdf").write_text(text)
     r, _ = run_action(repo, paths="arm.urdf", strict="true")
     assert r.returncode == 1 and r.stdout.startswith("::error file=arm.urdf,")
     r, _ = run_action(repo, paths="arm.urdf", strict="true", args="--ignore root-inertia")

@@ -53,15 +53,9 @@ def test_template_is_consistent(template: str) -> None:
         assert set(yaml.safe_load(f.read_text())["joint_names"]) <= arm_joints, f.name
 
 
-# The course's standalone arm keeps the course's layout: its root arm_base_link has 0.5 kg,
-# which KDL ignores (root-inertia, a warning that --strict makes an error). Issue 23.
-COURSE_ROOT_INERTIA = pytest.mark.xfail(strict=True, reason="root-inertia on standalone_arm")
-
-
-@pytest.mark.parametrize(
-    "template",
-    [pytest.param(t, marks=COURSE_ROOT_INERTIA) if t == "course" else t for t in sorted(TEMPLATES)],
-)
+# The course's standalone arm (root arm_base_link, 0.5 kg) hangs from a massless `world`
+# link, so it too checks clean: no root-inertia (issue 23).
+@pytest.mark.parametrize("template", sorted(TEMPLATES))
 def test_a_new_project_checks_clean_under_strict(
     template: str,
     tmp_path: Path,

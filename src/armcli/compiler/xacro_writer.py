@@ -25,7 +25,7 @@ from armcli.compiler.ros2_control import ros2_control_element
 from armcli.compiler.xmlfmt import XACRO_NS, robot, sub, to_bytes, vec
 from armcli.defaults import STANDALONE_ARM as STANDALONE_ARM_NAME
 from armcli.defaults import STANDALONE_ARM_URDF, STANDALONE_ARM_XACRO
-from armcli.spec.model import Arm, MobileBase, RobotSpec
+from armcli.spec.model import Arm, Joint, MobileBase, RobotSpec
 
 __all__ = ["joint_element", "xacro_files"]
 
@@ -41,6 +41,8 @@ PASSTHROUGH = "passthrough.xacro"
 ROS2_CONTROL = "ros2_control.xacro"
 STANDALONE_ARM = STANDALONE_ARM_XACRO
 TOP = "{name}.urdf.xacro"
+WORLD = "world"  # Gazebo (classic and gz-sim) welds a link of this name to the world
+WORLD_JOINT = "world_joint"
 
 
 def common_properties(spec: RobotSpec) -> etree._Element:
@@ -106,6 +108,21 @@ def _top(name: str, includes: list[str]) -> etree._Element:
     return root
 
 
+def standalone_arm(spec: RobotSpec, includes: list[str]) -> etree._Element:
+    """The arm alone's top-level file; split from a whole robot, it gets a `world` root.
+
+    The arm root of a robot with a base has mass (it is no root there), and KDL
+    (robot_state_publisher) ignores a root's inertia; a massless `world` link fixed to it
+    keeps that mass and fixes the arm to the world in Gazebo and MuJoCo (the worldbody).
+    An arm-only spec is the robot itself: its root is the author's (see the tabletop template).
+    """
+    root = _top(STANDALONE_ARM_NAME if has_base(spec) else spec.name, includes)
+    if has_base(spec) and WORLD not in spec.arm.links:
+        sub(root, "link", name=WORLD)
+        joint_element(root, WORLD_JOINT, Joint(type="fixed", parent=WORLD, child=spec.arm_root()))
+    return root
+
+
 def has_base(spec: RobotSpec) -> bool:
     """Whether the spec has a mobile base with a mount (a whole-robot top-level file)."""
     return spec.mounted_base() is not None
@@ -130,13 +147,12 @@ def xacro_files(
     rc = spec.ros2_control if hardware else None
     extra = [ROS2_CONTROL] if rc is not None and rc.hardware is not None else []
     extra += [PASSTHROUGH] if spec.passthrough else []
-    arm_top = STANDALONE_ARM_NAME if has_base(spec) else spec.name
     trees: dict[str, etree._Element] = {
         COMMON: common_properties(spec),
         ARM: part(spec, spec.arm, prefixes, names, "arm"),
         ARM_GAZEBO: arm_gazebo(spec),
-        STANDALONE_ARM: _top(
-            arm_top, [COMMON, ARM, ARM_GAZEBO, *([] if has_base(spec) else extra)]
+        STANDALONE_ARM: standalone_arm(
+            spec, [COMMON, ARM, ARM_GAZEBO, *([] if has_base(spec) else extra)]
         ),
     }
     if spec.passthrough:

@@ -296,7 +296,8 @@ def build_mjcf(
     parts.excludes(root, urdf, {str(el.get("name")) for el in root.iter("body")})
     parts.equalities(root, b.extras, {j.name for j in b.joints})
     actuators = parts.actuators(root, b.joints, spec, b.extras, b.notes)
-    keys = parts.keyframes(root, b.joints, actuators, spec, base == "free")
+    free = root.find(".//freejoint") is not None  # not under a `world` link: kept fixed
+    keys = parts.keyframes(root, b.joints, actuators, spec, free)
     b.notes[:0] = [*mass_notes, *assets.notes, *parts.notes(urdf, b.joints, b.extras, spec)]
     if header is not None:  # the report travels with the model
         header = f"{header}\n\n{text(b.notes)}".replace("--", "- -")

@@ -20,7 +20,15 @@ from lxml import etree
 
 from armcli.compiler.ros2_control import joint_block
 from armcli.compiler.sensors import bridge_entries, harmonic_sensor, harmonic_systems
-from armcli.compiler.xacro_writer import ARM, COMMON, MOBILE_BASE, has_base, joint_element
+from armcli.compiler.xacro_writer import (
+    ARM,
+    COMMON,
+    MOBILE_BASE,
+    WORLD,
+    WORLD_JOINT,
+    has_base,
+    joint_element,
+)
 from armcli.compiler.xmlfmt import XACRO_NS, fmt, to_bytes
 from armcli.errors import InputError
 from armcli.ros import interfaces
@@ -45,8 +53,6 @@ TOP = "{name}_gz.urdf.xacro"
 STANDALONE = "standalone_arm_gz.urdf.xacro"
 GZ_LAUNCH = "{name}_gz.launch.py"
 MOVE_GROUP_LAUNCH = "gz_move_group.launch.py"
-WORLD = "world"  # gz-sim welds a link of this name to the world
-WORLD_JOINT = "world_joint"
 # Everything the Jazzy bringup launch starts or loads, for its package.xml.
 BRINGUP_DEPENDS = [
     "ament_index_python", "control_msgs", "controller_manager", "gz_ros2_control",
