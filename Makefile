@@ -47,12 +47,22 @@ lint: install
 	$(BIN)/ruff format --check src tests bench
 	$(BIN)/mypy src
 
-# The suite in two timed runs: everything but the `slow` tests (installs into fresh
-# virtualenvs, pre-commit), then those; each prints its own time and slowest tests.
+# The suite in two timed runs: everything but the `slow` tests, and alongside it (on the
+# other core: mostly pip and one compile waiting) the `slow` ones (installs into fresh
+# virtualenvs, pre-commit), their output in out/test-slow.log, printed after. Each prints
+# its own time and slowest tests; either failing fails `make test`.
+SLOW_LOG := out/test-slow.log
 test: install sysdeps lint native-check
 	$(BIN)/armcli build --check $(SPEC)
-	$(BIN)/python -m pytest -q -m "not slow" --durations=10
-	$(BIN)/python -m pytest -q -m slow --durations=10
+	@mkdir -p out
+	@echo "test: the slow tests run alongside; their output follows the others' ($(SLOW_LOG))"
+	@$(BIN)/python -m pytest -q -m slow --durations=10 -p no:cacheprovider >$(SLOW_LOG) 2>&1 & \
+	  slow=$$!; trap 'kill $$slow 2>/dev/null; exit 130' INT TERM; \
+	  $(BIN)/python -m pytest -q -m "not slow" --durations=10; fast_rc=$$?; \
+	  wait $$slow; slow_rc=$$?; \
+	  echo "test: the slow tests (-m slow), run alongside:"; cat $(SLOW_LOG); \
+	  echo "test: not slow exit $$fast_rc, slow exit $$slow_rc"; \
+	  [ $$fast_rc -eq 0 ] && [ $$slow_rc -eq 0 ]
 
 # Rebuild the compiled rollout after editing its C++ (the editable install does not rebuild
 # on import): incremental, in build/, with the build tools of the dev extra. Not through the

@@ -15,12 +15,14 @@ import os
 import shutil
 import subprocess
 import sys
+from functools import cache
 from pathlib import Path
 
 import pytest
 import yaml
 
 from tests.helpers import ROOT
+from tests.install_helpers import wheelhouse
 
 pytestmark = pytest.mark.slow
 INSTALL_TIMEOUT = 900  # [s] pre-commit creates a virtualenv and pip-installs armcli
@@ -32,8 +34,19 @@ def git(*args: str, cwd: Path) -> str:
     return r.stdout.strip()
 
 
+@cache
+def hook_install_env() -> dict[str, str]:
+    """pip's settings for pre-commit's `pip install` of armcli: no engine compile, offline."""
+    return {
+        "SKBUILD_WHEEL_CMAKE": "false",
+        "PIP_NO_INDEX": "1",
+        "PIP_FIND_LINKS": str(wheelhouse()),
+    }
+
+
 def pre_commit(*args: str, cwd: Path, home: Path) -> subprocess.CompletedProcess[str]:
     env = {**os.environ, "PRE_COMMIT_HOME": str(home), "PRE_COMMIT_COLOR": "never"}
+    env.update(hook_install_env())
     env.pop("ARMCLI_DEBUG", None)
     return subprocess.run(
         [sys.executable, "-m", "pre_commit", *args],
