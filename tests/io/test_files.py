@@ -44,7 +44,7 @@ def _snapshot(d: Path) -> dict[str, bytes]:
 
 @pytest.mark.parametrize(
     ("module", "func"),
-    [("compiler.expand", "expand"), ("io.files", "_exchange"), ("io.files", "_write_temp")],
+    [("compiler.expand", "expand"), ("io.files", "_exchange"), ("io.files", "stage_file")],
     ids=["during-xacro", "before-swap", "while-staging"],
 )
 def test_sigkill_mid_build_keeps_previous_outputs(

@@ -200,11 +200,11 @@ def test_out_of_space_error_has_no_none(tmp_path: Path, monkeypatch: pytest.Monk
     def full(*args: object) -> Path:
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
-    monkeypatch.setattr(fsio, "_write_temp", full)
+    monkeypatch.setattr(fsio, "stage_file", full)
     with pytest.raises(BuildError) as info:
         write_tree_atomic(tmp_path / "o", {"a.txt": b"1"})
     assert str(info.value).endswith("cannot write: No space left on device"), str(info.value)
-    monkeypatch.setattr(together, "_stage", full)  # single files: the one staging writer
+    monkeypatch.setattr(together, "stage_file", full)  # single files: the one staging writer
     with pytest.raises(BuildError) as single:
         fsio.write_file_atomic(tmp_path / "f.txt", b"1")
     assert str(single.value).endswith("cannot write: No space left on device"), str(single.value)

@@ -11,7 +11,6 @@ all of them were written (a kill can then only land in that microsecond window).
 
 from __future__ import annotations
 
-import contextlib
 import ctypes
 import os
 import stat
@@ -32,25 +31,10 @@ from armcli.io.outdir import (
     resolve_output_dir,
     umask,
 )
-from armcli.io.together import write_files_together
+from armcli.io.together import stage_file, write_files_together
 
 _AT_FDCWD = -100
 _RENAME_EXCHANGE = 2
-
-
-def _write_temp(directory: Path, name: str, data: bytes) -> Path:
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{name}.", suffix=".tmp")
-    try:
-        os.fchmod(fd, 0o666 & ~umask())  # mkstemp makes 0600; outputs are ordinary files
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-    return Path(tmp)
 
 
 def _payload(data: bytes | str) -> bytes:
@@ -105,7 +89,7 @@ def _populate(stage: Path, root: Path, files: Mapping[str, bytes]) -> None:
         target.parent.mkdir(parents=True, exist_ok=True)
         if target.exists() or target.is_symlink():
             target.unlink()  # a hard link to the old file: never write through it
-        os.replace(_write_temp(target.parent, target.name, data), target)
+        os.replace(stage_file(target, data, "."), target)  # target unlinked: a new file's mode
     for path, mode in modes:  # innermost first: read-only directories receive files first
         os.chmod(path, mode)
     keep = stat.S_IMODE(os.stat(root).st_mode) if root.is_dir() else 0o777 & ~umask()

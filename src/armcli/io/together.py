@@ -51,7 +51,8 @@ def target_path(path: str | Path) -> Path:
     return Path(os.path.realpath(p)) if p.is_symlink() else p
 
 
-def _stage(target: Path, data: bytes, token: str) -> Path:
+def stage_file(target: Path, data: bytes, token: str) -> Path:
+    """`data` in a flushed hidden temp file beside `target`, with the mode `target` will have."""
     fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}{token}", suffix=".tmp")
     try:
         try:
@@ -172,7 +173,7 @@ def write_files_together(files: Mapping[Path, bytes], *, parents: bool = False) 
     staged: list[Path] = []
     try:
         for t, data in zip(targets, files.values(), strict=True):
-            staged.append(_stage(t, data, token))
+            staged.append(stage_file(t, data, token))
     except OSError as exc:
         for s in staged:
             with contextlib.suppress(OSError):
