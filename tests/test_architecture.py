@@ -23,6 +23,7 @@ SIBLING_EXCEPTIONS = {
     ("check", "armcli.sim.verdict"),
     ("check", "armcli.sim.tipping"),
     ("view", "armcli.sim.states"),
+    ("sim", "armcli.export.mjcf"),
 }
 
 
