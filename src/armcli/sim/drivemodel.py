@@ -36,12 +36,12 @@ from armcli.sim.diffdrive import DriveParams
 from armcli.urdf.doc import Urdf
 from armcli.urdf.stance import Stance
 
-SERVO_STEPS = 5.0  # wheel motor time constant in time steps (see the module docstring)
-# [s] MuJoCo's contact time constant (solref, critically damped). At its default 20 ms the
-# wheels' cylinder rim contacts chatter on and off the floor in a turn (3 % of the steps
-# unloaded, the caster 11 %); at 50 ms no wheel does (the caster 5 %, ~10 µm hops) and the
-# robot sinks 0.33 mm into the floor under its weight.
-CONTACT_TIME = 0.05
+SERVO_STEPS = 1.0  # wheel motor time constant in time steps (see the module docstring)
+# [s] MuJoCo's contact time constant (solref, critically damped): its default. Measured on
+# the course robot (tests/sim/test_drive.py): softer contacts (50 ms) stop the wheels'
+# chatter but let the robot coast 2.5 % past its wheels' travel after a stop; a wheel motor
+# slower than one step (SERVO_STEPS 5) lags a turn's load by 4 %.
+CONTACT_TIME = 0.02
 TOUCH_MARGIN = 0.02  # [m] a touch site is the link's bounding sphere plus this
 G = 9.81  # [m/s²] MuJoCo's default gravity magnitude
 

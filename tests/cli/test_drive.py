@@ -1,0 +1,131 @@
+"""`armcli simulate SPEC --cmd-vel`: the files it writes, read back, and the inputs it refuses.
+
+The MCAP is read by rosbags (its own MCAP parser and CDR decoder, ROS 2 Jazzy's message
+definitions) and compared with the CSV of the same run.
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from tests.helpers import DEFAULT_SPEC, ROOT, SPECS, run_main
+
+pytest.importorskip("mujoco")
+
+PICK = ROOT / "specs" / "trajectories" / "pick.yaml"
+DRIVE = ROOT / "specs" / "trajectories" / "drive.yaml"
+DURATION = "3.0"  # [s] 151 states at the plugin's 50 Hz
+
+
+def _rosbags(path: Path) -> dict[str, list[tuple[int, Any]]]:
+    from rosbags.rosbag2 import Reader
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS2_JAZZY)
+    out: dict[str, list[tuple[int, Any]]] = {}
+    with Reader(path) as reader:
+        for conn, t, raw in reader.messages():
+            out.setdefault(conn.topic, []).append((t, store.deserialize_cdr(raw, conn.msgtype)))
+    return out
+
+
+@pytest.fixture(scope="module")
+def drive_files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    out = tmp_path_factory.mktemp("drive")
+    files = {"mcap": out / "run.mcap", "csv": out / "run.csv", "png": out / "run.png"}
+    from armcli.cli import main
+
+    for key in ("mcap", "csv"):
+        args = ["simulate", DEFAULT_SPEC, "--cmd-vel", DRIVE, "-t", PICK, "--duration", DURATION,
+                "-o", files[key]]  # fmt: skip
+        if key == "csv":
+            args += ["--plot", files["png"]]
+        try:
+            main([str(a) for a in args])
+        except SystemExit as exc:
+            assert not exc.code
+    return files
+
+
+def test_mcap_has_the_drive_topics_and_equals_the_csv(drive_files: dict[str, Path]) -> None:
+    msgs = _rosbags(drive_files["mcap"])
+    with drive_files["csv"].open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == len(msgs["/odom"]) == len(msgs["/joint_states"]) == 151
+    assert [m.linear.x for _, m in msgs["/cmd_vel"]] == [0.3, 0.0]  # the commands up to 3 s
+    for (t, odom), (_, js), (_, tf), row in zip(msgs["/odom"], msgs["/joint_states"],
+                                                msgs["/tf"], rows, strict=True):  # fmt: skip
+        assert t == round(float(row["time"]) * 1e9)
+        assert (odom.header.frame_id, odom.child_frame_id) == ("odom", "base_footprint")
+        assert f"{odom.pose.pose.position.x:.9g}" == row["odom.x"]
+        assert f"{odom.pose.pose.position.y:.9g}" == row["odom.y"]
+        assert "base_left_wheel_joint" in js.name and "base_right_wheel_joint" in js.name
+        i = list(js.name).index("base_left_wheel_joint")
+        assert f"{js.position[i]:.9g}" == row["base_left_wheel_joint.position"]
+        frames = {(x.header.frame_id, x.child_frame_id): x.transform for x in tf.transforms}
+        assert ("odom", "base_footprint") in frames and ("world", "odom") in frames
+    # world -> odom -> base_footprint is the ground truth: at the end, the CSV's base.x
+    last = msgs["/tf"][-1][1].transforms
+    w_o = next(x.transform for x in last if x.child_frame_id == "odom")
+    o_b = next(x.transform for x in last if x.child_frame_id == "base_footprint")
+    import numpy as np
+
+    def mat(tr: Any) -> np.ndarray:
+        from scipy.spatial.transform import Rotation
+
+        T = np.eye(4)
+        r = tr.rotation
+        T[:3, :3] = Rotation.from_quat([r.x, r.y, r.z, r.w]).as_matrix()
+        T[:3, 3] = (tr.translation.x, tr.translation.y, tr.translation.z)
+        return T
+
+    T = mat(w_o) @ mat(o_b)
+    assert T[0, 3] == pytest.approx(float(rows[-1]["base.x"]), abs=1e-6)
+    assert T[1, 3] == pytest.approx(float(rows[-1]["base.y"]), abs=1e-6)
+
+
+def test_csv_columns_and_the_plot(drive_files: dict[str, Path]) -> None:
+    with drive_files["csv"].open() as fh:
+        header = next(csv.reader(fh))
+    base = [f"base.{c}" for c in ("x", "y", "z", "roll", "pitch", "yaw")]
+    odom = ["odom.x", "odom.y", "odom.yaw"]
+    loads = ["caster_wheel_link.normal_force", "base_right_wheel_link.normal_force"]
+    for name in (*base, *odom, "base_left_wheel_joint.effort", *loads):
+        assert name in header
+    assert drive_files["png"].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize(
+    ("text", "where"),
+    [
+        ("commands:\n  - {linear: {x: 0.2}, velocity: 1}\n", ":2 commands[0].velocity"),
+        ("commands:\n  - {linear: {x: .nan}}\n", ":2 commands[0].linear.x"),
+        ("commands:\n  - {time_from_start: 2}\n  - {time_from_start: 1}\n",
+         ":3 commands[1].time_from_start"),
+    ],
+)  # fmt: skip
+def test_bad_cmd_vel_is_exit_2_and_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], text: str, where: str
+) -> None:
+    cmd = tmp_path / "bad.yaml"
+    cmd.write_text(text)
+    out = tmp_path / "run.mcap"
+    code, _, err = run_main(["simulate", DEFAULT_SPEC, "--cmd-vel", cmd, "-o", out], capsys)
+    assert code == 2
+    assert f"{cmd}{where}" in err
+    assert not out.exists()
+
+
+def test_a_robot_without_a_diff_drive_is_exit_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "run.csv"
+    code, _, err = run_main(
+        ["simulate", SPECS / "tabletop_arm.yaml", "--cmd-vel", DRIVE, "-o", out], capsys
+    )
+    assert code == 2 and "mobile_base.diff_drive" in err
+    assert not out.exists()
