@@ -23,7 +23,7 @@ from armcli.io.files import write_tree_atomic
 from armcli.io.outdir import resolve_output_dir
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
-from armcli.urdf.xacro_safe import expand_safe
+from armcli.urdf.xacro_safe import REFUSED_HINT, expand_safe
 
 
 @dataclass(frozen=True)
@@ -49,7 +49,8 @@ def expand(xacro_dir: Path, xacro_name: str) -> bytes:
     try:
         xml = expand_safe(xacro_dir / xacro_name, [xacro_dir])
     except InputError as exc:
-        raise BuildError(f"generated {xacro_name} did not expand: {exc.message}") from None
+        why = exc.message.removesuffix(REFUSED_HINT)  # --trust-xacro is for foreign files
+        raise BuildError(f"generated {xacro_name} did not expand: {why}") from None
     return _banner_fix(xml, xacro_name)
 
 
