@@ -14,6 +14,7 @@ from pathlib import Path
 
 from lxml import etree
 
+from armcli.defaults import MAX_ROBOT_DOF, MAX_ROBOT_LINKS
 from armcli.errors import InputError, XacroRefusedError
 from armcli.io.userfile import read_regular
 from armcli.spec.joint_types import total_dof
@@ -38,8 +39,8 @@ MAX_URDF_DEPTH = 32
 # 256 links and ~20 s at 500; Pinocchio's Data grows ~cubically with the DoF (19 MB at
 # 63, 136 MB at 127, 24 GB RSS for `check` at 1000). The largest robot in
 # example-robot-data has 130 links and 101 DoF (tiago_dual).
-MAX_URDF_LINKS = 300
-MAX_URDF_DOF = 128
+MAX_URDF_LINKS = MAX_ROBOT_LINKS
+MAX_URDF_DOF = MAX_ROBOT_DOF
 MAX_URDF_COLLISIONS = 1000  # example-robot-data: at most 113 per robot
 
 
