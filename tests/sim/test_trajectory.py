@@ -58,16 +58,28 @@ def _ros2_topic_pub_positions(payload: str) -> list[list[float]]:
 @pytest.mark.parametrize(
     "positions", ["{0.5, 0.3}", "{0.3, 0.5}", "{0, 1.5}", "{0.0, 0.0}", "{1, 1.0}", "{0.5}"]
 )
-def test_brace_form_reads_as_ros_2_sends_it(positions: str) -> None:
+def test_brace_form_runs_as_written_and_says_what_ros_2_sends(positions: str) -> None:
     payload = f"{{joint_names: [{J1}, {J2}], points: [{{positions: {positions}}}]}}"
     sent = _ros2_topic_pub_positions(payload)[0]  # the independent reference: ROS's own code
-    if len(sent) == 2:
-        tr = loads_trajectory(payload, LIMITS)
-        assert tr.positions.tolist() == [sent]
-        assert len(tr.warnings) == 1 and "is a YAML mapping, not a list" in tr.warnings[0]
-    else:
-        with pytest.raises(SpecError, match=rf"{len(sent)} value\(s\) for 2 joint\(s\)"):
+    written = [float(x) for x in positions.strip("{}").split(",")]  # what the student typed
+    if len(written) != 2:  # nothing to recover: one value for two joints
+        with pytest.raises(SpecError, match=r"1 value\(s\) for 2 joint\(s\)"):
             loads_trajectory(payload, LIMITS)
+        return
+    tr = loads_trajectory(payload, LIMITS)
+    assert tr.positions.tolist() == [written]
+    assert len(tr.warnings) == 1 and "is a YAML mapping, not a list" in tr.warnings[0]
+    list_form = "[" + positions.strip("{}") + "]"
+    assert f"write a list: {list_form}" in tr.warnings[0] or list_form in tr.warnings[0]
+    if len(sent) != len(written):  # ROS 2 collapses the repeated key: the warning says so
+        assert f"would send its distinct keys, {len(sent)} value(s)" in tr.warnings[0]
+
+
+def test_brace_form_one_warning_for_every_point() -> None:
+    points = ", ".join(f"{{positions: {{0.{k}, 0.{k}}}}}" for k in range(1, 6))
+    tr = loads_trajectory(f"{{joint_names: [{J1}, {J2}], points: [{points}]}}", LIMITS)
+    assert tr.positions[:, 0].tolist() == [0.1, 0.2, 0.3, 0.4, 0.5]  # as written, per point
+    assert len(tr.warnings) == 1 and "(and 4 more)" in tr.warnings[0]
 
 
 @pytest.mark.parametrize("path", sorted((ROOT / "specs" / "trajectories").glob("*.yaml")))

@@ -200,6 +200,8 @@ def _run(
     err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
     write_notes([*job.notes, *(notes or [])])
     for w in job.trajectory.warnings:
+        source = w.split(" ", 1)[0]  # `SimOptions.message` is the flag `--message`
+        w = FLAGS.get(source, source) + w[len(source) :]
         err.print(one_line(f"warning: {w}"), markup=False, highlight=False)
     extra = None if tip is None else (lambda steps: tip.steps(job, steps))
     with _LazyProgress(err) as progress:
