@@ -9,7 +9,7 @@ from pathlib import Path
 
 from armcli.check.rules import CheckOptions, Collector
 from armcli.urdf.doc import Urdf
-from armcli.urdf.meshes import confined, resolve
+from armcli.urdf.meshes import confined, mesh_hint, resolve
 
 
 def check(urdf: Urdf, opts: CheckOptions, out: Collector) -> None:
@@ -46,6 +46,6 @@ def check(urdf: Urdf, opts: CheckOptions, out: Collector) -> None:
                 out.add(
                     "mesh-missing",
                     g.line,
-                    f"link {link.name!r}: mesh {g.filename!r}: {why}",
+                    f"link {link.name!r}: mesh {g.filename!r}: {why}; {mesh_hint(g.filename)}",
                     uri=g.filename,
                 )
