@@ -42,10 +42,14 @@ def check(urdf: Urdf, opts: CheckOptions, out: Collector) -> None:
                 continue
             if path is None or not path.is_file():
                 reported.add(g.filename)
-                why = "unknown package" if path is None else f"no file {path}"
+                why = (
+                    f"unknown package; {mesh_hint(g.filename)}"
+                    if path is None
+                    else f"no file {path}"
+                )
                 out.add(
                     "mesh-missing",
                     g.line,
-                    f"link {link.name!r}: mesh {g.filename!r}: {why}; {mesh_hint(g.filename)}",
+                    f"link {link.name!r}: mesh {g.filename!r}: {why}",
                     uri=g.filename,
                 )
