@@ -247,3 +247,9 @@ def test_simulating_a_urdf_needs_no_spec_layers() -> None:
                              "--kd", "5", "-m", msg, "--duration", "0.2"])  # fmt: skip
     assert "pinocchio" in loaded and "armcli.spec.model" not in loaded
     assert not {"matplotlib", "scipy", "mujoco", "numpy.ma"} & loaded
+
+
+def test_a_wheel_joint_is_not_an_arm_joint(capsys: pytest.CaptureFixture[str]) -> None:
+    message = SEED.replace("arm_base_forearm_joint", "base_left_wheel_joint")
+    code, _, err = run(["--message", message], capsys)
+    assert code == 2 and "is a wheel joint of the mobile base, not an arm joint" in err
