@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 
@@ -50,3 +51,18 @@ def test_readme_tune_section_quotes_the_shipped_gains() -> None:
     readme = (ROOT / "README.md").read_text()
     section = readme[readme.index("### `armcli tune") : readme.index("### `armcli ros-package")]
     assert f"kp = {kp:g}, kd = {kd:g}" in " ".join(section.split())
+
+
+def test_a_base_without_an_arm_gets_no_arm_advice(capsys: pytest.CaptureFixture[str]) -> None:
+    """TurtleBot3-like: wheels and a caster, no arm (tests/fixtures/tipover/wheeled_base.urdf)."""
+    urdf = ROOT / "tests" / "fixtures" / "tipover" / "wheeled_base.urdf"
+    code, out, _ = run_main(["check", urdf, "--format", "json"], capsys)
+    assert code == 0
+    doc = json.loads(out)
+    (margin,) = [f for f in doc["files"][0]["findings"] if f["rule"] == "support-margin"]
+    # centre of mass x = (1 kg * -0.01 m + 0.01 kg * -0.1 m) / 1.11 kg = -9.91 mm behind the
+    # wheel axle line (the polygon's front edge)
+    assert margin["values"]["margin"] == pytest.approx(0.011 / 1.11, rel=1e-9)
+    assert "arm" not in margin["hint"]
+    code, out, _ = run_main(["check", urdf], capsys)
+    assert "end effector" not in out  # a wheel is no tool point
