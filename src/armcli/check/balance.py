@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from armcli.urdf.boxsearch import minimize_box
+from armcli.urdf.pinocchio import link_frame
 from armcli.urdf.stance import Stance
 
 SEEDS_DESCENDED = 3  # local searches per edge and measure, from the best seeds
@@ -97,7 +98,7 @@ class _Mass:
         self.iq = [(jr.idx_q, jr.continuous) for jr in stance.joints]
         self.iv = [jr.idx_v for jr in stance.joints]
         p = stance.payload
-        self.frame = self.model.getFrameId(p.link) if p is not None else None
+        self.frame = link_frame(self.model, p.link) if p is not None else None
         self.xyz = np.asarray(p.xyz if p is not None else (0.0, 0.0, 0.0), dtype=float)
 
     def q(self, x: ArrayLike) -> NDArray[np.float64]:
