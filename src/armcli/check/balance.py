@@ -77,6 +77,7 @@ class StaticBalance:
     worst: tuple[PoseBalance, ...]  # per edge: the configuration closest to tipping over it
     worst_tip_angles: tuple[float, ...]  # [rad] per edge: smallest tipping angle over the range
     payload_max: float | None  # [kg] the most that holds at every named pose and over the range
+    contact_tol: float | None = None  # [m] how the contacts were found; None: user-named
 
     @property
     def worst_overall(self) -> PoseBalance:
@@ -177,6 +178,7 @@ def analyse(
         worst=worst,
         worst_tip_angles=tips,
         payload_max=min(known) if len(known) == len(best) else None,
+        contact_tol=None if stance.ground.declared else stance.ground.tol,
     )
 
 

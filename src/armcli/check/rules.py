@@ -195,6 +195,14 @@ _RULES = [
         "write the inertia of the shape and mass (the value in the message)",
     ),
     Rule(
+        "inertia-exceeds-visual",
+        WARNING,
+        "a moment of inertia above what any mass inside the link's one visual-only primitive "
+        "can have",
+        "a visual without a collision may be only illustrative (Go1's rotors); if it is the "
+        "body, write the inertia of the shape and mass (the value in the message)",
+    ),
+    Rule(
         "inertia-geometry",
         WARNING,
         "inertia differs from the solid-body formula of the geometry",

@@ -79,7 +79,7 @@ def _self_collision(c: Context) -> None:
 FAMILIES: tuple[Family, ...] = (
     Family("inertia", URDF, lambda c: inertia.check(c.urdf, c.tree, c.out)),
     Family("bodies", URDF, lambda c: bodies.check(c.urdf, c.tree, c.out)),
-    Family("joints", URDF, lambda c: joints.check(c.urdf, c.opts.spec, c.out)),
+    Family("joints", URDF, lambda c: joints.check(c.urdf, c.opts.spec, c.out, c.notes)),
     Family("meshes", URDF, lambda c: meshes.check(c.urdf, c.opts, c.out)),
     Family("gravity", DYNAMICS, _gravity),
     Family("servo", DYNAMICS, _servo),
