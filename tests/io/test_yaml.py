@@ -26,6 +26,8 @@ def test_line_numbers_follow_paths() -> None:
         ("a: [1, 2\n", "malformed YAML"),
         ("a: \x00\n", "NUL"),
         ("[" * 100 + "]" * 100, "nesting deeper"),
+        # deep enough that PyYAML's own scanner guard fires first: the same armcli message
+        ("a: " + "[" * 5000 + "]" * 5000, "nesting deeper than 64 levels"),
     ],
 )
 def test_refusals(text: str, fragment: str) -> None:

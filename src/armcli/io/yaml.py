@@ -77,9 +77,7 @@ def _scan_events(text: str, source: str) -> None:
             if isinstance(ev, yaml.CollectionStartEvent):
                 depth += 1
                 if depth > MAX_YAML_DEPTH:
-                    raise InputError(
-                        f"nesting deeper than {MAX_YAML_DEPTH} levels", file=source, line=line
-                    )
+                    raise _too_deep(source, line)
             elif isinstance(ev, yaml.CollectionEndEvent):
                 depth -= 1
     except yaml.YAMLError as exc:
@@ -90,7 +88,14 @@ def _yaml_error(exc: yaml.YAMLError, source: str) -> InputError:
     mark = getattr(exc, "problem_mark", None)
     line = mark.line + 1 if mark is not None else None
     problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+    if "nesting" in problem:  # the parser's own depth guard fired before the event scan's
+        return _too_deep(source, line)
     return InputError(f"malformed YAML: {problem}", file=source, line=line)
+
+
+def _too_deep(source: str, line: int | None) -> InputError:
+    """One message for every depth guard (ours, PyYAML's scanner, Python's recursion)."""
+    return InputError(f"nesting deeper than {MAX_YAML_DEPTH} levels", file=source, line=line)
 
 
 def _scalar(node: yaml.ScalarNode, loader: _Loader, path: Path_, doc: YamlDoc) -> Any:
@@ -208,7 +213,7 @@ def loads_yaml(text: str, source: str = "<string>", *, flow_sets: bool = False) 
     except yaml.YAMLError as exc:
         raise _yaml_error(exc, source) from None
     except RecursionError:
-        raise InputError("YAML nested too deeply", file=source) from None
+        raise _too_deep(source, None) from None
     finally:
         loader.dispose()
     return doc
