@@ -114,3 +114,24 @@ def test_zero_limits_stay_an_error_where_nothing_says_passive(
     (tmp_path / "bare.urdf").write_text(bare)
     code, out, _ = run_main(["check", tmp_path / "bare.urdf"], capsys)
     assert code == 1 and "limit-effort-velocity" in out
+
+
+def test_an_inertia_tensor_error_leaves_the_balance_running(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Fetch, Stretch, PR2: `--ignore` gave 0 errors and still no tip-over numbers.
+
+    A tensor breaking the triangle inequality moves no centre of mass: the balance runs,
+    the dynamics (which need the tensor) do not.
+    """
+    text = (REAL / "wheel_drop.urdf").read_text()
+    good = 'ixx="0.02" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.038"'
+    assert good in text
+    bad = tmp_path / "triangle.urdf"  # 0.01 + 0.01 < 0.038: no real body has these moments
+    bad.write_text(text.replace(good, 'ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.038"'))
+    for ignore in ([], ["--ignore", "inertia-triangle"]):
+        code, out, _ = run_main(["check", bad, *ignore], capsys)
+        assert code == (0 if ignore else 1)
+        assert "static balance on caster_link, left_wheel, right_wheel" in out
+        assert "support polygon (-0.120, 0.000) (0.000, -0.117) (0.000, 0.117) m" in out
+        assert "dynamics checks skipped" in out
