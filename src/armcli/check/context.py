@@ -5,8 +5,9 @@ family declares the stage it needs: `URDF` (the parsed document and its tree), `
 (the Pinocchio model, loaded once and only while no error of a rule that `blocks` the
 model stands), `BALANCE` (also valid masses, centres of mass and joint ranges: no negative
 mass, zero axis or limits out of order) or `DYNAMICS` (also no error of a rule that blocks
-the dynamics, such as an inertia tensor that is not positive definite). Families write findings to `out`, notes to `notes`, and what later ones
-or the summary read (the gravity load in `rows`, the servo joints, the PD verdict) here.
+the dynamics, such as an inertia tensor that is not positive definite). Families write
+findings to `out`, notes to `notes`, and what later ones or the summary read (the gravity
+load in `rows`, the servo joints, the PD verdict) here.
 """
 
 from __future__ import annotations
