@@ -22,7 +22,7 @@ from armcli.commands.xacro_inputs import (
 from armcli.errors import InputError, ModelRefusedError, UnstableLoopError
 from armcli.io import terminal
 from armcli.io.oneline import one_line
-from armcli.io.outdir import check_output_file
+from armcli.io.outdir import check_output_file, check_png_file
 from armcli.io.together import write_files_together
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
@@ -112,7 +112,7 @@ def simulate_cmd(
             states.output_format(output)
         check_output_file(output, "--output")
     if plot is not None:
-        check_output_file(plot, "--plot")
+        check_png_file(plot, "--plot")
     spec_path, spec_obj = None, None
     if spec is not None or urdf is None:  # the spec layers are imported only for a spec
         from armcli.spec.discover import find_spec
@@ -225,6 +225,8 @@ def _run(
     err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
     write_notes([*job.notes, *(notes or [])])
     for w in job.trajectory.warnings:
+        source = w.split(" ", 1)[0]  # `SimOptions.message` is the flag `--message`
+        w = FLAGS.get(source, source) + w[len(source) :]
         err.print(one_line(f"warning: {w}"), markup=False, highlight=False)
     extra = None if tip is None else (lambda steps: tip.steps(job, steps))
     with _LazyProgress(err) as progress:
