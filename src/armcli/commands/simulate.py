@@ -253,6 +253,8 @@ def _run(
     out.print(simreport.summary_table(metrics, ee, job.tool_label, res), crop=False)
     balance = tipping.report(tip, series) if tip is not None and series is not None else None
     if balance is not None:
+        for lift in balance.lifts:  # too short to tip the robot: a wheel unloads, a warning
+            err.print(one_line(f"warning: {lift.line()}"), markup=False, highlight=False)
         line = tipping.summary_line(balance)
         out.print(line, style="red" if balance.tips else None, markup=False, highlight=False)
     for path in (output, plot):
