@@ -51,7 +51,10 @@ def heavy_hand_spec(tmp_path: Path) -> Path:
     return path
 
 
-FORWARD = "joint_names: [arm_base_forearm_joint, forearm_hand_joint]\npoints:\n - {positions: [1.5, 0.0], time_from_start: 2.0}\n"
+FORWARD = (  # the arm straight forward in 2 s
+    "joint_names: [arm_base_forearm_joint, forearm_hand_joint]\n"
+    "points:\n - {positions: [1.5, 0.0], time_from_start: 2.0}\n"
+)
 
 
 def test_simulate_warns_of_lift_off_and_fails_only_a_robot_that_tips(
