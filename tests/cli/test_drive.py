@@ -129,3 +129,26 @@ def test_a_robot_without_a_diff_drive_is_exit_2(
     )
     assert code == 2 and "mobile_base.diff_drive" in err
     assert not out.exists()
+
+
+def test_a_robot_check_says_tips_is_refused_unless_ignored_then_tips(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    heavy = tmp_path / "heavy_hand.yaml"  # a 10 kg hand: tests/sim/test_drive.py
+    text = DEFAULT_SPEC.read_text()
+    heavy.write_text(text.replace("      material: orange\n      mass: 0.3\n",
+                                  "      material: orange\n      mass: 10.0\n"))  # fmt: skip
+    forward = tmp_path / "forward.yaml"
+    forward.write_text("joint_names: [arm_base_forearm_joint, forearm_hand_joint]\n"
+                       "points:\n - {positions: [1.5, 0.0], time_from_start: 2.0}\n")  # fmt: skip
+    still = tmp_path / "still.yaml"
+    still.write_text("commands:\n  - {time_from_start: 0}\n")
+    out = tmp_path / "run.mcap"
+    args = ["simulate", heavy, "--cmd-vel", still, "-t", forward, "--gravity-comp",
+            "--duration", "2.5", "-o", out]  # fmt: skip
+    code, _, err = run_main(args, capsys)
+    assert code == 2 and "com-outside-support" in err and "--ignore com-outside-support" in err
+    assert not out.exists()
+    code, stdout, err = run_main([*args, "--ignore", "com-outside-support"], capsys)
+    assert code == 1 and "the robot tips over" in err and "TIPS OVER" in stdout
+    assert out.exists()  # the run is written: open it to watch the robot fall

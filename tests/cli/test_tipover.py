@@ -86,8 +86,10 @@ def test_simulate_warns_of_lift_off_and_fails_only_a_robot_that_tips(
     assert min(float(r["zmp.margin"]) for r in rows) > 0  # the arm alone keeps it inside
 
     csv_path = tmp_path / "heavy.csv"
-    code, out, err = run(["simulate", heavy_hand_spec(tmp_path), "-m", FORWARD, "--gravity-comp",
-                          "-o", csv_path], capsys)  # fmt: skip
+    args = ["simulate", heavy_hand_spec(tmp_path), "-m", FORWARD, "--gravity-comp", "-o", csv_path]
+    code, out, err = run(args, capsys)  # `check` says it tips at its arm's range: refused
+    assert code == 2 and "--ignore com-outside-support" in err and not csv_path.exists()
+    code, out, err = run([*args, "--ignore", "com-outside-support"], capsys)  # watch it tip
     assert code == 1
     assert "the robot tips over" in err and "toward front" in err and "TIPS" in out
     assert csv_path.exists()  # the files are written before the error
