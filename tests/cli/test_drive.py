@@ -152,3 +152,27 @@ def test_a_robot_check_says_tips_is_refused_unless_ignored_then_tips(
     code, stdout, err = run_main([*args, "--ignore", "com-outside-support"], capsys)
     assert code == 1 and "the robot tips over" in err and "TIPS OVER" in stdout
     assert out.exists()  # the run is written: open it to watch the robot fall
+
+
+def test_replay_moves_the_base_from_either_file(drive_files: dict[str, Path]) -> None:
+    from armcli.sim import rosbag
+    from armcli.sim.states import load_replay
+    from armcli.view.browser import Viewer
+    from armcli.view.scene import load_robot
+
+    with drive_files["csv"].open() as fh:
+        last = list(csv.DictReader(fh))[-1]
+    robot = load_robot(DEFAULT_SPEC)
+    joints = ["arm_base_forearm_joint", "forearm_hand_joint", "base_left_wheel_joint",
+              "base_right_wheel_joint"]  # fmt: skip
+    for run in (load_replay(drive_files["csv"], joints),
+                rosbag.load_replay(drive_files["mcap"], joints)):  # fmt: skip
+        end = run.base_at(float(run.time[-1]))
+        assert end is not None
+        assert end[0][:2] == pytest.approx([float(last["base.x"]), float(last["base.y"])],
+                                           abs=1e-6)  # fmt: skip
+        assert abs(end[0][0]) > 0.5  # it drove 0.6 m and more
+        with Viewer(robot.xml, tool=robot.tool, replay=run, port=0) as v:
+            v.seek(float(run.time[-1] - run.time[0]))
+            assert v._base is not None
+            assert tuple(v._base.position)[:2] == pytest.approx(tuple(end[0][:2]), abs=1e-6)

@@ -28,7 +28,7 @@ from armcli.sim.rollout import Stats
 from armcli.sim.simulate import SETTLE_TOL, SimResult
 from armcli.sim.states import TIME, column, distinct, sample_states, sample_steps
 
-WORLD = "world"
+WORLD = rosbag.WORLD
 ODOMETRY = "nav_msgs/msg/Odometry"
 TWIST = "geometry_msgs/msg/Twist"
 ODOM, CMD_VEL = "/odom", "/cmd_vel"
