@@ -67,9 +67,16 @@ def _axle(run: drive.DriveRun) -> tuple[np.ndarray, np.ndarray]:
     return mid - mid[0], roll_pitch_yaw(s[:, L.base_quat])[2]
 
 
-def test_zero_cmd_vel_moves_the_arm_as_the_fixed_base_engine(tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    "extra",
+    [{}, {"kp": (30.0,), "kd": (2.0,)}, {"gravity_comp": True}],
+    ids=["spec-gains", "option-gains", "gravity-comp"],
+)
+def test_zero_cmd_vel_moves_the_arm_as_the_fixed_base_engine(
+    tmp_path: Path, extra: dict[str, object]
+) -> None:
     cmd = _cmd(tmp_path, "still", "commands:\n  - {time_from_start: 0}\n")
-    opts = SimOptions(message=MULTI, duration=6.0)
+    opts = SimOptions(message=MULTI, duration=6.0, **extra)  # type: ignore[arg-type]
     run = _run(DEFAULT_SPEC, opts, cmd)
     fixed = simjob.run(run.job.arm)  # the compiled engine, same job (gains, dt, reference)
     q_mj = run.sensors[fixed.step, run.job.model.layout.arm_pos]
