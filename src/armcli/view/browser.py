@@ -311,13 +311,19 @@ class Viewer:
         pose = self._replay.base_at(t0)
         if pose is not None and self._base is not None:
             self._base.position, self._base.wxyz = tuple(pose[0]), tuple(pose[1])
-        self.set_configuration({j: float(np.clip(v, *self._range(j))) for j, v in q.items()})
+        self.set_configuration({j: self._in_range(j, v) for j, v in q.items()})
         if self._ghost is not None:
             ref = self._replay.reference_at(t0)
             visible = ref is not None and bool(self._ghost_box.value)
             if ref is not None:
                 self._ghost.update_cfg(self._cfg_array({**self.configuration(), **ref}))
             self._ghost.show_visual = visible
+
+    def _in_range(self, joint: str, value: float) -> float:
+        """A bounded joint clipped to its limits; a continuous one (a wheel) wrapped to ±pi."""
+        if self._limits[joint] is None:
+            return float((value + math.pi) % (2.0 * math.pi) - math.pi)
+        return float(np.clip(value, *self._range(joint)))
 
     def _range(self, joint: str) -> tuple[float, float]:
         lim = self._limits[joint]
