@@ -89,6 +89,22 @@ def test_mcap_has_the_drive_topics_and_equals_the_csv(drive_files: dict[str, Pat
     assert T[1, 3] == pytest.approx(float(rows[-1]["base.y"]), abs=1e-6)
 
 
+def test_mcap_schemas_are_rosbags_ros2_definitions(drive_files: dict[str, Path]) -> None:
+    from mcap.reader import make_reader
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    store = get_typestore(Stores.ROS2_JAZZY)  # the standard ROS 2 types, not ours
+    with drive_files["mcap"].open("rb") as fh:
+        summary = make_reader(fh).get_summary()
+    assert summary is not None
+    names = {s.name for s in summary.schemas.values()}
+    assert {"nav_msgs/msg/Odometry", "geometry_msgs/msg/Twist"} <= names
+    for schema in summary.schemas.values():
+        types = get_types_from_msg(schema.data.decode(), schema.name)
+        for name, (consts, fields) in types.items():
+            assert (consts, fields) == tuple(store.fielddefs[name][:2]), name
+
+
 def test_csv_columns_and_the_plot(drive_files: dict[str, Path]) -> None:
     with drive_files["csv"].open() as fh:
         header = next(csv.reader(fh))

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from armcli.errors import InputError
+from armcli.errors import InputError, SimulationError
 from armcli.sim import job as simjob
 from armcli.sim.cmdvel import CmdVel, load_cmd_vel
 from armcli.sim.diffdrive import DiffDriveController, DriveParams, Odometry, encoder_odometry
@@ -199,9 +199,28 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
     mujoco.mj_forward(m, d)
     rec[steps], wheel_cmd[steps] = d.sensordata, command
     wall = time.perf_counter() - start
+    _refuse_reset(d, rec, job.dt)
     wl = rec[:-1, dm.layout.wheel_vel]
     odom = encoder_odometry(wl[:, 0], wl[:, 1], job.dt, job.params.radius, job.params.separation)
     return DriveRun(job, t, rec, q_ref, v_ref, wheel_cmd, odom, wall)
+
+
+def _refuse_reset(d: Any, rec: np.ndarray, dt: float) -> None:
+    """MuJoCo resets a state that became non-finite and goes on: such a run is no result."""
+    import mujoco
+
+    W = mujoco.mjtWarning
+    bad = [w for w in (W.mjWARN_BADQACC, W.mjWARN_BADQPOS, W.mjWARN_BADQVEL)
+           if d.warning[w].number > 0]  # fmt: skip
+    if bad:
+        rows = np.nonzero(~np.all(np.isfinite(rec), axis=1))[0]
+        step = int(rows[0]) if rows.size else None
+        raise SimulationError(
+            "MuJoCo's state became non-finite and was reset",
+            time=step * dt if step is not None else None,
+            step=step,
+            cause="gains too high for dt, or a model MuJoCo cannot integrate (try a smaller --dt)",
+        )
 
 
 def _contiguous(ids: np.ndarray) -> bool:
