@@ -31,10 +31,10 @@ from tests.sim import stability_reference as ref  # noqa: E402
 from armcli.check import dynamics as dyn  # noqa: E402
 from armcli.compiler.expand import expand_urdfs  # noqa: E402
 from armcli.defaults import STANDALONE_ARM_URDF  # noqa: E402
+from armcli.robot.load import joint_ranges, load_model  # noqa: E402
 from armcli.sim import stability as stab  # noqa: E402
 from armcli.sim import verdict as verdicts  # noqa: E402
 from armcli.spec.load import load_spec  # noqa: E402
-from armcli.urdf.pinocchio import joint_ranges, load_model  # noqa: E402
 
 DOFS = (30, 60, 120, 128)
 KP, KD, DAMPING, DT = 5.0, 0.05, 0.01, 1e-3

@@ -12,6 +12,7 @@ import pinocchio as pin
 import pytest
 
 from armcli.errors import InputError, SimulationError
+from armcli.robot.load import load_model
 from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim.reference import build_reference
@@ -27,7 +28,6 @@ from armcli.sim.simulate import (
     simulate_batch,
 )
 from armcli.sim.trajectory import loads_trajectory
-from armcli.urdf.pinocchio import load_model
 from tests.sim.engines import require_native, run_held
 from tests.sim.test_defects import TILTED_URDF
 

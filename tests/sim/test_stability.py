@@ -117,7 +117,7 @@ def test_suggested_bounds_are_the_stability_edge() -> None:
 def test_pinocchio_crba_matches_the_textbook_matrix(root) -> None:
     import pinocchio as pin
 
-    from armcli.urdf.pinocchio import configuration, load_model
+    from armcli.robot.load import configuration, load_model
 
     model = load_model(root / "urdf" / "standalone_arm.urdf").model
     data = model.createData()

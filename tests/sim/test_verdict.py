@@ -23,11 +23,11 @@ from armcli.check import dynamics as dyn
 from armcli.check.rules import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.errors import UnstableLoopError
+from armcli.robot.load import joint_ranges, load_model
 from armcli.sim.simulate import SimConfig, arm_from_model, check_stability
 from armcli.spec.load import load_spec
 from armcli.spec.model import Gains, RobotSpec
 from armcli.urdf.doc import Urdf
-from armcli.urdf.pinocchio import joint_ranges, load_model
 from armcli.urdf.read import parse_urdf
 from tests.helpers import DEFAULT_SPEC, ROOT
 

@@ -8,13 +8,13 @@ from pathlib import Path
 import pytest
 
 from armcli.errors import InputError, XacroRefusedError
+from armcli.robot.load import checked_model
 from armcli.urdf.packages import PackageLookup
 from armcli.urdf.source import (
     Trust,
     allowed_roots,
     expand_xacro,
     inside_roots,
-    load_checked_model,
     read_robot,
     read_urdf_file,
 )
@@ -60,12 +60,12 @@ def test_foreign_xacro_safe_by_suffix_or_content(tmp_path: Path, name: str) -> N
 
 def test_checked_model_refuses_what_pinocchio_would_accept(root: Path) -> None:
     with pytest.raises(InputError, match=r"nan_mass\.urdf:\d+: .*mass@value: non-finite"):
-        load_checked_model(BAD / "urdf" / "nan_mass.urdf")
+        checked_model(read_urdf_file(BAD / "urdf" / "nan_mass.urdf"))
     with pytest.raises(InputError, match="not a number: '0x1p-1'"):
-        load_checked_model(BAD / "urdf" / "hex_number.urdf")
+        checked_model(read_urdf_file(BAD / "urdf" / "hex_number.urdf"))
     with pytest.raises(XacroRefusedError):
-        load_checked_model(BAD / "xacro" / "eval_exploit_renamed.urdf")
-    loaded = load_checked_model(root / "urdf" / "standalone_arm.urdf")
+        checked_model(read_urdf_file(BAD / "xacro" / "eval_exploit_renamed.urdf"))
+    loaded = checked_model(read_urdf_file(root / "urdf" / "standalone_arm.urdf"))
     assert loaded.model.nq == 2
     assert abs(sum(i.mass for i in loaded.model.inertias) - ARM_MASS_KG) < MASS_TOL
 

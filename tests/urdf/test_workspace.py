@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from armcli.compiler.expand import expand_urdfs
+from armcli.robot.load import load_model
+from armcli.robot.tool import ToolPoint
 from armcli.spec.load import load_spec
-from armcli.urdf.pinocchio import load_model
-from armcli.urdf.tool import ToolPoint
 from armcli.urdf.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 from tests.helpers import DEFAULT_SPEC, ROOT
 

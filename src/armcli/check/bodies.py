@@ -20,7 +20,7 @@ import numpy as np
 from armcli.check.inertia import MIN_MOMENT
 from armcli.check.rules import Collector
 from armcli.check.structure import Tree, finite
-from armcli.urdf import inertia as inr
+from armcli.robot import inertia as inr
 from armcli.urdf.doc import Joint, Link, Urdf
 
 # A moving body lighter than this fraction of the robot makes the dynamics stiff.

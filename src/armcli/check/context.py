@@ -15,11 +15,11 @@ from typing import TYPE_CHECKING, Any, Literal
 
 from armcli.check.rules import RULES, CheckOptions, Collector, JointRow
 from armcli.check.structure import Tree
+from armcli.robot.load import JointRange
+from armcli.robot.mimic import follow, mimics
 from armcli.sim.verdict import StabilityReport
 from armcli.spec.joint_types import position_bounds
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mimic import follow, mimics
-from armcli.urdf.pinocchio import JointRange
 
 if TYPE_CHECKING:  # the balance and reach results: imported by their own families
     from armcli.check.balance import StaticBalance

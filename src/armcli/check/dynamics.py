@@ -18,14 +18,14 @@ import numpy as np
 from armcli.check.rules import CheckOptions, Collector, JointRow, Value
 from armcli.check.structure import finite
 from armcli.errors import InputError
+from armcli.robot.load import collision_model, configuration
+from armcli.robot.mimic import Mimic, follow
 from armcli.sim import stability as stab
 from armcli.sim import verdict as verdicts
 from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf
 from armcli.urdf.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
 from armcli.urdf.meshes import mesh_paths
-from armcli.urdf.mimic import Mimic, follow
-from armcli.urdf.pinocchio import collision_model, configuration
 
 GRID_POINTS = 5  # per joint, when the grid has at most MAX_GRID samples
 MAX_GRID = 125

@@ -9,7 +9,7 @@ REACH_TOL is an error naming how close it gets and where.
 from __future__ import annotations
 
 from armcli.check.context import Context
-from armcli.urdf.tool import tool_point
+from armcli.robot.tool import tool_point
 from armcli.urdf.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 
 

@@ -40,9 +40,9 @@ from armcli.check.context import (
 from armcli.check.rules import CheckOptions, Collector, Finding
 from armcli.check.summary import Summary
 from armcli.errors import ModelLoadError
+from armcli.robot.load import joint_ranges, load_model, parser_problems
+from armcli.robot.mimic import mimics
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mimic import mimics
-from armcli.urdf.pinocchio import joint_ranges, load_model, parser_problems
 
 
 @dataclass(frozen=True)

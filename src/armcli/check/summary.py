@@ -15,11 +15,11 @@ import numpy as np
 from armcli.check.context import Context, poses
 from armcli.check.rules import CheckOptions, JointRow
 from armcli.check.structure import finite
+from armcli.robot.load import configuration
+from armcli.robot.tool import tool_point
 from armcli.sim.verdict import StabilityReport
 from armcli.spec.joint_types import total_dof
 from armcli.urdf.doc import Urdf
-from armcli.urdf.pinocchio import configuration
-from armcli.urdf.tool import tool_point
 
 if TYPE_CHECKING:  # the balance and reach results: imported by their own families
     from armcli.check.balance import StaticBalance
@@ -94,7 +94,7 @@ def _total_mass(urdf: Urdf) -> float:
 def _end_effector(
     urdf: Urdf, opts: CheckOptions, model: Any
 ) -> tuple[str, int, tuple[float, float, float]]:
-    """The tool point (armcli.urdf.tool) as (label, Pinocchio frame id, offset [m])."""
+    """The tool point (armcli.robot.tool) as (label, Pinocchio frame id, offset [m])."""
     tool = tool_point(urdf, opts.spec)
     if tool is None or not model.existFrame(tool.link):
         name = str(model.frames[0].name)

@@ -38,7 +38,7 @@ from lxml import etree
 from armcli.compiler.xmlfmt import fmt, vec
 from armcli.errors import ExportRefusedError
 from armcli.export.mjcf_report import Note
-from armcli.urdf import inertia as inr
+from armcli.robot import inertia as inr
 from armcli.urdf.doc import Link, Vec3
 
 MJ_MINVAL = 1e-15  # mjMINVAL: a moving body's mass and principal moments must reach it

@@ -22,9 +22,9 @@ import numpy as np
 
 from armcli.defaults import COLLISION_SAMPLES
 from armcli.errors import BuildError, InputError
+from armcli.robot.load import load_model
+from armcli.robot.mimic import Mimic, follow, mimics
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mimic import Mimic, follow, mimics
-from armcli.urdf.pinocchio import load_model
 from armcli.urdf.read import parse_urdf
 
 DEFAULT_SAMPLES = COLLISION_SAMPLES

@@ -15,6 +15,9 @@ import numpy as np
 
 from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_URDF
 from armcli.errors import InputError
+from armcli.robot.load import checked_model
+from armcli.robot.mimic import Mimic, mimics
+from armcli.robot.tool import tool_point
 from armcli.sim.options import SimOptions
 from armcli.sim.plot import plot_steps
 from armcli.sim.reference import Reference, build_reference, coupled
@@ -32,10 +35,8 @@ from armcli.sim.simulate import (
 from armcli.sim.states import distinct, sample_steps
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mimic import Mimic, mimics
 from armcli.urdf.read import parse_urdf
-from armcli.urdf.source import Trust, checked_model, read_urdf_file
-from armcli.urdf.tool import tool_point
+from armcli.urdf.source import Trust, read_urdf_file
 from armcli.urdf.xacro_args import XacroInputs
 
 if TYPE_CHECKING:
@@ -178,7 +179,7 @@ def _refuse_integral_gain(arm: Arm, spec: RobotSpec | None) -> None:
 
 
 def _tool(arm: Arm, doc: Urdf, spec: RobotSpec | None) -> tuple[int, np.ndarray, str]:
-    """The tool point (armcli.urdf.tool) as (Pinocchio frame id, offset [m], label)."""
+    """The tool point (armcli.robot.tool) as (Pinocchio frame id, offset [m], label)."""
     model = arm.model
     tool = tool_point(doc, spec)
     if tool is None or not model.existFrame(tool.link):

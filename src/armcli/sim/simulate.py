@@ -33,13 +33,13 @@ import numpy as np
 
 from armcli.defaults import DEFAULT_DT
 from armcli.errors import InputError, SimulationError
+from armcli.robot.load import mass_matrix
 from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim import stability as stab
 from armcli.sim import verdict as verdicts
 from armcli.sim.options import INTEGRATORS, Integrator
 from armcli.sim.reference import Reference
-from armcli.urdf.pinocchio import mass_matrix
 
 VEL_ABORT_FACTOR = 10.0  # divergence when |v| exceeds this times the URDF velocity limit
 DEFAULT_VABORT = 1000.0  # [rad/s or m/s] when the URDF gives no velocity limit

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from armcli.errors import InputError, TipOverError
+from armcli.robot.tool import tool_point
 from armcli.sim import job as simjob
 from armcli.sim import zmp as zmps
 from armcli.sim.job import SimJob
@@ -28,7 +29,6 @@ from armcli.urdf.ground import mesh_loader
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.stance import NoStance, Payload, Stance, stance_of
-from armcli.urdf.tool import tool_point
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec

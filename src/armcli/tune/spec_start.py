@@ -15,11 +15,11 @@ import numpy as np
 from armcli.compiler.expand import expand_urdfs
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import InputError
+from armcli.robot.load import load_model
 from armcli.sim.simulate import arm_from_model
 from armcli.spec.joint_types import LIMITED_TYPES
 from armcli.spec.model import RobotSpec
 from armcli.tune.model_gains import TARGET_RATIO, start_gains
-from armcli.urdf.pinocchio import load_model
 
 STEP_CAP = math.pi / 2  # [rad or m] the largest step the start gains are sized for
 

@@ -12,7 +12,7 @@ Mesh URIs may only resolve inside the allowed roots, so a hostile URDF cannot ma
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -21,7 +21,6 @@ from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import EXPANDED_TAG, InputError, XacroRefusedError
 from armcli.urdf.doc import Urdf
 from armcli.urdf.packages import inside, real_roots
-from armcli.urdf.pinocchio import LoadedModel, load_model, parser_problems
 from armcli.urdf.read import parse_urdf, read_urdf
 from armcli.urdf.trust import Trust as Trust  # re-exported: read_robot and callers share it
 from armcli.urdf.xacro_args import Expansion, XacroInputs
@@ -32,14 +31,6 @@ if TYPE_CHECKING:
 SPEC_SUFFIXES = (".yaml", ".yml")
 XACRO_SUFFIX = ".xacro"
 TRUSTED_ENV_REFUSED = ("LD_", "PYTHON")  # --env names that would change how the child runs
-
-
-_PROBLEM = {
-    "missing": "missing number",
-    "not-a-number": "not a number:",
-    "non-finite": "non-finite number",
-    "length": "wrong number of values:",
-}
 
 
 @dataclass(frozen=True)
@@ -149,41 +140,6 @@ def _expand_trusted(
         roots=roots,
     )
     return xml, Expansion.from_dict(report.get("expansion", {}))
-
-
-def load_checked_model(
-    path: Path,
-    *,
-    trust_xacro: Trust = False,
-    gate: Callable[[Urdf], None] | None = None,
-    inputs: XacroInputs | None = None,
-) -> LoadedModel:
-    """A URDF/xacro file -> Pinocchio model, refusing what Pinocchio would silently accept.
-
-    For commands that compute with the model (simulate --urdf): a malformed or
-    non-finite number (Pinocchio turns mass="nan" into 0) or any error the URDF
-    parser prints is an InputError naming the file and line, not a wrong result.
-    """
-    urdf = read_urdf_file(path, trust_xacro=trust_xacro, inputs=inputs)
-    return checked_model(urdf, gate=gate)
-
-
-def checked_model(urdf: Urdf, *, gate: Callable[[Urdf], None] | None = None) -> LoadedModel:
-    """A parsed URDF -> Pinocchio model, refusing what Pinocchio would silently accept.
-
-    `gate`, when given, may refuse the document after the number checks (e.g.
-    check.gate.refuse_check_errors: the model `check` reports as an error).
-    """
-    if urdf.problems:
-        p = urdf.problems[0]
-        raise InputError(f"{p.where}: {_PROBLEM[p.kind]} {p.text!r}", file=urdf.source, line=p.line)
-    if gate is not None:
-        gate(urdf)
-    loaded = load_model(urdf.source, xml=urdf_text(urdf))
-    said = [m for m in parser_problems(loaded.parser_messages) if "error" in m.lower()]
-    if said:
-        raise InputError(f"the URDF parser reported: {said[0]}", file=urdf.source)
-    return loaded
 
 
 def urdf_text(urdf: Urdf) -> str:

@@ -18,9 +18,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from armcli.errors import InputError
+from armcli.robot.load import JointRange, configuration, joint_ranges, load_model
 from armcli.urdf.doc import Urdf, Vec3
 from armcli.urdf.ground import Ground, MeshVertices, find_ground, has_wheels
-from armcli.urdf.pinocchio import JointRange, configuration, joint_ranges, load_model
 from armcli.urdf.support import SupportPolygon, support_polygon
 
 FIXED_BASE = (

@@ -28,9 +28,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from armcli.robot.load import JointRange, configuration, joint_ranges
+from armcli.robot.tool import ToolPoint
 from armcli.urdf.boxsearch import minimize_box
-from armcli.urdf.pinocchio import JointRange, configuration, joint_ranges
-from armcli.urdf.tool import ToolPoint
 
 SAMPLES = 500  # `check`'s cloud: IK seeds and starts (extremes are refined); render draws more
 SAMPLE_SEED = 0

@@ -22,10 +22,10 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import InputError
+from armcli.robot.tool import ToolPoint
 from armcli.sim.states import Replay
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_root
-from armcli.urdf.tool import ToolPoint
 from armcli.urdf.tree import parse_tree
 from armcli.view.png import (
     full_configuration,

@@ -22,8 +22,8 @@ from numpy.typing import NDArray
 
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
-from armcli.urdf.pinocchio import load_model
-from armcli.urdf.tool import ToolPoint
+from armcli.robot.load import load_model
+from armcli.robot.tool import ToolPoint
 from armcli.urdf.workspace import (
     Chain,
     ReachPoint,

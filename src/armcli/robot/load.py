@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 import os
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -19,6 +19,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from armcli.errors import InputError, ModelLoadError
+from armcli.urdf.doc import Urdf
+from armcli.urdf.source import urdf_text
 
 
 @dataclass
@@ -157,3 +159,29 @@ def collision_model(model: Any, xml: str, package_dirs: list[str] | None = None)
     except (RuntimeError, ValueError) as exc:
         raise InputError(f"Pinocchio cannot load the collision geometry: {exc}") from None
     return gmodel
+
+
+_PROBLEM = {
+    "missing": "missing number",
+    "not-a-number": "not a number:",
+    "non-finite": "non-finite number",
+    "length": "wrong number of values:",
+}
+
+
+def checked_model(urdf: Urdf, *, gate: Callable[[Urdf], None] | None = None) -> LoadedModel:
+    """A parsed URDF -> Pinocchio model, refusing what Pinocchio would silently accept.
+
+    `gate`, when given, may refuse the document after the number checks (e.g.
+    check.gate.refuse_check_errors: the model `check` reports as an error).
+    """
+    if urdf.problems:
+        p = urdf.problems[0]
+        raise InputError(f"{p.where}: {_PROBLEM[p.kind]} {p.text!r}", file=urdf.source, line=p.line)
+    if gate is not None:
+        gate(urdf)
+    loaded = load_model(urdf.source, xml=urdf_text(urdf))
+    said = [m for m in parser_problems(loaded.parser_messages) if "error" in m.lower()]
+    if said:
+        raise InputError(f"the URDF parser reported: {said[0]}", file=urdf.source)
+    return loaded

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from armcli.urdf.mimic import Mimic, follow, mimics
+from armcli.robot.mimic import Mimic, follow, mimics
 from armcli.urdf.read import parse_urdf
 
 # Two fingers closing on each other along y: 0.04 m wide boxes whose centres start 0.1 m
@@ -56,7 +56,7 @@ def test_check_samples_and_poses_set_followers_from_leaders() -> None:
     from armcli.check.context import Context, poses
     from armcli.check.rules import CheckOptions, Collector
     from armcli.check.structure import check
-    from armcli.urdf.pinocchio import joint_ranges, load_model
+    from armcli.robot.load import joint_ranges, load_model
 
     doc = parse_urdf(gripper(COUPLED), "g.urdf")
     model = load_model("g.urdf", xml=doc.text.decode()).model
