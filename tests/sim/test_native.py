@@ -22,7 +22,6 @@ from armcli.sim.simulate import (
     Run,
     SimConfig,
     arm_from_model,
-    configuration,
     plant_of,
     simulate,
     simulate_batch,
@@ -72,7 +71,7 @@ def _free_step_equals_python_aba(model: pin.Model) -> bool:
                    friction=np.zeros(n), velocity=np.full(n, 1e9))  # fmt: skip
     rng = np.random.default_rng(n)
     q0, v0 = rng.uniform(-1, 1, n), rng.uniform(-1, 1, n)
-    a = pin.aba(wide.model, wide.model.createData(), configuration(wide.model, q0), v0,
+    a = pin.aba(wide.model, wide.model.createData(), wide.robot.q(q0), v0,
                 np.zeros(n), pin.Convention.WORLD)  # fmt: skip
     if not np.all(np.isfinite(a)):
         return False

@@ -45,11 +45,18 @@ class Joint:
 
     @property
     def span(self) -> tuple[float, float]:
-        """The finite range to sample it over [rad or m]: its limits, else [-pi, pi]."""
-        lo, hi = self.lower, self.upper
-        if self.continuous or not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi:
-            return -math.pi, math.pi
-        return lo, hi
+        """The finite range to sample it over [rad or m] (`span` of its limits)."""
+        return span(self.lower, self.upper)
+
+
+def span(lower: float, upper: float) -> tuple[float, float]:
+    """A joint range to sample over [rad or m]: [lower, upper], else [-pi, pi].
+
+    [-pi, pi] when the range is not finite and in order (a continuous joint's is infinite).
+    """
+    if not (math.isfinite(lower) and math.isfinite(upper)) or lower > upper:
+        return -math.pi, math.pi
+    return lower, upper
 
 
 def joint_table(model: Any) -> tuple[Joint, ...]:
@@ -231,11 +238,14 @@ class Robot:
         return Robot(model, mimics=self.mimics, tool=self.tool, source=self.source, xml=self.xml,
                      parser_messages=self.parser_messages)  # fmt: skip
 
-    def collision_model(self, package_dirs: Sequence[str] = ()) -> Any:
+    def collision_model(self, package_dirs: Sequence[str] = (), *, xml: str | None = None) -> Any:
         """The URDF's collision geometry (a pinocchio.GeometryModel); meshes need package_dirs.
 
-        InputError when the robot was not loaded from URDF text or the geometry is unusable.
+        `xml`: the same robot's URDF text to read instead of its own (e.g. with its mesh
+        paths resolved and confined by the caller). InputError when there is no URDF text
+        or the geometry is unusable.
         """
-        if self.xml is None:
+        text = self.xml if xml is None else xml
+        if text is None:
             raise InputError("no URDF text to read collision geometry from", file=self.source)
-        return collision_model(self.model, self.xml, list(package_dirs))
+        return collision_model(self.model, text, list(package_dirs))

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import itertools
 import random
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -53,8 +53,14 @@ def corners(box: Bounds) -> list[list[float]]:
 
 def draws(box: Bounds, count: int, seed: int = SAMPLE_SEED) -> list[list[float]]:
     """`count` seeded uniform draws in the box, drawn row after row."""
+    return list(iter_draws(box, count, seed))
+
+
+def iter_draws(box: Bounds, count: int, seed: int = SAMPLE_SEED) -> Iterator[list[float]]:
+    """`draws`, one row at a time (for samples too many to hold)."""
     rng = random.Random(seed)
-    return [[rng.uniform(lo, hi) for lo, hi in box] for _ in range(count)]
+    for _ in range(count):
+        yield [rng.uniform(lo, hi) for lo, hi in box]
 
 
 def grid(box: Bounds) -> list[list[float]] | None:

@@ -28,7 +28,6 @@ from armcli.sim.simulate import (
     SimResult,
     arm_from_model,
     check_stability,
-    configuration,
     simulate,
     steps_of,
 )
@@ -325,7 +324,7 @@ def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
     import pinocchio as pin
 
     data = job.arm.model.createData()
-    pin.framesForwardKinematics(job.arm.model, data, configuration(job.arm.model, q))
+    pin.framesForwardKinematics(job.arm.model, data, job.arm.robot.q(q))
     p_root = np.asarray(data.oMf[job.tool_frame].act(job.tool_offset), dtype=float)
     out: np.ndarray = job.T_frame_root[:3, :3] @ p_root + job.T_frame_root[:3, 3]
     return out
