@@ -35,7 +35,7 @@ from armcli.sim.states import distinct, sample_steps
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_urdf
-from armcli.urdf.source import Trust, read_urdf_file
+from armcli.urdf.source import Trust, read_urdf_file, spec_urdfs
 from armcli.urdf.xacro_args import XacroInputs
 
 if TYPE_CHECKING:
@@ -81,9 +81,7 @@ def arm_urdf(
         return read_urdf_file(urdf, trust_xacro=trust_xacro, inputs=inputs)
     if spec is None:
         raise InputError("give a spec or `SimOptions.urdf`", field="SimOptions.urdf")
-    from armcli.compiler.expand import expand_urdfs  # the spec compiler: only for a spec
-
-    return parse_urdf(expand_urdfs(spec)[ARM_URDF], ARM_URDF)
+    return parse_urdf(spec_urdfs(spec)[ARM_URDF], ARM_URDF)
 
 
 def load_arm(

@@ -28,7 +28,7 @@ from armcli.urdf.doc import Urdf
 from armcli.urdf.ground import mesh_loader
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_urdf
-from armcli.urdf.source import lookup_for
+from armcli.urdf.source import lookup_for, spec_urdfs
 from armcli.urdf.stance import NoStance, Payload, Stance, stance_of
 
 if TYPE_CHECKING:
@@ -88,10 +88,8 @@ def robot_urdf(spec: RobotSpec | None, job: SimJob) -> Urdf | None:
         and job.urdf.source.endswith(".urdf")
         and (spec.mounted_base() is not None)
     ):
-        from armcli.compiler.expand import expand_urdfs  # the spec compiler: only for a spec
-
         name = f"{spec.name}.urdf"
-        return parse_urdf(expand_urdfs(spec)[name], name)
+        return parse_urdf(spec_urdfs(spec)[name], name)
     return job.urdf
 
 

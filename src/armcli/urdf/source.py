@@ -12,6 +12,7 @@ Mesh URIs may only resolve inside the allowed roots, so a hostile URDF cannot ma
 from __future__ import annotations
 
 import os
+import threading
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -31,6 +32,9 @@ if TYPE_CHECKING:
 SPEC_SUFFIXES = (".yaml", ".yml")
 XACRO_SUFFIX = ".xacro"
 TRUSTED_ENV_REFUSED = ("LD_", "PYTHON")  # --env names that would change how the child runs
+COMPILED_KEPT = 4  # specs whose compiled URDFs `spec_urdfs` keeps (a command reads one or two)
+_COMPILED: list[tuple[RobotSpec, dict[str, bytes]]] = []  # (spec, its URDFs), newest last
+_COMPILED_LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
@@ -63,15 +67,33 @@ def read_robot(
         raise InputError("is a directory, expected a robot spec, URDF or xacro file", file=path)
     if path.suffix in SPEC_SUFFIXES:
         # the spec layers (pydantic models, ~0.3 s to import) only when a spec is read
-        from armcli.compiler.expand import expand_urdfs
         from armcli.spec.load import load_spec
 
         spec = load_spec(path)
         lookup_for(spec, inputs.packages if inputs is not None else None)  # refuse a bad one now
-        urdfs = expand_urdfs(spec)
+        urdfs = spec_urdfs(spec)
         docs = tuple(parse_urdf(urdfs[n], f"{path}#{n}") for n in sorted(urdfs))
         return RobotFile(path, docs, spec)
     return RobotFile(path, (read_urdf_file(path, trust_xacro=trust_xacro, inputs=inputs),))
+
+
+def spec_urdfs(spec: RobotSpec) -> dict[str, bytes]:
+    """URDF file name -> expanded bytes of the spec's xacro set, compiled once per spec.
+
+    A spec is frozen (pydantic, `frozen=True`), so its URDFs never change: the last
+    COMPILED_KEPT specs keep theirs, and every command asks here instead of compiling
+    again (`simulate` needs the standalone arm and the whole robot: one expansion).
+    """
+    with _COMPILED_LOCK:
+        hit = next((urdfs for s, urdfs in _COMPILED if s is spec), None)
+    if hit is None:
+        from armcli.compiler.expand import expand_urdfs  # the spec compiler: only for a spec
+
+        hit = expand_urdfs(spec)
+        with _COMPILED_LOCK:
+            _COMPILED.append((spec, hit))
+            del _COMPILED[:-COMPILED_KEPT]
+    return dict(hit)
 
 
 def lookup_for(spec: RobotSpec | None, search: PackageLookup | None = None) -> PackageLookup:
