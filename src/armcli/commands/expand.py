@@ -17,6 +17,7 @@ from armcli.commands.xacro_inputs import (
 )
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
+from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
 from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
@@ -51,7 +52,7 @@ def expand_cmd(
         sys.stdout.flush()
         return
     write_file_atomic(out, xml)
-    sys.stderr.write(f"wrote {out}\n")
+    sys.stderr.write(one_line(f"wrote {out}") + "\n")
 
 
 def register(app: typer.Typer) -> None:
