@@ -43,7 +43,7 @@ def expand_cmd(
     if robot is None:
         raise InputError("give the xacro file before its NAME:=VALUE arguments", field="FILE")
     if out is not None:
-        check_output_file(out, "--out")  # before any work: nothing is half-written
+        check_output_file(out, "--out", [robot])  # before any work; never over the input
     inputs = xacro_inputs(tokens, env, package_dir)
     xml, used = expand_xacro(robot, trust_xacro=trust_mode(trust_xacro, unsandboxed), inputs=inputs)
     write_notes(used.notes())
