@@ -23,6 +23,7 @@ SIBLING_EXCEPTIONS = {
     ("check", "armcli.sim.verdict"),
     ("check", "armcli.sim.tipping"),
     ("view", "armcli.sim.states"),
+    ("sim", "armcli.export.mjcf"),
 }
 # The compiler expands its own xacro set with the safe evaluator foreign files get (issue 27:
 # never xacro's Python eval). That evaluator still lives in urdf/ until the xacro/ package

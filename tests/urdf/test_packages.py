@@ -99,6 +99,19 @@ def test_file_uri_in_symlink_install_is_allowed(prefix: Path, tmp_path: Path) ->
     assert not confined(uri, mesh, urdf_dir, no_env())
 
 
+def test_a_four_slash_file_uri_is_the_same_file(prefix: Path, tmp_path: Path) -> None:
+    """COBOTTA writes `file:////abs/path`: the same file as `file:///abs/path` (RFC 8089's
+    empty authority plus an absolute path), found in its package, not reported missing."""
+    lookup = no_env(ament_prefixes=(prefix,))
+    urdf_dir = tmp_path / "elsewhere"
+    urdf_dir.mkdir()
+    mesh = prefix / "share" / ARM_PACKAGE / "meshes" / "upper.stl"
+    uri = f"file:///{mesh}"
+    assert uri.startswith("file:////")
+    assert resolve(uri, urdf_dir, lookup) == mesh == resolve(f"file://{mesh}", urdf_dir, lookup)
+    assert confined(uri, mesh, urdf_dir, lookup)
+
+
 def test_confinement_not_widened(prefix: Path, tmp_path: Path) -> None:
     lookup = no_env(ament_prefixes=(prefix,))
     urdf_dir = tmp_path / "robot"

@@ -43,7 +43,10 @@ from armcli.ros.srdf import chain_joints, srdf_bytes
 from armcli.spec.graph import root_links
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
+from armcli.urdf.meshes import localized
+from armcli.urdf.packages import PackageLookup
 from armcli.urdf.read import parse_urdf
+from armcli.urdf.source import lookup_for
 
 FORMAT3_SCHEMA = "http://download.ros.org/schema/package_format3.xsd"
 DISPLAY_RVIZ = "display.rviz"
@@ -292,11 +295,14 @@ def ros_packages(
     info: PackageInfo = PackageInfo(),
     source: str | None = None,
     target: str = DEFAULT_TARGET,
+    packages: PackageLookup | None = None,
 ) -> RosPackages:
     """All files of the three packages, in memory; deterministic for fixed samples and seed.
 
     `source` (the spec file) is only used to point at it in input errors. `target`
     "jazzy" swaps the Gazebo classic bringup for Gazebo Harmonic + ros2_control.
+    `packages`: where `package://` meshes are (--package-dir, the environment; the spec's
+    recorded `packages` are added), for the collision matrix's geometry.
     """
     if target not in TARGETS:
         raise InputError(f"unknown target {target!r}; known: {', '.join(TARGETS)}")
@@ -307,8 +313,9 @@ def ros_packages(
     urdfs = expand_urdfs(spec)
     urdf_xml = urdfs.get(f"{n.robot}.urdf", urdfs[STANDALONE_ARM_URDF])
     poses = {name: spec.pose(name) for name in spec.poses}
+    local = localized(urdf_xml, source or n.robot_xacro, spec.base_dir, lookup_for(spec, packages))
     matrix = compute_collision_matrix(
-        urdf_xml, samples=samples, seed=seed, source=n.robot_xacro, poses=poses
+        local, samples=samples, seed=seed, source=n.robot_xacro, poses=poses
     )
     note = GENERATED.format(spec=label)
     if target == "jazzy":
@@ -368,6 +375,7 @@ def write_ros_packages(
     info: PackageInfo = PackageInfo(),
     target: str = DEFAULT_TARGET,
     force: bool = False,
+    packages: PackageLookup | None = None,
 ) -> tuple[RosPackages, list[Path]]:
     """Load the spec, build the packages in memory, then write them in one atomic swap."""
     path = Path(spec_path)
@@ -381,5 +389,6 @@ def write_ros_packages(
         info=info,
         source=str(path),
         target=target,
+        packages=packages,
     )
     return pkgs, write_tree_atomic(out_dir, pkgs.files, force=force)

@@ -46,7 +46,7 @@ from armcli.spec.shapes import (
     Shape,
     Sphere,
 )
-from armcli.spec.types import Name, NonNeg, Positive, Real, RobotName, UrdfName, Vec3, _Model
+from armcli.spec.types import Name, NonNeg, Positive, Real, RobotName, Text, UrdfName, Vec3, _Model
 
 __all__ = [
     "Arm",
@@ -250,12 +250,27 @@ class RobotSpec(_Model):
         [],
         description="URDF elements kept verbatim (what `armcli import` could not type)",
     )
+    packages: dict[UrdfName, Text] = Field(
+        {},
+        description="where the ROS packages named by `package://` meshes are: NAME -> its "
+        "directory (holding its package.xml), relative to this spec; `armcli import` writes "
+        "it; `--package-dir` overrides",
+    )
     _source: Path | None = PrivateAttr(None)
 
     @property
     def base_dir(self) -> Path:
         """The directory relative mesh paths start from: the spec file's (else the cwd)."""
         return self._source.parent if self._source is not None else Path(".")
+
+    @property
+    def source_file(self) -> str:
+        """The spec file's name for messages ("<spec>" when built in memory)."""
+        return str(self._source) if self._source is not None else "<spec>"
+
+    def package_dirs(self) -> dict[str, Path]:
+        """`packages` with each directory from the spec file's directory."""
+        return {name: self.base_dir / rel for name, rel in self.packages.items()}
 
     def with_source(self, path: Path) -> RobotSpec:
         """This spec, remembering the file it was read from (for relative mesh paths)."""
