@@ -9,6 +9,7 @@ import typer
 
 from armcli.commands.flags import flag_errors
 from armcli.commands.options import spec_argument
+from armcli.io.oneline import one_line
 from armcli.spec.discover import find_spec
 
 
@@ -31,12 +32,12 @@ def build_cmd(
     spec = find_spec(spec)
     if check:
         check_fresh(spec, out)
-        sys.stdout.write(f"{out}: up to date with {spec}\n")
+        sys.stdout.write(one_line(f"{out}: up to date with {spec}") + "\n")
         return
     result = build(spec, out, force=force)
-    sys.stdout.write(f"built {len(result.files)} files from {spec} into {out}/\n")
+    sys.stdout.write(one_line(f"built {len(result.files)} files from {spec} into {out}/") + "\n")
     for f in result.files:
-        sys.stdout.write(f"  {f}\n")
+        sys.stdout.write(one_line(f"  {f}") + "\n")
 
 
 def register(app: typer.Typer) -> None:

@@ -13,6 +13,7 @@ from armcli.commands.flags import flag_errors
 from armcli.commands.importer import report
 from armcli.commands.xacro_inputs import write_notes
 from armcli.defaults import SPEC_FILE, TRAJECTORY_DIR
+from armcli.io.oneline import one_line
 from armcli.spec.scaffold import DEFAULT_TEMPLATE, TEMPLATES, init_project
 
 
@@ -47,9 +48,9 @@ def init_cmd(
         return
     written = init_project(directory, template)
     where = "." if directory == Path(".") else str(directory)
-    sys.stdout.write(f"wrote {len(written)} files into {where}{os.sep}\n")
+    sys.stdout.write(one_line(f"wrote {len(written)} files into {where}{os.sep}") + "\n")
     for path in written:
-        sys.stdout.write(f"  {path}\n")
+        sys.stdout.write(one_line(f"  {path}") + "\n")
     cd = "" if where == "." else f"cd {where} && "
     pick = (TRAJECTORY_DIR / "pick.yaml").as_posix()
     sys.stdout.write(

@@ -120,7 +120,9 @@ def render_cmd(
             one_line(f"warning: {src.source}: mesh {uri!r}: {what}; drawn without it") + "\n"
         )
     drawn = _drawn(src.poses, pose, q)
-    sys.stdout.write(f"wrote {res.path} ({res.width}x{res.height} px) at {drawn};{tip}\n")
+    sys.stdout.write(
+        one_line(f"wrote {res.path} ({res.width}x{res.height} px) at {drawn};{tip}") + "\n"
+    )
     for line in lines:
         sys.stdout.write(f"{line}\n")
 

@@ -257,7 +257,7 @@ def _run(
         out.print(line, style="red" if balance.tips else None, markup=False, highlight=False)
     for path in (output, plot):
         if path is not None:
-            out.print(f"wrote {path}", markup=False, highlight=False)
+            out.print(one_line(f"wrote {path}"), markup=False, highlight=False)
     if balance is not None and balance.tips:
         raise tipping.tip_error(balance)
 

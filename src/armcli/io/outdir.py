@@ -20,7 +20,7 @@ import os
 import pwd
 import shutil
 import stat
-from collections.abc import Collection
+from collections.abc import Collection, Sequence
 from pathlib import Path, PurePath, PurePosixPath
 
 from armcli.errors import OutputRefusedError
@@ -108,10 +108,21 @@ def resolve_output_dir(path: str | Path, *, force: bool = False, field: str = "o
     return real
 
 
-def check_output_file(path: str | Path, field: str) -> None:
-    """Refuse an output file path that cannot be written, before any output is written."""
+def check_output_file(path: str | Path, field: str, inputs: Sequence[str | Path] = ()) -> None:
+    """Refuse an output file path that cannot be written, before any output is written.
+
+    `inputs`: the files the command reads; writing over one of them (`expand a.xacro -o
+    a.xacro`, hard links and symlinks included) is refused (issue 27).
+    """
     p = Path(path)
     real = Path(os.path.realpath(p))
+    for given in inputs:
+        if os.path.realpath(given) == str(real) or (
+            real.exists() and Path(given).exists() and os.path.samefile(given, real)
+        ):
+            raise OutputRefusedError(
+                f"is the input file {given}; write elsewhere", file=p, field=field
+            )
     if real.is_dir():
         raise OutputRefusedError("is a directory, expected a file path", file=p, field=field)
     if os.path.lexists(real) and not real.is_file():
