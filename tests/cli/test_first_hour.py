@@ -66,3 +66,16 @@ def test_a_base_without_an_arm_gets_no_arm_advice(capsys: pytest.CaptureFixture[
     assert "arm" not in margin["hint"]
     code, out, _ = run_main(["check", urdf], capsys)
     assert "end effector" not in out  # a wheel is no tool point
+
+
+def test_the_demo_trajectory_ends_off_the_joint_stops() -> None:
+    """`make demo` simulates pick.yaml: ending on the stops gave stop hits on every run."""
+    from armcli.sim.trajectory import load_trajectory
+    from armcli.spec.load import load_spec
+
+    spec = load_spec(DEFAULT_SPEC)
+    limits = {n: (j.limit.lower, j.limit.upper) for n, j in spec.arm.joints.items() if j.limit}
+    traj = load_trajectory(PICK, limits)
+    for name, q in zip(traj.joint_names, traj.positions[-1], strict=True):
+        lower, upper = limits[name]
+        assert lower < q < upper, name
