@@ -79,3 +79,31 @@ def test_the_demo_trajectory_ends_off_the_joint_stops() -> None:
     for name, q in zip(traj.joint_names, traj.positions[-1], strict=True):
         lower, upper = limits[name]
         assert lower < q < upper, name
+
+
+def test_build_says_what_check_will_call_an_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    text = DEFAULT_SPEC.read_text()
+    spec = tmp_path / "v.yaml"
+    spec.write_text(text.replace("effort: 100, velocity: 100}", "effort: 100, velocity: 0}", 1))
+    code, _, err = run_main(["build", spec, "-o", tmp_path / "out"], capsys)
+    assert code == 0  # built: the URDF is valid, only physically meaningless
+    (line,) = err.strip().splitlines()
+    assert line.startswith(f"warning: {spec}:93 arm.joints.arm_base_forearm_joint.limit.velocity")
+    assert "velocity limit 0 must be > 0 (check: limit-effort-velocity)" in line
+    code, _, err = run_main(["check", spec], capsys)
+    assert code == 1  # the same finding, as check's error
+    code, _, err = run_main(["build", DEFAULT_SPEC, "-o", tmp_path / "ok"], capsys)
+    assert code == 0 and err == ""  # the example has none
+
+
+def test_export_mjcf_creates_its_directory_as_build_does(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, _, err = run_main(["export", "mjcf", DEFAULT_SPEC, "-o", tmp_path / "a/b/r.xml"], capsys)
+    assert code == 0, err
+    assert sorted(p.name for p in (tmp_path / "a" / "b").iterdir()) == ["r.xml", "scene.xml"]
+    (tmp_path / "f").write_text("")  # a file where a directory would go: refused, untouched
+    code, _, err = run_main(["export", "mjcf", DEFAULT_SPEC, "-o", tmp_path / "f/r.xml"], capsys)
+    assert code == 2 and "is not a directory" in err

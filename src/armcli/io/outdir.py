@@ -108,8 +108,12 @@ def resolve_output_dir(path: str | Path, *, force: bool = False, field: str = "o
     return real
 
 
-def check_output_file(path: str | Path, field: str) -> None:
-    """Refuse an output file path that cannot be written, before any output is written."""
+def check_output_file(path: str | Path, field: str, *, parents: bool = False) -> None:
+    """Refuse an output file path that cannot be written, before any output is written.
+
+    `parents`: the file heads a set written together (export mjcf: model, scene, meshes),
+    whose missing directories are created as `build -o` and `ros-package -o` create theirs.
+    """
     p = Path(path)
     real = Path(os.path.realpath(p))
     if real.is_dir():
@@ -120,6 +124,8 @@ def check_output_file(path: str | Path, field: str) -> None:
         )
     if not real.parent.is_dir():  # a typo must not create directories (issue 20)
         _check_parent(real, field)
+        if parents:
+            return
         raise OutputRefusedError(
             f"directory {real.parent} does not exist; create it first", file=p, field=field
         )
