@@ -18,7 +18,7 @@ from armcli.check.structure import finite
 from armcli.sim.verdict import StabilityReport
 from armcli.spec.joint_types import total_dof
 from armcli.urdf.doc import Urdf
-from armcli.urdf.pinocchio import configuration
+from armcli.urdf.pinocchio import configuration, link_frame
 from armcli.urdf.tool import tool_point
 
 if TYPE_CHECKING:  # the balance and reach results: imported by their own families
@@ -102,7 +102,7 @@ def _end_effector(
 ) -> tuple[str, int, tuple[float, float, float]]:
     """The tool point (armcli.urdf.tool) as (label, Pinocchio frame id, offset [m])."""
     tool = tool_point(urdf, opts.spec)
-    if tool is None or not model.existFrame(tool.link):
-        name = str(model.frames[0].name)
-        return name, model.getFrameId(name), (0.0, 0.0, 0.0)
-    return tool.label, model.getFrameId(tool.link), tool.xyz
+    frame = link_frame(model, tool.link) if tool is not None else None
+    if tool is None or frame is None:
+        return str(model.frames[0].name), 0, (0.0, 0.0, 0.0)
+    return tool.label, frame, tool.xyz

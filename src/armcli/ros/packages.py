@@ -20,14 +20,12 @@ import yaml
 from lxml import etree
 
 from armcli.compiler.expand import expand_urdfs
-from armcli.compiler.massprops import MAX_MESH_BYTES
-from armcli.compiler.meshfiles import MeshNames, package_meshes, package_of, spec_mesh_names
+from armcli.compiler.meshfiles import MeshNames, package_of, spec_mesh_names
 from armcli.compiler.xacro_writer import GENERATED, STANDALONE_ARM, top_level_files, xacro_files
 from armcli.defaults import ROS_TARGETS, STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.io.files import write_tree_atomic
 from armcli.io.outdir import resolve_output_dir
-from armcli.io.userfile import read_regular
 from armcli.ros import jazzy
 from armcli.ros import moveit as mc
 from armcli.ros.collision_matrix import (
@@ -36,6 +34,7 @@ from armcli.ros.collision_matrix import (
     CollisionMatrix,
     compute_collision_matrix,
 )
+from armcli.ros.copying import mesh_files
 from armcli.ros.jazzy_readme import readme as jazzy_readme
 from armcli.ros.launch import render
 from armcli.ros.ros2_control import moveit_urdf_xacro, ros2_control_xacro
@@ -234,14 +233,6 @@ def description_files(
     others = sorted({p for m in spec_mesh_names(spec) if (p := package_of(m)) is not None})
     depends = [*DESCRIPTION_DEPENDS, *(p for p in others if p != n.description)]
     return _package(n.description, about, depends, files, info)
-
-
-def mesh_files(spec: RobotSpec) -> dict[str, bytes]:
-    """The spec's path-named meshes, copied under `meshes/` (bounded regular files)."""
-    out = {}
-    for rel, path in package_meshes(spec).items():
-        out[rel] = read_regular(path, max_bytes=MAX_MESH_BYTES, what="mesh file")
-    return out
 
 
 def bringup_files(n: Names, note: str, info: PackageInfo) -> dict[str, bytes]:

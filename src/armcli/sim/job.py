@@ -33,6 +33,7 @@ from armcli.sim.states import distinct, sample_steps
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.urdf.doc import Urdf
 from armcli.urdf.mimic import Mimic, mimics
+from armcli.urdf.pinocchio import link_frame
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import Trust, checked_model, read_urdf_file
 from armcli.urdf.tool import tool_point
@@ -181,9 +182,10 @@ def _tool(arm: Arm, doc: Urdf, spec: RobotSpec | None) -> tuple[int, np.ndarray,
     """The tool point (armcli.urdf.tool) as (Pinocchio frame id, offset [m], label)."""
     model = arm.model
     tool = tool_point(doc, spec)
-    if tool is None or not model.existFrame(tool.link):
+    frame = link_frame(model, tool.link) if tool is not None else None
+    if tool is None or frame is None:
         raise InputError("this URDF has no link to report as the end effector", file=doc.source)
-    return model.getFrameId(tool.link), np.array(tool.xyz, dtype=float), tool.label
+    return frame, np.array(tool.xyz, dtype=float), tool.label
 
 
 def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:

@@ -279,8 +279,14 @@ def _short(x: Any) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
-def _time(point: dict[str, Any], previous: Sequence[float], k: int, c: _Collector) -> float:
-    path: tuple[str | int, ...] = ("points", k, "time_from_start")
+def _time(
+    point: dict[str, Any], previous: Sequence[float], k: int, c: _Collector, key: str = "points"
+) -> float:
+    """`time_from_start` of entry `k` of the list `key` [s] (seconds or {sec, nanosec}).
+
+    Missing: DEFAULT_SEGMENT_S after the previous entry. sim.cmdvel reads its times so too.
+    """
+    path: tuple[str | int, ...] = (key, k, "time_from_start")
     last = previous[-1] if previous else 0.0
     raw = point.get("time_from_start")
     if raw is None:
@@ -309,7 +315,7 @@ def _time(point: dict[str, Any], previous: Sequence[float], k: int, c: _Collecto
     elif t > MAX_TIME_S:
         c.add(path, f"must be <= {MAX_TIME_S:g} s, got {t:g}")
     elif previous and t <= last:
-        c.add(path, f"times must increase: {t:g} s is not after point {k - 1} at {last:g} s")
+        c.add(path, f"times must increase: {t:g} s is not after {key[:-1]} {k - 1} at {last:g} s")
     elif 0 < t - last < MIN_SEGMENT_S:
         c.add(
             path,

@@ -10,6 +10,7 @@ cross-references (parents exist, one root, plugin joints exist) are checked in
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -331,10 +332,14 @@ class RobotSpec(_Model):
 
 
 def _tree_order(joints: dict[str, Joint], root: str) -> Iterator[tuple[str, Joint]]:
-    frontier = [root]
+    """Joints breadth-first from `root`, siblings in spec order (linear in the tree's size)."""
+    below: dict[str, list[tuple[str, Joint]]] = {}
+    for name, j in joints.items():
+        below.setdefault(j.parent, []).append((name, j))
+    frontier, seen = deque([root]), {root}
     while frontier:
-        link = frontier.pop(0)
-        for name, j in joints.items():
-            if j.parent == link:
-                yield name, j
+        for name, j in below.get(frontier.popleft(), ()):
+            yield name, j
+            if j.child not in seen:  # a link with two parents is reported, not looped over
+                seen.add(j.child)
                 frontier.append(j.child)

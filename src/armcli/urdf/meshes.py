@@ -46,7 +46,10 @@ def resolve(uri: str, base_dir: Path, search: MeshSearch) -> Path | None:
         root = package_root(name, base_dir, search)
         return root / rel if root is not None else None
     if parsed.scheme == "file":
-        return Path(unquote(parsed.path))
+        # file:////abs/path (COBOTTA) is file:///abs/path: POSIX keeps a leading `//` in
+        # a path as a different root, which made the package lookup miss the file.
+        path = unquote(parsed.path)
+        return Path("/" + path.lstrip("/") if path.startswith("/") else path)
     if parsed.scheme:
         return None
     p = Path(uri)

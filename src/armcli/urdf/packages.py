@@ -18,7 +18,9 @@ package root the lookup found. A root counts with two real directories: its own 
 path and, when its package.xml is a symlink, the directory that package.xml really lives
 in: `colcon build --symlink-install` installs one symlink per file from `share/NAME` into
 the source package, and that source package is where its package.xml points. A symlink
-to anywhere else still leaves the roots.
+to anywhere else still leaves the roots. A root whose real path is `/`, a system
+directory or the home directory is no root at all (issue 27: an AMENT_PREFIX_PATH
+prefix registering a package whose share dir links to `/` opened every host file).
 """
 
 from __future__ import annotations
@@ -35,6 +37,42 @@ from armcli.urdf.mesh_confine import is_package, package_xml_name
 
 IGNORE_MARKERS = ("COLCON_IGNORE", "AMENT_IGNORE", "CATKIN_IGNORE")
 AMENT_INDEX = Path("share", "ament_index", "resource_index", "packages")
+# real paths that are never a package root: the filesystem root and system directories
+SYSTEM_DIRS = frozenset(
+    [
+        "/",
+        "/bin",
+        "/boot",
+        "/dev",
+        "/etc",
+        "/home",
+        "/lib",
+        "/lib32",
+        "/lib64",
+        "/libx32",
+        "/media",
+        "/mnt",
+        "/opt",
+        "/proc",
+        "/root",
+        "/run",
+        "/sbin",
+        "/srv",
+        "/sys",
+        "/tmp",
+        "/usr",
+        "/usr/bin",
+        "/usr/include",
+        "/usr/lib",
+        "/usr/lib64",
+        "/usr/local",
+        "/usr/sbin",
+        "/usr/share",
+        "/var",
+        "/var/lib",
+        "/var/tmp",
+    ]
+)
 MAX_CRAWL_DIRS = 200_000  # directories visited per ROS_PACKAGE_PATH entry (a typo'd "/")
 
 
@@ -268,7 +306,12 @@ def real_roots(root: Path) -> tuple[Path, ...]:
         source = Path(os.path.realpath(xml)).parent
         if source not in out and package_xml_name(source) == root.name:
             out.append(source)
-    return tuple(out)
+    return tuple(r for r in out if usable_root(r))
+
+
+def usable_root(real: Path) -> bool:
+    """Whether a real path may be a package root: not `/`, a system or the home directory."""
+    return str(real) not in SYSTEM_DIRS and real != Path(os.path.realpath(Path.home()))
 
 
 def inside(path: Path, roots: tuple[Path, ...] | list[Path]) -> bool:
