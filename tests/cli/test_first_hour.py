@@ -107,3 +107,30 @@ def test_export_mjcf_creates_its_directory_as_build_does(
     (tmp_path / "f").write_text("")  # a file where a directory would go: refused, untouched
     code, _, err = run_main(["export", "mjcf", DEFAULT_SPEC, "-o", tmp_path / "f/r.xml"], capsys)
     assert code == 2 and "is not a directory" in err
+
+
+def test_everyday_output_fits_80_columns(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every line within COLUMNS=80 (issue 31: `init`'s next line was 142, `render` 154-284,
+    check's xacro note 293 columns); names and paths are never cut to get there."""
+    monkeypatch.setenv("COLUMNS", "80")
+    monkeypatch.chdir(tmp_path)
+    urdf = ROOT / "tests" / "fixtures" / "tipover" / "wheeled_base.urdf"
+    runs = [
+        ["init", "a_project_directory_with_a_long_name"],
+        ["build", DEFAULT_SPEC, "-o", "urdf"],
+        ["check", DEFAULT_SPEC],
+        ["check", urdf],
+        ["render", DEFAULT_SPEC, "-o", "robot.png"],
+        ["tree", DEFAULT_SPEC],
+        ["ros-package", DEFAULT_SPEC, "-o", "ros", "--samples", "20"],
+        ["import", urdf, "-o", "imported.yaml"],
+    ]
+    for args in runs:
+        code, out, err = run_main(args, capsys)
+        assert code == 0, (args, err)
+        long = [line for line in (out + err).splitlines() if len(line) > 80]
+        assert not long, (args, long)
+    code, out, _ = run_main(["init", "b"], capsys)
+    assert "\n  armcli simulate --trajectory trajectories/pick.yaml\n" in out  # whole, to copy
