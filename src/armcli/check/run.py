@@ -113,6 +113,20 @@ def check_urdf(urdf: Urdf, options: CheckOptions | None = None) -> CheckResult:
     return CheckResult(urdf.source, tuple(out.findings), summary.summarise(ctx))
 
 
+def check_document(urdf: Urdf, options: CheckOptions | None = None) -> tuple[Finding, ...]:
+    """The findings of the rules that read the document alone (no model loaded).
+
+    Fast: what `build` reports of what `check` will say.
+    """
+    opts = options or CheckOptions()
+    out = Collector(urdf.source)
+    ctx = Context(urdf, opts, out, structure.check(urdf, out), rows=joint_rows(urdf))
+    for family in FAMILIES:
+        if family.needs == URDF:
+            family.run(ctx)
+    return tuple(out.findings)
+
+
 def _ready(ctx: Context, needs: Stage) -> bool:
     """Whether the stage `needs` is there, reaching it on first demand (see check/context.py)."""
     if needs == URDF:
