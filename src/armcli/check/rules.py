@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from armcli.urdf.meshes import MeshSearch
+from armcli.urdf.source import lookup_for
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -455,7 +456,7 @@ class CheckOptions:
 
     def mesh_search(self) -> MeshSearch:
         """The mesh-resolver view of these options (shared with view and render)."""
-        return MeshSearch(self.package_dirs, self.search_paths)
+        return lookup_for(self.spec, MeshSearch(self.package_dirs, self.search_paths))
 
 
 def apply_policy(

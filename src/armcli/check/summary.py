@@ -71,7 +71,7 @@ def summarise(ctx: Context) -> Summary:
         "reach": ctx.reach,
         "reach_points": ctx.reach_points,
     }
-    if ctx.model is None:
+    if ctx.model is None or _no_arm(ctx):
         return Summary(**base, end_effector="", poses=())
     import pinocchio as pin
 
@@ -84,6 +84,12 @@ def summarise(ctx: Context) -> Summary:
         xyz = data.oMf[ee_frame].act(np.asarray(ee_offset, dtype=float))
         pose_rows.append(PoseRow(name, tuple(values.items()), tuple(float(x) for x in xyz)))  # type: ignore[arg-type]
     return Summary(**base, end_effector=ee_label, poses=tuple(pose_rows))
+
+
+def _no_arm(ctx: Context) -> bool:
+    """A base without an arm: the tool point (the deepest link) is a wheel on the ground."""
+    tool = tool_point(ctx.urdf, ctx.opts.spec)
+    return tool is not None and ctx.stance is not None and tool.link in ctx.stance.ground.links
 
 
 def _total_mass(urdf: Urdf) -> float:

@@ -250,6 +250,18 @@ def _duration_and_rate(
     return float(total), float(rate)
 
 
+def base_joints(spec: RobotSpec | None) -> dict[str, str]:
+    """The mobile base's joints by name, with what they are (a trajectory may not name them)."""
+    if spec is None or spec.mobile_base is None:
+        return {}
+    return {
+        name: "a wheel joint of the mobile base"
+        if j.type == "continuous"
+        else "a mobile-base joint"
+        for name, j in spec.mobile_base.joints.items()
+    }
+
+
 def prepare(
     spec: RobotSpec | None, opts: SimOptions, *, gate: Callable[[Urdf], None] | None = None
 ) -> SimJob:
@@ -274,10 +286,13 @@ def prepare(
         n: (float(lo), float(hi))
         for n, lo, hi in zip(arm.joint_names, arm.lower, arm.upper, strict=True)
     }
+    others = base_joints(spec)
     if trajectory is not None:
-        traj = load_trajectory(trajectory, limits, clamp=opts.clamp)
+        traj = load_trajectory(trajectory, limits, clamp=opts.clamp, others=others)
     else:
-        traj = loads_trajectory(str(message), limits, source="SimOptions.message", clamp=opts.clamp)
+        traj = loads_trajectory(
+            str(message), limits, source="SimOptions.message", clamp=opts.clamp, others=others
+        )
     pairs = mimic_pairs(doc, arm, traj, str(trajectory) if trajectory else "SimOptions.message")
     q0 = start_state(arm, spec)
     for f, lead, m in pairs:
