@@ -24,6 +24,7 @@ import struct
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
+from typing import Any
 
 import numpy as np
 from lxml import etree
@@ -107,8 +108,8 @@ def _collada(data: bytes) -> MeshFile:
 
     try:
         with quiet_trimesh():  # a missing texture does not change a triangle
-            mesh = trimesh.load(io.BytesIO(data), file_type="dae", force="mesh", process=False)
-        v = np.asarray(mesh.vertices, dtype=float) * _collada_unit(data)
+            mesh: Any = trimesh.load(io.BytesIO(data), file_type="dae", force="mesh", process=False)
+        v = np.asarray(mesh.vertices, dtype=np.float64) * _collada_unit(data)
         f = np.asarray(mesh.faces, dtype=np.int64)
     except Exception as exc:  # trimesh and pycollada raise many types for bad files
         return MeshFile(data, ".dae", None, False, False, f"COLLADA not readable: {exc}")
