@@ -92,7 +92,7 @@ def test_init_creates_the_directory(tmp_path: Path, capsys: pytest.CaptureFixtur
     target = tmp_path / "a" / "new"
     assert _main(["init", str(target)]) == 0
     assert (target / "armcli.yaml").is_file() and (target / "trajectories" / "pick.yaml").is_file()
-    assert f"next: cd {target} && armcli build" in capsys.readouterr().out
+    assert f"\n  cd {target}\n  armcli build\n" in capsys.readouterr().out
     assert sorted(p.name for p in target.parent.iterdir()) == ["new"]  # no staging left
 
 

@@ -55,6 +55,24 @@ FLAGS = {
 }
 
 
+def _flagged(line: str) -> str:
+    """`SimOptions.message ...` as `--message ...`: a line names the flag the user typed."""
+    source = line.split(" ", 1)[0]
+    return FLAGS.get(source, source) + line[len(source) :]
+
+
+def _diagnose(job: Any) -> None:
+    """Refuse a reference faster than a velocity limit; warn of efforts below gravity."""
+    from armcli.sim.precheck import holding_problems, speed_problems
+
+    fast = speed_problems(job)
+    if fast:
+        more = f" (and {len(fast) - 1} more joint(s))" if len(fast) > 1 else ""
+        raise InputError(_flagged(fast[0]) + more)
+    for line in holding_problems(job):
+        sys.stderr.write(one_line(f"warning: {_flagged(line)}") + "\n")
+
+
 def _floats(text: str | None, option: str) -> list[float] | None:
     if text is None:
         return None
@@ -142,6 +160,7 @@ def simulate_cmd(
         _drive(spec_obj, opts, cmd_vel, tuple(ignore), output, plot, tip_opts != TipOptions())
         return
     job = _prepare(spec_obj, spec_path, opts, tuple(ignore))
+    _diagnose(job)  # the trajectory's own impossibilities before any simulated verdict
     notes: list[str] = []
     tip = tipping.prepare(spec_obj, job, tip_opts, inputs.packages, notes)
     asked = tip_opts != TipOptions()  # an arm on a fixed base is news only when asked about
@@ -232,9 +251,7 @@ def _run(
     err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
     write_notes([*job.notes, *(notes or [])])
     for w in job.trajectory.warnings:
-        source = w.split(" ", 1)[0]  # `SimOptions.message` is the flag `--message`
-        w = FLAGS.get(source, source) + w[len(source) :]
-        err.print(one_line(f"warning: {w}"), markup=False, highlight=False)
+        err.print(one_line(f"warning: {_flagged(w)}"), markup=False, highlight=False)
     extra = None if tip is None else (lambda steps: tip.steps(job, steps))
     with _LazyProgress(err) as progress:
         res = simjob.run(job, progress, plot=plot is not None, extra=extra)
@@ -266,7 +283,7 @@ def _run(
         out.print(line, style="red" if balance.tips else None, markup=False, highlight=False)
     for path in (output, plot):
         if path is not None:
-            out.print(f"wrote {path}", markup=False, highlight=False)
+            out.print(one_line(f"wrote {path}"), markup=False, highlight=False)
     if balance is not None and balance.tips:
         raise tipping.tip_error(balance)
 

@@ -30,7 +30,7 @@ from armcli.sim.diffdrive import DiffDriveController, DriveParams, Odometry, enc
 from armcli.sim.drivemodel import DriveModel, build_drive_model
 from armcli.sim.job import SimJob
 from armcli.sim.options import SimOptions
-from armcli.sim.simulate import configuration, steps_of
+from armcli.sim.simulate import steps_of
 from armcli.sim.tipping import robot_urdf
 from armcli.urdf.doc import Urdf
 from armcli.urdf.stance import NoStance, Stance, stance_of
@@ -231,10 +231,10 @@ def _gravity(arm: SimJob) -> Callable[[np.ndarray], np.ndarray]:
     """g(q) [N·m] of the fixed-base arm, as `simulate`'s controller adds it."""
     import pinocchio as pin
 
-    model = arm.arm.model
-    data = model.createData()
+    robot = arm.arm.robot
+    model, data = robot.model, robot.model.createData()
 
     def g(q: np.ndarray) -> Any:
-        return pin.computeGeneralizedGravity(model, data, configuration(model, q))
+        return pin.computeGeneralizedGravity(model, data, robot.q(q))
 
     return g

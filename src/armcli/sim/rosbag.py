@@ -33,6 +33,7 @@ import numpy as np
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
 from armcli.io.userfile import open_regular
+from armcli.sim.mcap_guard import check_chunks
 from armcli.sim.simulate import SimResult
 from armcli.sim.states import MAX_REPLAY_ROWS, TIME, Replay, column, sample_states
 from armcli.urdf.doc import Joint, Urdf
@@ -309,6 +310,7 @@ def load_replay(path: str | Path, joints: Sequence[str]) -> Replay:
     count = 0
     try:  # a regular file of bounded size (a FIFO blocked open() forever), bounded messages
         with open_regular(path, max_bytes=MAX_REPLAY_BYTES, what="MCAP file") as fh:
+            check_chunks(fh, source)  # chunks inflate within a bound, or one error (issue 27)
             reader = make_reader(fh, decoder_factories=[DecoderFactory()])
             for _, channel, _raw, msg in reader.iter_decoded_messages(
                 topics=[JOINT_STATES, REFERENCE, TF]
@@ -327,8 +329,13 @@ def load_replay(path: str | Path, joints: Sequence[str]) -> Replay:
                     raise InputError(f"{channel.topic} at t = {t:g} s: {bad[0]} is not finite",
                                      file=source)  # fmt: skip
                 rows[channel.topic].append((t, mine))
+    except InputError:
+        raise
     except (McapError, OSError, ValueError, KeyError) as exc:
         raise InputError(f"unreadable MCAP file: {exc}", file=source) from None
+    except Exception as exc:  # the CDR decoder of a crafted message: struct.error, IndexError...
+        why = f"a message does not decode ({type(exc).__name__}: {exc}"[:200] + ")"
+        raise InputError(f"unreadable MCAP file: {why}", file=source) from None
     if not rows[JOINT_STATES]:
         raise InputError(f"no {JOINT_STATES} messages", file=source)
     replay = _replay(source, rows[JOINT_STATES], rows[REFERENCE])

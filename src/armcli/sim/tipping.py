@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from armcli.errors import InputError, TipOverError
+from armcli.robot.tool import tool_point
 from armcli.sim import job as simjob
 from armcli.sim import zmp as zmps
 from armcli.sim.job import SimJob
@@ -27,9 +28,8 @@ from armcli.urdf.doc import Urdf
 from armcli.urdf.ground import mesh_loader
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_urdf
-from armcli.urdf.source import lookup_for
+from armcli.urdf.source import lookup_for, spec_urdfs
 from armcli.urdf.stance import NoStance, Payload, Stance, stance_of
-from armcli.urdf.tool import tool_point
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -88,10 +88,8 @@ def robot_urdf(spec: RobotSpec | None, job: SimJob) -> Urdf | None:
         and job.urdf.source.endswith(".urdf")
         and (spec.mounted_base() is not None)
     ):
-        from armcli.compiler.expand import expand_urdfs  # the spec compiler: only for a spec
-
         name = f"{spec.name}.urdf"
-        return parse_urdf(expand_urdfs(spec)[name], name)
+        return parse_urdf(spec_urdfs(spec)[name], name)
     return job.urdf
 
 

@@ -22,11 +22,12 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import InputError
+from armcli.robot.tool import ToolPoint
 from armcli.sim.states import Replay
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_root
-from armcli.urdf.tool import ToolPoint
 from armcli.urdf.tree import parse_tree
+from armcli.view.origin import checked_requests
 from armcli.view.png import (
     full_configuration,
     joint_limits,
@@ -105,7 +106,8 @@ class Viewer:
         self._stop = threading.Event()
         self._playing = False
         check_port_free(host, port)
-        with contextlib.redirect_stdout(io.StringIO()):  # viser prints a banner; the CLI prints
+        # viser prints a banner (the CLI prints its own); Host/Origin checked (view.origin)
+        with contextlib.redirect_stdout(io.StringIO()), checked_requests(host):
             self.server = viser.ViserServer(
                 host=host, port=port, label=f"armcli: {name}", verbose=False
             )
