@@ -100,7 +100,7 @@ def _check_free(ctx: PlanningContext, x: np.ndarray, what: str) -> None:
         )
 
 
-def values(ctx: PlanningContext, x: Sequence[float], what: str) -> np.ndarray:
+def values(ctx: PlanningContext, x: Sequence[float] | np.ndarray, what: str) -> np.ndarray:
     """Validated joint values: one finite number per planned joint."""
     arr = np.asarray(list(x), dtype=float)
     n = len(ctx.robot.joints)
@@ -113,7 +113,10 @@ def values(ctx: PlanningContext, x: Sequence[float], what: str) -> np.ndarray:
 
 
 def plan_motion(
-    ctx: PlanningContext, start: Sequence[float], goal: Sequence[float], options: PlanOptions
+    ctx: PlanningContext,
+    start: Sequence[float] | np.ndarray,
+    goal: Sequence[float] | np.ndarray,
+    options: PlanOptions,
 ) -> PlanResult:
     """A certified, time-parameterised collision-free motion from `start` to `goal`.
 
@@ -130,6 +133,7 @@ def plan_motion(
     limits = {n: (float(lo), float(hi)) for n, lo, hi in zip(robot.joints, robot.lower,
                                                             robot.upper, strict=True)}  # fmt: skip
     frame = str(robot.model.frames[1].name) if robot.model.nframes > 1 else ""
+    _import_planners()  # their import (~0.5 s) is not planning time
     t0 = time.perf_counter()
     path = plan_path(ctx.checker, robot.lower, robot.upper, xs, xg, planner=options.planner,
                      timeout=options.timeout, seed=options.seed, step=options.step)  # fmt: skip
@@ -150,12 +154,19 @@ def plan_motion(
     raise PlanningError("certify", f"the planned trajectory fails its certification: {last.text()}")
 
 
+def _import_planners() -> None:
+    import ompl.geometric
+    import toppra.algorithm
+
+    del ompl, toppra
+
+
 def solve_goal(
     ctx: PlanningContext,
     xyz: Sequence[float],
     rpy: Sequence[float] | None = None,
     *,
-    start: Sequence[float] | None = None,
+    start: Sequence[float] | np.ndarray | None = None,
     seed: int = 0,
 ) -> np.ndarray:
     """Joint values putting the tool point at `xyz` [m] (root frame), collision-free.
