@@ -80,7 +80,7 @@ class Link:
 
 @dataclass(frozen=True)
 class Limit:
-    """A <limit>: lower/upper [rad or m], effort [N·m or N], velocity [rad/s or m/s], acceleration."""
+    """A <limit>: lower/upper [rad or m], effort [N·m or N], velocity, acceleration [/s, /s²]."""
 
     lower: float | None
     upper: float | None
