@@ -36,8 +36,7 @@ GRAVITY_HELP = "Add g(q) to the PD torque (default: the spec's control.gravity_c
 IGNORE_HELP = "Simulate the robot despite this `check` rule's error (repeatable)."
 TRAJECTORY_HELP = "JointTrajectory YAML (a point without time_from_start: previous + 1 s)."
 BASE_ACCEL_HELP = (
-    "Base acceleration and braking [m/s²] for the zero-moment point "
-    "(default: the diff-drive plugin's max_wheel_acceleration)."
+    "Base acceleration and braking [m/s²] for the zero-moment point (default: the base at rest)."
 )
 PAYLOAD_LINK_HELP = "Link carrying --payload at its origin (default: the tool point)."
 CONTACT_LINKS_HELP = "Comma-separated links touching the ground (default: from the geometry)."
