@@ -147,3 +147,15 @@ def test_a_fifo_mesh_is_refused(tmp_path: Path) -> None:
     os.mkfifo(project / "meshes" / "pipe.stl")
     with pytest.raises(InputError, match=r"pipe\.stl"):
         ros_packages(load_spec(project / "armcli.yaml"), samples=10)
+
+
+def test_a_mesh_over_the_size_bound_is_not_copied(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from armcli.ros import copying
+
+    project = _hostile_project(tmp_path)
+    size = (project / "meshes" / "base.stl").stat().st_size
+    monkeypatch.setattr(copying, "MAX_MESH_BYTES", size - 1)  # the cap is 20 MB: shrunk here
+    with pytest.raises(InputError, match=r"base\.stl.*larger than"):
+        ros_packages(load_spec(project / "armcli.yaml"), samples=10)
