@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import Any
 
 import typer
 
@@ -38,6 +39,17 @@ def build_cmd(
     sys.stdout.write(one_line(f"built {len(result.files)} files from {spec} into {out}/") + "\n")
     for f in result.files:
         sys.stdout.write(one_line(f"  {f}") + "\n")
+    _report_check_errors(spec, result.files, result.spec)
+
+
+def _report_check_errors(spec: Path, files: tuple[Path, ...], model: Any) -> None:
+    """What `armcli check` will call an error in the built URDFs, said now (a warning each)."""
+    from armcli.check.inputs import spec_document_errors
+
+    urdfs = {p.name: p.read_bytes() for p in files if p.suffix == ".urdf"}
+    for f in spec_document_errors(spec, urdfs, model):
+        where = str(f.spec) if f.spec is not None else f.file
+        sys.stderr.write(one_line(f"warning: {where}: {f.message} (check: {f.rule})") + "\n")
 
 
 def register(app: typer.Typer) -> None:

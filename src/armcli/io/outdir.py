@@ -108,11 +108,15 @@ def resolve_output_dir(path: str | Path, *, force: bool = False, field: str = "o
     return real
 
 
-def check_output_file(path: str | Path, field: str, inputs: Sequence[str | Path] = ()) -> None:
+def check_output_file(
+    path: str | Path, field: str, inputs: Sequence[str | Path] = (), *, parents: bool = False
+) -> None:
     """Refuse an output file path that cannot be written, before any output is written.
 
     `inputs`: the files the command reads; writing over one of them (`expand a.xacro -o
     a.xacro`, hard links and symlinks included) is refused (issue 27).
+    `parents`: the file heads a set written together (export mjcf: model, scene, meshes),
+    whose missing directories are created as `build -o` and `ros-package -o` create theirs.
     """
     p = Path(path)
     real = Path(os.path.realpath(p))
@@ -131,6 +135,8 @@ def check_output_file(path: str | Path, field: str, inputs: Sequence[str | Path]
         )
     if not real.parent.is_dir():  # a typo must not create directories (issue 20)
         _check_parent(real, field)
+        if parents:
+            return
         raise OutputRefusedError(
             f"directory {real.parent} does not exist; create it first", file=p, field=field
         )

@@ -198,6 +198,7 @@ def _joint(num: _Numbers, el: etree._Element) -> Joint:
             velocity=_optional(num, limit_el, "velocity", where),
             line=_ln(limit_el),
             missing_bounds=tuple(a for a in ("lower", "upper") if limit_el.get(a) is None),
+            acceleration=_optional(num, limit_el, "acceleration", where),
         )
     parent, child = el.find("parent"), el.find("child")
     return Joint(
