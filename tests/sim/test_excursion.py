@@ -16,7 +16,7 @@ import pytest
 from armcli.sim import zmp as zmps
 from armcli.sim.excursion import excursions
 from armcli.urdf.read import parse_urdf
-from armcli.urdf.stance import Stance, stance_of
+from armcli.analysis.stance import Stance, stance_of
 from tests.helpers import FIXTURES
 
 G = 9.81  # [m/s²] Pinocchio's

@@ -20,7 +20,7 @@ from armcli.check.rules import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.robot.model import Robot
 from armcli.spec.load import load_spec
-from armcli.urdf.mesh_confine import MAX_MESH_BYTES
+from armcli.io.mesh_confine import MAX_MESH_BYTES
 from armcli.urdf.read import MAX_URDF_COLLISIONS, read_urdf
 from tests.helpers import run_cli
 
@@ -170,7 +170,7 @@ def test_collision_shape_count_bounded(tmp_path: Path, root: Path) -> None:
 def test_ament_index_registered_share_dir_is_a_package_root(tmp_path: Path) -> None:
     """ROS 2 resolves package://NAME through the ament index (<prefix>/share/NAME), whatever
     package.xml says (example-robot-data's names example_robot_descriptions)."""
-    from armcli.urdf.mesh_confine import is_package
+    from armcli.io.mesh_confine import is_package
 
     share = tmp_path / "prefix" / "share"
     pkg = share / "robot-data"

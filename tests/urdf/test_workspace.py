@@ -16,7 +16,7 @@ from armcli.compiler.expand import expand_urdfs
 from armcli.robot.model import Robot
 from armcli.robot.tool import ToolPoint
 from armcli.spec.load import load_spec
-from armcli.urdf.workspace import REACH_TOL, Chain, envelope, reach_point, sample
+from armcli.analysis.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 from tests.helpers import DEFAULT_SPEC, ROOT
 
 EXACT = 1e-9  # [m] local search converged onto an extreme

@@ -21,10 +21,10 @@ import pytest
 import xacro
 
 from armcli.errors import InputError, XacroRefusedError
-from armcli.urdf.packages import PackageLookup
+from armcli.io.packages import PackageLookup
 from armcli.urdf.source import allowed_roots
-from armcli.urdf.xacro_args import Expansion, XacroInputs
-from armcli.urdf.xacro_safe import MAX_MACRO_CALLS, expand_safe, expand_safe_report
+from armcli.xacro.args import Expansion, XacroInputs
+from armcli.xacro.safe import MAX_MACRO_CALLS, expand_safe, expand_safe_report
 from tests.helpers import (
     ARM_PACKAGE,
     DEMO_ARM,

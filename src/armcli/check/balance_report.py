@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 from armcli.check.balance import StaticBalance
 from armcli.io.terminal import Column, FitTable
-from armcli.urdf.workspace import ReachPoint, Workspace, describe, verdict
+from armcli.analysis.workspace import ReachPoint, Workspace, describe, verdict
 
 if TYPE_CHECKING:
     from armcli.sim.tipping import ZmpReport

@@ -21,7 +21,7 @@ from armcli.sim import stability as stab
 from armcli.sim import verdict as verdicts
 from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
+from armcli.io.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
 from armcli.urdf.meshes import mesh_paths
 
 # Shapes must overlap by more than this to count as colliding: links that merely

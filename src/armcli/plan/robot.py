@@ -23,7 +23,7 @@ from armcli.robot.load import checked_model, collision_model
 from armcli.robot.mimic import Mimic, follow, mimics
 from armcli.robot.tool import tool_point
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
+from armcli.io.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
 from armcli.urdf.meshes import MeshSearch, mesh_paths
 from armcli.urdf.source import RobotFile, urdf_text
 

@@ -43,7 +43,7 @@ from armcli.spec.graph import root_links
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
 from armcli.urdf.meshes import localized
-from armcli.urdf.packages import PackageLookup
+from armcli.io.packages import PackageLookup
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import lookup_for, spec_urdfs
 

@@ -33,7 +33,7 @@ from armcli.sim.options import SimOptions
 from armcli.sim.simulate import steps_of
 from armcli.sim.tipping import robot_urdf
 from armcli.urdf.doc import Urdf
-from armcli.urdf.stance import NoStance, Stance, stance_of
+from armcli.analysis.stance import NoStance, Stance, stance_of
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec

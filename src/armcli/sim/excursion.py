@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from armcli.sim import zmp as zmps
-from armcli.urdf.stance import Stance
+from armcli.analysis.stance import Stance
 
 G = 9.81  # [m/s²] Pinocchio's gravity
 

@@ -26,11 +26,11 @@ from armcli.sim.options import SimOptions
 from armcli.sim.simulate import SimResult
 from armcli.sim.states import sample_steps
 from armcli.urdf.doc import Urdf
-from armcli.urdf.ground import mesh_loader
+from armcli.analysis.ground import mesh_loader
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import lookup_for, spec_urdfs
-from armcli.urdf.stance import NoStance, Payload, Stance, stance_of
+from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec

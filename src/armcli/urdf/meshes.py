@@ -1,6 +1,6 @@
 """Mesh URIs -> local files, one resolver for every command (check, view, render, export).
 
-`package://NAME/...` resolves through armcli.urdf.packages (--package-dir,
+`package://NAME/...` resolves through armcli.io.packages (--package-dir,
 AMENT_PREFIX_PATH, ROS_PACKAGE_PATH, the enclosing package); relative URIs start at
 the URDF's directory. A resolved path must lie inside the allowed roots (see
 `confined`), so a hostile URDF cannot make armcli read `/etc/passwd` as a mesh.
@@ -14,7 +14,7 @@ from urllib.parse import unquote, urlparse
 
 from armcli.errors import InputError
 from armcli.urdf.doc import Urdf
-from armcli.urdf.packages import PackageLookup, inside, parse_package_dirs, real_roots
+from armcli.io.packages import PackageLookup, inside, parse_package_dirs, real_roots
 from armcli.urdf.source import allowed_roots
 
 # The CLI's package options as the mesh resolver sees them (one lookup for meshes and $(find)).
@@ -32,7 +32,7 @@ __all__ = [
 
 
 def package_root(name: str, base_dir: Path, search: MeshSearch) -> Path | None:
-    """Where package `name` lives (armcli.urdf.packages' order), or None."""
+    """Where package `name` lives (armcli.io.packages' order), or None."""
     return search.find(name, base_dir)
 
 
@@ -118,7 +118,7 @@ def localized(xml: bytes, source: str, base_dir: Path, search: MeshSearch) -> by
     """
     from lxml import etree
 
-    from armcli.urdf.mesh_confine import _safe_xml, bounded_mesh_file
+    from armcli.io.mesh_confine import _safe_xml, bounded_mesh_file
 
     root = etree.fromstring(xml, _safe_xml())
     changed = False

@@ -21,11 +21,11 @@ from typing import TYPE_CHECKING
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import EXPANDED_TAG, InputError, XacroRefusedError
 from armcli.urdf.doc import Urdf
-from armcli.urdf.packages import PackageLookup, inside, real_roots
+from armcli.io.packages import PackageLookup, inside, real_roots
 from armcli.urdf.read import parse_urdf, read_urdf
-from armcli.urdf.trust import Trust as Trust  # re-exported: read_robot and callers share it
-from armcli.urdf.xacro_args import Expansion, XacroInputs
-from armcli.urdf.xacro_lines import parse_map
+from armcli.xacro.trust import Trust as Trust  # re-exported: read_robot and callers share it
+from armcli.xacro.args import Expansion, XacroInputs
+from armcli.xacro.lines import parse_map
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -132,8 +132,8 @@ def expand_xacro(
     in xacro_sandbox's jail, which reports no argument use.
     """
     # imported here: reading a plain URDF (e.g. simulate --urdf) never loads the xacro stack
-    from armcli.urdf.xacro_safe import request_json
-    from armcli.urdf.xacro_sandbox import run_safe
+    from armcli.xacro.safe import request_json
+    from armcli.xacro.sandbox import run_safe
 
     given = inputs or XacroInputs()
     if trust_xacro:
@@ -159,7 +159,7 @@ def _expand_trusted(
             "or the loader runs)",
             field="--env",
         )
-    from armcli.urdf.xacro_sandbox import run_trusted
+    from armcli.xacro.sandbox import run_trusted
 
     known = given.packages.known(near=path)
     roots = [*allowed_roots(path.parent), *(p / "share" for p in given.packages.prefixes())]

@@ -25,7 +25,7 @@ from armcli.io.files import write_file_atomic
 from armcli.robot.load import link_frame
 from armcli.robot.model import Robot
 from armcli.robot.tool import ToolPoint
-from armcli.urdf.workspace import (
+from armcli.analysis.workspace import (
     Chain,
     ReachPoint,
     Workspace,

@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from armcli.robot.inertia import rpy_matrix
 from armcli.spec.joint_types import ROTARY_TYPES
 from armcli.urdf.doc import Shape, Urdf, Vec3
-from armcli.urdf.mesh_confine import bounded_mesh_file
+from armcli.io.mesh_confine import bounded_mesh_file
 from armcli.urdf.meshes import MeshSearch, mesh_paths
 from armcli.urdf.meshlog import quiet_trimesh
 

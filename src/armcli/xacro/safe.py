@@ -5,7 +5,7 @@ kept (they are xacro's own functions, unchanged); what is replaced is every
 place where the file could run code or reach the machine:
 
 - `${...}` is evaluated by xacro_expr's AST whitelist instead of `eval`;
-- `$(...)`: `arg`, `dirname`, `find PKG` (armcli.urdf.packages: --package-dir,
+- `$(...)`: `arg`, `dirname`, `find PKG` (armcli.io.packages: --package-dir,
   AMENT_PREFIX_PATH, ROS_PACKAGE_PATH, the enclosing package), `env` / `optenv`
   from the user's `--env VAR=VALUE` only (xacro_args); `eval`, `cwd` and `anon`
   are refused;
@@ -39,12 +39,12 @@ import yaml
 
 from armcli.errors import InputError, XacroRefusedError
 from armcli.io.userfile import read_regular
-from armcli.urdf.packages import PackageLookup, real_roots
-from armcli.urdf.xacro_args import Expansion, XacroInputs
-from armcli.urdf.xacro_expr import Evaluator, ExprRefusedError
-from armcli.urdf.xacro_lines import annotate, collect, expand_call, source_map
-from armcli.urdf.xacro_yaml import YamlRefusedError
-from armcli.urdf.xacro_yaml import load_yaml as read_yaml
+from armcli.io.packages import PackageLookup, real_roots
+from armcli.xacro.args import Expansion, XacroInputs
+from armcli.xacro.expr import Evaluator, ExprRefusedError
+from armcli.xacro.lines import annotate, collect, expand_call, source_map
+from armcli.xacro.yaml_tags import YamlRefusedError
+from armcli.xacro.yaml_tags import load_yaml as read_yaml
 
 MAX_XACRO_FILE_BYTES = 2_000_000  # one xacro or YAML file read during expansion
 MAX_MACRO_CALLS = 20_000  # tiago_dual-sized robots make a few hundred
@@ -168,7 +168,7 @@ class _State:
 
 
 def find_package(name: str, start: Path, packages: PackageLookup | None = None) -> Path | None:
-    """`$(find NAME)`: armcli.urdf.packages' lookup from the file being read."""
+    """`$(find NAME)`: armcli.io.packages' lookup from the file being read."""
     return (packages or PackageLookup()).find(name, start)
 
 

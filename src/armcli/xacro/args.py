@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from armcli.errors import InputError
-from armcli.urdf.packages import PackageLookup
+from armcli.io.packages import PackageLookup
 
 ARG_SEPARATOR = ":="
 ARGS_HELP = (

@@ -32,7 +32,7 @@ from armcli.robot.load import link_frame
 from armcli.robot.model import Joint, Robot
 from armcli.robot.sampling import REACH_DRAWS, SAMPLE_SEED
 from armcli.robot.tool import ToolPoint
-from armcli.urdf.boxsearch import minimize_box
+from armcli.analysis.boxsearch import minimize_box
 
 REFINE_FROM = 3  # local searches per extreme, from the best samples
 REACH_TOL = 1e-3  # [m] an inverse-kinematics residual below this is reached

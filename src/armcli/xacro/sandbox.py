@@ -32,9 +32,9 @@ from typing import Any
 
 from armcli.errors import InputError, XacroRefusedError
 from armcli.io.userfile import check_regular
-from armcli.urdf.xacro_args import XacroInputs
-from armcli.urdf.xacro_jail import jail_argv, sandbox_problem, seccomp_program
-from armcli.urdf.xacro_safe import request_json
+from armcli.xacro.args import XacroInputs
+from armcli.xacro.jail import jail_argv, sandbox_problem, seccomp_program
+from armcli.xacro.safe import request_json
 
 XACRO_TIMEOUT = 20.0  # wall clock [s]
 XACRO_CPU_SECONDS = 20
@@ -48,7 +48,7 @@ _SCRIPT = """
 import json, sys, types
 
 # $(find NAME) asks ament_index_python (ROS 2, not on PyPI): armcli's own lookup answers,
-# from the package map in argv[2] (armcli.urdf.packages, resolved before the jail).
+# from the package map in argv[2] (armcli.io.packages, resolved before the jail).
 _packages = json.loads(sys.argv[2])
 class PackageNotFoundError(KeyError):
     pass
@@ -97,7 +97,7 @@ _SAFE_SCRIPT = """
 import sys
 if sys.argv[1]:
     sys.path.insert(0, sys.argv[1])
-from armcli.urdf.xacro_safe import child_main
+from armcli.xacro.safe import child_main
 sys.exit(child_main(sys.argv[2:]))
 """
 
