@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 import trimesh
 
-import armcli.check.dynamics
+import armcli.robot.model
 from armcli.check.rules import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.spec.load import load_spec
@@ -80,13 +80,13 @@ def test_pinocchio_gets_only_absolute_confined_paths(
         _with_collision_meshes(_arm(root), "package://robot_pkg/etc/passwd", "../meshes/box.stl")
     )
     seen: list[tuple[str, list[str] | None]] = []
-    real = armcli.check.dynamics.collision_model
+    real = armcli.robot.model.collision_model  # what Robot.collision_model hands the xml to
 
     def spy(model: Any, xml: str, package_dirs: list[str] | None = None) -> Any:
         seen.append((xml, package_dirs))
         return real(model, xml, package_dirs)
 
-    monkeypatch.setattr(armcli.check.dynamics, "collision_model", spy)
+    monkeypatch.setattr(armcli.robot.model, "collision_model", spy)
     opts = CheckOptions(spec=load_spec(root / "specs" / "my_robot.yaml"))
     check_urdf(read_urdf(urdf), opts)
     assert len(seen) == 1
