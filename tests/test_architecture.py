@@ -16,7 +16,7 @@ SRC = ROOT / "src" / "armcli"
 RANK = {  # layer of each top-level module or subpackage (docs/ARCHITECTURE.md)
     "errors": 0, "defaults": 0, "io": 1, "spec": 2, "compiler": 3, "urdf": 4, "robot": 5,
     "analysis": 6, "check": 7, "sim": 7, "ros": 7, "view": 7, "export": 7, "importer": 7,
-    "tune": 8, "commands": 9, "cli": 10, "__main__": 11,
+    "tune": 8, "plan": 8, "commands": 9, "cli": 10, "__main__": 11,
 }  # fmt: skip
 # Modules of the analysis layer still waiting in urdf/ for their move to analysis/ (issue 28,
 # step 2): they stand above robot/, which they use, and nothing in urdf/ imports them.

@@ -207,3 +207,44 @@ def test_cli_exits_1_naming_the_link_and_writes_nothing(
     err = capsys.readouterr().err
     assert "link 'tip'" in err and "<inertial>" in err
     assert list(out.parent.iterdir()) == []
+
+
+def _wrist_through_frame(wrist_inertial: str) -> str:
+    """The Gen3 lite's end: a massless (or point-mass) wrist link turned by joint_6, then a
+    massless frame (dummy_link), then the 0.14 kg gripper base, both on fixed joints."""
+    return _robot(
+        _link("base_link", GOOD),
+        _link("upper_wrist_link", GOOD),
+        _link("end_effector_link", wrist_inertial),
+        _link("dummy_link"),
+        _link("gripper_base_link", _inertial(0.1395, 1.16e-4, 1.03e-4, 9.7e-5)),
+        _joint("joint_5", "base_link", "upper_wrist_link"),
+        _joint("joint_6", "upper_wrist_link", "end_effector_link"),
+        _joint("end_effector", "end_effector_link", "dummy_link", "fixed"),
+        _joint("gripper_base_joint", "dummy_link", "gripper_base_link", "fixed"),
+    )
+
+
+@pytest.mark.parametrize(
+    ("wrist", "merged"),
+    [("", False), (_inertial(0.05, 0.0, 0.0, 0.0), True)],  # no inertial; a point mass
+)
+def test_a_moving_link_holds_mass_through_a_massless_frame(
+    tmp_path: Path, wrist: str, merged: bool
+) -> None:
+    """Issue 32: the Gen3 lite was refused; the lumping looked one fixed joint down only.
+
+    MuJoCo counts the gripper two welds down; the wrist's own point mass, when it has one,
+    moves two frames down into it, and the mass matrix stays Pinocchio's.
+    """
+    urdf = _wrist_through_frame(wrist)
+    res, m = _export(tmp_path, urdf)
+    assert ("mass: merged into a rigid child" in _topics(res)) == merged
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(SEED)
+    for _ in range(N_CONFIGS):
+        d.qpos[:] = rng.uniform(-2.0, 2.0, m.nq)
+        mujoco.mj_forward(m, d)
+        M = np.zeros((m.nv, m.nv))
+        mujoco.mj_fullM(m, d, M)
+        assert np.max(np.abs(M - _pin_M(urdf, d.qpos.copy()))) < DYN_TOL

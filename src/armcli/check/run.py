@@ -9,7 +9,7 @@ rule family is a module with a function of the `Context` and one line in `FAMILI
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from armcli.check import (
     bodies,
@@ -110,7 +110,28 @@ def check_urdf(urdf: Urdf, options: CheckOptions | None = None) -> CheckResult:
         if _ready(ctx, family.needs):
             family.run(ctx)
     _ready(ctx, MODEL)  # the summary's poses need the model even without model rules
-    return CheckResult(urdf.source, tuple(out.findings), summary.summarise(ctx))
+    found = tuple(_at_origin(f, urdf) for f in out.findings)
+    return CheckResult(urdf.source, found, summary.summarise(ctx))
+
+
+def _at_origin(f: Finding, urdf: Urdf) -> Finding:
+    """A finding on a xacro expansion's element, with the line the user wrote it on."""
+    origin = urdf.origins.get(f.line) if f.line else None
+    return f if origin is None else replace(f, origin=origin)
+
+
+def check_document(urdf: Urdf, options: CheckOptions | None = None) -> tuple[Finding, ...]:
+    """The findings of the rules that read the document alone (no model loaded).
+
+    Fast: what `build` reports of what `check` will say.
+    """
+    opts = options or CheckOptions()
+    out = Collector(urdf.source)
+    ctx = Context(urdf, opts, out, structure.check(urdf, out), rows=joint_rows(urdf))
+    for family in FAMILIES:
+        if family.needs == URDF:
+            family.run(ctx)
+    return tuple(out.findings)
 
 
 def _ready(ctx: Context, needs: Stage) -> bool:

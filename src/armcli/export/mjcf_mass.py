@@ -156,13 +156,15 @@ class _Planner:
 
     def massless(self, n: Node, x: Mass | None) -> None:
         """A moving body without usable mass properties (none, zero, point, degenerate)."""
-        holder = self.static_child_with_mass(n)
-        if holder is not None:
+        path = self.static_child_with_mass(n)
+        if path:
+            holder = path[-1].link
             if x is not None:
                 held = self.plan[holder]
                 assert isinstance(held, Mass)
-                child = self.by_link[holder]
-                self.plan[holder] = join(held, moved(x, child.xyz, child.rpy, inverse=True))
+                for child in path:  # down the fixed joints into the holder's frame
+                    x = moved(x, child.xyz, child.rpy, inverse=True)
+                self.plan[holder] = join(held, x)
                 self.log("merged into a rigid child", f"{n.link} into {holder}")
             self.plan[n.link] = None
             return
@@ -184,14 +186,26 @@ class _Planner:
         what = f"{x.mass:.4g} kg kept" if x is not None else f"{DENSITY:g} kg/m³"
         self.log("inertia from geometry", f"{n.link} ({_why(classify(x), x)}; {what})")
 
-    def static_child_with_mass(self, n: Node) -> str | None:
-        """A rigidly attached child MuJoCo counts for this moving body (direct, valid mass)."""
+    def static_child_with_mass(self, n: Node) -> list[Node]:
+        """The fixed-joint path to a rigidly attached body with valid mass; [] if none.
+
+        MuJoCo counts every body welded to a moving one, however deep: the Gen3 lite's
+        0.14 kg gripper hangs off its massless wrist link through a massless frame
+        (end_effector_link -> dummy_link -> gripper_base_link). Breadth first, so the
+        nearest such body holds the moving link's own inertial.
+        """
+        children: dict[str, list[Node]] = {}
         for c in self.nodes:
-            if c.parent == n.link and not c.moving:
-                x = self.plan.get(c.link)
-                if isinstance(x, Mass) and x.mass >= MJ_MINVAL and classify(x) == "ok":
-                    return c.link  # "ok" means moments >= MJ_EPS > MJ_MINVAL
-        return None
+            if c.parent is not None and not c.moving:
+                children.setdefault(c.parent, []).append(c)
+        paths = [[c] for c in children.get(n.link, [])]
+        while paths:
+            path = paths.pop(0)
+            x = self.plan.get(path[-1].link)
+            if isinstance(x, Mass) and x.mass >= MJ_MINVAL and classify(x) == "ok":
+                return path  # "ok" means moments >= MJ_EPS > MJ_MINVAL
+            paths += [[*path, c] for c in children.get(path[-1].link, [])]
+        return []
 
     def notes(self) -> list[Note]:
         for details in self.done.values():

@@ -3,9 +3,9 @@
 The import reads links, joints, materials and top-level extensions, decides what the
 spec can type (derived inertials, named materials, Gazebo colours and friction, the
 course's plugins, the arm/base split) and keeps the rest verbatim in `passthrough`.
-It then builds the spec it wrote, in memory with the real xacro, and lists every way
-the result differs from the input (`armcli.importer.compare`): whatever cannot round-trip
-is reported, never silently lost.
+It then builds the spec it wrote, in memory with the safe xacro evaluator `build` uses,
+and lists every way the result differs from the input (`armcli.importer.compare`):
+whatever cannot round-trip is reported, never silently lost.
 """
 
 from __future__ import annotations

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -57,6 +57,9 @@ class ZmpSeries:
     threshold: float  # [m] margin below which the report warns
     impacts: int = 0  # kept states left out: a joint hit its hard stop in that step
     shift: NDArray[np.float64] | None = None  # (K,) [m per m/s²] backward x shift per a_b
+    # per state whose point leaves the polygon: the centre of mass [m] and the rotational
+    # inertia about it [kg·m²] (root axes), for the tipping bound (sim.tipping.excursions)
+    bodies: dict[int, tuple[NDArray[np.float64], NDArray[np.float64]]] = field(default_factory=dict)
 
     def worst(self) -> tuple[int, int]:
         """(state index, case index) of the least margin."""
@@ -155,6 +158,7 @@ def zmp_series(
     zmp = np.empty((len(rows), 3, 2))
     margin = np.empty((len(rows), 3))
     shift = np.empty(len(rows))
+    bodies: dict[int, tuple[NDArray[np.float64], NDArray[np.float64]]] = {}
     for i, r in enumerate(rows):
         qk, vk, ak = _state(stance.robot, cols, q_full, q[r], v[r], a[i])
         w = np.asarray(pin.rnea(model, data, qk, vk, ak)[:6], dtype=float)
@@ -165,8 +169,11 @@ def zmp_series(
             p = zero_moment_point(w + sign * base_accel * dw, z0)
             zmp[i, j] = p
             margin[i, j] = stance.polygon.margin(p) if np.all(np.isfinite(p)) else -math.inf
+        if np.min(margin[i]) < 0:
+            pin.ccrba(model, data, qk, np.zeros(model.nv))
+            bodies[i] = (c, np.array(data.Ig.inertia, dtype=float))
     return ZmpSeries(np.asarray(t)[rows], np.asarray(step)[rows], zmp, margin,
-                     float(base_accel), float(threshold), skipped, shift)  # fmt: skip
+                     float(base_accel), float(threshold), skipped, shift, bodies)  # fmt: skip
 
 
 def max_base_accel(series: ZmpSeries, polygon: SupportPolygon, threshold: float) -> float:

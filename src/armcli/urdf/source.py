@@ -25,6 +25,7 @@ from armcli.urdf.packages import PackageLookup, inside, real_roots
 from armcli.urdf.read import parse_urdf, read_urdf
 from armcli.urdf.trust import Trust as Trust  # re-exported: read_robot and callers share it
 from armcli.urdf.xacro_args import Expansion, XacroInputs
+from armcli.urdf.xacro_lines import parse_map
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -118,7 +119,8 @@ def read_urdf_file(
         except XacroRefusedError:
             pass  # xacro content in a .urdf: expanded like a .xacro file
     xml, used = expand_xacro(path, trust_xacro=trust_xacro, inputs=inputs)
-    return replace(parse_urdf(xml, f"{path}{EXPANDED_TAG}"), notes=used.notes())
+    doc = parse_urdf(xml, f"{path}{EXPANDED_TAG}")
+    return replace(doc, notes=used.notes(), origins=parse_map(used.source_map))
 
 
 def expand_xacro(

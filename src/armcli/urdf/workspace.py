@@ -37,6 +37,8 @@ from armcli.urdf.boxsearch import minimize_box
 REFINE_FROM = 3  # local searches per extreme, from the best samples
 REACH_TOL = 1e-3  # [m] an inverse-kinematics residual below this is reached
 IK_SEEDS = 5  # nearest samples the inverse kinematics starts from
+SEED_POOL = 50  # nearest samples the seeds are picked from
+SEED_SPREAD = 0.1  # seeds differ by this share of the joint ranges (root mean square)
 IK_ITERATIONS = 100
 IK_DAMPING = 1e-3  # [m] damped least squares' lambda
 
@@ -165,36 +167,44 @@ def envelope(chain: Chain, cloud: Cloud) -> Workspace:
         r = float(np.linalg.norm(d))
         return -r, -(d @ J) / max(r, 1e-12)
 
-    def high(sign: float) -> Callable[[NDArray[np.float64]], tuple[float, NDArray[np.float64]]]:
-        def f(x: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
-            p, J = chain.jacobian(x)
-            return -sign * float(p[2]), -sign * J[2]
-
-        return f
-
     def wide(x: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
         p, J = chain.jacobian(x)
         r = float(np.hypot(p[0], p[1]))
         return -r, -(p[:2] @ J[:2]) / max(r, 1e-12)
 
     reach, x_reach = _refine(chain, cloud, far, -np.linalg.norm(cloud.p - c, axis=1))
-    top, _ = _refine(chain, cloud, high(1.0), -cloud.p[:, 2])
-    bottom, _ = _refine(chain, cloud, high(-1.0), cloud.p[:, 2])
     side, _ = _refine(chain, cloud, wide, -np.hypot(cloud.p[:, 0], cloud.p[:, 1]))
-    lo, hi = cloud.p.min(axis=0), cloud.p.max(axis=0)
+    # The box: each face refined as the height is (the cloud alone put TurtleBot3's
+    # OpenMANIPULATOR-X x max 50 mm short of the brute-force value).
+    lo, hi = np.zeros(3), np.zeros(3)
+    for axis in range(3):
+        hi[axis] = -_refine(chain, cloud, _along(chain, axis, 1.0), -cloud.p[:, axis])[0]
+        lo[axis] = _refine(chain, cloud, _along(chain, axis, -1.0), cloud.p[:, axis])[0]
     return Workspace(
         point=chain.tool.label,
         shoulder=(float(c[0]), float(c[1]), float(c[2])),
         joints=tuple(jr.name for jr in chain.joints),
         samples=len(cloud.x),
         max_reach=-reach,
-        max_height=-top,
-        min_height=bottom,
+        max_height=float(hi[2]),
+        min_height=float(lo[2]),
         max_horizontal=-side,
-        lower=(float(lo[0]), float(lo[1]), float(min(lo[2], bottom))),
-        upper=(float(hi[0]), float(hi[1]), float(max(hi[2], -top))),
+        lower=(float(lo[0]), float(lo[1]), float(lo[2])),
+        upper=(float(hi[0]), float(hi[1]), float(hi[2])),
         reach_q=chain.names(x_reach),
     )
+
+
+def _along(
+    chain: Chain, axis: int, sign: float
+) -> Callable[[NDArray[np.float64]], tuple[float, NDArray[np.float64]]]:
+    """The objective -sign * p[axis] (minimised: the tool point's extreme along root `axis`)."""
+
+    def f(x: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
+        p, J = chain.jacobian(x)
+        return -sign * float(p[axis]), -sign * J[axis]
+
+    return f
 
 
 def _refine(
@@ -217,7 +227,7 @@ def reach_point(chain: Chain, cloud: Cloud, target: Sequence[float]) -> ReachPoi
     t = np.asarray(target, dtype=float)
     d = np.linalg.norm(cloud.p - t, axis=1)
     best_r, best_x = math.inf, cloud.x[int(np.argmin(d))]
-    for k in np.argsort(d)[:IK_SEEDS]:
+    for k in _seeds(chain, cloud, d):
         x, r = _ik(chain, cloud.x[k], t)
         if r < best_r:
             best_r, best_x = r, x
@@ -230,6 +240,25 @@ def reach_point(chain: Chain, cloud: Cloud, target: Sequence[float]) -> ReachPoi
         nearest_sample=float(np.min(d)),
         q=chain.names(best_x),
     )
+
+
+def _seeds(chain: Chain, cloud: Cloud, d: NDArray[np.float64]) -> list[int]:
+    """IK_SEEDS samples near the target, each in another arm configuration.
+
+    The nearest samples alone tend to be one configuration (one elbow, one wrist): their
+    searches end in the same local minimum, which for a point out of reach was 12 mm
+    farther than the closest a UR5 gets. A seed must differ from those taken by
+    SEED_SPREAD of the joint ranges (root mean square); the nearest SEED_POOL are looked at.
+    """
+    span = np.maximum(chain.upper - chain.lower, 1e-9)
+    taken: list[int] = []
+    for k in np.argsort(d)[:SEED_POOL]:
+        u = cloud.x[k] / span
+        if all(np.sqrt(np.mean((u - cloud.x[j] / span) ** 2)) > SEED_SPREAD for j in taken):
+            taken.append(int(k))
+            if len(taken) == IK_SEEDS:
+                break
+    return taken
 
 
 def _ik(chain: Chain, x0: NDArray[np.float64], target: NDArray[np.float64]) -> tuple[Any, float]:
@@ -246,7 +275,20 @@ def _ik(chain: Chain, x0: NDArray[np.float64], target: NDArray[np.float64]) -> t
             break
         step = J.T @ np.linalg.solve(J @ J.T + IK_DAMPING**2 * np.eye(3), e)
         x = np.clip(x + step, chain.lower, chain.upper)
-    return best_x, best_r
+    if best_r < REACH_TOL * 1e-3 or not len(x):
+        return best_x, best_r
+    # Clipping stalls damped least squares against a limit (TurtleBot3's OpenMANIPULATOR-X
+    # missed a reachable point by 2.8 mm): a projected gradient search on |e|²/2 slides
+    # along the limits to the closest point.
+
+    def half_square(x: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
+        p, J = chain.jacobian(x)
+        e = p - target
+        return 0.5 * float(e @ e), J.T @ e
+
+    res = minimize_box(half_square, best_x, chain.lower, chain.upper)
+    r = math.sqrt(2.0 * max(res.f, 0.0))
+    return (res.x, r) if r < best_r else (best_x, best_r)
 
 
 def describe(ws: Workspace) -> str:
