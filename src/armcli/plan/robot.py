@@ -1,7 +1,7 @@
 """The robot a plan moves: Pinocchio model, planned joints and their limits, collision geometry.
 
-`load_plan_robot` is the one place this package loads a model (through urdf.source and
-urdf.pinocchio today; the one Robot of issue 28 once it lands). The whole robot is loaded with
+`load_plan_robot` is the one place this package loads a model (robot.load's checked
+loader; `PlanRobot.q` is `robot.model.Robot.q`). The whole robot is loaded with
 a fixed root, so the arm is checked against its own mobile base. Planned joints are the
 free 1-DoF joints a plan moves; mimic followers follow their leaders; every other joint
 stays at its rest value (0, or the middle of its range when 0 is outside it).
@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -21,6 +22,7 @@ from armcli.defaults import DEFAULT_JOINT_ACCELERATION
 from armcli.errors import InputError
 from armcli.robot.load import checked_model, collision_model
 from armcli.robot.mimic import Mimic, follow, mimics
+from armcli.robot.model import Robot
 from armcli.robot.tool import tool_point
 from armcli.urdf.doc import Urdf
 from armcli.urdf.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
@@ -59,26 +61,19 @@ class PlanRobot:
     spec: RobotSpec | None = None
     acceleration_defaulted: tuple[str, ...] = ()  # joints given DEFAULT_JOINT_ACCELERATION
 
+    @cached_property
+    def robot(self) -> Robot:
+        """The model's robot handle (`Robot.q` builds the configuration)."""
+        return Robot(self.model)
+
     def q(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Pinocchio configuration with the planned joints at `x` and followers following."""
+        """Pinocchio configuration with the planned joints at `x` and followers following.
+
+        Every other 1-DoF joint at its `rest` value; multi-DoF joints stay neutral.
+        """
         values = dict(self.rest)
         values.update(zip(self.joints, (float(v) for v in x), strict=True))
-        values = follow(self.mimic, values)
-        q = np.zeros(self.model.nq)
-        for jid in range(1, self.model.njoints):
-            jm = self.model.joints[jid]
-            v = values.get(str(self.model.names[jid]), 0.0)
-            if jm.nq == 2 and jm.nv == 1:
-                q[jm.idx_q], q[jm.idx_q + 1] = math.cos(v), math.sin(v)
-            elif jm.nq == 1:
-                q[jm.idx_q] = v
-            else:  # multi-DoF joints stay neutral
-                import pinocchio as pin
-
-                q[jm.idx_q : jm.idx_q + jm.nq] = pin.neutral(self.model)[
-                    jm.idx_q : jm.idx_q + jm.nq
-                ]
-        return q
+        return self.robot.q(follow(self.mimic, values))
 
     def v_indices(self) -> list[int]:
         """Velocity indices of the planned joints in the model (for Jacobians and torques)."""
