@@ -82,9 +82,9 @@ def test_pinocchio_gets_only_absolute_confined_paths(
     seen: list[tuple[str, list[str] | None]] = []
     real = armcli.robot.model.collision_model  # what Robot.collision_model hands the xml to
 
-    def spy(model: Any, xml: str, package_dirs: list[str] | None = None) -> Any:
+    def spy(model: Any, xml: str, package_dirs: list[str] | None = None, source: str = "") -> Any:
         seen.append((xml, package_dirs))
-        return real(model, xml, package_dirs)
+        return real(model, xml, package_dirs, source)
 
     monkeypatch.setattr(armcli.robot.model, "collision_model", spy)
     opts = CheckOptions(spec=load_spec(root / "specs" / "my_robot.yaml"))

@@ -20,13 +20,12 @@ import numpy as np
 
 from armcli.defaults import DEFAULT_JOINT_ACCELERATION
 from armcli.errors import InputError
-from armcli.robot.load import checked_model, collision_model
+from armcli.robot.load import checked_model
 from armcli.robot.mimic import Mimic, follow, mimics
 from armcli.robot.model import Robot
 from armcli.robot.tool import tool_point
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
-from armcli.urdf.meshes import MeshSearch, mesh_paths
+from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import RobotFile, urdf_text
 
 if TYPE_CHECKING:
@@ -107,17 +106,6 @@ def default_joints(urdf: Urdf, spec: RobotSpec | None) -> tuple[str, ...]:
     return tuple(movable)
 
 
-def _collision_geometry(model: Any, urdf: Urdf, search: MeshSearch) -> Any:
-    """The collision shapes, meshes resolved inside the allowed roots only (as `check`)."""
-    meshes = mesh_paths(urdf, search)
-    missing = sorted(uri for uri, p in meshes.items() if p is None or not p.is_file())
-    if missing:
-        raise InputError(f"mesh {missing[0]!r} cannot be found", file=urdf.source)
-    real = {uri: bounded_mesh_file(p, urdf.source) for uri, p in meshes.items() if p is not None}
-    check_total(real.values(), urdf.source)
-    return collision_model(model, with_real_mesh_paths(urdf.text, real), [])
-
-
 def load_plan_robot(
     robot: RobotFile,
     *,
@@ -133,7 +121,7 @@ def load_plan_robot(
     urdf, spec = robot.robot, robot.spec
     model = checked_model(urdf).model
     urdf_text(urdf)  # refuses a non-UTF-8 document before Pinocchio sees it
-    geometry = _collision_geometry(model, urdf, search or MeshSearch())
+    geometry = Robot(model, source=urdf.source, urdf=urdf).collision_model(search or MeshSearch())
     followers = {m.follower for m in mimics(urdf.joints)}
     chosen = tuple(joints) if joints else default_joints(urdf, spec)
     by_name = {j.name: j for j in urdf.joints}
