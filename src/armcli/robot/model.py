@@ -120,6 +120,7 @@ class Robot:
         self.parser_messages = tuple(parser_messages)
         self._by_name = {j.name: j for j in self.joints}
         self._data: Any = None
+        self._neutral: NDArray[np.float64] | None = None
 
     @classmethod
     def from_xml(
@@ -183,9 +184,11 @@ class Robot:
 
     def neutral(self) -> NDArray[np.float64]:
         """Pinocchio's neutral configuration (every joint at 0, the free-flyer at identity)."""
-        import pinocchio as pin
+        if self._neutral is None:
+            import pinocchio as pin
 
-        return np.asarray(pin.neutral(self.model), dtype=float)
+            self._neutral = np.asarray(pin.neutral(self.model), dtype=float)
+        return self._neutral.copy()
 
     def follow(self, values: Mapping[str, float]) -> dict[str, float]:
         """`values` with every mimic follower of a given leader set from it."""
@@ -205,7 +208,7 @@ class Robot:
         order). `base` defaults to the neutral configuration. Mimic followers are not
         moved here: `follow` the values first.
         """
-        q = np.array(self.neutral() if base is None else base, dtype=float)
+        q = self.neutral() if base is None else np.array(base, dtype=float)
         if isinstance(values, Mapping):
             pairs: Iterable[tuple[Joint, Any]] = (
                 (self._by_name[n], x) for n, x in values.items() if n in self._by_name
