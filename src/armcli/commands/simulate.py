@@ -174,7 +174,7 @@ def _prepare(
 
     A model `check` reports as an error is not simulated (same rule ids), unless ignored.
     """
-    from armcli.check.gate import refuse_check_errors
+    from armcli.check.gate import bears_on_balance, refuse_check_errors
     from armcli.sim import job as simjob
 
     def gate(doc: Any) -> None:
@@ -186,7 +186,9 @@ def _prepare(
             from armcli.sim.tipping import robot_urdf
 
             whole = robot_urdf(spec, job)
-            if whole is not None:
+            if whole is not None and whole is not job.urdf:  # the base: only for the balance
+                refuse_check_errors(whole, ignore=ignore, only=bears_on_balance)
+            elif whole is not None:
                 gate(whole)
         return job
     except ModelRefusedError as exc:

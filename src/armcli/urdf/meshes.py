@@ -118,7 +118,7 @@ def localized(xml: bytes, source: str, base_dir: Path, search: MeshSearch) -> by
     """
     from lxml import etree
 
-    from armcli.urdf.mesh_confine import _safe_xml
+    from armcli.urdf.mesh_confine import _safe_xml, bounded_mesh_file
 
     root = etree.fromstring(xml, _safe_xml())
     changed = False
@@ -131,6 +131,6 @@ def localized(xml: bytes, source: str, base_dir: Path, search: MeshSearch) -> by
         if path is None or not path.is_file() or not confined(uri, path, base_dir, search):
             why = "its package is unknown" if path is None else f"no file {path}"
             raise InputError(f"mesh {uri!r} not found ({why}): {mesh_hint(uri)}", file=source)
-        el.set("filename", str(path))
+        el.set("filename", str(bounded_mesh_file(path, source)))  # size, bombs (issue 27)
         changed = True
     return etree.tostring(root) if changed else xml
