@@ -9,16 +9,15 @@ pairs, trimesh gave up on large shapes, and two links of 5000 boxes hung check.
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import pytest
 import trimesh
 
+import armcli.robot.model
 from armcli.check.rules import CheckOptions
 from armcli.check.run import check_urdf
-from armcli.robot.model import Robot
 from armcli.spec.load import load_spec
 from armcli.io.mesh_confine import MAX_MESH_BYTES
 from armcli.urdf.read import MAX_URDF_COLLISIONS, read_urdf
@@ -81,13 +80,13 @@ def test_pinocchio_gets_only_absolute_confined_paths(
         _with_collision_meshes(_arm(root), "package://robot_pkg/etc/passwd", "../meshes/box.stl")
     )
     seen: list[tuple[str, list[str] | None]] = []
-    real = Robot.collision_model
+    real = armcli.robot.model.collision_model  # what Robot.collision_model hands the xml to
 
-    def spy(self: Robot, package_dirs: Sequence[str] = (), *, xml: str | None = None) -> Any:
-        seen.append((xml or "", list(package_dirs)))
-        return real(self, package_dirs, xml=xml)
+    def spy(model: Any, xml: str, package_dirs: list[str] | None = None, source: str = "") -> Any:
+        seen.append((xml, package_dirs))
+        return real(model, xml, package_dirs, source)
 
-    monkeypatch.setattr(Robot, "collision_model", spy)
+    monkeypatch.setattr(armcli.robot.model, "collision_model", spy)
     opts = CheckOptions(spec=load_spec(root / "specs" / "my_robot.yaml"))
     check_urdf(read_urdf(urdf), opts)
     assert len(seen) == 1
