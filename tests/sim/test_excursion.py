@@ -13,10 +13,10 @@ import math
 import numpy as np
 import pytest
 
+from armcli.analysis.stance import Stance, stance_of
 from armcli.sim import zmp as zmps
 from armcli.sim.excursion import excursions
 from armcli.urdf.read import parse_urdf
-from armcli.analysis.stance import Stance, stance_of
 from tests.helpers import FIXTURES
 
 G = 9.81  # [m/s²] Pinocchio's

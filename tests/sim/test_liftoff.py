@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
+from armcli.analysis.stance import Stance, stance_of
 from armcli.sim.liftoff import LIFT_CLEARANCE, lifts, roll_pitch_yaw, static_tipping_angle, tilt
 from armcli.urdf.read import parse_urdf
-from armcli.analysis.stance import Stance, stance_of
 from tests.helpers import FIXTURES
 
 EXACT = 1e-12

@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 
 from armcli.errors import InputError, XacroRefusedError
-from armcli.robot.load import checked_model
 from armcli.io.packages import PackageLookup
+from armcli.robot.load import checked_model
 from armcli.urdf.source import (
     Trust,
     allowed_roots,

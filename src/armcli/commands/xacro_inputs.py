@@ -19,8 +19,8 @@ import typer
 
 from armcli.errors import InputError
 from armcli.io.oneline import one_line
-from armcli.io.terminal import say
 from armcli.io.packages import PackageLookup, parse_package_dirs
+from armcli.io.terminal import say
 from armcli.xacro.args import ARGS_HELP, ENV_HELP, XacroInputs, is_arg, parse_args, parse_env
 
 PACKAGE_DIR_HELP = (

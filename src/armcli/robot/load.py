@@ -18,8 +18,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from armcli.errors import InputError, ModelLoadError
-from armcli.urdf.doc import Urdf
 from armcli.io.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
+from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import MeshSearch, mesh_paths
 from armcli.urdf.source import urdf_text
 

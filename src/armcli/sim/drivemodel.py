@@ -30,11 +30,11 @@ from typing import Any
 
 import numpy as np
 
+from armcli.analysis.stance import Stance
 from armcli.errors import InputError
 from armcli.export.mjcf import FREE_JOINT, build_mjcf
 from armcli.sim.diffdrive import DriveParams
 from armcli.urdf.doc import Urdf
-from armcli.analysis.stance import Stance
 
 SERVO_STEPS = 1.0  # wheel motor time constant in time steps (see the module docstring)
 # [s] MuJoCo's contact time constant (solref, critically damped): its default. Measured on

@@ -16,6 +16,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from armcli.analysis.ground import mesh_loader
+from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
 from armcli.errors import InputError, TipOverError
 from armcli.robot.tool import tool_point
 from armcli.sim import job as simjob
@@ -26,11 +28,9 @@ from armcli.sim.options import SimOptions
 from armcli.sim.simulate import SimResult
 from armcli.sim.states import sample_steps
 from armcli.urdf.doc import Urdf
-from armcli.analysis.ground import mesh_loader
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import lookup_for, spec_urdfs
-from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec

@@ -13,8 +13,8 @@ from pathlib import Path
 from urllib.parse import unquote, urlparse
 
 from armcli.errors import InputError
-from armcli.urdf.doc import Urdf
 from armcli.io.packages import PackageLookup, inside, parse_package_dirs, real_roots
+from armcli.urdf.doc import Urdf
 from armcli.urdf.source import allowed_roots
 
 # The CLI's package options as the mesh resolver sees them (one lookup for meshes and $(find)).

@@ -85,7 +85,7 @@ class Expansion:
     unused: tuple[str, ...] = ()  # given, but the file neither declares nor reads them
     optenv_defaults: tuple[str, ...] = ()  # $(optenv VAR ...) that took their default
     warnings: tuple[str, ...] = ()
-    source_map: str = ""  # xacro_lines.source_map: where each expanded element was written
+    source_map: str = ""  # xacro.lines.source_map: where each expanded element was written
 
     @property
     def defaults(self) -> tuple[str, ...]:

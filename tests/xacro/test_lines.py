@@ -10,10 +10,9 @@ from pathlib import Path
 
 from lxml import etree
 
-from armcli.urdf.doc import Origin
 from armcli.urdf.source import allowed_roots
 from armcli.xacro.args import XacroInputs
-from armcli.xacro.lines import parse_map
+from armcli.xacro.lines import Origin, parse_map
 from armcli.xacro.safe import expand_safe_report
 from tests.helpers import FIXTURES
 

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from armcli.urdf.meshes import confined, resolve
 from armcli.io.packages import PackageLookup, crawl, real_roots
+from armcli.urdf.meshes import confined, resolve
 from tests.helpers import ARM_PACKAGE, GRIPPER_PACKAGE, ROS_WS_SRC, symlink_install
 
 

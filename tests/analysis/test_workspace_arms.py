@@ -19,10 +19,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from armcli.analysis.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 from armcli.robot.load import load_model
 from armcli.robot.model import Robot
 from armcli.robot.tool import ToolPoint
-from armcli.analysis.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 from tests.helpers import FIXTURES
 
 BRUTE = 20_000  # brute-force draws per arm (about 0.1 s of forward kinematics)

@@ -18,8 +18,8 @@ import trimesh
 import armcli.robot.model
 from armcli.check.rules import CheckOptions
 from armcli.check.run import check_urdf
-from armcli.spec.load import load_spec
 from armcli.io.mesh_confine import MAX_MESH_BYTES
+from armcli.spec.load import load_spec
 from armcli.urdf.read import MAX_URDF_COLLISIONS, read_urdf
 from tests.helpers import run_cli
 
