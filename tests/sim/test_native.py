@@ -180,3 +180,24 @@ def test_an_extension_built_from_other_source_is_refused(
     monkeypatch.setattr(native, "SOURCE", edited)
     monkeypatch.setattr(native, "_state", {})
     assert native.load() is None and "built from another" in native.why_missing()
+
+
+def test_the_type_stub_declares_exactly_what_the_extension_exports() -> None:
+    """_rollout.pyi is written by hand from the bindings; the live module's names check it."""
+    import ast
+
+    mod = require_native()
+    stub = ast.parse((Path(native.__file__).parent / "_rollout.pyi").read_text())
+    declared: dict[str, set[str]] = {}
+    for node in stub.body:
+        if isinstance(node, ast.ClassDef):
+            declared[node.name] = {n.name for n in node.body if isinstance(n, ast.FunctionDef)}
+        elif isinstance(node, ast.FunctionDef):
+            declared[node.name] = set()
+        elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
+            declared[node.target.id] = set()
+    public = {n for n in dir(mod) if not n.startswith("_")}
+    assert set(declared) == public
+    for name, members in declared.items():
+        if members:
+            assert members == {n for n in dir(getattr(mod, name)) if not n.startswith("_")}, name

@@ -14,9 +14,12 @@ import hashlib
 import os
 from pathlib import Path
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from armcli.errors import InputError
+
+if TYPE_CHECKING:
+    from armcli.sim import _rollout
 
 SOURCE = Path(__file__).parent / "_native" / "rollout.cpp"
 _state: dict[str, Any] = {}
@@ -51,7 +54,7 @@ def _import() -> tuple[ModuleType | None, str]:
     import pinocchio  # noqa: F401  (loads libpinocchio_default before the extension)
 
     try:
-        from armcli.sim import _rollout  # type: ignore[attr-defined]
+        from armcli.sim import _rollout
     except ImportError as exc:
         return None, f"the armcli.sim._rollout extension is not installed ({exc})"
     if SOURCE.is_file() and _sha256(SOURCE) != _rollout.SOURCE_SHA256:
@@ -70,7 +73,7 @@ def why_missing() -> str:
     return why
 
 
-def compiled_model(mod: ModuleType, model: Any) -> Any:
+def compiled_model(mod: ModuleType, model: Any) -> _rollout.Model:
     """The extension's copy of a pinocchio.Model, exact: Pinocchio's own binary serialisation.
 
     Build once and reuse across rollouts of the same model.
@@ -79,7 +82,8 @@ def compiled_model(mod: ModuleType, model: Any) -> Any:
 
     buf = pin.serialization.StreamBuffer()
     model.saveToBinary(buf)
-    return mod.load_model(buf.tobytes())
+    compiled: _rollout.Model = mod.load_model(buf.tobytes())
+    return compiled
 
 
 if __name__ == "__main__":  # `python -m armcli.sim.native`: is the simulator installed
