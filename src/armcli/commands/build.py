@@ -39,15 +39,19 @@ def build_cmd(
     sys.stdout.write(one_line(f"built {len(result.files)} files from {spec} into {out}/") + "\n")
     for f in result.files:
         sys.stdout.write(one_line(f"  {f}") + "\n")
-    _report_check_errors(spec, result.files, result.spec)
+    _report_check_errors(spec, result.spec)
 
 
-def _report_check_errors(spec: Path, files: tuple[Path, ...], model: Any) -> None:
-    """What `armcli check` will call an error in the built URDFs, said now (a warning each)."""
+def _report_check_errors(spec: Path, model: Any) -> None:
+    """What `armcli check` will call an error in the built URDFs, said now (a warning each).
+
+    The URDFs `check SPEC` reads (meshes resolved from the spec), not the written ones:
+    those name their meshes relative to the output directory.
+    """
     from armcli.check.inputs import spec_document_errors
+    from armcli.urdf.source import spec_urdfs
 
-    urdfs = {p.name: p.read_bytes() for p in files if p.suffix == ".urdf"}
-    for f in spec_document_errors(spec, urdfs, model):
+    for f in spec_document_errors(spec, spec_urdfs(model), model):
         where = str(f.spec) if f.spec is not None else f.file
         sys.stderr.write(one_line(f"warning: {where}: {f.message} (check: {f.rule})") + "\n")
 
