@@ -15,6 +15,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
 from armcli.robot.load import load_model
 from armcli.sim.reference import Reference, build_reference
@@ -28,6 +29,7 @@ DOP_TOL = 1e-12  # DOP853 rtol and atol
 KP, KD, DAMPING, DT = 50.0, 2.0, 0.1, 1e-3  # dt (Kd + D) lambda_max(M^-1) = 1.2: RK4-stable
 POINTS = [(0.6, 0.4), (0.9, 1.2), (0.5, 0.8), (0.3, 0.3)]
 ON_GRID = (0.5, 1.0, 1.5, 2.0)
+EQUILIBRIUM_TOL = 1e-9  # [rad] converged static equilibrium vs brentq on the statics
 OFF_GRID = (0.5003, 1.0007, 1.4996, 2.0001)  # [s] between steps of 1 ms
 
 
@@ -168,3 +170,75 @@ def test_euler_is_first_order_against_dop853(arm: Arm) -> None:
         errs[dt] = np.max(np.abs(res.q - exact[::every]))
     assert errs[1e-3] < 2e-3  # [rad] measured 7.3e-4 (O(dt) with this loop's ~0.5 s time scale)
     assert 1.6 < errs[1e-3] / errs[5e-4] < 2.4
+
+
+# RK4 at joint stops (it once gave a resting joint dt a / 2 of phantom velocity) ----------
+
+
+def test_rk4_resting_on_a_stop_has_no_phantom_velocity() -> None:
+    # hanging pendulum held at q = 0.3 by its lower stop: gravity presses it on the stop
+    arm = _arm(pendulum().model, lower=0.3, upper=2.0)
+    cfg = SimConfig(np.zeros(1), np.zeros(1), dt=5e-4, integrator="rk4")
+    a = run_held(plant_of(arm, cfg, energy_max=1e9), [0.3], [0.0], 2000, [0.3]).trace
+    assert np.all(a.q[:, 0] == 0.3)  # on the stop, exactly
+    assert np.all(a.v[:, 0] == 0.0)  # and at rest: no dt a / 2 into the stop
+    assert np.all(a.stop[:, 0])
+
+
+def test_rk4_coupled_joint_settles_at_its_static_equilibrium(built_dir: Path) -> None:
+    model = arm_from_model(load_model(built_dir / "standalone_arm.urdf").model).model
+    arm = _arm(model, lower=0.0, upper=math.pi / 2, damping=0.2)
+    kp, q2_ref = 50.0, 0.8
+    cfg = SimConfig(np.array([0.0, kp]), np.array([0.0, 2.0]), dt=5e-4, integrator="rk4")
+    a = run_held(plant_of(arm, cfg, energy_max=1e9), [math.pi / 2, 0.5], [0.0, 0.0], 16_000,  # 8 s
+                 [math.pi / 2, q2_ref]).trace  # fmt: skip
+    # gravity presses joint 1 on its upper stop; joint 2's statics: Kp (q_ref - q2) = g2(q)
+    data = model.createData()
+
+    def residual(q2: float) -> float:
+        g = pin.computeGeneralizedGravity(model, data, np.array([math.pi / 2, q2]))
+        return float(kp * (q2_ref - q2) - g[1])
+
+    q2_eq = brentq(residual, 0.0, math.pi / 2, xtol=1e-14)
+    assert a.q[-1, 0] == math.pi / 2 and a.v[-1, 0] == 0.0
+    assert a.q[-1, 1] == pytest.approx(q2_eq, abs=EQUILIBRIUM_TOL)
+    assert abs(a.v[-1, 1]) < EQUILIBRIUM_TOL
+
+
+# RK4 order on positions-only trajectories (reference velocity jumps) --------------------
+
+POSITIONS_ONLY = (  # linear segments: the reference velocity jumps at every knot
+    "joint_names: [arm_base_forearm_joint, forearm_hand_joint]\npoints:\n"
+    " - {positions: [0.6, 0.4], time_from_start: 0.5}\n"
+    " - {positions: [0.9, 1.2], time_from_start: 1.0}\n"
+    " - {positions: [0.5, 0.8], time_from_start: 1.5}\n"
+)
+
+
+def test_rk4_is_fourth_order_on_positions_only_trajectory(built_dir: Path) -> None:
+    model = arm_from_model(load_model(built_dir / "standalone_arm.urdf").model).model
+    arm = _arm(model, damping=0.1)
+    kp, kd, t_end = 50.0, 1.0, 2.0
+    tr = loads_trajectory(POSITIONS_ONLY, dict.fromkeys(arm.joint_names, (0.0, math.pi / 2)))
+    q0 = np.array([0.2, 0.2])
+    ref = build_reference(tr, arm.joint_names, q0)
+    data = model.createData()
+
+    def f(t: float, y: np.ndarray, seg: float) -> np.ndarray:
+        qr, vr = (x[0] for x in ref.sample(np.array([t]), segment_time=np.array([seg])))
+        tau = kp * (qr - y[:2]) + kd * (vr - y[2:]) - 0.1 * y[2:]
+        return np.concatenate([y[2:], pin.aba(model, data, y[:2], y[2:], tau)])
+
+    # DOP853 restarted at each knot, so it never steps across a reference discontinuity
+    y = np.concatenate([q0, np.zeros(2)])
+    knots = [0.0, 0.5, 1.0, 1.5, t_end]
+    for t0, t1 in itertools.pairwise(knots):
+        sol = solve_ivp(f, (t0, t1), y, "DOP853", rtol=1e-13, atol=1e-13, args=(0.5 * (t0 + t1),))
+        y = sol.y[:, -1]
+    errors = []
+    for dt in (2e-3, 1e-3, 5e-4):
+        cfg = SimConfig(np.full(2, kp), np.full(2, kd), dt=dt, integrator="rk4")
+        errors.append(np.max(np.abs(simulate(arm, ref, q0, t_end, cfg).q[-1] - y[:2])))
+    # fourth order: halving dt divides the error by 2^4 = 16 (measured 19 and 18)
+    assert errors[0] < 1e-9
+    assert 12 < errors[0] / errors[1] < 24 and 12 < errors[1] / errors[2] < 24

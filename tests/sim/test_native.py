@@ -28,7 +28,7 @@ from armcli.sim.simulate import (
 )
 from armcli.sim.trajectory import loads_trajectory
 from tests.sim.engines import require_native, run_held
-from tests.sim.test_defects import TILTED_URDF
+from tests.sim.test_rollout import TILTED_URDF
 
 ERD = (
     Path(pin.__file__).resolve().parents[4] / "share" / "example-robot-data" / "robots"
