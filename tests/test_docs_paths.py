@@ -2,13 +2,18 @@
 
 Names are dotted (`armcli.sim.stability`, maybe ending in an attribute such as
 `armcli.check.rules.RULES`) or paths (`sim/states.py`, relative to the repository,
-`src/armcli/`, `tests/` or `bench/`). A renamed module fails this test until the text
-that sends readers to it is updated.
+`src/armcli/`, `tests/` or `bench/`). In the source's docstrings and comments, a name
+relative to the package in backticks or parentheses (`(`urdf.tree`)`, `(sim.rollout: ...`)
+is checked too. A renamed module fails this test until the text that sends readers to it
+is updated.
 """
 
 from __future__ import annotations
 
+import ast
+import io
 import re
+import tokenize
 from pathlib import Path
 
 import pytest
@@ -95,8 +100,45 @@ def test_modules_named_in_docstrings_and_comments_exist() -> None:
     assert not missing, "\n".join(missing)
 
 
+SUBPACKAGES = sorted(p.name for p in (SRC / "armcli").iterdir() if (p / "__init__.py").is_file())
+# `urdf.tree` or (sim.rollout: a package-relative name, not a variable's attribute in code
+RELATIVE = re.compile(rf"(?<=[`(])(?:{'|'.join(SUBPACKAGES)})\.[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*")
+
+
+def _prose(path: Path) -> list[tuple[int, str]]:
+    """(line, text) of a module's docstrings and comments."""
+    text = path.read_text(encoding="utf-8")
+    out = []
+    for node in ast.walk(ast.parse(text)):
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
+            doc = ast.get_docstring(node, clean=False)
+            if doc is not None:
+                out.append((node.body[0].lineno, doc))
+    for tok in tokenize.generate_tokens(io.StringIO(text).readline):
+        if tok.type == tokenize.COMMENT:
+            out.append((tok.start[0], tok.string))
+    return out
+
+
+def test_package_relative_names_in_docstrings_and_comments_exist() -> None:
+    missing, seen = [], 0
+    for path in sorted((SRC / "armcli").rglob("*.py")):
+        for n, text in _prose(path):
+            for m in RELATIVE.finditer(text):
+                seen += 1
+                why = dotted_problem(f"armcli.{m[0]}")
+                if why:
+                    missing.append(f"{path.relative_to(ROOT)}:{n}: {m[0]}: {why}")
+    assert not missing, "\n".join(missing)
+    assert seen > 20  # the pattern still finds the source's references
+
+
 def test_a_stale_name_is_caught() -> None:
     assert dotted_problem("armcli.stability") == "no module or attribute 'stability' in armcli"
     assert dotted_problem("armcli.check.rules.NO_TABLE") is not None
     assert dotted_problem("armcli.sim.states") is None
     assert dotted_problem("armcli.check.rules.RULES") is None
+    assert RELATIVE.findall("(`urdf.ground`) and (urdf.xacro_safe: x) but not urdf.links") == [
+        "urdf.ground",
+        "urdf.xacro_safe",
+    ]

@@ -1,7 +1,7 @@
 """The support polygon a robot stands on, and how far a point on the ground is inside it.
 
 The polygon is the convex hull of the ground contact
-points (`urdf.ground`), in the root link's x-y plane: rigid contacts on flat ground. A
+points (`analysis.ground`), in the root link's x-y plane: rigid contacts on flat ground. A
 point on the ground is statically balanced while it lies inside; its margin is the
 distance to the nearest edge (negative outside: minus the distance to the polygon).
 Each edge is a tipping axis; its outward normal names the direction the robot tips.

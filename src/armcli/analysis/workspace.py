@@ -4,7 +4,7 @@ The chain is the moving joints between the root and the tool point's link. Forwa
 kinematics (Pinocchio) of the zero pose, every corner of the range box when there are few
 and seeded uniform draws of those joints (`robot.sampling.search_starts`) gives a cloud
 of tool positions in the root frame; each extreme of the envelope is then refined by a
-local search within the limits (`urdf.boxsearch`) from the best samples, so it does not
+local search within the limits (`analysis.boxsearch`) from the best samples, so it does not
 depend on a lucky draw:
 
 - max reach: the largest distance from the shoulder (the origin of the chain's first

@@ -3,7 +3,7 @@
 Model: rigid bodies on rigid, flat, level ground, contacts that neither slip nor lift,
 and no motion (velocities and accelerations are `simulate`'s zero-moment point). The
 centre of mass (Pinocchio, payload included as a point mass) projects vertically onto
-the ground; its margin toward an edge of the support polygon (`urdf.support`) is its
+the ground; its margin toward an edge of the support polygon (`analysis.support`) is its
 distance to that edge's line, positive inside. On a slope rising at theta toward an edge,
 gravity leans by theta in the robot's frame and the projection moves h tan(theta)
 toward that edge (h: the centre of mass's height above the ground), so the robot tips
@@ -12,7 +12,7 @@ at the slope angle atan(d / h): the tipping angle of that direction.
 The worst over the joint range is found by search, per edge and per measure (margin,
 tipping angle): every seed (the zero pose, the named poses, every corner of the range
 box when there are at most 64, and seeded uniform draws) is evaluated, and a projected
-gradient descent (`urdf.boxsearch`, with Pinocchio's centre-of-mass Jacobian as the
+gradient descent (`analysis.boxsearch`, with Pinocchio's centre-of-mass Jacobian as the
 gradient) runs from the best three within the joint limits.
 """
 

@@ -1,6 +1,6 @@
 """Rule `reach-point` and the summary's reach envelope: where can the tool point go?
 
-The envelope of the tool point over the chain's joint ranges (`urdf.workspace`: sampled
+The envelope of the tool point over the chain's joint ranges (`analysis.workspace`: sampled
 forward kinematics, extremes refined by local search) goes to the summary; each
 `--reach-point` is tested by inverse kinematics, and one the arm cannot reach within
 REACH_TOL is an error naming how close it gets and where.

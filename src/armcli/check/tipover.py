@@ -1,6 +1,6 @@
 """Rules `com-outside-support` and `support-margin`: will the robot tip over standing still?
 
-The robot's support polygon (its wheels' and caster's ground contacts, `urdf.ground`)
+The robot's support polygon (its wheels' and caster's ground contacts, `analysis.ground`)
 and its centre of mass with the payload (`check.balance`), at every named pose and at
 the worst configuration of the joint range. A robot whose base is bolted down (an arm
 alone: no wheel touches the ground) is skipped with a note, unless contact links are

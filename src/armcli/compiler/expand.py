@@ -1,7 +1,7 @@
 """`armcli build`: spec -> xacro set -> expanded URDFs through armcli's safe xacro evaluator.
 
 Only files armcli generated itself are expanded here, from a private temporary
-directory, and with the same evaluator foreign files get (urdf.xacro_safe: xacro's
+directory, and with the same evaluator foreign files get (xacro.safe: xacro's
 own machinery, `${...}` by an AST whitelist, files confined to that directory),
 never xacro's Python `eval`: data in a spec never becomes code (issue 27). The
 real xacro stays the test oracle (tests/compiler/test_expand_oracle.py: identical

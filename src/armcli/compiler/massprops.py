@@ -20,7 +20,7 @@ from armcli.io.meshbound import check_mesh_payload
 from armcli.io.userfile import check_regular
 from armcli.spec.model import Inertial, Shape
 
-MAX_MESH_BYTES = 20_000_000  # same cap as urdf.mesh_confine for meshes check and view load
+MAX_MESH_BYTES = 20_000_000  # same cap as io.mesh_confine for meshes check and view load
 MIN_VOLUME = 1e-15  # [m³] below this a "solid" is a sheet
 
 

@@ -1,6 +1,6 @@
 """Mesh files for the MJCF model: bounded like `check`'s, in a form MuJoCo decodes.
 
-Each mesh is read once, under the caps `check` and `render` apply (urdf.mesh_confine:
+Each mesh is read once, under the caps `check` and `render` apply (io.mesh_confine:
 a regular file, symlinks resolved, per-file and per-robot byte limits), so a hostile
 URDF cannot make the export read or write gigabytes. Then what MuJoCo's decoders
 need: its STL reader takes binary STL only, of at most MJ_STL_MAX_FACES faces, so an

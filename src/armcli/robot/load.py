@@ -126,7 +126,7 @@ def confined_mesh_xml(urdf: Urdf, search: MeshSearch) -> str:
     """The URDF text with every mesh named by its confined, bounded real path.
 
     Meshes are resolved inside the allowed roots (`urdf.meshes`) and checked to be bounded
-    files (`urdf.mesh_confine`). InputError naming a mesh that cannot be found or one
+    files (`io.mesh_confine`). InputError naming a mesh that cannot be found or one
     over the size caps.
     """
     meshes = mesh_paths(urdf, search)

@@ -5,7 +5,7 @@ collision geoms, the arm's `position` actuators (Kp, Kd, effort limit) and Gazeb
 `mu1` as sliding friction. Added here through MuJoCo's model editor (MjSpec):
 
 - contacts of time constant CONTACT_TIME;
-- a ground plane at z = 0, the robot's lowest contact point on it (urdf.stance), with sliding
+- a ground plane at z = 0, the robot's lowest contact point on it (analysis.stance), with sliding
   friction 0 so that each contact takes the robot geom's own coefficient (MuJoCo
   combines two geoms by the larger one; Gazebo's ODE by the smaller, and its ground
   plane's mu is 100, so in both the robot's coefficient counts). A collision without

@@ -1,8 +1,10 @@
-"""Piecewise-polynomial reference built from a Trajectory, sampled for all steps at once.
+"""Piecewise-polynomial reference built from a Trajectory: what the simulator tracks.
 
 Segments are stored as quintic coefficients in local time (linear and cubic segments have
-zero higher terms), so sampling a whole run is one `searchsorted` and a Horner evaluation
-over arrays, with no per-step Python work.
+zero higher terms). The compiled engine receives these arrays (sim/rollout.py hands them
+over) and evaluates them itself at every step; `Reference.sample` evaluates the same
+polynomials in NumPy for everything outside the step: speed prechecks, the planner's
+certificate, driving's arm commands, plots and the tests' independent integrators.
 """
 
 from __future__ import annotations
@@ -30,8 +32,9 @@ class Reference:
         """Reference positions and velocities at times `t`, each (len(t), n).
 
         `segment_time` (same length) picks the polynomial piece evaluated at each `t`
-        (default: the piece holding `t`); a simulator step samples the piece of its
-        midpoint so that all its stages see one smooth function.
+        (default: the piece holding `t`). The compiled RK4 step evaluates the piece of its
+        midpoint so that all its stages see one smooth function (rollout.cpp); a reference
+        integrator reproduces that through `segment_time`.
         """
         t = np.asarray(t, dtype=float)
         ts = t if segment_time is None else np.asarray(segment_time, dtype=float)

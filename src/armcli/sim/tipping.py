@@ -1,7 +1,7 @@
 """Will the robot tip over while its arm runs a trajectory? `simulate`'s balance report.
 
 From a prepared simulation (`sim.job`): the whole robot standing on its contacts
-(`urdf.stance`: the spec's full URDF, or a given URDF whose wheels touch the ground),
+(`analysis.stance`: the spec's full URDF, or a given URDF whose wheels touch the ground),
 the steps the run must keep for the zero-moment point (`sim.zmp`), and after the run
 the series, its worst moment, the states-file columns and the summary line.
 """

@@ -2,7 +2,7 @@
 
 Parents and children exist, each part is one tree, names are unique across
 parts, plugin/gain/pose joint names exist, poses are within limits. Returns
-problems with dotted field paths; `spec.spec_from_doc` adds file and line.
+problems with dotted field paths; `spec.load.spec_from_doc` adds file and line.
 """
 
 from __future__ import annotations

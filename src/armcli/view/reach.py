@@ -1,7 +1,7 @@
 """Where the tool point can go, drawn over the robot: `armcli render --reach`.
 
 The reachable region is the cloud of tool positions from seeded uniform draws of the
-chain's joints within their limits (`urdf.workspace`, the sampler `check` uses, here
+chain's joints within their limits (`analysis.workspace`, the sampler `check` uses, here
 denser), coloured by height, over the robot at the rendered pose; joints off the chain
 (a torso, the wheels) stay at that pose. Each `--reach-point` is a marker: a green ring
 when inverse kinematics reaches it within REACH_TOL, a red cross joined by a dashed line
