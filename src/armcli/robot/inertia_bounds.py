@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from armcli.robot import inertia as inr
-from armcli.urdf.doc import Geometry, Link, Shape
+from armcli.urdf.doc import Geometry
 
 Matrix = NDArray[np.float64]
 
@@ -43,17 +43,6 @@ class Excess:
     centre: tuple[float, float, float]  # diag of the inertia about the shape centre [kg·m²]
     bound: tuple[float, float, float]  # all-mass-on-the-extremes bound [kg·m²]
     solid: tuple[float, float, float]  # the solid body's moments [kg·m²]
-
-
-def collision_primitive(link: Link) -> Shape | None:
-    """The link's collision geometry when it is exactly one box, cylinder or sphere."""
-    if len(link.collisions) != 1:
-        return None
-    shape = link.collisions[0]
-    g = shape.geometry
-    if g is None or g.kind not in ("box", "cylinder", "sphere") or g.dims is None:
-        return None
-    return shape if all(d > 0 for d in g.dims) else None
 
 
 def extreme_bound(g: Geometry, m: float) -> NDArray[np.float64]:

@@ -8,12 +8,10 @@ from __future__ import annotations
 
 import io
 from collections.abc import Callable, Sequence
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from armcli.io.files import write_file_atomic
 from armcli.sim.simulate import SimResult
 
 PLOT_POINTS = 4000  # states a tracking plot draws at most: finer than the figure's pixels
@@ -79,10 +77,3 @@ def tracking_png(
     fig.savefig(buf, format="png", dpi=100, metadata={"Software": None})
     plt.close(fig)
     return buf.getvalue()
-
-
-def write_tracking_plot(
-    path: Path, res: SimResult, effort_limits: np.ndarray | None = None
-) -> None:
-    """Write the tracking plot PNG atomically; `effort_limits` [N·m] mark saturation."""
-    write_file_atomic(path, tracking_png(res, effort_limits))

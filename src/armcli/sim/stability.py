@@ -373,11 +373,6 @@ def spectral_radius(A: Array) -> float:
     return float(np.max(np.abs(np.linalg.eigvals(A))))
 
 
-def is_stable(radius: float) -> bool:
-    """A spectral radius that does not grow (see RADIUS_TOL)."""
-    return radius <= 1.0 + RADIUS_TOL
-
-
 def stable(lin: Linearised, pd: PD, dt: float, scheme: Scheme) -> bool:
     """Whether the loop is stable at dt at every operating point.
 

@@ -107,8 +107,3 @@ def evaluate_candidates(
                     costs[v, c] = run_cost(metrics[v, c], weights)
         out.append(CandidateEval(not reason, reason, costs, metrics))
     return out
-
-
-def evaluate_candidate(problem: TuneProblem, gains: np.ndarray, weights: Weights) -> CandidateEval:
-    """`evaluate_candidates` for a single candidate."""
-    return evaluate_candidates(problem, [gains], weights)[0]

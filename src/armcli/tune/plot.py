@@ -7,12 +7,10 @@ from __future__ import annotations
 
 import io
 from collections.abc import Sequence
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from armcli.io.files import write_file_atomic
 from armcli.sim.simulate import SimResult
 from armcli.tune.objective import INFEASIBLE_COST
 from armcli.tune.search import TrialRecord
@@ -67,9 +65,3 @@ def _history(ax: Any, history: Sequence[TrialRecord]) -> None:
     ax.set_title("optimisation history")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-
-
-def write_tune_plot(path: Path, history: Sequence[TrialRecord],
-                    runs: Sequence[tuple[str, SimResult]], case_label: str) -> None:  # fmt: skip
-    """Write `tune_png` atomically."""
-    write_file_atomic(path, tune_png(history, runs, case_label))
