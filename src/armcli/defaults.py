@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Literal
 
 DEFAULT_SPEC = Path("specs/my_robot.yaml")  # preferred when specs/ holds several
 SPEC_FILE = Path("armcli.yaml")  # what `armcli init` writes; found first in the cwd
@@ -27,7 +28,8 @@ DEFAULT_STATE_RATE_HZ = 10.0  # [Hz] joint-state output without a joint_state_pu
 ROS_TARGETS = ("humble-classic", "jazzy")  # the course's ROS 2 Humble + Gazebo classic; Jazzy + gz
 COLLISION_SAMPLES = 10_000  # the MoveIt Setup Assistant's default "sampling density"
 MJCF_BASES = ("fixed", "free")  # `export mjcf --base`: root welded to the world, or free
-PD_LOOPS = ("implicit", "explicit")  # `tune --loop`: armcli's simulator, or an explicit torque loop
+PdLoop = Literal["implicit", "explicit"]  # armcli's simulator, or an explicit torque loop
+PD_LOOPS: tuple[PdLoop, ...] = ("implicit", "explicit")  # `tune --loop`
 ROBUST_MODES = ("worst", "quantile")  # `tune --robust-mode` over the perturbed models
 
 # [rad/s² or m/s²] a joint's acceleration limit when neither the spec nor the URDF gives one:

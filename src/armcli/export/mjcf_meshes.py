@@ -58,7 +58,7 @@ class MeshFile:
     """A mesh as the export writes it, or why it is left out."""
 
     data: bytes
-    suffix: str  # ".stl" | ".obj" | ".msh"
+    suffix: str  # the written file's, lower case: ".stl" (converted too), ".obj", ".msh", ...
     faces: int | None  # None where armcli does not parse the format (.msh)
     flat: bool  # all vertices in one plane: MuJoCo needs inertia="shell"
     converted: bool  # an ASCII STL (or a COLLADA file) rewritten as binary STL

@@ -16,6 +16,7 @@ import itertools
 import math
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -28,7 +29,7 @@ from armcli.urdf.read import parse_urdf
 
 DEFAULT_SAMPLES = COLLISION_SAMPLES
 DEFAULT_SEED = 0
-REASONS = ("Adjacent", "Default", "Never")
+Reason = Literal["Adjacent", "Default", "Never"]  # MoveIt Setup Assistant's words
 
 
 @dataclass(frozen=True)
@@ -37,7 +38,7 @@ class DisabledPair:
 
     link1: str
     link2: str
-    reason: str  # one of REASONS
+    reason: Reason
 
 
 @dataclass(frozen=True)
@@ -64,7 +65,7 @@ class CollisionMatrix:
     seed: int
     pose_collisions: tuple[tuple[str, str, str], ...] = ()  # (pose, link1, link2) in contact
 
-    def reason(self, a: str, b: str) -> str | None:
+    def reason(self, a: str, b: str) -> Reason | None:
         """Why the pair (a, b) is disabled, or None if MoveIt keeps checking it."""
         key = _pair(a, b)
         return next((d.reason for d in self.disabled if (d.link1, d.link2) == key), None)

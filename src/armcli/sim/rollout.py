@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -19,6 +19,7 @@ from armcli.sim import native
 from armcli.sim.options import Integrator
 from armcli.sim.reference import Reference
 
+Failure = Literal["", "nonfinite", "velocity", "energy"]  # why a run stopped early
 CHUNK_STEPS = 10_000  # steps per call into the engine, between progress reports
 
 
@@ -78,7 +79,7 @@ class Rollout:
     v: np.ndarray
     fail_step: int  # -1 when the run completed
     fail_joint: int  # index, -1 when not joint-specific
-    failure: str  # "" | "nonfinite" | "velocity" | "energy"
+    failure: Failure  # "": the run completed
 
 
 def run(
@@ -117,12 +118,13 @@ def run(
         fail_step, fail_joint, code = r.advance(CHUNK_STEPS)
         if progress is not None:
             progress(r.step, steps)
-    failure = {
+    failures: dict[int, Failure] = {
         mod.FAIL_NONE: "",
         mod.FAIL_NONFINITE: "nonfinite",
         mod.FAIL_VELOCITY: "velocity",
         mod.FAIL_ENERGY: "energy",
-    }[code]
+    }
+    failure = failures[code]
     recs, stats = r.records(), r.statistics()
     flags = {"saturated": recs.pop("saturated").astype(bool), "stop": recs.pop("stop").astype(bool)}
     fields = Stats.__dataclass_fields__

@@ -56,6 +56,7 @@ BISECT_STEPS = 60  # halvings for the largest stable dt (relative error 2^-60)
 DT_CEILING = 1e6  # [s] a loop stable beyond this is stable for every dt
 
 Scheme = Literal["explicit", "implicit", "rk4"]
+Scaled = Literal["Kp", "Kd", "Kp and Kd"]  # which gains a GainScale scales, in words
 """How the PD loop is stepped: semi-implicit Euler with damping explicit (a torque loop as
 in Gazebo's effort controllers) or implicit (armcli's simulator), or RK4 (explicit)."""
 
@@ -264,7 +265,7 @@ class GainScale:
     kd: bool  # Kd is scaled
 
     @property
-    def label(self) -> str:
+    def label(self) -> Scaled:
         """The scaled gains, in words."""
         return "Kp and Kd" if self.kp and self.kd else ("Kp" if self.kp else "Kd")
 

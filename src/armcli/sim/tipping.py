@@ -196,7 +196,7 @@ class ZmpReport:
     threshold: float  # [m]
     min_margin: float  # [m] over the run and the cases (negative: it tips)
     time: float  # [s] when
-    case: str  # one of sim.zmp.CASES
+    case: zmps.Case
     direction: str  # toward which edge
     zmp: tuple[float, float]  # [m] the point then
     arm_margin: float  # [m] least margin of the arm motion alone (base at rest)

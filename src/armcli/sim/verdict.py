@@ -20,7 +20,7 @@ import numpy as np
 
 from armcli.errors import UnstableLoopError
 from armcli.sim import stability as stab
-from armcli.sim.stability import PD, Linearised, Scheme
+from armcli.sim.stability import PD, Linearised, Scaled, Scheme
 
 # Remedies: a time step or gains this fraction inside the strict bound, rounded down to
 # REMEDY_DIGITS significant digits (a rounded remedy stays stable: A grows as dt or a gain
@@ -51,7 +51,7 @@ class Suggestion:
 class LoopVerdict:
     """One loop's verdict over the operating points, with its bounds and remedy."""
 
-    scheme: str  # "implicit" | "explicit" | "rk4"
+    scheme: Scheme
     loop: str  # which loop this is, in words (LOOP_NAMES)
     stable: bool
     a: float  # Kp dt² lambda at the worst point (largest gains; the scalar explanation)
@@ -59,7 +59,7 @@ class LoopVerdict:
     spectral_radius: float  # of the linearised step at the worst point
     dt_max: float  # largest stable dt with these gains [s] (inf: every dt)
     gain_scale: float | None  # largest stable factor on `scaled` at dt (None: none helps)
-    scaled: str | None  # which gains that factor scales: "Kp", "Kd" or "Kp and Kd"
+    scaled: Scaled | None  # which gains that factor scales
     suggestion: Suggestion | None  # None when stable
     worst: int  # index of the operating point that sets dt_max
 

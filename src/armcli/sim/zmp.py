@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -38,7 +38,8 @@ from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_root
 
 MAX_SAMPLES = 20_000  # states whose zero-moment point is computed, at most (pairs of steps)
-CASES = ("arm motion", "accelerating", "braking")
+Case = Literal["arm motion", "accelerating", "braking"]
+CASES: tuple[Case, Case, Case] = ("arm motion", "accelerating", "braking")
 # gazebo_ros_diff_drive limits the change of each wheel's rim speed by this [m/s²]
 # (its code multiplies the joint velocity by the radius before comparing): the base's
 # linear acceleration. gz-sim's DiffDrive names it max_linear_acceleration [m/s²].

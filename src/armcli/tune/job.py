@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from armcli.defaults import PdLoop
 from armcli.errors import InputError
 from armcli.io.yaml import load_yaml
 from armcli.sim.job import ARM_URDF, SETTLE_EXTRA_S, start_state
@@ -78,8 +79,10 @@ def default_trajectories(spec_path: Path, joints: Sequence[str]) -> list[Path]:
     return out
 
 
-def _validate(s: TuneSettings) -> None:
-    if s.loop not in LOOPS:
+def _validate(s: TuneSettings) -> PdLoop:
+    """The settings' loop, once every setting is known to be valid."""
+    loop = next((x for x in LOOPS if x == s.loop), None)
+    if loop is None:
         valid = ", ".join(LOOPS)
         raise InputError(f"unknown loop {s.loop!r}; valid: {valid}", field="TuneSettings.loop")
     if not (math.isfinite(s.zeta) and s.zeta > 0):
@@ -95,6 +98,7 @@ def _validate(s: TuneSettings) -> None:
     for field, (a, b) in (("mass_scale", s.mass_scale), ("friction_scale", s.friction_scale)):
         if not (math.isfinite(a) and math.isfinite(b) and 0 < a <= b):
             raise InputError(f"need 0 < a <= b, got {a:g},{b:g}", field=f"TuneSettings.{field}")
+    return loop
 
 
 def _pose_cases(
@@ -131,10 +135,10 @@ def prepare(
     spec: RobotSpec, spec_path: Path, trajectories: Sequence[Path], s: TuneSettings
 ) -> TuneJob:
     """Validate every input and build the job; raises InputError/SpecError on bad input."""
-    _validate(s)
+    loop = _validate(s)
     xml = spec_urdfs(spec)[ARM_URDF].decode("utf-8")
     base = TuneProblem(xml, ARM_URDF, tuple(s.joints or ()), spec.control.dt, "euler",
-                       bool(spec.control.gravity_compensation), s.loop, 1.0, (), ())  # fmt: skip
+                       bool(spec.control.gravity_compensation), loop, 1.0, (), ())  # fmt: skip
     arm = nominal_arm(base)
     joints = arm.joint_names
     limits = {n: (float(lo), float(hi)) for n, lo, hi in zip(joints, arm.lower, arm.upper,
@@ -160,7 +164,7 @@ def prepare(
                         gravity=not base.gravity_comp)  # fmt: skip
     variants = draw_variants(arm, s.robust, s.mass_scale, s.friction_scale, s.seed)
     problem = TuneProblem(xml, ARM_URDF, joints, spec.control.dt, "euler", base.gravity_comp,
-                          s.loop, STABILITY_MARGIN, tuple(cases), variants).with_key()  # fmt: skip
+                          loop, STABILITY_MARGIN, tuple(cases), variants).with_key()  # fmt: skip
     return TuneJob(problem, start, _spec_gains(spec, joints))
 
 

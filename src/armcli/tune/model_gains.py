@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -40,6 +41,7 @@ STABILITY_MARGIN = 2.0  # gains must be stable at this multiple of dt
 WN_BRACKET = (1e-6, 1e9)  # [rad/s] search interval for the stability cap
 SCALE_FLOOR = 1e-9  # smallest common kp scale the coupled check tries
 LOOPS = PD_LOOPS
+Binding = Literal["target", "stability", "effort"]  # which cap chose a joint's wn
 
 
 @dataclass(frozen=True)
@@ -59,7 +61,7 @@ class JointReasoning:
     zeta: float
     kp: float  # [N·m/rad]
     kd: float  # [N·m·s/rad]
-    binding: str  # "target" | "stability" | "effort"
+    binding: Binding
 
 
 @dataclass(frozen=True)
@@ -167,7 +169,7 @@ def start_gains(
             loop, m_max, zeta, float(arm.damping[j]), float(lam_j[j]), dt, float(g_jj[j])
         )
         wn_e = _effort_cap(name, float(arm.effort[j]), float(g[j]), float(steps[j]), m_max)
-        caps = {"target": wn_target, "stability": wn_s, "effort": wn_e}
+        caps: dict[Binding, float] = {"target": wn_target, "stability": wn_s, "effort": wn_e}
         binding = min(caps, key=lambda k: caps[k])
         wn = caps[binding]
         kp_j, kd_j = m_max * wn * wn, 2.0 * zeta * wn * m_max

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from armcli.defaults import PdLoop
 from armcli.robot.load import load_model
 from armcli.sim.options import Integrator
 from armcli.sim.reference import Reference
@@ -64,7 +65,7 @@ class TuneProblem:
     dt: float  # [s]
     integrator: Integrator
     gravity_comp: bool
-    loop: str  # "implicit" | "explicit": which stability bound makes a candidate infeasible
+    loop: PdLoop  # which stability bound makes a candidate infeasible
     stability_margin: float  # nominal model: stable at stability_margin * dt; variants: at dt
     cases: tuple[Case, ...]
     variants: tuple[Variant, ...]  # empty: the nominal model only

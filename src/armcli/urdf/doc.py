@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import Literal
 
 from armcli.spec.joint_types import JOINT_DOF
 from armcli.xacro.lines import Origin
@@ -20,7 +21,7 @@ ZERO3: Vec3 = (0.0, 0.0, 0.0)
 class NumberProblem:
     """A numeric attribute that is missing, unparsable, non-finite or of the wrong length."""
 
-    kind: str  # "missing" | "not-a-number" | "non-finite" | "length"
+    kind: Literal["missing", "not-a-number", "non-finite", "length"]
     where: str  # e.g. "link base_link: inertial/mass@value"
     text: str
     line: int | None
