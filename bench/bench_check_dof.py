@@ -32,7 +32,7 @@ from armcli.compiler.expand import expand_urdfs  # noqa: E402
 from armcli.defaults import STANDALONE_ARM_URDF  # noqa: E402
 from armcli.robot import sampling  # noqa: E402
 from armcli.robot.model import Robot  # noqa: E402
-from armcli.sim import stability as stab  # noqa: E402
+from armcli.sim import pdloop  # noqa: E402
 from armcli.sim import verdict as verdicts  # noqa: E402
 from armcli.spec.load import load_spec  # noqa: E402
 
@@ -75,14 +75,14 @@ def analysis_seconds(spec_path: Path, with_reference: bool) -> tuple[float, floa
     samples = sampling.configurations(robot)
     n = model.nv
     t0 = time.perf_counter()
-    lin = stab.linearise(model, [q for _, q in samples])
-    pd = stab.PD.of(range(n), [KP] * n, [KD] * n, [DAMPING] * n)
+    lin = pdloop.linearise(model, [q for _, q in samples])
+    pd = pdloop.PD.of(range(n), [KP] * n, [KD] * n, [DAMPING] * n)
     verdicts.analyse(lin, [[p[r.name] for r in ranges] for p, _ in samples], pd, DT)
     new = time.perf_counter() - t0
     if not with_reference:
         return new, None
     t0 = time.perf_counter()
-    lin = stab.linearise(model, [q for _, q in samples], gravity=False)  # M only, as before
+    lin = pdloop.linearise(model, [q for _, q in samples], gravity=False)  # M only, as before
     Ms, Gs = list(lin.M), list(lin.G)
     kp, d = np.full(n, KP), np.full(n, KD + DAMPING)
     for scheme in ("explicit", "implicit"):

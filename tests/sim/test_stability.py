@@ -11,6 +11,7 @@ import pinocchio as pin
 import pytest
 
 from armcli.errors import UnstableLoopError
+from armcli.sim import pdloop
 from armcli.sim import stability as stab
 from armcli.sim import verdict as verdicts
 from armcli.sim.job import load_arm
@@ -73,13 +74,13 @@ def test_jury_condition_matches_iterating_the_scalar_mode(a: float, b: float) ->
     assert stab.explicit_stable(a, b) == (not grows)
 
 
-def _lin(*Ms: np.ndarray) -> stab.Linearised:
+def _lin(*Ms: np.ndarray) -> pdloop.Linearised:
     """Mass matrices without gravity (the textbook arm lies in a horizontal plane)."""
-    return stab.Linearised(np.array(Ms), np.zeros((len(Ms), *Ms[0].shape)))
+    return pdloop.Linearised(np.array(Ms), np.zeros((len(Ms), *Ms[0].shape)))
 
 
-def _pd(kp: float, kd: float, damping: float, n: int = 2) -> stab.PD:
-    return stab.PD.of(range(n), [kp] * n, [kd] * n, [damping] * n)
+def _pd(kp: float, kd: float, damping: float, n: int = 2) -> pdloop.PD:
+    return pdloop.PD.of(range(n), [kp] * n, [kd] * n, [damping] * n)
 
 
 def test_seed_arm_explicit_diverges_implicit_converges() -> None:
@@ -162,7 +163,7 @@ def test_check_verdict_equals_simulate_acceptance(
         M = pin.crba(arm.model, data, q)
         Ms.append(np.triu(M) + np.triu(M, 1).T)
     G = [pin.computeGeneralizedGravityDerivatives(arm.model, data, q) for q in configs]
-    lin = stab.Linearised(np.array(Ms), np.array([0.5 * (g + g.T) for g in G]))
+    lin = pdloop.Linearised(np.array(Ms), np.array([0.5 * (g + g.T) for g in G]))
     rep = verdicts.analyse(lin, configs.tolist(), _pd(kp, kd, damping), dt)
     cfg = SimConfig(kp=np.full(2, kp), kd=np.full(2, kd), dt=dt)
     try:

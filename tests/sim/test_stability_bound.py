@@ -12,6 +12,7 @@ import math
 import numpy as np
 import pytest
 
+from armcli.sim import pdloop
 from armcli.sim import stability as stab
 from tests.sim import stability_reference as ref
 
@@ -21,7 +22,7 @@ DT_RTOL = 1e-7  # bisection to 2^-60 on both sides; the reference's eigvals limi
 SCALE_ATOL = 1e-7
 
 
-def _case(seed: int) -> tuple[stab.Linearised, stab.PD, float]:
+def _case(seed: int) -> tuple[pdloop.Linearised, pdloop.PD, float]:
     rng = np.random.default_rng(seed)
     n = int(rng.integers(1, 5))
     free = n > 1 and rng.random() < 0.3
@@ -40,17 +41,17 @@ def _case(seed: int) -> tuple[stab.Linearised, stab.PD, float]:
     # around the scalar edge of the stiffest mode, so both verdicts occur
     edge = stab.implicit_dt_max(float(kp.max()), float((kd + damping).max()), lam)
     dt = float(min(edge, 1.0) * 10 ** rng.uniform(-0.7, 0.5))
-    lin = stab.Linearised(M[None], G[None])
-    return lin, stab.PD.of(idx, kp, kd, damping), dt
+    lin = pdloop.Linearised(M[None], G[None])
+    return lin, pdloop.PD.of(idx, kp, kd, damping), dt
 
 
-def _ref_args(lin: stab.Linearised, pd: stab.PD) -> tuple:
+def _ref_args(lin: pdloop.Linearised, pd: pdloop.PD) -> tuple:
     return list(lin.M), list(lin.G), list(pd.idx), pd.kp, pd.kd + pd.damping
 
 
 @pytest.mark.parametrize("seed", range(CASES))
 @pytest.mark.parametrize("scheme", ["implicit", "explicit"])
-def test_verdict_equals_the_eigenvalue_reference(seed: int, scheme: stab.Scheme) -> None:
+def test_verdict_equals_the_eigenvalue_reference(seed: int, scheme: pdloop.Scheme) -> None:
     lin, pd, dt = _case(seed)
     Ms, Gs, idx, kp, D = _ref_args(lin, pd)
     rho = ref.worst_radius(Ms, Gs, idx, kp, D, dt, scheme)
@@ -61,7 +62,9 @@ def test_verdict_equals_the_eigenvalue_reference(seed: int, scheme: stab.Scheme)
 
 @pytest.mark.parametrize("seed", range(CASES))
 @pytest.mark.parametrize("scheme", ["implicit", "explicit"])
-def test_largest_stable_dt_equals_the_eigenvalue_reference(seed: int, scheme: stab.Scheme) -> None:
+def test_largest_stable_dt_equals_the_eigenvalue_reference(
+    seed: int, scheme: pdloop.Scheme
+) -> None:
     lin, pd, dt = _case(seed)
     Ms, Gs, idx, kp, D = _ref_args(lin, pd)
     expected = ref.largest_stable_dt(Ms, Gs, idx, kp, D, scheme, dt)
@@ -74,7 +77,7 @@ def test_largest_stable_dt_equals_the_eigenvalue_reference(seed: int, scheme: st
 
 @pytest.mark.parametrize("seed", range(CASES))
 @pytest.mark.parametrize("scheme", ["implicit", "explicit"])
-def test_gain_scale_equals_the_eigenvalue_reference(seed: int, scheme: stab.Scheme) -> None:
+def test_gain_scale_equals_the_eigenvalue_reference(seed: int, scheme: pdloop.Scheme) -> None:
     lin, pd, dt = _case(seed)
     Ms, Gs, idx, _, _ = _ref_args(lin, pd)
     got = stab.gain_scale(lin, pd, dt, scheme)
@@ -97,8 +100,8 @@ def test_gain_scale_equals_the_eigenvalue_reference(seed: int, scheme: stab.Sche
 @pytest.mark.parametrize("b", [0.0, 0.1, 0.9, 1.4, 1.9, 2.1])
 def test_one_joint_is_the_jury_condition(a: float, b: float) -> None:
     """lambda = 1, dt = 1: Kp = a and D = b; explicit a + 2b <= 4, implicit a - 2b <= 4."""
-    lin = stab.Linearised(np.eye(1)[None], np.zeros((1, 1, 1)))
-    pd = stab.PD.of([0], [a], [b], [0.0])
+    lin = pdloop.Linearised(np.eye(1)[None], np.zeros((1, 1, 1)))
+    pd = pdloop.PD.of([0], [a], [b], [0.0])
     if a + 2 * b != 4.0:
         assert stab.stable(lin, pd, 1.0, "explicit") == (a + 2 * b < 4.0)
     assert stab.stable(lin, pd, 1.0, "implicit") == (a - 2 * b < 4.0)

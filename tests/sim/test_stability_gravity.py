@@ -22,6 +22,7 @@ import pytest
 from armcli.check.rules import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.robot.load import load_model
+from armcli.sim import pdloop
 from armcli.sim import stability as stab
 from armcli.sim.reference import build_reference
 from armcli.sim.simulate import SimConfig, arm_from_model, simulate
@@ -47,7 +48,7 @@ def model():  # type: ignore[no-untyped-def]
 
 
 def _lin(model, thetas):  # type: ignore[no-untyped-def]
-    return stab.linearise(model, [np.array([t]) for t in thetas])
+    return pdloop.linearise(model, [np.array([t]) for t in thetas])
 
 
 @pytest.mark.parametrize("theta", [0.0, 0.7, 1.5, 2.5, -3.0])
@@ -63,7 +64,7 @@ def test_pinocchio_gives_the_pendulum_inertia_and_stiffness(model, theta: float)
 def test_largest_stable_dt_is_the_closed_form(model, kp: float, kd: float, scheme: str) -> None:  # type: ignore[no-untyped-def]
     """Over the whole range the hanging pose is the stiffest: k = Kp + m g l."""
     lin = _lin(model, np.linspace(-3.0, 3.0, 13))
-    pd = stab.PD.of([0], [kp], [kd], [0.0])
+    pd = pdloop.PD.of([0], [kp], [kd], [0.0])
     k = kp + MASS * G0 * DEPTH
     bound = stab.implicit_dt_max if scheme == "implicit" else stab.explicit_dt_max
     expected = bound(k, kd, 1.0 / INERTIA)
@@ -73,8 +74,8 @@ def test_largest_stable_dt_is_the_closed_form(model, kp: float, kd: float, schem
 
 def test_without_gravity_the_bound_ignores_it(model) -> None:  # type: ignore[no-untyped-def]
     """Gravity compensation cancels g(q) at the same q: only Kp is left."""
-    lin = stab.linearise(model, [np.zeros(1)], gravity=False)
-    pd = stab.PD.of([0], [0.001], [0.0], [0.0])
+    lin = pdloop.linearise(model, [np.zeros(1)], gravity=False)
+    pd = pdloop.PD.of([0], [0.001], [0.0], [0.0])
     expected = stab.implicit_dt_max(0.001, 0.0, 1.0 / INERTIA)
     assert stab.largest_stable_dt(lin, pd, "implicit", 0.01) == pytest.approx(expected, rel=DT_RTOL)
 

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from armcli.sim import pdloop
 from armcli.sim import stability as stab
 from armcli.sim.reference import Reference
 from armcli.spec.load import load_spec
@@ -57,7 +58,7 @@ def test_shared_work_is_done_once_per_model(
     fresh = job.problem.with_key()  # a new key: the per-process cache starts empty
     monkeypatch.setattr(problem, "_CACHE", {})
     sampled = _counting(monkeypatch, Reference, "sample")
-    linearised = _counting(monkeypatch, stab, "linearise")
+    linearised = _counting(monkeypatch, pdloop, "linearise")
     evs = evaluate.evaluate_candidates(fresh, _batch(job), Weights())
     assert all(ev.feasible for ev in evs)
     assert sampled[0] == 0  # no reference is sampled per candidate (nor at all)
@@ -71,7 +72,7 @@ def test_stability_verdict_per_candidate_is_the_bound(job: tjob.TuneJob) -> None
     Ms, Gs = list(sm.lin.M), list(sm.lin.G)
     for scale in (1.0, 30.0, 1e3, 1e5):
         kp = job.start.kp * scale
-        pd = stab.PD.of(range(n), kp, job.start.kd, sm.arm.damping)
+        pd = pdloop.PD.of(range(n), kp, job.start.kd, sm.arm.damping)
         d = job.start.kd + sm.arm.damping
         rho = ref.worst_radius(Ms, Gs, range(n), kp, d, job.problem.dt, "implicit")
         assert stab.stable(sm.lin, pd, job.problem.dt, "implicit") == (rho <= 1 + ref.RADIUS_TOL)

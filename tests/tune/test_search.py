@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from armcli.sim import stability as stab
+from armcli.sim import pdloop
 from armcli.sim.verdict import analyse
 from armcli.spec.load import load_spec
 from armcli.tune import job as tjob
@@ -51,7 +51,7 @@ def test_tuned_gains_stable_at_the_spec_dt(job: tjob.TuneJob, outcome: session.O
     qs = sample_configurations(arm)
     n = len(arm.joint_names)
     best = outcome.result.best
-    pd = stab.PD.of(range(n), best[:n], best[n:], arm.damping)
+    pd = pdloop.PD.of(range(n), best[:n], best[n:], arm.damping)
     rep = analyse(linearised(arm, qs, gravity=True), qs.tolist(), pd, load_spec(SPEC).control.dt)
     assert rep.implicit.stable
     assert rep.implicit.spectral_radius < 1.0

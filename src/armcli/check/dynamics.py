@@ -17,7 +17,7 @@ from armcli.check.rules import CheckOptions, Collector, JointRow, Value
 from armcli.check.structure import finite
 from armcli.errors import ModelLoadError
 from armcli.robot.model import Robot
-from armcli.sim import stability as stab
+from armcli.sim import pdloop
 from armcli.sim import verdict as verdicts
 from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf
@@ -104,9 +104,9 @@ def stability(
         notes.append("stability skipped: no controlled joint found in this URDF")
         return None
     gravity = not spec.control.gravity_compensation
-    lin = stab.linearise(robot.model, [q for _, q in samples], gravity=gravity, data=robot.data)
+    lin = pdloop.linearise(robot.model, [q for _, q in samples], gravity=gravity, data=robot.data)
     gains = [spec.control.gains[n] for n in names]
-    pd = stab.PD.of(
+    pd = pdloop.PD.of(
         [v_of[n] for n in names],
         [g.kp for g in gains],
         [g.kd for g in gains],

@@ -36,9 +36,8 @@ from armcli.defaults import DEFAULT_DT
 from armcli.errors import InputError, SimulationError
 from armcli.robot.load import mass_matrix
 from armcli.robot.model import Robot
-from armcli.sim import native
+from armcli.sim import native, pdloop
 from armcli.sim import rollout as ro
-from armcli.sim import stability as stab
 from armcli.sim import verdict as verdicts
 from armcli.sim.options import INTEGRATORS, Integrator
 from armcli.sim.reference import Reference
@@ -204,9 +203,9 @@ def check_stability(arm: Arm, cfg: SimConfig, configurations: np.ndarray) -> Non
     Raises UnstableLoopError, which names no option: the command says where dt came from.
     """
     qs = [arm.robot.q(q) for q in configurations]
-    lin = stab.linearise(arm.model, qs, gravity=not cfg.gravity_comp)
-    pd = stab.PD.of(range(arm.model.nv), cfg.kp, cfg.kd, arm.damping)
-    scheme: stab.Scheme = "rk4" if cfg.integrator == "rk4" else "implicit"
+    lin = pdloop.linearise(arm.model, qs, gravity=not cfg.gravity_comp)
+    pd = pdloop.PD.of(range(arm.model.nv), cfg.kp, cfg.kd, arm.damping)
+    scheme: pdloop.Scheme = "rk4" if cfg.integrator == "rk4" else "implicit"
     verdicts.refuse_unstable(lin, pd, cfg.dt, scheme, arm.joint_names, configurations.tolist())
 
 

@@ -35,17 +35,15 @@ the continuous modes mu (eigenvalues of the linearised loop), stable where |p| <
 
 from __future__ import annotations
 
-import contextlib
 import math
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import partial
-from typing import Any, Literal
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
-from armcli.robot.load import mass_matrix
+from armcli.sim.pdloop import PD, Array, Linearised, Scaled, Scheme
 
 # The loop counts as stable when its step map does not grow: spectral radius <= 1 + RADIUS_TOL
 # (RK4 and reports), or A + PSD_RTOL * 4M positive definite (Euler). Undamped symplectic
@@ -54,62 +52,6 @@ RADIUS_TOL = 1e-9
 PSD_RTOL = 1e-10
 BISECT_STEPS = 60  # halvings for the largest stable dt (relative error 2^-60)
 DT_CEILING = 1e6  # [s] a loop stable beyond this is stable for every dt
-
-Scheme = Literal["explicit", "implicit", "rk4"]
-Scaled = Literal["Kp", "Kd", "Kp and Kd"]  # which gains a GainScale scales, in words
-"""How the PD loop is stepped: semi-implicit Euler with damping explicit (a torque loop as
-in Gazebo's effort controllers) or implicit (armcli's simulator), or RK4 (explicit)."""
-
-Array = NDArray[np.float64]
-
-
-@dataclass(frozen=True)
-class Linearised:
-    """The arm at its operating points: symmetric M(q) and gravity's stiffness G(q)."""
-
-    M: Array  # (S, nv, nv) [kg·m²]
-    G: Array  # (S, nv, nv) dg/dq [N·m/rad]; zeros with gravity compensation
-
-    def __len__(self) -> int:
-        return int(self.M.shape[0])
-
-
-@dataclass(frozen=True)
-class PD:
-    """PD gains on the controlled velocity indices `idx` (the others move freely)."""
-
-    idx: tuple[int, ...]
-    kp: Array  # [N·m/rad]
-    kd: Array  # [N·m·s/rad]
-    damping: Array  # joint viscous damping of the controlled joints [N·m·s/rad]
-
-    @staticmethod
-    def of(idx: Sequence[int], kp: ArrayLike, kd: ArrayLike, damping: ArrayLike) -> PD:
-        """Gains as float arrays (one entry per controlled joint)."""
-        arr = [np.asarray(x, dtype=float).reshape(-1) for x in (kp, kd, damping)]
-        return PD(tuple(int(i) for i in idx), arr[0], arr[1], arr[2])
-
-    def scaled(self, kp: float, kd: float) -> PD:
-        """The same joints with Kp and Kd multiplied by `kp` and `kd` (damping is physical)."""
-        return PD(self.idx, self.kp * kp, self.kd * kd, self.damping)
-
-
-@contextlib.contextmanager
-def one_blas_thread() -> Iterator[None]:
-    """Run numpy's linear algebra on one thread inside the block.
-
-    The analysis factors many small matrices; a multi-threaded BLAS spends more on waking
-    its threads than on the work (a 129 x 129 Cholesky: 0.12 ms on one thread, ~10 ms with
-    OpenBLAS's threads on a busy 2-core machine), and under `tune`'s threads it competes
-    with the rollouts. Without threadpoolctl the block runs as is.
-    """
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:  # pragma: no cover - optional speed-up
-        yield
-        return
-    with threadpool_limits(limits=1, user_api="blas"):
-        yield
 
 
 # -- scalar modes (the closed forms the matrix bound reduces to for one joint) ----------------
@@ -132,31 +74,6 @@ def implicit_dt_max(kp: float, d: float, lam: float) -> float:
     if kp <= 0.0:
         return math.inf
     return (d * lam + math.sqrt((d * lam) ** 2 + 4.0 * kp * lam)) / (kp * lam)
-
-
-# -- the operating points -------------------------------------------------------------------
-
-
-def linearise(
-    model: Any, configurations: Sequence[Any], *, gravity: bool = True, data: Any = None
-) -> Linearised:
-    """M(q) (CRBA, symmetric) and G(q) = dg/dq at each Pinocchio configuration.
-
-    `gravity=False` for a loop that compensates g(q) (then G = 0).
-    """
-    import pinocchio as pin
-
-    data = data if data is not None else model.createData()
-    Ms, Gs = [], []
-    for q in configurations:
-        q = np.asarray(q, dtype=float)
-        Ms.append(mass_matrix(model, data, q))
-        if gravity:
-            G = np.array(pin.computeGeneralizedGravityDerivatives(model, data, q), dtype=float)
-            Gs.append(0.5 * (G + G.T))
-        else:
-            Gs.append(np.zeros((model.nv, model.nv)))
-    return Linearised(np.array(Ms, dtype=float), np.array(Gs, dtype=float))
 
 
 # -- Euler: A >= 0 --------------------------------------------------------------------------

@@ -19,8 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from armcli.errors import UnstableLoopError
+from armcli.sim import pdloop
 from armcli.sim import stability as stab
-from armcli.sim.stability import PD, Linearised, Scaled, Scheme
+from armcli.sim.pdloop import PD, Linearised, Scaled, Scheme
 
 # Remedies: a time step or gains this fraction inside the strict bound, rounded down to
 # REMEDY_DIGITS significant digits (a rounded remedy stays stable: A grows as dt or a gain
@@ -105,7 +106,7 @@ def suggest(dt_max: float, scale: stab.GainScale | None, pd: PD) -> Suggestion:
 
 def verdict(lin: Linearised, pd: PD, dt: float, scheme: Scheme) -> LoopVerdict:
     """One loop's verdict at dt over every operating point, its bounds and its remedy."""
-    with stab.one_blas_thread():
+    with pdloop.one_blas_thread():
         dt_max, worst = stab.dt_max_at(lin, pd, scheme, dt)
         ok = stab.stable(lin, pd, dt, scheme)
         scale = stab.gain_scale(lin, pd, dt, scheme)
@@ -128,7 +129,7 @@ def analyse(
     implicit = verdict(lin, pd, dt, "implicit")
     shown = implicit if not implicit.stable or explicit.stable else explicit
     kp = _largest(pd.kp)
-    with stab.one_blas_thread():
+    with pdloop.one_blas_thread():
         lam = max(_lambda_max(M, pd) for M in lin.M)
         g = max(0.0, float(np.max(np.linalg.eigvalsh(lin.G)[:, -1]))) if len(lin) else 0.0
         kd_max = _common_kd_max(lin, pd, dt)
@@ -189,7 +190,7 @@ def message(v: LoopVerdict, names: Sequence[str], q: Sequence[float], dt: float,
 def refuse_unstable(lin: Linearised, pd: PD, dt: float, scheme: Scheme,
                     names: Sequence[str], qs: Sequence[Sequence[float]]) -> None:  # fmt: skip
     """Raise UnstableLoopError, with the verdict's remedy, when the loop diverges at dt."""
-    with stab.one_blas_thread():
+    with pdloop.one_blas_thread():
         if stab.stable(lin, pd, dt, scheme):
             return
         euler_ok = scheme == "rk4" and stab.stable(lin, pd, dt, "implicit")

@@ -33,6 +33,7 @@ from armcli.defaults import PD_LOOPS
 from armcli.errors import InputError
 from armcli.robot import sampling
 from armcli.robot.model import span
+from armcli.sim import pdloop
 from armcli.sim import stability as stab
 from armcli.sim.simulate import Arm
 
@@ -82,12 +83,12 @@ def sample_configurations(arm: Arm) -> np.ndarray:
     return sampling.joint_space([span(lo, hi) for lo, hi in zip(arm.lower, arm.upper, strict=True)])
 
 
-def linearised(arm: Arm, qs: np.ndarray, *, gravity: bool) -> stab.Linearised:
+def linearised(arm: Arm, qs: np.ndarray, *, gravity: bool) -> pdloop.Linearised:
     """M(q) and gravity's stiffness at every sample, as the stability bound needs them.
 
     `gravity=False` (gravity compensation) gives zero stiffness.
     """
-    return stab.linearise(arm.model, [arm.robot.q(q) for q in qs], gravity=gravity)
+    return pdloop.linearise(arm.model, [arm.robot.q(q) for q in qs], gravity=gravity)
 
 
 def gravity_max(arm: Arm, qs: np.ndarray) -> np.ndarray:
@@ -204,16 +205,16 @@ def _effort_cap(name: str, effort: float, g: float, step: float, m: float) -> fl
 
 
 def loop_stable(
-    arm: Arm, lin: stab.Linearised, kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
+    arm: Arm, lin: pdloop.Linearised, kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
 ) -> bool:
     """The verdict of `armcli.sim.stability` at every sample, for `loop` at dt."""
-    pd = stab.PD.of(range(len(kp)), kp, kd, arm.damping)
-    scheme: stab.Scheme = "implicit" if loop == "implicit" else "explicit"
+    pd = pdloop.PD.of(range(len(kp)), kp, kd, arm.damping)
+    scheme: pdloop.Scheme = "implicit" if loop == "implicit" else "explicit"
     return stab.stable(lin, pd, dt, scheme)
 
 
 def _coupled_scale(
-    arm: Arm, lin: stab.Linearised, kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
+    arm: Arm, lin: pdloop.Linearised, kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
 ) -> float:
     """Common kp scale keeping the coupled loop stable at margin * dt (1 when it is).
 
@@ -224,8 +225,8 @@ def _coupled_scale(
     if loop_stable(arm, lin, kp, kd, loop, h):
         return 1.0
     if not loop_stable(arm, lin, kp * SCALE_FLOOR, kd * math.sqrt(SCALE_FLOOR), loop, h):
-        scheme: stab.Scheme = "implicit" if loop == "implicit" else "explicit"
-        free = stab.PD.of(range(len(kp)), 0.0 * kp, 0.0 * kd, arm.damping)
+        scheme: pdloop.Scheme = "implicit" if loop == "implicit" else "explicit"
+        free = pdloop.PD.of(range(len(kp)), 0.0 * kp, 0.0 * kd, arm.damping)
         edge = stab.largest_stable_dt(lin, free, scheme, dt)
         raise InputError(
             f"= {dt:g} s: gravity's stiffness alone makes the {loop} loop unstable at "

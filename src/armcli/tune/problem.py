@@ -18,9 +18,9 @@ import numpy as np
 from armcli.defaults import PdLoop
 from armcli.robot.load import load_model
 from armcli.sim.options import Integrator
+from armcli.sim.pdloop import Linearised
 from armcli.sim.reference import Reference
 from armcli.sim.simulate import Arm, arm_from_model
-from armcli.sim.stability import Linearised
 from armcli.tune.model_gains import linearised, sample_configurations
 
 _CACHE: dict[str, tuple[Scored, ...]] = {}
