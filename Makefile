@@ -46,7 +46,7 @@ demo: install
 lint: install-dev
 	$(BIN)/ruff check src tests bench
 	$(BIN)/ruff format --check src tests bench
-	$(BIN)/mypy src
+	$(BIN)/mypy src tests
 
 # The suite in two timed runs: everything but the `slow` tests, and alongside it (on the
 # other core: mostly pip and one compile waiting) the `slow` ones (installs into fresh

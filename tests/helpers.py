@@ -77,10 +77,11 @@ def run_cli(
     )
 
 
-def run_main(
-    args: Sequence[str | Path], capsys: pytest.CaptureFixture[str]
-) -> tuple[int, str, str]:
-    """`armcli ARGS` in this process (`armcli.cli.main`): exit code, stdout, stderr."""
+def run_main(args: Sequence[object], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    """`armcli ARGS` in this process (`armcli.cli.main`): exit code, stdout, stderr.
+
+    Each argument is passed as its `str()`: paths and numbers as they are.
+    """
     from armcli.cli import main
 
     try:
@@ -92,7 +93,7 @@ def run_main(
     return code, out.out, out.err
 
 
-HOSTILE_SCALARS = st.one_of(
+HOSTILE_SCALARS: st.SearchStrategy[Any] = st.one_of(
     st.sampled_from(
         [
             math.nan,

@@ -33,7 +33,7 @@ SIM_SECONDS = 1.5
 
 
 @pytest.fixture(scope="module", params=SPECS, ids=[p.stem for p in SPECS])
-def built(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory):  # type: ignore[no-untyped-def]
+def built(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory):
     out = tmp_path_factory.mktemp(request.param.stem)
     result = build(request.param, out)
     return request.param, result.spec, out

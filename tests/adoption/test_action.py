@@ -75,9 +75,9 @@ def test_broken_and_clean_files_annotate_and_write_sarif(tmp_path: Path) -> None
     assert r.returncode == 1, r.stderr
     lines = r.stdout.splitlines()
     assert lines and all(ANNOTATION.match(line) for line in lines), lines
-    files = {ANNOTATION.match(line).group(2) for line in lines}  # type: ignore[union-attr]
+    files = {ANNOTATION.match(line).group(2) for line in lines}
     assert files == {"robots/broken.urdf"}  # the clean file has nothing to say
-    assert {ANNOTATION.match(line).group(4) for line in lines} == {"mass-nonpositive"}  # type: ignore[union-attr]
+    assert {ANNOTATION.match(line).group(4) for line in lines} == {"mass-nonpositive"}
     assert outputs == {"exit-code": "1", "sarif-file": "reports/armcli.sarif"}
     doc = json.loads((repo / "reports" / "armcli.sarif").read_text())
     validate(doc)

@@ -32,7 +32,7 @@ def two_link_tip_height(x: np.ndarray) -> tuple[float, np.ndarray]:
         (lambda x: (float(np.sum((x - 0.3) ** 2)), 2 * (x - 0.3)), [1, -1, 0.5], [-1] * 3, [1] * 3),
     ],
 )
-def test_same_minimum_as_lbfgsb(fun, x0, lo, hi) -> None:  # type: ignore[no-untyped-def]
+def test_same_minimum_as_lbfgsb(fun, x0, lo, hi) -> None:
     ours = minimize_box(fun, x0, lo, hi, max_iterations=20000)
     ref = minimize(
         fun,

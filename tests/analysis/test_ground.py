@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from armcli.analysis.ground import find_ground, has_wheels, mesh_loader
+from armcli.analysis.ground import Ground, find_ground, has_wheels, mesh_loader
 from armcli.compiler.expand import expand_urdfs
 from armcli.robot.load import load_model
 from armcli.spec.load import load_spec
@@ -30,7 +30,7 @@ WHEEL = """<link name="{n}"><collision><origin rpy="1.5707963 0 0"/><geometry>{g
   <child link="{n}"/><origin xyz="-0.2 {y} 0.1"/><axis xyz="0 1 0"/></joint>"""
 
 
-def ground_of(xml: str, tmp: Path | None = None) -> object:
+def ground_of(xml: str, tmp: Path | None = None) -> Ground | None:
     urdf = parse_urdf(xml.encode(), str((tmp or Path("/nonexistent")) / "r.urdf"))
     model = load_model(urdf.source, xml=xml, floating=True).model
     missing: list[str] = []
@@ -45,11 +45,12 @@ def test_course_robot_touches_on_its_wheels_and_caster() -> None:
     assert g.height == pytest.approx(0.0, abs=TOL)
     got = {c.link: (c.rolling, c.points) for c in g.contacts}
     # wheels (radius 0.1 on axles at z 0.1): one point below the axle; caster ball: its bottom
-    assert got == {
+    expected: dict[str, object] = {
         "base_right_wheel_link": (True, ((-0.15, -0.225, pytest.approx(0.0, abs=TOL)),)),
         "base_left_wheel_link": (True, ((-0.15, 0.225, pytest.approx(0.0, abs=TOL)),)),
         "caster_wheel_link": (False, ((0.2, 0.0, pytest.approx(0.0, abs=TOL)),)),
     }
+    assert got == expected
 
 
 def test_a_skid_touches_at_its_bottom_corners() -> None:

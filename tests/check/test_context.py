@@ -2,10 +2,20 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import pytest
 
 from armcli.check import run
-from armcli.check.context import BLOCKS_DYNAMICS, BLOCKS_MODEL, DYNAMICS, MODEL, URDF
+from armcli.check.context import (
+    BLOCKS_DYNAMICS,
+    BLOCKS_MODEL,
+    DYNAMICS,
+    MODEL,
+    URDF,
+    Context,
+    Stage,
+)
 from armcli.check.rules import ERROR, RULES, CheckOptions
 from armcli.urdf.read import parse_urdf, read_urdf
 from tests.helpers import ROOT
@@ -16,10 +26,11 @@ GOOD = ROOT / "urdf" / "my_robot.urdf"
 def _record(monkeypatch: pytest.MonkeyPatch) -> list[tuple[str, bool]]:
     """Add one family per stage (as a new rule module would) that records its call."""
     seen: list[tuple[str, bool]] = []
-    extra = tuple(
-        run.Family(f"probe-{s}", s, lambda c, s=s: seen.append((s, c.robot is not None)))
-        for s in (DYNAMICS, MODEL, URDF)
-    )
+
+    def probe(stage: Stage) -> Callable[[Context], None]:
+        return lambda c: seen.append((stage, c.robot is not None))
+
+    extra = tuple(run.Family(f"probe-{s}", s, probe(s)) for s in (DYNAMICS, MODEL, URDF))
     monkeypatch.setattr(run, "FAMILIES", run.FAMILIES + extra)
     return seen
 

@@ -41,7 +41,7 @@ def test_corpus_is_there() -> None:
     assert len(CORPUS) >= 20
 
 
-def _check(path: Path):  # type: ignore[no-untyped-def]
+def _check(path: Path):
     try:
         return check_urdf(read_urdf(path), CheckOptions())
     except ArmcliError as exc:  # unusable input is a clean exit 2, not a crash

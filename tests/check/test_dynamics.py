@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import pytest
 
@@ -40,8 +40,8 @@ def test_pd_remedy_is_stable(tmp_path: Path) -> None:
     lam = float(f.values["lambda_max"])  # type: ignore[arg-type]
     kp, damping = float(f.values["kp"]), 0.1  # type: ignore[arg-type]
     kd = float(f.values["kd_plus_damping"]) - damping  # type: ignore[arg-type]
-    fixed_kd = max(f.fix["kd"])  # type: ignore[type-var]
-    for dt, d in ((f.fix["dt"], kd + damping), (float(f.values["dt"]), fixed_kd + damping)):
+    fixed_kd = max(cast(list[float], f.fix["kd"]))
+    for dt, d in ((f.fix["dt"], kd + damping), (cast(float, f.values["dt"]), fixed_kd + damping)):
         # Jury test on the semi-implicit Euler update: a + 2b < 4 (docs/check.md); with
         # equal gains the worst mode is lambda_max's.
         a, b = kp * float(dt) * float(dt) * lam, float(d) * float(dt) * lam  # type: ignore[arg-type]

@@ -102,5 +102,5 @@ def test_servo_verdict_matches_the_simulated_law(
 def test_mock_hardware_and_no_block_are_left_to_the_pd_bound(gz_urdf: bytes) -> None:
     mock = _position(gz_urdf).replace(ci.GZ_SYSTEMS[0].encode(), b"mock_components/GenericSystem")
     assert ci.read_interfaces(mock) is not None
-    assert not ci.read_interfaces(mock).gazebo  # type: ignore[union-attr]
+    assert not ci.read_interfaces(mock).gazebo
     assert ci.read_interfaces(b"<robot name='r'><link name='a'/></robot>") is None

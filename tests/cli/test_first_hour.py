@@ -74,7 +74,11 @@ def test_the_demo_trajectory_ends_off_the_joint_stops() -> None:
     from armcli.spec.load import load_spec
 
     spec = load_spec(DEFAULT_SPEC)
-    limits = {n: (j.limit.lower, j.limit.upper) for n, j in spec.arm.joints.items() if j.limit}
+    limits = {
+        n: (j.limit.lower, j.limit.upper)
+        for n, j in spec.arm.joints.items()
+        if j.limit and j.limit.lower is not None and j.limit.upper is not None
+    }
     traj = load_trajectory(PICK, limits)
     for name, q in zip(traj.joint_names, traj.positions[-1], strict=True):
         lower, upper = limits[name]
@@ -117,7 +121,7 @@ def test_everyday_output_fits_80_columns(
     monkeypatch.setenv("COLUMNS", "80")
     monkeypatch.chdir(tmp_path)
     urdf = ROOT / "tests" / "fixtures" / "tipover" / "wheeled_base.urdf"
-    runs = [
+    runs: list[list[object]] = [
         ["init", "a_project_directory_with_a_long_name"],
         ["build", DEFAULT_SPEC, "-o", "urdf"],
         ["check", DEFAULT_SPEC],

@@ -84,7 +84,9 @@ def test_failure_as_json(capsys: pytest.CaptureFixture[str]) -> None:
         (["--to", "reach", "--planner", "prm"], "--planner: unknown value 'prm'"),
     ],
 )
-def test_bad_input_exit_2(args: list[str], words: str, capsys: pytest.CaptureFixture[str]) -> None:
+def test_bad_input_exit_2(
+    args: list[str | Path], words: str, capsys: pytest.CaptureFixture[str]
+) -> None:
     code, _, err = plan(args, capsys)
     assert code == 2
     assert words in err and len(err.strip().splitlines()) == 1

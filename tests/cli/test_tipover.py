@@ -36,7 +36,7 @@ def braking_spec(tmp_path: Path) -> Path:
     return path
 
 
-def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+def run(args: list[object], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
     return run_main(args, capsys)
 
 

@@ -103,16 +103,16 @@ def test_check_does_not_flag_the_mimic_gripper(built: Path) -> None:
     assert about_fingers == []
 
 
-FINGERS = ["left_finger_joint", "right_finger_joint"]
+FINGERS = ("left_finger_joint", "right_finger_joint")
 
 
-def _finger_job(built: Path, msg: str, joints: list[str] = FINGERS) -> Any:
+def _finger_job(built: Path, msg: str, joints: tuple[str, ...] = FINGERS) -> Any:
     from armcli.sim import job as simjob
     from armcli.sim.options import SimOptions
     from armcli.spec.load import load_spec
 
     spec = load_spec(built.parent.parent / "armcli.yaml")
-    opts = SimOptions(message=msg, joints=joints, kp=[200.0], kd=[2.0], duration=1.5)
+    opts = SimOptions(message=msg, joints=joints, kp=(200.0,), kd=(2.0,), duration=1.5)
     return simjob.prepare(spec, opts)
 
 
@@ -123,7 +123,7 @@ def test_simulate_drives_the_mimic_finger_through_its_leader(built: Path) -> Non
 
     msg = "{joint_names: [left_finger_joint], points: [{positions: [0.02], time_from_start: 0.5}]}"
     job = _finger_job(built, msg)
-    assert list(job.arm.joint_names) == FINGERS
+    assert tuple(job.arm.joint_names) == FINGERS
     q_ref, v_ref = job.reference.sample(np.array([0.0, 0.25, 0.5, 1.0]))
     np.testing.assert_array_equal(q_ref[:, 1], q_ref[:, 0])  # exactly: 1 * leader + 0
     np.testing.assert_array_equal(v_ref[:, 1], v_ref[:, 0])
@@ -141,7 +141,7 @@ def test_simulate_refuses_commanding_a_follower_or_locking_its_leader(built: Pat
         _finger_job(built, msg)
     msg = "{joint_names: [wrist_3_joint], points: [{positions: [0.2], time_from_start: 1}]}"
     with pytest.raises(InputError, match="which is locked: lock 'right_finger_joint' too"):
-        _finger_job(built, msg, ["wrist_3_joint", "right_finger_joint"])
+        _finger_job(built, msg, ("wrist_3_joint", "right_finger_joint"))
 
 
 def test_coupled_reference_adds_multiplier_and_offset() -> None:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import shutil
 import subprocess
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import pytest
 import yaml
@@ -83,7 +83,7 @@ def _floats(el: etree._Element | None, attr: str) -> list[float]:
 
 
 def _camera_sensor(root: etree._Element) -> etree._Element:
-    (sensor,) = root.xpath("gazebo[@reference='camera_link']/sensor")
+    (sensor,) = cast("list[etree._Element]", root.xpath("gazebo[@reference='camera_link']/sensor"))
     return sensor
 
 
@@ -93,7 +93,7 @@ def test_links_and_joints_are_the_courses(built: etree._Element, course: etree._
         assert ours is not None and theirs is not None
         assert ours.get("type") == theirs.get("type") == "fixed"
         for end in ("parent", "child"):
-            assert ours.find(end).get("link") == theirs.find(end).get("link")  # type: ignore[union-attr]
+            assert ours.find(end).get("link") == theirs.find(end).get("link")
         for attr in ("xyz", "rpy"):
             assert _floats(ours.find("origin"), attr) == pytest.approx(
                 _floats(theirs.find("origin"), attr), abs=1e-15
@@ -124,12 +124,12 @@ def test_sensor_is_the_courses_camera(built: etree._Element, course: etree._Elem
         assert yaml.safe_load(str(ours.findtext(tag))) == yaml.safe_load(str(theirs.findtext(tag)))
     for tag in ("plugin/frame_name",):
         assert ours.findtext(tag) == theirs.findtext(tag) == "camera_link_optical"
-    assert ours.find("plugin").get("filename") == theirs.find("plugin").get("filename")  # type: ignore[union-attr]
+    assert ours.find("plugin").get("filename") == theirs.find("plugin").get("filename")
     # the topics gazebo_ros_camera gives the course's sensor: <camera_name>/image_raw, ...
     remaps = [r.text for r in ours.iterfind("plugin/ros/remapping")]
     assert remaps == ["~/image_raw:=camera_sensor/image_raw",
                       "~/camera_info:=camera_sensor/camera_info"]  # fmt: skip
-    (material,) = built.xpath("gazebo[@reference='camera_link']/material/text()")
+    (material,) = cast("list[str]", built.xpath("gazebo[@reference='camera_link']/material/text()"))
     assert material == "Gazebo/Red"
 
 
@@ -148,7 +148,7 @@ def test_sdformat_reads_both_the_same(
         (sensor,) = etree.fromstring(sdf.stdout.encode()).iter("sensor")
         sensors.append(sensor)
     ours, theirs = sensors
-    assert ours.getparent().get("name") == theirs.getparent().get("name") == "base_footprint"  # type: ignore[union-attr]
+    assert ours.getparent().get("name") == theirs.getparent().get("name") == "base_footprint"
     assert _floats_text(ours.findtext("pose")) == pytest.approx(
         _floats_text(theirs.findtext("pose"))
     )

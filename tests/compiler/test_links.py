@@ -52,30 +52,30 @@ def test_shapes_come_out_in_order_with_their_materials() -> None:
     assert [v.get("name") for v in visuals] == ["shell", None]
     mesh = visuals[0].find("geometry/mesh")
     assert mesh is not None and mesh.get("scale") == "0.001 0.001 0.001"
-    assert visuals[0].find("origin").get("rpy") == "0 0 1.5707963267948966"  # type: ignore[union-attr]
-    assert visuals[0].find("material").attrib == {"name": "grey"}  # type: ignore[union-attr]
+    assert visuals[0].find("origin").get("rpy") == "0 0 1.5707963267948966"
+    assert visuals[0].find("material").attrib == {"name": "grey"}
     inline = visuals[1].find("material")
     assert inline is not None and inline.get("name") == "Grey Steel"
-    assert inline.find("color").get("rgba") == "0.4 0.4 0.45 1"  # type: ignore[union-attr]
+    assert inline.find("color").get("rgba") == "0.4 0.4 0.45 1"
     assert [c.find("geometry")[0].tag for c in link.findall("collision")] == ["box", "sphere"]  # type: ignore[index]
     # density 500 kg/m³ x the 0.2 x 0.2 x 0.1 box, by the box macro about its centre
     inertial = link.find("inertial")
     assert inertial is not None
-    mass = float(inertial.find("mass").get("value"))  # type: ignore[union-attr, arg-type]
+    mass = float(inertial.find("mass").get("value"))  # type: ignore[arg-type]
     assert abs(mass - 2.0) < 1e-12
-    assert inertial.find("origin").get("xyz") == "0 0 0.05"  # type: ignore[union-attr]
+    assert inertial.find("origin").get("xyz") == "0 0 0.05"
 
 
 def test_passthrough_is_copied_literally() -> None:
     root = _urdf(SPEC)
     note = root.find("gazebo/note")
     assert note is not None and note.text == "${not_xacro} $(nor_this)"  # not evaluated by xacro
-    assert root.find("gazebo/selfCollide").text == "true"  # type: ignore[union-attr]
+    assert root.find("gazebo/selfCollide").text == "true"
 
 
 def test_mesh_paths_stay_where_they_are(tmp_path: Path) -> None:
     in_memory = _urdf(SPEC.replace("joints: {}", "joints: {}"), None)
-    uri = in_memory.find("link/visual/geometry/mesh").get("filename")  # type: ignore[union-attr]
+    uri = in_memory.find("link/visual/geometry/mesh").get("filename")
     assert uri is not None and Path(uri).is_absolute() and uri.endswith("meshes/base.dae")
     built = _urdf(SPEC, tmp_path)
     uris = [m.get("filename") for m in built.iter("mesh")]

@@ -60,7 +60,7 @@ arm:
 def _inertial(urdf: bytes, link: str) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
     el = etree.fromstring(urdf).find(f"link[@name='{link}']/inertial")
     assert el is not None
-    i = {k: float(v) for k, v in el.find("inertia").attrib.items()}  # type: ignore[union-attr]
+    i = {k: float(v) for k, v in el.find("inertia").attrib.items()}
     J = np.array(
         [
             [i["ixx"], i["ixy"], i["ixz"]],
@@ -69,9 +69,9 @@ def _inertial(urdf: bytes, link: str) -> tuple[float, np.ndarray, np.ndarray, np
         ]
     )
     origin = el.find("origin")
-    xyz = np.array([float(x) for x in origin.get("xyz").split()])  # type: ignore[union-attr]
-    rpy = np.array([float(x) for x in origin.get("rpy").split()])  # type: ignore[union-attr]
-    return float(el.find("mass").get("value")), xyz, rpy, J  # type: ignore[union-attr]
+    xyz = np.array([float(x) for x in origin.get("xyz").split()])
+    rpy = np.array([float(x) for x in origin.get("rpy").split()])
+    return float(str(el.find("mass").get("value"))), xyz, rpy, J
 
 
 @pytest.fixture

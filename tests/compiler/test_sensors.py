@@ -43,7 +43,7 @@ def _ign(*args: str) -> subprocess.CompletedProcess[str]:
 
 
 def _classic_topics(sensor: etree._Element) -> set[str]:
-    remaps = [r.text.split(":=")[1] for r in sensor.iter("remapping")]  # type: ignore[union-attr]
+    remaps = [r.text.split(":=")[1] for r in sensor.iter("remapping")]
     return set(remaps)
 
 
@@ -55,10 +55,10 @@ def test_classic_sensors_are_in_the_built_urdf(project: Path) -> None:
         got = _classic_topics(sensors[name])
         assert got <= topics and ("image_raw" in str(got) or got == topics), (name, got)
     cam = sensors["wrist_camera"]
-    assert cam.getparent().get("reference") == "wrist_3_link"  # type: ignore[union-attr]
+    assert cam.getparent().get("reference") == "wrist_3_link"
     assert cam.findtext("camera/image/width") == "640"
     assert cam.findtext("update_rate") == "30"
-    assert cam.find("plugin").get("filename") == "libgazebo_ros_camera.so"  # type: ignore[union-attr]
+    assert cam.find("plugin").get("filename") == "libgazebo_ros_camera.so"
     assert sensors["base_scan"].findtext("plugin/output_type") == "sensor_msgs/LaserScan"
     assert sensors["base_cloud"].findtext("plugin/output_type") == "sensor_msgs/PointCloud2"
     assert sensors["base_cloud"].findtext("ray/scan/vertical/samples") == "16"
@@ -133,7 +133,6 @@ def test_sensor_mistakes(sensor: str, fragment: str) -> None:
 
 def test_sdformat_accepts_the_harmonic_description(project: Path, tmp_path: Path) -> None:
     import xacro
-
     from armcli.ros.packages import ros_packages
 
     spec = load_spec(project / "armcli.yaml")

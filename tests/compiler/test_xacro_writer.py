@@ -53,7 +53,7 @@ def _inertials(urdf: bytes) -> dict[str, tuple[float, np.ndarray, str, str]]:
         inertial = link.find("inertial")
         if inertial is None:
             continue
-        i = inertial.find("inertia").attrib  # type: ignore[union-attr]
+        i = inertial.find("inertia").attrib
         tensor = np.array(
             [
                 [float(i["ixx"]), float(i["ixy"]), float(i["ixz"])],
@@ -61,9 +61,9 @@ def _inertials(urdf: bytes) -> dict[str, tuple[float, np.ndarray, str, str]]:
                 [float(i["ixz"]), float(i["iyz"]), float(i["izz"])],
             ]
         )
-        origin = inertial.find("origin").attrib  # type: ignore[union-attr]
-        mass = float(inertial.find("mass").attrib["value"])  # type: ignore[union-attr]
-        out[link.attrib["name"]] = (mass, tensor, origin["xyz"], origin["rpy"])
+        origin = inertial.find("origin").attrib
+        mass = float(inertial.find("mass").attrib["value"])
+        out[str(link.attrib["name"])] = (mass, tensor, str(origin["xyz"]), str(origin["rpy"]))
     return out
 
 
@@ -134,7 +134,7 @@ def test_course_file_set_and_includes() -> None:
     mount = top.find("joint")
     assert mount is not None and mount.get("name") == "mobile_base_arm_joint"
     assert mount.get("type") == "fixed"
-    assert mount.find("origin").get("xyz") == "0.15 0 0.2"  # type: ignore[union-attr]
+    assert mount.find("origin").get("xyz") == "0.15 0 0.2"
     standalone = etree.fromstring(files["standalone_arm.urdf.xacro"])
     assert [e.get("filename") for e in standalone.findall("xacro:include", ns)] == [
         "common_properties.xacro",
@@ -159,7 +159,7 @@ def test_gazebo_plugins_carry_the_seed_rates() -> None:
     assert dd.findtext("wheel_separation") == "0.45"
     assert dd.findtext("wheel_diameter") == "0.2"
     caster = base_gz.find("gazebo[@reference='caster_wheel_link']")
-    assert caster is not None and caster.find("mu1").get("value") == "0.1"  # type: ignore[union-attr]
+    assert caster is not None and caster.find("mu1").get("value") == "0.1"
 
 
 @pytest.mark.parametrize(

@@ -38,7 +38,8 @@ def test_header_comment_is_one_wellformed_comment(text: str) -> None:
     comments = [n for n in doc.getroot().itersiblings(preceding=True)]
     assert len(comments) == 1 and isinstance(comments[0], etree._Comment)
     assert doc.getroot().tag == "robot" and len(doc.getroot()) == 0
-    assert "--" not in comments[0].text and not comments[0].text.endswith("-")
+    text = str(comments[0].text)
+    assert "--" not in text and not text.endswith("-")
 
 
 def test_comment_text_keeps_ordinary_text() -> None:

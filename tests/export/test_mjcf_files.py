@@ -75,7 +75,7 @@ def test_a_failed_write_leaves_the_previous_export_whole(
             raise OSError(errno.ENOSPC, "No space left on device")
         real_fsync(fd)
 
-    monkeypatch.setattr(together.os, "fsync", full_disk)
+    monkeypatch.setattr("armcli.io.together.os.fsync", full_disk)
     with pytest.raises(ArmcliError, match="No space left"):
         export_mjcf(_robot(tmp_path, mass=2.0), out)
     monkeypatch.undo()

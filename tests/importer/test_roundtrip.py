@@ -177,7 +177,7 @@ def test_relative_mesh_paths_follow_the_spec(tmp_path: Path) -> None:
 def test_pi_over_2_from_xacro_is_written_as_pi(tmp_path: Path) -> None:
     _, spec_path, _ = round_trip(STUDENT, tmp_path)
     assert "upper: pi/2" in spec_path.read_text()
-    assert math.pi / 2 == load_spec(spec_path).arm.joints["forearm_hand_joint"].limit.upper  # type: ignore[union-attr]
+    assert math.pi / 2 == load_spec(spec_path).arm.joints["forearm_hand_joint"].limit.upper
 
 
 def test_existing_spec_is_not_overwritten(tmp_path: Path) -> None:

@@ -19,6 +19,7 @@ import armcli.robot.model
 from armcli.check.rules import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.io.mesh_confine import MAX_MESH_BYTES
+from armcli.robot.load import collision_model
 from armcli.spec.load import load_spec
 from armcli.urdf.read import MAX_URDF_COLLISIONS, read_urdf
 from tests.helpers import run_cli
@@ -80,7 +81,7 @@ def test_pinocchio_gets_only_absolute_confined_paths(
         _with_collision_meshes(_arm(root), "package://robot_pkg/etc/passwd", "../meshes/box.stl")
     )
     seen: list[tuple[str, list[str] | None]] = []
-    real = armcli.robot.model.collision_model  # what Robot.collision_model hands the xml to
+    real = collision_model  # what Robot.collision_model hands the xml to
 
     def spy(model: Any, xml: str, package_dirs: list[str] | None = None, source: str = "") -> Any:
         seen.append((xml, package_dirs))

@@ -33,7 +33,7 @@ def test_course_ik_matches_closed_form_fk(course: Loaded) -> None:
     for _ in range(CASES):
         q = rng.uniform(0.1, 1.4, 2)  # inside the limits [0, pi/2], away from the base
         target = course_tool(*q)
-        x = solve_goal(ctx, target, start=ctx.robot.pose("home"), seed=1)
+        x = solve_goal(ctx, list(target), start=ctx.robot.pose("home"), seed=1)
         assert np.linalg.norm(course_tool(*x) - target) < POSITION_TOL
         assert np.all(x >= ctx.robot.lower) and np.all(x <= ctx.robot.upper)
 

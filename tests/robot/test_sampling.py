@@ -93,7 +93,7 @@ def test_check_and_tune_draw_identical_samples(monkeypatch: pytest.MonkeyPatch) 
     from armcli.sim.simulate import arm_from_model
     from armcli.tune.model_gains import start_gains
 
-    seen: list[tuple[list[tuple[float, float]], np.ndarray]] = []
+    seen: list[tuple[list[tuple[float, ...]], np.ndarray]] = []
     real = sampling.joint_space
 
     def recording(box: sampling.Bounds) -> np.ndarray:

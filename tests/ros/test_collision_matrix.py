@@ -45,7 +45,7 @@ def _link(root: etree._Element, name: str, shape: str | None = None, **dims: str
         xyz = dims.pop("xyz", "0 0 0")
         col = etree.SubElement(link, "collision")
         _origin(col, xyz)
-        etree.SubElement(etree.SubElement(col, "geometry"), shape, **dims)
+        etree.SubElement(etree.SubElement(col, "geometry"), shape, dims)
 
 
 def _joint(root: etree._Element, name: str, kind: str, parent: str, child: str, xyz: str) -> None:

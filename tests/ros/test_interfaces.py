@@ -31,16 +31,18 @@ ros2_control:
 
 
 @pytest.fixture
-def spec():  # type: ignore[no-untyped-def]
+def spec():
     return loads_spec(DEFAULT_SPEC.read_text() + CONTROL, "specs/my_robot.yaml")
 
 
 def _joints(xml: bytes) -> dict[str, etree._Element]:
     root = etree.fromstring(xml)
-    return {j.get("name"): j for j in root.iter("joint") if j.getparent().tag == "ros2_control"}  # type: ignore[union-attr]
+    return {
+        str(j.get("name")): j for j in root.iter("joint") if j.getparent().tag == "ros2_control"
+    }
 
 
-def test_humble_moveit_block_takes_the_spec_interfaces(spec) -> None:  # type: ignore[no-untyped-def]
+def test_humble_moveit_block_takes_the_spec_interfaces(spec) -> None:
     joints = _joints(ros2_control_xacro(spec))
     fore = joints["arm_base_forearm_joint"]
     cmd = fore.find("command_interface")
@@ -55,7 +57,7 @@ def test_humble_moveit_block_takes_the_spec_interfaces(spec) -> None:  # type: i
     assert joints["base_left_wheel_joint"].find("command_interface") is None
 
 
-def test_controllers_use_the_common_interface_and_need_no_gains_for_position(spec) -> None:  # type: ignore[no-untyped-def]
+def test_controllers_use_the_common_interface_and_need_no_gains_for_position(spec) -> None:
     arm = mc.ros2_controllers(spec)[mc.ARM_CONTROLLER]["ros__parameters"]
     assert arm["command_interfaces"] == ["position"]
     gz = jazzy.controllers(spec)[mc.ARM_CONTROLLER]["ros__parameters"]
@@ -65,23 +67,23 @@ def test_controllers_use_the_common_interface_and_need_no_gains_for_position(spe
     assert cmd is not None and cmd.get("name") == "position"
 
 
-def test_default_jazzy_is_effort_with_gains(default_spec_path) -> None:  # type: ignore[no-untyped-def]
+def test_default_jazzy_is_effort_with_gains(default_spec_path) -> None:
     spec = load_spec(default_spec_path)
     gz = jazzy.controllers(spec)[mc.ARM_CONTROLLER]["ros__parameters"]
     assert gz["command_interfaces"] == ["effort"] and set(gz["gains"]) == set(spec.control.gains)
 
 
-def test_build_writes_the_block_when_hardware_is_given(spec) -> None:  # type: ignore[no-untyped-def]
+def test_build_writes_the_block_when_hardware_is_given(spec) -> None:
     urdf = etree.fromstring(expand_urdfs(spec)["my_robot.urdf"])
     (block,) = urdf.findall("ros2_control")
     assert (block.get("name"), block.get("type")) == ("course_arm", "system")
     assert block.findtext("hardware/plugin") == "my_driver/ArmSystem"
-    assert block.find("hardware/param[@name='port']").text == "/dev/ttyUSB0"  # type: ignore[union-attr]
+    assert block.find("hardware/param[@name='port']").text == "/dev/ttyUSB0"
     init = block.find("joint[@name='arm_base_forearm_joint']/state_interface/param")
     assert init is not None and (init.get("name"), init.text) == ("initial_value", "0.1")
 
 
-def test_no_common_interface_is_refused(spec) -> None:  # type: ignore[no-untyped-def]
+def test_no_common_interface_is_refused(spec) -> None:
     text = DEFAULT_SPEC.read_text() + CONTROL.replace(
         "{position: {min: 0, max: pi/2}, velocity: {max: 2}}", "{velocity: {max: 2}}"
     )
@@ -96,7 +98,7 @@ def test_unknown_or_fixed_joints_are_refused() -> None:
         loads_spec(bad)
 
 
-def test_yaml_of_the_controllers_is_plain(spec) -> None:  # type: ignore[no-untyped-def]
+def test_yaml_of_the_controllers_is_plain(spec) -> None:
     text = mc.dump_yaml(jazzy.controllers(spec)).decode()
     assert yaml.safe_load(text)[mc.ARM_CONTROLLER]["ros__parameters"]["joints"] == [
         "arm_base_forearm_joint",
@@ -112,7 +114,7 @@ def _mjcf_actuators(text: str) -> tuple[dict[str, etree._Element], list[str]]:
     urdf = parse_urdf(expand_urdfs(spec)["standalone_arm.urdf"], "standalone_arm.urdf")
     out = build_mjcf(urdf, spec)
     root = etree.fromstring(out.model)
-    acts = {a.get("joint"): a for a in root.find("actuator")}  # type: ignore[union-attr]
+    acts = {str(a.get("joint")): a for a in root.find("actuator")}
     mujoco = pytest.importorskip("mujoco")
     mujoco.MjModel.from_xml_string(out.model.decode())  # MuJoCo accepts what it is given
     return acts, [f"{n.what}: {n.done}" for n in out.notes]

@@ -27,6 +27,7 @@ from lxml import etree
 
 from armcli.check.rules import CheckOptions
 from armcli.check.run import check_urdf
+from armcli.compiler.xacro_writer import WORLD_JOINT
 from armcli.errors import InputError
 from armcli.ros import jazzy
 from armcli.ros.packages import RosPackages, ros_packages
@@ -340,9 +341,9 @@ def test_jazzy_urdf_has_the_course_dynamics_in_pinocchio(
 
 def test_standalone_arm_is_welded_to_the_world(files: Mapping[str, bytes], tmp_path: Path) -> None:
     urdf = parse_urdf(expand(files, "standalone_arm_gz.urdf.xacro", tmp_path), "arm")
-    anchor = next(j for j in urdf.joints if j.name == jazzy.WORLD_JOINT)
+    anchor = next(j for j in urdf.joints if j.name == WORLD_JOINT)
     assert (anchor.type, anchor.parent, anchor.child) == ("fixed", "world", "arm_base_link")
-    assert urdf.link("world") is not None and urdf.link("world").inertial is None  # type: ignore[union-attr]
+    assert urdf.link("world") is not None and urdf.link("world").inertial is None
 
 
 def test_cli_target_choice_and_one_line_error(tmp_path: Path) -> None:

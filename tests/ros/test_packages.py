@@ -260,7 +260,7 @@ def test_display_launch(files: Mapping[str, bytes], built_dir: Path) -> None:
 
 def test_gazebo_launch(files: Mapping[str, bytes]) -> None:
     facts = _launch(files, f"{BRINGUP}/launch/my_robot_gazebo.launch.py")
-    nodes = {n["package"] + "/" + str(n["executable"]): n for n in facts.nodes()}
+    nodes = {f"{n['package']}/{n['executable']}": n for n in facts.nodes()}
     spawn = nodes["gazebo_ros/spawn_entity.py"]
     assert spawn["arguments"] == ["-topic", "robot_description", "-entity", "my_robot"]
     rsp = facts.calls[[n for n, _ in facts.calls].index("Node")][1]
@@ -336,8 +336,9 @@ def test_rviz_configs(files: Mapping[str, bytes], urdf: etree._Element) -> None:
 
 def _expand(path: Path, out_dir: Path, monkeypatch: pytest.MonkeyPatch) -> etree._Element:
     """Run the real xacro, resolving $(find pkg) to the generated packages."""
-    import xacro
     import xacro.substitution_args
+
+    import xacro
 
     monkeypatch.setattr(xacro.substitution_args, "_eval_find", lambda pkg: str(out_dir / pkg))
     doc = xacro.process_file(str(path))

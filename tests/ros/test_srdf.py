@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import cast
 
 import pytest
 from lxml import etree
 
-from armcli.ros.collision_matrix import CollisionMatrix, DisabledPair
+from armcli.ros.collision_matrix import CollisionMatrix, DisabledPair, Reason
 from armcli.ros.srdf import arm_chain, chain_joints, srdf_bytes
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
@@ -73,7 +74,7 @@ def test_group_states_are_the_spec_poses(srdf: etree._Element, spec: RobotSpec) 
 
 def test_disable_collisions_copy_the_matrix(srdf: etree._Element, matrix: CollisionMatrix) -> None:
     entries = [
-        DisabledPair(d.get("link1", ""), d.get("link2", ""), d.get("reason", ""))
+        DisabledPair(d.get("link1", ""), d.get("link2", ""), cast(Reason, d.get("reason")))
         for d in srdf.findall("disable_collisions")
     ]
     assert tuple(entries) == matrix.disabled

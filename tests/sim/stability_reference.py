@@ -47,7 +47,7 @@ def radius(A: np.ndarray) -> float:
     return float(np.max(np.abs(np.linalg.eigvals(A))))
 
 
-def worst_radius(Ms, Gs, idx, kp, D, dt, scheme) -> float:  # type: ignore[no-untyped-def]
+def worst_radius(Ms, Gs, idx, kp, D, dt, scheme) -> float:
     return max(
         radius(step_matrix(M, G, idx, kp, D, dt, scheme)) for M, G in zip(Ms, Gs, strict=True)
     )
@@ -60,7 +60,7 @@ def _bisect(ok: Callable[[float], bool], lo: float, hi: float) -> float:
     return lo
 
 
-def largest_stable_dt(Ms, Gs, idx, kp, D, scheme, start) -> float:  # type: ignore[no-untyped-def]
+def largest_stable_dt(Ms, Gs, idx, kp, D, scheme, start) -> float:
     def ok(h: float) -> bool:
         return worst_radius(Ms, Gs, idx, kp, D, h, scheme) <= 1.0 + RADIUS_TOL
 
@@ -72,7 +72,7 @@ def largest_stable_dt(Ms, Gs, idx, kp, D, scheme, start) -> float:  # type: igno
     return _bisect(ok, lo, hi)
 
 
-def largest_stable_scale(Ms, Gs, idx, kp, kd, damping, dt, scheme, kp_too, kd_too) -> float:  # type: ignore[no-untyped-def]
+def largest_stable_scale(Ms, Gs, idx, kp, kd, damping, dt, scheme, kp_too, kd_too) -> float:
     """Largest s in [0, 1] with s Kp (when `kp_too`) and s Kd (when `kd_too`) stable at dt."""
 
     def ok(s: float) -> bool:

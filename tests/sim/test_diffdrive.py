@@ -29,7 +29,7 @@ def test_the_spec_gives_the_plugins_parameters() -> None:
 
 def test_a_spec_without_the_plugin_is_refused() -> None:
     spec = load_spec(DEFAULT_SPEC)
-    base = spec.mobile_base.model_copy(update={"diff_drive": None})  # type: ignore[union-attr]
+    base = spec.mobile_base.model_copy(update={"diff_drive": None})
     with pytest.raises(InputError) as info:
         DriveParams.of(spec.model_copy(update={"mobile_base": base}))
     assert info.value.field == "mobile_base.diff_drive"

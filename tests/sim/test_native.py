@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 import pinocchio as pin
@@ -15,6 +16,7 @@ from armcli.errors import InputError, SimulationError
 from armcli.robot.load import load_model
 from armcli.sim import native
 from armcli.sim import rollout as ro
+from armcli.sim.options import Integrator
 from armcli.sim.reference import build_reference
 from armcli.sim.simulate import (
     SETTLE_TOL,
@@ -45,7 +47,7 @@ def arm(built_dir: Path) -> Arm:
     return arm_from_model(load_model(built_dir / "standalone_arm.urdf").model)
 
 
-def _reference(arm: Arm):  # type: ignore[no-untyped-def]
+def _reference(arm: Arm):
     tr = loads_trajectory(TRAJ, dict.fromkeys(arm.joint_names, (0.0, math.pi / 2)))
     return build_reference(tr, arm.joint_names, np.zeros(2))
 
@@ -139,12 +141,15 @@ def test_batch_on_threads_equals_simulate_run_by_run(arm: Arm) -> None:
     free = replace(arm, effort=np.full(2, np.inf), lower=np.full(2, -1e3), upper=np.full(2, 1e3))
     runs = [
         Run(a, ref, np.zeros(2), 1.5, SimConfig(np.full(2, kp), np.full(2, kd), 1e-3, integ))
-        for a, kp, kd, integ in [
-            (arm, 50, 5, "euler"),
-            (weak, 200, 2, "euler"),
-            (arm, 50, 1, "rk4"),
-            (free, 1e8, 0, "euler"),  # far beyond the stability bound: diverges
-        ]
+        for a, kp, kd, integ in cast(
+            list[tuple[Arm, float, float, Integrator]],
+            [
+                (arm, 50, 5, "euler"),
+                (weak, 200, 2, "euler"),
+                (arm, 50, 1, "rk4"),
+                (free, 1e8, 0, "euler"),  # far beyond the stability bound: diverges
+            ],
+        )
     ]
     batch = simulate_batch(runs, threads=3)
     assert sum(isinstance(r, SimulationError) for r in batch) == 1

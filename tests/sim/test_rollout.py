@@ -14,6 +14,7 @@ import pinocchio as pin
 import pytest
 
 from armcli.sim import rollout as ro
+from armcli.sim.options import Integrator
 from armcli.sim.simulate import Arm, SimConfig, arm_from_model, plant_of
 from tests.sim.engines import run_held
 
@@ -67,7 +68,7 @@ def pendulum(length: float = 0.5) -> pin.Model:
 
 
 @pytest.mark.parametrize("integrator", ["euler", "rk4"])
-def test_tilted_axes_run_into_the_prismatic_stop(integrator: str) -> None:
+def test_tilted_axes_run_into_the_prismatic_stop(integrator: Integrator) -> None:
     arm = arm_from_model(pin.buildModelFromXML(TILTED_URDF))
     kinds = {arm.model.joints[j].shortname() for j in range(1, arm.model.njoints)}
     assert {"JointModelRevoluteUnaligned", "JointModelPrismaticUnaligned"} <= kinds

@@ -13,6 +13,7 @@ import pytest
 from armcli.errors import InputError, SimulationError, UnstableLoopError
 from armcli.robot.load import load_model
 from armcli.sim import rollout as ro
+from armcli.sim.options import Integrator
 from armcli.sim.reference import build_reference
 from armcli.sim.simulate import (
     Arm,
@@ -80,7 +81,7 @@ def test_free_motion_keeps_velocity() -> None:
 
 
 @pytest.mark.parametrize("integrator", ["euler", "rk4"])
-def test_pendulum_small_amplitude_period(integrator: str) -> None:
+def test_pendulum_small_amplitude_period(integrator: Integrator) -> None:
     m, length = 1.0, 0.5
     arm = pendulum(m, length)
     cfg = SimConfig(kp=np.zeros(1), kd=np.zeros(1), dt=1e-3, integrator=integrator)

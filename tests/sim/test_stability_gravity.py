@@ -43,16 +43,16 @@ SWING_RTOL = 0.02  # the linear invariant against the nonlinear pendulum at ~0.1
 
 
 @pytest.fixture(scope="module")
-def model():  # type: ignore[no-untyped-def]
+def model():
     return load_model(PENDULUM).model
 
 
-def _lin(model, thetas):  # type: ignore[no-untyped-def]
+def _lin(model, thetas):
     return pdloop.linearise(model, [np.array([t]) for t in thetas])
 
 
 @pytest.mark.parametrize("theta", [0.0, 0.7, 1.5, 2.5, -3.0])
-def test_pinocchio_gives_the_pendulum_inertia_and_stiffness(model, theta: float) -> None:  # type: ignore[no-untyped-def]
+def test_pinocchio_gives_the_pendulum_inertia_and_stiffness(model, theta: float) -> None:
     lin = _lin(model, [theta])
     assert lin.M[0, 0, 0] == pytest.approx(INERTIA, rel=RTOL)
     assert lin.G[0, 0, 0] == pytest.approx(MASS * G0 * DEPTH * math.cos(theta), rel=RTOL)
@@ -61,7 +61,7 @@ def test_pinocchio_gives_the_pendulum_inertia_and_stiffness(model, theta: float)
 @pytest.mark.parametrize("kp", [0.0, 0.001, 0.01, 0.1])
 @pytest.mark.parametrize("kd", [0.0, 1e-5, 1e-4])
 @pytest.mark.parametrize("scheme", ["implicit", "explicit"])
-def test_largest_stable_dt_is_the_closed_form(model, kp: float, kd: float, scheme: str) -> None:  # type: ignore[no-untyped-def]
+def test_largest_stable_dt_is_the_closed_form(model, kp: float, kd: float, scheme: str) -> None:
     """Over the whole range the hanging pose is the stiffest: k = Kp + m g l."""
     lin = _lin(model, np.linspace(-3.0, 3.0, 13))
     pd = pdloop.PD.of([0], [kp], [kd], [0.0])
@@ -72,7 +72,7 @@ def test_largest_stable_dt_is_the_closed_form(model, kp: float, kd: float, schem
     assert got == pytest.approx(expected, rel=DT_RTOL)
 
 
-def test_without_gravity_the_bound_ignores_it(model) -> None:  # type: ignore[no-untyped-def]
+def test_without_gravity_the_bound_ignores_it(model) -> None:
     """Gravity compensation cancels g(q) at the same q: only Kp is left."""
     lin = pdloop.linearise(model, [np.zeros(1)], gravity=False)
     pd = pdloop.PD.of([0], [0.001], [0.0], [0.0])
@@ -80,7 +80,7 @@ def test_without_gravity_the_bound_ignores_it(model) -> None:  # type: ignore[no
     assert stab.largest_stable_dt(lin, pd, "implicit", 0.01) == pytest.approx(expected, rel=DT_RTOL)
 
 
-def _swing(model, dt: float, seconds: float) -> np.ndarray:  # type: ignore[no-untyped-def]
+def _swing(model, dt: float, seconds: float) -> np.ndarray:
     """The real simulator (semi-implicit Euler, both engines' step) from 0.05 rad, Kp 0.001."""
     arm = arm_from_model(model)
     traj = loads_trajectory(
@@ -93,7 +93,7 @@ def _swing(model, dt: float, seconds: float) -> np.ndarray:  # type: ignore[no-u
     return simulate(arm, ref, q0, seconds, cfg).q[:, 0]
 
 
-def test_the_simulator_swings_below_the_bound_and_bangs_above(model) -> None:  # type: ignore[no-untyped-def]
+def test_the_simulator_swings_below_the_bound_and_bangs_above(model) -> None:
     """The issue's case: at dt = 0.1 s the pendulum bangs between the stops; just below the
     bound it keeps swinging, bounded. Symplectic Euler on I x'' = -k x conserves
     x² - dt x v + v² / w² (w² = k / I), so from rest at x0 the swing peaks at

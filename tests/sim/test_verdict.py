@@ -116,13 +116,13 @@ def test_every_suggestion_applied_passes_check_and_simulate(
         assert 0.0 < fix["dt"] < dt
         attempts = [(kp, kd, float(fix["dt"]))]
         if "kp" in fix:
-            new_kp, new_kd = list(fix["kp"]), list(fix["kd"])  # type: ignore[arg-type]
+            new_kp, new_kd = list(fix["kp"]), list(fix["kd"])
             assert all(0.0 <= a <= b for a, b in zip(new_kp, kp, strict=True))
             assert all(0.0 <= a <= b for a, b in zip(new_kd, kd, strict=True))
             attempts.append((new_kp, new_kd, dt))
         if rule == "pd-unstable":  # simulate suggests what check writes
             assert refusal is not None and refusal.suggestion_dt == fix["dt"]
-            assert refusal.kp == (tuple(fix["kp"]) if "kp" in fix else None)  # type: ignore[arg-type]
+            assert refusal.kp == (tuple(fix["kp"]) if "kp" in fix else None)
         for a_kp, a_kd, a_dt in attempts:
             again = {g.rule for g in _check(urdf, a_kp, a_kd, a_dt, gc).findings}
             cleared = {"pd-unstable", "pd-explicit-unstable"} if rule != "pd-unstable" else {rule}
@@ -142,7 +142,7 @@ def test_the_issues_kp_50000_case_reads_as_one_story() -> None:
     assert found["pd-explicit-unstable"].message.startswith("explicit torque loop")
     assert "Kd < -" not in found["pd-explicit-unstable"].message
     refusal = _simulate_accepts(urdf, [5e4, 5e4], [5.0, 5.0], 1e-3, False)
-    assert refusal is not None and refusal.kp == tuple(implicit.fix["kp"])  # type: ignore[arg-type]
+    assert refusal is not None and refusal.kp == tuple(implicit.fix["kp"])
     kp_max = result.summary.stability.kp_max_implicit
     assert kp_max is not None and kp_max < 5e4  # the bound it prints is below the gains
 

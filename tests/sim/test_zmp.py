@@ -19,6 +19,8 @@ from armcli.analysis.stance import Payload, Stance, stance_of
 from armcli.compiler.expand import expand_urdfs
 from armcli.sim import zmp as zmps
 from armcli.spec.load import load_spec
+from armcli.spec.model import RobotSpec
+from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_urdf
 from tests.helpers import DEFAULT_SPEC, FIXTURES
 
@@ -38,7 +40,7 @@ SETTLE_S = 1.0  # [s] MuJoCo's robot settles into its soft contacts before the s
 
 
 @pytest.fixture(scope="module")
-def course() -> tuple[object, object, Stance]:
+def course() -> tuple[RobotSpec, Urdf, Stance]:
     spec = load_spec(DEFAULT_SPEC)
     urdf = parse_urdf(expand_urdfs(spec)["my_robot.urdf"], "my_robot.urdf")
     stance = stance_of(urdf, candidates=set(spec.mobile_base.links),
@@ -47,7 +49,7 @@ def course() -> tuple[object, object, Stance]:
     return spec, urdf, stance
 
 
-def series_at(stance: Stance, q: np.ndarray, v: np.ndarray, a: np.ndarray, accel: float = 0.0):  # type: ignore[no-untyped-def]
+def series_at(stance: Stance, q: np.ndarray, v: np.ndarray, a: np.ndarray, accel: float = 0.0):
     """The point at one state: two kept steps whose velocity difference is a dt."""
     dt = 1e-3
     t, kept = np.array([0.0, dt]), np.array([0, 1])
@@ -55,7 +57,7 @@ def series_at(stance: Stance, q: np.ndarray, v: np.ndarray, a: np.ndarray, accel
     return zmps.zmp_series(stance, ARM, t, kept, qs, vs, dt, accel, 0.02)
 
 
-def test_at_rest_it_is_the_centre_of_mass(course: tuple[object, object, Stance]) -> None:
+def test_at_rest_it_is_the_centre_of_mass(course: tuple[RobotSpec, Urdf, Stance]) -> None:
     _, _, stance = course
     q = np.array([0.7, 0.9])
     s = series_at(stance, q, np.zeros(2), np.zeros(2), accel=2.0)
@@ -72,7 +74,7 @@ def test_at_rest_it_is_the_centre_of_mass(course: tuple[object, object, Stance])
 
 
 def test_largest_base_acceleration_puts_it_on_the_edge(
-    course: tuple[object, object, Stance],
+    course: tuple[RobotSpec, Urdf, Stance],
 ) -> None:
     _, _, stance = course
     q = np.array([1.2, 0.3])
@@ -82,7 +84,7 @@ def test_largest_base_acceleration_puts_it_on_the_edge(
     assert min(at.margin[0, 1:]) == pytest.approx(0.0, abs=EXACT)
 
 
-def _mujoco_model(spec: object, urdf: object, tmp: Path, gravity: tuple[float, float, float]):  # type: ignore[no-untyped-def]
+def _mujoco_model(spec: RobotSpec, urdf: Urdf, tmp: Path, gravity: tuple[float, float, float]):
     mujoco = pytest.importorskip("mujoco")
     from lxml import etree
 
@@ -104,7 +106,7 @@ def _mujoco_model(spec: object, urdf: object, tmp: Path, gravity: tuple[float, f
     return mujoco, m
 
 
-def _centre_of_pressure(mujoco, m, d) -> tuple[np.ndarray, float]:  # type: ignore[no-untyped-def]
+def _centre_of_pressure(mujoco, m, d) -> tuple[np.ndarray, float]:
     floor = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "floor")
     num, den, f6 = np.zeros(2), 0.0, np.zeros(6)
     for i in range(d.ncon):
@@ -121,14 +123,14 @@ def _centre_of_pressure(mujoco, m, d) -> tuple[np.ndarray, float]:  # type: igno
     return (R.T @ (p - x))[:2], den  # in the base's frame, where the model holds it
 
 
-def _arm_state(mujoco, m, d) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # type: ignore[no-untyped-def]
+def _arm_state(mujoco, m, d) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in ARM]
     qa, va = [m.jnt_qposadr[i] for i in ids], [m.jnt_dofadr[i] for i in ids]
     return d.qpos[qa].copy(), d.qvel[va].copy(), d.qacc[va].copy()
 
 
 def test_zmp_agrees_with_mujoco_along_a_fast_swing(
-    course: tuple[object, object, Stance], tmp_path: Path
+    course: tuple[RobotSpec, Urdf, Stance], tmp_path: Path
 ) -> None:
     from armcli.sim.reference import build_reference
     from armcli.sim.trajectory import load_trajectory
@@ -140,7 +142,7 @@ def test_zmp_agrees_with_mujoco_along_a_fast_swing(
         FIXTURES / "tipover" / "swing.yaml", dict.fromkeys(ARM, (0.0, math.pi / 2))
     )
     ref = build_reference(traj, ARM, np.zeros(2))
-    gains = [spec.control.gains[j] for j in ARM]  # type: ignore[attr-defined]
+    gains = [spec.control.gains[j] for j in ARM]
     lead = np.array([g.kd / g.kp for g in gains])  # the exported actuator's ctrl (export/mjcf.py)
     ours, theirs = [], []
     steps = round((SETTLE_S + traj.duration + 0.5) / m.opt.timestep)
@@ -160,7 +162,7 @@ def test_zmp_agrees_with_mujoco_along_a_fast_swing(
 
 
 def test_base_acceleration_agrees_with_mujoco(
-    course: tuple[object, object, Stance], tmp_path: Path
+    course: tuple[RobotSpec, Urdf, Stance], tmp_path: Path
 ) -> None:
     """Accelerating at a is, in the base's frame, gravity leaning by (-a, 0, -g)."""
     spec, urdf, stance = course

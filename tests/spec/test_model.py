@@ -28,8 +28,8 @@ def test_default_spec_holds_the_seed_values(default_spec_path: Path) -> None:
         assert (j.limit.effort, j.limit.velocity) == (100.0, 100.0)
         assert (j.dynamics.friction, j.dynamics.damping) == (0.05, 0.1)
     links = spec.arm.links
-    assert links["arm_base_link"].geometry.box.size == (0.1, 0.1, 0.02)  # type: ignore[union-attr]
-    assert links["forearm_link"].geometry.cylinder.radius == 0.02  # type: ignore[union-attr]
+    assert links["arm_base_link"].geometry.box.size == (0.1, 0.1, 0.02)
+    assert links["forearm_link"].geometry.cylinder.radius == 0.02
     assert [links[n].mass for n in links] == [0.5, 0.3, 0.3]
     assert spec.arm.joint_state_publisher is not None
     assert spec.arm.joint_state_publisher.update_rate == 10

@@ -12,6 +12,7 @@ import subprocess
 import sys
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -77,7 +78,7 @@ def _free_port() -> int:
         return int(s.getsockname()[1])
 
 
-def _stop(procs: list[subprocess.Popen[bytes]]) -> None:
+def _stop(procs: list[subprocess.Popen[Any]]) -> None:
     for p in reversed(procs):
         if p.poll() is None:
             p.terminate()
@@ -98,13 +99,17 @@ def scheduler_address(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]
     port = _free_port()
     address = f"tcp://127.0.0.1:{port}"
     cwd = tmp_path_factory.mktemp("dask")
-    common = {"cwd": cwd, "stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+    common: dict[str, Any] = {
+        "cwd": cwd,
+        "stdout": subprocess.DEVNULL,
+        "stderr": subprocess.DEVNULL,
+    }
     procs = [
         subprocess.Popen(
             [exe, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
             **common,
         )
-    ]  # type: ignore[call-overload]
+    ]
     try:
         for _ in range(2):
             procs.append(
@@ -123,7 +128,7 @@ def scheduler_address(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]
                     ],
                     **common,
                 )
-            )  # type: ignore[call-overload]
+            )
         from distributed import Client
 
         with Client(address, timeout=f"{START_TIMEOUT_S}s") as client:

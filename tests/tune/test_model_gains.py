@@ -11,7 +11,7 @@ import pytest
 
 from armcli.robot.load import load_model
 from armcli.sim.reference import Reference
-from armcli.sim.simulate import Arm, SimConfig, arm_from_model, simulate
+from armcli.sim.simulate import Arm, SimConfig, SimResult, arm_from_model, simulate
 from armcli.tune.model_gains import STABILITY_MARGIN, start_gains
 from armcli.tune.objective import overshoot
 from tests.helpers import FIXTURES
@@ -30,7 +30,9 @@ def arm() -> Arm:
     return arm_from_model(load_model(URDF).model)
 
 
-def step_response(arm: Arm, kp: float, kd: float, duration: float) -> tuple[np.ndarray, ...]:
+def step_response(
+    arm: Arm, kp: float, kd: float, duration: float
+) -> tuple[np.ndarray, np.ndarray, SimResult]:
     ref = Reference(knots=np.array([0.0]), coeffs=np.zeros((0, 6, 1)), final=np.array([STEP]))
     cfg = SimConfig(np.array([kp]), np.array([kd]), DT_FINE)
     res = simulate(arm, ref, np.zeros(1), duration, cfg)

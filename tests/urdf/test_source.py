@@ -201,9 +201,9 @@ def test_simulate_runs_xacro_once(
     """`simulate` needs the standalone arm and the whole robot (its zero-moment point): one
     expansion of the spec's xacro set gives both (issue 28: it used to run four)."""
     from armcli.compiler import expand
+    from armcli.xacro.safe import expand_safe as real
 
     expanded: list[str] = []
-    real = expand.expand_safe
 
     def counting(path: Path, *args: object, **kwargs: object) -> bytes:
         expanded.append(path.name)

@@ -22,11 +22,11 @@ LABEL_TOL = 1e-5  # urdf_to_graphviz prints C++ ostream's 6 significant digits
 
 
 @pytest.fixture(scope="module")
-def robot(default_spec_path: Path):  # type: ignore[no-untyped-def]
+def robot(default_spec_path: Path):
     return load_robot(default_spec_path)
 
 
-def test_tree_matches_the_spec(robot, default_spec_path: Path) -> None:  # type: ignore[no-untyped-def]
+def test_tree_matches_the_spec(robot, default_spec_path: Path) -> None:
     """Every spec joint appears with its parent, child, type and limits; the root is the base."""
     spec = load_spec(default_spec_path)
     tree = parse_tree(robot.xml, robot.source)
@@ -50,7 +50,7 @@ def test_tree_matches_the_spec(robot, default_spec_path: Path) -> None:  # type:
     ]
 
 
-def test_rich_tree_shows_links_types_and_limits(robot) -> None:  # type: ignore[no-untyped-def]
+def test_rich_tree_shows_links_types_and_limits(robot) -> None:
     from rich.console import Console
 
     buf = io.StringIO()
@@ -75,7 +75,7 @@ def _edges(dot: str) -> list[tuple[str, str, list[float]]]:
     return out
 
 
-def test_dot_matches_urdf_to_graphviz(robot, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+def test_dot_matches_urdf_to_graphviz(robot, tmp_path: Path) -> None:
     """Same link boxes, same edges in the same order, same origins as urdfdom's own tool."""
     exe = shutil.which("urdf_to_graphviz")
     if exe is None:

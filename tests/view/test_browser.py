@@ -59,12 +59,12 @@ CHROMIUM_FLAGS = (
 
 
 @pytest.fixture(scope="module")
-def robot(default_spec_path: Path):  # type: ignore[no-untyped-def]
+def robot(default_spec_path: Path):
     return load_robot(default_spec_path)
 
 
 @pytest.fixture
-def viewer(robot) -> Iterator[Viewer]:  # type: ignore[no-untyped-def]
+def viewer(robot) -> Iterator[Viewer]:
     v = Viewer(robot.xml, name=robot.name, poses=robot.poses, tool=robot.tool, port=0)
     try:
         yield v
@@ -97,7 +97,7 @@ def test_api_moves_joints_and_reports_the_tool(viewer: Viewer) -> None:
     viewer.close()  # idempotent
 
 
-def test_taken_port_is_a_clear_error(robot) -> None:  # type: ignore[no-untyped-def]
+def test_taken_port_is_a_clear_error(robot) -> None:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         s.listen()
@@ -156,7 +156,7 @@ def test_bad_replay_file_names_line_and_column(tmp_path: Path, edit: Any, messag
         load_replay(csv, list(ARM))
 
 
-def test_replay_seek_play_and_ghost(robot, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+def test_replay_seek_play_and_ghost(robot, tmp_path: Path) -> None:
     csv = tmp_path / "states.csv"
     write_run(csv, blank_refs_after=10)
     run = load_replay(csv, list(ARM))
@@ -174,7 +174,7 @@ def test_replay_seek_play_and_ghost(robot, tmp_path: Path) -> None:  # type: ign
         assert 0.0 < moved <= 0.5 * 2.0
 
 
-def test_ghost_shows_only_the_links_the_references_move(robot) -> None:  # type: ignore[no-untyped-def]
+def test_ghost_shows_only_the_links_the_references_move(robot) -> None:
     from armcli.urdf.read import parse_urdf
 
     ghost = parse_urdf(moving_parts(robot.xml, ARM).encode(), "ghost")

@@ -30,12 +30,12 @@ def tip(q1: float, q2: float) -> tuple[float, float, float]:
 
 
 @pytest.fixture(scope="module")
-def robot(default_spec_path: Path):  # type: ignore[no-untyped-def]
+def robot(default_spec_path: Path):
     return load_robot(default_spec_path)
 
 
 @pytest.fixture(scope="module")
-def renders(robot, tmp_path_factory: pytest.TempPathFactory):  # type: ignore[no-untyped-def]
+def renders(robot, tmp_path_factory: pytest.TempPathFactory):
     """The default robot at home and folded, rendered once for the module."""
     out = tmp_path_factory.mktemp("render")
     urdf = load_urdf(robot.xml, robot.source)
@@ -63,7 +63,7 @@ def shade_mask(img: np.ndarray, rgb: tuple[float, float, float]) -> np.ndarray:
     return (resid < SHADE_TOL) & (k > AMBIENT - SHADE_TOL) & (k < 1 + SHADE_TOL)
 
 
-def test_image_size_and_determinism(renders, robot, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+def test_image_size_and_determinism(renders, robot, tmp_path: Path) -> None:
     home = renders["home"]
     assert size(home.path) == (1200, 600) == (home.width, home.height)
     again = render_png(
@@ -74,7 +74,7 @@ def test_image_size_and_determinism(renders, robot, tmp_path: Path) -> None:  # 
     assert size(small.path) == (640, 320)
 
 
-def test_robot_colours_are_present(renders, default_spec_path: Path) -> None:  # type: ignore[no-untyped-def]
+def test_robot_colours_are_present(renders, default_spec_path: Path) -> None:
     from armcli.spec.load import load_spec
 
     spec = load_spec(default_spec_path)
@@ -85,7 +85,7 @@ def test_robot_colours_are_present(renders, default_spec_path: Path) -> None:  #
         assert shade_mask(img, rgb).sum() > MIN_PIXELS, f"{name} {rgb} not drawn"
 
 
-def test_tool_point_matches_closed_form(renders) -> None:  # type: ignore[no-untyped-def]
+def test_tool_point_matches_closed_form(renders) -> None:
     # The brief: hand tip at (0.15, 0, 0.92) at q = 0.
     assert renders["home"].tool_position == pytest.approx((0.15, 0.0, 0.92), abs=TIP_TOL)
     assert renders["folded"].tool_position == pytest.approx(
@@ -102,7 +102,7 @@ def _yellow_box(path: Path) -> tuple[int, int]:
     return int(xs.max() - xs.min()), int(ys.max() - ys.min())
 
 
-def test_two_poses_give_different_images(renders) -> None:  # type: ignore[no-untyped-def]
+def test_two_poses_give_different_images(renders) -> None:
     a, b = pixels(renders["home"].path), pixels(renders["folded"].path)
     changed = (np.abs(a - b).max(axis=-1) > 0.1).sum()
     assert changed > 10 * MIN_PIXELS
@@ -113,7 +113,7 @@ def test_two_poses_give_different_images(renders) -> None:  # type: ignore[no-un
     assert w_fold > 3 * h_fold
 
 
-def test_out_of_limits_is_refused_and_nothing_written(robot, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+def test_out_of_limits_is_refused_and_nothing_written(robot, tmp_path: Path) -> None:
     out = tmp_path / "x.png"
     with pytest.raises(InputError, match=r"outside its limits \[0, 1.5708\]"):
         render_png(load_urdf(robot.xml), {"forearm_hand_joint": 2.0}, out, field="--q")

@@ -52,7 +52,7 @@ def course() -> tuple[str, object, object]:
     return xml, load_urdf(xml, "my_robot.urdf"), spec_tool(spec)
 
 
-def test_region_numbers_and_points(course, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+def test_region_numbers_and_points(course, tmp_path: Path) -> None:
     xml, urdf, tool = course
     targets = [tool_at(*INSIDE), (SHOULDER[0] + 0.7, 0.0, SHOULDER[2])]  # in; 0.1 m too far
     pic = render_reach_png(urdf, xml, "my_robot.urdf", {}, tmp_path / "r.png", tool=tool,
@@ -72,7 +72,7 @@ def test_region_numbers_and_points(course, tmp_path: Path) -> None:  # type: ign
     assert count(img, REACHABLE_RGB) > 5 and count(img, MISSED_RGB) > 5  # both markers drawn
 
 
-def test_joints_off_the_chain_and_the_pose(course, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+def test_joints_off_the_chain_and_the_pose(course, tmp_path: Path) -> None:
     """The region does not depend on where the arm is drawn; the wheels do not move it."""
     xml, urdf, tool = course
     pose = {"arm_base_forearm_joint": 0.7, "base_left_wheel_joint": 2.0}

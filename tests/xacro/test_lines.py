@@ -7,6 +7,7 @@ stay byte for byte what xacro itself writes (xacro run in this process on our ow
 from __future__ import annotations
 
 from pathlib import Path
+from typing import cast
 
 from lxml import etree
 
@@ -49,13 +50,14 @@ def test_an_included_macros_element_points_at_its_own_file_and_the_call() -> Non
     assert out == xacro.process_file(str(TOP)).toprettyxml(indent="  ", encoding="utf-8")
     root = etree.fromstring(out)
     (inertia,) = root.iterfind("link[@name='back_caster_link']/inertial/inertia")
-    o = origins[inertia.sourceline]
+    o = origins[cast(int, inertia.sourceline)]
     parts = TOP.parent / "parts" / "caster.xacro"
     assert (o.file, o.line) == (str(parts), _line(parts.read_text(), "<inertia ixx"))
     assert o.calls == ((str(TOP), _line(TOP.read_text(), "<xacro:caster ")),)
     # An element written in the top file itself: its own line, no call.
     (base,) = root.iterfind("link[@name='base_link']")
-    assert origins[base.sourceline] == Origin(str(TOP), _line(TOP.read_text(), '"base_link">'))
+    o = origins[cast(int, base.sourceline)]
+    assert o == Origin(str(TOP), _line(TOP.read_text(), '"base_link">'))
 
 
 def test_nested_macro_calls_are_listed_innermost_first(tmp_path: Path) -> None:
@@ -63,7 +65,7 @@ def test_nested_macro_calls_are_listed_innermost_first(tmp_path: Path) -> None:
     path.write_text(NESTED)
     out, origins = _expand(path)
     (link,) = etree.fromstring(out).iterfind("link[@name='a_link']")
-    o = origins[link.sourceline]
+    o = origins[cast(int, link.sourceline)]
     assert o.line == _line(NESTED, "${n}_link")
     assert o.calls == ((str(path), _line(NESTED, '<xacro:inner n="${n}"')),
                        (str(path), _line(NESTED, '<xacro:outer n="a"')))  # fmt: skip

@@ -20,7 +20,7 @@ residual is what is left of |p(q) - target| (reachable when under REACH_TOL).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -222,7 +222,7 @@ def _refine(
     return best_f, best_x
 
 
-def reach_point(chain: Chain, cloud: Cloud, target: Sequence[float]) -> ReachPoint:
+def reach_point(chain: Chain, cloud: Cloud, target: ArrayLike) -> ReachPoint:
     """Whether the tool point can reach `target` [m]: nearest sample, then inverse kinematics."""
     t = np.asarray(target, dtype=float)
     d = np.linalg.norm(cloud.p - t, axis=1)
