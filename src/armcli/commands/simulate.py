@@ -33,7 +33,7 @@ if TYPE_CHECKING:  # the simulator is imported when the command runs: `--help` s
 
 INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
 GRAVITY_HELP = "Add g(q) to the PD torque (default: the spec's control.gravity_compensation)."
-IGNORE_HELP = "Simulate a --urdf despite this `check` rule's error (repeatable)."
+IGNORE_HELP = "Simulate the robot despite this `check` rule's error (repeatable)."
 TRAJECTORY_HELP = "JointTrajectory YAML (a point without time_from_start: previous + 1 s)."
 BASE_ACCEL_HELP = (
     "Base acceleration and braking [m/s²] for the zero-moment point "
@@ -181,7 +181,14 @@ def _prepare(
         refuse_check_errors(doc, ignore=ignore)
 
     try:
-        return simjob.prepare(spec, opts, gate=gate)
+        job = simjob.prepare(spec, opts, gate=gate)
+        if spec is not None and opts.urdf is None:  # a spec's whole robot, as `check` sees it
+            from armcli.sim.tipping import robot_urdf
+
+            whole = robot_urdf(spec, job)
+            if whole is not None:
+                gate(whole)
+        return job
     except ModelRefusedError as exc:
         flags = " ".join(f"--ignore {r}" for r in exc.rules())
         raise ModelRefusedError(
@@ -270,11 +277,13 @@ def _run(
     out.print(simreport.summary_table(metrics, ee, job.tool_label, res), crop=False)
     balance = tipping.report(tip, series) if tip is not None and series is not None else None
     if balance is not None:
+        for lift in balance.lifts:  # too short to tip the robot: a wheel unloads, a warning
+            err.print(one_line(f"warning: {lift.line()}"), markup=False, highlight=False)
         line = tipping.summary_line(balance)
         out.print(line, style="red" if balance.tips else None, markup=False, highlight=False)
     for path in (output, plot):
         if path is not None:
-            out.print(f"wrote {path}", markup=False, highlight=False)
+            out.print(one_line(f"wrote {path}"), markup=False, highlight=False)
     if balance is not None and balance.tips:
         raise tipping.tip_error(balance)
 

@@ -16,6 +16,8 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import IO, Any
 
+from armcli.io.oneline import one_line
+
 UNBOUNDED = 1_000_000  # [columns] "no limit": a file or pipe gets each line whole
 NAME_MIN = 12  # [columns] a wrapped text column keeps at least this many
 GAP = 1  # [columns] between table columns (a space, as in ps or df)
@@ -339,7 +341,11 @@ def fit_line(text: str, stream: IO[str] | None = None) -> str:
 
 
 def say(text: str, stream: IO[str] | None = None) -> None:
-    """Write `text` (one or more lines) to `stream` (stdout), each fitted by `fit_line`."""
+    """Write `text` (one or more lines) to `stream` (stdout), each escaped and fitted.
+
+    Every line goes through `one_line` (names from files carry no control characters to
+    the terminal or a CI log, issue 27), then `fit_line`.
+    """
     stream = sys.stdout if stream is None else stream
     for line in text.rstrip("\n").split("\n"):
-        stream.write(fit_line(line, stream) + "\n")
+        stream.write(fit_line(one_line(line), stream) + "\n")

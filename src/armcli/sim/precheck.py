@@ -14,7 +14,6 @@ import math
 import numpy as np
 
 from armcli.sim.job import SimJob
-from armcli.sim.simulate import configuration
 
 SPEED_SAMPLES = 64  # per segment: the cubic/quintic reference's peak speed, within 0.1 %
 SPEED_TOL = 1e-9  # relative slack over a velocity or effort limit
@@ -57,13 +56,14 @@ def holding_problems(job: SimJob) -> list[str]:
     import pinocchio as pin
 
     arm = job.arm
-    data = arm.model.createData()
+    robot = arm.robot
+    data = robot.data
     times = np.concatenate(([0.0], job.trajectory.times))
     q_ref, _ = job.reference.sample(times)
     worst = np.zeros(len(arm.joint_names))
     where = np.zeros(len(arm.joint_names), dtype=int)
     for k, q in enumerate(q_ref):
-        g = np.abs(pin.computeGeneralizedGravity(arm.model, data, configuration(arm.model, q)))
+        g = np.abs(pin.computeGeneralizedGravity(arm.model, data, robot.q(q)))
         better = g > worst
         worst, where = np.where(better, g, worst), np.where(better, k, where)
     out = []
