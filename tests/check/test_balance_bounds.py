@@ -11,10 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from armcli.analysis.stance import Stance
 from armcli.check import balance
 from armcli.check.run import check_urdf
 from armcli.urdf.read import read_urdf
-from armcli.urdf.stance import Stance
 
 BRUTE = 2000  # random configurations of the brute-force reference
 SEED = 31
