@@ -365,7 +365,7 @@ class Finding:
 
     @property
     def calls_text(self) -> str:
-        """ " (through the macro call at FILE:LINE, ...)" for an element a macro produced."""
+        """The message's tail naming the macro calls that produced a xacro element, or ""."""
         if self.origin is None or not self.origin.calls:
             return ""
         at = ", then ".join(f"{shown_path(f)}:{n}" for f, n in self.origin.calls)

@@ -5,9 +5,10 @@ Pinocchio's forward kinematics in the root link's frame; the ground plane is the
 point of all of them, and a link touches it when its own lowest point is within a
 tolerance of that plane (rigid bodies on flat ground, the root frame upright): 2 % of the
 robot's footprint (the larger horizontal extent of the lowest points within 5 mm of the
-plane), at least 5 mm and at most 10 mm. Real bases are not exact at the zero pose: LoCoBot's wheels sit 2.45 mm above its
-caster and a Dingo's 2.24 mm, both resting on a spring or tyre that gives that much. A
-user may name the contact links instead (`--contact-links`).
+plane), at least 5 mm and at most 10 mm. Real bases are not exact at the zero pose:
+LoCoBot's wheels sit 2.45 mm above its caster and a Dingo's 2.24 mm, both resting on a
+spring or tyre that gives that much. A user may name the contact links instead
+(`--contact-links`).
 
 Contact points. A rolling link (a wheel: the child of a revolute or continuous joint
 whose axis is horizontal) touches the ground at one point, the middle of its tread below
