@@ -86,6 +86,7 @@ bench: install-dev native-check
 	$(BIN)/python bench/bench_process.py
 	$(BIN)/python bench/bench_tune.py
 	$(BIN)/python bench/bench_check_dof.py
+	$(BIN)/python bench/bench_check_corpus.py
 
 fuzz: install-dev
 	HYPOTHESIS_PROFILE=fuzz $(BIN)/python -m pytest -q tests -k fuzz

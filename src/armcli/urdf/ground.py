@@ -23,7 +23,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -32,9 +31,8 @@ from numpy.typing import NDArray
 from armcli.spec.joint_types import ROTARY_TYPES
 from armcli.urdf.doc import Shape, Urdf, Vec3
 from armcli.urdf.inertia import rpy_matrix
-from armcli.urdf.mesh_confine import bounded_mesh_file
+from armcli.urdf.mesh_points import read_vertices
 from armcli.urdf.meshes import MeshSearch, mesh_paths
-from armcli.urdf.meshlog import quiet_trimesh
 
 CONTACT_TOL = 0.005  # [m] a link within this of the lowest point touches the ground, at least
 CONTACT_RTOL = 0.02  # of the robot's footprint: a 0.35 m base takes links within 7 mm
@@ -247,24 +245,10 @@ def mesh_loader(urdf: Urdf, search: MeshSearch, missing: list[str]) -> MeshVerti
 
     def vertices(uri: str, scale: Vec3) -> NDArray[np.float64] | None:
         if uri not in cache:
-            cache[uri] = _read_vertices(paths.get(uri), urdf.source)
+            cache[uri] = read_vertices(paths.get(uri), urdf.source)
             if cache[uri] is None:
                 missing.append(uri)
         v = cache[uri]
         return None if v is None else v * np.asarray(scale, dtype=float)
 
     return vertices
-
-
-def _read_vertices(path: Path | None, source: str) -> NDArray[np.float64] | None:
-    import trimesh
-
-    if path is None or not path.is_file():
-        return None
-    try:
-        with quiet_trimesh():  # a missing texture does not move a vertex
-            mesh = trimesh.load(str(bounded_mesh_file(path, source)), force="mesh", process=False)
-    except Exception:  # trimesh raises many types for unreadable files
-        return None
-    v = np.asarray(getattr(mesh, "vertices", np.empty((0, 3))), dtype=float)
-    return v if v.ndim == 2 and v.shape[1] == 3 and len(v) else None
