@@ -46,6 +46,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "armcli.commands.simulate",
         "Simulate the arm tracking a trajectory (Pinocchio ABA under PD control).",
     ),
+    "plan": (
+        "armcli.commands.plan",
+        "Plan a collision-free motion, time it within the limits, certify it, write it.",
+    ),
     "tune": (
         "armcli.commands.tune",
         "Tune PD gains: model-based start, then a seeded search over simulated rollouts.",

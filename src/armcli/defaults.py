@@ -29,3 +29,9 @@ COLLISION_SAMPLES = 10_000  # the MoveIt Setup Assistant's default "sampling den
 MJCF_BASES = ("fixed", "free")  # `export mjcf --base`: root welded to the world, or free
 PD_LOOPS = ("implicit", "explicit")  # `tune --loop`: armcli's simulator, or an explicit torque loop
 ROBUST_MODES = ("worst", "quantile")  # `tune --robust-mode` over the perturbed models
+
+# [rad/s² or m/s²] a joint's acceleration limit when neither the spec nor the URDF gives one:
+# MoveIt's time-optimal parameterisation uses the same 1.0 (DEFAULT_ACCELERATION_LIMIT).
+DEFAULT_JOINT_ACCELERATION = 1.0
+# `plan --planner`: OMPL geometric planners (RRT-Connect first: MoveIt's default)
+PLANNERS = ("rrtconnect", "rrt", "rrtstar", "informedrrtstar", "aorrtc")

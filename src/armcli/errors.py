@@ -334,3 +334,19 @@ class NoSpecError(InputError):
 
 class ExistingFileError(InputError):
     """A file `armcli init` would write already exists; nothing was written."""
+
+
+class PlanningError(ArmcliError):
+    """No certified motion: start or goal in collision, goal out of limits, no IK, no path.
+
+    `kind` names the failure (`start-collision`, `goal-collision`, `goal-limits`, `ik`,
+    `no-path`, `certify`); `pair` the two colliding bodies when there are some.
+    """
+
+    exit_code = EXIT_FAILED
+
+    def __init__(self, kind: str, message: str, *, pair: tuple[str, str] | None = None) -> None:
+        self.kind = kind
+        self.pair = pair
+        self.reason = message
+        super().__init__(message)

@@ -3,7 +3,7 @@
 The fixtures reproduce what real descriptions do (planning-only industrial arms without
 inertials, 1e-6 kg dummy links with singular tensors, CAD inertias violating the
 triangle inequality, point masses); before the fix each exported with exit 0 and MuJoCo
-refused the result. References: closed-form solids (urdf.inertia) for the inertia MuJoCo
+refused the result. References: closed-form solids (robot.inertia) for the inertia MuJoCo
 takes from geometry, Pinocchio on the original URDF for merges that must not change the
 dynamics, and MuJoCo itself compiling every written model.
 """
@@ -20,7 +20,7 @@ import pytest
 from armcli.errors import ExportRefusedError
 from armcli.export.mjcf_files import export_mjcf
 from armcli.export.mjcf_mass import DENSITY, POINT_RADIUS
-from armcli.urdf import inertia as inr
+from armcli.robot import inertia as inr
 
 mujoco = pytest.importorskip("mujoco")
 pin = pytest.importorskip("pinocchio")

@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from armcli.urdf.pinocchio import load_model
-from armcli.urdf.tool import ToolPoint
+from armcli.robot.load import load_model
+from armcli.robot.tool import ToolPoint
 from armcli.urdf.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 from tests.helpers import FIXTURES
 

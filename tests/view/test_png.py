@@ -89,7 +89,8 @@ def test_tool_point_matches_closed_form(renders) -> None:  # type: ignore[no-unt
     # The brief: hand tip at (0.15, 0, 0.92) at q = 0.
     assert renders["home"].tool_position == pytest.approx((0.15, 0.0, 0.92), abs=TIP_TOL)
     assert renders["folded"].tool_position == pytest.approx(
-        tip(math.pi / 2, math.pi / 2), abs=TIP_TOL
+        tip(1.5, math.pi / 2),
+        abs=TIP_TOL,  # the spec's folded pose
     )
 
 
@@ -105,7 +106,7 @@ def test_two_poses_give_different_images(renders) -> None:  # type: ignore[no-un
     a, b = pixels(renders["home"].path), pixels(renders["folded"].path)
     changed = (np.abs(a - b).max(axis=-1) > 0.1).sum()
     assert changed > 10 * MIN_PIXELS
-    # Side view: the forearm stands upright at home and lies along x when folded (q1 = pi/2).
+    # Side view: the forearm stands upright at home and lies along x when folded (q1 = 1.5).
     w_home, h_home = _yellow_box(renders["home"].path)
     w_fold, h_fold = _yellow_box(renders["folded"].path)
     assert h_home > 3 * w_home

@@ -365,7 +365,7 @@ class Finding:
 
     @property
     def calls_text(self) -> str:
-        """The message's tail naming the macro calls that produced a xacro element, or ""."""
+        """The `(through the macro call at FILE:LINE, ...)` suffix of a macro's element."""
         if self.origin is None or not self.origin.calls:
             return ""
         at = ", then ".join(f"{shown_path(f)}:{n}" for f, n in self.origin.calls)

@@ -80,7 +80,7 @@ class Link:
 
 @dataclass(frozen=True)
 class Limit:
-    """A <limit>: lower/upper [rad or m], effort [N·m or N], velocity [rad/s or m/s]."""
+    """A <limit>: lower/upper [rad or m], effort [N·m or N], velocity, acceleration [/s, /s²]."""
 
     lower: float | None
     upper: float | None
@@ -88,6 +88,7 @@ class Limit:
     velocity: float | None
     line: int | None
     missing_bounds: tuple[str, ...] = ()  # "lower"/"upper" absent (URDF reads them as 0)
+    acceleration: float | None = None  # [rad/s² or m/s²] URDF 1.2's optional attribute
 
 
 @dataclass(frozen=True)

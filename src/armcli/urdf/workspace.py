@@ -1,10 +1,11 @@
 """The arm's workspace: where its tool point can go within the joint limits.
 
 The chain is the moving joints between the root and the tool point's link. Forward
-kinematics (Pinocchio) of seeded uniform draws of those joints, plus every corner of
-the range box when there are at most 64, gives a cloud of tool positions in the root
-frame; each extreme of the envelope is then refined by a local search within the
-limits (`urdf.boxsearch`) from the best samples, so it does not depend on a lucky draw:
+kinematics (Pinocchio) of the zero pose, every corner of the range box when there are few
+and seeded uniform draws of those joints (`robot.sampling.search_starts`) gives a cloud
+of tool positions in the root frame; each extreme of the envelope is then refined by a
+local search within the limits (`urdf.boxsearch`) from the best samples, so it does not
+depend on a lucky draw:
 
 - max reach: the largest distance from the shoulder (the origin of the chain's first
   moving joint) to the tool point;
@@ -18,9 +19,7 @@ residual is what is left of |p(q) - target| (reachable when under REACH_TOL).
 
 from __future__ import annotations
 
-import itertools
 import math
-import random
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -28,13 +27,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from armcli.robot import sampling
+from armcli.robot.load import link_frame
+from armcli.robot.model import Joint, Robot
+from armcli.robot.sampling import REACH_DRAWS, SAMPLE_SEED
+from armcli.robot.tool import ToolPoint
 from armcli.urdf.boxsearch import minimize_box
-from armcli.urdf.pinocchio import JointRange, configuration, joint_ranges, link_frame
-from armcli.urdf.tool import ToolPoint
 
-SAMPLES = 500  # `check`'s cloud: IK seeds and starts (extremes are refined); render draws more
-SAMPLE_SEED = 0
-MAX_CORNERS = 64
 REFINE_FROM = 3  # local searches per extreme, from the best samples
 REACH_TOL = 1e-3  # [m] an inverse-kinematics residual below this is reached
 IK_SEEDS = 5  # nearest samples the inverse kinematics starts from
@@ -76,14 +75,16 @@ class Chain:
     """Forward kinematics of the tool point over the chain's joints, and its Jacobian."""
 
     def __init__(
-        self, model: Any, tool: ToolPoint, others: Mapping[str, float] | None = None
+        self, robot: Robot, tool: ToolPoint, others: Mapping[str, float] | None = None
     ) -> None:
         """`others`: values [rad or m] of joints off the chain (neutral where silent)."""
+        model = robot.model
         frame = link_frame(model, tool.link)
         if frame is None:
             raise ValueError(f"no link {tool.link!r} in the model")
+        self.robot = robot
         self.model = model
-        self.data = model.createData()
+        self.data = robot.data
         self.frame = frame
         self.xyz = np.asarray(tool.xyz, dtype=float)
         self.tool = tool
@@ -93,23 +94,18 @@ class Chain:
             path.append(jid)
             jid = model.parents[jid]
         ids = set(path)
-        self.joints: tuple[JointRange, ...] = tuple(
-            jr for jr in joint_ranges(model) if model.getJointId(jr.name) in ids
+        self.joints: tuple[Joint, ...] = tuple(
+            j for j in robot.joints if model.getJointId(j.name) in ids
         )
-        self.iv = [jr.idx_v for jr in self.joints]
-        self.q0 = np.asarray(configuration(model, others or {}), dtype=float)
-        self.lower = np.array([jr.lower for jr in self.joints])
-        self.upper = np.array([jr.upper for jr in self.joints])
+        self.iv = [j.idx_v for j in self.joints]
+        self.q0 = robot.q(others or {})
+        self.box = sampling.bounds(self.joints)
+        self.lower = np.array([lo for lo, _ in self.box])
+        self.upper = np.array([hi for _, hi in self.box])
 
     def q(self, x: ArrayLike) -> NDArray[np.float64]:
         """The model's configuration with the chain's joints at x [rad or m]."""
-        q = self.q0.copy()
-        for jr, v in zip(self.joints, np.asarray(x, dtype=float), strict=True):
-            if jr.continuous:
-                q[jr.idx_q], q[jr.idx_q + 1] = math.cos(v), math.sin(v)
-            else:
-                q[jr.idx_q] = v
-        return q
+        return self.robot.q(x, joints=self.joints, base=self.q0)
 
     def position(self, x: ArrayLike) -> NDArray[np.float64]:
         """The tool point [m] in the root frame."""
@@ -154,13 +150,9 @@ class Cloud:
     p: NDArray[np.float64]
 
 
-def sample(chain: Chain, n: int = SAMPLES, seed: int = SAMPLE_SEED) -> Cloud:
-    """Seeded uniform draws of the chain's joints, plus the range box's corners."""
-    rng = random.Random(seed)  # stdlib: numpy.random costs 20 ms of start-up
-    rows = [[min(max(0.0, jr.lower), jr.upper) for jr in chain.joints]]
-    if 2 ** len(chain.joints) <= MAX_CORNERS:
-        rows += [list(c) for c in itertools.product(*[(jr.lower, jr.upper) for jr in chain.joints])]
-    rows += [[rng.uniform(jr.lower, jr.upper) for jr in chain.joints] for _ in range(n)]
+def sample(chain: Chain, n: int = REACH_DRAWS, seed: int = SAMPLE_SEED) -> Cloud:
+    """The zero pose, the range box's corners and n seeded draws of the chain's joints."""
+    rows = sampling.search_starts(chain.box, n, seed=seed)
     x = np.array(rows, dtype=float).reshape(len(rows), len(chain.joints))
     return Cloud(x, np.array([chain.position(r) for r in x]))
 

@@ -20,12 +20,12 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
+from armcli.robot.tool import ToolPoint
 from armcli.spec.joint_types import position_bounds
 from armcli.urdf.mesh_confine import bounded_mesh_file, check_total
 from armcli.urdf.meshes import MeshSearch, confined, resolve
 from armcli.urdf.meshlog import MeshLog, quiet_trimesh
 from armcli.urdf.read import parse_root
-from armcli.urdf.tool import ToolPoint
 
 MAX_EDGE = 0.04  # [m] faces are split to this edge length so depth sorting works
 SPLIT_ROUNDS = 8  # halvings at most; longer edges stay longer than MAX_EDGE

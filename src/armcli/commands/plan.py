@@ -1,0 +1,206 @@
+"""`armcli plan`: a certified collision-free motion between two poses, as a JointTrajectory."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import typer
+
+from armcli.commands.flags import flag_errors
+from armcli.commands.options import choice, option, spec_argument
+from armcli.commands.xacro_inputs import (
+    args_argument,
+    env_option,
+    package_dir_option,
+    split_robot,
+    xacro_inputs,
+)
+from armcli.defaults import PLANNERS
+from armcli.errors import InputError, PlanningError
+from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+
+if TYPE_CHECKING:
+    from armcli.plan.api import PlanResult
+    from armcli.plan.execute import Execution
+
+FORMATS = ("text", "json")
+FROM_HELP = "Start: a named pose (spec poses, SRDF group states) or q1,q2,... [rad]."
+TO_HELP = "Goal: a named pose or q1,q2,... [rad] in the order of --joints."
+XYZ_HELP = "Goal of the tool point x,y,z [m] in the robot's root frame (inverse kinematics)."
+RPY_HELP = (
+    "With --to-xyz: the tool link's roll,pitch,yaw [rad] (default: position only < 6 joints)."
+)
+SCENE_HELP = "Obstacles: YAML shaped like moveit_msgs/PlanningScene world.collision_objects."
+SRDF_HELP = "SRDF of a --urdf: its disable_collisions and group_state entries."
+EXECUTE_HELP = "Simulate the plan right away; exit 1 if it breaks a limit or tips over."
+FLAGS = {
+    "start": "--from",
+    "goal": "--to",
+    "joints": "--joints",
+    "pose": "--from/--to",
+    "to-xyz": "--to-xyz",
+    "to-rpy": "--to-rpy",
+    "planner": "--planner",
+    "timeout": "--timeout",
+}
+
+
+@flag_errors(FLAGS)
+def plan_cmd(
+    spec: Path | None = spec_argument(),
+    args: list[str] = args_argument(),
+    start: str = option(None, "--from", help=FROM_HELP + " Default: home."),
+    goal: str = option(None, "--to", help=TO_HELP),
+    to_xyz: str = option(None, "--to-xyz", help=XYZ_HELP),
+    to_rpy: str = option(None, "--to-rpy", help=RPY_HELP),
+    urdf: Path = option(None, "--urdf", help="Plan for this URDF or xacro file instead of a spec."),
+    srdf: Path = option(None, "--srdf", help=SRDF_HELP),
+    scene: Path = option(None, "--scene", help=SCENE_HELP),
+    joints: str = option(None, "--joints", help="Comma-separated joints to plan (default: arm)."),
+    planner: str = choice(
+        "rrtconnect", PLANNERS, "--planner", help="OMPL planner (default: rrtconnect)."
+    ),
+    timeout: float = option(1.0, "--timeout", help="Planning time limit [s]"),
+    seed: int = option(0, "--seed", help="Random seed: same inputs and seed, same bytes"),
+    output: Path = option(None, "--output", "-o", help="JointTrajectory YAML to write."),
+    fmt: str = choice("text", FORMATS, "--format", help="Output format (default: text)."),
+    execute: bool = option(False, "--execute", help=EXECUTE_HELP),
+    package_dir: list[str] = package_dir_option(),
+    env: list[str] = env_option(),
+    trust_xacro: bool = option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
+    unsandboxed: bool = option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
+) -> None:
+    """Plan a collision-free motion, time it within the limits, certify it, write it."""
+    from armcli.io.outdir import check_output_file
+    from armcli.plan.api import PlanOptions, plan_motion, solve_goal
+    from armcli.plan.inputs import configuration, load_context, numbers
+    from armcli.urdf.source import read_robot
+
+    spec, tokens = split_robot(spec, args)
+    inputs = xacro_inputs(tokens, env, package_dir)
+    if (goal is None) == (to_xyz is None):
+        raise InputError("give exactly one goal: --to POSE|q1,q2,... or --to-xyz x,y,z",
+                         field="--to")  # fmt: skip
+    if to_rpy is not None and to_xyz is None:
+        raise InputError("--to-rpy needs --to-xyz", field="--to-rpy")
+    if output is not None:
+        check_output_file(output, "--output")
+    trust = trust_mode(trust_xacro, unsandboxed)
+    if urdf is not None:
+        robot_file = read_robot(urdf, trust_xacro=trust, inputs=inputs)
+    else:
+        from armcli.spec.discover import find_spec
+
+        robot_file = read_robot(find_spec(spec))
+    chosen = [j.strip() for j in joints.split(",") if j.strip()] if joints else None
+    loaded = load_context(robot_file, srdf=srdf, scene=scene, joints=chosen,
+                          search=inputs.packages)  # fmt: skip
+    ctx = loaded.context
+    if start is None and "home" not in ctx.robot.poses:
+        raise InputError("this robot has no `home` pose: give --from", field="--from")
+    x_start = configuration(ctx, start or "home", "--from")
+    xyz = numbers(to_xyz, 3, "--to-xyz")
+    rpy = numbers(to_rpy, 3, "--to-rpy")
+    x_goal = configuration(ctx, goal, "--to") if goal is not None else None
+    what = f"from {start or 'home'} to {goal or 'xyz ' + str(to_xyz)}"
+    opts = PlanOptions(planner=planner, timeout=timeout, seed=seed,
+                       comment=f"armcli plan {what}, {planner}, seed {seed}")  # fmt: skip
+    try:
+        if x_goal is None:
+            assert xyz is not None
+            x_goal = solve_goal(ctx, xyz, rpy, start=x_start, seed=seed)
+        result = plan_motion(ctx, x_start, x_goal, opts)
+    except PlanningError as exc:
+        if fmt == "json":
+            _json({"status": "failed", "output": None, "reason": exc.reason})
+            raise typer.Exit(1) from None
+        raise
+    if output is not None:
+        from armcli.io.files import write_file_atomic
+
+        write_file_atomic(output, result.document)
+    done = None
+    if execute:
+        done = _execute(robot_file, urdf, inputs, trust, result)
+    if fmt == "json":
+        _json(_summary(result, output, planner, seed, done))
+    else:
+        _print(result, output, what, planner, seed, done)
+    if done is not None and done.broken:
+        raise typer.Exit(1)
+
+
+def _execute(
+    robot_file: Any, urdf: Path | None, inputs: Any, trust: Any, result: PlanResult
+) -> Execution:
+    from armcli.plan.execute import execute
+    from armcli.sim.options import SimOptions
+
+    opts = SimOptions(message=result.document.decode("utf-8"), urdf=urdf, trust_xacro=trust,
+                      xacro=inputs)  # fmt: skip
+    return execute(robot_file.spec, opts, inputs.packages)
+
+
+def _summary(
+    r: PlanResult, output: Path | None, planner: str, seed: int, done: Execution | None
+) -> dict[str, Any]:
+    doc: dict[str, Any] = {
+        "status": "planned",
+        "planning_time_s": r.planning_time_s,
+        "certify_time_s": r.certify_time_s,
+        "duration_s": r.duration_s,
+        "path_length_rad": r.path_length_rad,
+        "waypoints": len(r.path),
+        "points": len(r.timed.times),
+        "joints": list(r.joints),
+        "planner": planner,
+        "seed": seed,
+        "output": str(output) if output is not None else None,
+    }
+    if done is not None:
+        doc["execute"] = {
+            "broken": done.broken,
+            "problems": list(done.problems),
+            "max_tracking_error_rad": {m.name: m.max_error for m in done.metrics},
+            "peak_effort": dict(zip(done.joints, done.peak_effort.tolist(), strict=True)),
+            "effort_limit": dict(zip(done.joints, done.effort_limit.tolist(), strict=True)),
+            "tip_margin_m": done.tip_margin,
+        }
+    return doc
+
+
+def _json(doc: dict[str, Any]) -> None:
+    from armcli.io.jsondoc import dumps
+
+    sys.stdout.write(dumps(doc))
+
+
+def _print(
+    r: PlanResult, output: Path | None, what: str, planner: str, seed: int, done: Execution | None
+) -> None:
+    lines = [
+        f"planned {what} ({planner}, seed {seed})",
+        f"  joints: {', '.join(r.joints)}",
+        f"  path: {len(r.path)} waypoints, {r.path_length_rad:.4f} rad; "
+        f"motion {r.duration_s:.3f} s in {len(r.timed.times)} points",
+        f"  planning {r.planning_time_s * 1e3:.1f} ms; certified at 1 kHz "
+        f"({r.certify_time_s * 1e3:.0f} ms): limits and collisions",
+    ]
+    if done is not None:
+        lines.append("  executed in simulation:")
+        for m, tau, lim in zip(done.metrics, done.peak_effort, done.effort_limit, strict=True):
+            lines.append(f"    {m.name}: max error {m.max_error:.4f} rad, "
+                         f"peak effort {tau:.3g} of {lim:g}")  # fmt: skip
+        if done.tip_margin is not None:
+            lines.append(f"    tip-over margin {done.tip_margin * 1e3:.1f} mm")
+        lines += [f"    broken: {p}" for p in done.problems]
+    if output is not None:
+        lines.append(f"wrote {output}")
+    sys.stdout.write("\n".join(lines) + "\n")
+
+
+def register(app: typer.Typer) -> None:
+    """Add the `plan` command to the typer app."""
+    app.command("plan")(plan_cmd)

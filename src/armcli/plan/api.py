@@ -1,0 +1,206 @@
+"""The planning API: `planning_context` once per robot and scene, then `plan_motion`, `solve_goal`.
+
+    ctx = planning_context(robot, scene, disabled)        # collision model, built once
+    x_goal = solve_goal(ctx, xyz=(0.3, 0, 0.5), start=x_start)   # IK (optional)
+    result = plan_motion(ctx, x_start, x_goal, PlanOptions(seed=1))
+    result.document                                       # certified JointTrajectory YAML
+
+`plan_motion` plans a path (geometric), times it (timing), writes it (output), reads the
+written document back as `simulate` does and certifies it (certify); a trajectory with a
+kinematic violation is re-timed with tighter limits (MARGINS), and a PlanningError is
+raised when none passes. Nothing here prints or writes files.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from armcli.errors import InputError, PlanningError
+from armcli.plan.certify import certify
+from armcli.plan.collision import PADDING, CollisionChecker
+from armcli.plan.geometric import plan_path
+from armcli.plan.ik import IkResult, solve_ik
+from armcli.plan.output import read_back, trajectory_yaml
+from armcli.plan.robot import PlanRobot
+from armcli.plan.scene import Scene
+from armcli.plan.timing import Timed, parameterise
+
+MARGINS = (0.78, 0.6, 0.45)  # TOPP-RA limit scales tried until the certification passes
+LIMIT_SLACK = 1e-9  # [rad or m] a start or goal may sit this far beyond a limit (rounding)
+
+
+@dataclass(frozen=True)
+class PlanOptions:
+    """How to plan: OMPL planner name, timeout [s], seed, collision-check step [rad or m]."""
+
+    planner: str = "rrtconnect"
+    timeout: float = 1.0
+    seed: int = 0
+    step: float = 0.02
+    comment: str = ""  # first lines of the written document
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    """A certified motion: the path, its timing, the document to write and the figures."""
+
+    joints: tuple[str, ...]
+    path: np.ndarray  # (W, n) waypoints after shortcutting
+    timed: Timed  # as read back from `document`
+    document: bytes  # JointTrajectory YAML
+    planning_time_s: float  # planning + shortcutting + parameterisation
+    certify_time_s: float
+    margin: float  # the limit scale TOPP-RA used
+
+    @property
+    def duration_s(self) -> float:
+        """Duration of the motion [s]."""
+        return self.timed.duration
+
+    @property
+    def path_length_rad(self) -> float:
+        """Joint-space length of the path (Euclidean, [rad] for revolute joints)."""
+        return float(np.sum(np.linalg.norm(np.diff(self.path, axis=0), axis=1)))
+
+
+@dataclass(frozen=True)
+class PlanningContext:
+    """A robot with its obstacles and collision pairs, ready to plan many motions."""
+
+    robot: PlanRobot
+    checker: CollisionChecker
+
+
+def planning_context(
+    robot: PlanRobot, scene: Scene | None = None, disabled: Iterable[tuple[str, str]] = ()
+) -> PlanningContext:
+    """Build the collision model once; `disabled`: link pairs never checked (the SRDF's)."""
+    return PlanningContext(robot, CollisionChecker(robot, scene or Scene(), disabled))
+
+
+def _check_limits(robot: PlanRobot, x: np.ndarray, what: str) -> None:
+    for name, v, lo, hi in zip(robot.joints, x, robot.lower, robot.upper, strict=True):
+        if not (lo - LIMIT_SLACK <= v <= hi + LIMIT_SLACK):
+            raise PlanningError(
+                f"{what}-limits",
+                f"{what} is outside the joint limits: {name} = {v:g}, limits [{lo:g}, {hi:g}]",
+            )
+
+
+def _check_free(ctx: PlanningContext, x: np.ndarray, what: str) -> None:
+    pair = ctx.checker.first_collision(x, every_pair=True)
+    if pair is not None:
+        raise PlanningError(
+            f"{what}-collision", f"{what} is in collision: {pair[0]} and {pair[1]}", pair=pair
+        )
+
+
+def values(ctx: PlanningContext, x: Sequence[float] | np.ndarray, what: str) -> np.ndarray:
+    """Validated joint values: one finite number per planned joint."""
+    arr = np.asarray(list(x), dtype=float)
+    n = len(ctx.robot.joints)
+    if arr.shape != (n,):
+        raise InputError(f"give {n} value(s), one per joint of {', '.join(ctx.robot.joints)}; "
+                         f"got {arr.size}", field=what)  # fmt: skip
+    if not np.all(np.isfinite(arr)):
+        raise InputError("values must be finite numbers", field=what)
+    return arr
+
+
+def plan_motion(
+    ctx: PlanningContext,
+    start: Sequence[float] | np.ndarray,
+    goal: Sequence[float] | np.ndarray,
+    options: PlanOptions,
+) -> PlanResult:
+    """A certified, time-parameterised collision-free motion from `start` to `goal`.
+
+    Raises PlanningError (start/goal out of limits or in collision, no path within the
+    timeout, no trajectory passing the certification) and InputError for bad values.
+    """
+    robot = ctx.robot
+    xs, xg = values(ctx, start, "start"), values(ctx, goal, "goal")
+    _check_limits(robot, xs, "start")
+    _check_limits(robot, xg, "goal")
+    xs, xg = np.clip(xs, robot.lower, robot.upper), np.clip(xg, robot.lower, robot.upper)
+    _check_free(ctx, xs, "start")
+    _check_free(ctx, xg, "goal")
+    limits = {n: (float(lo), float(hi)) for n, lo, hi in zip(robot.joints, robot.lower,
+                                                            robot.upper, strict=True)}  # fmt: skip
+    frame = str(robot.model.frames[1].name) if robot.model.nframes > 1 else ""
+    ctx.checker.pad(PADDING, (xs, xg))
+    _import_planners()  # their import (~0.5 s) is not planning time
+    t0 = time.perf_counter()
+    path = plan_path(ctx.checker, robot.lower, robot.upper, xs, xg, planner=options.planner,
+                     timeout=options.timeout, seed=options.seed, step=options.step)  # fmt: skip
+    t_plan, t_cert, last = 0.0, 0.0, None
+    for margin in MARGINS:
+        timed = parameterise(robot, path, margin)
+        t_plan = time.perf_counter() - t0
+        doc = trajectory_yaml(robot.joints, timed, frame_id=frame, comment=options.comment)
+        t1 = time.perf_counter()
+        back = read_back(doc, limits)
+        last = certify(robot, ctx.checker, back)
+        t_cert += time.perf_counter() - t1
+        if last is None:
+            return PlanResult(robot.joints, path, back, doc, t_plan, t_cert, margin)
+        if last.kind == "collision":
+            break
+    assert last is not None
+    raise PlanningError("certify", f"the planned trajectory fails its certification: {last.text()}")
+
+
+def _import_planners() -> None:
+    import ompl.geometric
+    import toppra.algorithm
+
+    del ompl, toppra
+
+
+def solve_goal(
+    ctx: PlanningContext,
+    xyz: Sequence[float],
+    rpy: Sequence[float] | None = None,
+    *,
+    start: Sequence[float] | np.ndarray | None = None,
+    seed: int = 0,
+) -> np.ndarray:
+    """Joint values putting the tool point at `xyz` [m] (root frame), collision-free.
+
+    `rpy` [rad]: also the tool link's orientation (fixed-axis roll, pitch, yaw). Without it,
+    an arm of 6 or more joints keeps the start's tool orientation and a smaller arm solves
+    for the position only. PlanningError("ik") says the closest distance reached.
+    """
+    import pinocchio as pin
+
+    robot = ctx.robot
+    target = np.asarray(list(xyz), dtype=float)
+    if target.shape != (3,) or not np.all(np.isfinite(target)):
+        raise InputError("give x,y,z: three finite numbers [m]", field="to-xyz")
+    x0 = values(ctx, start, "start") if start is not None else None
+    rotation = None
+    if rpy is not None:
+        r = np.asarray(list(rpy), dtype=float)
+        if r.shape != (3,) or not np.all(np.isfinite(r)):
+            raise InputError("give r,p,y: three finite numbers [rad]", field="to-rpy")
+        rotation = np.asarray(pin.rpy.rpyToMatrix(*r))
+    elif len(robot.joints) >= 6 and x0 is not None:
+        from armcli.plan.ik import tool_pose
+
+        rotation = tool_pose(robot, robot.model.createData(), x0)[1]
+    res: IkResult = solve_ik(robot, target, rotation, seed_x=x0, seed=seed,
+                             free=lambda x: ctx.checker.first_collision(x, every_pair=True)
+                             is None)  # fmt: skip
+    if res.x is None:
+        what = f"{res.distance:.4g} m" + (
+            f", {math.degrees(res.angle):.3g}°" if rotation is not None else ""
+        )
+        raise PlanningError(
+            "ik", f"no collision-free IK solution for the tool point; closest: {what} away"
+        )
+    return res.x

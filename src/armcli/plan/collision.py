@@ -1,0 +1,169 @@
+"""Collision checking for planning: robot links, scene objects and the ground, through coal.
+
+Self-collision pairs are filtered by the allowed-collision matrix (`disabled`: the pairs
+`ros-package` writes into the SRDF, or a given SRDF's). Pairs whose relative pose no
+planned joint changes (two links on the same rigid body, a scene object and an unmoved
+link) are checked once at the start and goal (`first_collision(..., every_pair=True)`)
+and left out of the planner's per-state check, where only moving pairs can change.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from armcli.plan.robot import PlanRobot
+from armcli.plan.scene import Scene, Shape
+
+GROUND_ID = "ground"  # the name the ground plane has in collision reports
+PADDING = 0.005  # [m] clearance the planner keeps (CollisionChecker.pad)
+
+
+@dataclass(frozen=True)
+class Body:
+    """One collision geometry's owner: a robot link, a scene object or the ground."""
+
+    name: str
+    moves_with: frozenset[str]  # planned joints that move it (empty: static)
+    is_link: bool
+
+
+def _coal_shape(shape: Shape) -> Any:
+    import coal
+
+    d = shape.dimensions
+    if shape.kind == "box":
+        return coal.Box(*d)
+    if shape.kind == "sphere":
+        return coal.Sphere(d[0])
+    if shape.kind == "cylinder":  # SolidPrimitive: [height, radius]
+        return coal.Cylinder(d[1], d[0])
+    if shape.kind == "cone":
+        return coal.Cone(d[1], d[0])
+    assert shape.vertices is not None and shape.triangles is not None
+    bvh = coal.BVHModelOBBRSS()
+    bvh.beginModel(len(shape.triangles), len(shape.vertices))
+    bvh.addSubModel(shape.vertices, shape.triangles)
+    bvh.endModel()
+    return bvh
+
+
+def _moving_joints(robot: PlanRobot) -> dict[int, frozenset[str]]:
+    """Pinocchio joint id -> the planned joints above it (followers count as their leader)."""
+    model = robot.model
+    leader = {m.follower: m.leader for m in robot.mimic}
+    planned = set(robot.joints)
+    out = {}
+    for jid in range(model.njoints):
+        names = {str(model.names[k]) for k in model.supports[jid] if k > 0}
+        names = {leader.get(n, n) for n in names}
+        out[jid] = frozenset(names & planned)
+    return out
+
+
+class CollisionChecker:
+    """The robot's collision model plus obstacles, with the pairs to check."""
+
+    def __init__(self, robot: PlanRobot, scene: Scene, disabled: Iterable[tuple[str, str]]):
+        import pinocchio as pin
+
+        self.pin = pin
+        self.robot = robot
+        self.model = robot.model
+        self.data = robot.model.createData()
+        gmodel = robot.geometry.copy()
+        moving = _moving_joints(robot)
+        frames = self.model.frames
+        self.bodies: list[Body] = [
+            Body(str(frames[g.parentFrame].name), moving[g.parentJoint], True)
+            for g in gmodel.geometryObjects
+        ]
+        for obj in scene.objects:
+            fid = self.model.getFrameId(obj.frame) if obj.frame else 0
+            joint = frames[fid].parentJoint if obj.frame else 0
+            T_joint_frame = frames[fid].placement if obj.frame else pin.SE3.Identity()
+            for k, shape in enumerate(obj.shapes):
+                placement = T_joint_frame * pin.SE3(shape.T_frame_shape)
+                geom = pin.GeometryObject(
+                    f"{obj.id}#{k}", joint, fid, placement, _coal_shape(shape)
+                )
+                gmodel.addGeometryObject(geom)
+                self.bodies.append(Body(obj.id, moving[joint], False))
+        if robot.mobile:
+            import coal
+
+            plane = coal.Halfspace(np.array([0.0, 0.0, 1.0]), 0.0)
+            gmodel.addGeometryObject(pin.GeometryObject(GROUND_ID, 0, 0, pin.SE3.Identity(), plane))
+            self.bodies.append(Body(GROUND_ID, frozenset(), False))
+        self.pairs = self._pairs(gmodel, {_key(a, b) for a, b in disabled})
+        self.gmodel = gmodel
+        self.gdata_all = pin.GeometryData(gmodel)
+        self.gdata = pin.GeometryData(gmodel)
+        for k, (i, j) in enumerate(self.pairs):
+            if self.bodies[i].moves_with == self.bodies[j].moves_with:
+                self.gdata.deactivateCollisionPair(k)  # their relative pose never changes
+
+    def _pairs(self, gmodel: Any, disabled: set[tuple[str, str]]) -> list[tuple[int, int]]:
+        pairs = []
+        robot_root = {b.name for b in self.bodies if b.is_link and not b.moves_with}
+        for i, a in enumerate(self.bodies):
+            for j in range(i + 1, len(self.bodies)):
+                b = self.bodies[j]
+                if a.name == b.name or (not a.is_link and not b.is_link):
+                    continue
+                if a.is_link and b.is_link and _key(a.name, b.name) in disabled:
+                    continue
+                ground = GROUND_ID in (a.name, b.name)
+                if ground and (a.name in robot_root or b.name in robot_root):
+                    continue  # the base stands on the ground by construction
+                gmodel.addCollisionPair(self.pin.CollisionPair(i, j))
+                pairs.append((i, j))
+        return pairs
+
+    def pad(self, padding: float, ends: Iterable[np.ndarray]) -> None:
+        """Plan `padding` [m] clear of everything, except pairs closer than that at `ends`.
+
+        The planner's check only: a path then keeps a clearance that the trajectory's small
+        deviations between its points (timing) cannot eat; certification checks with none.
+        """
+        for req in self.gdata.collisionRequests:
+            req.security_margin = padding
+        for x in ends:
+            q = self.robot.q(x)
+            self.pin.computeCollisions(self.model, self.data, self.gmodel, self.gdata, q, False)
+            for req, res in zip(self.gdata.collisionRequests, self.gdata.collisionResults,
+                                strict=True):  # fmt: skip
+                if res.isCollision():
+                    req.security_margin = 0.0
+
+    def first_collision(self, x: np.ndarray, *, every_pair: bool = False) -> tuple[str, str] | None:
+        """The first colliding pair at planned joint values `x` (names), or None."""
+        gdata = self.gdata_all if every_pair else self.gdata
+        q = self.robot.q(x)
+        if not self.pin.computeCollisions(self.model, self.data, self.gmodel, gdata, q, True):
+            return None
+        for k, res in enumerate(gdata.collisionResults):
+            if res.isCollision():
+                i, j = self.pairs[k]
+                return self.bodies[i].name, self.bodies[j].name
+        return None  # pragma: no cover - computeCollisions said there was one
+
+    def free(self, x: np.ndarray) -> bool:
+        """Whether `x` is collision-free (moving pairs only: the planner's check)."""
+        q = self.robot.q(x)
+        return not self.pin.computeCollisions(
+            self.model, self.data, self.gmodel, self.gdata, q, True
+        )
+
+    def motion_free(self, xa: np.ndarray, xb: np.ndarray, step: float) -> bool:
+        """Whether the straight joint-space segment is free, checked every `step` [rad or m]."""
+        n = max(1, math.ceil(float(np.max(np.abs(xb - xa))) / step))
+        return all(self.free(xa + (xb - xa) * (k / n)) for k in range(1, n + 1))
+
+
+def _key(a: str, b: str) -> tuple[str, str]:
+    return (a, b) if a <= b else (b, a)

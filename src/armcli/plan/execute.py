@@ -1,0 +1,79 @@
+"""Execute a plan: run it through `simulate`'s library and judge the executed motion.
+
+The certified document is simulated as `armcli simulate --trajectory` would run it (same
+job preparation: the spec's standalone arm or the given URDF, the spec's gains, its PD
+loop), every step kept. The executed motion is broken when a motor torque reaches its
+effort limit, a joint moves faster than its velocity limit, or (a robot on a mobile base)
+the zero-moment point leaves the support polygon.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from armcli.sim import job as simjob
+from armcli.sim import report as simreport
+from armcli.sim import tipping
+from armcli.sim.options import SimOptions
+from armcli.urdf.meshes import MeshSearch
+
+if TYPE_CHECKING:
+    from armcli.spec.model import RobotSpec
+
+VELOCITY_TOL = 1e-9  # relative slack on the velocity limit
+
+
+@dataclass(frozen=True)
+class Execution:
+    """What executing the plan in simulation showed."""
+
+    metrics: tuple[simreport.JointMetrics, ...]
+    peak_effort: np.ndarray  # [N·m or N] per simulated joint
+    effort_limit: np.ndarray
+    peak_velocity: np.ndarray  # [rad/s or m/s]
+    velocity_limit: np.ndarray
+    joints: tuple[str, ...]
+    tip_margin: float | None  # [m] least zero-moment-point margin; None: fixed base
+    problems: tuple[str, ...]  # why the executed motion is broken (empty: it is not)
+
+    @property
+    def broken(self) -> bool:
+        """Whether a limit was broken or the robot tipped."""
+        return bool(self.problems)
+
+
+def execute(
+    spec: RobotSpec | None, opts: SimOptions, search: MeshSearch | None = None
+) -> Execution:
+    """Simulate `opts.message` (the plan's document) and judge it; see the module docstring."""
+    job = simjob.prepare(spec, opts)
+    notes: list[str] = []
+    tip = tipping.prepare(spec, job, tipping.TipOptions(), search or MeshSearch(), notes)
+
+    def keep(steps: int) -> np.ndarray:
+        every = np.arange(steps + 1)
+        return every if tip is None else np.union1d(every, tip.steps(job, steps))
+
+    res = simjob.run(job, extra=keep)
+    metrics = tuple(simreport.joint_metrics(res, job.trajectory.duration))
+    arm = job.arm
+    peak_tau = np.max(np.abs(res.tau), axis=0)
+    peak_v = np.max(np.abs(res.v), axis=0)
+    vlim = np.where(arm.velocity > 0, arm.velocity, np.inf)
+    problems = []
+    for i, name in enumerate(arm.joint_names):
+        if res.stats.saturated_steps[i] > 0:
+            problems.append(f"{name} reaches its effort limit {arm.effort[i]:g}")
+        if peak_v[i] > vlim[i] * (1 + VELOCITY_TOL):
+            problems.append(f"{name} moves at {peak_v[i]:.4g}, beyond its limit {vlim[i]:g}")
+    margin = None
+    if tip is not None:
+        rep = tipping.report(tip, tip.series(job, res))
+        margin = rep.min_margin
+        if rep.tips:
+            problems.append(tipping.tip_error(rep).args[0])
+    return Execution(metrics, peak_tau, arm.effort, peak_v, vlim, arm.joint_names, margin,
+                     tuple(problems))  # fmt: skip

@@ -1,0 +1,152 @@
+"""A collision-free joint-space path: OMPL (RRT-Connect by default), then shortcutting.
+
+A straight segment that is free is taken as it is (no sampling needed). Otherwise OMPL
+plans in the box of the planned joints' limits with the checker as its state validity
+callback, its motion checks at `step` [rad or m]. OMPL's random numbers are seeded, so a
+seed gives the same path whenever the planner finishes before the timeout. Shortcutting is
+armcli's own, seeded with numpy: first the greedy pass (from each waypoint, the farthest one
+reachable in a straight line), then random shortcuts between points on the path.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from armcli.defaults import PLANNERS
+from armcli.errors import InputError, PlanningError
+from armcli.plan.collision import CollisionChecker
+
+SHORTCUT_TRIES = 100  # random shortcut attempts after the greedy pass
+_OMPL_NAMES = {
+    "rrtconnect": "RRTConnect",
+    "rrt": "RRT",
+    "rrtstar": "RRTstar",
+    "informedrrtstar": "InformedRRTstar",
+    "aorrtc": "AORRTC",
+}
+
+
+def _ompl_path(
+    checker: CollisionChecker,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    start: np.ndarray,
+    goal: np.ndarray,
+    *,
+    planner: str,
+    timeout: float,
+    seed: int,
+    step: float,
+) -> np.ndarray | None:
+    """OMPL's path (W, n), or None when it found none within `timeout` [s]."""
+    import ompl.base as ob
+    import ompl.geometric as og
+    import ompl.util as ou
+
+    ou.setLogLevel(ou.LogLevel.LOG_NONE)
+    ou.RNG.setSeed(seed)
+    n = len(start)
+    space = ob.RealVectorStateSpace(n)
+    bounds = ob.RealVectorBounds(n)
+    for i in range(n):
+        bounds.setLow(i, float(lower[i]))
+        bounds.setHigh(i, float(upper[i]) if upper[i] > lower[i] else float(lower[i]) + 1e-9)
+    space.setBounds(bounds)
+    setup = og.SimpleSetup(space)
+    free = checker.free
+    setup.setStateValidityChecker(lambda s: free(np.fromiter((s[i] for i in range(n)), float, n)))
+    info = setup.getSpaceInformation()
+    info.setStateValidityCheckingResolution(min(1.0, step / max(space.getMaximumExtent(), 1e-9)))
+    a, b = space.allocState(), space.allocState()
+    for i in range(n):
+        a[i], b[i] = float(start[i]), float(goal[i])
+    setup.setStartAndGoalStates(a, b)
+    setup.setPlanner(getattr(og, _OMPL_NAMES[planner])(info))
+    status = setup.solve(timeout)
+    path = None
+    if setup.haveExactSolutionPath() and str(status) == "Exact solution":
+        p = setup.getSolutionPath()
+        path = np.array([[p.getState(k)[i] for i in range(n)] for k in range(p.getStateCount())])
+    setup.clear()
+    return path
+
+
+def _greedy(path: np.ndarray, ok: Callable[[np.ndarray, np.ndarray], bool]) -> np.ndarray:
+    """Keep only the waypoints needed: from each kept one, jump to the farthest reachable."""
+    out, i = [path[0]], 0
+    while i < len(path) - 1:
+        j = len(path) - 1
+        while j > i + 1 and not ok(path[i], path[j]):
+            j -= 1
+        out.append(path[j])
+        i = j
+    return np.array(out)
+
+
+def _point_at(path: np.ndarray, cum: np.ndarray, d: float) -> tuple[int, np.ndarray]:
+    """(segment index, point) at arc length `d` along the polyline."""
+    k = int(np.clip(np.searchsorted(cum, d, side="right") - 1, 0, len(path) - 2))
+    seg = cum[k + 1] - cum[k]
+    u = 0.0 if seg <= 0 else (d - cum[k]) / seg
+    return k, path[k] + (path[k + 1] - path[k]) * u
+
+
+def shortcut(
+    path: np.ndarray, ok: Callable[[np.ndarray, np.ndarray], bool], seed: int
+) -> np.ndarray:
+    """A shorter path with the same ends: greedy pass, then seeded random shortcuts."""
+    path = _greedy(path, ok)
+    rng = np.random.default_rng(seed)
+    for _ in range(SHORTCUT_TRIES):
+        if len(path) < 3:
+            break
+        cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
+        d1, d2 = np.sort(rng.uniform(0.0, cum[-1], 2))
+        k1, p1 = _point_at(path, cum, d1)
+        k2, p2 = _point_at(path, cum, d2)
+        if k1 == k2 or not ok(p1, p2):
+            continue
+        path = np.vstack([path[: k1 + 1], p1, p2, path[k2 + 1 :]])
+        path = _drop_repeats(path)
+    return _greedy(path, ok)
+
+
+def _drop_repeats(path: np.ndarray) -> np.ndarray:
+    keep = [0] + [k for k in range(1, len(path)) if np.any(path[k] != path[k - 1])]
+    return path[keep]
+
+
+def plan_path(
+    checker: CollisionChecker,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    start: np.ndarray,
+    goal: np.ndarray,
+    *,
+    planner: str = "rrtconnect",
+    timeout: float = 1.0,
+    seed: int = 0,
+    step: float = 0.02,
+) -> np.ndarray:
+    """A collision-free polyline (W, n) from start to goal; PlanningError when none is found."""
+    if planner not in PLANNERS:
+        raise InputError(f"unknown planner {planner!r}; valid: {', '.join(PLANNERS)}",
+                         field="planner")  # fmt: skip
+    if not (math.isfinite(timeout) and timeout > 0):
+        raise InputError(f"must be > 0 s, got {timeout:g}", field="timeout")
+
+    def ok(a: np.ndarray, b: np.ndarray) -> bool:
+        return checker.motion_free(a, b, step)
+
+    if ok(start, goal):
+        return np.array([start, goal])
+    raw: Any = _ompl_path(checker, lower, upper, start, goal, planner=planner,
+                          timeout=timeout, seed=seed, step=step)  # fmt: skip
+    if raw is None:
+        raise PlanningError("no-path", f"no collision-free path found within {timeout:g} s")
+    raw[0], raw[-1] = start, goal
+    return shortcut(raw, ok, seed)

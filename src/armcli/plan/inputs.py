@@ -1,0 +1,85 @@
+"""What a user names (files, pose names, `q1,q2` values) -> a planning context, joint values.
+
+`load_context` is what `armcli plan` and the viewer's planning panel call: the robot,
+its SRDF (or ros-package's collision matrix), the scene, collision model built once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from armcli.errors import InputError
+from armcli.plan.api import PlanningContext, planning_context, values
+from armcli.plan.robot import load_plan_robot
+from armcli.plan.scene import Scene, load_scene
+from armcli.plan.srdf import allowed_pairs, read_srdf
+from armcli.urdf.meshes import MeshSearch
+from armcli.urdf.source import RobotFile
+
+
+@dataclass(frozen=True)
+class Loaded:
+    """A planning context and where it came from."""
+
+    context: PlanningContext
+    robot_file: RobotFile
+    scene: Scene
+
+
+def load_context(
+    robot_file: RobotFile,
+    *,
+    srdf: Path | None = None,
+    scene: Path | None = None,
+    joints: Sequence[str] | None = None,
+    search: MeshSearch | None = None,
+) -> Loaded:
+    """The planning context of a robot file, an optional SRDF and an optional scene file."""
+    parsed = read_srdf(srdf) if srdf is not None else None
+    robot = load_plan_robot(
+        robot_file,
+        joints=joints,
+        search=search,
+        group_states=parsed.group_states if parsed is not None else None,
+    )
+    links = [lk.name for lk in robot.urdf.links]
+    obstacles = load_scene(scene, links) if scene is not None else Scene()
+    ctx = planning_context(robot, obstacles, allowed_pairs(robot_file, parsed))
+    return Loaded(ctx, robot_file, obstacles)
+
+
+def configuration(ctx: PlanningContext, text: str, field: str) -> np.ndarray:
+    """A named pose or comma-separated joint values [rad or m] in the planned joints' order."""
+    text = text.strip()
+    robot = ctx.robot
+    if text in robot.poses:
+        return robot.pose(text)
+    parts = [p.strip() for p in text.split(",")]
+    try:
+        numbers = [float(p) for p in parts]
+    except ValueError:
+        valid = ", ".join(sorted(robot.poses)) or "none"
+        raise InputError(
+            f"unknown pose {text!r}; valid poses: {valid}, or {len(robot.joints)} "
+            f"comma-separated values for {', '.join(robot.joints)}",
+            field=field,
+        ) from None
+    return values(ctx, numbers, field)
+
+
+def numbers(text: str | None, count: int, field: str) -> list[float] | None:
+    """`x,y,z`-style option values: exactly `count` finite numbers."""
+    if text is None:
+        return None
+    try:
+        out = [float(p) for p in text.split(",")]
+    except ValueError:
+        raise InputError(f"expected {count} comma-separated numbers, got {text!r}",
+                         field=field) from None  # fmt: skip
+    if len(out) != count or not all(np.isfinite(out)):
+        raise InputError(f"expected {count} finite numbers, got {text!r}", field=field)
+    return out
