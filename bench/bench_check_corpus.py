@@ -1,6 +1,6 @@
 """Benchmark: `armcli check` CPU per real robot description, beside urdf_validate.
 
-    python bench/bench_check_corpus.py [--files LIST] [--limit N] [--per-file]
+    python bench/bench_check_corpus.py [--files LIST] [--limit N] [--per-file] [--src DIR]
 
 The corpus: every URDF example-robot-data installs (the dev extra; 69 public robots from
 a double pendulum to Talos), plus the files named in LIST (one path per line, then any
@@ -10,8 +10,9 @@ check FILE --format json`), and the peer, urdf-validator's `urdf_validate FILE` 
 urdf-validator, the physics-aware validator in the same space: inertia, statics,
 stability, workspace), on the same file in the same run. CPU is user + system time of
 the child process (RUSAGE_CHILDREN), so other jobs on the machine change it less than
-wall time. Prints the per-file median, the 90th percentile, the largest, and the ratio
-of the medians. Not a test: the numbers depend on the machine and its load (printed).
+wall time. `--src` times another checkout's armcli (a "before" run). Prints the per-file
+median, the 90th percentile, the largest, and the ratio of the medians. Not a test: the
+numbers depend on the machine and its load (printed).
 """
 
 from __future__ import annotations
@@ -66,11 +67,12 @@ def main() -> int:
     ap.add_argument("--files", type=Path, help="more descriptions: one path (+ args) a line")
     ap.add_argument("--limit", type=int, default=0, help="only the first N files")
     ap.add_argument("--per-file", action="store_true", help="print every file's numbers")
+    ap.add_argument("--src", type=Path, default=ROOT / "src", help="armcli source to time")
     opts = ap.parse_args()
     entries = corpus(opts.files)[: opts.limit or None]
     peer = shutil.which("urdf_validate") or str(Path(sys.executable).parent / "urdf_validate")
     have_peer = Path(peer).is_file()
-    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    env = {**os.environ, "PYTHONPATH": str(opts.src)}
     print(f"load average {os.getloadavg()[0]:.1f}; {len(entries)} files")
     ours: list[float] = []
     theirs: list[float] = []
