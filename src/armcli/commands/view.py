@@ -21,7 +21,7 @@ from armcli.commands.xacro_inputs import (
 from armcli.errors import InputError
 from armcli.io.oneline import one_line
 from armcli.spec.discover import find_spec
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 
 @flag_errors({"pose": "--pose", "q": "--q", "port": "--port", "replay": "--replay"})

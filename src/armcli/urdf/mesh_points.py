@@ -4,7 +4,7 @@
 ground), and importing trimesh (with scipy.spatial) cost about 2 s of the ~3 s `check`
 took on a robot with STL meshes. Binary and ASCII STL and OBJ are read here with numpy;
 other formats (COLLADA, ...) through trimesh. The file is the bounded real path
-`urdf.mesh_confine` gives.
+`io.mesh_confine` gives.
 """
 
 from __future__ import annotations
@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from armcli.io.mesh_confine import MAX_MESH_BYTES, bounded_mesh_file
 from armcli.io.userfile import read_regular
-from armcli.urdf.mesh_confine import MAX_MESH_BYTES, bounded_mesh_file
 from armcli.urdf.meshlog import quiet_trimesh
 
 _FLOAT = rb"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
