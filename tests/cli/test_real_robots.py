@@ -33,6 +33,13 @@ def test_a_link_and_a_joint_sharing_a_name_simulate_and_check(
     assert code == 0, err
     assert "internal error" not in err
     assert "reach of knee" in out
+    # `plan` looks the tool up too (its default tool point is the link `knee`).
+    code, out, err = run_main(
+        ["plan", "--urdf", SHARED, "--from", "0,0", "--to", "0.5,0.5", "--joints", "hip,knee"],
+        capsys,
+    )
+    assert code == 0, err
+    assert "certified" in out
 
 
 def test_stray_text_after_a_kept_element_imports(
