@@ -23,7 +23,12 @@ SIBLING_EXCEPTIONS = {
     ("check", "armcli.sim.verdict"),
     ("check", "armcli.sim.tipping"),
     ("view", "armcli.sim.states"),
+    ("sim", "armcli.export.mjcf"),
 }
+# The compiler expands its own xacro set with the safe evaluator foreign files get (issue 27:
+# never xacro's Python eval). That evaluator still lives in urdf/ until the xacro/ package
+# (issue 28) sits below the compiler; this one upward edge is the documented exception.
+UPWARD_EXCEPTIONS = {("compiler", "armcli.urdf.xacro_safe")}
 
 
 def _module_name(path: Path) -> str:
@@ -72,7 +77,7 @@ def test_imports_only_go_down() -> None:
             there = _layer(target)
             if target == "armcli" or here == there:
                 continue
-            if RANK[there] > RANK[here]:
+            if RANK[there] > RANK[here] and (here, target) not in UPWARD_EXCEPTIONS:
                 bad.append(f"{module} -> {target} (upward)")
             elif RANK[there] == RANK[here] and (here, target) not in SIBLING_EXCEPTIONS:
                 bad.append(f"{module} -> {target} (sibling)")

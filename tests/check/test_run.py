@@ -188,6 +188,14 @@ def gz_position_servo(gain: float) -> Callable[[Any], None]:
     return edit
 
 
+def both(*edits: Callable[[Any], None]) -> Callable[[Any], None]:
+    def edit(r: Any) -> None:
+        for e in edits:
+            e(r)
+
+    return edit
+
+
 CASES: dict[str, tuple[Callable[[Any], None], RobotSpec | CheckOptions | None, set[str]]] = {
     "duplicate-name": (append('<link name="hand_link"/>'), None, {"duplicate-name"}),
     "unknown-link": (set_attr(J2, "parent", "link", "no_such_link"), None, {"unknown-link"}),
@@ -257,6 +265,12 @@ CASES: dict[str, tuple[Callable[[Any], None], RobotSpec | CheckOptions | None, s
     # 1.5x the solid cylinder: a hollow hand could have it (the bound is 2x on the axis).
     "inertia-geometry": (scale_hand_inertia(1.5), None, {"inertia-geometry"}),
     "inertia-exceeds-geometry": (scale_hand_inertia(4.0), None, {"inertia-exceeds-geometry"}),
+    # The same 4x on a hand drawn only by its visual (no collision): weaker evidence, a warning
+    "inertia-exceeds-visual": (
+        both(scale_hand_inertia(4.0), remove(HAND, "collision")),
+        None,
+        {"inertia-exceeds-visual", "visual-no-collision"},
+    ),
     "com-geometry": (set_attr(HAND, "inertial/origin", "xyz", "0 0 0.2"), None, {"com-geometry"}),
     "limit-order": (set_attr(J2, "limit", "upper", "0"), None, {"limit-order"}),
     "limit-effort-velocity": (
@@ -457,5 +471,8 @@ def test_inertia_exceeds_geometry_names_the_shape_it_measured(drop: str | None, 
         if drop:
             HAND(r).remove(HAND(r).find(drop))
 
-    (f,) = [f for f in run(edit, None).findings if f.rule == "inertia-exceeds-geometry"]
+    rule = "inertia-exceeds-visual" if drop == "collision" else "inertia-exceeds-geometry"
+    (f,) = [f for f in run(edit, None).findings if f.rule == rule]
     assert f"inside that {role} shape can have" in f.message
+    # A visual-only shape may be only a picture (Go1's rotors): a warning, not an error.
+    assert f.severity == ("warning" if drop == "collision" else "error")

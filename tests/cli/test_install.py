@@ -23,7 +23,7 @@ import pytest
 import yaml
 from lxml import etree
 
-from tests.install_helpers import ROOT, build_wheel, fresh_venv, wheelhouse
+from tests.install_helpers import ROOT, fresh_venv
 
 pytestmark = pytest.mark.slow
 
@@ -58,11 +58,12 @@ class Installed:
 
 
 @pytest.fixture(scope="module")
-def installed(tmp_path_factory: pytest.TempPathFactory) -> Installed:
+def installed(
+    tmp_path_factory: pytest.TempPathFactory, armcli_wheel: tuple[Path, Path]
+) -> Installed:
     base = tmp_path_factory.mktemp("install")
     assert not base.resolve().is_relative_to(ROOT)  # really outside the checkout
-    house = wheelhouse()
-    wheel = build_wheel(base, house)
+    wheel, house = armcli_wheel
     bin_dir = fresh_venv(base / "venv", wheel, house)
     env = {
         "PATH": f"{bin_dir}{os.pathsep}/usr/bin{os.pathsep}/bin",  # the venv, not .venv

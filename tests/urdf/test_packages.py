@@ -99,6 +99,19 @@ def test_file_uri_in_symlink_install_is_allowed(prefix: Path, tmp_path: Path) ->
     assert not confined(uri, mesh, urdf_dir, no_env())
 
 
+def test_a_four_slash_file_uri_is_the_same_file(prefix: Path, tmp_path: Path) -> None:
+    """COBOTTA writes `file:////abs/path`: the same file as `file:///abs/path` (RFC 8089's
+    empty authority plus an absolute path), found in its package, not reported missing."""
+    lookup = no_env(ament_prefixes=(prefix,))
+    urdf_dir = tmp_path / "elsewhere"
+    urdf_dir.mkdir()
+    mesh = prefix / "share" / ARM_PACKAGE / "meshes" / "upper.stl"
+    uri = f"file:///{mesh}"
+    assert uri.startswith("file:////")
+    assert resolve(uri, urdf_dir, lookup) == mesh == resolve(f"file://{mesh}", urdf_dir, lookup)
+    assert confined(uri, mesh, urdf_dir, lookup)
+
+
 def test_confinement_not_widened(prefix: Path, tmp_path: Path) -> None:
     lookup = no_env(ament_prefixes=(prefix,))
     urdf_dir = tmp_path / "robot"
@@ -145,3 +158,47 @@ def test_json_round_trip_fixes_the_environment(
     assert copy.prefixes() == (prefix,) and copy.crawl_paths() == (ROS_WS_SRC,)
     assert copy.package_dirs == {"x": Path("/x")}
     assert copy.known()[GRIPPER_PACKAGE] == prefix / "share" / GRIPPER_PACKAGE
+
+
+def _root_package(tmp_path: Path) -> Path:
+    """An install prefix registering package `evil` whose share dir is a symlink to `/`."""
+    prefix = tmp_path / "evil_prefix"
+    index = prefix / "share" / "ament_index" / "resource_index" / "packages"
+    index.mkdir(parents=True)
+    (index / "evil").write_text("")
+    (prefix / "share" / "evil").symlink_to("/")
+    return prefix
+
+
+def test_a_package_root_is_never_slash_or_a_system_dir(tmp_path: Path) -> None:
+    """Issue 27: share/evil -> / made every host file "inside the package"."""
+    prefix = _root_package(tmp_path)
+    lookup = no_env(ament_prefixes=(prefix,))
+    root = lookup.find("evil")
+    assert root is not None
+    assert real_roots(root) == ()
+    uri = "package://evil/etc/passwd"
+    path = resolve(uri, tmp_path, lookup)
+    assert path is not None and not confined(uri, path, tmp_path, lookup)
+
+
+def test_safe_xacro_reads_nothing_through_a_slash_package(tmp_path: Path) -> None:
+    from armcli.errors import XacroRefusedError
+    from armcli.urdf.xacro_args import XacroInputs
+    from armcli.urdf.xacro_safe import expand_safe
+
+    prefix = _root_package(tmp_path)
+    secret = tmp_path / "host" / "secret.yaml"
+    secret.parent.mkdir()
+    secret.write_text("token: s3cret\n")
+    robot = tmp_path / "robot"
+    robot.mkdir()
+    top = robot / "r.urdf.xacro"
+    top.write_text(
+        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        f'<xacro:property name="y" value="${{xacro.load_yaml(\'$(find evil){secret}\')}}"/>'
+        "<link name=\"${y['token']}\"/></robot>"
+    )
+    inputs = XacroInputs(packages=no_env(ament_prefixes=(prefix,)))
+    with pytest.raises(XacroRefusedError, match="outside the allowed directories"):
+        expand_safe(top, [robot], inputs=inputs)

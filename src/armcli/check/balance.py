@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from armcli.urdf.boxsearch import minimize_box
+from armcli.urdf.pinocchio import link_frame
 from armcli.urdf.stance import Stance
 
 SEEDS_DESCENDED = 3  # local searches per edge and measure, from the best seeds
@@ -76,6 +77,7 @@ class StaticBalance:
     worst: tuple[PoseBalance, ...]  # per edge: the configuration closest to tipping over it
     worst_tip_angles: tuple[float, ...]  # [rad] per edge: smallest tipping angle over the range
     payload_max: float | None  # [kg] the most that holds at every named pose and over the range
+    contact_tol: float | None = None  # [m] how the contacts were found; None: user-named
 
     @property
     def worst_overall(self) -> PoseBalance:
@@ -97,7 +99,7 @@ class _Mass:
         self.iq = [(jr.idx_q, jr.continuous) for jr in stance.joints]
         self.iv = [jr.idx_v for jr in stance.joints]
         p = stance.payload
-        self.frame = self.model.getFrameId(p.link) if p is not None else None
+        self.frame = link_frame(self.model, p.link) if p is not None else None
         self.xyz = np.asarray(p.xyz if p is not None else (0.0, 0.0, 0.0), dtype=float)
 
     def q(self, x: ArrayLike) -> NDArray[np.float64]:
@@ -176,6 +178,7 @@ def analyse(
         worst=worst,
         worst_tip_angles=tips,
         payload_max=min(known) if len(known) == len(best) else None,
+        contact_tol=None if stance.ground.declared else stance.ground.tol,
     )
 
 

@@ -53,7 +53,12 @@ def _cell(margin: float, angle: float) -> str:
 
 def _title(b: StaticBalance) -> str:
     load = f", {b.payload}" if b.payload else ""
-    return f"static balance on {', '.join(b.contacts)}{load}"
+    taken = (
+        " (the links you named)"
+        if b.contact_tol is None
+        else f" (the links within {b.contact_tol * 1e3:.1f} mm of the lowest point at q = 0)"
+    )
+    return f"static balance on {', '.join(b.contacts)}{taken}{load}"
 
 
 def _caption(b: StaticBalance) -> str:

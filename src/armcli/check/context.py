@@ -3,9 +3,11 @@
 `run.py` builds one `Context` per URDF and hands it to each family of its registry. A
 family declares the stage it needs: `URDF` (the parsed document and its tree), `MODEL`
 (the Pinocchio model, loaded once and only while no error of a rule that `blocks` the
-model stands) or `DYNAMICS` (also no error of a rule that blocks the dynamics, such as a
-negative mass). Families write findings to `out`, notes to `notes`, and what later ones
-or the summary read (the gravity load in `rows`, the servo joints, the PD verdict) here.
+model stands), `BALANCE` (also valid masses, centres of mass and joint ranges: no negative
+mass, zero axis or limits out of order) or `DYNAMICS` (also no error of a rule that blocks
+the dynamics, such as an inertia tensor that is not positive definite). Families write
+findings to `out`, notes to `notes`, and what later ones or the summary read (the gravity
+load in `rows`, the servo joints, the PD verdict) here.
 """
 
 from __future__ import annotations
@@ -27,16 +29,18 @@ if TYPE_CHECKING:  # the balance and reach results: imported by their own famili
     from armcli.urdf.stance import Stance
     from armcli.urdf.workspace import ReachPoint, Workspace
 
-Stage = Literal["urdf", "model", "dynamics"]
+Stage = Literal["urdf", "model", "balance", "dynamics"]
 URDF: Stage = "urdf"
 MODEL: Stage = "model"
+BALANCE: Stage = "balance"
 DYNAMICS: Stage = "dynamics"
 
 # Errors after which the model is not loaded (urdfdom would only repeat them: a NaN mass
 # came back as two parser errors, a nameless <robot> as model-load), and after which the
 # dynamics rules would compute with unusable numbers. Declared per rule in rules.py.
 BLOCKS_MODEL = frozenset(r.id for r in RULES.values() if r.blocks == MODEL)
-BLOCKS_DYNAMICS = BLOCKS_MODEL | {r.id for r in RULES.values() if r.blocks == DYNAMICS}
+BLOCKS_BALANCE = BLOCKS_MODEL | {r.id for r in RULES.values() if r.blocks == BALANCE}
+BLOCKS_DYNAMICS = BLOCKS_BALANCE | {r.id for r in RULES.values() if r.blocks == DYNAMICS}
 MODEL_SKIPPED = "model checks skipped: fix the structure errors first"
 DYNAMICS_SKIPPED = "dynamics checks skipped: fix the number and inertia errors first"
 

@@ -9,6 +9,7 @@ REACH_TOL is an error naming how close it gets and where.
 from __future__ import annotations
 
 from armcli.check.context import Context
+from armcli.urdf.pinocchio import link_frame
 from armcli.urdf.tool import tool_point
 from armcli.urdf.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 
@@ -16,7 +17,7 @@ from armcli.urdf.workspace import REACH_TOL, Chain, envelope, reach_point, sampl
 def check(c: Context) -> None:
     """The workspace of the tool point, and the findings for unreachable points."""
     tool = tool_point(c.urdf, c.opts.spec)
-    if tool is None or not c.model.existFrame(tool.link):
+    if tool is None or link_frame(c.model, tool.link) is None:
         return
     if c.stance is not None and tool.link in c.stance.ground.links:
         c.notes.append(f"workspace skipped: the tool point {tool.label} touches the ground "

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from armcli.urdf.meshes import MeshSearch
+from armcli.urdf.source import lookup_for
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -21,6 +22,7 @@ if TYPE_CHECKING:
 ERROR = "error"
 WARNING = "warning"
 _MODEL = "model"  # see Rule.blocks
+_BALANCE = "balance"
 _DYNAMICS = "dynamics"
 
 Value = float | int | str | list[float] | None
@@ -31,7 +33,9 @@ class Rule:
     """One check rule: stable id (for --ignore and JSON), severity, title and fix hint.
 
     `blocks`: while an error of this rule stands, the rule families that need the Pinocchio
-    model ("model") or usable dynamics numbers ("dynamics") are skipped (check/context.py).
+    model ("model"), valid masses, centres of mass and joint ranges ("balance": the static
+    balance) or usable dynamics numbers ("dynamics") are skipped (check/context.py). An
+    inertia tensor error blocks only the dynamics: it moves no centre of mass.
     """
 
     id: str
@@ -154,7 +158,7 @@ _RULES = [
         ERROR,
         "negative mass, or a moving body without mass",
         "give the link its real mass",
-        blocks=_DYNAMICS,
+        blocks=_BALANCE,
     ),
     Rule(
         "inertia-not-pd",
@@ -195,6 +199,14 @@ _RULES = [
         "write the inertia of the shape and mass (the value in the message)",
     ),
     Rule(
+        "inertia-exceeds-visual",
+        WARNING,
+        "a moment of inertia above what any mass inside the link's one visual-only primitive "
+        "can have",
+        "a visual without a collision may be only illustrative (Go1's rotors); if it is the "
+        "body, write the inertia of the shape and mass (the value in the message)",
+    ),
+    Rule(
         "inertia-geometry",
         WARNING,
         "inertia differs from the solid-body formula of the geometry",
@@ -212,7 +224,7 @@ _RULES = [
         ERROR,
         "lower limit not below upper limit",
         "swap or fix the limits",
-        blocks=_DYNAMICS,
+        blocks=_BALANCE,
     ),
     Rule(
         "limit-effort-velocity",
@@ -220,7 +232,7 @@ _RULES = [
         "effort or velocity limit <= 0",
         "give the actuator's real effort and velocity limits",
     ),
-    Rule("axis", ERROR, "joint axis zero", "give a unit axis such as 0 0 1", blocks=_DYNAMICS),
+    Rule("axis", ERROR, "joint axis zero", "give a unit axis such as 0 0 1", blocks=_BALANCE),
     Rule("axis-unit", WARNING, "joint axis not unit length", "normalise the axis"),
     Rule(
         "limit-degrees",
@@ -444,7 +456,7 @@ class CheckOptions:
 
     def mesh_search(self) -> MeshSearch:
         """The mesh-resolver view of these options (shared with view and render)."""
-        return MeshSearch(self.package_dirs, self.search_paths)
+        return lookup_for(self.spec, MeshSearch(self.package_dirs, self.search_paths))
 
 
 def apply_policy(

@@ -25,6 +25,8 @@ from armcli.check import (
 from armcli.check import dynamics as dyn
 from armcli.check import zmp as zmp_rules
 from armcli.check.context import (
+    BALANCE,
+    BLOCKS_BALANCE,
     BLOCKS_DYNAMICS,
     BLOCKS_MODEL,
     DYNAMICS,
@@ -79,13 +81,13 @@ def _self_collision(c: Context) -> None:
 FAMILIES: tuple[Family, ...] = (
     Family("inertia", URDF, lambda c: inertia.check(c.urdf, c.tree, c.out)),
     Family("bodies", URDF, lambda c: bodies.check(c.urdf, c.tree, c.out)),
-    Family("joints", URDF, lambda c: joints.check(c.urdf, c.opts.spec, c.out)),
+    Family("joints", URDF, lambda c: joints.check(c.urdf, c.opts.spec, c.out, c.notes)),
     Family("meshes", URDF, lambda c: meshes.check(c.urdf, c.opts, c.out)),
     Family("gravity", DYNAMICS, _gravity),
     Family("servo", DYNAMICS, _servo),
     Family("stability", DYNAMICS, _stability),
     Family("self-collision", MODEL, _self_collision),
-    Family("tipover", DYNAMICS, tipover.check),
+    Family("tipover", BALANCE, tipover.check),
     Family("zmp", DYNAMICS, zmp_rules.check),
     Family("reach", MODEL, reach.check),
 )
@@ -127,6 +129,8 @@ def _ready(ctx: Context, needs: Stage) -> bool:
             ctx.stage = DYNAMICS
     if needs == MODEL:
         return ctx.model is not None
+    if needs == BALANCE:  # masses and centres of mass: an inertia tensor error moves neither
+        return ctx.model is not None and not ctx.out.has_errors(BLOCKS_BALANCE)
     return ctx.stage == DYNAMICS
 
 

@@ -18,7 +18,7 @@ from armcli.check.structure import finite
 from armcli.sim.verdict import StabilityReport
 from armcli.spec.joint_types import total_dof
 from armcli.urdf.doc import Urdf
-from armcli.urdf.pinocchio import configuration
+from armcli.urdf.pinocchio import configuration, link_frame
 from armcli.urdf.tool import tool_point
 
 if TYPE_CHECKING:  # the balance and reach results: imported by their own families
@@ -71,7 +71,7 @@ def summarise(ctx: Context) -> Summary:
         "reach": ctx.reach,
         "reach_points": ctx.reach_points,
     }
-    if ctx.model is None:
+    if ctx.model is None or _no_arm(ctx):
         return Summary(**base, end_effector="", poses=())
     import pinocchio as pin
 
@@ -86,6 +86,12 @@ def summarise(ctx: Context) -> Summary:
     return Summary(**base, end_effector=ee_label, poses=tuple(pose_rows))
 
 
+def _no_arm(ctx: Context) -> bool:
+    """A base without an arm: the tool point (the deepest link) is a wheel on the ground."""
+    tool = tool_point(ctx.urdf, ctx.opts.spec)
+    return tool is not None and ctx.stance is not None and tool.link in ctx.stance.ground.links
+
+
 def _total_mass(urdf: Urdf) -> float:
     masses = (lk.inertial.mass for lk in urdf.links if lk.inertial is not None)
     return math.fsum(m for m in masses if m is not None and finite(m) and m > 0)
@@ -96,7 +102,7 @@ def _end_effector(
 ) -> tuple[str, int, tuple[float, float, float]]:
     """The tool point (armcli.urdf.tool) as (label, Pinocchio frame id, offset [m])."""
     tool = tool_point(urdf, opts.spec)
-    if tool is None or not model.existFrame(tool.link):
-        name = str(model.frames[0].name)
-        return name, model.getFrameId(name), (0.0, 0.0, 0.0)
-    return tool.label, model.getFrameId(tool.link), tool.xyz
+    frame = link_frame(model, tool.link) if tool is not None else None
+    if tool is None or frame is None:
+        return str(model.frames[0].name), 0, (0.0, 0.0, 0.0)
+    return tool.label, frame, tool.xyz

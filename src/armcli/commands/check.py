@@ -97,7 +97,7 @@ def check_cmd(
     payload_link: str = typer.Option(None, "--payload-link", help=PAYLOAD_LINK_HELP),
     contact_links: str = typer.Option(None, "--contact-links", help=CONTACT_LINKS_HELP),
     min_margin: float = typer.Option(
-        0.02, "--min-margin", help="Balance margin [m] below which to warn (default 0.02)."
+        0.02, "--min-margin", help="Balance margin [m] below which to warn."
     ),
     trajectory: Path = typer.Option(None, "--trajectory", "-t", help=TRAJECTORY_HELP),
     base_accel: float = typer.Option(None, "--base-accel", help=BASE_ACCEL_HELP),

@@ -88,7 +88,8 @@ def render_cmd(
     values = pose_q(src, pose, q)
     width, height = _size(size)
     skipped: dict[str, str] = {}
-    urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search, skipped)
+    said: dict[str, str] = {}  # what trimesh said about a mesh it drew (a missing texture)
+    urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search, skipped, said)
     field = "--pose" if pose else "--q"
     lines: list[str] = []
     if reach or targets:
@@ -113,6 +114,10 @@ def render_cmd(
         hint = f" ({MESH_HINT})" if why == "not found" else ""
         sys.stderr.write(
             one_line(f"warning: {src.source}: mesh {uri!r} {why}, not drawn{hint}") + "\n"
+        )
+    for uri, what in said.items():
+        sys.stderr.write(
+            one_line(f"warning: {src.source}: mesh {uri!r}: {what}; drawn without it") + "\n"
         )
     drawn = _drawn(src.poses, pose, q)
     sys.stdout.write(f"wrote {res.path} ({res.width}x{res.height} px) at {drawn};{tip}\n")

@@ -9,6 +9,7 @@ import typer
 
 from armcli.commands.flags import flag_errors
 from armcli.commands.options import choice, option, out_option, spec_argument
+from armcli.commands.xacro_inputs import package_dir_option
 from armcli.defaults import COLLISION_SAMPLES, ROS_TARGETS
 from armcli.spec.discover import find_spec
 
@@ -40,10 +41,12 @@ def ros_package_cmd(
     force: bool = option(
         False, "--force", help="Write into an existing non-empty directory armcli did not create."
     ),
+    package_dir: list[str] = package_dir_option(),
 ) -> None:
     """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
     from armcli.compiler.expand import spec_label  # on use: `--help` stays light
     from armcli.ros.packages import PackageInfo, write_ros_packages
+    from armcli.urdf.packages import PackageLookup, parse_package_dirs
 
     spec = find_spec(spec)
     info = PackageInfo(maintainer=maintainer, email=email, license=license_)
@@ -56,6 +59,7 @@ def ros_package_cmd(
         info=info,
         target=target,
         force=force,
+        packages=PackageLookup(parse_package_dirs(list(package_dir))),
     )
     n, m = pkgs.names, pkgs.matrix
     counts = {r: sum(d.reason == r for d in m.disabled) for r in ("Adjacent", "Default", "Never")}

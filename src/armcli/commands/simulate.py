@@ -22,7 +22,7 @@ from armcli.commands.xacro_inputs import (
 from armcli.errors import InputError, ModelRefusedError, UnstableLoopError
 from armcli.io import terminal
 from armcli.io.oneline import one_line
-from armcli.io.outdir import check_output_file
+from armcli.io.outdir import check_output_file, check_png_file
 from armcli.io.together import write_files_together
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
@@ -41,6 +41,10 @@ BASE_ACCEL_HELP = (
 )
 PAYLOAD_LINK_HELP = "Link carrying --payload at its origin (default: the tool point)."
 CONTACT_LINKS_HELP = "Comma-separated links touching the ground (default: from the geometry)."
+CMD_VEL_HELP = (
+    "Drive the whole robot on its wheels in MuJoCo: /cmd_vel commands YAML (`commands:` "
+    "Twist + time_from_start); --trajectory then optional."
+)
 PROGRESS_AFTER_S = 1.0  # show a progress bar when the run is projected to take longer
 # The library's names for what these flags set (errors name them; commands.flags maps back).
 FLAGS = {
@@ -89,6 +93,7 @@ def simulate_cmd(
     payload: float = option(0.0, "--payload", help="Payload [kg] at the tool point (ZMP)."),
     payload_link: str = option(None, "--payload-link", help=PAYLOAD_LINK_HELP),
     contact_links: str = option(None, "--contact-links", help=CONTACT_LINKS_HELP),
+    cmd_vel: Path = option(None, "--cmd-vel", help=CMD_VEL_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
     from armcli.check.rules import unknown_rules
@@ -107,7 +112,7 @@ def simulate_cmd(
             states.output_format(output)
         check_output_file(output, "--output")
     if plot is not None:
-        check_output_file(plot, "--plot")
+        check_png_file(plot, "--plot")
     spec_path, spec_obj = None, None
     if spec is not None or urdf is None:  # the spec layers are imported only for a spec
         from armcli.spec.discover import find_spec
@@ -133,6 +138,9 @@ def simulate_cmd(
         xacro=inputs,
     )
     tip_opts = TipOptions(base_accel, payload, payload_link, _names(contact_links))
+    if cmd_vel is not None:
+        _drive(spec_obj, opts, cmd_vel, tuple(ignore), output, plot, tip_opts != TipOptions())
+        return
     job = _prepare(spec_obj, spec_path, opts, tuple(ignore))
     notes: list[str] = []
     tip = tipping.prepare(spec_obj, job, tip_opts, inputs.packages, notes)
@@ -176,6 +184,23 @@ def _sources(spec_path: Path | None, opts: SimOptions) -> dict[str, Any]:
     return {"file": spec_path if from_spec else None, "field": ", ".join(fields) or None}
 
 
+def _drive(
+    spec: Any, opts: SimOptions, cmd_vel: Path, ignore: tuple[str, ...], output: Path | None,
+    plot: Path | None, tip_asked: bool,
+) -> None:  # fmt: skip
+    """The whole robot on its wheels (commands.drive); the base-at-rest options do not apply."""
+    from armcli.commands.drive import run_drive
+
+    if tip_asked:
+        raise InputError(
+            "--base-accel, --payload, --payload-link and --contact-links are for the "
+            "fixed-base run; a drive simulates the contacts",
+            field="--cmd-vel",
+        )
+    with _LazyProgress(terminal.console(sys.stderr)) as progress:
+        run_drive(spec, opts, cmd_vel, ignore, output, plot, progress)
+
+
 def _names(text: str | None) -> tuple[str, ...] | None:
     return None if text is None else tuple(n.strip() for n in text.split(",") if n.strip())
 
@@ -200,6 +225,8 @@ def _run(
     err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
     write_notes([*job.notes, *(notes or [])])
     for w in job.trajectory.warnings:
+        source = w.split(" ", 1)[0]  # `SimOptions.message` is the flag `--message`
+        w = FLAGS.get(source, source) + w[len(source) :]
         err.print(one_line(f"warning: {w}"), markup=False, highlight=False)
     extra = None if tip is None else (lambda steps: tip.steps(job, steps))
     with _LazyProgress(err) as progress:

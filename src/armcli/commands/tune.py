@@ -13,7 +13,7 @@ from armcli.commands.options import choice, option, spec_argument
 from armcli.defaults import PD_LOOPS, ROBUST_MODES
 from armcli.errors import InputError
 from armcli.io import terminal
-from armcli.io.outdir import check_output_file
+from armcli.io.outdir import check_output_file, check_png_file
 from armcli.spec.discover import find_spec
 
 if TYPE_CHECKING:  # the tuner is imported when the command runs: `--help` stays light
@@ -102,9 +102,10 @@ def tune_cmd(
         validate(opts)
         if output is not None and output.suffix.lower() != ".json":
             raise InputError("the output file must end in .json", field="--output")
-        for path, name in ((output, "--output"), (plot, "--plot")):
-            if path is not None:
-                check_output_file(path, name)  # before the search: no partial outputs
+        if output is not None:  # before the search: no partial outputs
+            check_output_file(output, "--output")
+        if plot is not None:
+            check_png_file(plot, "--plot")
         if write:
             check_writable(spec_path)
         settings = tjob.TuneSettings(

@@ -27,7 +27,9 @@ from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 def view_cmd(
     robot: Path | None = spec_argument(ROBOT_HELP),
     args: list[str] = args_argument(),
-    replay: Path = typer.Option(None, "--replay", help="A CSV written by `armcli simulate`."),
+    replay: Path = typer.Option(
+        None, "--replay", help="A run written by `armcli simulate -o` (.csv or .mcap)."
+    ),
     pose: str = typer.Option(None, "--pose", help="Start at this named pose."),
     host: str = typer.Option(
         "127.0.0.1", "--host", show_default=False, help="Address to listen on (default: 127.0.0.1)."

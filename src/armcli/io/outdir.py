@@ -125,6 +125,16 @@ def check_output_file(path: str | Path, field: str) -> None:
         )
 
 
+def check_png_file(path: str | Path, field: str) -> None:
+    """Refuse a plot path that does not end in .png (the plots are PNG; x.jpg would lie)."""
+    p = Path(path)
+    check_output_file(p, field)
+    if p.suffix.lower() != ".png":
+        raise OutputRefusedError(
+            f"plots are written as PNG; name the file {p.stem or 'plot'}.png", file=p, field=field
+        )
+
+
 def clean_stale_stages(parent: Path, name: str) -> None:
     """Remove staging entries of any type left by killed armcli processes."""
     prefix = f".{name}{STAGE_TAG}"

@@ -33,6 +33,7 @@ from armcli.sim.states import distinct, sample_steps
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.urdf.doc import Urdf
 from armcli.urdf.mimic import Mimic, mimics
+from armcli.urdf.pinocchio import link_frame
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import Trust, checked_model, read_urdf_file
 from armcli.urdf.tool import tool_point
@@ -181,9 +182,10 @@ def _tool(arm: Arm, doc: Urdf, spec: RobotSpec | None) -> tuple[int, np.ndarray,
     """The tool point (armcli.urdf.tool) as (Pinocchio frame id, offset [m], label)."""
     model = arm.model
     tool = tool_point(doc, spec)
-    if tool is None or not model.existFrame(tool.link):
+    frame = link_frame(model, tool.link) if tool is not None else None
+    if tool is None or frame is None:
         raise InputError("this URDF has no link to report as the end effector", file=doc.source)
-    return model.getFrameId(tool.link), np.array(tool.xyz, dtype=float), tool.label
+    return frame, np.array(tool.xyz, dtype=float), tool.label
 
 
 def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
@@ -248,6 +250,18 @@ def _duration_and_rate(
     return float(total), float(rate)
 
 
+def base_joints(spec: RobotSpec | None) -> dict[str, str]:
+    """The mobile base's joints by name, with what they are (a trajectory may not name them)."""
+    if spec is None or spec.mobile_base is None:
+        return {}
+    return {
+        name: "a wheel joint of the mobile base"
+        if j.type == "continuous"
+        else "a mobile-base joint"
+        for name, j in spec.mobile_base.joints.items()
+    }
+
+
 def prepare(
     spec: RobotSpec | None, opts: SimOptions, *, gate: Callable[[Urdf], None] | None = None
 ) -> SimJob:
@@ -272,10 +286,13 @@ def prepare(
         n: (float(lo), float(hi))
         for n, lo, hi in zip(arm.joint_names, arm.lower, arm.upper, strict=True)
     }
+    others = base_joints(spec)
     if trajectory is not None:
-        traj = load_trajectory(trajectory, limits, clamp=opts.clamp)
+        traj = load_trajectory(trajectory, limits, clamp=opts.clamp, others=others)
     else:
-        traj = loads_trajectory(str(message), limits, source="SimOptions.message", clamp=opts.clamp)
+        traj = loads_trajectory(
+            str(message), limits, source="SimOptions.message", clamp=opts.clamp, others=others
+        )
     pairs = mimic_pairs(doc, arm, traj, str(trajectory) if trajectory else "SimOptions.message")
     q0 = start_state(arm, spec)
     for f, lead, m in pairs:

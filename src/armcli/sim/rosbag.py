@@ -103,7 +103,7 @@ def message_definition(datatype: str) -> str:
 _INFINITE = {"sec": 9223372036, "nsec": 854775807}  # RMW_DURATION_INFINITE
 
 
-def _qos(depth: int, transient_local: bool) -> str:
+def qos(depth: int, transient_local: bool) -> str:
     """`offered_qos_profiles` YAML: reliable, keep last `depth`, volatile or transient local."""
     import yaml
 
@@ -171,14 +171,15 @@ def joint_transform(j: Joint, value: float) -> tuple[np.ndarray, np.ndarray]:
 # -- messages --------------------------------------------------------------------------------
 
 
-def _stamp(ns: int) -> dict[str, int]:
+def stamp(ns: int) -> dict[str, int]:
+    """builtin_interfaces/Time of a time [ns]."""
     return {"sec": ns // 1_000_000_000, "nanosec": ns % 1_000_000_000}
 
 
 def _transform(j: Joint, value: float, ns: int) -> dict[str, Any]:
     t, r = joint_transform(j, value)
     return {
-        "header": {"stamp": _stamp(ns), "frame_id": j.parent},
+        "header": {"stamp": stamp(ns), "frame_id": j.parent},
         "child_frame_id": j.child,
         "transform": {
             "translation": dict(zip("xyz", map(float, t), strict=True)),
@@ -188,7 +189,7 @@ def _transform(j: Joint, value: float, ns: int) -> dict[str, Any]:
 
 
 def _joint_state(ns: int, names: Sequence[str], **arrays: Sequence[float]) -> dict[str, Any]:
-    msg: dict[str, Any] = {"header": {"stamp": _stamp(ns), "frame_id": ""}, "name": list(names)}
+    msg: dict[str, Any] = {"header": {"stamp": stamp(ns), "frame_id": ""}, "name": list(names)}
     for key in ("position", "velocity", "effort"):
         msg[key] = [float(x) for x in arrays.get(key, [])]
     return msg
@@ -208,6 +209,7 @@ def channels(cols: Mapping[str, np.ndarray], names: Sequence[str], urdf: Urdf) -
     """Every topic of the file from the sampled states `cols` (sim.states' columns)."""
     stamps = [round(float(t) * 1e9) for t in cols[TIME]]
     state, ref, tf = [], [], []
+    tracked = [n for n in names if column(n, "reference") in cols]  # a wheel has no reference
     moving = [j for j in urdf.joints if j.type != "fixed" and j.movable]
     for k, ns in enumerate(stamps):
         values = {n: float(cols[column(n, "position")][k]) for n in names}
@@ -215,20 +217,20 @@ def channels(cols: Mapping[str, np.ndarray], names: Sequence[str], urdf: Urdf) -
             ns, names, **{f: [cols[column(n, f)][k] for n in names]
                           for f in ("position", "velocity", "effort")},
         )))  # fmt: skip
-        ref.append((ns, _joint_state(ns, names, position=[cols[column(n, "reference")][k]
-                                                          for n in names])))  # fmt: skip
+        ref.append((ns, _joint_state(ns, tracked, position=[cols[column(n, "reference")][k]
+                                                            for n in tracked])))  # fmt: skip
         tf.append((ns, {"transforms": [_transform(j, values.get(j.name, 0.0), ns)
                                        for j in moving]}))  # fmt: skip
     fixed = [j for j in urdf.joints if j.type == "fixed"]
     start = stamps[0]
     text = urdf.text.decode("utf-8")
     return [
-        Channel(DESCRIPTION, STRING, _qos(1, True), [(start, {"data": text})]),
-        Channel(TF_STATIC, TF_MESSAGE, _qos(1, True),
+        Channel(DESCRIPTION, STRING, qos(1, True), [(start, {"data": text})]),
+        Channel(TF_STATIC, TF_MESSAGE, qos(1, True),
                 [(start, {"transforms": [_transform(j, 0.0, start) for j in fixed]})]),
-        Channel(JOINT_STATES, JOINT_STATE, _qos(10, False), state),
-        Channel(REFERENCE, JOINT_STATE, _qos(10, False), ref),
-        Channel(TF, TF_MESSAGE, _qos(100, False), tf),
+        Channel(JOINT_STATES, JOINT_STATE, qos(10, False), state),
+        Channel(REFERENCE, JOINT_STATE, qos(10, False), ref),
+        Channel(TF, TF_MESSAGE, qos(100, False), tf),
     ]  # fmt: skip
 
 

@@ -94,7 +94,8 @@ def output_format(path: Path) -> str:
     ext = path.suffix.lower()
     if ext not in (".csv", ".json"):
         raise InputError(
-            f"unknown output format {ext or '(none)'!r}; use .csv or .json", field="output"
+            f"unknown output format {ext or '(none)'!r}; use .csv, .json or .mcap",
+            field="output",
         )
     return ext[1:]
 

@@ -27,6 +27,7 @@ from armcli.urdf.doc import Urdf
 from armcli.urdf.ground import mesh_loader
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_urdf
+from armcli.urdf.source import lookup_for
 from armcli.urdf.stance import NoStance, Payload, Stance, stance_of
 from armcli.urdf.tool import tool_point
 
@@ -111,6 +112,7 @@ def prepare(
     else:
         return None
     missing: list[str] = []
+    search = lookup_for(spec, search)  # the packages the spec records too
     found = stance_of(urdf, candidates=candidates, declared=opts.contact_links,
                       mesh=mesh_loader(urdf, search, missing), payload=payload)  # fmt: skip
     if isinstance(found, NoStance):

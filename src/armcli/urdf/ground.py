@@ -2,8 +2,11 @@
 
 At the neutral pose (every joint at zero) each link's collision shapes are placed by
 Pinocchio's forward kinematics in the root link's frame; the ground plane is the lowest
-point of all of them, and a link touches it when its own lowest point is within
-`CONTACT_TOL` of that plane (rigid bodies on flat ground, the root frame upright). A
+point of all of them, and a link touches it when its own lowest point is within a
+tolerance of that plane (rigid bodies on flat ground, the root frame upright): 2 % of the
+robot's footprint (the larger horizontal extent of its collision geometry), at least
+5 mm. Real bases are not exact at the zero pose: LoCoBot's wheels sit 2.45 mm above its
+caster and a Dingo's 2.24 mm, both resting on a spring or tyre that gives that much. A
 user may name the contact links instead (`--contact-links`).
 
 Contact points. A rolling link (a wheel: the child of a revolute or continuous joint
@@ -30,8 +33,10 @@ from armcli.urdf.doc import Shape, Urdf, Vec3
 from armcli.urdf.inertia import rpy_matrix
 from armcli.urdf.mesh_confine import bounded_mesh_file
 from armcli.urdf.meshes import MeshSearch, mesh_paths
+from armcli.urdf.meshlog import quiet_trimesh
 
-CONTACT_TOL = 0.005  # [m] a link within this of the lowest point touches the ground
+CONTACT_TOL = 0.005  # [m] a link within this of the lowest point touches the ground, at least
+CONTACT_RTOL = 0.02  # of the robot's footprint: a 0.35 m base takes links within 7 mm
 HORIZONTAL_TOL = 0.1  # |axis_z| below this: a wheel's axle (about 6 deg from level)
 CIRCLE_POINTS = 32  # an upright cylinder's bottom rim: within 0.5 % of its radius
 
@@ -54,6 +59,7 @@ class Ground:
     height: float
     contacts: tuple[Contact, ...]
     declared: bool = False  # the contact links were named by the user
+    tol: float = CONTACT_TOL  # [m] links whose lowest point is this close to the plane touch
 
     def points(self) -> list[Vec3]:
         """Every contact point [m] in the root frame."""
@@ -131,9 +137,11 @@ def link_poses(model: Any, names: Collection[str]) -> dict[str, NDArray[np.float
 def _rolling_links(urdf: Urdf, poses: dict[str, NDArray[np.float64]]) -> set[str]:
     """Links turned by a revolute or continuous joint about a horizontal axis (wheels).
 
-    The joint's parent must be the base: joined to the root by fixed joints only. A wrist
-    that hangs below a bolted arm's base at the neutral pose (example-robot-data's UR5)
-    turns about a horizontal axis too, but behind moving joints: it is not a wheel.
+    The joint's parent must be the base: joined to the root by fixed or prismatic joints
+    only (a prismatic joint is a suspension or a wheel drop, as on LoCoBot's Create 3: it
+    moves the axle without turning it). A wrist that hangs below a bolted arm's base at
+    the neutral pose (example-robot-data's UR5) turns about a horizontal axis too, but
+    behind rotary joints: it is not a wheel.
     """
     by_child = {j.child: j for j in urdf.joints if j.child is not None}
 
@@ -142,7 +150,7 @@ def _rolling_links(urdf: Urdf, poses: dict[str, NDArray[np.float64]]) -> set[str
         while link is not None and link in by_child and link not in seen:
             seen.add(link)
             up = by_child[link]
-            if up.type != "fixed":
+            if up.type not in ("fixed", "prismatic"):
                 return False
             link = up.parent
         return True
@@ -164,13 +172,14 @@ def find_ground(
     candidates: Collection[str] | None = None,
     declared: Sequence[str] | None = None,
     mesh: MeshVertices | None = None,
-    tol: float = CONTACT_TOL,
+    tol: float | None = None,
 ) -> Ground | None:
     """The ground contacts at the neutral pose; None when no link has collision geometry.
 
     `candidates` limits which links may touch (a spec's mobile base); `declared` names the
     contact links outright: each then touches at its own lowest points. Links missing from
-    the model are ignored; `declared` names are checked by the caller.
+    the model are ignored; `declared` names are checked by the caller. `tol` [m]: by
+    default `contact_tol` of the robot's collision geometry.
     """
     wanted = list(declared) if declared is not None else None
     pool = [lk for lk in urdf.links if lk.collisions]
@@ -190,6 +199,8 @@ def find_ground(
     if not lowest:
         return None
     floor = min(float(p[:, 2].min()) for p in lowest.values())
+    if tol is None:
+        tol = contact_tol(np.vstack(list(lowest.values())))
     rolling = _rolling_links(urdf, poses)
     contacts = []
     for name, cloud in lowest.items():
@@ -203,7 +214,16 @@ def find_ground(
         else:
             chosen = [(float(p[0]), float(p[1]), float(p[2])) for p in low]
         contacts.append(Contact(name, tuple(chosen), name in rolling))
-    return Ground(floor, tuple(contacts), declared=wanted is not None)
+    return Ground(floor, tuple(contacts), declared=wanted is not None, tol=tol)
+
+
+def contact_tol(points: NDArray[Any]) -> float:
+    """The contact tolerance [m] for a robot whose collision geometry has these points (n, 3).
+
+    CONTACT_RTOL of the footprint (the larger of its x and y extents), at least CONTACT_TOL.
+    """
+    extent = np.ptp(points[:, :2], axis=0) if len(points) else np.zeros(2)
+    return max(CONTACT_TOL, CONTACT_RTOL * float(np.max(extent)))
 
 
 def has_wheels(ground: Ground | None) -> bool:
@@ -237,7 +257,8 @@ def _read_vertices(path: Path | None, source: str) -> NDArray[np.float64] | None
     if path is None or not path.is_file():
         return None
     try:
-        mesh = trimesh.load(str(bounded_mesh_file(path, source)), force="mesh", process=False)
+        with quiet_trimesh():  # a missing texture does not move a vertex
+            mesh = trimesh.load(str(bounded_mesh_file(path, source)), force="mesh", process=False)
     except Exception:  # trimesh raises many types for unreadable files
         return None
     v = np.asarray(getattr(mesh, "vertices", np.empty((0, 3))), dtype=float)

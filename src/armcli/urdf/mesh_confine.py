@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from armcli.errors import InputError
+from armcli.io.meshbound import check_mesh_payload
 from armcli.io.userfile import check_regular, read_regular
 
 MAX_MESH_BYTES = 20_000_000  # one mesh file; a 50 MB STL took 51 s and 1.6 GB to render
@@ -79,6 +80,10 @@ def bounded_mesh_file(path: Path, source: str) -> Path:
             f"mesh {real} is {size} bytes, more than the {MAX_MESH_BYTES}-byte cap per mesh",
             file=source,
         )
+    try:  # compressed meshes inflated under a cap, declared triangles counted (issue 27)
+        check_mesh_payload(real, MAX_MESH_BYTES)
+    except InputError as exc:
+        raise InputError(exc.message, file=source) from None
     return real
 
 

@@ -18,7 +18,9 @@ package root the lookup found. A root counts with two real directories: its own 
 path and, when its package.xml is a symlink, the directory that package.xml really lives
 in: `colcon build --symlink-install` installs one symlink per file from `share/NAME` into
 the source package, and that source package is where its package.xml points. A symlink
-to anywhere else still leaves the roots.
+to anywhere else still leaves the roots. A root whose real path is `/`, a system
+directory or the home directory is no root at all (issue 27: an AMENT_PREFIX_PATH
+prefix registering a package whose share dir links to `/` opened every host file).
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ import functools
 import json
 import os
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from armcli.errors import InputError
@@ -35,6 +37,42 @@ from armcli.urdf.mesh_confine import is_package, package_xml_name
 
 IGNORE_MARKERS = ("COLCON_IGNORE", "AMENT_IGNORE", "CATKIN_IGNORE")
 AMENT_INDEX = Path("share", "ament_index", "resource_index", "packages")
+# real paths that are never a package root: the filesystem root and system directories
+SYSTEM_DIRS = frozenset(
+    [
+        "/",
+        "/bin",
+        "/boot",
+        "/dev",
+        "/etc",
+        "/home",
+        "/lib",
+        "/lib32",
+        "/lib64",
+        "/libx32",
+        "/media",
+        "/mnt",
+        "/opt",
+        "/proc",
+        "/root",
+        "/run",
+        "/sbin",
+        "/srv",
+        "/sys",
+        "/tmp",
+        "/usr",
+        "/usr/bin",
+        "/usr/include",
+        "/usr/lib",
+        "/usr/lib64",
+        "/usr/local",
+        "/usr/sbin",
+        "/usr/share",
+        "/var",
+        "/var/lib",
+        "/var/tmp",
+    ]
+)
 MAX_CRAWL_DIRS = 200_000  # directories visited per ROS_PACKAGE_PATH entry (a typo'd "/")
 
 
@@ -42,14 +80,29 @@ def _env_paths(variable: str) -> tuple[Path, ...]:
     return tuple(Path(p) for p in os.environ.get(variable, "").split(os.pathsep) if p)
 
 
+def _absolute(paths: tuple[Path, ...]) -> tuple[Path, ...]:
+    """Relative entries against the working directory (not a child's, e.g. the xacro's)."""
+    return tuple(Path(os.path.abspath(p)) for p in paths)
+
+
 def parse_package_dirs(values: list[str]) -> dict[str, Path]:
-    """`--package-dir NAME=PATH` options -> {NAME: PATH}; InputError on a malformed one."""
+    """`--package-dir NAME=PATH` options -> {NAME: absolute PATH}.
+
+    A relative PATH starts at the working directory, where the user typed it (the safe
+    expander's child runs elsewhere); InputError on a malformed option or a PATH that is
+    not a directory (a typo would otherwise surface as "unknown package" later).
+    """
     out = {}
     for v in values:
         name, sep, path = v.partition("=")
         if not sep or not name or not path:
             raise InputError(f"expected NAME=PATH, got {v!r}", field="--package-dir")
-        out[name] = Path(path)
+        where = Path(os.path.abspath(path))
+        if not where.is_dir():
+            raise InputError(
+                f"{v}: {path} is not a directory (from {os.getcwd()})", field="--package-dir"
+            )
+        out[name] = where
     return out
 
 
@@ -82,13 +135,35 @@ class PackageLookup:
         return (*self.search_paths, *env)
 
     def resolved(self) -> PackageLookup:
-        """The same lookup with the environment read now."""
+        """The same lookup with the environment read now, every path absolute (from the cwd)."""
         return PackageLookup(
-            dict(self.package_dirs),
-            self.search_paths,
-            self.prefixes(),
-            self.crawl_paths()[len(self.search_paths) :],
+            {k: Path(os.path.abspath(v)) for k, v in self.package_dirs.items()},
+            _absolute(self.search_paths),
+            _absolute(self.prefixes()),
+            _absolute(self.crawl_paths()[len(self.search_paths) :]),
         )
+
+    def with_recorded(self, recorded: Mapping[str, Path], where: str) -> PackageLookup:
+        """This lookup plus packages a spec records (`--package-dir` wins over them).
+
+        A recorded directory must be that ROS package (its package.xml names it), so a
+        spec can point at a package it was imported with but not at any directory.
+        """
+        extra = {}
+        for name, path in recorded.items():
+            if name in self.package_dirs:
+                continue
+            if package_xml_name(path) != name:
+                raise InputError(
+                    f"{path} is not the ROS package {name!r} (no package.xml naming it); "
+                    f"fix the path or pass --package-dir {name}=PATH",
+                    file=where,
+                    field=f"packages.{name}",
+                )
+            extra[name] = Path(os.path.abspath(path))
+        if not extra:
+            return self
+        return replace(self, package_dirs={**extra, **self.package_dirs})
 
     def find(self, name: str, near: Path | None = None) -> Path | None:
         """The root directory of package `name` (None when unknown); `near`: the file read."""
@@ -231,7 +306,12 @@ def real_roots(root: Path) -> tuple[Path, ...]:
         source = Path(os.path.realpath(xml)).parent
         if source not in out and package_xml_name(source) == root.name:
             out.append(source)
-    return tuple(out)
+    return tuple(r for r in out if usable_root(r))
+
+
+def usable_root(real: Path) -> bool:
+    """Whether a real path may be a package root: not `/`, a system or the home directory."""
+    return str(real) not in SYSTEM_DIRS and real != Path(os.path.realpath(Path.home()))
 
 
 def inside(path: Path, roots: tuple[Path, ...] | list[Path]) -> bool:

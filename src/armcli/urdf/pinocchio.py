@@ -157,3 +157,16 @@ def collision_model(model: Any, xml: str, package_dirs: list[str] | None = None)
     except (RuntimeError, ValueError) as exc:
         raise InputError(f"Pinocchio cannot load the collision geometry: {exc}") from None
     return gmodel
+
+
+def link_frame(model: Any, name: str) -> int | None:
+    """The Pinocchio frame id of the link `name`, None if there is no such link.
+
+    URDF names links and joints separately (ANYmal C has a link and a joint both called
+    LF_HFE), so a lookup by name alone is ambiguous: a link is the BODY frame.
+    """
+    import pinocchio as pin
+
+    if not model.existFrame(name, pin.BODY):
+        return None
+    return int(model.getFrameId(name, pin.BODY))

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import EXPANDED_TAG, InputError, XacroRefusedError
 from armcli.urdf.doc import Urdf
-from armcli.urdf.packages import inside, real_roots
+from armcli.urdf.packages import PackageLookup, inside, real_roots
 from armcli.urdf.pinocchio import LoadedModel, load_model, parser_problems
 from armcli.urdf.read import parse_urdf, read_urdf
 from armcli.urdf.trust import Trust as Trust  # re-exported: read_robot and callers share it
@@ -76,10 +76,19 @@ def read_robot(
         from armcli.spec.load import load_spec
 
         spec = load_spec(path)
+        lookup_for(spec, inputs.packages if inputs is not None else None)  # refuse a bad one now
         urdfs = expand_urdfs(spec)
         docs = tuple(parse_urdf(urdfs[n], f"{path}#{n}") for n in sorted(urdfs))
         return RobotFile(path, docs, spec)
     return RobotFile(path, (read_urdf_file(path, trust_xacro=trust_xacro, inputs=inputs),))
+
+
+def lookup_for(spec: RobotSpec | None, search: PackageLookup | None = None) -> PackageLookup:
+    """The package lookup for a robot: the CLI's options plus the packages its spec records."""
+    base = search if search is not None else PackageLookup()
+    if spec is None or not spec.packages:
+        return base
+    return base.with_recorded(spec.package_dirs(), spec.source_file)
 
 
 def read_urdf_file(

@@ -20,7 +20,13 @@ from numpy.typing import ArrayLike, NDArray
 from armcli.errors import InputError
 from armcli.urdf.doc import Urdf, Vec3
 from armcli.urdf.ground import Ground, MeshVertices, find_ground, has_wheels
-from armcli.urdf.pinocchio import JointRange, configuration, joint_ranges, load_model
+from armcli.urdf.pinocchio import (
+    JointRange,
+    configuration,
+    joint_ranges,
+    link_frame,
+    load_model,
+)
 from armcli.urdf.support import SupportPolygon, support_polygon
 
 FIXED_BASE = (
@@ -90,7 +96,7 @@ def with_payload(model: Any, payload: Payload) -> Any:
     import pinocchio as pin
 
     out = pin.Model(model)
-    frame = out.frames[out.getFrameId(payload.link)]
+    frame = out.frames[link_frame(out, payload.link)]
     point = frame.placement.act(np.asarray(payload.xyz, dtype=float))
     jid = frame.parentJoint
     out.inertias[jid] = out.inertias[jid] + pin.Inertia(payload.mass, point, np.zeros((3, 3)))
@@ -130,7 +136,7 @@ def stance_of(
     if polygon is None:
         links = ", ".join(ground.links)
         return NoStance(f"the ground contacts ({links}) span no area: no support polygon")
-    if payload is not None and not model.existFrame(payload.link):
+    if payload is not None and link_frame(model, payload.link) is None:
         raise InputError(f"unknown link {payload.link!r} for the payload", field="payload_link")
     return Stance(model, ground, polygon, payload, _free_joints(model, ground.links))
 

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from armcli.urdf.boxsearch import minimize_box
-from armcli.urdf.pinocchio import JointRange, configuration, joint_ranges
+from armcli.urdf.pinocchio import JointRange, configuration, joint_ranges, link_frame
 from armcli.urdf.tool import ToolPoint
 
 SAMPLES = 500  # `check`'s cloud: IK seeds and starts (extremes are refined); render draws more
@@ -77,11 +77,12 @@ class Chain:
         self, model: Any, tool: ToolPoint, others: Mapping[str, float] | None = None
     ) -> None:
         """`others`: values [rad or m] of joints off the chain (neutral where silent)."""
-        if not model.existFrame(tool.link):
+        frame = link_frame(model, tool.link)
+        if frame is None:
             raise ValueError(f"no link {tool.link!r} in the model")
         self.model = model
         self.data = model.createData()
-        self.frame = model.getFrameId(tool.link)
+        self.frame = frame
         self.xyz = np.asarray(tool.xyz, dtype=float)
         self.tool = tool
         jid = model.frames[self.frame].parentJoint

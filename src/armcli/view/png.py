@@ -23,6 +23,7 @@ from armcli.io.files import write_file_atomic
 from armcli.spec.joint_types import position_bounds
 from armcli.urdf.mesh_confine import bounded_mesh_file, check_total
 from armcli.urdf.meshes import MeshSearch, confined, resolve
+from armcli.urdf.meshlog import MeshLog, quiet_trimesh
 from armcli.urdf.read import parse_root
 from armcli.urdf.tool import ToolPoint
 
@@ -56,7 +57,11 @@ TITLE_WIDTH = 110  # [characters] per title line, so many joints do not run off 
 
 
 def _mesh_handler(
-    base: Path, where: MeshSearch, source: str, skipped: dict[str, str] | None
+    base: Path,
+    where: MeshSearch,
+    source: str,
+    skipped: dict[str, str] | None,
+    said: MeshLog | None = None,
 ) -> Callable[[str], str]:
     """Yourdfpy's filename handler: armcli's resolver, confinement and size caps.
 
@@ -66,6 +71,8 @@ def _mesh_handler(
     loaded: set[Path] = set()
 
     def resolve_mesh(fname: str) -> str:
+        if said is not None:
+            said.current = fname  # trimesh loads this file next: its complaints are about it
         path = resolve(fname, base, where)
         why = None
         if path is not None and not confined(fname, path, base, where):  # never read
@@ -95,6 +102,7 @@ def load_urdf(
     mesh_dir: str | Path | None = None,
     search: MeshSearch | None = None,
     skipped: dict[str, str] | None = None,
+    mesh_notes: dict[str, str] | None = None,
 ) -> Any:
     """URDF text -> yourdfpy.URDF with its visual scene.
 
@@ -104,21 +112,41 @@ def load_urdf(
     parser would resolve entities. A mesh file that cannot be found, or lies outside the
     allowed directories (never read), is an InputError where yourdfpy would log and draw
     nothing, unless the caller passes a `skipped` dict: then URI -> why is recorded there
-    and the rest is drawn (render warns).
+    and the rest is drawn (render warns). What trimesh said while loading a mesh (a
+    missing texture image: the mesh is drawn in its plain colour) goes to `mesh_notes`
+    (URI -> message) when given, and never to stderr.
     """
+    parse_root(xml.encode("utf-8"), source)
+    base = Path(mesh_dir or ".")
+    absent: dict[str, str] = {}
+    with quiet_trimesh() as said:
+        resolve_mesh = _mesh_handler(base, search or MeshSearch(), source, absent, said)
+        urdf = _load(xml, source, resolve_mesh)
+    if mesh_notes is not None:
+        mesh_notes.update(said.said)
+
+    if skipped is not None:
+        skipped.update(absent)
+    elif absent:
+        uri, why = next(iter(absent.items()))
+        if why != "not found":
+            raise InputError(f"mesh {uri!r} {why}", file=source)
+        raise InputError(
+            f"mesh file not found: {uri} (searched from {base}; {MESH_HINT})", file=source
+        )
+    return urdf
+
+
+def _load(xml: str, source: str, resolve_mesh: Callable[[str], str]) -> Any:
+    """yourdfpy.URDF.load with its visual meshes; its warnings become our errors."""
     import logging
 
     import yourdfpy
 
-    parse_root(xml.encode("utf-8"), source)
-    base = Path(mesh_dir or ".")
-    absent: dict[str, str] = {}
-    resolve_mesh = _mesh_handler(base, search or MeshSearch(), source, absent)
-
     log = logging.getLogger("yourdfpy")
-    level, log.level = log.level, logging.CRITICAL  # its warnings become our error below
+    level, log.level = log.level, logging.CRITICAL  # its warnings become our error above
     try:
-        urdf = yourdfpy.URDF.load(
+        return yourdfpy.URDF.load(
             io.BytesIO(xml.encode("utf-8")),
             build_collision_scene_graph=False,
             load_collision_meshes=False,
@@ -130,16 +158,6 @@ def load_urdf(
         raise InputError(f"cannot load this URDF: {exc}", file=source) from None
     finally:
         log.level = level
-    if skipped is not None:
-        skipped.update(absent)
-    elif absent:
-        uri, why = next(iter(absent.items()))
-        if why != "not found":
-            raise InputError(f"mesh {uri!r} {why}", file=source)
-        raise InputError(
-            f"mesh file not found: {uri} (searched from {base}; {MESH_HINT})", file=source
-        )
-    return urdf
 
 
 def joint_limits(urdf: Any) -> dict[str, tuple[float, float] | None]:

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
-from armcli.urdf.pinocchio import load_model
+from armcli.urdf.pinocchio import link_frame, load_model
 from armcli.urdf.tool import ToolPoint
 from armcli.urdf.workspace import (
     Chain,
@@ -60,7 +60,7 @@ def reach_of(
 ) -> tuple[Chain, NDArray[np.float64], Workspace, tuple[ReachPoint, ...]]:
     """The chain at pose `q`, its sampled tool positions (n, 3) [m], envelope and verdicts."""
     model = load_model(source, xml=xml).model
-    if not model.existFrame(tool.link):
+    if link_frame(model, tool.link) is None:
         raise InputError(f"no link {tool.link!r} for the tool point", file=source)
     chain = Chain(model, tool, q)
     if not chain.joints:

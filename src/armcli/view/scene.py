@@ -13,7 +13,7 @@ from pathlib import Path
 from armcli.errors import InputError
 from armcli.spec.expr import eval_expr
 from armcli.urdf.meshes import MeshSearch
-from armcli.urdf.source import Trust, read_robot, urdf_text
+from armcli.urdf.source import Trust, lookup_for, read_robot, urdf_text
 from armcli.urdf.tool import ToolPoint, tool_point
 from armcli.urdf.tree import tree_from_urdf
 from armcli.urdf.xacro_args import XacroInputs
@@ -48,7 +48,7 @@ def load_robot(
     """
     robot = read_robot(path, trust_xacro=trust_xacro, inputs=inputs)
     spec = robot.spec
-    where = search or MeshSearch()
+    where = lookup_for(spec, search)  # the spec's recorded packages too
     if spec is not None:
         return RobotSource(
             xml=urdf_text(robot.robot),
