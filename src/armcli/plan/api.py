@@ -22,7 +22,7 @@ import numpy as np
 
 from armcli.errors import InputError, PlanningError
 from armcli.plan.certify import certify
-from armcli.plan.collision import CollisionChecker
+from armcli.plan.collision import PADDING, CollisionChecker
 from armcli.plan.geometric import plan_path
 from armcli.plan.ik import IkResult, solve_ik
 from armcli.plan.output import read_back, trajectory_yaml
@@ -30,7 +30,7 @@ from armcli.plan.robot import PlanRobot
 from armcli.plan.scene import Scene
 from armcli.plan.timing import Timed, parameterise
 
-MARGINS = (0.9, 0.75, 0.5)  # TOPP-RA limit scales tried until the certification passes
+MARGINS = (0.78, 0.6, 0.45)  # TOPP-RA limit scales tried until the certification passes
 LIMIT_SLACK = 1e-9  # [rad or m] a start or goal may sit this far beyond a limit (rounding)
 
 
@@ -133,6 +133,7 @@ def plan_motion(
     limits = {n: (float(lo), float(hi)) for n, lo, hi in zip(robot.joints, robot.lower,
                                                             robot.upper, strict=True)}  # fmt: skip
     frame = str(robot.model.frames[1].name) if robot.model.nframes > 1 else ""
+    ctx.checker.pad(PADDING, (xs, xg))
     _import_planners()  # their import (~0.5 s) is not planning time
     t0 = time.perf_counter()
     path = plan_path(ctx.checker, robot.lower, robot.upper, xs, xg, planner=options.planner,

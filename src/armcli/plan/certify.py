@@ -18,10 +18,14 @@ from armcli.plan.collision import CollisionChecker
 from armcli.plan.robot import PlanRobot
 from armcli.plan.timing import Timed, inverse_dynamics
 from armcli.sim.reference import build_reference
-from armcli.sim.trajectory import LIMIT_TOL, Trajectory
+from armcli.sim.trajectory import Trajectory
 
 CERTIFY_RATE_HZ = 1000.0  # [Hz] samples checked, whatever the output rate
 RELATIVE_TOL = 1e-9  # velocity, acceleration and effort may reach their limit, not pass it
+# [rad or m] how far the interpolation between two points may pass a position limit the
+# motion starts or ends at: the quintic through TOPP-RA's samples can dip ~1e-7 rad below a
+# limit the joint leaves from (the points themselves are always inside: LIMIT_TOL).
+POSITION_SLACK = 1e-6
 
 
 @dataclass(frozen=True)
@@ -87,8 +91,8 @@ def _limit(s: Samples, values: np.ndarray, limit: np.ndarray, kind: str, joints:
 def kinematic_violation(robot: PlanRobot, s: Samples) -> Violation | None:
     """The worst position, velocity, acceleration or effort excess, or None."""
     names = robot.joints
-    below = robot.lower - LIMIT_TOL - s.q
-    above = s.q - robot.upper - LIMIT_TOL
+    below = robot.lower - POSITION_SLACK - s.q
+    above = s.q - robot.upper - POSITION_SLACK
     for excess in (below, above):
         if np.any(excess > 0):
             k, j = np.unravel_index(int(np.argmax(excess)), excess.shape)

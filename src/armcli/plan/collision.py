@@ -20,6 +20,7 @@ from armcli.plan.robot import PlanRobot
 from armcli.plan.scene import Scene, Shape
 
 GROUND_ID = "ground"  # the name the ground plane has in collision reports
+PADDING = 0.005  # [m] clearance the planner keeps (CollisionChecker.pad)
 
 
 @dataclass(frozen=True)
@@ -122,6 +123,22 @@ class CollisionChecker:
                 gmodel.addCollisionPair(self.pin.CollisionPair(i, j))
                 pairs.append((i, j))
         return pairs
+
+    def pad(self, padding: float, ends: Iterable[np.ndarray]) -> None:
+        """Plan `padding` [m] clear of everything, except pairs closer than that at `ends`.
+
+        The planner's check only: a path then keeps a clearance that the trajectory's small
+        deviations between its points (timing) cannot eat; certification checks with none.
+        """
+        for req in self.gdata.collisionRequests:
+            req.security_margin = padding
+        for x in ends:
+            q = self.robot.q(x)
+            self.pin.computeCollisions(self.model, self.data, self.gmodel, self.gdata, q, False)
+            for req, res in zip(self.gdata.collisionRequests, self.gdata.collisionResults,
+                                strict=True):  # fmt: skip
+                if res.isCollision():
+                    req.security_margin = 0.0
 
     def first_collision(self, x: np.ndarray, *, every_pair: bool = False) -> tuple[str, str] | None:
         """The first colliding pair at planned joint values `x` (names), or None."""

@@ -20,7 +20,7 @@ from armcli.defaults import PLANNERS
 from armcli.errors import InputError, PlanningError
 from armcli.plan.collision import CollisionChecker
 
-SHORTCUT_TRIES = 60  # random shortcut attempts after the greedy pass
+SHORTCUT_TRIES = 100  # random shortcut attempts after the greedy pass
 _OMPL_NAMES = {
     "rrtconnect": "RRTConnect",
     "rrt": "RRT",
@@ -112,7 +112,7 @@ def shortcut(
             continue
         path = np.vstack([path[: k1 + 1], p1, p2, path[k2 + 1 :]])
         path = _drop_repeats(path)
-    return path
+    return _greedy(path, ok)
 
 
 def _drop_repeats(path: np.ndarray) -> np.ndarray:

@@ -1,7 +1,7 @@
 """The robot a plan moves: Pinocchio model, planned joints and their limits, collision geometry.
 
 `load_plan_robot` is the one place this package loads a model (through urdf.source and
-urdf.pinocchio today; `armcli.robot.Robot` once it lands). The whole robot is loaded with
+urdf.pinocchio today; the one Robot of issue 28 once it lands). The whole robot is loaded with
 a fixed root, so the arm is checked against its own mobile base. Planned joints are the
 free 1-DoF joints a plan moves; mimic followers follow their leaders; every other joint
 stays at its rest value (0, or the middle of its range when 0 is outside it).

@@ -1,13 +1,17 @@
 """Time parameterisation with TOPP-RA under velocity, acceleration and effort limits.
 
-The geometric path is the planner's polyline itself, each segment traversed with a
-quintic smoothstep `h(u) = 10u³ - 15u⁴ + 6u⁵` of the path parameter: the path is C² and
-every joint stops at each corner (dq/ds = 0 there), so the timed motion never leaves the
-collision-checked segments nor the joint-limit box they lie in. Effort is TOPP-RA's joint
-torque constraint with inverse dynamics (Pinocchio RNEA) along the path. TOPP-RA holds the
-limits at its grid points; the output is sampled at OUTPUT_RATE_HZ and simulate interpolates
-it with quintics, so the limits given to TOPP-RA are scaled by `margin` < 1 and the result
-is certified afterwards (plan.certify).
+The geometric path is the planner's polyline itself, and each straight segment is timed on
+its own, from rest to rest: the timed motion never leaves the collision-checked segments
+nor the joint-limit box they lie in. On a straight segment dq/ds is constant and d²q/ds² is
+zero, so TOPP-RA's piecewise-constant path acceleration keeps joint velocity and
+acceleration within their limits between its grid points too, not only at them. Effort is
+TOPP-RA's joint torque constraint with inverse dynamics (Pinocchio RNEA) along the path.
+The whole motion is sampled at OUTPUT_RATE_HZ and the points get the velocities and
+accelerations of the C² cubic spline through them (simulate's quintic interpolation then
+follows that spline exactly). The spline averages TOPP-RA's bang-bang accelerations over a
+sample interval and overshoots their jumps by up to ~27 % (the decay ratio 2 - √3 of
+cubic spline interpolation), so the limits given to TOPP-RA are scaled by `margin` < 1 and
+the result is certified afterwards (plan.certify).
 """
 
 from __future__ import annotations
@@ -41,32 +45,20 @@ class Timed:
         return float(self.times[-1])
 
 
-def _h(u: np.ndarray, order: int) -> np.ndarray:
-    if order == 0:
-        return u**3 * (10.0 - 15.0 * u + 6.0 * u**2)
-    if order == 1:
-        return 30.0 * u**2 * (1.0 - u) ** 2
-    return 60.0 * u * (1.0 - u) * (1.0 - 2.0 * u)
+class SegmentPath:
+    """A straight segment q(s) = a + s (b - a), s in [0, 1] (TOPP-RA's path interface)."""
 
-
-class PolylinePath:
-    """The waypoints (W, n) as a C² path over s in [0, W - 1] (TOPP-RA's path interface)."""
-
-    def __init__(self, waypoints: np.ndarray) -> None:
-        self.points = np.asarray(waypoints, dtype=float)
-        self.deltas = np.diff(self.points, axis=0)
+    def __init__(self, a: np.ndarray, b: np.ndarray) -> None:
+        self.a = np.asarray(a, dtype=float)
+        self.d = np.asarray(b, dtype=float) - self.a
 
     def __call__(self, s: Any, order: int = 0) -> np.ndarray:
         """Positions (order 0) or derivatives d/ds, d²/ds² at path positions `s`."""
-        scalar = np.ndim(s) == 0
-        ss = np.atleast_1d(np.asarray(s, dtype=float))
-        k = np.clip(np.floor(ss).astype(int), 0, len(self.deltas) - 1)
-        u = np.clip(ss - k, 0.0, 1.0)[:, None]
-        out = self.deltas[k] * _h(u, order)
+        ss = np.asarray(s, dtype=float)
+        shape = (*ss.shape, len(self.a))
         if order == 0:
-            out = out + self.points[k]
-        result: np.ndarray = out[0] if scalar else out
-        return result
+            return np.asarray(self.a + ss[..., None] * self.d)
+        return np.broadcast_to(self.d if order == 1 else 0.0 * self.d, shape).copy()
 
     def eval(self, s: Any) -> np.ndarray:
         """Positions at `s`."""
@@ -77,18 +69,18 @@ class PolylinePath:
         return self(s, 1)
 
     def evaldd(self, s: Any) -> np.ndarray:
-        """d²q/ds² at `s`."""
+        """d²q/ds² at `s` (zero)."""
         return self(s, 2)
 
     @property
     def dof(self) -> int:
         """Number of joints."""
-        return int(self.points.shape[1])
+        return len(self.a)
 
     @property
     def path_interval(self) -> np.ndarray:
-        """[0, W - 1]."""
-        return np.array([0.0, float(len(self.points) - 1)])
+        """[0, 1]."""
+        return np.array([0.0, 1.0])
 
     @property
     def waypoints(self) -> None:
@@ -126,37 +118,62 @@ def _follower_map(robot: PlanRobot) -> list[tuple[int, int, float]]:
     return out
 
 
-def parameterise(robot: PlanRobot, waypoints: np.ndarray, margin: float) -> Timed:
-    """Time-optimal motion along the polyline, limits scaled by `margin`; rest at both ends."""
-    import toppra
-    import toppra.algorithm as algo
+def _spline(times: np.ndarray, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Velocities and accelerations at the points of the C² cubic spline through them.
+
+    simulate's quintic between two points with these end values is that cubic exactly,
+    so what is certified is one smooth function (at rest at both ends).
+    """
+    from scipy.interpolate import CubicSpline
+
+    zero = np.zeros(pos.shape[1])
+    spline = CubicSpline(times, pos, bc_type=((1, zero), (1, zero)))
+    return np.asarray(spline(times, 1)), np.asarray(spline(times, 2))
+
+
+def _constraints(robot: PlanRobot, margin: float) -> list[Any]:
     import toppra.constraint as constraint
 
-    logging.getLogger("toppra").setLevel(logging.ERROR)  # library code never prints
-    path = PolylinePath(waypoints)
-    segments = len(waypoints) - 1
-    grid = np.linspace(0.0, float(segments), segments * GRID_PER_SEGMENT + 1)
     cons: list[Any] = [
         constraint.JointVelocityConstraint(np.minimum(robot.velocity, UNLIMITED) * margin),
         constraint.JointAccelerationConstraint(robot.acceleration * margin),
     ]
     if np.any(np.isfinite(robot.effort)):
         effort = np.where(np.isfinite(robot.effort), robot.effort, UNLIMITED)
-        lim = np.column_stack([-effort, effort]) * margin
-        cons.append(
-            constraint.JointTorqueConstraint(
-                inverse_dynamics(robot), lim, np.zeros(path.dof), discretization_scheme=1
-            )
-        )
-    solver = algo.TOPPRA(cons, path, gridpoints=grid, parametrizer="ParametrizeConstAccel")
-    traj = solver.compute_trajectory(0.0, 0.0)
-    if traj is None:
-        raise PlanningError("timing", "TOPP-RA found no motion within the limits along the path")
-    duration = float(traj.duration)
+        # effort is mostly gravity, which the spline does not change: half the margin
+        lim = np.column_stack([-effort, effort]) * (0.5 + 0.5 * margin)
+        tau = inverse_dynamics(robot)
+        cons.append(constraint.JointTorqueConstraint(tau, lim, np.zeros(len(effort)),
+                                                     discretization_scheme=1))  # fmt: skip
+    return cons
+
+
+def parameterise(robot: PlanRobot, waypoints: np.ndarray, margin: float) -> Timed:
+    """Time-optimal motion along the polyline, limits scaled by `margin`; rest at each waypoint."""
+    import toppra.algorithm as algo
+
+    logging.getLogger("toppra").setLevel(logging.ERROR)  # library code never prints
+    cons = _constraints(robot, margin)
+    grid = np.linspace(0.0, 1.0, GRID_PER_SEGMENT + 1)
+    pieces, starts = [], [0.0]
+    for k in range(len(waypoints) - 1):
+        path = SegmentPath(waypoints[k], waypoints[k + 1])
+        solver = algo.TOPPRA(cons, path, gridpoints=grid, parametrizer="ParametrizeConstAccel")
+        traj = solver.compute_trajectory(0.0, 0.0)
+        if traj is None:
+            raise PlanningError("timing", f"TOPP-RA found no motion within the limits along "
+                                f"segment {k + 1} of the path")  # fmt: skip
+        pieces.append(traj)
+        starts.append(starts[-1] + float(traj.duration))
+    duration = starts[-1]
     n_out = max(2, int(np.ceil(duration * OUTPUT_RATE_HZ)) + 1)
     times = np.linspace(0.0, duration, n_out)
-    pos, vel, acc = traj(times, 0), traj(times, 1), traj(times, 2)
+    seg = np.clip(np.searchsorted(starts, times, side="right") - 1, 0, len(pieces) - 1)
+    pos = np.empty((n_out, waypoints.shape[1]))
+    for k, traj in enumerate(pieces):
+        sel = seg == k
+        if np.any(sel):
+            local = np.clip(times[sel] - starts[k], 0.0, float(traj.duration))
+            pos[sel] = np.asarray(traj(local, 0))
     pos[0], pos[-1] = waypoints[0], waypoints[-1]
-    vel[0], vel[-1] = 0.0, 0.0
-    del toppra
-    return Timed(times, np.asarray(pos), np.asarray(vel), np.asarray(acc))
+    return Timed(times, pos, *_spline(times, pos))

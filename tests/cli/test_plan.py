@@ -1,0 +1,100 @@
+"""`armcli plan` through the real command: plan, then simulate the file; failures and bad input."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from tests.helpers import DEFAULT_SPEC, FIXTURES, run_main
+
+BOX = FIXTURES / "plan" / "box_in_the_way.yaml"
+
+
+def plan(args: list[str | Path], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    return run_main(["plan", DEFAULT_SPEC, *args], capsys)
+
+
+def test_plan_home_to_reach_then_simulate(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out_file = tmp_path / "t.yaml"
+    code, out, err = plan(["--from", "home", "--to", "reach", "-o", out_file], capsys)
+    assert code == 0, err
+    assert f"wrote {out_file}" in out
+    assert all(len(line) <= 80 for line in out.splitlines())
+    code, out, err = run_main(["simulate", DEFAULT_SPEC, "--trajectory", out_file], capsys)
+    assert code == 0, err
+    assert "forearm_hand_joint" in out
+
+
+def test_plan_around_a_box_json_and_same_bytes(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    files = [tmp_path / "a.yaml", tmp_path / "b.yaml"]
+    for f in files:
+        code, out, err = plan(["--to", "reach", "--scene", BOX, "--seed", "2", "--format",
+                               "json", "-o", f], capsys)  # fmt: skip
+        assert code == 0, err
+        doc = json.loads(out)
+        assert doc["status"] == "planned" and doc["output"] == str(f)
+        assert doc["waypoints"] > 2  # around the box, not straight through it
+        assert doc["duration_s"] > 0 and doc["path_length_rad"] > 1.1107  # > straight line
+    assert files[0].read_bytes() == files[1].read_bytes()
+
+
+def test_execute_reports_tracking_and_effort(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = plan(["--to", "reach", "--execute", "--format", "json"], capsys)
+    assert code == 0, err
+    done = json.loads(out)["execute"]
+    assert not done["broken"]
+    assert set(done["peak_effort"]) == {"arm_base_forearm_joint", "forearm_hand_joint"}
+    assert done["tip_margin_m"] > 0  # the course arm on its mobile base stays upright
+
+
+def test_start_in_collision_names_link_and_object(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out_file = tmp_path / "t.yaml"
+    # q = (0.4, 0.3): the hand crosses the box (tests/plan/test_api.py's independent check)
+    code, _, err = plan(["--from", "0.4,0.3", "--to", "reach", "--scene", BOX, "-o",
+                           out_file], capsys)  # fmt: skip
+    assert code == 1
+    assert err.strip().splitlines() == ["error: start is in collision: hand_link and box"]
+    assert not out_file.exists()
+
+
+def test_failure_as_json(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = plan(["--to-xyz", "3,0,0.5", "--format", "json"], capsys)
+    assert code == 1
+    doc = json.loads(out)
+    assert doc["status"] == "failed" and doc["output"] is None
+    assert "closest" in doc["reason"]
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["--to", "nowhere"], "--to: unknown pose 'nowhere'"),
+        (["--to", "0.1,0.2,0.3"], "--to: give 2 value(s)"),
+        (["--to", "reach", "--to-xyz", "1,2,3"], "--to: give exactly one goal"),
+        (["--to-xyz", "1,2"], "--to-xyz: expected 3"),
+        (["--to", "reach", "--joints", "wheel"], "--joints: unknown joint 'wheel'"),
+        (["--to", "reach", "--planner", "prm"], "--planner: unknown value 'prm'"),
+    ],
+)
+def test_bad_input_exit_2(args: list[str], words: str, capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = plan(args, capsys)
+    assert code == 2
+    assert words in err and len(err.strip().splitlines()) == 1
+
+
+def test_bad_scene_names_file_and_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    scene = tmp_path / "scene.yaml"
+    scene.write_text(
+        "collision_objects:\n  - id: a\n    primitives: [{type: 7}]\n    primitive_poses: [{}]\n"
+    )
+    code, _, err = plan(["--to", "reach", "--scene", scene], capsys)
+    assert code == 2
+    assert f"{scene}:3 collision_objects[0].primitives[0].type: unknown primitive 7" in err
