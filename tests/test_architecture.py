@@ -15,14 +15,13 @@ from tests.helpers import ROOT
 SRC = ROOT / "src" / "armcli"
 RANK = {  # layer of each top-level module or subpackage (docs/ARCHITECTURE.md)
     "errors": 0, "defaults": 0, "io": 1, "spec": 2, "compiler": 3, "urdf": 4,
-    "check": 5, "sim": 5, "ros": 5, "view": 5, "export": 5, "importer": 5,
-    "tune": 6, "plan": 6, "commands": 7, "cli": 8, "__main__": 9,
+    "check": 5, "sim": 5, "ros": 5, "export": 5, "importer": 5,
+    "tune": 6, "plan": 6, "view": 7, "commands": 8, "cli": 9, "__main__": 10,
 }  # fmt: skip
 SIBLING_EXCEPTIONS = {
     ("check", "armcli.sim.stability"),
     ("check", "armcli.sim.verdict"),
     ("check", "armcli.sim.tipping"),
-    ("view", "armcli.sim.states"),
     ("sim", "armcli.export.mjcf"),
 }
 # The compiler expands its own xacro set with the safe evaluator foreign files get (issue 27:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
@@ -21,6 +22,17 @@ from armcli.commands.xacro_inputs import (
 from armcli.errors import InputError
 from armcli.spec.discover import find_spec
 from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+
+if TYPE_CHECKING:
+    from armcli.urdf.source import Trust
+    from armcli.urdf.xacro_args import XacroInputs
+    from armcli.view.browser import Viewer
+    from armcli.view.panel import PlanningPanel
+    from armcli.view.scene import RobotSource
+
+SCENE_HELP = "Obstacles for the planning panel: YAML like moveit_msgs/PlanningScene."
+SRDF_HELP = "SRDF of a URDF: its named poses (group_state) and disabled collision pairs."
+SAVE_HELP = "Directory the planning panel's Save writes into (default: the current one)."
 
 
 @flag_errors({"pose": "--pose", "q": "--q", "port": "--port", "replay": "--replay"})
@@ -40,12 +52,15 @@ def view_cmd(
         show_default=False,
         help="Port to listen on (default: 8080; 0: any free port).",
     ),
+    scene: Path = typer.Option(None, "--scene", help=SCENE_HELP),
+    srdf: Path = typer.Option(None, "--srdf", help=SRDF_HELP),
+    save_dir: Path = typer.Option(Path("."), "--save-dir", show_default=False, help=SAVE_HELP),
     package_dir: list[str] = package_dir_option(),
     env: list[str] = env_option(),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
-    """Open a browser 3-D viewer with joint sliders, named poses and simulation replay."""
+    """Open a browser 3-D viewer: joint sliders, named poses, replay, motion planning."""
     from armcli.sim import rosbag  # on use: `--help` stays light
     from armcli.sim.states import load_replay
     from armcli.view.browser import Viewer
@@ -54,9 +69,8 @@ def view_cmd(
 
     robot, tokens = split_robot(robot, args)
     inputs = xacro_inputs(tokens, env, package_dir)
-    src = load_robot(
-        find_spec(robot), trust_mode(trust_xacro, unsandboxed), inputs.packages, inputs
-    )
+    trust = trust_mode(trust_xacro, unsandboxed)
+    src = load_robot(find_spec(robot), trust, inputs.packages, inputs)
     write_notes(src.notes)
     pose_q(src, pose, None)  # validate before starting the server
     if not 0 <= port <= 65535:
@@ -78,7 +92,9 @@ def view_cmd(
         host=host,
         port=port,
     )
+    panel = None
     try:  # entered before the URL is printed, so an early Ctrl-C still stops cleanly
+        panel = _panel(viewer, src, scene, srdf, save_dir, trust, inputs)
         if pose:
             viewer.apply_pose(pose)
         sys.stdout.write(f"armcli view: {src.name} at {viewer.url}  (Ctrl-C to stop)\n")
@@ -87,7 +103,40 @@ def view_cmd(
     except KeyboardInterrupt:
         sys.stdout.write("viewer stopped\n")
     finally:
+        if panel is not None:
+            panel.close()
         viewer.close()
+
+
+def _panel(
+    viewer: Viewer,
+    src: RobotSource,
+    scene: Path | None,
+    srdf: Path | None,
+    save_dir: Path,
+    trust: Trust,
+    inputs: XacroInputs,
+) -> PlanningPanel | None:
+    """The planning panel; a robot that cannot be planned for gets none (and a note)."""
+    from armcli.sim.options import SimOptions
+    from armcli.view.panel import PlanningPanel
+    from armcli.view.planning import load_session
+
+    if not save_dir.is_dir():
+        raise InputError(f"{save_dir} is not a directory", field="--save-dir")
+    assert src.file is not None
+    sim = SimOptions(urdf=None if src.file.spec else src.file.path, trust_xacro=trust,
+                     xacro=inputs)  # fmt: skip
+    try:
+        session = load_session(src.file, srdf=srdf, scene=scene, search=src.search, sim=sim,
+                               save_dir=save_dir)  # fmt: skip
+    except InputError as exc:
+        if scene is not None or srdf is not None:
+            raise
+        sys.stderr.write(f"note: no planning panel: {exc}\n")
+        return None
+    return PlanningPanel(viewer, session, src.xml, source=src.source, mesh_dir=src.mesh_dir,
+                         search=src.search)  # fmt: skip
 
 
 def register(app: typer.Typer) -> None:
