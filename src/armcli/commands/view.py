@@ -26,8 +26,7 @@ from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 if TYPE_CHECKING:
     from armcli.urdf.source import Trust
     from armcli.urdf.xacro_args import XacroInputs
-    from armcli.view.browser import Viewer
-    from armcli.view.panel import PlanningPanel
+    from armcli.view.planning import PlanningSession
     from armcli.view.scene import RobotSource
 
 SCENE_HELP = "Obstacles for the planning panel: YAML like moveit_msgs/PlanningScene."
@@ -64,6 +63,7 @@ def view_cmd(
     from armcli.sim import rosbag  # on use: `--help` stays light
     from armcli.sim.states import load_replay
     from armcli.view.browser import Viewer
+    from armcli.view.panel import PlanningPanel
     from armcli.view.png import joint_limits, load_urdf
     from armcli.view.scene import load_robot, pose_q
 
@@ -80,6 +80,7 @@ def view_cmd(
         names = list(joint_limits(load_urdf(src.xml, src.source, src.mesh_dir, src.search)))
         load = rosbag.load_replay if rosbag.is_mcap(replay) else load_replay
         run = load(replay, names)
+    session = _session(src, scene, srdf, save_dir, trust, inputs)  # before the server starts
     viewer = Viewer(
         src.xml,
         name=src.name,
@@ -94,7 +95,9 @@ def view_cmd(
     )
     panel = None
     try:  # entered before the URL is printed, so an early Ctrl-C still stops cleanly
-        panel = _panel(viewer, src, scene, srdf, save_dir, trust, inputs)
+        if session is not None:
+            panel = PlanningPanel(viewer, session, src.xml, source=src.source,
+                                  mesh_dir=src.mesh_dir, search=src.search)  # fmt: skip
         if pose:
             viewer.apply_pose(pose)
         sys.stdout.write(f"armcli view: {src.name} at {viewer.url}  (Ctrl-C to stop)\n")
@@ -108,18 +111,16 @@ def view_cmd(
         viewer.close()
 
 
-def _panel(
-    viewer: Viewer,
+def _session(
     src: RobotSource,
     scene: Path | None,
     srdf: Path | None,
     save_dir: Path,
     trust: Trust,
     inputs: XacroInputs,
-) -> PlanningPanel | None:
-    """The planning panel; a robot that cannot be planned for gets none (and a note)."""
+) -> PlanningSession | None:
+    """The planning panel's session; a robot that cannot be planned for gets none (a note)."""
     from armcli.sim.options import SimOptions
-    from armcli.view.panel import PlanningPanel
     from armcli.view.planning import load_session
 
     if not save_dir.is_dir():
@@ -135,8 +136,7 @@ def _panel(
             raise
         sys.stderr.write(f"note: no planning panel: {exc}\n")
         return None
-    return PlanningPanel(viewer, session, src.xml, source=src.source, mesh_dir=src.mesh_dir,
-                         search=src.search)  # fmt: skip
+    return session
 
 
 def register(app: typer.Typer) -> None:

@@ -32,6 +32,7 @@ TRAIL_RGBA = (0.85, 0.2, 0.75, 0.22)  # translucent magenta ghosts along the pla
 PATH_RGB = (200, 30, 170)  # the tool point's planned path
 OBSTACLE_RGB = (150, 150, 165)  # the scene's collision objects
 PATH_THICKNESS = 0.006  # [m]
+CAMERA_BACK = 1.2  # the first view steps back this much to take in the poses' reach
 HANDLE_SCALE = 0.15  # [m] size of the tool point's drag handles
 CURRENT = "<current>"  # start: where the robot is now
 DRAGGED = "<dragged>"  # goal: wherever the tool point was dragged
@@ -62,6 +63,7 @@ class PlanningPanel:
         self._path: Any = None
         self._build_gui()
         self._build_handle()
+        self._frame_camera()
         for k, ob in enumerate(session.obstacles()):
             viewer.server.scene.add_mesh_simple(f"/plan/scene/{k}", ob.vertices, ob.faces,
                                                 color=OBSTACLE_RGB, opacity=0.6)  # fmt: skip
@@ -72,6 +74,10 @@ class PlanningPanel:
     def status(self) -> str:
         """The one status line shown under the buttons."""
         return str(self._status.content)
+
+    def replaying(self) -> bool:
+        """Whether an executed motion is being replayed on the robot."""
+        return self._replayer is not None and self._replayer.is_alive()
 
     def trail_visible(self) -> bool:
         """Whether a plan's ghost trail is drawn."""
@@ -226,6 +232,16 @@ class PlanningPanel:
             self._quiet = False
 
     # -- scene ---------------------------------------------------------------------------
+    def _frame_camera(self) -> None:
+        """Aim the first view at the robot and the tool points of its named poses."""
+        cam = self.viewer.server.initial_camera
+        look, eye = np.asarray(cam.look_at, dtype=float), np.asarray(cam.position, dtype=float)
+        names = self.session.pose_names
+        pts = np.array([look, *(self.session.tool(self.session.pose(n))[0] for n in names)])
+        centre = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+        cam.look_at = centre
+        cam.position = centre + CAMERA_BACK * (eye - look)
+
     def _ghost(self, root: str, rgba: tuple[float, float, float, float]) -> Any:
         from viser.extras import ViserUrdf
 
@@ -246,8 +262,9 @@ class PlanningPanel:
         self._buttons(busy=False)
 
     def _place_handle(self, p: np.ndarray, R: np.ndarray) -> None:
-        self._handle.position = tuple(float(v) for v in p)
-        self._handle.wxyz = tuple(float(v) for v in _quaternion(R))
+        w, x, y, z = (float(v) for v in _quaternion(R))
+        self._handle.position = (float(p[0]), float(p[1]), float(p[2]))
+        self._handle.wxyz = (w, x, y, z)
 
     def _draw_trail(self) -> None:
         trail = self.session.trail()
