@@ -1,4 +1,4 @@
-"""`armcli view`: a browser 3-D viewer with sliders, named poses and replay."""
+"""`armcli view`: a browser 3-D viewer with sliders, named poses, replay and a planning panel."""
 
 from __future__ import annotations
 
