@@ -14,10 +14,15 @@ from tests.helpers import ROOT
 
 SRC = ROOT / "src" / "armcli"
 RANK = {  # layer of each top-level module or subpackage (docs/ARCHITECTURE.md)
-    "errors": 0, "defaults": 0, "io": 1, "spec": 2, "compiler": 3, "urdf": 4,
-    "check": 5, "sim": 5, "ros": 5, "export": 5, "importer": 5,
-    "tune": 6, "plan": 6, "view": 7, "commands": 8, "cli": 9, "__main__": 10,
+    "errors": 0, "defaults": 0, "io": 1, "spec": 2, "compiler": 3, "urdf": 4, "robot": 5,
+    "analysis": 6, "check": 7, "sim": 7, "ros": 7, "export": 7, "importer": 7,
+    "tune": 8, "plan": 8, "view": 9, "commands": 10, "cli": 11, "__main__": 12,
 }  # fmt: skip
+# Modules of the analysis layer still waiting in urdf/ for their move to analysis/ (issue 28,
+# step 2): they stand above robot/, which they use, and nothing in urdf/ imports them.
+PENDING_ANALYSIS = {
+    f"armcli.urdf.{m}" for m in ("stance", "ground", "support", "workspace", "boxsearch")
+}
 SIBLING_EXCEPTIONS = {
     ("check", "armcli.sim.stability"),
     ("check", "armcli.sim.verdict"),
@@ -54,6 +59,8 @@ def _graph() -> dict[str, set[str]]:
 
 
 def _layer(module: str) -> str:
+    if module in PENDING_ANALYSIS:
+        return "analysis"
     parts = module.split(".")
     return parts[1] if len(parts) > 1 else "errors"  # the package itself holds only metadata
 

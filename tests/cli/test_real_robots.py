@@ -135,3 +135,40 @@ def test_an_inertia_tensor_error_leaves_the_balance_running(
         assert "static balance on caster_link, left_wheel, right_wheel" in out
         assert "support polygon (-0.120, 0.000) (0.000, -0.117) (0.000, 0.117) m" in out
         assert "dynamics checks skipped" in out
+
+
+LINES = REAL / "xacro_lines"
+TOP, PARTS = LINES / "robot.urdf.xacro", LINES / "parts" / "caster.xacro"
+
+
+def _line_of(path: Path, needle: str) -> int:
+    """The 1-based line of the fixture text that holds `needle` (once)."""
+    (k,) = [i for i, row in enumerate(path.read_text().splitlines(), 1) if needle in row]
+    return k
+
+
+def test_xacro_findings_land_on_the_users_own_lines(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """TurtleBot3: a caster inertia defined by a macro in an included file was reported at
+    the expanded document's line, with no `line=` for GitHub and no SARIF region."""
+    inertia = _line_of(PARTS, "<inertia ixx")  # the start tag, not where it ends (+2)
+    call = _line_of(TOP, "<xacro:caster ")
+    monkeypatch.chdir(LINES)  # annotations name files relative to the repository
+    code, out, _ = run_main(["check", TOP, "--format", "github"], capsys)
+    assert code == 1
+    (line,) = [ln for ln in out.splitlines() if "inertia-exceeds-geometry" in ln]
+    assert line.startswith(f"::error file=parts/caster.xacro,line={inertia},")
+    assert f"through the macro call at robot.urdf.xacro:{call}" in line
+    code, out, _ = run_main(["check", TOP, "--format", "sarif"], capsys)
+    (result,) = [
+        r
+        for r in json.loads(out)["runs"][0]["results"]
+        if r["ruleId"] == "inertia-exceeds-geometry"
+    ]
+    place = result["locations"][0]["physicalLocation"]
+    assert place["artifactLocation"]["uri"] == "parts/caster.xacro"
+    assert place["region"] == {"startLine": inertia}
+    (called,) = result["relatedLocations"]
+    assert called["physicalLocation"]["artifactLocation"]["uri"] == "robot.urdf.xacro"
+    assert called["physicalLocation"]["region"] == {"startLine": call}

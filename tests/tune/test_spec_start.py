@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from armcli.robot.load import load_model
 from armcli.sim.simulate import Arm, arm_from_model
 from armcli.tune.model_gains import linearised, loop_stable, sample_configurations
 from armcli.tune.spec_start import KD_MARGIN, _explicit_kd
-from armcli.urdf.pinocchio import load_model
 from tests.helpers import FIXTURES
 
 URDF = FIXTURES / "tune" / "pendulum.urdf"

@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from armcli.compiler.expand import expand_urdfs
+from armcli.robot.model import Robot
+from armcli.robot.tool import ToolPoint
 from armcli.spec.load import load_spec
-from armcli.urdf.pinocchio import load_model
-from armcli.urdf.tool import ToolPoint
 from armcli.urdf.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 from tests.helpers import DEFAULT_SPEC, ROOT
 
@@ -25,10 +25,10 @@ SHOULDER = np.array([0.15, 0.0, 0.32])  # mount (0.15, 0, 0.2) above base_link a
 
 
 @pytest.fixture(scope="module")
-def model() -> object:
+def model() -> Robot:
     spec = load_spec(DEFAULT_SPEC)
     text = expand_urdfs(spec)["my_robot.urdf"].decode()
-    return load_model("my_robot.urdf", xml=text).model
+    return Robot.from_xml(text, "my_robot.urdf")
 
 
 def tool_at(q1: float, q2: float) -> np.ndarray:
@@ -39,7 +39,7 @@ def tool_at(q1: float, q2: float) -> np.ndarray:
     )
 
 
-def test_envelope_of_the_tool_point(model: object) -> None:
+def test_envelope_of_the_tool_point(model: Robot) -> None:
     chain = Chain(model, ToolPoint("hand_link", (0.0, 0.0, 0.3)))
     assert [jr.name for jr in chain.joints] == ["arm_base_forearm_joint", "forearm_hand_joint"]
     w = envelope(chain, sample(chain, 200))
@@ -50,7 +50,7 @@ def test_envelope_of_the_tool_point(model: object) -> None:
     assert w.max_horizontal == pytest.approx(0.15 + 0.6, abs=EXACT)  # stretched forward
 
 
-def test_reachable_points_and_residuals(model: object) -> None:
+def test_reachable_points_and_residuals(model: Robot) -> None:
     chain = Chain(model, ToolPoint("hand_link", (0.0, 0.0, 0.3)))
     cloud = sample(chain, 500)
     inside = tool_at(0.4, 1.1)  # a configuration within the limits
@@ -67,7 +67,7 @@ def test_reachable_points_and_residuals(model: object) -> None:
 
 
 @pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")  # its open()
-def test_agrees_with_urdf_validator_on_its_point(model: object) -> None:
+def test_agrees_with_urdf_validator_on_its_point(model: Robot) -> None:
     """urdf-validator 1.6.0 measures the hand link's origin, not the tool point, and its
     max reach from the arm's mount link origin (0.02 m below the shoulder joint): with the
     same point and centre the numbers agree; armcli's own definitions differ on purpose."""

@@ -179,6 +179,10 @@ def test_cli_checks_foreign_xacro_without_trust(root: Path) -> None:
     ]
     safe, trusted = (json.loads(r.stdout)["files"][0]["findings"] for r in runs)
     assert runs[0].returncode == runs[1].returncode == 1  # the course's 4x inertias (test_check)
+    # Safe mode also knows where each element was written (xacro itself does not say).
+    origins = [f.pop("origin") for f in safe]
+    assert all(o is not None and o["file"] == str(fixture) for o in origins)
+    assert all(f.pop("origin") is None for f in trusted)
     assert safe == trusted and {f["rule"] for f in safe} >= {"inertia-geometry"}
 
 

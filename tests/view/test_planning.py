@@ -48,6 +48,20 @@ def session(robot, tmp_path: Path) -> PlanningSession:  # type: ignore[no-untype
     return load_session(robot.file, save_dir=tmp_path)
 
 
+@pytest.fixture
+def boxed(robot, tmp_path: Path) -> PlanningSession:  # type: ignore[no-untyped-def]
+    """The course robot with a 0.1 m box around the tool point of its `reach` pose."""
+    x, _, z = (float(v) for v in tip(np.array([math.pi / 4, math.pi / 4])))
+    scene = tmp_path / "scene.yaml"
+    scene.write_text(
+        "collision_objects:\n"
+        "  - id: box\n"
+        "    primitives: [{type: box, dimensions: [0.1, 0.1, 0.1]}]\n"
+        f"    primitive_poses: [{{position: {{x: {x!r}, y: 0.0, z: {z!r}}}}}]\n"
+    )
+    return load_session(robot.file, scene=scene, save_dir=tmp_path)
+
+
 def test_poses_and_tool_match_the_closed_form(session: PlanningSession) -> None:
     assert session.joints == ("arm_base_forearm_joint", "forearm_hand_joint")
     assert session.pose_names == ("home", "reach", "folded")  # the spec's order
@@ -73,10 +87,11 @@ def test_plan_draws_a_trail_from_start_to_goal(session: PlanningSession) -> None
     assert np.allclose(trail.tool_path[:, 1], 0.0, atol=FK_TOL)  # planar arm: y stays 0
 
 
-def test_a_failed_plan_is_one_line_and_no_trail(session: PlanningSession) -> None:
-    session.set_goal(session.pose("folded"))  # the forearm folds into the base
-    assert session.plan() is None
-    assert session.reason == "goal is in collision: base_link and forearm_link"
+def test_a_failed_plan_is_one_line_and_no_trail(boxed: PlanningSession) -> None:
+    boxed.set_goal(boxed.pose("reach"))  # the hand ends inside the box
+    assert boxed.plan() is None
+    assert boxed.reason == "goal is in collision: hand_link and box"
+    session = boxed
     with pytest.raises(PlanningError, match="nothing planned yet"):
         session.trail()
 
@@ -155,9 +170,9 @@ def test_scene_obstacles_become_meshes_where_the_scene_puts_them(
 
 
 @pytest.fixture
-def panel(robot, session: PlanningSession) -> Iterator[PlanningPanel]:  # type: ignore[no-untyped-def]
+def panel(robot, boxed: PlanningSession) -> Iterator[PlanningPanel]:  # type: ignore[no-untyped-def]
     viewer = Viewer(robot.xml, name=robot.name, poses=robot.poses, tool=robot.tool, port=0)
-    p = PlanningPanel(viewer, session, robot.xml, source=robot.source)
+    p = PlanningPanel(viewer, boxed, robot.xml, source=robot.source)
     try:
         yield p
     finally:
@@ -168,19 +183,21 @@ def panel(robot, session: PlanningSession) -> Iterator[PlanningPanel]:  # type: 
 def test_panel_widgets_drive_the_session(panel: PlanningPanel) -> None:
     session = panel.session
     assert np.array_equal(session.goal, session.pose("reach"))  # the first pose after home
-    panel.choose_start("reach")  # a named start also moves the robot there
-    assert panel.viewer.configuration()["arm_base_forearm_joint"] == pytest.approx(math.pi / 4)
+    panel.choose_start("folded")  # a named start also moves the robot there
+    folded = session.pose("folded")
+    assert panel.viewer.tool_position() == pytest.approx(tip(folded), abs=FK_TOL)
     panel.choose_start("<current>")
-    panel.choose_goal("folded")
+    panel.choose_goal("home")
+    panel.choose_goal("reach")  # into the box
     assert not panel.plan()
-    assert panel.status == "no plan: goal is in collision: base_link and forearm_link"
+    assert panel.status == "no plan: goal is in collision: hand_link and box"
     assert not panel.trail_visible()
     assert panel.save() is None and panel.status.startswith("not saved: nothing planned")
     panel.drag(tuple(tip(np.array([0.2, 0.6]))))
     assert panel.status == "goal: tool point reached"
     assert panel._goal_box.value == DRAGGED
-    assert panel.plan() and panel.trail_visible()  # from the current pose (reach) to the drag
-    assert session.start == pytest.approx(session.pose("reach"), abs=END_TOL)
+    assert panel.plan() and panel.trail_visible()  # from the current pose (folded) to the drag
+    assert session.start == pytest.approx(folded, abs=END_TOL)
     assert panel.status.startswith("planned: ") and panel.status.endswith("; certified")
     saved = panel.save()
     assert saved is not None and saved.read_bytes() == session.result.document  # type: ignore[union-attr]

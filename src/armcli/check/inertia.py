@@ -11,8 +11,8 @@ import numpy as np
 
 from armcli.check.rules import Collector
 from armcli.check.structure import Tree, finite
-from armcli.urdf import inertia as inr
-from armcli.urdf import inertia_bounds as bounds
+from armcli.robot import inertia as inr
+from armcli.robot import inertia_bounds as bounds
 from armcli.urdf.doc import Inertial, Link, Shape, Urdf
 
 # Inertia within 5 % (Frobenius, relative) of the solid-body formula counts as

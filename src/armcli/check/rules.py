@@ -8,11 +8,13 @@ module is the floor they all stand on, so it imports none of them.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from armcli.urdf.doc import Origin
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import lookup_for
 
@@ -359,6 +361,15 @@ class Finding:
     hint: str = ""
     fix: Mapping[str, Value] = field(default_factory=dict)  # the numbers that would pass
     spec: SpecPlace | None = None  # the spec field behind a generated URDF's element
+    origin: Origin | None = None  # a xacro expansion's element: the line the user wrote
+
+    @property
+    def calls_text(self) -> str:
+        """The `(through the macro call at FILE:LINE, ...)` suffix of a macro's element."""
+        if self.origin is None or not self.origin.calls:
+            return ""
+        at = ", then ".join(f"{shown_path(f)}:{n}" for f, n in self.origin.calls)
+        return f" (through the macro call at {at})"
 
     def to_dict(self) -> dict[str, Any]:
         """The finding as a JSON object in the stable schema of docs/check.md."""
@@ -372,7 +383,20 @@ class Finding:
             "hint": self.hint,
             "fix": dict(self.fix),
             "spec": None if self.spec is None else vars(self.spec).copy(),
+            "origin": None
+            if self.origin is None
+            else {
+                "file": self.origin.file,
+                "line": self.origin.line,
+                "calls": [{"file": f, "line": n} for f, n in self.origin.calls],
+            },
         }
+
+
+def shown_path(path: str) -> str:
+    """A path as a message shows it: relative to the working directory when under it."""
+    rel = os.path.relpath(path) if os.path.isabs(path) else path
+    return path if rel.startswith("..") else rel
 
 
 class Collector:

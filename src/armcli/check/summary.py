@@ -15,11 +15,11 @@ import numpy as np
 from armcli.check.context import Context, poses
 from armcli.check.rules import CheckOptions, JointRow
 from armcli.check.structure import finite
+from armcli.robot.load import link_frame
+from armcli.robot.tool import tool_point
 from armcli.sim.verdict import StabilityReport
 from armcli.spec.joint_types import total_dof
 from armcli.urdf.doc import Urdf
-from armcli.urdf.pinocchio import configuration, link_frame
-from armcli.urdf.tool import tool_point
 
 if TYPE_CHECKING:  # the balance and reach results: imported by their own families
     from armcli.check.balance import StaticBalance
@@ -71,15 +71,15 @@ def summarise(ctx: Context) -> Summary:
         "reach": ctx.reach,
         "reach_points": ctx.reach_points,
     }
-    if ctx.model is None or _no_arm(ctx):
+    if ctx.robot is None or _no_arm(ctx):
         return Summary(**base, end_effector="", poses=())
     import pinocchio as pin
 
-    model, data = ctx.model, ctx.data
+    model, data = ctx.robot.model, ctx.robot.data
     ee_label, ee_frame, ee_offset = _end_effector(urdf, ctx.opts, model)
     pose_rows = []
     for name, values in poses(ctx):
-        q = configuration(model, values)
+        q = ctx.robot.q(values)
         pin.framesForwardKinematics(model, data, q)
         xyz = data.oMf[ee_frame].act(np.asarray(ee_offset, dtype=float))
         pose_rows.append(PoseRow(name, tuple(values.items()), tuple(float(x) for x in xyz)))  # type: ignore[arg-type]
@@ -100,7 +100,7 @@ def _total_mass(urdf: Urdf) -> float:
 def _end_effector(
     urdf: Urdf, opts: CheckOptions, model: Any
 ) -> tuple[str, int, tuple[float, float, float]]:
-    """The tool point (armcli.urdf.tool) as (label, Pinocchio frame id, offset [m])."""
+    """The tool point (armcli.robot.tool) as (label, Pinocchio frame id, offset [m])."""
     tool = tool_point(urdf, opts.spec)
     frame = link_frame(model, tool.link) if tool is not None else None
     if tool is None or frame is None:

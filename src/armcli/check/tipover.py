@@ -16,9 +16,9 @@ from armcli.check import balance
 from armcli.check.balance import PoseBalance, StaticBalance
 from armcli.check.context import Context, poses
 from armcli.check.rules import Collector, Value
+from armcli.robot.tool import tool_point
 from armcli.urdf.ground import mesh_loader
 from armcli.urdf.stance import NoStance, Payload, Stance, stance_of
-from armcli.urdf.tool import tool_point
 
 NEAR_NAMED = 1e-3  # [m] a range's worst within this of a named pose's is that pose's finding
 

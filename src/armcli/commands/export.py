@@ -64,7 +64,7 @@ def mjcf_cmd(
     from armcli.compiler.expand import spec_label  # on use: `--help` stays light
     from armcli.export.mjcf_files import export_mjcf
 
-    check_output_file(out, "--out")  # before any work: nothing else is written
+    check_output_file(out, "--out", parents=True)  # before any work: nothing else is written
     robot, tokens = split_robot(robot, args)
     inputs = xacro_inputs(tokens, env, package_dir)
     robot = find_spec(robot)

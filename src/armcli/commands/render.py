@@ -23,6 +23,7 @@ from armcli.commands.xacro_inputs import (
 from armcli.errors import InputError
 from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
+from armcli.io.terminal import say
 from armcli.spec.discover import find_spec
 from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
@@ -120,9 +121,9 @@ def render_cmd(
             one_line(f"warning: {src.source}: mesh {uri!r}: {what}; drawn without it") + "\n"
         )
     drawn = _drawn(src.poses, pose, q)
-    sys.stdout.write(f"wrote {res.path} ({res.width}x{res.height} px) at {drawn};{tip}\n")
+    say(f"wrote {res.path} ({res.width}x{res.height} px) at {drawn};{tip}")
     for line in lines:
-        sys.stdout.write(f"{line}\n")
+        say(line)
 
 
 def _drawn(poses: Mapping[str, Mapping[str, float]], pose: str | None, q: str | None) -> str:

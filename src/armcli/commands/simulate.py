@@ -33,7 +33,7 @@ if TYPE_CHECKING:  # the simulator is imported when the command runs: `--help` s
 
 INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
 GRAVITY_HELP = "Add g(q) to the PD torque (default: the spec's control.gravity_compensation)."
-IGNORE_HELP = "Simulate a --urdf despite this `check` rule's error (repeatable)."
+IGNORE_HELP = "Simulate the robot despite this `check` rule's error (repeatable)."
 TRAJECTORY_HELP = "JointTrajectory YAML (a point without time_from_start: previous + 1 s)."
 BASE_ACCEL_HELP = (
     "Base acceleration and braking [m/s²] for the zero-moment point "
@@ -53,6 +53,24 @@ FLAGS = {
     "joints": "--joints",
     "output": "--output",
 }
+
+
+def _flagged(line: str) -> str:
+    """`SimOptions.message ...` as `--message ...`: a line names the flag the user typed."""
+    source = line.split(" ", 1)[0]
+    return FLAGS.get(source, source) + line[len(source) :]
+
+
+def _diagnose(job: Any) -> None:
+    """Refuse a reference faster than a velocity limit; warn of efforts below gravity."""
+    from armcli.sim.precheck import holding_problems, speed_problems
+
+    fast = speed_problems(job)
+    if fast:
+        more = f" (and {len(fast) - 1} more joint(s))" if len(fast) > 1 else ""
+        raise InputError(_flagged(fast[0]) + more)
+    for line in holding_problems(job):
+        sys.stderr.write(one_line(f"warning: {_flagged(line)}") + "\n")
 
 
 def _floats(text: str | None, option: str) -> list[float] | None:
@@ -142,6 +160,7 @@ def simulate_cmd(
         _drive(spec_obj, opts, cmd_vel, tuple(ignore), output, plot, tip_opts != TipOptions())
         return
     job = _prepare(spec_obj, spec_path, opts, tuple(ignore))
+    _diagnose(job)  # the trajectory's own impossibilities before any simulated verdict
     notes: list[str] = []
     tip = tipping.prepare(spec_obj, job, tip_opts, inputs.packages, notes)
     asked = tip_opts != TipOptions()  # an arm on a fixed base is news only when asked about
@@ -162,7 +181,14 @@ def _prepare(
         refuse_check_errors(doc, ignore=ignore)
 
     try:
-        return simjob.prepare(spec, opts, gate=gate)
+        job = simjob.prepare(spec, opts, gate=gate)
+        if spec is not None and opts.urdf is None:  # a spec's whole robot, as `check` sees it
+            from armcli.sim.tipping import robot_urdf
+
+            whole = robot_urdf(spec, job)
+            if whole is not None:
+                gate(whole)
+        return job
     except ModelRefusedError as exc:
         flags = " ".join(f"--ignore {r}" for r in exc.rules())
         raise ModelRefusedError(
@@ -225,9 +251,7 @@ def _run(
     err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
     write_notes([*job.notes, *(notes or [])])
     for w in job.trajectory.warnings:
-        source = w.split(" ", 1)[0]  # `SimOptions.message` is the flag `--message`
-        w = FLAGS.get(source, source) + w[len(source) :]
-        err.print(one_line(f"warning: {w}"), markup=False, highlight=False)
+        err.print(one_line(f"warning: {_flagged(w)}"), markup=False, highlight=False)
     extra = None if tip is None else (lambda steps: tip.steps(job, steps))
     with _LazyProgress(err) as progress:
         res = simjob.run(job, progress, plot=plot is not None, extra=extra)
@@ -253,11 +277,13 @@ def _run(
     out.print(simreport.summary_table(metrics, ee, job.tool_label, res), crop=False)
     balance = tipping.report(tip, series) if tip is not None and series is not None else None
     if balance is not None:
+        for lift in balance.lifts:  # too short to tip the robot: a wheel unloads, a warning
+            err.print(one_line(f"warning: {lift.line()}"), markup=False, highlight=False)
         line = tipping.summary_line(balance)
         out.print(line, style="red" if balance.tips else None, markup=False, highlight=False)
     for path in (output, plot):
         if path is not None:
-            out.print(f"wrote {path}", markup=False, highlight=False)
+            out.print(one_line(f"wrote {path}"), markup=False, highlight=False)
     if balance is not None and balance.tips:
         raise tipping.tip_error(balance)
 

@@ -13,6 +13,7 @@ from armcli.commands.options import choice, option, spec_argument
 from armcli.defaults import PD_LOOPS, ROBUST_MODES
 from armcli.errors import InputError
 from armcli.io import terminal
+from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file, check_png_file
 from armcli.spec.discover import find_spec
 
@@ -175,7 +176,7 @@ def _run(
     write_files_together(files)
     for path in (output, plot, spec_path if write else None):
         if path is not None:
-            out.print(f"wrote {path}", markup=False, highlight=False)
+            out.print(one_line(f"wrote {path}"), markup=False, highlight=False)
 
 
 def _summary(out: Any, outcome: session.Outcome) -> None:

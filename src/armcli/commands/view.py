@@ -20,6 +20,7 @@ from armcli.commands.xacro_inputs import (
     xacro_inputs,
 )
 from armcli.errors import InputError
+from armcli.io.oneline import one_line
 from armcli.spec.discover import find_spec
 from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
@@ -100,7 +101,9 @@ def view_cmd(
                                   mesh_dir=src.mesh_dir, search=src.search)  # fmt: skip
         if pose:
             viewer.apply_pose(pose)
-        sys.stdout.write(f"armcli view: {src.name} at {viewer.url}  (Ctrl-C to stop)\n")
+        sys.stdout.write(
+            one_line(f"armcli view: {src.name} at {viewer.url}  (Ctrl-C to stop)") + "\n"
+        )
         sys.stdout.flush()
         viewer.serve_forever()
     except KeyboardInterrupt:

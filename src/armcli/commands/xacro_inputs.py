@@ -19,6 +19,7 @@ import typer
 
 from armcli.errors import InputError
 from armcli.io.oneline import one_line
+from armcli.io.terminal import say
 from armcli.urdf.packages import PackageLookup, parse_package_dirs
 from armcli.urdf.xacro_args import ARGS_HELP, ENV_HELP, XacroInputs, is_arg, parse_args, parse_env
 
@@ -93,4 +94,4 @@ def write_notes(notes: Iterable[str], file: str | None = None) -> None:
     for line in notes:
         label, _, text = line.partition(": ")
         shown = f"{label}: {file}: {text}" if file else line
-        sys.stderr.write(one_line(shown) + "\n")
+        say(one_line(shown), sys.stderr)  # one line in a log; wrapped at a terminal

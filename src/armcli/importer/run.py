@@ -3,9 +3,9 @@
 The import reads links, joints, materials and top-level extensions, decides what the
 spec can type (derived inertials, named materials, Gazebo colours and friction, the
 course's plugins, the arm/base split) and keeps the rest verbatim in `passthrough`.
-It then builds the spec it wrote, in memory with the real xacro, and lists every way
-the result differs from the input (`armcli.importer.compare`): whatever cannot round-trip
-is reported, never silently lost.
+It then builds the spec it wrote, in memory with the safe xacro evaluator `build` uses,
+and lists every way the result differs from the input (`armcli.importer.compare`):
+whatever cannot round-trip is reported, never silently lost.
 """
 
 from __future__ import annotations
@@ -19,7 +19,6 @@ from typing import Any
 
 from lxml import etree
 
-from armcli.compiler.expand import expand_urdfs
 from armcli.compiler.meshfiles import is_path
 from armcli.compiler.xacro_writer import top_level_files
 from armcli.errors import InputError, SpecError
@@ -34,6 +33,7 @@ from armcli.spec.joint_types import ONE_DOF_TYPES
 from armcli.spec.load import loads_spec
 from armcli.spec.model import RobotSpec
 from armcli.urdf.read import parse_root
+from armcli.urdf.source import spec_urdfs
 
 _GAZEBO_NAME = re.compile(r"^[A-Za-z0-9_/]{1,64}$")
 _NOT_NAME = re.compile(r"[^A-Za-z0-9_-]")
@@ -276,7 +276,7 @@ def import_urdf(
         ]
         text = document(data, header, comments)
         spec = _load(text, out, source)
-    built = expand_urdfs(spec)
+    built = spec_urdfs(spec)
     main = next(n for n in (f"{spec.name}.urdf", *top_level_files(spec)) if n in built)
     got = etree.fromstring(built[main])
     diffs = compare_urdf(root, got, (base, None))

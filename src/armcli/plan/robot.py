@@ -19,13 +19,13 @@ import numpy as np
 
 from armcli.defaults import DEFAULT_JOINT_ACCELERATION
 from armcli.errors import InputError
+from armcli.robot.load import checked_model, collision_model
+from armcli.robot.mimic import Mimic, follow, mimics
+from armcli.robot.tool import tool_point
 from armcli.urdf.doc import Urdf
 from armcli.urdf.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
 from armcli.urdf.meshes import MeshSearch, mesh_paths
-from armcli.urdf.mimic import Mimic, follow, mimics
-from armcli.urdf.pinocchio import collision_model
-from armcli.urdf.source import RobotFile, checked_model, urdf_text
-from armcli.urdf.tool import tool_point
+from armcli.urdf.source import RobotFile, urdf_text
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec

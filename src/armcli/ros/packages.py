@@ -19,7 +19,6 @@ from typing import Any
 import yaml
 from lxml import etree
 
-from armcli.compiler.expand import expand_urdfs
 from armcli.compiler.meshfiles import MeshNames, package_of, spec_mesh_names
 from armcli.compiler.xacro_writer import GENERATED, STANDALONE_ARM, top_level_files, xacro_files
 from armcli.defaults import ROS_TARGETS, STANDALONE_ARM_URDF
@@ -46,7 +45,7 @@ from armcli.spec.model import RobotSpec
 from armcli.urdf.meshes import localized
 from armcli.urdf.packages import PackageLookup
 from armcli.urdf.read import parse_urdf
-from armcli.urdf.source import lookup_for
+from armcli.urdf.source import lookup_for, spec_urdfs
 
 FORMAT3_SCHEMA = "http://download.ros.org/schema/package_format3.xsd"
 DISPLAY_RVIZ = "display.rviz"
@@ -310,7 +309,7 @@ def ros_packages(
     mc.controller_update_rate(spec, source)  # refuse bad input before the slow sampling
     if target == "jazzy":
         jazzy.required_gains(spec, source)
-    urdfs = expand_urdfs(spec)
+    urdfs = spec_urdfs(spec)
     urdf_xml = urdfs.get(f"{n.robot}.urdf", urdfs[STANDALONE_ARM_URDF])
     poses = {name: spec.pose(name) for name in spec.poses}
     local = localized(urdf_xml, source or n.robot_xacro, spec.base_dir, lookup_for(spec, packages))

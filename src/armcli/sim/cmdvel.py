@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import Problem, SpecError
-from armcli.io.yaml import YamlDoc, load_yaml, loads_yaml
+from armcli.io.yaml import YamlDoc, dotted, load_yaml, loads_yaml
 from armcli.sim.trajectory import _Collector, _finite, _short, _time
 
 _TOP_KEYS = {"commands"}
@@ -122,7 +122,8 @@ def _ignored(linear: np.ndarray, angular: np.ndarray, source: str) -> tuple[str,
             rows = np.nonzero(values[:, i])[0]
             if rows.size:
                 out.append(
-                    f"{source} commands.{int(rows[0])}.{part}.{axis}: a differential drive "
-                    f"follows linear.x and angular.z only; {part}.{axis} is ignored"
+                    f"{source} {dotted(('commands', int(rows[0]), part, axis))}: a "
+                    f"differential drive follows linear.x and angular.z only; {part}.{axis} "
+                    "is ignored"
                 )
     return tuple(out)

@@ -23,14 +23,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from armcli.errors import InputError
+from armcli.errors import InputError, SimulationError
 from armcli.sim import job as simjob
 from armcli.sim.cmdvel import CmdVel, load_cmd_vel
 from armcli.sim.diffdrive import DiffDriveController, DriveParams, Odometry, encoder_odometry
 from armcli.sim.drivemodel import DriveModel, build_drive_model
 from armcli.sim.job import SimJob
 from armcli.sim.options import SimOptions
-from armcli.sim.simulate import configuration, steps_of
+from armcli.sim.simulate import steps_of
 from armcli.sim.tipping import robot_urdf
 from armcli.urdf.doc import Urdf
 from armcli.urdf.stance import NoStance, Stance, stance_of
@@ -97,7 +97,10 @@ def prepare(
     stance = stance_of(robot, candidates=set(spec.mobile_base.links) if spec.mobile_base else None)
     if isinstance(stance, NoStance):
         raise InputError(f"the robot cannot stand: {stance.reason}", field="mobile_base")
-    gains = (np.asarray(job.config.kp, dtype=float), np.asarray(job.config.kd, dtype=float))
+    n = len(job.arm.joint_names)
+    kp = np.broadcast_to(np.asarray(job.config.kp, dtype=float), (n,))
+    kd = np.broadcast_to(np.asarray(job.config.kd, dtype=float), (n,))
+    gains = (kp, kd, np.asarray(job.arm.effort, dtype=float))
     model = build_drive_model(
         robot, spec, stance, params, job.arm.joint_names, gains, job.config.dt
     )
@@ -170,8 +173,12 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
     rec = np.empty((steps + 1, dm.layout.size))
     wheel_cmd = np.zeros((steps + 1, 2))
     controller = DiffDriveController(job.params)
-    n, wheel_act, wheel_dof = len(arm.arm.joint_names), dm.wheel_act, dm.wheel_dof
-    arm_act = slice(0, n) if np.array_equal(dm.arm_act, np.arange(n)) else dm.arm_act
+    wheel_act, wheel_dof = dm.wheel_act, dm.wheel_dof
+    cols = np.nonzero(dm.arm_act >= 0)[0]  # a mimic joint follows its leader: no actuator
+    ctrl_arm, inv_kp = ctrl_arm[:, cols], inv_kp[cols]
+    act = dm.arm_act[cols]
+    arm_act = slice(int(act[0]), int(act[-1]) + 1) if _contiguous(act) else act
+    arm_qpos = dm.arm_qpos
     ctrl, u, command = d.ctrl, 0, np.zeros(2)
     mujoco.mj_forward(m, d)
     start = time.perf_counter()
@@ -184,7 +191,7 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
         if gravity is None:
             ctrl[arm_act] = ctrl_arm[k]
         else:
-            ctrl[arm_act] = ctrl_arm[k] + gravity(d.qpos[dm.arm_qpos]) * inv_kp
+            ctrl[arm_act] = ctrl_arm[k] + gravity(d.qpos[arm_qpos])[cols] * inv_kp
         mujoco.mj_step(m, d)
         rec[k] = d.sensordata
         if progress is not None and k % PROGRESS_STEPS == 0 and k:
@@ -192,19 +199,42 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
     mujoco.mj_forward(m, d)
     rec[steps], wheel_cmd[steps] = d.sensordata, command
     wall = time.perf_counter() - start
+    _refuse_reset(d, rec, job.dt)
     wl = rec[:-1, dm.layout.wheel_vel]
     odom = encoder_odometry(wl[:, 0], wl[:, 1], job.dt, job.params.radius, job.params.separation)
     return DriveRun(job, t, rec, q_ref, v_ref, wheel_cmd, odom, wall)
+
+
+def _refuse_reset(d: Any, rec: np.ndarray, dt: float) -> None:
+    """MuJoCo resets a state that became non-finite and goes on: such a run is no result."""
+    import mujoco
+
+    W = mujoco.mjtWarning
+    bad = [w for w in (W.mjWARN_BADQACC, W.mjWARN_BADQPOS, W.mjWARN_BADQVEL)
+           if d.warning[w].number > 0]  # fmt: skip
+    if bad:
+        rows = np.nonzero(~np.all(np.isfinite(rec), axis=1))[0]
+        step = int(rows[0]) if rows.size else None
+        raise SimulationError(
+            "MuJoCo's state became non-finite and was reset",
+            time=step * dt if step is not None else None,
+            step=step,
+            cause="gains too high for dt, or a model MuJoCo cannot integrate (try a smaller --dt)",
+        )
+
+
+def _contiguous(ids: np.ndarray) -> bool:
+    return len(ids) > 0 and bool(np.all(np.diff(ids) == 1))
 
 
 def _gravity(arm: SimJob) -> Callable[[np.ndarray], np.ndarray]:
     """g(q) [N·m] of the fixed-base arm, as `simulate`'s controller adds it."""
     import pinocchio as pin
 
-    model = arm.arm.model
-    data = model.createData()
+    robot = arm.arm.robot
+    model, data = robot.model, robot.model.createData()
 
     def g(q: np.ndarray) -> Any:
-        return pin.computeGeneralizedGravity(model, data, configuration(model, q))
+        return pin.computeGeneralizedGravity(model, data, robot.q(q))
 
     return g

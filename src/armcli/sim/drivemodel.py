@@ -36,12 +36,12 @@ from armcli.sim.diffdrive import DriveParams
 from armcli.urdf.doc import Urdf
 from armcli.urdf.stance import Stance
 
-SERVO_STEPS = 5.0  # wheel motor time constant in time steps (see the module docstring)
-# [s] MuJoCo's contact time constant (solref, critically damped). At its default 20 ms the
-# wheels' cylinder rim contacts chatter on and off the floor in a turn (3 % of the steps
-# unloaded, the caster 11 %); at 50 ms no wheel does (the caster 5 %, ~10 µm hops) and the
-# robot sinks 0.33 mm into the floor under its weight.
-CONTACT_TIME = 0.05
+SERVO_STEPS = 1.0  # wheel motor time constant in time steps (see the module docstring)
+# [s] MuJoCo's contact time constant (solref, critically damped): its default. Measured on
+# the course robot (tests/sim/test_drive.py): softer contacts (50 ms) stop the wheels'
+# chatter but let the robot coast 2.5 % past its wheels' travel after a stop; a wheel motor
+# slower than one step (SERVO_STEPS 5) lags a turn's load by 4 %.
+CONTACT_TIME = 0.02
 TOUCH_MARGIN = 0.02  # [m] a touch site is the link's bounding sphere plus this
 G = 9.81  # [m/s²] MuJoCo's default gravity magnitude
 
@@ -70,7 +70,7 @@ class DriveModel:
     model: Any  # mujoco.MjModel
     arm_joints: tuple[str, ...]
     arm_qpos: np.ndarray  # (n,) int
-    arm_act: np.ndarray  # (n,) int: the arm's position actuators, in arm_joints order
+    arm_act: np.ndarray  # (n,) int: the arm's position actuators; -1: a mimic joint follows
     wheel_qpos: np.ndarray  # (2,) int, left then right
     wheel_dof: np.ndarray  # (2,) int
     wheel_act: np.ndarray  # (2,) int
@@ -86,13 +86,14 @@ def build_drive_model(
     stance: Stance,
     params: DriveParams,
     arm_joints: tuple[str, ...],
-    gains: tuple[np.ndarray, np.ndarray],
+    gains: tuple[np.ndarray, np.ndarray, np.ndarray],
     dt: float,
     meshes: dict[str, bytes] | None = None,
 ) -> DriveModel:
     """Compile the export's free-base model with floor, wheel motors and sensors.
 
-    `gains`: the arm's (Kp, Kd) as the run uses them (the spec's or the options').
+    `gains`: the arm's (Kp, Kd, effort limit) as the run uses them (the spec's or the
+    options'; effort inf: none).
     """
     import mujoco
 
@@ -114,15 +115,13 @@ def build_drive_model(
     )
     root = _root_body(ms)
     wheel_inertia = _wheel_motors(ms, params, stance, dt)
+    driven = _arm_actuators(ms, arm_joints, gains)
     _sensors(ms, root, arm_joints, params, stance.ground.links)
     notes = [*_mu2_notes(urdf), *wheel_inertia]
     model = ms.compile()
     model.geom_solref[:] = (CONTACT_TIME, 1.0)
-    arm_act = np.array([model.actuator(j).id for j in arm_joints], dtype=int)
-    kp, kd = gains
-    model.actuator_gainprm[arm_act, 0] = kp
-    model.actuator_biasprm[arm_act, 1] = -kp
-    model.actuator_biasprm[arm_act, 2] = -kd
+    arm_act = np.array([model.actuator(driven[j]).id if j in driven else -1
+                        for j in arm_joints], dtype=int)  # fmt: skip
     return DriveModel(
         model=model,
         arm_joints=arm_joints,
@@ -142,6 +141,40 @@ def build_drive_model(
         base_z=-stance.ground.height,
         notes=tuple(notes),
     )
+
+
+def _arm_actuators(
+    ms: Any, joints: tuple[str, ...], gains: tuple[np.ndarray, np.ndarray, np.ndarray]
+) -> dict[str, str]:
+    """Joint -> its PD actuator: the export's `position` actuator with the run's gains.
+
+    The export gives one to a joint with spec gains; a joint given gains by options only
+    gets one here (the export's other actuator on it switched off); a mimic joint (an
+    equality constraint to its leader, no actuator in the export) gets none.
+    """
+    import mujoco
+
+    kp, kd, effort = gains
+    followers = {str(e.name1) for e in ms.equalities}
+    out = {}
+    for i, joint in enumerate(joints):
+        acts = [a for a in ms.actuators if a.target == joint]
+        pd = next((a for a in acts if a.name == joint and a.biasprm[1] != 0.0), None)
+        if pd is None and not acts and joint in followers:
+            continue
+        if pd is None:
+            for a in acts:
+                a.gainprm[0], a.biasprm[:3] = 0.0, 0.0
+            pd = ms.add_actuator(name=f"{joint}_pd", target=joint,
+                                 trntype=mujoco.mjtTrn.mjTRN_JOINT)  # fmt: skip
+            if np.isfinite(effort[i]):
+                pd.forcelimited = 1
+                pd.forcerange = [-effort[i], effort[i]]
+        pd.gaintype, pd.biastype = mujoco.mjtGain.mjGAIN_FIXED, mujoco.mjtBias.mjBIAS_AFFINE
+        pd.gainprm[0] = kp[i]
+        pd.biasprm[:3] = [0.0, -kp[i], -kd[i]]
+        out[joint] = pd.name
+    return out
 
 
 def _root_body(ms: Any) -> Any:
@@ -208,13 +241,10 @@ def _sensors(
     def add(kind: Any, objtype: Any, name: str) -> None:
         ms.add_sensor(type=kind, objtype=objtype, objname=name)
 
-    for joints, actuators in ((arm, arm), (wheels, tuple(f"{w}_motor" for w in wheels))):
-        for j in joints:
-            add(S.mjSENS_JOINTPOS, Obj.mjOBJ_JOINT, j)
-        for j in joints:
-            add(S.mjSENS_JOINTVEL, Obj.mjOBJ_JOINT, j)
-        for a in actuators:
-            add(S.mjSENS_ACTUATORFRC, Obj.mjOBJ_ACTUATOR, a)
+    for joints in (arm, wheels):
+        for kind in (S.mjSENS_JOINTPOS, S.mjSENS_JOINTVEL, S.mjSENS_JOINTACTFRC):
+            for j in joints:
+                add(kind, Obj.mjOBJ_JOINT, j)
     add(S.mjSENS_FRAMEPOS, Obj.mjOBJ_XBODY, root.name)
     add(S.mjSENS_FRAMEQUAT, Obj.mjOBJ_XBODY, root.name)
     for link in contacts:

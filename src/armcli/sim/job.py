@@ -15,6 +15,9 @@ import numpy as np
 
 from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_URDF
 from armcli.errors import InputError
+from armcli.robot.load import checked_model, link_frame
+from armcli.robot.mimic import Mimic, mimics
+from armcli.robot.tool import tool_point
 from armcli.sim.options import SimOptions
 from armcli.sim.plot import plot_steps
 from armcli.sim.reference import Reference, build_reference, coupled
@@ -25,18 +28,14 @@ from armcli.sim.simulate import (
     SimResult,
     arm_from_model,
     check_stability,
-    configuration,
     simulate,
     steps_of,
 )
 from armcli.sim.states import distinct, sample_steps
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mimic import Mimic, mimics
-from armcli.urdf.pinocchio import link_frame
 from armcli.urdf.read import parse_urdf
-from armcli.urdf.source import Trust, checked_model, read_urdf_file
-from armcli.urdf.tool import tool_point
+from armcli.urdf.source import Trust, read_urdf_file, spec_urdfs
 from armcli.urdf.xacro_args import XacroInputs
 
 if TYPE_CHECKING:
@@ -82,9 +81,7 @@ def arm_urdf(
         return read_urdf_file(urdf, trust_xacro=trust_xacro, inputs=inputs)
     if spec is None:
         raise InputError("give a spec or `SimOptions.urdf`", field="SimOptions.urdf")
-    from armcli.compiler.expand import expand_urdfs  # the spec compiler: only for a spec
-
-    return parse_urdf(expand_urdfs(spec)[ARM_URDF], ARM_URDF)
+    return parse_urdf(spec_urdfs(spec)[ARM_URDF], ARM_URDF)
 
 
 def load_arm(
@@ -179,7 +176,7 @@ def _refuse_integral_gain(arm: Arm, spec: RobotSpec | None) -> None:
 
 
 def _tool(arm: Arm, doc: Urdf, spec: RobotSpec | None) -> tuple[int, np.ndarray, str]:
-    """The tool point (armcli.urdf.tool) as (Pinocchio frame id, offset [m], label)."""
+    """The tool point (armcli.robot.tool) as (Pinocchio frame id, offset [m], label)."""
     model = arm.model
     tool = tool_point(doc, spec)
     frame = link_frame(model, tool.link) if tool is not None else None
@@ -325,7 +322,7 @@ def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
     import pinocchio as pin
 
     data = job.arm.model.createData()
-    pin.framesForwardKinematics(job.arm.model, data, configuration(job.arm.model, q))
+    pin.framesForwardKinematics(job.arm.model, data, job.arm.robot.q(q))
     p_root = np.asarray(data.oMf[job.tool_frame].act(job.tool_offset), dtype=float)
     out: np.ndarray = job.T_frame_root[:3, :3] @ p_root + job.T_frame_root[:3, 3]
     return out

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from armcli.errors import InputError, TipOverError
+from armcli.robot.tool import tool_point
 from armcli.sim import job as simjob
 from armcli.sim import zmp as zmps
 from armcli.sim.job import SimJob
@@ -27,9 +28,8 @@ from armcli.urdf.doc import Urdf
 from armcli.urdf.ground import mesh_loader
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_urdf
-from armcli.urdf.source import lookup_for
+from armcli.urdf.source import lookup_for, spec_urdfs
 from armcli.urdf.stance import NoStance, Payload, Stance, stance_of
-from armcli.urdf.tool import tool_point
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -88,10 +88,8 @@ def robot_urdf(spec: RobotSpec | None, job: SimJob) -> Urdf | None:
         and job.urdf.source.endswith(".urdf")
         and (spec.mounted_base() is not None)
     ):
-        from armcli.compiler.expand import expand_urdfs  # the spec compiler: only for a spec
-
         name = f"{spec.name}.urdf"
-        return parse_urdf(expand_urdfs(spec)[name], name)
+        return parse_urdf(spec_urdfs(spec)[name], name)
     return job.urdf
 
 
@@ -122,7 +120,7 @@ def prepare(
     if missing_joints:
         notes.append(f"no zero-moment point: {', '.join(missing_joints)} not in {urdf.source}")
         return None
-    accel, source = _base_accel(opts, urdf)
+    accel, source = _base_accel(opts, urdf, plugin_default=False)
     return Tipping(found, accel, source, opts.min_margin)
 
 
@@ -146,9 +144,16 @@ def trajectory_zmp(
     return report(tip, tip.series(job, res))
 
 
-def _base_accel(opts: TipOptions, urdf: Urdf) -> tuple[float, str]:
+def _base_accel(opts: TipOptions, urdf: Urdf, plugin_default: bool = True) -> tuple[float, str]:
+    """The base's acceleration: the option's, else a base at rest or the plugin's limit.
+
+    `simulate` assumes no acceleration nobody asked for; `check --trajectory` keeps its
+    worst case (`plugin_default`): the diff-drive plugin's max_wheel_acceleration.
+    """
     if opts.base_accel is not None:
         return opts.base_accel, "--base-accel"
+    if not plugin_default:
+        return 0.0, "a base at rest (--base-accel adds one)"
     limit = zmps.drive_acceleration(urdf)
     if limit is not None:
         return limit, "the diff-drive plugin's max_wheel_acceleration"
@@ -180,6 +185,92 @@ def columns(series: zmps.ZmpSeries, res: SimResult, rate: float) -> dict[str, ND
     }
 
 
+G = 9.81  # [m/s²] Pinocchio's gravity
+
+
+@dataclass(frozen=True)
+class Excursion:
+    """One interval during which the zero-moment point of one case stays outside the polygon.
+
+    `impulse` = ∫ e dt [m·s], e the distance outside; the robot turns about the edge by
+    the angular velocity m g impulse / I_edge, and tips when that carries its centre of
+    mass over the edge: impulse >= `bound` = sqrt(2 I_edge m g (sqrt(d² + h²) - h)) / (m g),
+    d, h the centre of mass's distance inside the edge and height (docs/check.md).
+    """
+
+    case: str
+    start: float  # [s]
+    duration: float  # [s]
+    depth: float  # [m] the farthest outside
+    direction: str  # toward which edge
+    impulse: float  # [m·s]
+    bound: float  # [m·s]; 0: the centre of mass itself is past the edge
+
+    @property
+    def tips(self) -> bool:
+        """Whether it rotates the robot over the edge."""
+        return self.impulse >= self.bound
+
+    def line(self) -> str:
+        """The lift-off warning of an excursion that does not tip the robot."""
+        share = f"{100 * self.impulse / self.bound:.2g} %" if self.bound > 0 else "all"
+        return (
+            f"the zero-moment point leaves the support polygon toward {self.direction} at "
+            f"t = {self.start:.3f} s for {self.duration:.3f} s ({self.case}, up to "
+            f"{self.depth * 1e3:.1f} mm): a wheel lifts off for that long, the robot does not "
+            f"tip (its turning impulse is {share} of what tips it, docs/check.md)"
+        )
+
+
+def excursions(stance: Stance, series: zmps.ZmpSeries) -> tuple[Excursion, ...]:
+    """Every interval of every case with the point outside, and whether it tips the robot."""
+    cases = 1 if series.base_accel == 0 else len(zmps.CASES)
+    out = []
+    for c in range(cases):
+        outside = series.margin[:, c] < 0
+        edges = np.diff(np.concatenate([[0], outside.astype(np.int8), [0]]))
+        for a, b in zip(np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0], strict=True):
+            out.append(_excursion(stance, series, c, int(a), int(b)))
+    return tuple(sorted(out, key=lambda e: (e.start, e.case)))
+
+
+def _excursion(stance: Stance, series: zmps.ZmpSeries, c: int, a: int, b: int) -> Excursion:
+    """Rows a..b-1 of case c are outside; the neighbours bound the interval (e = 0 there)."""
+    lo, hi = max(a - 1, 0), min(b, len(series.t) - 1)
+    t = series.t[lo : hi + 1]
+    e = np.clip(-series.margin[lo : hi + 1, c], 0.0, None)
+    e = np.where(np.isfinite(e), e, 0.0)  # f_z <= 0 (no point): counted by its neighbours
+    impulse = float(np.sum(0.5 * (e[1:] + e[:-1]) * np.diff(t))) if len(t) > 1 else 0.0
+    k = a + int(np.argmax(np.nan_to_num(-series.margin[a:b, c], posinf=1e9)))
+    p = series.zmp[k, c]
+    poly = stance.polygon
+    edge = poly.nearest_edge(p) if np.all(np.isfinite(p)) else 0
+    com, inertia = series.bodies.get(k, (np.zeros(3), np.zeros((3, 3))))
+    mass = float(sum(i.mass for i in stance.loaded().inertias))
+    d = float(poly.edge_distances(com[:2])[edge])
+    h = stance.height(com)
+    ex = poly.edges[edge]
+    u = np.array([ex.b[0] - ex.a[0], ex.b[1] - ex.a[1], 0.0])
+    u /= max(float(np.linalg.norm(u)), 1e-12)
+    i_edge = float(u @ inertia @ u) + mass * (d * d + h * h)
+    barrier = mass * G * (math.hypot(d, h) - h) if d > 0 else 0.0
+    depth = float(np.max(np.where(np.isfinite(e), e, 0.0)))
+    return Excursion(
+        case=zmps.CASES[c],
+        start=float(series.t[a]),
+        duration=float(series.t[b - 1] - series.t[a]) + _dt(series),
+        depth=depth,
+        direction=ex.direction,
+        impulse=impulse,
+        bound=math.sqrt(2.0 * i_edge * barrier) / (mass * G),
+    )
+
+
+def _dt(series: zmps.ZmpSeries) -> float:
+    """[s] the time of one kept state (the smallest spacing of the series)."""
+    return float(np.min(np.diff(series.t))) if len(series.t) > 1 else 0.0
+
+
 @dataclass(frozen=True)
 class ZmpReport:
     """A run's zero-moment point in numbers: its worst moment and what still holds."""
@@ -197,11 +288,17 @@ class ZmpReport:
     max_base_accel: float  # [m/s²] the largest that keeps the margin >= 0 at every state
     max_base_accel_margin: float  # [m/s²] the largest that keeps it >= threshold
     impacts: int  # states left out: joint-stop impacts
+    excursions: tuple[Excursion, ...] = ()  # the point outside the polygon, interval by interval
 
     @property
     def tips(self) -> bool:
-        """Whether the point leaves the polygon."""
-        return self.min_margin < 0
+        """Whether an excursion of the point rotates the robot over a support edge."""
+        return any(e.tips for e in self.excursions)
+
+    @property
+    def lifts(self) -> tuple[Excursion, ...]:
+        """The excursions too short to tip the robot: a wheel lifts off for an instant."""
+        return tuple(e for e in self.excursions if not e.tips)
 
     @property
     def when(self) -> str:
@@ -230,6 +327,7 @@ def report(tip: Tipping, series: zmps.ZmpSeries) -> ZmpReport:
         max_base_accel=zmps.max_base_accel(series, poly, 0.0),
         max_base_accel_margin=zmps.max_base_accel(series, poly, tip.threshold),
         impacts=series.impacts,
+        excursions=excursions(tip.stance, series),
     )
 
 
@@ -242,6 +340,9 @@ def summary_line(r: ZmpReport) -> str:
         what = (
             f"TIPS: {-r.min_margin * 1e3:.1f} mm outside the support polygon toward {r.direction}"
         )
+    elif r.min_margin < 0:
+        what = (f"{-r.min_margin * 1e3:.1f} mm outside toward {r.direction} for "
+                f"{sum(e.duration for e in r.lifts):.3f} s: a wheel lifts off, no tip")  # fmt: skip
     else:
         what = f"least margin {r.min_margin * 1e3:.1f} mm toward {r.direction}"
     left = f"; {r.impacts} joint-stop impact(s) left out" if r.impacts else ""
@@ -254,12 +355,15 @@ def summary_line(r: ZmpReport) -> str:
 
 def tip_error(r: ZmpReport) -> TipOverError:
     """The error a run that tips the robot over ends with (after its files are written)."""
+    e = next(e for e in r.excursions if e.tips)
+    accel = f" at {r.base_accel:g} m/s²" if e.case != zmps.CASES[0] else ""
     return TipOverError(
-        f"the robot tips over: its zero-moment point is {-r.min_margin * 1e3:.1f} mm outside "
-        f"the support polygon toward {r.direction} at t = {r.time:.3f} s ({r.when})",
-        time=r.time,
-        margin=r.min_margin,
-        case=r.case,
+        f"the robot tips over: its zero-moment point is up to {e.depth * 1e3:.1f} mm outside "
+        f"the support polygon toward {e.direction} from t = {e.start:.3f} s for "
+        f"{e.duration:.3f} s ({e.case}{accel}), long enough to rotate it over that edge",
+        time=e.start,
+        margin=-e.depth,
+        case=e.case,
     )
 
 

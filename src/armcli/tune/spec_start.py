@@ -12,9 +12,9 @@ import math
 
 import numpy as np
 
-from armcli.compiler.expand import expand_urdfs
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import InputError
+from armcli.robot.load import load_model
 from armcli.sim.simulate import Arm, arm_from_model
 from armcli.spec.joint_types import LIMITED_TYPES
 from armcli.spec.model import RobotSpec
@@ -26,7 +26,7 @@ from armcli.tune.model_gains import (
     sample_configurations,
     start_gains,
 )
-from armcli.urdf.pinocchio import load_model
+from armcli.urdf.source import spec_urdfs
 
 STEP_CAP = math.pi / 2  # [rad or m] the largest step the start gains are sized for
 KD_FLOOR = 1e-6  # smallest Kd scale tried for the explicit loop
@@ -46,7 +46,7 @@ def spec_start_gains(spec: RobotSpec) -> dict[str, tuple[float, float]]:
     ]
     if not joints:
         return {}
-    xml = expand_urdfs(spec)[STANDALONE_ARM_URDF].decode("utf-8")
+    xml = spec_urdfs(spec)[STANDALONE_ARM_URDF].decode("utf-8")
     arm = arm_from_model(load_model(STANDALONE_ARM_URDF, xml=xml).model, joints)
     steps = np.minimum(
         np.where(np.isfinite(arm.upper - arm.lower), arm.upper - arm.lower, STEP_CAP), STEP_CAP

@@ -6,6 +6,7 @@ at the line; numbers that did not parse are kept as `NumberProblem`s.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from armcli.spec.joint_types import JOINT_DOF
@@ -79,7 +80,7 @@ class Link:
 
 @dataclass(frozen=True)
 class Limit:
-    """A <limit>: lower/upper [rad or m], effort [N·m or N], velocity [rad/s or m/s], acceleration."""
+    """A <limit>: lower/upper [rad or m], effort [N·m or N], velocity, acceleration [/s, /s²]."""
 
     lower: float | None
     upper: float | None
@@ -128,6 +129,15 @@ class Material:
 
 
 @dataclass(frozen=True)
+class Origin:
+    """Where an element of a xacro expansion was written [file, 1-based line] (xacro_lines)."""
+
+    file: str
+    line: int
+    calls: tuple[tuple[str, int], ...] = ()  # macro calls that produced it, innermost first
+
+
+@dataclass(frozen=True)
 class Urdf:
     """What `check` needs from one URDF document."""
 
@@ -140,6 +150,8 @@ class Urdf:
     problems: tuple[NumberProblem, ...] = field(default=())
     line: int | None = None  # the <robot> element's
     notes: tuple[str, ...] = ()  # `note: ...`/`warning: ...` lines: xacro arguments used, ...
+    # a xacro expansion's element lines -> where they were written (xacro_lines); empty else
+    origins: Mapping[int, Origin] = field(default_factory=dict)
 
     def link(self, name: str) -> Link | None:
         """The link called `name`, or None."""

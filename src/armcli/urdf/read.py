@@ -16,6 +16,7 @@ from lxml import etree
 
 from armcli.defaults import MAX_ROBOT_DOF, MAX_ROBOT_LINKS
 from armcli.errors import InputError, XacroRefusedError
+from armcli.io.oneline import one_line
 from armcli.io.userfile import read_regular
 from armcli.spec.joint_types import total_dof
 from armcli.spec.xacro_names import xacro_use
@@ -308,7 +309,30 @@ def parse_root(data: bytes, source: str) -> etree._Element:
             file=source,
         )
     _check_size(root, source)
+    _check_names(root, source)
     return root
+
+
+NAME_ATTRIBUTES = ("name", "link", "joint", "reference")  # names and references to them
+
+
+def _check_names(root: etree._Element, source: str) -> None:
+    """Refuse names holding line breaks or control characters (issue 27).
+
+    Names are printed by every command (tree, check, simulate, view); a robot named
+    `r&#10;::add-mask::X` printed a GitHub workflow command line of its own, and a C1
+    character (U+009B) is a terminal control sequence.
+    """
+    for el in root.iter():
+        for attr in NAME_ATTRIBUTES:
+            value = el.get(attr)
+            if value is not None and one_line(value) != value:
+                raise InputError(
+                    f"<{el.tag}> {attr}={one_line(value)!r} holds line breaks or control "
+                    "characters; names must be printable",
+                    file=source,
+                    line=_ln(el),
+                )
 
 
 def _check_size(root: etree._Element, source: str) -> None:

@@ -12,7 +12,8 @@ Mesh URIs may only resolve inside the allowed roots, so a hostile URDF cannot ma
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterable
+import threading
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -21,10 +22,10 @@ from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import EXPANDED_TAG, InputError, XacroRefusedError
 from armcli.urdf.doc import Urdf
 from armcli.urdf.packages import PackageLookup, inside, real_roots
-from armcli.urdf.pinocchio import LoadedModel, load_model, parser_problems
 from armcli.urdf.read import parse_urdf, read_urdf
 from armcli.urdf.trust import Trust as Trust  # re-exported: read_robot and callers share it
 from armcli.urdf.xacro_args import Expansion, XacroInputs
+from armcli.urdf.xacro_lines import parse_map
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -32,14 +33,9 @@ if TYPE_CHECKING:
 SPEC_SUFFIXES = (".yaml", ".yml")
 XACRO_SUFFIX = ".xacro"
 TRUSTED_ENV_REFUSED = ("LD_", "PYTHON")  # --env names that would change how the child runs
-
-
-_PROBLEM = {
-    "missing": "missing number",
-    "not-a-number": "not a number:",
-    "non-finite": "non-finite number",
-    "length": "wrong number of values:",
-}
+COMPILED_KEPT = 4  # specs whose compiled URDFs `spec_urdfs` keeps (a command reads one or two)
+_COMPILED: list[tuple[RobotSpec, dict[str, bytes]]] = []  # (spec, its URDFs), newest last
+_COMPILED_LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
@@ -72,15 +68,33 @@ def read_robot(
         raise InputError("is a directory, expected a robot spec, URDF or xacro file", file=path)
     if path.suffix in SPEC_SUFFIXES:
         # the spec layers (pydantic models, ~0.3 s to import) only when a spec is read
-        from armcli.compiler.expand import expand_urdfs
         from armcli.spec.load import load_spec
 
         spec = load_spec(path)
         lookup_for(spec, inputs.packages if inputs is not None else None)  # refuse a bad one now
-        urdfs = expand_urdfs(spec)
+        urdfs = spec_urdfs(spec)
         docs = tuple(parse_urdf(urdfs[n], f"{path}#{n}") for n in sorted(urdfs))
         return RobotFile(path, docs, spec)
     return RobotFile(path, (read_urdf_file(path, trust_xacro=trust_xacro, inputs=inputs),))
+
+
+def spec_urdfs(spec: RobotSpec) -> dict[str, bytes]:
+    """URDF file name -> expanded bytes of the spec's xacro set, compiled once per spec.
+
+    A spec is frozen (pydantic, `frozen=True`), so its URDFs never change: the last
+    COMPILED_KEPT specs keep theirs, and every command asks here instead of compiling
+    again (`simulate` needs the standalone arm and the whole robot: one expansion).
+    """
+    with _COMPILED_LOCK:
+        hit = next((urdfs for s, urdfs in _COMPILED if s is spec), None)
+    if hit is None:
+        from armcli.compiler.expand import expand_urdfs  # the spec compiler: only for a spec
+
+        hit = expand_urdfs(spec)
+        with _COMPILED_LOCK:
+            _COMPILED.append((spec, hit))
+            del _COMPILED[:-COMPILED_KEPT]
+    return dict(hit)
 
 
 def lookup_for(spec: RobotSpec | None, search: PackageLookup | None = None) -> PackageLookup:
@@ -105,7 +119,8 @@ def read_urdf_file(
         except XacroRefusedError:
             pass  # xacro content in a .urdf: expanded like a .xacro file
     xml, used = expand_xacro(path, trust_xacro=trust_xacro, inputs=inputs)
-    return replace(parse_urdf(xml, f"{path}{EXPANDED_TAG}"), notes=used.notes())
+    doc = parse_urdf(xml, f"{path}{EXPANDED_TAG}")
+    return replace(doc, notes=used.notes(), origins=parse_map(used.source_map))
 
 
 def expand_xacro(
@@ -158,41 +173,6 @@ def _expand_trusted(
         roots=roots,
     )
     return xml, Expansion.from_dict(report.get("expansion", {}))
-
-
-def load_checked_model(
-    path: Path,
-    *,
-    trust_xacro: Trust = False,
-    gate: Callable[[Urdf], None] | None = None,
-    inputs: XacroInputs | None = None,
-) -> LoadedModel:
-    """A URDF/xacro file -> Pinocchio model, refusing what Pinocchio would silently accept.
-
-    For commands that compute with the model (simulate --urdf): a malformed or
-    non-finite number (Pinocchio turns mass="nan" into 0) or any error the URDF
-    parser prints is an InputError naming the file and line, not a wrong result.
-    """
-    urdf = read_urdf_file(path, trust_xacro=trust_xacro, inputs=inputs)
-    return checked_model(urdf, gate=gate)
-
-
-def checked_model(urdf: Urdf, *, gate: Callable[[Urdf], None] | None = None) -> LoadedModel:
-    """A parsed URDF -> Pinocchio model, refusing what Pinocchio would silently accept.
-
-    `gate`, when given, may refuse the document after the number checks (e.g.
-    check.gate.refuse_check_errors: the model `check` reports as an error).
-    """
-    if urdf.problems:
-        p = urdf.problems[0]
-        raise InputError(f"{p.where}: {_PROBLEM[p.kind]} {p.text!r}", file=urdf.source, line=p.line)
-    if gate is not None:
-        gate(urdf)
-    loaded = load_model(urdf.source, xml=urdf_text(urdf))
-    said = [m for m in parser_problems(loaded.parser_messages) if "error" in m.lower()]
-    if said:
-        raise InputError(f"the URDF parser reported: {said[0]}", file=urdf.source)
-    return loaded
 
 
 def urdf_text(urdf: Urdf) -> str:

@@ -18,15 +18,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from armcli.errors import InputError
+from armcli.robot import sampling
+from armcli.robot.load import link_frame
+from armcli.robot.model import Joint, Robot
 from armcli.urdf.doc import Urdf, Vec3
 from armcli.urdf.ground import Ground, MeshVertices, find_ground, has_wheels
-from armcli.urdf.pinocchio import (
-    JointRange,
-    configuration,
-    joint_ranges,
-    link_frame,
-    load_model,
-)
 from armcli.urdf.support import SupportPolygon, support_polygon
 
 FIXED_BASE = (
@@ -58,20 +54,33 @@ class Payload:
 class Stance:
     """A robot on its support polygon: floating model (payload included) and joints."""
 
-    model: Any  # pinocchio.Model on a free-flyer root, without the payload
+    robot: Robot  # on a free-flyer root, without the payload
     ground: Ground
     polygon: SupportPolygon
     payload: Payload | None
-    joints: tuple[JointRange, ...]  # move the centre of mass, not the contacts
+    joints: tuple[Joint, ...]  # move the centre of mass, not the contacts
 
-    def q(self, values: Mapping[str, float]) -> NDArray[np.float64]:
-        """Pinocchio configuration: root at the identity, named joints set [rad or m]."""
-        return np.asarray(configuration(self.model, values), dtype=float)
+    @property
+    def model(self) -> Any:
+        """The robot's pinocchio.Model (free-flyer root, no payload)."""
+        return self.robot.model
+
+    @property
+    def box(self) -> list[tuple[float, float]]:
+        """The joints' sampling ranges [rad or m] (`Joint.span`), the search's box."""
+        return sampling.bounds(self.joints)
+
+    def q(self, values: Mapping[str, float] | ArrayLike) -> NDArray[np.float64]:
+        """Pinocchio configuration: root at the identity, joints set [rad or m].
+
+        `values` by name, or a sequence aligned with `joints`.
+        """
+        return self.robot.q(values, joints=self.joints)
 
     @property
     def mass(self) -> float:
         """Mass of the robot [kg], without the payload."""
-        return float(sum(inertia.mass for inertia in self.model.inertias))
+        return self.robot.mass
 
     def loaded(self) -> Any:
         """The model with the payload's point mass on its link (for inverse dynamics)."""
@@ -120,7 +129,8 @@ def stance_of(
     names = {lk.name for lk in urdf.links}
     if declared is None and candidates is not None and not names & set(candidates):
         return NoStance(FIXED_BASE)  # e.g. a spec's standalone arm: none of its base's links
-    model = load_model(urdf.source, xml=urdf.text.decode("utf-8"), floating=True).model
+    robot = Robot.from_urdf(urdf, floating=True)
+    model = robot.model
     if declared is not None:
         unknown = [n for n in declared if n not in names]
         if unknown:
@@ -138,17 +148,18 @@ def stance_of(
         return NoStance(f"the ground contacts ({links}) span no area: no support polygon")
     if payload is not None and link_frame(model, payload.link) is None:
         raise InputError(f"unknown link {payload.link!r} for the payload", field="payload_link")
-    return Stance(model, ground, polygon, payload, _free_joints(model, ground.links))
+    return Stance(robot, ground, polygon, payload, _free_joints(robot, ground.links))
 
 
-def _free_joints(model: Any, contacts: Collection[str]) -> tuple[JointRange, ...]:
+def _free_joints(robot: Robot, contacts: Collection[str]) -> tuple[Joint, ...]:
     """The 1-DoF joints that carry no contact link (those would move the polygon)."""
     import pinocchio as pin
 
+    model = robot.model
     carrying: set[int] = set()
     for link in contacts:
         jid = model.frames[model.getFrameId(link, pin.BODY)].parentJoint
         while jid > 0:
             carrying.add(jid)
             jid = model.parents[jid]
-    return tuple(jr for jr in joint_ranges(model) if model.getJointId(jr.name) not in carrying)
+    return tuple(j for j in robot.joints if model.getJointId(j.name) not in carrying)

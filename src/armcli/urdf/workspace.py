@@ -1,10 +1,11 @@
 """The arm's workspace: where its tool point can go within the joint limits.
 
 The chain is the moving joints between the root and the tool point's link. Forward
-kinematics (Pinocchio) of seeded uniform draws of those joints, plus every corner of
-the range box when there are at most 64, gives a cloud of tool positions in the root
-frame; each extreme of the envelope is then refined by a local search within the
-limits (`urdf.boxsearch`) from the best samples, so it does not depend on a lucky draw:
+kinematics (Pinocchio) of the zero pose, every corner of the range box when there are few
+and seeded uniform draws of those joints (`robot.sampling.search_starts`) gives a cloud
+of tool positions in the root frame; each extreme of the envelope is then refined by a
+local search within the limits (`urdf.boxsearch`) from the best samples, so it does not
+depend on a lucky draw:
 
 - max reach: the largest distance from the shoulder (the origin of the chain's first
   moving joint) to the tool point;
@@ -18,9 +19,7 @@ residual is what is left of |p(q) - target| (reachable when under REACH_TOL).
 
 from __future__ import annotations
 
-import itertools
 import math
-import random
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -28,16 +27,18 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from armcli.robot import sampling
+from armcli.robot.load import link_frame
+from armcli.robot.model import Joint, Robot
+from armcli.robot.sampling import REACH_DRAWS, SAMPLE_SEED
+from armcli.robot.tool import ToolPoint
 from armcli.urdf.boxsearch import minimize_box
-from armcli.urdf.pinocchio import JointRange, configuration, joint_ranges, link_frame
-from armcli.urdf.tool import ToolPoint
 
-SAMPLES = 500  # `check`'s cloud: IK seeds and starts (extremes are refined); render draws more
-SAMPLE_SEED = 0
-MAX_CORNERS = 64
 REFINE_FROM = 3  # local searches per extreme, from the best samples
 REACH_TOL = 1e-3  # [m] an inverse-kinematics residual below this is reached
 IK_SEEDS = 5  # nearest samples the inverse kinematics starts from
+SEED_POOL = 50  # nearest samples the seeds are picked from
+SEED_SPREAD = 0.1  # seeds differ by this share of the joint ranges (root mean square)
 IK_ITERATIONS = 100
 IK_DAMPING = 1e-3  # [m] damped least squares' lambda
 
@@ -74,14 +75,16 @@ class Chain:
     """Forward kinematics of the tool point over the chain's joints, and its Jacobian."""
 
     def __init__(
-        self, model: Any, tool: ToolPoint, others: Mapping[str, float] | None = None
+        self, robot: Robot, tool: ToolPoint, others: Mapping[str, float] | None = None
     ) -> None:
         """`others`: values [rad or m] of joints off the chain (neutral where silent)."""
+        model = robot.model
         frame = link_frame(model, tool.link)
         if frame is None:
             raise ValueError(f"no link {tool.link!r} in the model")
+        self.robot = robot
         self.model = model
-        self.data = model.createData()
+        self.data = robot.data
         self.frame = frame
         self.xyz = np.asarray(tool.xyz, dtype=float)
         self.tool = tool
@@ -91,23 +94,18 @@ class Chain:
             path.append(jid)
             jid = model.parents[jid]
         ids = set(path)
-        self.joints: tuple[JointRange, ...] = tuple(
-            jr for jr in joint_ranges(model) if model.getJointId(jr.name) in ids
+        self.joints: tuple[Joint, ...] = tuple(
+            j for j in robot.joints if model.getJointId(j.name) in ids
         )
-        self.iv = [jr.idx_v for jr in self.joints]
-        self.q0 = np.asarray(configuration(model, others or {}), dtype=float)
-        self.lower = np.array([jr.lower for jr in self.joints])
-        self.upper = np.array([jr.upper for jr in self.joints])
+        self.iv = [j.idx_v for j in self.joints]
+        self.q0 = robot.q(others or {})
+        self.box = sampling.bounds(self.joints)
+        self.lower = np.array([lo for lo, _ in self.box])
+        self.upper = np.array([hi for _, hi in self.box])
 
     def q(self, x: ArrayLike) -> NDArray[np.float64]:
         """The model's configuration with the chain's joints at x [rad or m]."""
-        q = self.q0.copy()
-        for jr, v in zip(self.joints, np.asarray(x, dtype=float), strict=True):
-            if jr.continuous:
-                q[jr.idx_q], q[jr.idx_q + 1] = math.cos(v), math.sin(v)
-            else:
-                q[jr.idx_q] = v
-        return q
+        return self.robot.q(x, joints=self.joints, base=self.q0)
 
     def position(self, x: ArrayLike) -> NDArray[np.float64]:
         """The tool point [m] in the root frame."""
@@ -152,13 +150,9 @@ class Cloud:
     p: NDArray[np.float64]
 
 
-def sample(chain: Chain, n: int = SAMPLES, seed: int = SAMPLE_SEED) -> Cloud:
-    """Seeded uniform draws of the chain's joints, plus the range box's corners."""
-    rng = random.Random(seed)  # stdlib: numpy.random costs 20 ms of start-up
-    rows = [[min(max(0.0, jr.lower), jr.upper) for jr in chain.joints]]
-    if 2 ** len(chain.joints) <= MAX_CORNERS:
-        rows += [list(c) for c in itertools.product(*[(jr.lower, jr.upper) for jr in chain.joints])]
-    rows += [[rng.uniform(jr.lower, jr.upper) for jr in chain.joints] for _ in range(n)]
+def sample(chain: Chain, n: int = REACH_DRAWS, seed: int = SAMPLE_SEED) -> Cloud:
+    """The zero pose, the range box's corners and n seeded draws of the chain's joints."""
+    rows = sampling.search_starts(chain.box, n, seed=seed)
     x = np.array(rows, dtype=float).reshape(len(rows), len(chain.joints))
     return Cloud(x, np.array([chain.position(r) for r in x]))
 
@@ -173,36 +167,44 @@ def envelope(chain: Chain, cloud: Cloud) -> Workspace:
         r = float(np.linalg.norm(d))
         return -r, -(d @ J) / max(r, 1e-12)
 
-    def high(sign: float) -> Callable[[NDArray[np.float64]], tuple[float, NDArray[np.float64]]]:
-        def f(x: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
-            p, J = chain.jacobian(x)
-            return -sign * float(p[2]), -sign * J[2]
-
-        return f
-
     def wide(x: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
         p, J = chain.jacobian(x)
         r = float(np.hypot(p[0], p[1]))
         return -r, -(p[:2] @ J[:2]) / max(r, 1e-12)
 
     reach, x_reach = _refine(chain, cloud, far, -np.linalg.norm(cloud.p - c, axis=1))
-    top, _ = _refine(chain, cloud, high(1.0), -cloud.p[:, 2])
-    bottom, _ = _refine(chain, cloud, high(-1.0), cloud.p[:, 2])
     side, _ = _refine(chain, cloud, wide, -np.hypot(cloud.p[:, 0], cloud.p[:, 1]))
-    lo, hi = cloud.p.min(axis=0), cloud.p.max(axis=0)
+    # The box: each face refined as the height is (the cloud alone put TurtleBot3's
+    # OpenMANIPULATOR-X x max 50 mm short of the brute-force value).
+    lo, hi = np.zeros(3), np.zeros(3)
+    for axis in range(3):
+        hi[axis] = -_refine(chain, cloud, _along(chain, axis, 1.0), -cloud.p[:, axis])[0]
+        lo[axis] = _refine(chain, cloud, _along(chain, axis, -1.0), cloud.p[:, axis])[0]
     return Workspace(
         point=chain.tool.label,
         shoulder=(float(c[0]), float(c[1]), float(c[2])),
         joints=tuple(jr.name for jr in chain.joints),
         samples=len(cloud.x),
         max_reach=-reach,
-        max_height=-top,
-        min_height=bottom,
+        max_height=float(hi[2]),
+        min_height=float(lo[2]),
         max_horizontal=-side,
-        lower=(float(lo[0]), float(lo[1]), float(min(lo[2], bottom))),
-        upper=(float(hi[0]), float(hi[1]), float(max(hi[2], -top))),
+        lower=(float(lo[0]), float(lo[1]), float(lo[2])),
+        upper=(float(hi[0]), float(hi[1]), float(hi[2])),
         reach_q=chain.names(x_reach),
     )
+
+
+def _along(
+    chain: Chain, axis: int, sign: float
+) -> Callable[[NDArray[np.float64]], tuple[float, NDArray[np.float64]]]:
+    """The objective -sign * p[axis] (minimised: the tool point's extreme along root `axis`)."""
+
+    def f(x: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
+        p, J = chain.jacobian(x)
+        return -sign * float(p[axis]), -sign * J[axis]
+
+    return f
 
 
 def _refine(
@@ -225,7 +227,7 @@ def reach_point(chain: Chain, cloud: Cloud, target: Sequence[float]) -> ReachPoi
     t = np.asarray(target, dtype=float)
     d = np.linalg.norm(cloud.p - t, axis=1)
     best_r, best_x = math.inf, cloud.x[int(np.argmin(d))]
-    for k in np.argsort(d)[:IK_SEEDS]:
+    for k in _seeds(chain, cloud, d):
         x, r = _ik(chain, cloud.x[k], t)
         if r < best_r:
             best_r, best_x = r, x
@@ -238,6 +240,25 @@ def reach_point(chain: Chain, cloud: Cloud, target: Sequence[float]) -> ReachPoi
         nearest_sample=float(np.min(d)),
         q=chain.names(best_x),
     )
+
+
+def _seeds(chain: Chain, cloud: Cloud, d: NDArray[np.float64]) -> list[int]:
+    """IK_SEEDS samples near the target, each in another arm configuration.
+
+    The nearest samples alone tend to be one configuration (one elbow, one wrist): their
+    searches end in the same local minimum, which for a point out of reach was 12 mm
+    farther than the closest a UR5 gets. A seed must differ from those taken by
+    SEED_SPREAD of the joint ranges (root mean square); the nearest SEED_POOL are looked at.
+    """
+    span = np.maximum(chain.upper - chain.lower, 1e-9)
+    taken: list[int] = []
+    for k in np.argsort(d)[:SEED_POOL]:
+        u = cloud.x[k] / span
+        if all(np.sqrt(np.mean((u - cloud.x[j] / span) ** 2)) > SEED_SPREAD for j in taken):
+            taken.append(int(k))
+            if len(taken) == IK_SEEDS:
+                break
+    return taken
 
 
 def _ik(chain: Chain, x0: NDArray[np.float64], target: NDArray[np.float64]) -> tuple[Any, float]:
@@ -254,7 +275,20 @@ def _ik(chain: Chain, x0: NDArray[np.float64], target: NDArray[np.float64]) -> t
             break
         step = J.T @ np.linalg.solve(J @ J.T + IK_DAMPING**2 * np.eye(3), e)
         x = np.clip(x + step, chain.lower, chain.upper)
-    return best_x, best_r
+    if best_r < REACH_TOL * 1e-3 or not len(x):
+        return best_x, best_r
+    # Clipping stalls damped least squares against a limit (TurtleBot3's OpenMANIPULATOR-X
+    # missed a reachable point by 2.8 mm): a projected gradient search on |e|²/2 slides
+    # along the limits to the closest point.
+
+    def half_square(x: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
+        p, J = chain.jacobian(x)
+        e = p - target
+        return 0.5 * float(e @ e), J.T @ e
+
+    res = minimize_box(half_square, best_x, chain.lower, chain.upper)
+    r = math.sqrt(2.0 * max(res.f, 0.0))
+    return (res.x, r) if r < best_r else (best_x, best_r)
 
 
 def describe(ws: Workspace) -> str:

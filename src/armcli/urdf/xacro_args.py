@@ -85,6 +85,7 @@ class Expansion:
     unused: tuple[str, ...] = ()  # given, but the file neither declares nor reads them
     optenv_defaults: tuple[str, ...] = ()  # $(optenv VAR ...) that took their default
     warnings: tuple[str, ...] = ()
+    source_map: str = ""  # xacro_lines.source_map: where each expanded element was written
 
     @property
     def defaults(self) -> tuple[str, ...]:
@@ -121,6 +122,7 @@ class Expansion:
             "unused": list(self.unused),
             "optenv_defaults": list(self.optenv_defaults),
             "warnings": list(self.warnings),
+            "source_map": self.source_map,
         }
 
     @classmethod
@@ -132,6 +134,7 @@ class Expansion:
             tuple(map(str, d.get("unused", ()))),
             tuple(map(str, d.get("optenv_defaults", ()))),
             tuple(map(str, d.get("warnings", ()))),
+            str(d.get("source_map", "")),
         )
 
 

@@ -31,6 +31,7 @@ import re
 import sys
 import time
 from collections.abc import Iterator, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -41,6 +42,7 @@ from armcli.io.userfile import read_regular
 from armcli.urdf.packages import PackageLookup, real_roots
 from armcli.urdf.xacro_args import Expansion, XacroInputs
 from armcli.urdf.xacro_expr import Evaluator, ExprRefusedError
+from armcli.urdf.xacro_lines import annotate, collect, expand_call, source_map
 from armcli.urdf.xacro_yaml import YamlRefusedError
 from armcli.urdf.xacro_yaml import load_yaml as read_yaml
 
@@ -99,6 +101,7 @@ class _State:
         self.start = time.monotonic()
         self.warnings: list[str] = []
         self.optenv_defaults: list[str] = []
+        self.sources: list[str] = []  # files parsed, in order: xacro_lines' file indices
 
     def add_package(self, root: Path) -> None:
         for r in real_roots(root):
@@ -329,7 +332,11 @@ def _patches(state: _State, xacro: Any) -> dict[str, Any]:
                 xacro.filestack.pop()
                 err = FileNotFoundError(2, "No such file or directory", path)
                 raise xacro.XacroException(f"No such file or directory: {path}", exc=err)
-            return xml.dom.minidom.parseString(state.read(path, "included file"))  # str: UTF-8
+            text = state.read(path, "included file")
+            doc = xml.dom.minidom.parseString(text)  # str: UTF-8
+            annotate(doc, text, len(state.sources))  # each element's file and line
+            state.sources.append(os.path.abspath(path))
+            return doc
         return xml.dom.minidom.parseString(inp) if isinstance(inp, str | bytes) else inp
 
     def get_include_files(filename_spec: str, symbols: Any) -> Iterator[str]:
@@ -344,7 +351,7 @@ def _patches(state: _State, xacro: Any) -> dict[str, Any]:
             raise _ProblemError(f"more than {MAX_MACRO_CALLS} macro calls")
         if time.monotonic() - state.start > MAX_SECONDS:
             raise _ProblemError(f"expansion took longer than {MAX_SECONDS:g} s")
-        return real_macro_call(node, macros, symbols)
+        return expand_call(node, lambda: real_macro_call(node, macros, symbols))
 
     def warning(*args: Any, **_: Any) -> None:
         state.warnings.append(f"{_current(xacro, state)}: xacro: {' '.join(map(str, args))}")
@@ -456,8 +463,9 @@ def expand_safe_report(
             doc = xacro.process_file(str(path), mappings=state.args)
         except Exception as exc:  # xacro wraps everything in XacroException
             _raise(state, xacro, exc, path)
+    tags = collect(doc)  # the positions out of the document: the bytes are xacro's
     out: bytes = doc.toprettyxml(indent="  ", encoding="utf-8")
-    return out, state.expansion()
+    return out, replace(state.expansion(), source_map=source_map(out, tags, state.sources))
 
 
 def child_main(argv: Sequence[str]) -> int:

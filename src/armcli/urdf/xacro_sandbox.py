@@ -40,7 +40,7 @@ XACRO_TIMEOUT = 20.0  # wall clock [s]
 XACRO_CPU_SECONDS = 20
 XACRO_MEMORY_BYTES = 1 << 30
 XACRO_MAX_OUTPUT = 10_000_000  # same cap as urdf.read.MAX_URDF_BYTES
-XACRO_MAX_STDERR = 100_000
+XACRO_MAX_STDERR = 4_000_000  # the report carries the source map: ~15 bytes per element
 XACRO_MAX_FILES = 64
 _CHUNK = 65536
 
@@ -95,8 +95,10 @@ sys.stderr.write("\\n" + json.dumps({"kind": "ok", "expansion": used}) + "\\n")
 """
 _SAFE_SCRIPT = """
 import sys
+if sys.argv[1]:
+    sys.path.insert(0, sys.argv[1])
 from armcli.urdf.xacro_safe import child_main
-sys.exit(child_main(sys.argv[1:]))
+sys.exit(child_main(sys.argv[2:]))
 """
 
 
@@ -195,6 +197,19 @@ def _python() -> list[str]:
     return [sys.executable, "-I"]
 
 
+def _armcli_root() -> str:
+    """The directory this armcli is imported from, when `-I` would not find it by itself.
+
+    An isolated child sees site-packages but no PYTHONPATH: from a source checkout (a
+    worktree, PYTHONPATH=src) it would import whichever armcli is installed, a different
+    version of the safe expander than the parent's. Empty for an installed armcli.
+    """
+    import armcli
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(armcli.__file__)))
+    return "" if os.path.basename(root) in ("site-packages", "dist-packages") else root
+
+
 def expand_foreign(path: str | Path, roots: Sequence[Path], request: str | None = None) -> bytes:
     """Safe-mode expansion (xacro_safe) of a foreign xacro file in a limited child."""
     return run_safe(path, request or request_json(roots, XacroInputs()))[0]
@@ -204,7 +219,7 @@ def run_safe(path: str | Path, request: str) -> tuple[bytes, dict[str, Any]]:
     """xacro_safe's child on `path` with its JSON `request`: the URDF bytes and its report."""
     p = Path(path)
     check_regular(p, "xacro file")
-    argv = [*_python(), "-c", _SAFE_SCRIPT, os.path.abspath(p), request]  # as given, like xacro
+    argv = [*_python(), "-c", _SAFE_SCRIPT, _armcli_root(), os.path.abspath(p), request]
     res = run_limited(argv, p.resolve().parent, env={"PATH": os.defpath, "LANG": "C.UTF-8"})
     if res.why is not None:
         raise InputError(f"xacro expansion {res.why}", file=p)

@@ -20,12 +20,12 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
+from armcli.robot.tool import ToolPoint
 from armcli.spec.joint_types import position_bounds
 from armcli.urdf.mesh_confine import bounded_mesh_file, check_total
 from armcli.urdf.meshes import MeshSearch, confined, resolve
 from armcli.urdf.meshlog import MeshLog, quiet_trimesh
 from armcli.urdf.read import parse_root
-from armcli.urdf.tool import ToolPoint
 
 MAX_EDGE = 0.04  # [m] faces are split to this edge length so depth sorting works
 SPLIT_ROUNDS = 8  # halvings at most; longer edges stay longer than MAX_EDGE
@@ -54,6 +54,10 @@ class RenderResult:
 MESH_HINT = "--package-dir NAME=PATH points package://NAME at a folder"
 FALLBACK_RGBA = (0.6, 0.6, 0.6, 1.0)  # meshes whose colour cannot be read
 TITLE_WIDTH = 110  # [characters] per title line, so many joints do not run off the figure
+TITLE_LINES = 4  # of joint values at most: PR2's 40-odd joints end in "... and N more"
+TITLE_FONT = 10  # [pt]
+LINE_SPACING = 1.4  # text line height / font size (matplotlib's default 1.2, plus leading)
+VIEW_TITLE_SPACE = 0.45  # [in] the views' own titles above their axes
 
 
 def _mesh_handler(
@@ -286,8 +290,14 @@ def _title(name: str, q: Mapping[str, float], urdf: Any, tip: np.ndarray | None)
     limits = joint_limits(urdf)
     shown = {j: v for j, v in q.items() if v != 0.0 or limits.get(j) is not None} or q
     unit = {j: "m" if urdf.joint_map[j].type == "prismatic" else "rad" for j in shown}
-    joints = ", ".join(f"{j} = {v:.3f} {unit[j]}" for j, v in shown.items())
-    text = textwrap.fill(f"{name}: {joints or 'no movable joints'}", TITLE_WIDTH)
+    entries = [f"{j} = {v:.3f} {unit[j]}" for j, v in shown.items()]
+    rows = textwrap.wrap(f"{name}: {', '.join(entries) or 'no movable joints'}", TITLE_WIDTH)
+    k = len(entries)
+    while len(rows) > TITLE_LINES and k > 0:  # more would run into the views (PR2, G1)
+        k -= 1
+        more = f" ... and {len(entries) - k} more joint(s)"
+        rows = textwrap.wrap(f"{name}: {', '.join(entries[:k])}{more}", TITLE_WIDTH)
+    text = "\n".join(rows)
     if tip is not None:
         text += "\ntool at ({:.3f}, {:.3f}, {:.3f}) m".format(*tip)
     return text
@@ -323,8 +333,14 @@ def render_figure(
             ax.set_yticks([])
             ax.set_ylabel("")
         ax.set_title(title, fontsize=10)
-    fig.suptitle(_title(name, q, urdf, tip), fontsize=10)
-    fig.subplots_adjust(left=0.02, right=0.96, bottom=0.04, top=0.86, wspace=0.12)
+    title = _title(name, q, urdf, tip)
+    fig.suptitle(title, fontsize=TITLE_FONT, y=0.99, va="top")
+    # The views start below the title's lines and their own titles (a fixed top let a long
+    # title overprint them: PR2, G1).
+    height = size[1] / DPI  # [in]
+    used = (title.count("\n") + 1) * TITLE_FONT * LINE_SPACING / 72.0 + VIEW_TITLE_SPACE
+    top = max(0.3, min(0.86, 0.99 - used / height))
+    fig.subplots_adjust(left=0.02, right=0.96, bottom=0.04, top=top, wspace=0.12)
     return fig
 
 

@@ -22,8 +22,9 @@ from numpy.typing import NDArray
 
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
-from armcli.urdf.pinocchio import link_frame, load_model
-from armcli.urdf.tool import ToolPoint
+from armcli.robot.load import link_frame
+from armcli.robot.model import Robot
+from armcli.robot.tool import ToolPoint
 from armcli.urdf.workspace import (
     Chain,
     ReachPoint,
@@ -59,10 +60,10 @@ def reach_of(
     samples: int = REACH_SAMPLES,
 ) -> tuple[Chain, NDArray[np.float64], Workspace, tuple[ReachPoint, ...]]:
     """The chain at pose `q`, its sampled tool positions (n, 3) [m], envelope and verdicts."""
-    model = load_model(source, xml=xml).model
-    if link_frame(model, tool.link) is None:
+    robot = Robot.from_xml(xml, source)
+    if link_frame(robot.model, tool.link) is None:
         raise InputError(f"no link {tool.link!r} for the tool point", file=source)
-    chain = Chain(model, tool, q)
+    chain = Chain(robot, tool, q)
     if not chain.joints:
         raise InputError(
             f"no moving joint between the root and {tool.label}: nothing to reach with",

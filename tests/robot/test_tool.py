@@ -8,13 +8,13 @@ import pytest
 
 from armcli.check.rules import CheckOptions
 from armcli.check.run import check_urdf
+from armcli.robot.tool import ToolPoint, spec_tool, tool_point
 from armcli.ros.srdf import arm_chain
 from armcli.sim import job as simjob
 from armcli.sim.options import SimOptions
 from armcli.spec.load import load_spec
 from armcli.urdf.read import parse_urdf, read_urdf
 from armcli.urdf.source import read_robot
-from armcli.urdf.tool import ToolPoint, spec_tool, tool_point
 from armcli.view.scene import load_robot
 from tests.helpers import DEFAULT_SPEC
 

@@ -7,10 +7,9 @@ what it said as warnings for the caller (checks turn them into findings).
 
 from __future__ import annotations
 
-import math
 import os
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -19,6 +18,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from armcli.errors import InputError, ModelLoadError
+from armcli.urdf.doc import Urdf
+from armcli.urdf.source import urdf_text
 
 
 @dataclass
@@ -55,7 +56,7 @@ def _capture_stderr(fn: Any) -> tuple[Any, list[str]]:
     return result, lines
 
 
-def parser_problems(lines: list[str]) -> list[str]:
+def parser_problems(lines: Sequence[str]) -> list[str]:
     """The urdfdom messages, one per problem: continuation lines (C++ source locations) dropped."""
     out: list[str] = []
     for ln in lines:
@@ -87,52 +88,6 @@ def load_model(path: str | Path, *, xml: str | None = None, floating: bool = Fal
     return LoadedModel(model=model, source=source, parser_messages=messages)
 
 
-@dataclass(frozen=True)
-class JointRange:
-    """One 1-DoF joint of a Pinocchio model and the range to sample it over."""
-
-    name: str
-    idx_q: int
-    idx_v: int
-    continuous: bool  # stored as (cos, sin) in q
-    lower: float  # [rad or m]
-    upper: float
-
-
-def joint_ranges(model: Any) -> list[JointRange]:
-    """The model's 1-DoF joints with finite sampling ranges (continuous: [-pi, pi]).
-
-    Multi-DoF joints (floating, planar) are left out: they stay at neutral.
-    """
-    out = []
-    for jid in range(1, model.njoints):
-        jm = model.joints[jid]
-        if jm.nv != 1:
-            continue
-        continuous = jm.nq == 2
-        lo = -math.pi if continuous else float(model.lowerPositionLimit[jm.idx_q])
-        hi = math.pi if continuous else float(model.upperPositionLimit[jm.idx_q])
-        if not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi:
-            lo, hi = -math.pi, math.pi
-        out.append(JointRange(str(model.names[jid]), jm.idx_q, jm.idx_v, continuous, lo, hi))
-    return out
-
-
-def configuration(model: Any, values: Mapping[str, float]) -> Any:
-    """Neutral q with the named 1-DoF joints set to `values` [rad or m]."""
-    import pinocchio as pin
-
-    q = pin.neutral(model)
-    for jr in joint_ranges(model):
-        if jr.name in values:
-            x = float(values[jr.name])
-            if jr.continuous:
-                q[jr.idx_q], q[jr.idx_q + 1] = math.cos(x), math.sin(x)
-            else:
-                q[jr.idx_q] = x
-    return q
-
-
 def mass_matrix(model: Any, data: Any, q: Any) -> NDArray[np.float64]:
     """The joint-space mass matrix M(q) [kg·m² or kg], symmetric.
 
@@ -157,6 +112,32 @@ def collision_model(model: Any, xml: str, package_dirs: list[str] | None = None)
     except (RuntimeError, ValueError) as exc:
         raise InputError(f"Pinocchio cannot load the collision geometry: {exc}") from None
     return gmodel
+
+
+_PROBLEM = {
+    "missing": "missing number",
+    "not-a-number": "not a number:",
+    "non-finite": "non-finite number",
+    "length": "wrong number of values:",
+}
+
+
+def checked_model(urdf: Urdf, *, gate: Callable[[Urdf], None] | None = None) -> LoadedModel:
+    """A parsed URDF -> Pinocchio model, refusing what Pinocchio would silently accept.
+
+    `gate`, when given, may refuse the document after the number checks (e.g.
+    check.gate.refuse_check_errors: the model `check` reports as an error).
+    """
+    if urdf.problems:
+        p = urdf.problems[0]
+        raise InputError(f"{p.where}: {_PROBLEM[p.kind]} {p.text!r}", file=urdf.source, line=p.line)
+    if gate is not None:
+        gate(urdf)
+    loaded = load_model(urdf.source, xml=urdf_text(urdf))
+    said = [m for m in parser_problems(loaded.parser_messages) if "error" in m.lower()]
+    if said:
+        raise InputError(f"the URDF parser reported: {said[0]}", file=urdf.source)
+    return loaded
 
 
 def link_frame(model: Any, name: str) -> int | None:

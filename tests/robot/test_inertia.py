@@ -1,4 +1,4 @@
-"""armcli.urdf.inertia against independent references: numerical integration over the solid,
+"""armcli.robot.inertia against independent references: numerical integration over the solid,
 point clouds for frame changes, scipy for URDF's roll-pitch-yaw convention."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from armcli.urdf import inertia as inr
+from armcli.robot import inertia as inr
 
 # Midpoint quadrature with N cells per axis has O(1/N²) error: N = 60 gives ~1e-4.
 QUADRATURE_RTOL = 5e-4

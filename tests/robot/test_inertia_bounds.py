@@ -9,15 +9,15 @@ import random
 import numpy as np
 import pytest
 
-from armcli.urdf import inertia as inr
-from armcli.urdf.doc import Geometry
-from armcli.urdf.inertia_bounds import (
+from armcli.robot import inertia as inr
+from armcli.robot.inertia_bounds import (
     EXCEEDS_RTOL,
     excess,
     extreme_bound,
     fix_values,
     solid_inertia,
 )
+from armcli.urdf.doc import Geometry
 
 BOX = Geometry("box", (0.6, 0.4, 0.2), None)
 CYLINDER = Geometry("cylinder", (0.1, 0.05), None)  # radius, length (axis z)

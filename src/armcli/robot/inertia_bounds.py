@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from armcli.urdf import inertia as inr
+from armcli.robot import inertia as inr
 from armcli.urdf.doc import Geometry, Link, Shape
 
 Matrix = NDArray[np.float64]

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from armcli.urdf.mimic import Mimic, follow, mimics
+from armcli.robot.mimic import Mimic, follow, mimics
 from armcli.urdf.read import parse_urdf
 
 # Two fingers closing on each other along y: 0.04 m wide boxes whose centres start 0.1 m
@@ -52,22 +52,22 @@ def test_chains_resolve_leaders_first_and_cycles_drop_out() -> None:
 
 
 def test_check_samples_and_poses_set_followers_from_leaders() -> None:
-    from armcli.check import dynamics as dyn
     from armcli.check.context import Context, poses
     from armcli.check.rules import CheckOptions, Collector
     from armcli.check.structure import check
-    from armcli.urdf.pinocchio import joint_ranges, load_model
+    from armcli.robot import sampling
+    from armcli.robot.model import Robot
 
     doc = parse_urdf(gripper(COUPLED), "g.urdf")
-    model = load_model("g.urdf", xml=doc.text.decode()).model
-    ranges = joint_ranges(model)
-    sample = dyn.samples(model, ranges, mimics(doc.joints))
+    robot = Robot.from_urdf(doc)
+    model = robot.model
+    sample = sampling.configurations(robot)
     assert len(sample) > 2
     for values, q in sample:
         assert values["right_joint"] == pytest.approx(0.035 - values["left_joint"], abs=1e-15)
         assert q[model.joints[model.getJointId("right_joint")].idx_q] == values["right_joint"]
     out = Collector("g.urdf")
-    ctx = Context(doc, CheckOptions(), out, check(doc, out), ranges=ranges)
+    ctx = Context(doc, CheckOptions(), out, check(doc, out), robot=robot)
     by_name = dict(poses(ctx))
     assert by_name["lower"] == {"left_joint": 0.0, "right_joint": 0.035}
     assert by_name["upper"] == pytest.approx({"left_joint": 0.035, "right_joint": 0.0})
