@@ -79,7 +79,7 @@ class Link:
 
 @dataclass(frozen=True)
 class Limit:
-    """A <limit>: lower/upper [rad or m], effort [N·m or N], velocity [rad/s or m/s], acceleration."""
+    """A <limit>: lower/upper [rad or m], effort [N·m or N], velocity, acceleration [rad/s(²)]."""
 
     lower: float | None
     upper: float | None
