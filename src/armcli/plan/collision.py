@@ -102,10 +102,12 @@ class CollisionChecker:
         self.pairs = self._pairs(gmodel, {_key(a, b) for a, b in disabled})
         self.gmodel = gmodel
         self.gdata_all = pin.GeometryData(gmodel)
-        self.gdata = pin.GeometryData(gmodel)
+        self.gdata = pin.GeometryData(gmodel)  # moving pairs, padded: the planner's
+        self.gdata_moving = pin.GeometryData(gmodel)  # moving pairs, exact
         for k, (i, j) in enumerate(self.pairs):
             if self.bodies[i].moves_with == self.bodies[j].moves_with:
                 self.gdata.deactivateCollisionPair(k)  # their relative pose never changes
+                self.gdata_moving.deactivateCollisionPair(k)
 
     def _pairs(self, gmodel: Any, disabled: set[tuple[str, str]]) -> list[tuple[int, int]]:
         pairs = []
@@ -141,8 +143,11 @@ class CollisionChecker:
                     req.security_margin = 0.0
 
     def first_collision(self, x: np.ndarray, *, every_pair: bool = False) -> tuple[str, str] | None:
-        """The first colliding pair at planned joint values `x` (names), or None."""
-        gdata = self.gdata_all if every_pair else self.gdata
+        """The first colliding pair at planned joint values `x` (names), or None.
+
+        Exact geometry (no padding); `every_pair` also checks the pairs no planned joint moves.
+        """
+        gdata = self.gdata_all if every_pair else self.gdata_moving
         q = self.robot.q(x)
         if not self.pin.computeCollisions(self.model, self.data, self.gmodel, gdata, q, True):
             return None
