@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from armcli.errors import OutputRefusedError, PlanningError
+from armcli.errors import InputError, OutputRefusedError, PlanningError
 from armcli.view.browser import Viewer
 from armcli.view.panel import DRAGGED, PlanningPanel
 from armcli.view.planning import PlanningSession, load_session
@@ -28,6 +28,7 @@ IK_TOL = 1.5e-4  # [m] plan.ik's POSITION_TOL (1e-4 m) with rounding room
 END_TOL = 1e-9  # [rad] the plan's first and last points are its start and goal
 TRACK_TOL = 0.05  # [rad] the simulated arm ends this close to the goal (PD, gravity)
 MESH_TOL = 1e-9  # [m] a box's corners vs its pose and half-extents
+ROTATION_TOL = 1.5e-3  # [rad] plan.ik's ROTATION_TOL (1e-3 rad) with rounding room
 
 
 def tip(q: np.ndarray) -> np.ndarray:
@@ -201,3 +202,35 @@ def test_panel_widgets_drive_the_session(panel: PlanningPanel) -> None:
     assert panel.status.startswith("planned: ") and panel.status.endswith("; certified")
     saved = panel.save()
     assert saved is not None and saved.read_bytes() == session.result.document  # type: ignore[union-attr]
+
+
+def test_panda_drag_solves_position_and_orientation(tmp_path: Path) -> None:
+    """Seven joints and a finger: the handle's rotation counts; yourdfpy (second engine) agrees."""
+    from armcli.urdf.packages import PackageLookup
+    from armcli.view.png import load_urdf
+    from tests.plan.conftest import ERD, PANDA
+
+    if not PANDA.is_dir():
+        pytest.skip("example-robot-data's Panda is not installed")
+    src = load_robot(
+        PANDA / "urdf" / "panda.urdf", search=PackageLookup({"example-robot-data": ERD})
+    )
+    assert src.file is not None and src.tool is not None
+    session = load_session(src.file, srdf=PANDA / "srdf" / "panda.srdf", search=src.search,
+                           save_dir=tmp_path)  # fmt: skip
+    assert session.pose_names == ("default",)  # the SRDF's one group_state
+    session.set_goal(session.pose("default"))
+    p, R = session.tool(session.goal)
+    target = p + np.array([0.0, 0.1, -0.05])  # 11 cm away, same orientation
+    assert session.drag_goal(target, R).x is not None
+    urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search)
+    urdf.update_cfg(
+        {**{j: 0.0 for j in urdf.actuated_joint_names}, **session.as_dict(session.goal)}
+    )
+    T = urdf.get_transform(src.tool.link, urdf.base_link)
+    assert T[:3, :3] @ np.asarray(src.tool.xyz) + T[:3, 3] == pytest.approx(target, abs=IK_TOL)
+    angle = math.acos(np.clip((np.trace(T[:3, :3].T @ R) - 1) / 2, -1.0, 1.0))
+    assert angle < ROTATION_TOL
+    assert session.plan() is not None, session.reason
+    with pytest.raises(InputError, match=r"no PD gains to simulate with: .*armcli import"):
+        session.execute()  # a URDF carries no gains

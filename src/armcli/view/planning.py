@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from armcli.errors import OutputRefusedError, PlanningError
+from armcli.errors import InputError, OutputRefusedError, PlanningError
 from armcli.io.files import write_file_atomic
 from armcli.io.outdir import check_output_file, relative_inside
 from armcli.plan.api import PlanningContext, PlanOptions, PlanResult, plan_motion, values
@@ -30,7 +30,7 @@ from armcli.sim.options import SimOptions
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import RobotFile
 
-LIVE_IK_ATTEMPTS = 4  # seeded at the current goal, then a few restarts: a drag stays fluid
+LIVE_IK_ATTEMPTS = 16  # seeded at the goal, then restarts (Panda: ~0.1 s; 4 miss by singularities)
 TRAIL_POSES = 7  # ghost poses drawn along a plan, both ends included
 TRAIL_POINTS = 60  # tool-point samples of the drawn path
 SAVE_SUFFIXES = (".yaml", ".yml")
@@ -88,7 +88,7 @@ class PlanningSession:
     ) -> None:
         self.context, self.robot_file = context, robot_file
         self.scene = scene or Scene()
-        self._sim = sim or SimOptions()
+        self._sim = sim or SimOptions(urdf=None if robot_file.spec else robot_file.path)
         self._search = search
         self.save_dir = Path(save_dir)
         self._options = options or PlanOptions()
@@ -201,7 +201,16 @@ class PlanningSession:
             trust_xacro=self._sim.trust_xacro,
             xacro=self._sim.xacro,
         )
-        self.execution = execute(self.robot_file.spec, opts, self._search)
+        try:
+            self.execution = execute(self.robot_file.spec, opts, self._search)
+        except InputError as exc:
+            if exc.field not in ("SimOptions.kp", "SimOptions.kd"):
+                raise
+            raise InputError(
+                "no PD gains to simulate with: Execute runs a spec's control.gains; "
+                "`armcli import` turns this URDF into a spec that has them",
+                field="execute",
+            ) from None
         return self.execution
 
     def save_path(self, name: str) -> Path:
