@@ -9,6 +9,9 @@ executing replays the simulated motion onto the robot.
 from __future__ import annotations
 
 import json
+import signal
+import subprocess
+import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -178,3 +181,36 @@ def test_cli_bad_scene_names_file_line_and_field(root: Path, tmp_path: Path) -> 
         f"error: {scene}:3 collision_objects[0].primitives[0].type: unknown primitive 'pyramid'"
     )
     assert proc.stdout == ""
+
+
+def test_cli_robot_without_joints_gets_the_viewer_without_a_panel(
+    root: Path, tmp_path: Path
+) -> None:
+    urdf = tmp_path / "block.urdf"
+    urdf.write_text(
+        '<robot name="block"><link name="base">'
+        '<visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual>'
+        '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>'
+        '<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"'
+        ' ixy="0" ixz="0" iyz="0"/></inertial></link></robot>'
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "armcli.cli", "view", str(urdf), "--port", "0"],
+        cwd=root,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    try:
+        first = proc.stdout.readline() if proc.stdout else ""
+        assert first.startswith("armcli view: block at http://127.0.0.1:"), first
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 0, err
+    assert out == "viewer stopped\n"
+    assert err.startswith("note: no planning panel: ") and err.count("\n") == 1, err
