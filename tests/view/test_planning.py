@@ -184,6 +184,9 @@ def panel(robot, boxed: PlanningSession) -> Iterator[PlanningPanel]:  # type: ig
 def test_panel_widgets_drive_the_session(panel: PlanningPanel) -> None:
     session = panel.session
     assert np.array_equal(session.goal, session.pose("reach"))  # the first pose after home
+    panel.viewer.set_configuration(session.as_dict(session.pose("reach")))  # hand in the box
+    assert not panel.plan()  # start <current>: the robot's pose
+    assert panel.status == "no plan: start is in collision: hand_link and box"
     panel.choose_start("folded")  # a named start also moves the robot there
     folded = session.pose("folded")
     assert panel.viewer.tool_position() == pytest.approx(tip(folded), abs=FK_TOL)

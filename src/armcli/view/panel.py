@@ -25,6 +25,7 @@ from armcli.view.planning import PlanningSession
 from armcli.view.png import load_urdf
 
 if TYPE_CHECKING:
+    from armcli.plan.api import PlanResult
     from armcli.view.browser import Viewer
 
 GOAL_RGBA = (1.0, 0.5, 0.05, 0.45)  # RViz's goal state: orange
@@ -109,13 +110,11 @@ class PlanningPanel:
         with self._lock:
             self._buttons(busy=True)
             try:
-                if self._start_box.value == CURRENT:
-                    self.session.set_start(self.session.from_dict(self.viewer.configuration()))
                 self._set_status("planning...")
-                result = self.session.plan()
+                result, reason = self._plan()
                 if result is None:
                     self._hide_trail()
-                    self._set_status(f"no plan: {self.session.reason}")
+                    self._set_status(f"no plan: {reason}")
                     return False
                 self._draw_trail()
                 self._set_status(
@@ -125,6 +124,14 @@ class PlanningPanel:
                 return True
             finally:
                 self._buttons(busy=False)
+
+    def _plan(self) -> tuple[PlanResult | None, str | None]:
+        try:
+            if self._start_box.value == CURRENT:
+                self.session.set_start(self.session.from_dict(self.viewer.configuration()))
+            return self.session.plan(), self.session.reason
+        except ArmcliError as exc:  # e.g. a current pose the planner cannot take
+            return None, str(exc)
 
     def execute(self, *, wait: bool = False) -> bool:
         """Simulate the plan, then replay it on the robot; False with a reason if broken."""
@@ -159,9 +166,13 @@ class PlanningPanel:
 
     def close(self) -> None:
         """Stop a running replay (before the viewer closes)."""
+        self._stop_replay()
+
+    def _stop_replay(self) -> None:
         self._stop.set()
         if self._replayer is not None:
             self._replayer.join(timeout=2.0)
+        self._stop = threading.Event()
 
     # -- widgets -------------------------------------------------------------------------
     def _build_gui(self) -> None:
@@ -287,7 +298,8 @@ class PlanningPanel:
         done = self.session.execution
         if done is None or done.states is None:
             return
-        states, joints = done.states, self.session.joints
+        self._stop_replay()  # a second Execute restarts the replay
+        states, joints, stop = done.states, self.session.joints, self._stop
         lo = dict(zip(joints, self.session.context.robot.lower, strict=True))
         hi = dict(zip(joints, self.session.context.robot.upper, strict=True))
 
@@ -298,7 +310,7 @@ class PlanningPanel:
                 at = states.positions_at(t0 + min(t, states.duration))
                 q = {j: float(np.clip(v, lo[j], hi[j])) for j, v in at.items() if j in lo}
                 self.viewer.set_configuration(q)
-                if t >= states.duration or self._stop.wait(1.0 / FRAME_RATE):
+                if t >= states.duration or stop.wait(1.0 / FRAME_RATE):
                     return
 
         self._replayer = threading.Thread(target=play, daemon=True)
