@@ -53,8 +53,9 @@ class PlanningPanel:
         search: MeshSearch | None = None,
     ) -> None:
         self.viewer, self.session = viewer, session
-        self._ghost_xml = moving_parts(urdf_xml, session.joints, source)
-        self._load = (source, mesh_dir, search)
+        # one yourdfpy model for every ghost: each ghost poses it and reads it at once
+        self._ghost_urdf = load_urdf(moving_parts(urdf_xml, session.joints, source), source,
+                                     mesh_dir, search)  # fmt: skip
         self._lock = threading.RLock()
         self._quiet = False  # set while the panel moves its own widgets
         self._trail: list[Any] = []
@@ -256,9 +257,8 @@ class PlanningPanel:
     def _ghost(self, root: str, rgba: tuple[float, float, float, float]) -> Any:
         from viser.extras import ViserUrdf
 
-        source, mesh_dir, search = self._load
-        urdf = load_urdf(self._ghost_xml, source, mesh_dir, search)
-        return ViserUrdf(self.viewer.server, urdf, root_node_name=root, mesh_color_override=rgba)
+        return ViserUrdf(self.viewer.server, self._ghost_urdf, root_node_name=root,
+                         mesh_color_override=rgba)  # fmt: skip
 
     def _cfg(self, x: np.ndarray) -> np.ndarray:
         """A ghost's configuration: the viewer's joints, planned ones at `x`."""
