@@ -14,25 +14,10 @@ from tests.helpers import ROOT
 
 SRC = ROOT / "src" / "armcli"
 RANK = {  # layer of each top-level module or subpackage (docs/ARCHITECTURE.md)
-    "errors": 0, "defaults": 0, "io": 1, "spec": 2, "compiler": 3, "urdf": 4, "robot": 5,
-    "analysis": 6, "check": 7, "sim": 7, "ros": 7, "export": 7, "importer": 7,
-    "tune": 8, "plan": 8, "view": 9, "commands": 10, "cli": 11, "__main__": 12,
+    "errors": 0, "defaults": 0, "io": 1, "spec": 2, "xacro": 3, "compiler": 4, "urdf": 5,
+    "robot": 6, "analysis": 7, "export": 8, "importer": 8, "ros": 8, "sim": 9, "check": 10,
+    "tune": 10, "plan": 10, "view": 11, "commands": 12, "cli": 13, "__main__": 14,
 }  # fmt: skip
-# Modules of the analysis layer still waiting in urdf/ for their move to analysis/ (issue 28,
-# step 2): they stand above robot/, which they use, and nothing in urdf/ imports them.
-PENDING_ANALYSIS = {
-    f"armcli.urdf.{m}" for m in ("stance", "ground", "support", "workspace", "boxsearch")
-}
-SIBLING_EXCEPTIONS = {
-    ("check", "armcli.sim.stability"),
-    ("check", "armcli.sim.verdict"),
-    ("check", "armcli.sim.tipping"),
-    ("sim", "armcli.export.mjcf"),
-}
-# The compiler expands its own xacro set with the safe evaluator foreign files get (issue 27:
-# never xacro's Python eval). That evaluator still lives in urdf/ until the xacro/ package
-# (issue 28) sits below the compiler; this one upward edge is the documented exception.
-UPWARD_EXCEPTIONS = {("compiler", "armcli.urdf.xacro_safe")}
 
 
 def _module_name(path: Path) -> str:
@@ -59,8 +44,6 @@ def _graph() -> dict[str, set[str]]:
 
 
 def _layer(module: str) -> str:
-    if module in PENDING_ANALYSIS:
-        return "analysis"
     parts = module.split(".")
     return parts[1] if len(parts) > 1 else "errors"  # the package itself holds only metadata
 
@@ -83,9 +66,9 @@ def test_imports_only_go_down() -> None:
             there = _layer(target)
             if target == "armcli" or here == there:
                 continue
-            if RANK[there] > RANK[here] and (here, target) not in UPWARD_EXCEPTIONS:
+            if RANK[there] > RANK[here]:
                 bad.append(f"{module} -> {target} (upward)")
-            elif RANK[there] == RANK[here] and (here, target) not in SIBLING_EXCEPTIONS:
+            elif RANK[there] == RANK[here]:
                 bad.append(f"{module} -> {target} (sibling)")
     assert not bad, "\n".join(sorted(bad))
 

@@ -16,7 +16,7 @@ from armcli.check.run import check_urdf
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
 from armcli.urdf.read import parse_urdf, read_urdf
-from armcli.urdf.xacro_sandbox import expand_untrusted
+from armcli.xacro.sandbox import expand_untrusted
 from tests.helpers import FIXTURES as ALL_FIXTURES
 from tests.helpers import ROOT
 

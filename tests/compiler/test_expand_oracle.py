@@ -25,7 +25,7 @@ from armcli.compiler.expand import expand_urdfs
 from armcli.compiler.xacro_writer import top_level_files, xacro_files
 from armcli.errors import BuildError
 from armcli.importer.file import import_file
-from armcli.spec.load import load_spec
+from armcli.spec.load import load_spec, loads_spec
 from armcli.spec.model import RobotSpec
 from tests.compiler.test_acceptance import write_meshes
 from tests.helpers import FIXTURES, SPECS
@@ -63,6 +63,19 @@ def test_safe_expansion_equals_real_xacro(path: Path, tmp_path: Path) -> None:
     spec = load_spec(tmp_path / path.name)
     safe = expand_urdfs(spec)
     assert safe == _real_xacro(spec)
+
+
+@pytest.mark.parametrize("module", ["test_links", "test_parts", "test_xacro_writer"])
+def test_inline_test_specs_expand_as_real_xacro(module: str) -> None:
+    """The compiler tests' own specs: general links with passthrough `${`/`$(` text, mirrored
+    parts (the `reflect` macro), every primitive shape."""
+    import importlib
+
+    mod = importlib.import_module(f"tests.compiler.{module}")
+    name = {"test_links": "SPEC", "test_parts": "_arms_spec", "test_xacro_writer": "SHAPES_SPEC"}
+    text = getattr(mod, name[module])
+    spec = loads_spec(text() if callable(text) else text)
+    assert expand_urdfs(spec) == _real_xacro(spec)
 
 
 @pytest.mark.parametrize("urdf", IMPORT_FIXTURES, ids=lambda p: p.name)

@@ -18,7 +18,7 @@ from lxml import etree
 from armcli.errors import InputError
 from armcli.export.mjcf_files import export_mjcf
 from armcli.export.mjcf_meshes import MJ_STL_MAX_FACES, is_flat, read_mesh
-from armcli.urdf.mesh_confine import MAX_MESH_BYTES, MAX_MESH_TOTAL_BYTES
+from armcli.io.mesh_confine import MAX_MESH_BYTES, MAX_MESH_TOTAL_BYTES
 
 mujoco = pytest.importorskip("mujoco")
 

@@ -14,9 +14,9 @@ import pytest
 
 from armcli.compiler.massprops import mesh_mass_properties
 from armcli.errors import InputError
+from armcli.io.mesh_confine import MAX_MESH_BYTES, bounded_mesh_file
 from armcli.io.meshbound import MAX_MESH_PAYLOAD_BYTES, MAX_MESH_TRIANGLES, check_mesh_payload
 from armcli.spec.shapes import Geometry, Inertial, Mesh, Shape
-from armcli.urdf.mesh_confine import MAX_MESH_BYTES, bounded_mesh_file
 from tests.meshes import house_triangles, write_stl
 
 MIB = 1 << 20

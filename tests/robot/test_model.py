@@ -4,6 +4,7 @@ closed-form kinematics, the reduced model and the collision model on demand."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -12,7 +13,9 @@ import pytest
 from armcli.errors import InputError
 from armcli.robot.model import Robot
 from armcli.robot.tool import ToolPoint
+from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_urdf
+from tests.meshes import prism_triangles, write_stl
 
 EXACT = 1e-12  # same arithmetic, only rounding of cos/sin and one rotation product
 
@@ -127,3 +130,18 @@ def test_collision_model_on_demand(robot: Robot) -> None:
 def test_mass_and_data(robot: Robot) -> None:
     assert robot.mass == pytest.approx(3.1, abs=EXACT)  # 1 + 1 + 1 + 0.1 kg in URDF
     assert robot.data is robot.data
+
+
+def test_collision_model_resolves_meshes_inside_the_allowed_roots(tmp_path: Path) -> None:
+    write_stl(tmp_path / "meshes" / "box.stl", prism_triangles(0.05, 0.1, 4))
+    mesh = b'<mesh filename="meshes/box.stl"/>'
+    text = URDF.replace(b'<box size="0.1 0.1 0.1"/>', mesh)
+    (tmp_path / "t.urdf").write_bytes(text)
+    robot = Robot.from_urdf(parse_urdf(text, str(tmp_path / "t.urdf")))
+    gm = robot.collision_model(MeshSearch())
+    real = (tmp_path / "meshes" / "box.stl").resolve()
+    assert [g.meshPath for g in gm.geometryObjects if g.meshPath.endswith(".stl")] == [str(real)]
+    gone = Robot.from_urdf(parse_urdf(text.replace(b"box.stl", b"gone.stl"),
+                                      str(tmp_path / "t.urdf")))  # fmt: skip
+    with pytest.raises(InputError, match=r"mesh 'meshes/gone\.stl' cannot be found"):
+        gone.collision_model(MeshSearch())

@@ -147,3 +147,35 @@ def test_a_fifo_mesh_is_refused(tmp_path: Path) -> None:
     os.mkfifo(project / "meshes" / "pipe.stl")
     with pytest.raises(InputError, match=r"pipe\.stl"):
         ros_packages(load_spec(project / "armcli.yaml"), samples=10)
+
+
+def test_a_mesh_over_the_size_bound_is_not_copied(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from armcli.ros import copying
+
+    project = _hostile_project(tmp_path)
+    size = (project / "meshes" / "base.stl").stat().st_size
+    monkeypatch.setattr(copying, "MAX_MESH_BYTES", size - 1)  # the cap is 20 MB: shrunk here
+    with pytest.raises(InputError, match=r"base\.stl.*larger than"):
+        ros_packages(load_spec(project / "armcli.yaml"), samples=10)
+
+
+def test_a_compressed_collision_mesh_bomb_is_refused(tmp_path: Path) -> None:
+    """The collision matrix loads collision meshes: they pass the same bounds as check's."""
+    import gzip
+
+    project = _hostile_project(tmp_path)
+    stl = b"\0" * 80 + (800_000).to_bytes(4, "little") + b"\0" * (50 * 800_000)  # 40 MB
+    (project / "meshes" / "bomb.stl").write_bytes(gzip.compress(stl, 1))
+    text = (project / "armcli.yaml").read_text()
+    text = text.replace(
+        "geometry: {cylinder: {radius: 0.08, length: 0.1}}",
+        "geometry: {mesh: {filename: meshes/bomb.stl}}",
+    ).replace(
+        "inertial: {shape: collision, mass: 4}",
+        "inertial: {mass: 4, inertia: {ixx: 0.01, iyy: 0.01, izz: 0.01}}",
+    )
+    (project / "armcli.yaml").write_text(text)
+    with pytest.raises(InputError, match="decompresses"):
+        ros_packages(load_spec(project / "armcli.yaml"), samples=10)

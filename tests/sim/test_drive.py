@@ -143,3 +143,32 @@ def test_a_heavy_hand_swung_forward_tips_and_the_course_transient_does_not(
     verdict = driveout.tip_verdict(run)
     assert not verdict.tips
     assert verdict.max_tilt < math.radians(2.0)  # measured 0.02 deg, no lift-off
+
+
+def test_a_jerk_lifts_a_wheel_in_both_models_and_tips_neither(tmp_path: Path) -> None:
+    """The reference jumping at t = 0 (Kp 50 / Kd 5): the zero-moment point of the fixed-base
+    run leaves the polygon for ~16 ms, too briefly to tip (sim.tipping's bound); MuJoCo's
+    contact simulation of the same run lifts a contact off the ground and stays upright."""
+    from armcli.sim import tipping
+    from armcli.sim.tipping import TipOptions
+    from armcli.urdf.meshes import MeshSearch
+
+    course = course_gains_spec(tmp_path)
+    jerk = ("joint_names: [arm_base_forearm_joint, forearm_hand_joint]\npoints:\n"
+            " - {positions: [0.3, 1.2], time_from_start: 0.0}\n"
+            " - {positions: [0.3, 1.2], time_from_start: 1.0}\n")  # fmt: skip
+    opts = SimOptions(message=jerk, duration=1.5)
+    spec = load_spec(course)
+    job = simjob.prepare(spec, opts)
+    tip = tipping.prepare(spec, job, TipOptions(), MeshSearch(), [])
+    assert tip is not None
+    res = simjob.run(job, extra=lambda steps: tip.steps(job, steps))
+    report = tipping.report(tip, tip.series(job, res))
+    assert report.min_margin < 0 and not report.tips  # outside, briefly
+    (lift,) = report.lifts
+    assert lift.duration < 0.05 and lift.impulse < 0.5 * lift.bound  # measured 12 %
+
+    still = _cmd(tmp_path, "still", "commands:\n  - {time_from_start: 0}\n")
+    verdict = driveout.tip_verdict(_run(course, opts, still))
+    assert not verdict.tips and verdict.lifts  # MuJoCo: a contact leaves the ground
+    assert verdict.max_tilt < math.radians(5.0)  # measured 0.86 deg

@@ -35,6 +35,7 @@ HOSTILE = {
     ' q:name="x"/>',
     "comment evaluation switched on": "<gazebo><!-- xacro:eval-comments -->"
     "<!-- ${{1}} --></gazebo>",
+    "substitution in a namespace URI": '<gazebo xmlns:v="urn:$(find x)"><v:a/></gazebo>',
     "root element itself": '<xacro:include xmlns:xacro="http://wiki.ros.org/xacro"'
     ' filename="{secret}"/>',
 }

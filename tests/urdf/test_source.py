@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 
 from armcli.errors import InputError, XacroRefusedError
+from armcli.io.packages import PackageLookup
 from armcli.robot.load import checked_model
-from armcli.urdf.packages import PackageLookup
 from armcli.urdf.source import (
     Trust,
     allowed_roots,
@@ -19,8 +19,8 @@ from armcli.urdf.source import (
     read_urdf_file,
     spec_urdfs,
 )
-from armcli.urdf.xacro_args import XacroInputs
-from armcli.urdf.xacro_jail import sandbox_problem
+from armcli.xacro.args import XacroInputs
+from armcli.xacro.jail import sandbox_problem
 from tests.helpers import (
     ARM_PACKAGE,
     DEFAULT_SPEC,

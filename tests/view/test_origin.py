@@ -11,6 +11,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+import viser
 
 from armcli.view.browser import Viewer
 from armcli.view.origin import allowed
@@ -36,7 +37,7 @@ def _upgrade(v: Viewer, host: str, origin: str | None) -> int:
         "Connection": "Upgrade",
         "Sec-WebSocket-Key": "dGhlIHNhbXBsZSBub25jZQ==",
         "Sec-WebSocket-Version": "13",
-        "Sec-WebSocket-Protocol": "viser-v1",
+        "Sec-WebSocket-Protocol": f"viser-v{viser.__version__}",  # else viser prints a warning
         **({"Origin": origin} if origin is not None else {}),
     }
     conn.request("GET", "/", headers=headers)

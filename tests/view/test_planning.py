@@ -209,7 +209,7 @@ def test_panel_widgets_drive_the_session(panel: PlanningPanel) -> None:
 
 def test_panda_drag_solves_position_and_orientation(tmp_path: Path) -> None:
     """Seven joints and a finger: the handle's rotation counts; yourdfpy (second engine) agrees."""
-    from armcli.urdf.packages import PackageLookup
+    from armcli.io.packages import PackageLookup
     from armcli.view.png import load_urdf
     from tests.plan.conftest import ERD, PANDA
 

@@ -26,11 +26,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from armcli.analysis.boxsearch import minimize_box
+from armcli.analysis.stance import Stance
 from armcli.robot import sampling
 from armcli.robot.load import link_frame
 from armcli.robot.sampling import BALANCE_DRAWS
-from armcli.urdf.boxsearch import minimize_box
-from armcli.urdf.stance import Stance
 
 SEEDS_DESCENDED = 3  # local searches per edge and measure, from the best seeds
 PAYLOAD_ROUNDS = 8  # fixed-point rounds for the largest payload over the range

@@ -10,9 +10,9 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
+from armcli.analysis.workspace import ReachPoint, Workspace, describe, verdict
 from armcli.check.balance import StaticBalance
 from armcli.io.terminal import Column, FitTable
-from armcli.urdf.workspace import ReachPoint, Workspace, describe, verdict
 
 if TYPE_CHECKING:
     from armcli.sim.tipping import ZmpReport

@@ -23,10 +23,10 @@ from armcli.spec.joint_types import position_bounds
 from armcli.urdf.doc import Urdf
 
 if TYPE_CHECKING:  # the balance and reach results: imported by their own families
+    from armcli.analysis.stance import Stance
+    from armcli.analysis.workspace import ReachPoint, Workspace
     from armcli.check.balance import StaticBalance
     from armcli.sim.tipping import ZmpReport
-    from armcli.urdf.stance import Stance
-    from armcli.urdf.workspace import ReachPoint, Workspace
 
 Stage = Literal["urdf", "model", "balance", "dynamics"]
 URDF: Stage = "urdf"

@@ -15,13 +15,12 @@ import numpy as np
 
 from armcli.check.rules import CheckOptions, Collector, JointRow, Value
 from armcli.check.structure import finite
-from armcli.errors import InputError
+from armcli.errors import ModelLoadError
 from armcli.robot.model import Robot
 from armcli.sim import stability as stab
 from armcli.sim import verdict as verdicts
 from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
 from armcli.urdf.meshes import mesh_paths
 
 # Shapes must overlap by more than this to count as colliding: links that merely
@@ -159,15 +158,13 @@ def self_collision(
     """
     import pinocchio as pin
 
-    meshes = mesh_paths(urdf, opts.mesh_search())
-    if any(p is None or not p.is_file() for p in meshes.values()):
+    search = opts.mesh_search()
+    if any(p is None or not p.is_file() for p in mesh_paths(urdf, search).values()):
         notes.append("self-collision skipped: some meshes cannot be found")
         return
-    real = {uri: bounded_mesh_file(p, urdf.source) for uri, p in meshes.items() if p is not None}
-    check_total(real.values(), urdf.source)
     try:  # Pinocchio gets absolute confined paths and no search directories
-        gmodel = robot.collision_model(xml=with_real_mesh_paths(urdf.text, real))
-    except InputError as exc:
+        gmodel = robot.collision_model(search)
+    except ModelLoadError as exc:
         notes.append(f"self-collision skipped: {exc.message}")
         return
     model, data = robot.model, robot.data

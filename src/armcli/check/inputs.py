@@ -21,7 +21,7 @@ from armcli.io.yaml import load_yaml, read_text
 from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import Trust, read_robot, read_urdf_file
-from armcli.urdf.xacro_args import XacroInputs
+from armcli.xacro.args import XacroInputs
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec

@@ -8,10 +8,10 @@ REACH_TOL is an error naming how close it gets and where.
 
 from __future__ import annotations
 
+from armcli.analysis.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 from armcli.check.context import Context
 from armcli.robot.load import link_frame
 from armcli.robot.tool import tool_point
-from armcli.urdf.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 
 
 def check(c: Context) -> None:

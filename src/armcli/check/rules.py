@@ -14,9 +14,9 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from armcli.urdf.doc import Origin
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import lookup_for
+from armcli.xacro.lines import Origin
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec

@@ -22,9 +22,9 @@ from armcli.spec.joint_types import total_dof
 from armcli.urdf.doc import Urdf
 
 if TYPE_CHECKING:  # the balance and reach results: imported by their own families
+    from armcli.analysis.workspace import ReachPoint, Workspace
     from armcli.check.balance import StaticBalance
     from armcli.sim.tipping import ZmpReport
-    from armcli.urdf.workspace import ReachPoint, Workspace
 
 
 @dataclass(frozen=True)

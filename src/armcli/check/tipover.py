@@ -12,13 +12,13 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+from armcli.analysis.ground import mesh_loader
+from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
 from armcli.check import balance
 from armcli.check.balance import PoseBalance, StaticBalance
 from armcli.check.context import Context, poses
 from armcli.check.rules import Collector, Value
 from armcli.robot.tool import tool_point
-from armcli.urdf.ground import mesh_loader
-from armcli.urdf.stance import NoStance, Payload, Stance, stance_of
 
 NEAR_NAMED = 1e-3  # [m] a range's worst within this of a named pose's is that pose's finding
 

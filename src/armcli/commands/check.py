@@ -28,7 +28,7 @@ from armcli.errors import (
 )
 from armcli.io import terminal
 from armcli.spec.discover import find_spec
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 if TYPE_CHECKING:  # the checker is imported when the command runs: `--help` stays light
     from armcli.check.inputs import CheckRun

@@ -30,7 +30,7 @@ def run_drive(
 ) -> None:
     """Prepare, run, write and report a drive run; raises TipOverError when it tips."""
     from armcli.check.gate import refuse_check_errors
-    from armcli.sim import drive, driveout, rosbag, states
+    from armcli.sim import drive, drivebag, driveout, driveplot, rosbag, states
     from armcli.sim import job as simjob
     from armcli.sim import report as simreport
 
@@ -59,12 +59,12 @@ def run_drive(
     if output is not None:
         cols = driveout.columns(res_run, res, rate)
         files[output] = (
-            driveout.mcap_bytes(res_run, cols, rate)
+            drivebag.mcap_bytes(res_run, cols, rate)
             if rosbag.is_mcap(output)
             else states.states_bytes(cols, states.output_format(output))
         )
     if plot is not None:
-        files[plot] = driveout.plot_png(res_run, res, verdict)
+        files[plot] = driveplot.plot_png(res_run, res, verdict)
     write_files_together(files)
     for lift in verdict.lifts:
         err.print(one_line(f"warning: {lift.line()}"), markup=False, highlight=False)

@@ -19,7 +19,7 @@ from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
 from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 
 def expand_cmd(

@@ -19,7 +19,7 @@ from armcli.commands.xacro_inputs import (
 from armcli.defaults import MJCF_BASES
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 export_app = typer.Typer(
     help="Export the robot to other simulators' formats.", no_args_is_help=True

@@ -19,7 +19,7 @@ from armcli.defaults import SPEC_FILE
 from armcli.errors import InputError
 from armcli.io.oneline import one_line
 from armcli.io.terminal import say
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 if TYPE_CHECKING:  # the importer is imported when the command runs: `--help` stays light
     from armcli.importer.run import ImportResult

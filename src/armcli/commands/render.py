@@ -25,7 +25,7 @@ from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
 from armcli.io.terminal import say
 from armcli.spec.discover import find_spec
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 REACH_HELP = (
     "Also draw where the tool point can reach within the joint limits (sampled forward "
@@ -74,7 +74,7 @@ def render_cmd(
     reach_point: list[str] = typer.Option([], "--reach-point", help=REACH_POINT_HELP),
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
-    from armcli.urdf.workspace import describe, verdict  # on use: `--help` stays light
+    from armcli.analysis.workspace import describe, verdict  # on use: `--help` stays light
     from armcli.view.png import MESH_HINT, load_urdf, render_png
     from armcli.view.scene import load_robot, pose_q
 

@@ -46,8 +46,8 @@ def ros_package_cmd(
 ) -> None:
     """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
     from armcli.compiler.expand import spec_label  # on use: `--help` stays light
+    from armcli.io.packages import PackageLookup, parse_package_dirs
     from armcli.ros.packages import PackageInfo, write_ros_packages
-    from armcli.urdf.packages import PackageLookup, parse_package_dirs
 
     spec = find_spec(spec)
     info = PackageInfo(maintainer=maintainer, email=email, license=license_)

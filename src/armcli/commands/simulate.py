@@ -25,7 +25,7 @@ from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file, check_png_file
 from armcli.io.together import write_files_together
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 if TYPE_CHECKING:  # the simulator is imported when the command runs: `--help` stays light
     from armcli.sim import job as simjob
@@ -36,8 +36,7 @@ GRAVITY_HELP = "Add g(q) to the PD torque (default: the spec's control.gravity_c
 IGNORE_HELP = "Simulate the robot despite this `check` rule's error (repeatable)."
 TRAJECTORY_HELP = "JointTrajectory YAML (a point without time_from_start: previous + 1 s)."
 BASE_ACCEL_HELP = (
-    "Base acceleration and braking [m/s²] for the zero-moment point "
-    "(default: the diff-drive plugin's max_wheel_acceleration)."
+    "Base acceleration and braking [m/s²] for the zero-moment point (default: the base at rest)."
 )
 PAYLOAD_LINK_HELP = "Link carrying --payload at its origin (default: the tool point)."
 CONTACT_LINKS_HELP = "Comma-separated links touching the ground (default: from the geometry)."
@@ -174,7 +173,7 @@ def _prepare(
 
     A model `check` reports as an error is not simulated (same rule ids), unless ignored.
     """
-    from armcli.check.gate import refuse_check_errors
+    from armcli.check.gate import bears_on_balance, refuse_check_errors
     from armcli.sim import job as simjob
 
     def gate(doc: Any) -> None:
@@ -186,7 +185,9 @@ def _prepare(
             from armcli.sim.tipping import robot_urdf
 
             whole = robot_urdf(spec, job)
-            if whole is not None:
+            if whole is not None and whole is not job.urdf:  # the base: only for the balance
+                refuse_check_errors(whole, ignore=ignore, only=bears_on_balance)
+            elif whole is not None:
                 gate(whole)
         return job
     except ModelRefusedError as exc:

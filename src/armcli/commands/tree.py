@@ -24,7 +24,7 @@ from armcli.io.files import write_file_atomic
 from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 TREE_FORMATS = ("text", "dot")
 

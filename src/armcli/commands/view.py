@@ -22,13 +22,13 @@ from armcli.commands.xacro_inputs import (
 from armcli.errors import InputError
 from armcli.io.oneline import one_line
 from armcli.spec.discover import find_spec
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 if TYPE_CHECKING:
-    from armcli.urdf.source import Trust
-    from armcli.urdf.xacro_args import XacroInputs
     from armcli.view.planning import PlanningSession
     from armcli.view.scene import RobotSource
+    from armcli.xacro.args import XacroInputs
+    from armcli.xacro.trust import Trust
 
 SCENE_HELP = "Obstacles for the planning panel: YAML like moveit_msgs/PlanningScene."
 SRDF_HELP = "SRDF of a URDF: its named poses (group_state) and disabled collision pairs."

@@ -23,7 +23,7 @@ from armcli.io.files import write_tree_atomic
 from armcli.io.outdir import resolve_output_dir
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
-from armcli.urdf.xacro_safe import REFUSED_HINT, expand_safe
+from armcli.xacro.safe import REFUSED_HINT, expand_safe
 
 
 @dataclass(frozen=True)

@@ -31,9 +31,9 @@ from lxml import etree
 
 from armcli.compiler.xmlfmt import vec
 from armcli.export.mjcf_report import Note
+from armcli.io.mesh_confine import MAX_MESH_BYTES, bounded_mesh_file, check_total
 from armcli.io.userfile import read_regular
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mesh_confine import MAX_MESH_BYTES, bounded_mesh_file, check_total
 from armcli.urdf.meshlog import quiet_trimesh
 
 MESH_SUFFIXES = (".stl", ".obj", ".msh")  # what MuJoCo loads

@@ -9,11 +9,11 @@ from urllib.parse import unquote, urlparse
 from armcli.errors import ExistingFileError, InputError
 from armcli.importer.run import GainSource, ImportResult, import_urdf
 from armcli.io.files import write_file_atomic
+from armcli.io.mesh_confine import package_xml_name
+from armcli.io.packages import PackageLookup
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mesh_confine import package_xml_name
-from armcli.urdf.packages import PackageLookup
 from armcli.urdf.source import Trust, read_urdf_file
-from armcli.urdf.xacro_args import XacroInputs
+from armcli.xacro.args import XacroInputs
 
 
 def source_label(path: Path, inputs: XacroInputs | None) -> str:

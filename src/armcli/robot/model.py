@@ -19,13 +19,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from armcli.errors import InputError
-from armcli.robot.load import collision_model, load_model
+from armcli.robot.load import collision_model, confined_mesh_xml, load_model
 from armcli.robot.mimic import Mimic, follow, mimics
 from armcli.robot.tool import ToolPoint, tool_point
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
     from armcli.urdf.doc import Urdf
+    from armcli.urdf.meshes import MeshSearch
 
 
 @dataclass(frozen=True)
@@ -92,8 +93,8 @@ class Robot:
 
     `joints` are the 1-DoF joints in tree order; `mimics` the URDF's couplings (leaders
     first; a follower is never set on its own); `tool` the end-effector point
-    (`robot.tool`), None for a model without links. `xml` is the URDF text the model
-    came from, kept for the collision geometry.
+    (`robot.tool`), None for a model without links. `xml` and `urdf` are the URDF text
+    and document the model came from, kept for the collision geometry.
     """
 
     def __init__(
@@ -104,6 +105,7 @@ class Robot:
         tool: ToolPoint | None = None,
         source: str = "<model>",
         xml: str | None = None,
+        urdf: Urdf | None = None,
         parser_messages: Sequence[str] = (),
     ) -> None:
         """Wrap `model` (a pinocchio.Model); see the class docstring for the rest."""
@@ -114,9 +116,11 @@ class Robot:
         self.tool = tool
         self.source = source
         self.xml = xml
+        self.urdf = urdf
         self.parser_messages = tuple(parser_messages)
         self._by_name = {j.name: j for j in self.joints}
         self._data: Any = None
+        self._neutral: NDArray[np.float64] | None = None
 
     @classmethod
     def from_xml(
@@ -127,10 +131,11 @@ class Robot:
         floating: bool = False,
         mimics: Iterable[Mimic] = (),
         tool: ToolPoint | None = None,
+        urdf: Urdf | None = None,
     ) -> Robot:
         """Load URDF text (`floating`: the root on a free-flyer joint); ModelLoadError if bad."""
         loaded = load_model(source, xml=xml, floating=floating)
-        return cls(loaded.model, mimics=mimics, tool=tool, source=source, xml=xml,
+        return cls(loaded.model, mimics=mimics, tool=tool, source=source, xml=xml, urdf=urdf,
                    parser_messages=loaded.parser_messages)  # fmt: skip
 
     @classmethod
@@ -143,7 +148,7 @@ class Robot:
         except UnicodeDecodeError:
             raise InputError("URDF is not UTF-8 text", file=urdf.source) from None
         return cls.from_xml(xml, urdf.source, floating=floating, mimics=mimics(urdf.joints),
-                            tool=tool_point(urdf, spec))  # fmt: skip
+                            tool=tool_point(urdf, spec), urdf=urdf)  # fmt: skip
 
     @property
     def data(self) -> Any:
@@ -179,9 +184,11 @@ class Robot:
 
     def neutral(self) -> NDArray[np.float64]:
         """Pinocchio's neutral configuration (every joint at 0, the free-flyer at identity)."""
-        import pinocchio as pin
+        if self._neutral is None:
+            import pinocchio as pin
 
-        return np.asarray(pin.neutral(self.model), dtype=float)
+            self._neutral = np.asarray(pin.neutral(self.model), dtype=float)
+        return self._neutral.copy()
 
     def follow(self, values: Mapping[str, float]) -> dict[str, float]:
         """`values` with every mimic follower of a given leader set from it."""
@@ -201,7 +208,7 @@ class Robot:
         order). `base` defaults to the neutral configuration. Mimic followers are not
         moved here: `follow` the values first.
         """
-        q = np.array(self.neutral() if base is None else base, dtype=float)
+        q = self.neutral() if base is None else np.array(base, dtype=float)
         if isinstance(values, Mapping):
             pairs: Iterable[tuple[Joint, Any]] = (
                 (self._by_name[n], x) for n, x in values.items() if n in self._by_name
@@ -236,16 +243,23 @@ class Robot:
             return self
         model = pin.buildReducedModel(self.model, lock, pin.neutral(self.model))
         return Robot(model, mimics=self.mimics, tool=self.tool, source=self.source, xml=self.xml,
-                     parser_messages=self.parser_messages)  # fmt: skip
+                     urdf=self.urdf, parser_messages=self.parser_messages)  # fmt: skip
 
-    def collision_model(self, package_dirs: Sequence[str] = (), *, xml: str | None = None) -> Any:
-        """The URDF's collision geometry (a pinocchio.GeometryModel); meshes need package_dirs.
+    def collision_model(self, search: MeshSearch | None = None) -> Any:
+        """The URDF's collision geometry, a pinocchio.GeometryModel, built on demand.
 
-        `xml`: the same robot's URDF text to read instead of its own (e.g. with its mesh
-        paths resolved and confined by the caller). InputError when there is no URDF text
-        or the geometry is unusable.
+        With `search` (the package lookup), every mesh is resolved inside the allowed
+        roots and bounded first (`load.confined_mesh_xml`: `check`, `plan`); without it
+        the URDF text is read as it is (its meshes already resolved by the caller).
+        InputError without a URDF (text) or for a mesh not found or over the size caps;
+        ModelLoadError when Pinocchio refuses the geometry.
         """
-        text = self.xml if xml is None else xml
+        if search is not None and self.urdf is not None:
+            text: str | None = confined_mesh_xml(self.urdf, search)
+        elif search is not None:
+            raise InputError("no URDF document to resolve meshes in", file=self.source)
+        else:
+            text = self.xml
         if text is None:
             raise InputError("no URDF text to read collision geometry from", file=self.source)
-        return collision_model(self.model, text, list(package_dirs))
+        return collision_model(self.model, text, [], self.source)

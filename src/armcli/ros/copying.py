@@ -17,9 +17,9 @@ from pathlib import Path
 
 from armcli.compiler.meshfiles import package_meshes
 from armcli.errors import InputError
+from armcli.io.mesh_confine import MAX_MESH_BYTES, MAX_MESH_TOTAL_BYTES
 from armcli.io.userfile import read_regular
 from armcli.spec.model import RobotSpec
-from armcli.urdf.mesh_confine import MAX_MESH_BYTES, MAX_MESH_TOTAL_BYTES
 from armcli.urdf.meshes import MeshSearch, confined
 
 

@@ -25,6 +25,7 @@ from armcli.defaults import ROS_TARGETS, STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.io.files import write_tree_atomic
 from armcli.io.outdir import resolve_output_dir
+from armcli.io.packages import PackageLookup
 from armcli.ros import jazzy
 from armcli.ros import moveit as mc
 from armcli.ros.collision_matrix import (
@@ -43,7 +44,6 @@ from armcli.spec.graph import root_links
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
 from armcli.urdf.meshes import localized
-from armcli.urdf.packages import PackageLookup
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import lookup_for, spec_urdfs
 

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from armcli.analysis.stance import NoStance, Stance, stance_of
 from armcli.errors import InputError, SimulationError
 from armcli.sim import job as simjob
 from armcli.sim.cmdvel import CmdVel, load_cmd_vel
@@ -33,7 +34,6 @@ from armcli.sim.options import SimOptions
 from armcli.sim.simulate import steps_of
 from armcli.sim.tipping import robot_urdf
 from armcli.urdf.doc import Urdf
-from armcli.urdf.stance import NoStance, Stance, stance_of
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec

@@ -5,7 +5,7 @@ collision geoms, the arm's `position` actuators (Kp, Kd, effort limit) and Gazeb
 `mu1` as sliding friction. Added here through MuJoCo's model editor (MjSpec):
 
 - contacts of time constant CONTACT_TIME;
-- a ground plane under the robot's lowest contact point (urdf.stance), with sliding
+- a ground plane at z = 0, the robot's lowest contact point on it (urdf.stance), with sliding
   friction 0 so that each contact takes the robot geom's own coefficient (MuJoCo
   combines two geoms by the larger one; Gazebo's ODE by the smaller, and its ground
   plane's mu is 100, so in both the robot's coefficient counts). A collision without
@@ -14,7 +14,7 @@ collision geoms, the arm's `position` actuators (Kp, Kd, effort limit) and Gazeb
 - one `velocity` actuator per drive wheel: the plugin's joint motor (ODE `vel` with
   `fmax` = max_wheel_torque). ODE solves it as a constraint; its MuJoCo stand-in has
   the gain kv = I / (SERVO_STEPS dt), I the wheel's inertia plus half the robot's mass
-  at the rim, so it reaches a commanded speed within a few steps (MuJoCo's
+  at the rim, so it reaches a commanded speed in about one step (MuJoCo's
   `implicitfast` integrates kv implicitly: stable for any kv);
 - sensors, so one copy of `sensordata` per step records the run: the arm and wheel
   joints' position, velocity and actuator force, the root body's pose, and per
@@ -30,11 +30,11 @@ from typing import Any
 
 import numpy as np
 
+from armcli.analysis.stance import Stance
 from armcli.errors import InputError
 from armcli.export.mjcf import FREE_JOINT, build_mjcf
 from armcli.sim.diffdrive import DriveParams
 from armcli.urdf.doc import Urdf
-from armcli.urdf.stance import Stance
 
 SERVO_STEPS = 1.0  # wheel motor time constant in time steps (see the module docstring)
 # [s] MuJoCo's contact time constant (solref, critically damped): its default. Measured on
@@ -43,7 +43,6 @@ SERVO_STEPS = 1.0  # wheel motor time constant in time steps (see the module doc
 # slower than one step (SERVO_STEPS 5) lags a turn's load by 4 %.
 CONTACT_TIME = 0.02
 TOUCH_MARGIN = 0.02  # [m] a touch site is the link's bounding sphere plus this
-G = 9.81  # [m/s²] MuJoCo's default gravity magnitude
 
 
 @dataclass(frozen=True)

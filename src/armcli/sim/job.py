@@ -36,7 +36,7 @@ from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import Trust, read_urdf_file, spec_urdfs
-from armcli.urdf.xacro_args import XacroInputs
+from armcli.xacro.args import XacroInputs
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from armcli.analysis.stance import Stance
 from armcli.errors import TipOverError
-from armcli.urdf.stance import Stance
 
 TIP_CAP_DEG = 15.0  # [deg] a base tilted further has tipped whatever its geometry
 MIN_BOUND_DEG = 1.0  # [deg] below this the soft contacts' own rocking would count as tipping

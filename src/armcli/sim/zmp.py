@@ -31,11 +31,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from armcli.analysis.stance import Stance
+from armcli.analysis.support import SupportPolygon
 from armcli.robot.model import Joint, Robot
 from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_root
-from armcli.urdf.stance import Stance
-from armcli.urdf.support import SupportPolygon
 
 MAX_SAMPLES = 20_000  # states whose zero-moment point is computed, at most (pairs of steps)
 CASES = ("arm motion", "accelerating", "braking")

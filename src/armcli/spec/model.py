@@ -95,7 +95,7 @@ __all__ = [
 
 
 class DiffDrive(_Model):
-    """gazebo_ros_diff_drive parameters."""
+    """gazebo_ros_diff_drive parameters; `simulate --cmd-vel` drives the robot with them."""
 
     update_rate: Positive = Field(description="plugin update rate [Hz]")
     left_joint: UrdfName = Field(description="left wheel joint name")

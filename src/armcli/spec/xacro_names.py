@@ -19,6 +19,7 @@ XACRO_PREFIX = "xacro"
 # www.ros.org/wiki/xacro, ros.org/wiki/xacro, wiki.ros.org/xacro (all occur); any URI naming
 # xacro is treated as one, since refusing a vendor's odd URI costs less than missing one
 _XACRO_URI = re.compile(r"xacro", re.IGNORECASE)
+_SUBSTITUTION = re.compile(r"\$[({]")  # `${...}` and `$(...)`: escaped in text, refused in URIs
 
 
 def is_xacro_uri(uri: str | None) -> bool:
@@ -39,6 +40,9 @@ def xacro_use(el: etree._Element) -> str | None:
                 return "a comment naming xacro: (xacro:eval-comments evaluates comments)"
             continue
         name = etree.QName(node)
+        for uri in node.nsmap.values():  # xacro evaluates xmlns declarations as attributes
+            if _SUBSTITUTION.search(str(uri)):
+                return f"namespace URI {uri!r} of <{name.localname}> holds a xacro substitution"
         if is_xacro_uri(name.namespace) or node.prefix == XACRO_PREFIX:
             return f"element <{node.prefix + ':' if node.prefix else ''}{name.localname}> is xacro"
         for key in node.attrib:

@@ -10,6 +10,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from armcli.spec.joint_types import JOINT_DOF
+from armcli.xacro.lines import Origin
 
 Vec3 = tuple[float, float, float]
 ZERO3: Vec3 = (0.0, 0.0, 0.0)
@@ -129,15 +130,6 @@ class Material:
 
 
 @dataclass(frozen=True)
-class Origin:
-    """Where an element of a xacro expansion was written [file, 1-based line] (xacro_lines)."""
-
-    file: str
-    line: int
-    calls: tuple[tuple[str, int], ...] = ()  # macro calls that produced it, innermost first
-
-
-@dataclass(frozen=True)
 class Urdf:
     """What `check` needs from one URDF document."""
 
@@ -150,7 +142,7 @@ class Urdf:
     problems: tuple[NumberProblem, ...] = field(default=())
     line: int | None = None  # the <robot> element's
     notes: tuple[str, ...] = ()  # `note: ...`/`warning: ...` lines: xacro arguments used, ...
-    # a xacro expansion's element lines -> where they were written (xacro_lines); empty else
+    # a xacro expansion's element lines -> where they were written (xacro.lines); empty else
     origins: Mapping[int, Origin] = field(default_factory=dict)
 
     def link(self, name: str) -> Link | None:

@@ -1,6 +1,6 @@
 """Mesh URIs -> local files, one resolver for every command (check, view, render, export).
 
-`package://NAME/...` resolves through armcli.urdf.packages (--package-dir,
+`package://NAME/...` resolves through armcli.io.packages (--package-dir,
 AMENT_PREFIX_PATH, ROS_PACKAGE_PATH, the enclosing package); relative URIs start at
 the URDF's directory. A resolved path must lie inside the allowed roots (see
 `confined`), so a hostile URDF cannot make armcli read `/etc/passwd` as a mesh.
@@ -13,8 +13,8 @@ from pathlib import Path
 from urllib.parse import unquote, urlparse
 
 from armcli.errors import InputError
+from armcli.io.packages import PackageLookup, inside, parse_package_dirs, real_roots
 from armcli.urdf.doc import Urdf
-from armcli.urdf.packages import PackageLookup, inside, parse_package_dirs, real_roots
 from armcli.urdf.source import allowed_roots
 
 # The CLI's package options as the mesh resolver sees them (one lookup for meshes and $(find)).
@@ -32,7 +32,7 @@ __all__ = [
 
 
 def package_root(name: str, base_dir: Path, search: MeshSearch) -> Path | None:
-    """Where package `name` lives (armcli.urdf.packages' order), or None."""
+    """Where package `name` lives (armcli.io.packages' order), or None."""
     return search.find(name, base_dir)
 
 
@@ -118,7 +118,7 @@ def localized(xml: bytes, source: str, base_dir: Path, search: MeshSearch) -> by
     """
     from lxml import etree
 
-    from armcli.urdf.mesh_confine import _safe_xml
+    from armcli.io.mesh_confine import _safe_xml, bounded_mesh_file
 
     root = etree.fromstring(xml, _safe_xml())
     changed = False
@@ -131,6 +131,6 @@ def localized(xml: bytes, source: str, base_dir: Path, search: MeshSearch) -> by
         if path is None or not path.is_file() or not confined(uri, path, base_dir, search):
             why = "its package is unknown" if path is None else f"no file {path}"
             raise InputError(f"mesh {uri!r} not found ({why}): {mesh_hint(uri)}", file=source)
-        el.set("filename", str(path))
+        el.set("filename", str(bounded_mesh_file(path, source)))  # size, bombs (issue 27)
         changed = True
     return etree.tostring(root) if changed else xml

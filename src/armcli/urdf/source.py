@@ -3,8 +3,8 @@
 A path given to `check`, `view`, `render`, `tree` (and `simulate --urdf`) is one
 of: a spec YAML (built in memory, nothing written), a URDF (read by urdf.read's
 strict reader) or a xacro file. Xacro runs Python from the file, so a foreign
-one is expanded in safe mode (xacro_safe: no code runs, files confined) unless
-the user passes `--trust-xacro` (xacro itself, sandboxed by xacro_sandbox).
+one is expanded in safe mode (xacro.safe: no code runs, files confined) unless
+the user passes `--trust-xacro` (xacro itself, sandboxed by xacro.sandbox).
 Mesh URIs may only resolve inside the allowed roots, so a hostile URDF cannot make armcli read
 `/etc/passwd` as a "mesh".
 """
@@ -20,12 +20,12 @@ from typing import TYPE_CHECKING
 
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import EXPANDED_TAG, InputError, XacroRefusedError
+from armcli.io.packages import PackageLookup, inside, real_roots
 from armcli.urdf.doc import Urdf
-from armcli.urdf.packages import PackageLookup, inside, real_roots
 from armcli.urdf.read import parse_urdf, read_urdf
-from armcli.urdf.trust import Trust as Trust  # re-exported: read_robot and callers share it
-from armcli.urdf.xacro_args import Expansion, XacroInputs
-from armcli.urdf.xacro_lines import parse_map
+from armcli.xacro.args import Expansion, XacroInputs
+from armcli.xacro.lines import parse_map
+from armcli.xacro.trust import Trust as Trust  # re-exported: read_robot and callers share it
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -62,7 +62,7 @@ def read_robot(
 ) -> RobotFile:
     """Spec YAML, URDF or xacro -> RobotFile; InputError when unusable.
 
-    `inputs`: a xacro file's arguments, --env values and package lookup (xacro_args).
+    `inputs`: a xacro file's arguments, --env values and package lookup (xacro.args).
     """
     if path.is_dir():
         raise InputError("is a directory, expected a robot spec, URDF or xacro file", file=path)
@@ -110,7 +110,7 @@ def read_urdf_file(
 ) -> Urdf:
     """A URDF or xacro file -> Urdf (xacro by suffix or content).
 
-    A xacro file is expanded in safe mode (xacro_safe: no code from the file runs), or
+    A xacro file is expanded in safe mode (xacro.safe: no code from the file runs), or
     with xacro itself when trusted; `Urdf.notes` says which arguments it used.
     """
     if path.suffix != XACRO_SUFFIX:
@@ -128,12 +128,12 @@ def expand_xacro(
 ) -> tuple[bytes, Expansion]:
     """A xacro file's expansion (the bytes xacro itself writes) and what it used.
 
-    Safe mode (xacro_safe, in a limited child) unless `trust_xacro`: then xacro itself
-    in xacro_sandbox's jail, which reports no argument use.
+    Safe mode (xacro.safe, in a limited child) unless `trust_xacro`: then xacro itself
+    in xacro.sandbox's jail, which reports no argument use.
     """
     # imported here: reading a plain URDF (e.g. simulate --urdf) never loads the xacro stack
-    from armcli.urdf.xacro_safe import request_json
-    from armcli.urdf.xacro_sandbox import run_safe
+    from armcli.xacro.safe import request_json
+    from armcli.xacro.sandbox import run_safe
 
     given = inputs or XacroInputs()
     if trust_xacro:
@@ -146,7 +146,7 @@ def expand_xacro(
 def _expand_trusted(
     path: Path, given: XacroInputs, *, unsandboxed: bool
 ) -> tuple[bytes, Expansion]:
-    """Xacro itself in xacro_sandbox's jail, `$(find)` answered by armcli's package lookup.
+    """Xacro itself in xacro.sandbox's jail, `$(find)` answered by armcli's package lookup.
 
     Every package the lookup knows is passed in with its directories bound read-only
     (the install prefixes' share/ and each package's real roots: a symlink-install tree
@@ -159,7 +159,7 @@ def _expand_trusted(
             "or the loader runs)",
             field="--env",
         )
-    from armcli.urdf.xacro_sandbox import run_trusted
+    from armcli.xacro.sandbox import run_trusted
 
     known = given.packages.known(near=path)
     roots = [*allowed_roots(path.parent), *(p / "share" for p in given.packages.prefixes())]

@@ -20,9 +20,9 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
+from armcli.io.mesh_confine import bounded_mesh_file, check_total
 from armcli.robot.tool import ToolPoint
 from armcli.spec.joint_types import position_bounds
-from armcli.urdf.mesh_confine import bounded_mesh_file, check_total
 from armcli.urdf.meshes import MeshSearch, confined, resolve
 from armcli.urdf.meshlog import MeshLog, quiet_trimesh
 from armcli.urdf.read import parse_root

@@ -20,12 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from armcli.errors import InputError
-from armcli.io.files import write_file_atomic
-from armcli.robot.load import link_frame
-from armcli.robot.model import Robot
-from armcli.robot.tool import ToolPoint
-from armcli.urdf.workspace import (
+from armcli.analysis.workspace import (
     Chain,
     ReachPoint,
     Workspace,
@@ -33,6 +28,11 @@ from armcli.urdf.workspace import (
     reach_point,
     sample,
 )
+from armcli.errors import InputError
+from armcli.io.files import write_file_atomic
+from armcli.robot.load import link_frame
+from armcli.robot.model import Robot
+from armcli.robot.tool import ToolPoint
 from armcli.view.png import DEFAULT_SIZE, DPI, RenderResult, full_configuration, render_figure
 
 REACH_SAMPLES = 6000  # drawn points: a filled region at 1200x600 px, ~1 s to draw

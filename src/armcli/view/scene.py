@@ -16,7 +16,7 @@ from armcli.spec.expr import eval_expr
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import RobotFile, Trust, lookup_for, read_robot, urdf_text
 from armcli.urdf.tree import tree_from_urdf
-from armcli.urdf.xacro_args import XacroInputs
+from armcli.xacro.args import XacroInputs
 
 
 @dataclass(frozen=True)

@@ -10,11 +10,10 @@ from pathlib import Path
 
 from lxml import etree
 
-from armcli.urdf.doc import Origin
 from armcli.urdf.source import allowed_roots
-from armcli.urdf.xacro_args import XacroInputs
-from armcli.urdf.xacro_lines import parse_map
-from armcli.urdf.xacro_safe import expand_safe_report
+from armcli.xacro.args import XacroInputs
+from armcli.xacro.lines import Origin, parse_map
+from armcli.xacro.safe import expand_safe_report
 from tests.helpers import FIXTURES
 
 TOP = FIXTURES / "real_robots" / "xacro_lines" / "robot.urdf.xacro"

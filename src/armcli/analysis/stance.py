@@ -17,13 +17,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from armcli.analysis.ground import Ground, MeshVertices, find_ground, has_wheels
+from armcli.analysis.support import SupportPolygon, support_polygon
 from armcli.errors import InputError
 from armcli.robot import sampling
 from armcli.robot.load import link_frame
 from armcli.robot.model import Joint, Robot
 from armcli.urdf.doc import Urdf, Vec3
-from armcli.urdf.ground import Ground, MeshVertices, find_ground, has_wheels
-from armcli.urdf.support import SupportPolygon, support_polygon
 
 FIXED_BASE = (
     "fixed base: no wheel touches the ground (name the contact links to analyse a robot "

@@ -1,7 +1,7 @@
 """Where each element of a xacro expansion was written: file, line and the macro calls.
 
 `check` reads the expanded document, so its findings carry lines of that document,
-which nobody can open. While xacro_safe expands a file, each element it parses is
+which nobody can open. While xacro.safe expands a file, each element it parses is
 tagged with its own file and line (an attribute xacro copies with the element
 through macro bodies, blocks and conditionals, never evaluates and never sees as a
 parameter); each macro call appends its own position to the elements it produced.
@@ -17,17 +17,25 @@ xacro would warn about an unknown attribute; they produce no URDF element.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 from lxml import etree
-
-from armcli.urdf.doc import Origin
 
 MAX_TAG_LINES = 50  # a start tag spread over more lines keeps the line libxml2 gives
 SRC = "armcli-src"  # the tag's attribute name (no xacro file uses it)
 KEYWORDS = frozenset(
     {"macro", "property", "include", "if", "unless", "arg", "insert_block", "attribute"}
 )
+
+
+@dataclass(frozen=True)
+class Origin:
+    """Where an element of a xacro expansion was written [file, 1-based line] (xacro.lines)."""
+
+    file: str
+    line: int
+    calls: tuple[tuple[str, int], ...] = ()  # macro calls that produced it, innermost first
 
 
 def _elements(node: Any) -> Iterator[Any]:

@@ -27,12 +27,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from armcli.analysis.boxsearch import minimize_box
 from armcli.robot import sampling
 from armcli.robot.load import link_frame
 from armcli.robot.model import Joint, Robot
 from armcli.robot.sampling import REACH_DRAWS, SAMPLE_SEED
 from armcli.robot.tool import ToolPoint
-from armcli.urdf.boxsearch import minimize_box
 
 REFINE_FROM = 3  # local searches per extreme, from the best samples
 REACH_TOL = 1e-3  # [m] an inverse-kinematics residual below this is reached

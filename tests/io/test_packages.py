@@ -1,7 +1,7 @@
 """Package lookup as ROS does it (issue 19): AMENT_PREFIX_PATH, ROS_PACKAGE_PATH, --package-dir,
 the enclosing package by its package.xml name, and confinement in symlink-install trees.
 
-Before armcli.urdf.packages: `$(find)` and `package://` ignored AMENT_PREFIX_PATH (what a
+Before armcli.io.packages: `$(find)` and `package://` ignored AMENT_PREFIX_PATH (what a
 sourced ROS 2 workspace sets), a clone directory not named like its package was not found,
 and every `file://` mesh of a colcon --symlink-install tree was "outside the allowed
 directories" (20 false errors on MoveIt's panda).
@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pytest
 
+from armcli.io.packages import PackageLookup, crawl, real_roots
 from armcli.urdf.meshes import confined, resolve
-from armcli.urdf.packages import PackageLookup, crawl, real_roots
 from tests.helpers import ARM_PACKAGE, GRIPPER_PACKAGE, ROS_WS_SRC, symlink_install
 
 
@@ -184,8 +184,8 @@ def test_a_package_root_is_never_slash_or_a_system_dir(tmp_path: Path) -> None:
 
 def test_safe_xacro_reads_nothing_through_a_slash_package(tmp_path: Path) -> None:
     from armcli.errors import XacroRefusedError
-    from armcli.urdf.xacro_args import XacroInputs
-    from armcli.urdf.xacro_safe import expand_safe
+    from armcli.xacro.args import XacroInputs
+    from armcli.xacro.safe import expand_safe
 
     prefix = _root_package(tmp_path)
     secret = tmp_path / "host" / "secret.yaml"

@@ -5,10 +5,10 @@ CPU, memory, file-size and open-file limits, an empty environment, no stdin,
 its own process group (killed as a whole) and stdout read with a streaming
 cap (the child is killed as soon as it writes more than the cap):
 
-- `expand_foreign` (the default): xacro_safe's expansion, where the file
+- `expand_foreign` (the default): xacro.safe's expansion, where the file
   cannot run code (AST-whitelisted expressions, confined includes);
 - `expand_untrusted` (`--trust-xacro`): xacro itself, which runs Python from
-  the file. It runs under xacro_jail (bubblewrap: read-only root, private
+  the file. It runs under xacro.jail (bubblewrap: read-only root, private
   /tmp, no network, PID namespace, cleared environment) when available, and
   only with `--trust-xacro=unsandboxed` otherwise. See docs/security.md.
 """
@@ -32,9 +32,9 @@ from typing import Any
 
 from armcli.errors import InputError, XacroRefusedError
 from armcli.io.userfile import check_regular
-from armcli.urdf.xacro_args import XacroInputs
-from armcli.urdf.xacro_jail import jail_argv, sandbox_problem, seccomp_program
-from armcli.urdf.xacro_safe import request_json
+from armcli.xacro.args import XacroInputs
+from armcli.xacro.jail import jail_argv, sandbox_problem, seccomp_program
+from armcli.xacro.safe import request_json
 
 XACRO_TIMEOUT = 20.0  # wall clock [s]
 XACRO_CPU_SECONDS = 20
@@ -48,7 +48,7 @@ _SCRIPT = """
 import json, sys, types
 
 # $(find NAME) asks ament_index_python (ROS 2, not on PyPI): armcli's own lookup answers,
-# from the package map in argv[2] (armcli.urdf.packages, resolved before the jail).
+# from the package map in argv[2] (armcli.io.packages, resolved before the jail).
 _packages = json.loads(sys.argv[2])
 class PackageNotFoundError(KeyError):
     pass
@@ -97,7 +97,7 @@ _SAFE_SCRIPT = """
 import sys
 if sys.argv[1]:
     sys.path.insert(0, sys.argv[1])
-from armcli.urdf.xacro_safe import child_main
+from armcli.xacro.safe import child_main
 sys.exit(child_main(sys.argv[2:]))
 """
 
@@ -211,12 +211,12 @@ def _armcli_root() -> str:
 
 
 def expand_foreign(path: str | Path, roots: Sequence[Path], request: str | None = None) -> bytes:
-    """Safe-mode expansion (xacro_safe) of a foreign xacro file in a limited child."""
+    """Safe-mode expansion (xacro.safe) of a foreign xacro file in a limited child."""
     return run_safe(path, request or request_json(roots, XacroInputs()))[0]
 
 
 def run_safe(path: str | Path, request: str) -> tuple[bytes, dict[str, Any]]:
-    """xacro_safe's child on `path` with its JSON `request`: the URDF bytes and its report."""
+    """xacro.safe's child on `path` with its JSON `request`: the URDF bytes and its report."""
     p = Path(path)
     check_regular(p, "xacro file")
     argv = [*_python(), "-c", _SAFE_SCRIPT, _armcli_root(), os.path.abspath(p), request]
@@ -267,7 +267,7 @@ def expand_untrusted(
 ) -> bytes:
     """The expanded URDF bytes of a user-trusted xacro file; InputError if expansion fails.
 
-    xacro runs inside xacro_jail's bubblewrap sandbox, where it can read only the
+    xacro runs inside xacro.jail's bubblewrap sandbox, where it can read only the
     system and interpreter directories, the file's directory, ROS_PACKAGE_PATH and
     `roots` (package roots); where the sandbox cannot run, the expansion is refused
     unless `unsandboxed` (`--trust-xacro=unsandboxed`: the resource limits only).
@@ -331,7 +331,7 @@ def jail_readable(p: Path, env: Mapping[str, str], roots: Iterable[Path] = ()) -
     """What the sandboxed xacro may read besides the system directories.
 
     Its own directory, ROS_PACKAGE_PATH entries, `roots` (package roots) and this
-    interpreter's directories; xacro_jail binds each read-only at its real path.
+    interpreter's directories; xacro.jail binds each read-only at its real path.
     """
     package_path = [Path(r) for r in env.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if r]
     return [p.resolve().parent, *package_path, *roots, *_interpreter_dirs()]

@@ -32,11 +32,11 @@ from pathlib import Path
 
 import pytest
 
-import armcli.urdf.xacro_sandbox as sandbox
+import armcli.xacro.sandbox as sandbox
 from armcli.errors import InputError, XacroRefusedError
 from armcli.urdf.source import read_urdf_file
-from armcli.urdf.xacro_jail import readable_binds, sandbox_problem
-from armcli.urdf.xacro_sandbox import XACRO_MAX_OUTPUT, XACRO_TIMEOUT, expand_untrusted
+from armcli.xacro.jail import readable_binds, sandbox_problem
+from armcli.xacro.sandbox import XACRO_MAX_OUTPUT, XACRO_TIMEOUT, expand_untrusted
 from tests.helpers import ROOT, run_cli
 from tests.urdf.ordinary_user import ordinary_user
 

@@ -11,7 +11,7 @@ import math
 
 import pytest
 
-from armcli.urdf.xacro_expr import MAX_SEQUENCE, Evaluator, ExprRefusedError
+from armcli.xacro.expr import MAX_SEQUENCE, Evaluator, ExprRefusedError
 
 SYMBOLS = {"xyz": "0.1 0.2 0.3", "name": "  Left_Arm ", "joints": ["a", "b"], "pi": math.pi}
 

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from armcli.errors import InputError
-from armcli.urdf.mesh_confine import is_package, package_xml_name
+from armcli.io.mesh_confine import is_package, package_xml_name
 
 IGNORE_MARKERS = ("COLCON_IGNORE", "AMENT_IGNORE", "CATKIN_IGNORE")
 AMENT_INDEX = Path("share", "ament_index", "resource_index", "packages")

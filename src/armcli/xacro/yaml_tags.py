@@ -3,7 +3,7 @@
 xacro reads YAML with PyYAML's `safe_load` plus its unit tags (`!degrees 90`,
 `!radians pi/2`, `!millimeters 35`, ...), whose text it evaluates as an
 expression, and it keeps the last value of a duplicated key silently. Here the
-same loader runs with the unit expressions evaluated by xacro_expr's whitelist
+same loader runs with the unit expressions evaluated by xacro.expr's whitelist
 (the caller's `evaluate`), the unit table taken from the installed xacro, and a
 duplicate key accepted as xacro does but reported (`warn`, with file and line).
 Anchors and aliases are kept (xacro accepts them) but counted, so a

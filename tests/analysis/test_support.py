@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.spatial import ConvexHull
 
-from armcli.urdf.support import convex_hull, direction_name, support_polygon
+from armcli.analysis.support import convex_hull, direction_name, support_polygon
 
 TOL = 1e-12  # [m] plain arithmetic on coordinates of order 1
 

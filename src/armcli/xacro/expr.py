@@ -3,13 +3,13 @@
 xacro evaluates `${...}` with Python's `eval` (builtins removed, but attribute
 access, `type`, `vars` and friends remain), which is why a foreign xacro file
 is code. Real description files only compute with numbers and strings, so
-xacro_safe replaces that `eval` with this walker: literals, property names,
+xacro.safe replaces that `eval` with this walker: literals, property names,
 arithmetic, comparisons, boolean logic, conditional expressions, indexing,
 `math` functions, pure builtins (with keyword arguments: `dict(joint_1=0.0)`) and
 a fixed set of read-only `str` methods plus a few list/dict ones (`xyz.split(' ')`,
 `levels.pop(0)`, `d.get(k)`); nothing that formats (`format`, `%`) or reaches
 attributes. A callable may only be passed to another (`map(float, xs)`) when it is
-itself allowed. Anything else raises ExprRefusedError, which xacro_safe turns into
+itself allowed. Anything else raises ExprRefusedError, which xacro.safe turns into
 an error naming the file and line. Sizes are bounded so that `'x' * 4000000000`,
 `9 ** 9 ** 9` or `s.replace('a', s)` cannot exhaust memory or time.
 """

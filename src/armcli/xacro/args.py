@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from armcli.errors import InputError
-from armcli.urdf.packages import PackageLookup
+from armcli.io.packages import PackageLookup
 
 ARG_SEPARATOR = ":="
 ARGS_HELP = (
@@ -85,7 +85,7 @@ class Expansion:
     unused: tuple[str, ...] = ()  # given, but the file neither declares nor reads them
     optenv_defaults: tuple[str, ...] = ()  # $(optenv VAR ...) that took their default
     warnings: tuple[str, ...] = ()
-    source_map: str = ""  # xacro_lines.source_map: where each expanded element was written
+    source_map: str = ""  # xacro.lines.source_map: where each expanded element was written
 
     @property
     def defaults(self) -> tuple[str, ...]:

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize
 
-from armcli.urdf.boxsearch import minimize_box
+from armcli.analysis.boxsearch import minimize_box
 
 TOL = 1e-6  # objective agreement between two local solvers stopping at their own tolerances
 

@@ -28,10 +28,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from armcli.io.mesh_confine import bounded_mesh_file
 from armcli.robot.inertia import rpy_matrix
 from armcli.spec.joint_types import ROTARY_TYPES
 from armcli.urdf.doc import Shape, Urdf, Vec3
-from armcli.urdf.mesh_confine import bounded_mesh_file
 from armcli.urdf.meshes import MeshSearch, mesh_paths
 from armcli.urdf.meshlog import quiet_trimesh
 

@@ -6,10 +6,10 @@ from pathlib import Path
 
 import pytest
 
+from armcli.analysis.ground import find_ground, has_wheels, mesh_loader
 from armcli.compiler.expand import expand_urdfs
 from armcli.robot.load import load_model
 from armcli.spec.load import load_spec
-from armcli.urdf.ground import find_ground, has_wheels, mesh_loader
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_urdf
 from tests.helpers import DEFAULT_SPEC

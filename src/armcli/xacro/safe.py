@@ -4,20 +4,20 @@ xacro's macros, properties, blocks, includes, conditionals and arguments are
 kept (they are xacro's own functions, unchanged); what is replaced is every
 place where the file could run code or reach the machine:
 
-- `${...}` is evaluated by xacro_expr's AST whitelist instead of `eval`;
-- `$(...)`: `arg`, `dirname`, `find PKG` (armcli.urdf.packages: --package-dir,
+- `${...}` is evaluated by xacro.expr's AST whitelist instead of `eval`;
+- `$(...)`: `arg`, `dirname`, `find PKG` (armcli.io.packages: --package-dir,
   AMENT_PREFIX_PATH, ROS_PACKAGE_PATH, the enclosing package), `env` / `optenv`
-  from the user's `--env VAR=VALUE` only (xacro_args); `eval`, `cwd` and `anon`
+  from the user's `--env VAR=VALUE` only (xacro.args); `eval`, `cwd` and `anon`
   are refused;
 - includes and `load_yaml` read only regular files inside the allowed roots
   (the file's directory and package, the packages `find` resolved, with their real
   directories: packages.real_roots), size-capped, with DOCTYPE/entities refused;
-  YAML goes through xacro_yaml (xacro's unit tags, duplicate keys warned);
+  YAML goes through xacro.yaml_tags (xacro's unit tags, duplicate keys warned);
 - macro calls and wall time are bounded (exponential macro bombs).
 
 A refusal is an XacroRefusedError naming the construct, file and line; any other
 failure is an InputError with the same (nothing is re-raised without its cause).
-The expansion runs in xacro_sandbox's resource-limited child process, so memory
+The expansion runs in xacro.sandbox's resource-limited child process, so memory
 is bounded too (`child_main` is that child's entry point).
 """
 
@@ -38,13 +38,13 @@ from typing import Any, NoReturn
 import yaml
 
 from armcli.errors import InputError, XacroRefusedError
+from armcli.io.packages import PackageLookup, real_roots
 from armcli.io.userfile import read_regular
-from armcli.urdf.packages import PackageLookup, real_roots
-from armcli.urdf.xacro_args import Expansion, XacroInputs
-from armcli.urdf.xacro_expr import Evaluator, ExprRefusedError
-from armcli.urdf.xacro_lines import annotate, collect, expand_call, source_map
-from armcli.urdf.xacro_yaml import YamlRefusedError
-from armcli.urdf.xacro_yaml import load_yaml as read_yaml
+from armcli.xacro.args import Expansion, XacroInputs
+from armcli.xacro.expr import Evaluator, ExprRefusedError
+from armcli.xacro.lines import annotate, collect, expand_call, source_map
+from armcli.xacro.yaml_tags import YamlRefusedError
+from armcli.xacro.yaml_tags import load_yaml as read_yaml
 
 MAX_XACRO_FILE_BYTES = 2_000_000  # one xacro or YAML file read during expansion
 MAX_MACRO_CALLS = 20_000  # tiago_dual-sized robots make a few hundred
@@ -101,7 +101,7 @@ class _State:
         self.start = time.monotonic()
         self.warnings: list[str] = []
         self.optenv_defaults: list[str] = []
-        self.sources: list[str] = []  # files parsed, in order: xacro_lines' file indices
+        self.sources: list[str] = []  # files parsed, in order: xacro.lines' file indices
 
     def add_package(self, root: Path) -> None:
         for r in real_roots(root):
@@ -168,7 +168,7 @@ class _State:
 
 
 def find_package(name: str, start: Path, packages: PackageLookup | None = None) -> Path | None:
-    """`$(find NAME)`: armcli.urdf.packages' lookup from the file being read."""
+    """`$(find NAME)`: armcli.io.packages' lookup from the file being read."""
     return (packages or PackageLookup()).find(name, start)
 
 

@@ -19,9 +19,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from armcli.analysis.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 from armcli.robot.load import load_model
+from armcli.robot.model import Robot
 from armcli.robot.tool import ToolPoint
-from armcli.urdf.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 from tests.helpers import FIXTURES
 
 BRUTE = 20_000  # brute-force draws per arm (about 0.1 s of forward kinematics)
@@ -55,7 +56,7 @@ def arm(request: pytest.FixtureRequest) -> tuple[Chain, np.ndarray, np.ndarray]:
     path, link, n = ARMS[request.param]
     if path is None:
         pytest.skip("example-robot-data is not installed (pip install -e '.[dev]')")
-    chain = Chain(load_model(path).model, ToolPoint(link))
+    chain = Chain(Robot(load_model(path).model), ToolPoint(link))
     assert len(chain.joints) == n
     rng = np.random.default_rng(SEED)
     x = rng.uniform(chain.lower, chain.upper, size=(BRUTE, n))

@@ -15,11 +15,11 @@ from typing import Any
 import pytest
 import trimesh
 
-import armcli.check.dynamics
+import armcli.robot.model
 from armcli.check.rules import CheckOptions
 from armcli.check.run import check_urdf
+from armcli.io.mesh_confine import MAX_MESH_BYTES
 from armcli.spec.load import load_spec
-from armcli.urdf.mesh_confine import MAX_MESH_BYTES
 from armcli.urdf.read import MAX_URDF_COLLISIONS, read_urdf
 from tests.helpers import run_cli
 
@@ -80,13 +80,13 @@ def test_pinocchio_gets_only_absolute_confined_paths(
         _with_collision_meshes(_arm(root), "package://robot_pkg/etc/passwd", "../meshes/box.stl")
     )
     seen: list[tuple[str, list[str] | None]] = []
-    real = armcli.check.dynamics.collision_model
+    real = armcli.robot.model.collision_model  # what Robot.collision_model hands the xml to
 
-    def spy(model: Any, xml: str, package_dirs: list[str] | None = None) -> Any:
+    def spy(model: Any, xml: str, package_dirs: list[str] | None = None, source: str = "") -> Any:
         seen.append((xml, package_dirs))
-        return real(model, xml, package_dirs)
+        return real(model, xml, package_dirs, source)
 
-    monkeypatch.setattr(armcli.check.dynamics, "collision_model", spy)
+    monkeypatch.setattr(armcli.robot.model, "collision_model", spy)
     opts = CheckOptions(spec=load_spec(root / "specs" / "my_robot.yaml"))
     check_urdf(read_urdf(urdf), opts)
     assert len(seen) == 1
@@ -169,7 +169,7 @@ def test_collision_shape_count_bounded(tmp_path: Path, root: Path) -> None:
 def test_ament_index_registered_share_dir_is_a_package_root(tmp_path: Path) -> None:
     """ROS 2 resolves package://NAME through the ament index (<prefix>/share/NAME), whatever
     package.xml says (example-robot-data's names example_robot_descriptions)."""
-    from armcli.urdf.mesh_confine import is_package
+    from armcli.io.mesh_confine import is_package
 
     share = tmp_path / "prefix" / "share"
     pkg = share / "robot-data"

@@ -18,13 +18,13 @@ docs/security.md):
 - an empty environment (`--clearenv`) plus what the caller passes;
 - a seccomp filter (`seccomp_program`) refusing with EPERM: process creation
   (fork, vfork, clone, clone3: the child has no descendants, so the
-  per-process limits in xacro_sandbox.limit_child bound the whole sandbox),
+  per-process limits in xacro.sandbox.limit_child bound the whole sandbox),
   unix sockets (`socket`/`socketpair` with AF_UNIX: a bound directory may
   hold a socket of a host service), new namespaces (`unshare`, `setns`),
   mount operations, ptrace, keyrings, bpf, perf events, userfaultfd and
   io_uring (whose operations bypass seccomp);
 - stdout and stderr read with a streaming cap, and a wall-clock timeout
-  that kills the sandbox (xacro_sandbox.run_limited).
+  that kills the sandbox (xacro.sandbox.run_limited).
 
 Where bubblewrap is missing or cannot create namespaces, `sandbox_problem`
 says why and `--trust-xacro` is refused unless `--trust-xacro=unsandboxed`.

@@ -18,13 +18,13 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-import xacro
 
+import xacro
 from armcli.errors import InputError, XacroRefusedError
-from armcli.urdf.packages import PackageLookup
+from armcli.io.packages import PackageLookup
 from armcli.urdf.source import allowed_roots
-from armcli.urdf.xacro_args import Expansion, XacroInputs
-from armcli.urdf.xacro_safe import MAX_MACRO_CALLS, expand_safe, expand_safe_report
+from armcli.xacro.args import Expansion, XacroInputs
+from armcli.xacro.safe import MAX_MACRO_CALLS, expand_safe, expand_safe_report
 from tests.helpers import (
     ARM_PACKAGE,
     DEMO_ARM,

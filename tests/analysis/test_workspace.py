@@ -12,11 +12,11 @@ import math
 import numpy as np
 import pytest
 
+from armcli.analysis.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 from armcli.compiler.expand import expand_urdfs
 from armcli.robot.model import Robot
 from armcli.robot.tool import ToolPoint
 from armcli.spec.load import load_spec
-from armcli.urdf.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 from tests.helpers import DEFAULT_SPEC, ROOT
 
 EXACT = 1e-9  # [m] local search converged onto an extreme
