@@ -85,6 +85,7 @@ bench: install native-check
 	$(BIN)/python bench/bench_process.py
 	$(BIN)/python bench/bench_tune.py
 	$(BIN)/python bench/bench_check_dof.py
+	$(BIN)/python bench/bench_plan.py
 
 fuzz: install
 	HYPOTHESIS_PROFILE=fuzz $(BIN)/python -m pytest -q tests -k fuzz

@@ -112,11 +112,15 @@ class Roboplan:
         color = np.array([0.5, 0.5, 0.5, 1.0])
         shapes = {"box": lambda d: Box(*d), "sphere": lambda d: Sphere(d[0]),
                   "cylinder": lambda d: Cylinder(d[1], d[0])}  # fmt: skip
+        names = [f"{o.id}_{k}" for o in obstacles.objects for k in range(len(o.shapes))]
         for obj in obstacles.objects:
             for k, shape in enumerate(obj.shapes):
                 adder = getattr(self.scene, f"add{shape.kind.capitalize()}Geometry")
                 adder(f"{obj.id}_{k}", "universe", shapes[shape.kind](shape.dimensions),
                       np.asfortranarray(shape.T_frame_shape), color)  # fmt: skip
+        pairs = [(a, b) for i, a in enumerate(names) for b in names[i + 1 :]]
+        if pairs:  # obstacles touching each other are no collision of the robot's
+            self.scene.setCollisions(pairs, False)
         opts = RRTOptions(group_name="arm", rrt_connect=True, max_planning_time=TIMEOUT_S,
                           max_nodes=100000, collision_check_step_size=STEP)  # fmt: skip
         self.rrt = RRT(self.scene, opts)
@@ -183,7 +187,7 @@ def floor_plan(
     path = None
     if setup.haveExactSolutionPath():
         p = setup.getSolutionPath()
-        og.PathSimplifier(info).shortcutPath(p)
+        og.PathSimplifier(info).reduceVertices(p)
         path = np.array([[p.getState(k)[i] for i in range(n)] for k in range(p.getStateCount())])
     dt = time.perf_counter() - t0
     setup.clear()
