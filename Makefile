@@ -2,26 +2,27 @@
 PY ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
-STAMP := $(VENV)/.installed-stamp
 SPEC ?= specs/my_robot.yaml
 
-.PHONY: spec-docs install sysdeps demo test lint bench native native-check fuzz clean
+.PHONY: spec-docs install install-dev sysdeps demo test lint bench native native-check fuzz clean
 
-# The install builds the compiled rollout (armcli.sim._rollout, CMakeLists.txt) too, so a
-# change to its C++ source or build files reinstalls.
-# pip prints what it collects and builds: a first install downloads ~80 packages and
-# compiles the engine (README, "Set-up": minutes and memory measured here).
+# Two installs: `install` (make demo) is armcli and its runtime dependencies, with the compiled
+# rollout (armcli.sim._rollout, CMakeLists.txt) built in; `install-dev` (make test, lint,
+# bench) adds the dev extra's tools without rebuilding armcli. A change to pyproject.toml or
+# the engine's C++/build files reinstalls. Both print their steps and, while pip is silent
+# (the compile), a heartbeat every 30 s (scripts/install.sh).
+STAMP := $(VENV)/.installed-stamp
+DEV_STAMP := $(VENV)/.dev-stamp
 $(STAMP): pyproject.toml CMakeLists.txt src/armcli/sim/_native/rollout.cpp
-	@echo "install [1/3]: virtual environment in $(VENV)"
-	$(PY) -m venv $(VENV)
-	@echo "install [2/3]: pip"
-	$(BIN)/python -m pip install -q --upgrade pip
-	@echo "install [3/3]: armcli and its dependencies, compiling the engine (the longest step)"
-	$(BIN)/python -m pip install --progress-bar off -e '.[dev]'
+	@bash scripts/install.sh runtime $(PY) $(VENV)
 	touch $(STAMP)
-	@echo "install: done"
+
+$(DEV_STAMP): $(STAMP) pyproject.toml
+	@bash scripts/install.sh dev $(VENV)
+	touch $(DEV_STAMP)
 
 install: $(STAMP)
+install-dev: $(DEV_STAMP)
 
 # Debian tools some tests use (check_urdf, headless Chromium). Tests skip with a
 # reason where these cannot be installed (no apt, not root).
@@ -42,7 +43,7 @@ demo: install
 	$(BIN)/armcli ros-package $(SPEC) -o $(DEMO)/ros
 	@echo "demo: outputs in urdf/ and $(DEMO)/"
 
-lint: install
+lint: install-dev
 	$(BIN)/ruff check src tests bench
 	$(BIN)/ruff format --check src tests bench
 	$(BIN)/mypy src
@@ -52,7 +53,7 @@ lint: install
 # virtualenvs, pre-commit), their output in out/test-slow.log, printed after. Each prints
 # its own time and slowest tests; either failing fails `make test`.
 SLOW_LOG := out/test-slow.log
-test: install sysdeps lint native-check
+test: install-dev sysdeps lint native-check
 	$(BIN)/armcli build --check $(SPEC)
 	@mkdir -p out
 	@echo "test: the slow tests run alongside; their output follows the others' ($(SLOW_LOG))"
@@ -68,31 +69,33 @@ test: install sysdeps lint native-check
 # on import): incremental, in build/, with the build tools of the dev extra. Not through the
 # install stamp, which a C++ edit outdates: that would recreate the whole venv.
 native:
-	@test -x $(BIN)/python || $(MAKE) install
+	@test -x $(BIN)/python || $(MAKE) install-dev
 	@echo "native: recompiling the engine (armcli.sim._rollout)"
 	$(BIN)/python -m pip install -q --no-build-isolation --no-deps -e .
 	$(BIN)/python -m armcli.sim.native
 
 # The compiled engine must be there wherever a C++ compiler exists: a failed build fails
 # `make test` instead of skipping its tests.
-native-check: install
+native-check: install-dev
 	@if command -v c++ >/dev/null 2>&1 || command -v g++ >/dev/null 2>&1; then \
 	  $(BIN)/python -m armcli.sim.native; \
 	else echo "no C++ compiler: armcli installs without its simulator; simulator tests skip"; fi
 
-bench: install native-check
+bench: install-dev native-check
 	$(BIN)/python bench/bench_sim.py
 	$(BIN)/python bench/bench_process.py
 	$(BIN)/python bench/bench_tune.py
 	$(BIN)/python bench/bench_check_dof.py
 	$(BIN)/python bench/bench_plan.py
+	$(BIN)/python bench/bench_build_expand.py
+	$(BIN)/python bench/bench_drive.py
 
-fuzz: install
+fuzz: install-dev
 	HYPOTHESIS_PROFILE=fuzz $(BIN)/python -m pytest -q tests -k fuzz
 
 clean:
 	rm -rf $(VENV) build dist out .pytest_cache .ruff_cache .mypy_cache
 
 # The spec reference is generated from the pydantic models (a test keeps it in sync).
-spec-docs: install
+spec-docs: install-dev
 	$(BIN)/python -m armcli.spec.reference > docs/spec.md

@@ -29,11 +29,11 @@ OFF = ("armcli.check.tipover", "armcli.check.zmp", "armcli.check.reach")
 REPORT = "armcli.check.balance_report"
 THEIRS = (  # loaded only for the balance and reach families
     "armcli.check.balance",
-    "armcli.urdf.stance",
-    "armcli.urdf.ground",
-    "armcli.urdf.support",
-    "armcli.urdf.workspace",
-    "armcli.urdf.boxsearch",
+    "armcli.analysis.stance",
+    "armcli.analysis.ground",
+    "armcli.analysis.support",
+    "armcli.analysis.workspace",
+    "armcli.analysis.boxsearch",
     "armcli.sim.tipping",
     "armcli.sim.zmp",
 )

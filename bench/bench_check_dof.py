@@ -28,13 +28,13 @@ sys.path[:0] = [str(ROOT / "src"), str(ROOT)]
 
 from tests.sim import stability_reference as ref  # noqa: E402
 
-from armcli.check import dynamics as dyn  # noqa: E402
 from armcli.compiler.expand import expand_urdfs  # noqa: E402
 from armcli.defaults import STANDALONE_ARM_URDF  # noqa: E402
+from armcli.robot import sampling  # noqa: E402
+from armcli.robot.model import Robot  # noqa: E402
 from armcli.sim import stability as stab  # noqa: E402
 from armcli.sim import verdict as verdicts  # noqa: E402
 from armcli.spec.load import load_spec  # noqa: E402
-from armcli.urdf.pinocchio import joint_ranges, load_model  # noqa: E402
 
 DOFS = (30, 60, 120, 128)
 KP, KD, DAMPING, DT = 5.0, 0.05, 0.01, 1e-3
@@ -70,9 +70,9 @@ def analysis_seconds(spec_path: Path, with_reference: bool) -> tuple[float, floa
     """The stability analysis on check's samples: new, and the old eigenvalue computation."""
     spec = load_spec(spec_path)
     xml = expand_urdfs(spec)[STANDALONE_ARM_URDF].decode()
-    model = load_model(STANDALONE_ARM_URDF, xml=xml).model
-    ranges = joint_ranges(model)
-    samples = dyn.samples(model, ranges)
+    robot = Robot.from_xml(xml, STANDALONE_ARM_URDF)
+    model, ranges = robot.model, robot.joints
+    samples = sampling.configurations(robot)
     n = model.nv
     t0 = time.perf_counter()
     lin = stab.linearise(model, [q for _, q in samples])

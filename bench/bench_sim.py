@@ -22,6 +22,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
+from armcli.robot.load import load_model  # noqa: E402
 from armcli.sim import native  # noqa: E402
 from armcli.sim import rollout as ro  # noqa: E402
 from armcli.sim.reference import build_reference  # noqa: E402
@@ -34,7 +35,6 @@ from armcli.sim.simulate import (  # noqa: E402
     simulate_batch,
 )
 from armcli.sim.trajectory import loads_trajectory  # noqa: E402
-from armcli.urdf.pinocchio import load_model  # noqa: E402
 
 DT = 1e-3  # [s] the spec's control.dt
 KP, KD = 50.0, 5.0

@@ -24,9 +24,9 @@ sys.path.insert(0, str(ROOT / "src"))
 
 import xacro  # noqa: E402
 
-from armcli.urdf.xacro_jail import sandbox_problem  # noqa: E402
-from armcli.urdf.xacro_safe import expand_safe  # noqa: E402
-from armcli.urdf.xacro_sandbox import expand_foreign, expand_untrusted  # noqa: E402
+from armcli.xacro.jail import sandbox_problem  # noqa: E402
+from armcli.xacro.safe import expand_safe  # noqa: E402
+from armcli.xacro.sandbox import expand_foreign, expand_untrusted  # noqa: E402
 
 FILES = (
     ROOT / "tests" / "fixtures" / "check" / "course_macros.urdf.xacro",

@@ -29,6 +29,18 @@ def built_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
+@pytest.fixture(scope="session")
+def armcli_wheel(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """The wheel of this checkout, built once per test session, and its wheelhouse.
+
+    The build compiles the engine (minutes): every test that needs the wheel shares it.
+    """
+    from tests.install_helpers import build_wheel, wheelhouse
+
+    house = wheelhouse()
+    return build_wheel(tmp_path_factory.mktemp("wheel"), house), house
+
+
 def _hypothesis_profiles() -> None:
     """`default` keeps `make test` quick; `make fuzz` selects the long `fuzz` profile."""
     import os

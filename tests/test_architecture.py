@@ -14,16 +14,10 @@ from tests.helpers import ROOT
 
 SRC = ROOT / "src" / "armcli"
 RANK = {  # layer of each top-level module or subpackage (docs/ARCHITECTURE.md)
-    "errors": 0, "defaults": 0, "io": 1, "spec": 2, "compiler": 3, "urdf": 4,
-    "check": 5, "sim": 5, "ros": 5, "view": 5, "export": 5, "importer": 5,
-    "tune": 6, "plan": 6, "commands": 7, "cli": 8, "__main__": 9,
+    "errors": 0, "defaults": 0, "io": 1, "spec": 2, "xacro": 3, "compiler": 4, "urdf": 5,
+    "robot": 6, "analysis": 7, "export": 8, "importer": 8, "ros": 8, "sim": 9, "check": 10,
+    "tune": 10, "plan": 10, "view": 11, "commands": 12, "cli": 13, "__main__": 14,
 }  # fmt: skip
-SIBLING_EXCEPTIONS = {
-    ("check", "armcli.sim.stability"),
-    ("check", "armcli.sim.verdict"),
-    ("check", "armcli.sim.tipping"),
-    ("view", "armcli.sim.states"),
-}
 
 
 def _module_name(path: Path) -> str:
@@ -74,7 +68,7 @@ def test_imports_only_go_down() -> None:
                 continue
             if RANK[there] > RANK[here]:
                 bad.append(f"{module} -> {target} (upward)")
-            elif RANK[there] == RANK[here] and (here, target) not in SIBLING_EXCEPTIONS:
+            elif RANK[there] == RANK[here]:
                 bad.append(f"{module} -> {target} (sibling)")
     assert not bad, "\n".join(sorted(bad))
 

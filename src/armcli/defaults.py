@@ -16,6 +16,10 @@ STANDALONE_ARM = "standalone_arm"
 STANDALONE_ARM_XACRO = f"{STANDALONE_ARM}.urdf.xacro"
 STANDALONE_ARM_URDF = f"{STANDALONE_ARM}.urdf"
 
+# armcli's bound on robot size (URDF reader and spec parts alike): tiago_dual, the largest
+# robot in example-robot-data, has 130 links and 101 DoF; a 1000-joint chain made check use 24 GB
+MAX_ROBOT_LINKS = 300
+MAX_ROBOT_DOF = 128
 DEFAULT_DT = 0.001  # [s] control and simulation step when the spec gives none
 DEFAULT_STATE_RATE_HZ = 10.0  # [Hz] joint-state output without a joint_state_publisher
 

@@ -16,13 +16,13 @@ import math
 import numpy as np
 import pytest
 
+from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
 from armcli.check.balance import analyse
 from armcli.check.rules import CheckOptions, TipoverOptions
 from armcli.check.run import check_urdf
 from armcli.compiler.expand import expand_urdfs
 from armcli.spec.load import load_spec
 from armcli.urdf.read import parse_urdf, read_urdf
-from armcli.urdf.stance import NoStance, Payload, Stance, stance_of
 from tests.helpers import DEFAULT_SPEC, FIXTURES
 
 BOX_ROD = FIXTURES / "tipover" / "box_rod.urdf"

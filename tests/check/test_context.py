@@ -17,7 +17,7 @@ def _record(monkeypatch: pytest.MonkeyPatch) -> list[tuple[str, bool]]:
     """Add one family per stage (as a new rule module would) that records its call."""
     seen: list[tuple[str, bool]] = []
     extra = tuple(
-        run.Family(f"probe-{s}", s, lambda c, s=s: seen.append((s, c.model is not None)))
+        run.Family(f"probe-{s}", s, lambda c, s=s: seen.append((s, c.robot is not None)))
         for s in (DYNAMICS, MODEL, URDF)
     )
     monkeypatch.setattr(run, "FAMILIES", run.FAMILIES + extra)

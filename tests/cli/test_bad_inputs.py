@@ -191,7 +191,9 @@ def test_fifo_input_refused(command: str, name: str, tmp_path: Path, root: Path)
 
 def test_diverging_simulation_exits_1_without_output(tmp_path: Path, root: Path) -> None:
     # A URDF whose velocity limit (0.01 rad/s) the PD loop exceeds tenfold in one step:
-    # the run must stop with the evidence, not write a misleading CSV or plot.
+    # the run must stop with the evidence, not write a misleading CSV or plot. The point is
+    # the reference from t = 0 (a step, no segment to outrun the limit: a slower segment
+    # would be refused before the run, sim.precheck), so the PD loop itself diverges.
     slow = tmp_path / "slow.urdf"
     slow.write_text(
         (root / "urdf" / "standalone_arm.urdf")
@@ -202,7 +204,7 @@ def test_diverging_simulation_exits_1_without_output(tmp_path: Path, root: Path)
     out.mkdir()
     message = (
         "{joint_names: [arm_base_forearm_joint, forearm_hand_joint], "
-        "points: [{positions: [1.0, 1.0], time_from_start: 0.5}]}"
+        "points: [{positions: [1.0, 1.0], time_from_start: 0}]}"
     )
     proc = run_cli(
         [

@@ -186,7 +186,7 @@ HUGE_XACRO = (
 
 def test_sandbox_stops_runaway_xacro(tmp_path: Path) -> None:
     from armcli.errors import InputError
-    from armcli.urdf.xacro_sandbox import XACRO_MEMORY_BYTES, expand_untrusted
+    from armcli.xacro.sandbox import XACRO_MEMORY_BYTES, expand_untrusted
 
     slow, huge = tmp_path / "slow.xacro", tmp_path / "huge.xacro"
     slow.write_text(SLOW_XACRO)

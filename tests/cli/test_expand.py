@@ -111,3 +111,23 @@ def test_every_command_takes_xacro_arguments(
         assert "l_finger_link" in r.stdout and "l_shoulder" in r.stdout
     if command[0] == "check":  # the file:// and package:// meshes of the install resolve
         assert "mesh-missing" not in r.stdout and "0 error(s)" in r.stdout
+
+
+@pytest.mark.parametrize("how", ["same path", "symlink", "hard link"])
+def test_expand_never_writes_over_its_input(how: str, tmp_path: Path) -> None:
+    """Issue 27: `armcli expand a.xacro -o a.xacro` replaced the xacro by its expansion."""
+    from tests.helpers import run_cli
+
+    src = tmp_path / "a.xacro"
+    text = '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="l"/></robot>'
+    src.write_text(text)
+    out = src
+    if how == "symlink":
+        out = tmp_path / "link.urdf"
+        out.symlink_to(src)
+    elif how == "hard link":
+        out = tmp_path / "hard.urdf"
+        out.hardlink_to(src)
+    proc = run_cli(["expand", src, "-o", out])
+    assert proc.returncode == 2 and "is the input file" in proc.stderr, proc.stderr
+    assert src.read_text() == text

@@ -19,7 +19,7 @@ LIBRARY = ROOT / "src" / "armcli"
 FLAG_FIELD = re.compile(r"""field(?:: str)?\s*=\s*f?["']--""")  # a keyword or a default
 # Still naming flags: parsers of CLI-format values (NAME=PATH, VAR=VALUE) and the --env
 # values they produce (urdf/source.py); a library caller passes dicts instead.
-LEFT = {"urdf/packages.py", "urdf/xacro_args.py", "urdf/source.py"}
+LEFT = {"io/packages.py", "xacro/args.py", "urdf/source.py"}
 MESSAGE = "joint_names: [arm_base_forearm_joint]\npoints: [{positions: [0.1]}]"
 
 

@@ -44,16 +44,30 @@ def test_seed_message(capsys: pytest.CaptureFixture[str]) -> None:
     assert "(0.1500, 0.0000, 0.9200) m" in out
 
 
+COURSE_MESSAGE = (  # the course's `ros2 topic pub -1 /set_joint_trajectory ...` payload, verbatim
+    "{header: {frame_id: arm_base_link}, joint_names: [arm_base_forearm_joint, "
+    "forearm_hand_joint], points: [{positions: {0.0, 0.0}}]}"
+)
+
+
 def test_course_brace_form(capsys: pytest.CaptureFixture[str]) -> None:
-    """`{0.0, 0.0}` is one position in ROS 2 (refused); `{0.5, 0.3}` is two (a warning)."""
-    code, _, err = run(["--message", SEED.replace("[0.0, 0.0]", "{0.0, 0.0}")], capsys)
-    assert code == 2 and "1 value(s) for 2 joint(s)" in err and "[0.0, 0.0]" in err
+    """The course's `{0.0, 0.0}` runs as the two zeros written, with one warning."""
+    code, out, err = run(["--message", COURSE_MESSAGE], capsys)
+    assert code == 0, err
+    assert "(0.1500, 0.0000, 0.9200) m" in out  # q = 0, as test_seed_message
+    assert err.count("warning:") == 1 and err.count("is a YAML mapping, not a list") == 1
+    assert "--message points[0].positions" in err  # the flag, not the library's name
+    assert "1 value(s) [0.0] for 2 joint(s)" in err and "[0.0, 0.0]" in err
     code, _, err = run(["--message", SEED.replace("[0.0, 0.0]", "{0.5, 0.3}")], capsys)
     assert code == 0, err
     assert err.count("is a YAML mapping, not a list") == 1 and "[0.5, 0.3]" in err
+    code, _, err = run(["--message", SEED.replace("[0.0, 0.0]", "{0.5}")], capsys)
+    assert code == 2 and "1 value(s) for 2 joint(s)" in err
 
 
-@pytest.mark.parametrize("name", sorted(p.name for p in TRAJ.glob("*.yaml")))
+@pytest.mark.parametrize(  # drive.yaml holds /cmd_vel commands: tests/cli/test_drive.py
+    "name", sorted(p.name for p in TRAJ.glob("*.yaml") if "\ncommands:" not in p.read_text())
+)
 def test_example_trajectories_csv(
     name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -235,3 +249,9 @@ def test_simulating_a_urdf_needs_no_spec_layers() -> None:
                              "--kd", "5", "-m", msg, "--duration", "0.2"])  # fmt: skip
     assert "pinocchio" in loaded and "armcli.spec.model" not in loaded
     assert not {"matplotlib", "scipy", "mujoco", "numpy.ma"} & loaded
+
+
+def test_a_wheel_joint_is_not_an_arm_joint(capsys: pytest.CaptureFixture[str]) -> None:
+    message = SEED.replace("arm_base_forearm_joint", "base_left_wheel_joint")
+    code, _, err = run(["--message", message], capsys)
+    assert code == 2 and "is a wheel joint of the mobile base, not an arm joint" in err

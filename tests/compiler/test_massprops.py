@@ -16,8 +16,10 @@ import pytest
 from lxml import etree
 
 from armcli.compiler.expand import expand_urdfs
+from armcli.compiler.massprops import mesh_mass_properties
 from armcli.errors import InputError
 from armcli.spec.load import load_spec
+from armcli.spec.shapes import Geometry, Inertial, Mesh, Shape
 from tests.meshes import (
     as_stored,
     box_triangles,
@@ -141,3 +143,12 @@ def test_missing_mesh_is_refused_naming_the_file(project: Path) -> None:
     (project / "meshes" / "box.stl").unlink()
     with pytest.raises(InputError, match=r"mesh file meshes/box.stl not found"):
         _build(project)
+
+
+@pytest.mark.parametrize("scale", [1e200, -1e200])
+def test_a_huge_mesh_scale_is_one_input_error(scale: float, tmp_path: Path) -> None:
+    """Issue 27: a scale of 1e200 overflowed to a NaN mass (then an internal error)."""
+    write_stl(tmp_path / "house.stl", house_triangles())
+    shape = Shape(geometry=Geometry(mesh=Mesh(filename="house.stl", scale=(scale,) * 3)))
+    with pytest.raises(InputError, match="non-finite volume or inertia"):
+        mesh_mass_properties(shape, Inertial(shape="visual", mass=1.0), tmp_path)

@@ -19,12 +19,12 @@ from lxml import etree
 
 from armcli.export.mjcf import quat
 from armcli.export.mjcf_files import export_mjcf
+from armcli.robot.inertia import rpy_matrix
+from armcli.robot.load import load_model
 from armcli.sim.reference import build_reference
 from armcli.sim.simulate import SimConfig, arm_from_model, simulate
 from armcli.sim.trajectory import loads_trajectory
 from armcli.spec.load import load_spec
-from armcli.urdf.inertia import rpy_matrix
-from armcli.urdf.pinocchio import load_model
 from armcli.urdf.source import read_robot
 from tests.helpers import COURSE_GAINS, ROOT, course_gains_spec
 

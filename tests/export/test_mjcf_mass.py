@@ -3,7 +3,7 @@
 The fixtures reproduce what real descriptions do (planning-only industrial arms without
 inertials, 1e-6 kg dummy links with singular tensors, CAD inertias violating the
 triangle inequality, point masses); before the fix each exported with exit 0 and MuJoCo
-refused the result. References: closed-form solids (urdf.inertia) for the inertia MuJoCo
+refused the result. References: closed-form solids (robot.inertia) for the inertia MuJoCo
 takes from geometry, Pinocchio on the original URDF for merges that must not change the
 dynamics, and MuJoCo itself compiling every written model.
 """
@@ -20,7 +20,7 @@ import pytest
 from armcli.errors import ExportRefusedError
 from armcli.export.mjcf_files import export_mjcf
 from armcli.export.mjcf_mass import DENSITY, POINT_RADIUS
-from armcli.urdf import inertia as inr
+from armcli.robot import inertia as inr
 
 mujoco = pytest.importorskip("mujoco")
 pin = pytest.importorskip("pinocchio")
@@ -207,3 +207,44 @@ def test_cli_exits_1_naming_the_link_and_writes_nothing(
     err = capsys.readouterr().err
     assert "link 'tip'" in err and "<inertial>" in err
     assert list(out.parent.iterdir()) == []
+
+
+def _wrist_through_frame(wrist_inertial: str) -> str:
+    """The Gen3 lite's end: a massless (or point-mass) wrist link turned by joint_6, then a
+    massless frame (dummy_link), then the 0.14 kg gripper base, both on fixed joints."""
+    return _robot(
+        _link("base_link", GOOD),
+        _link("upper_wrist_link", GOOD),
+        _link("end_effector_link", wrist_inertial),
+        _link("dummy_link"),
+        _link("gripper_base_link", _inertial(0.1395, 1.16e-4, 1.03e-4, 9.7e-5)),
+        _joint("joint_5", "base_link", "upper_wrist_link"),
+        _joint("joint_6", "upper_wrist_link", "end_effector_link"),
+        _joint("end_effector", "end_effector_link", "dummy_link", "fixed"),
+        _joint("gripper_base_joint", "dummy_link", "gripper_base_link", "fixed"),
+    )
+
+
+@pytest.mark.parametrize(
+    ("wrist", "merged"),
+    [("", False), (_inertial(0.05, 0.0, 0.0, 0.0), True)],  # no inertial; a point mass
+)
+def test_a_moving_link_holds_mass_through_a_massless_frame(
+    tmp_path: Path, wrist: str, merged: bool
+) -> None:
+    """Issue 32: the Gen3 lite was refused; the lumping looked one fixed joint down only.
+
+    MuJoCo counts the gripper two welds down; the wrist's own point mass, when it has one,
+    moves two frames down into it, and the mass matrix stays Pinocchio's.
+    """
+    urdf = _wrist_through_frame(wrist)
+    res, m = _export(tmp_path, urdf)
+    assert ("mass: merged into a rigid child" in _topics(res)) == merged
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(SEED)
+    for _ in range(N_CONFIGS):
+        d.qpos[:] = rng.uniform(-2.0, 2.0, m.nq)
+        mujoco.mj_forward(m, d)
+        M = np.zeros((m.nv, m.nv))
+        mujoco.mj_fullM(m, d, M)
+        assert np.max(np.abs(M - _pin_M(urdf, d.qpos.copy()))) < DYN_TOL

@@ -18,7 +18,7 @@ from lxml import etree
 from armcli.errors import InputError
 from armcli.export.mjcf_files import export_mjcf
 from armcli.export.mjcf_meshes import MJ_STL_MAX_FACES, is_flat, read_mesh
-from armcli.urdf.mesh_confine import MAX_MESH_BYTES, MAX_MESH_TOTAL_BYTES
+from armcli.io.mesh_confine import MAX_MESH_BYTES, MAX_MESH_TOTAL_BYTES
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -122,3 +122,30 @@ def test_meshes_over_the_robot_total_are_refused(tmp_path: Path) -> None:
         export_mjcf(tmp_path / "r.urdf", tmp_path / "out" / "robot.xml")
     assert not (tmp_path / "out").exists()
     assert os.path.getsize(tmp_path / "m0.stl") == MAX_MESH_BYTES  # untouched
+
+
+DAE = Path(__file__).parents[1] / "fixtures" / "real_robots" / "meshes" / "textured.dae"
+
+
+@pytest.mark.parametrize("unit", [1.0, 0.001])
+def test_collada_collision_meshes_become_binary_stl_in_metres(tmp_path: Path, unit: float) -> None:
+    """Doosan M1013: every collision mesh is COLLADA, which MuJoCo cannot read; they were
+    left out with exit 0. The fixture is TET with the same faces (its texture is missing,
+    as PR2's); a millimetre copy (unit 0.001, coordinates x1000) must give the same metres.
+    """
+    text = DAE.read_text()
+    if unit != 1.0:
+        text = text.replace('<unit name="meter" meter="1"/>', f'<unit name="mm" meter="{unit}"/>')
+        text = text.replace("0 0 0 0.1 0 0 0 0.1 0 0 0 0.1", "0 0 0 100 0 0 0 100 0 0 0 100")
+        assert f'meter="{unit}"' in text and "100 0 0" in text
+    (tmp_path / "tet.dae").write_text(text)
+    res = export_mjcf(_urdf(tmp_path, "tet.dae"), tmp_path / "out" / "robot.xml")
+    data = (tmp_path / "out" / "meshes" / "tet.stl").read_bytes()
+    n = int(np.frombuffer(data, "<u4", 1, 80)[0])
+    assert len(data) == 84 + 50 * n and n == len(TET_FACES)
+    got = np.frombuffer(data, FACET, n, 84)["v"]
+    assert np.allclose(got, TET[np.array(TET_FACES)], atol=1e-7)  # float32 of 0.1
+    assert "tet.dae" in res.report and "converted to binary STL" in res.report
+    m = mujoco.MjModel.from_xml_path(str(tmp_path / "out" / "scene.xml"))
+    assert m.nmesh == 1 and m.mesh_facenum[0] == len(TET_FACES)
+    assert int(np.sum(m.geom_type == mujoco.mjtGeom.mjGEOM_MESH)) == 2  # visual + collision

@@ -77,13 +77,16 @@ def test_table_when_it_fits_records_below() -> None:
     assert "kd 3.48" in narrow
 
 
-def test_names_wrap_after_underscores() -> None:
-    assert [x.plain for x in fold(Text("arm_base_forearm_joint"), 12)] == [
-        "arm_base_",
-        "forearm_",
-        "joint",
-    ]
-    assert [x.plain for x in fold(Text("abcdefghij"), 4)] == ["abcd", "efgh", "ij"]
+def test_cells_wrap_between_words_never_inside_a_name() -> None:
+    assert [x.plain for x in fold(Text("worst in range"), 8)] == ["worst in", "range"]
+    # issue 31: `base_right_` / `wheel_joint` and paths cut mid-word
+    t = FitTable([Column("joint", number=False), Column("type", number=False), Column("kp")])
+    for name in ("base_right_wheel_joint", "urdf/my_robot_description/meshes/base.stl"):
+        t.add_row(name, "continuous", "1.742e+04")
+    for width in (80, 60, 50, 40):
+        out = _render(t, width)
+        assert "base_right_wheel_joint" in out.split(), (width, out)
+        assert "urdf/my_robot_description/meshes/base.stl" in out.split(), (width, out)
 
 
 def test_wrap_parts_breaks_only_between_parts() -> None:

@@ -26,6 +26,8 @@ def test_line_numbers_follow_paths() -> None:
         ("a: [1, 2\n", "malformed YAML"),
         ("a: \x00\n", "NUL"),
         ("[" * 100 + "]" * 100, "nesting deeper"),
+        # deep enough that PyYAML's own scanner guard fires first: the same armcli message
+        ("a: " + "[" * 5000 + "]" * 5000, "nesting deeper than 64 levels"),
     ],
 )
 def test_refusals(text: str, fragment: str) -> None:
@@ -67,3 +69,16 @@ def test_files(tmp_path: Path) -> None:
     binary.write_bytes(b"\xff\xfe\x00garbage")
     with pytest.raises(InputError, match="not UTF-8"):
         load_yaml(binary)
+
+
+def test_a_tab_is_named_as_a_tab() -> None:
+    # libyaml says "found character that cannot start any token", hiding the character
+    with pytest.raises(InputError, match=r"a tab character, column 1; YAML indents with spaces"):
+        loads_yaml("name: x\n\tarm: 1\n", "spec.yaml")
+
+
+def test_a_ros2_topic_echo_file_ending_in_dashes_is_one_document() -> None:
+    echo = "joint_names:\n- a\npoints:\n- positions:\n  - 0.1\n---\n"  # as `ros2 topic echo`
+    assert loads_yaml(echo).data == {"joint_names": ["a"], "points": [{"positions": [0.1]}]}
+    with pytest.raises(InputError, match="malformed YAML"):  # a second message is not dropped
+        loads_yaml(echo + "joint_names: [b]\n")

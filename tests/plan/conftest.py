@@ -37,7 +37,7 @@ def two_link() -> Loaded:
 def panda() -> Loaded:
     if not PANDA.is_dir():
         pytest.skip("example-robot-data's Panda is not installed")
-    from armcli.urdf.packages import PackageLookup
+    from armcli.io.packages import PackageLookup
 
     return load_context(
         read_robot(PANDA / "urdf" / "panda.urdf"),

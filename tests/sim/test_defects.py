@@ -17,11 +17,11 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
+from armcli.robot.load import load_model
 from armcli.sim import rollout as ro
 from armcli.sim.reference import build_reference
 from armcli.sim.simulate import Arm, SimConfig, arm_from_model, plant_of, simulate
 from armcli.sim.trajectory import loads_trajectory
-from armcli.urdf.pinocchio import load_model
 from tests.sim.engines import run_held
 
 ID_TOL = 1e-9  # [N·m] inverse dynamics vs reported torque: round-off of (v' - v) / dt

@@ -16,10 +16,10 @@ import pinocchio as pin
 import pytest
 from scipy.integrate import solve_ivp
 
+from armcli.robot.load import load_model
 from armcli.sim.reference import Reference, build_reference
 from armcli.sim.simulate import Arm, SimConfig, arm_from_model, plant_of, simulate
 from armcli.sim.trajectory import loads_trajectory
-from armcli.urdf.pinocchio import load_model
 from tests.sim.engines import run_held
 from tests.sim.test_simulate import _arm, pendulum
 

@@ -15,10 +15,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from armcli.robot.load import load_model
 from armcli.sim.reference import build_reference
 from armcli.sim.simulate import Arm, SimConfig, arm_from_model, simulate
 from armcli.sim.trajectory import loads_trajectory
-from armcli.urdf.pinocchio import load_model
 
 mujoco = pytest.importorskip("mujoco")
 

@@ -12,6 +12,7 @@ import pinocchio as pin
 import pytest
 
 from armcli.errors import InputError, SimulationError
+from armcli.robot.load import load_model
 from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim.reference import build_reference
@@ -21,13 +22,11 @@ from armcli.sim.simulate import (
     Run,
     SimConfig,
     arm_from_model,
-    configuration,
     plant_of,
     simulate,
     simulate_batch,
 )
 from armcli.sim.trajectory import loads_trajectory
-from armcli.urdf.pinocchio import load_model
 from tests.sim.engines import require_native, run_held
 from tests.sim.test_defects import TILTED_URDF
 
@@ -72,7 +71,7 @@ def _free_step_equals_python_aba(model: pin.Model) -> bool:
                    friction=np.zeros(n), velocity=np.full(n, 1e9))  # fmt: skip
     rng = np.random.default_rng(n)
     q0, v0 = rng.uniform(-1, 1, n), rng.uniform(-1, 1, n)
-    a = pin.aba(wide.model, wide.model.createData(), configuration(wide.model, q0), v0,
+    a = pin.aba(wide.model, wide.model.createData(), wide.robot.q(q0), v0,
                 np.zeros(n), pin.Convention.WORLD)  # fmt: skip
     if not np.all(np.isfinite(a)):
         return False

@@ -11,6 +11,7 @@ import pinocchio as pin
 import pytest
 
 from armcli.errors import InputError, SimulationError, UnstableLoopError
+from armcli.robot.load import load_model
 from armcli.sim import rollout as ro
 from armcli.sim.reference import build_reference
 from armcli.sim.simulate import (
@@ -22,7 +23,6 @@ from armcli.sim.simulate import (
     simulate,
 )
 from armcli.sim.trajectory import loads_trajectory
-from armcli.urdf.pinocchio import load_model
 from tests.sim.engines import run_held
 
 G = 9.81

@@ -117,12 +117,13 @@ def test_suggested_bounds_are_the_stability_edge() -> None:
 def test_pinocchio_crba_matches_the_textbook_matrix(root) -> None:
     import pinocchio as pin
 
-    from armcli.urdf.pinocchio import configuration, load_model
+    from armcli.robot.load import load_model
+    from armcli.robot.model import Robot
 
-    model = load_model(root / "urdf" / "standalone_arm.urdf").model
-    data = model.createData()
+    robot = Robot(load_model(root / "urdf" / "standalone_arm.urdf").model)
+    model, data = robot.model, robot.data
     for q2 in (0.0, 0.7, math.pi / 2):
-        q = configuration(model, {"arm_base_forearm_joint": 0.3, "forearm_hand_joint": q2})
+        q = robot.q({"arm_base_forearm_joint": 0.3, "forearm_hand_joint": q2})
         M = pin.crba(model, data, q)
         M = np.triu(M) + np.triu(M, 1).T
         np.testing.assert_allclose(M, two_link_mass_matrix(q2), rtol=1e-9)

@@ -21,12 +21,12 @@ import pytest
 
 from armcli.check.rules import CheckOptions
 from armcli.check.run import check_urdf
+from armcli.robot.load import load_model
 from armcli.sim import stability as stab
 from armcli.sim.reference import build_reference
 from armcli.sim.simulate import SimConfig, arm_from_model, simulate
 from armcli.sim.trajectory import loads_trajectory
 from armcli.spec.load import load_spec
-from armcli.urdf.pinocchio import load_model
 from armcli.urdf.read import read_urdf
 from tests.helpers import FIXTURES
 

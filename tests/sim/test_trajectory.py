@@ -30,20 +30,12 @@ def _sample1(ref, t: float) -> tuple[np.ndarray, np.ndarray]:
     return q[0], v[0]
 
 
-def test_seed_payload_is_refused_as_ros_reads_it() -> None:
-    """The course's `{0.0, 0.0}`: PyYAML keeps one key, so ROS 2 sends one position."""
-    with pytest.raises(SpecError) as exc:
-        loads_trajectory(SEED, LIMITS)
-    msg = str(exc.value)
-    assert "points[0].positions" in msg and "1 value(s) for 2 joint(s)" in msg
-    assert "write a list: [0.0, 0.0]" in msg
-    tr = loads_trajectory(SEED.replace("{0.0, 0.0}", "[0.0, 0.0]"), LIMITS)
-    assert tr.joint_names == (J1, J2)
-    assert tr.frame_id == "arm_base_link"
-    np.testing.assert_array_equal(tr.positions, [[0.0, 0.0]])
-    assert tr.times.tolist() == [DEFAULT_SEGMENT_S]  # documented default for a missing time
-    assert tr.velocities is None and tr.accelerations is None
-    assert tr.warnings == ()
+def test_seed_payload_runs_as_written() -> None:
+    """The course's `{0.0, 0.0}`: ROS 2 sends one position; armcli runs the two written."""
+    tr = loads_trajectory(SEED, LIMITS)
+    assert tr.positions.tolist() == [[0.0, 0.0]]
+    assert len(tr.warnings) == 1
+    assert "points[0].positions" in tr.warnings[0] and "[0.0, 0.0]" in tr.warnings[0]
 
 
 def _ros2_topic_pub_positions(payload: str) -> list[list[float]]:
@@ -58,20 +50,35 @@ def _ros2_topic_pub_positions(payload: str) -> list[list[float]]:
 @pytest.mark.parametrize(
     "positions", ["{0.5, 0.3}", "{0.3, 0.5}", "{0, 1.5}", "{0.0, 0.0}", "{1, 1.0}", "{0.5}"]
 )
-def test_brace_form_reads_as_ros_2_sends_it(positions: str) -> None:
+def test_brace_form_runs_as_written_and_says_what_ros_2_sends(positions: str) -> None:
     payload = f"{{joint_names: [{J1}, {J2}], points: [{{positions: {positions}}}]}}"
     sent = _ros2_topic_pub_positions(payload)[0]  # the independent reference: ROS's own code
-    if len(sent) == 2:
-        tr = loads_trajectory(payload, LIMITS)
-        assert tr.positions.tolist() == [sent]
-        assert len(tr.warnings) == 1 and "is a YAML mapping, not a list" in tr.warnings[0]
-    else:
-        with pytest.raises(SpecError, match=rf"{len(sent)} value\(s\) for 2 joint\(s\)"):
+    written = [float(x) for x in positions.strip("{}").split(",")]  # what the student typed
+    if len(written) != 2:  # nothing to recover: one value for two joints
+        with pytest.raises(SpecError, match=r"1 value\(s\) for 2 joint\(s\)"):
             loads_trajectory(payload, LIMITS)
+        return
+    tr = loads_trajectory(payload, LIMITS)
+    assert tr.positions.tolist() == [written]
+    assert len(tr.warnings) == 1 and "is a YAML mapping, not a list" in tr.warnings[0]
+    list_form = "[" + positions.strip("{}") + "]"
+    assert f"write a list: {list_form}" in tr.warnings[0] or list_form in tr.warnings[0]
+    if len(sent) != len(written):  # ROS 2 collapses the repeated key: the warning says so
+        assert f"would send its distinct keys, {len(sent)} value(s)" in tr.warnings[0]
 
 
-@pytest.mark.parametrize("path", sorted((ROOT / "specs" / "trajectories").glob("*.yaml")))
-def test_example_trajectories_load(path: Path) -> None:
+def test_brace_form_one_warning_for_every_point() -> None:
+    points = ", ".join(f"{{positions: {{0.{k}, 0.{k}}}}}" for k in range(1, 6))
+    tr = loads_trajectory(f"{{joint_names: [{J1}, {J2}], points: [{points}]}}", LIMITS)
+    assert tr.positions[:, 0].tolist() == [0.1, 0.2, 0.3, 0.4, 0.5]  # as written, per point
+    assert len(tr.warnings) == 1 and "(and 4 more)" in tr.warnings[0]
+
+
+EXAMPLES = sorted((ROOT / "specs" / "trajectories").glob("*.yaml"))
+
+
+@pytest.mark.parametrize("path", [p for p in EXAMPLES if "\ncommands:" not in p.read_text()])
+def test_example_trajectories_load(path: Path) -> None:  # drive.yaml: tests/sim/test_cmdvel.py
     tr = load_trajectory(path, LIMITS)
     assert tr.positions.shape[1] == 2
     assert np.all(np.diff(tr.times) > 0)
@@ -221,3 +228,39 @@ def test_fuzz_trajectory_structured(doc: object) -> None:
     ref = build_reference(tr, (J1, J2), np.zeros(2))
     q, v = ref.sample(np.linspace(0, tr.duration + 1, 50))
     assert np.all(np.isfinite(q)) and np.all(np.isfinite(v))
+
+
+def _problems(text: str, **kw: object) -> list[str]:
+    with pytest.raises(SpecError) as exc:
+        loads_trajectory(text, LIMITS, **kw)  # type: ignore[arg-type]
+    return exc.value.lines()
+
+
+def test_a_typo_is_one_message_with_a_suggestion() -> None:
+    points = "".join(f"  - {{postions: [0.{k}, 0.{k}]}}\n" for k in range(1, 6))
+    lines = _problems(f"joint_names: [{J1}, {J2}]\npoints:\n{points}")
+    assert len(lines) == 1  # not one per point, and not also "positions: missing"
+    assert "points[0].postions" in lines[0] and "did you mean 'positions'?" in lines[0]
+    assert "(and 4 more)" in lines[0]
+
+
+def test_joint_names_suggest_and_say_what_a_wheel_is() -> None:
+    (line,) = _problems(
+        f"joint_names: [arm_base_forarm_joint, {J2}]\npoints: [{{positions: [0, 0]}}]"
+    )
+    assert f"did you mean {J1!r}?" in line
+    wheel = {"base_left_wheel_joint": "a wheel joint of the mobile base"}
+    text = f"joint_names: [base_left_wheel_joint, {J2}]\npoints: [{{positions: [0, 0]}}]"
+    (line,) = _problems(text, others=wheel)
+    assert "'base_left_wheel_joint' is a wheel joint of the mobile base, not an arm joint" in line
+
+
+def test_degrees_are_named_as_degrees() -> None:
+    head = f"joint_names: [{J1}, {J2}]\npoints:\n"
+    # one message for the file, not one per value
+    (line,) = _problems(head + "  - {positions: [45, 60]}\n  - {positions: [30, 60]}")
+    # 45° = 45 pi / 180 = 0.785398... rad
+    assert "looks like degrees: 45° = 0.785 rad" in line and "--clamp" not in line
+    # out of range in radians too: the limit, once per joint
+    (line,) = _problems(head + "  - {positions: [2, 0.1]}\n  - {positions: [2, 0.2]}")
+    assert "(use --clamp to clamp)" in line and "(and 1 more)" in line

@@ -19,15 +19,16 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from armcli.check import dynamics as dyn
 from armcli.check.rules import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.errors import UnstableLoopError
+from armcli.robot import sampling
+from armcli.robot.load import load_model
+from armcli.robot.model import Robot
 from armcli.sim.simulate import SimConfig, arm_from_model, check_stability
 from armcli.spec.load import load_spec
 from armcli.spec.model import Gains, RobotSpec
 from armcli.urdf.doc import Urdf
-from armcli.urdf.pinocchio import joint_ranges, load_model
 from armcli.urdf.read import parse_urdf
 from tests.helpers import DEFAULT_SPEC, ROOT
 
@@ -63,7 +64,7 @@ def _simulate_accepts(urdf: Urdf, kp: list[float], kd: list[float], dt: float,
     model = load_model(urdf.source, xml=urdf.text.decode()).model
     arm = arm_from_model(model)
     configs = np.array(
-        [[p[j] for j in arm.joint_names] for p, _ in dyn.samples(model, joint_ranges(model))]
+        [[p[j] for j in arm.joint_names] for p, _ in sampling.configurations(Robot(model))]
     )
     cfg = SimConfig(np.array(kp, dtype=float), np.array(kd, dtype=float), dt, gravity_comp=gc)
     try:

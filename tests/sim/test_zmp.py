@@ -15,11 +15,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from armcli.analysis.stance import Payload, Stance, stance_of
 from armcli.compiler.expand import expand_urdfs
 from armcli.sim import zmp as zmps
 from armcli.spec.load import load_spec
 from armcli.urdf.read import parse_urdf
-from armcli.urdf.stance import Payload, Stance, stance_of
 from tests.helpers import DEFAULT_SPEC, FIXTURES
 
 ARM = ("arm_base_forearm_joint", "forearm_hand_joint")

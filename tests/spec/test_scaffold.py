@@ -50,7 +50,11 @@ def test_template_is_consistent(template: str) -> None:
     assert t.pose in spec["poses"]  # the README's render command
     arm_joints = set(spec["arm"]["joints"])
     for f in (EXAMPLES / t.trajectories).glob("*.yaml"):
-        assert set(yaml.safe_load(f.read_text())["joint_names"]) <= arm_joints, f.name
+        data = yaml.safe_load(f.read_text())
+        if "commands" in data:  # /cmd_vel commands (simulate --cmd-vel): a spec with a drive
+            assert spec["mobile_base"]["diff_drive"], f.name
+            continue
+        assert set(data["joint_names"]) <= arm_joints, f.name
 
 
 # The course's standalone arm (root arm_base_link, 0.5 kg) hangs from a massless `world`
@@ -88,7 +92,7 @@ def test_init_creates_the_directory(tmp_path: Path, capsys: pytest.CaptureFixtur
     target = tmp_path / "a" / "new"
     assert _main(["init", str(target)]) == 0
     assert (target / "armcli.yaml").is_file() and (target / "trajectories" / "pick.yaml").is_file()
-    assert f"next: cd {target} && armcli build" in capsys.readouterr().out
+    assert f"\n  cd {target}\n  armcli build\n" in capsys.readouterr().out
     assert sorted(p.name for p in target.parent.iterdir()) == ["new"]  # no staging left
 
 

@@ -9,11 +9,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from armcli.robot.load import load_model
 from armcli.sim.reference import Reference
 from armcli.sim.simulate import Arm, SimConfig, arm_from_model, simulate
 from armcli.tune.model_gains import STABILITY_MARGIN, start_gains
 from armcli.tune.objective import overshoot
-from armcli.urdf.pinocchio import load_model
 from tests.helpers import FIXTURES
 
 URDF = FIXTURES / "tune" / "pendulum.urdf"

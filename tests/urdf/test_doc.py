@@ -6,10 +6,10 @@ import pytest
 
 from armcli.check.rules import CheckOptions
 from armcli.check.run import check_urdf
+from armcli.robot.load import load_model
 from armcli.spec.joint_types import position_bounds, total_dof
 from armcli.spec.model import Limit as SpecLimit
 from armcli.urdf.doc import Limit
-from armcli.urdf.pinocchio import load_model
 from armcli.urdf.read import parse_urdf
 
 

@@ -8,19 +8,28 @@ from pathlib import Path
 import pytest
 
 from armcli.errors import InputError, XacroRefusedError
-from armcli.urdf.packages import PackageLookup
+from armcli.io.packages import PackageLookup
+from armcli.robot.load import checked_model
 from armcli.urdf.source import (
     Trust,
     allowed_roots,
     expand_xacro,
     inside_roots,
-    load_checked_model,
     read_robot,
     read_urdf_file,
+    spec_urdfs,
 )
-from armcli.urdf.xacro_args import XacroInputs
-from armcli.urdf.xacro_jail import sandbox_problem
-from tests.helpers import ARM_PACKAGE, DEMO_ARM, ROOT, ROS_WS_SRC, symlink_install
+from armcli.xacro.args import XacroInputs
+from armcli.xacro.jail import sandbox_problem
+from tests.helpers import (
+    ARM_PACKAGE,
+    DEFAULT_SPEC,
+    DEMO_ARM,
+    ROOT,
+    ROS_WS_SRC,
+    run_main,
+    symlink_install,
+)
 
 COURSE_XACRO = ROOT / "tests" / "fixtures" / "check" / "course_macros.urdf.xacro"
 BAD = ROOT / "tests" / "bad_inputs"
@@ -60,12 +69,12 @@ def test_foreign_xacro_safe_by_suffix_or_content(tmp_path: Path, name: str) -> N
 
 def test_checked_model_refuses_what_pinocchio_would_accept(root: Path) -> None:
     with pytest.raises(InputError, match=r"nan_mass\.urdf:\d+: .*mass@value: non-finite"):
-        load_checked_model(BAD / "urdf" / "nan_mass.urdf")
+        checked_model(read_urdf_file(BAD / "urdf" / "nan_mass.urdf"))
     with pytest.raises(InputError, match="not a number: '0x1p-1'"):
-        load_checked_model(BAD / "urdf" / "hex_number.urdf")
+        checked_model(read_urdf_file(BAD / "urdf" / "hex_number.urdf"))
     with pytest.raises(XacroRefusedError):
-        load_checked_model(BAD / "xacro" / "eval_exploit_renamed.urdf")
-    loaded = load_checked_model(root / "urdf" / "standalone_arm.urdf")
+        checked_model(read_urdf_file(BAD / "xacro" / "eval_exploit_renamed.urdf"))
+    loaded = checked_model(read_urdf_file(root / "urdf" / "standalone_arm.urdf"))
     assert loaded.model.nq == 2
     assert abs(sum(i.mass for i in loaded.model.inertias) - ARM_MASS_KG) < MASS_TOL
 
@@ -161,3 +170,47 @@ def test_trusted_xacro_unknown_package_and_refused_env(tmp_path: Path) -> None:
     env = XacroInputs(env={"LD_PRELOAD": "/tmp/x.so"})
     with pytest.raises(InputError, match="--env: LD_PRELOAD may not be set"):
         expand_xacro(top, trust_xacro="unsandboxed", inputs=env)
+
+
+def test_spec_urdfs_compiles_each_spec_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    from armcli.compiler import expand
+    from armcli.spec.load import load_spec
+
+    calls: list[str] = []
+    real = expand.expand_urdfs
+
+    def counting(spec: object, *args: object) -> dict[str, bytes]:
+        calls.append(spec.name)  # type: ignore[attr-defined]
+        return real(spec, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(expand, "expand_urdfs", counting)
+    spec = load_spec(DEFAULT_SPEC)
+    first = spec_urdfs(spec)
+    first["my_robot.urdf"] = b"changed by a caller"  # a copy: the kept one is untouched
+    again = spec_urdfs(spec)
+    assert calls == ["my_robot"]
+    assert again == real(spec) and again["my_robot.urdf"] != b"changed by a caller"
+    renamed = spec.model_copy(update={"name": "other"})  # another spec: compiled on its own
+    assert set(spec_urdfs(renamed)) == {"other.urdf", "standalone_arm.urdf"}
+    assert calls == ["my_robot", "other"]
+
+
+def test_simulate_runs_xacro_once(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`simulate` needs the standalone arm and the whole robot (its zero-moment point): one
+    expansion of the spec's xacro set gives both (issue 28: it used to run four)."""
+    from armcli.compiler import expand
+
+    expanded: list[str] = []
+    real = expand.expand_safe
+
+    def counting(path: Path, *args: object, **kwargs: object) -> bytes:
+        expanded.append(path.name)
+        return real(path, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(expand, "expand_safe", counting)
+    code, out, _ = run_main(["simulate", DEFAULT_SPEC, "--trajectory",
+                             ROOT / "specs" / "trajectories" / "pick.yaml"], capsys)  # fmt: skip
+    assert code == 0 and "zero-moment point" in out  # the whole robot was used too
+    assert sorted(expanded) == ["my_robot.urdf.xacro", "standalone_arm.urdf.xacro"]

@@ -76,11 +76,16 @@ def test_api_moves_joints_and_reports_the_tool(viewer: Viewer) -> None:
     assert viewer.url.startswith("http://127.0.0.1:")
     # The brief: hand tip at (0.15, 0, 0.92) in base_footprint at q = 0.
     assert viewer.tool_position() == pytest.approx((0.15, 0.0, 0.92), abs=TIP_TOL)
-    viewer.apply_pose("folded")  # both joints at pi/2: forearm along +x, hand pointing down
-    assert viewer.tool_position() == pytest.approx((0.15 + 0.3, 0.0, 0.32 - 0.3), abs=TIP_TOL)
-    viewer.set_configuration({"forearm_hand_joint": 0.0})  # the other joint keeps pi/2
-    assert viewer.configuration()["arm_base_forearm_joint"] == pytest.approx(math.pi / 2)
-    assert viewer.tool_position() == pytest.approx((0.15 + 0.6, 0.0, 0.32), abs=TIP_TOL)
+    viewer.apply_pose("folded")  # a = 1.5 rad from upright, then the hand a further pi/2
+    a, b = 1.5, math.pi / 2
+    # planar two-link chain from the shoulder at (0.15, 0, 0.32), links 0.3 m, angles from +z
+    elbow = (0.15 + 0.3 * math.sin(a), 0.32 + 0.3 * math.cos(a))
+    tip = (elbow[0] + 0.3 * math.sin(a + b), elbow[1] + 0.3 * math.cos(a + b))
+    assert viewer.tool_position() == pytest.approx((tip[0], 0.0, tip[1]), abs=TIP_TOL)
+    viewer.set_configuration({"forearm_hand_joint": 0.0})  # the other joint keeps 1.5
+    assert viewer.configuration()["arm_base_forearm_joint"] == pytest.approx(a)
+    straight = (0.15 + 0.6 * math.sin(a), 0.0, 0.32 + 0.6 * math.cos(a))
+    assert viewer.tool_position() == pytest.approx(straight, abs=TIP_TOL)
     with pytest.raises(InputError, match="unknown movable joint 'elbow'; known: "):
         viewer.set_configuration({"elbow": 0.1})
     with pytest.raises(InputError, match="outside its limits"):
@@ -330,7 +335,7 @@ def test_browser_draws_robot_and_follows_the_api(viewer: Viewer, browser: Any) -
     assert robot_drawn(home), {k: int(v.sum()) for k, v in colour_masks(home).items()}
     row_home = np.nonzero(colour_masks(home)["yellow"])[0].mean()
 
-    viewer.apply_pose("folded")  # the forearm swings from upright to horizontal at z = 0.32 m
+    viewer.apply_pose("folded")  # the forearm swings from upright to near horizontal (1.5 rad)
 
     def dropped(img: np.ndarray) -> bool:
         ys = np.nonzero(colour_masks(img)["yellow"])[0]

@@ -89,7 +89,8 @@ def test_tool_point_matches_closed_form(renders) -> None:  # type: ignore[no-unt
     # The brief: hand tip at (0.15, 0, 0.92) at q = 0.
     assert renders["home"].tool_position == pytest.approx((0.15, 0.0, 0.92), abs=TIP_TOL)
     assert renders["folded"].tool_position == pytest.approx(
-        tip(math.pi / 2, math.pi / 2), abs=TIP_TOL
+        tip(1.5, math.pi / 2),
+        abs=TIP_TOL,  # the spec's folded pose
     )
 
 
@@ -105,7 +106,7 @@ def test_two_poses_give_different_images(renders) -> None:  # type: ignore[no-un
     a, b = pixels(renders["home"].path), pixels(renders["folded"].path)
     changed = (np.abs(a - b).max(axis=-1) > 0.1).sum()
     assert changed > 10 * MIN_PIXELS
-    # Side view: the forearm stands upright at home and lies along x when folded (q1 = pi/2).
+    # Side view: the forearm stands upright at home and lies along x when folded (q1 = 1.5).
     w_home, h_home = _yellow_box(renders["home"].path)
     w_fold, h_fold = _yellow_box(renders["folded"].path)
     assert h_home > 3 * w_home
@@ -249,3 +250,35 @@ def test_render_never_opens_a_mesh_outside_the_roots(tmp_path: Path) -> None:
     res = run_cli(["render", str(urdf), "-o", str(tmp_path / "r.png")], tmp_path)
     assert res.returncode == 0, res.stderr
     assert f"mesh 'file://{outside}/trap.stl' resolves to" in res.stderr
+
+
+def _many_joints(n: int) -> str:
+    parts = ['<robot name="many"><link name="l0"/>']
+    for i in range(1, n + 1):
+        parts.append(
+            f'<joint name="a_rather_long_joint_name_{i}" type="revolute"><parent link="l{i - 1}"/>'
+            f'<child link="l{i}"/><origin xyz="0 0 0.05"/><axis xyz="0 1 0"/>'
+            '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+            f'<link name="l{i}"><visual><geometry><box size="0.02 0.02 0.05"/></geometry>'
+            "</visual></link>"
+        )
+    return "".join(parts) + "</robot>"
+
+
+@pytest.mark.parametrize("joints", [2, 29, 45])  # the course arm, G1, PR2
+def test_the_title_never_overprints_the_views(joints: int) -> None:
+    """PR2 and G1: a title wrapped over many lines ran into the views' own titles."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from armcli.view.png import render_figure
+
+    urdf = load_urdf(_many_joints(joints), "many.urdf")
+    fig = render_figure(urdf, {j: 0.0 for j in urdf.actuated_joint_names}, name="many")
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    title = fig._suptitle.get_window_extent(renderer)
+    assert title.y1 <= fig.bbox.y1  # inside the picture
+    for ax in fig.axes:  # below the title: the views' titles and their axes
+        assert ax.title.get_window_extent(renderer).y1 < title.y0
+        assert ax.get_window_extent(renderer).y1 < title.y0
+    if joints > 29:  # too many to list: the title says how many it left out
+        assert "more joint(s)" in fig._suptitle.get_text()

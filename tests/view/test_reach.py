@@ -16,8 +16,8 @@ import pytest
 
 from armcli.cli import main
 from armcli.compiler.expand import expand_urdfs
+from armcli.robot.tool import spec_tool
 from armcli.spec.load import load_spec
-from armcli.urdf.tool import spec_tool
 from armcli.view.png import load_urdf
 from armcli.view.reach import REACH_SAMPLES, render_reach_png
 from tests.helpers import DEFAULT_SPEC

@@ -18,9 +18,7 @@ gradient) runs from the best three within the joint limits.
 
 from __future__ import annotations
 
-import itertools
 import math
-import random
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -28,13 +26,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from armcli.urdf.boxsearch import minimize_box
-from armcli.urdf.stance import Stance
+from armcli.analysis.boxsearch import minimize_box
+from armcli.analysis.stance import Stance
+from armcli.robot import sampling
+from armcli.robot.load import link_frame
+from armcli.robot.sampling import BALANCE_DRAWS
 
 SEEDS_DESCENDED = 3  # local searches per edge and measure, from the best seeds
-RANDOM_SEEDS = 32
-SEARCH_SEED = 0
-MAX_CORNERS = 64
 PAYLOAD_ROUNDS = 8  # fixed-point rounds for the largest payload over the range
 PAYLOAD_TOL = 1e-6  # [m] slack below which a payload still counts as holding
 MAX_PAYLOAD = 1e4  # [kg] beyond this the payload "holds" anything: reported as inf
@@ -76,6 +74,7 @@ class StaticBalance:
     worst: tuple[PoseBalance, ...]  # per edge: the configuration closest to tipping over it
     worst_tip_angles: tuple[float, ...]  # [rad] per edge: smallest tipping angle over the range
     payload_max: float | None  # [kg] the most that holds at every named pose and over the range
+    contact_tol: float | None = None  # [m] how the contacts were found; None: user-named
 
     @property
     def worst_overall(self) -> PoseBalance:
@@ -87,27 +86,18 @@ class _Mass:
     """Centre of mass and its Jacobian over the searched joints, with a payload of mass m."""
 
     def __init__(self, stance: Stance) -> None:
-        import pinocchio as pin
 
         self.s = stance
         self.model = stance.model
-        self.data = self.model.createData()
+        self.data = stance.robot.data
         self.M = stance.mass
-        self.q0 = np.asarray(pin.neutral(self.model), dtype=float)
-        self.iq = [(jr.idx_q, jr.continuous) for jr in stance.joints]
         self.iv = [jr.idx_v for jr in stance.joints]
         p = stance.payload
-        self.frame = self.model.getFrameId(p.link) if p is not None else None
+        self.frame = link_frame(self.model, p.link) if p is not None else None
         self.xyz = np.asarray(p.xyz if p is not None else (0.0, 0.0, 0.0), dtype=float)
 
     def q(self, x: ArrayLike) -> NDArray[np.float64]:
-        q = self.q0.copy()
-        for (i, cont), v in zip(self.iq, np.asarray(x, dtype=float), strict=True):
-            if cont:
-                q[i], q[i + 1] = math.cos(v), math.sin(v)
-            else:
-                q[i] = v
-        return q
+        return self.s.q(x)
 
     def parts(self, x: ArrayLike) -> tuple[NDArray[Any], NDArray[Any]]:
         """(unloaded centre of mass, payload point) [m] at joint values x."""
@@ -176,6 +166,7 @@ def analyse(
         worst=worst,
         worst_tip_angles=tips,
         payload_max=min(known) if len(known) == len(best) else None,
+        contact_tol=None if stance.ground.declared else stance.ground.tol,
     )
 
 
@@ -186,7 +177,8 @@ def _point_label(stance: Stance) -> str:
 
 def _values(stance: Stance, values: dict[str, float]) -> list[float]:
     """The searched joints' values of a pose (0 clamped into range where it gives none)."""
-    return [float(np.clip(values.get(jr.name, 0.0), jr.lower, jr.upper)) for jr in stance.joints]
+    return [float(np.clip(values.get(j.name, 0.0), lo, hi))
+            for j, (lo, hi) in zip(stance.joints, stance.box, strict=True)]  # fmt: skip
 
 
 def _at(
@@ -225,13 +217,7 @@ def _payload_max(ev: _Mass, c0: NDArray[Any], p: NDArray[Any], threshold: float)
 
 
 def _seeds(stance: Stance, named: list[list[float]]) -> list[list[float]]:
-    joints = stance.joints
-    rows = [[float(np.clip(0.0, jr.lower, jr.upper)) for jr in joints], *named]
-    if 2 ** len(joints) <= MAX_CORNERS:
-        rows += [list(c) for c in itertools.product(*[(jr.lower, jr.upper) for jr in joints])]
-    rng = random.Random(SEARCH_SEED)  # stdlib: numpy.random costs 20 ms of start-up
-    rows += [[rng.uniform(jr.lower, jr.upper) for jr in joints] for _ in range(RANDOM_SEEDS)]
-    return rows
+    return sampling.search_starts(stance.box, BALANCE_DRAWS, named=named)
 
 
 def _search(
@@ -272,8 +258,8 @@ def _descend(
     """Projected gradient descent within the joint limits from the best seeds; the best point."""
     if not stance.joints:
         return []
-    lower = [jr.lower for jr in stance.joints]
-    upper = [jr.upper for jr in stance.joints]
+    lower = [lo for lo, _ in stance.box]
+    upper = [hi for _, hi in stance.box]
     best_x, best_f = seeds[int(np.argmin(values))], float(np.min(values))
     for k in np.argsort(values)[:SEEDS_DESCENDED]:
         res = minimize_box(fun, seeds[k], lower, upper)

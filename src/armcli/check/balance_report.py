@@ -10,9 +10,9 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
+from armcli.analysis.workspace import ReachPoint, Workspace, describe, verdict
 from armcli.check.balance import StaticBalance
 from armcli.io.terminal import Column, FitTable
-from armcli.urdf.workspace import ReachPoint, Workspace, describe, verdict
 
 if TYPE_CHECKING:
     from armcli.sim.tipping import ZmpReport
@@ -53,7 +53,12 @@ def _cell(margin: float, angle: float) -> str:
 
 def _title(b: StaticBalance) -> str:
     load = f", {b.payload}" if b.payload else ""
-    return f"static balance on {', '.join(b.contacts)}{load}"
+    taken = (
+        " (the links you named)"
+        if b.contact_tol is None
+        else f" (the links within {b.contact_tol * 1e3:.1f} mm of the lowest point at q = 0)"
+    )
+    return f"static balance on {', '.join(b.contacts)}{taken}{load}"
 
 
 def _caption(b: StaticBalance) -> str:

@@ -1,7 +1,7 @@
 """Rules on the rigid bodies the joints move, lumped as simulators lump them.
 
-A body is a movable joint's child link plus everything fixed to it (Pinocchio,
-MuJoCo's fusestatic, Gazebo's fixed-joint reduction).
+A body is a movable joint's child link plus everything fixed to it (`robot.bodies`, as
+Pinocchio, MuJoCo's fusestatic and Gazebo's fixed-joint reduction lump them).
 
 A zero-mass frame link fixed to a heavy link is fine; what breaks the mass
 matrix is a moving *body* with no mass or a singular inertia (a lone point
@@ -13,90 +13,19 @@ an oracle.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
-
-import numpy as np
 
 from armcli.check.inertia import MIN_MOMENT
 from armcli.check.rules import Collector
 from armcli.check.structure import Tree, finite
-from armcli.urdf import inertia as inr
-from armcli.urdf.doc import Joint, Link, Urdf
+from armcli.robot import inertia as inr
+from armcli.robot.bodies import Body, lump
+from armcli.urdf.doc import Link, Urdf
 
 # A moving body lighter than this fraction of the robot makes the dynamics stiff.
 TINY_MASS_RATIO = 1e-4
 # A link-level finding of these rules already names the problem of the body it belongs to
 # (negative mass is not reported again as "the body has no mass").
 LINK_ERRORS = ("mass-nonpositive", "inertia-not-pd", "inertia-triangle")
-
-
-@dataclass(frozen=True)
-class Body:
-    """A lumped rigid body in the frame of the link its joint moves."""
-
-    joint: str
-    link: str
-    links: tuple[str, ...]
-    mass: float  # [kg]
-    com: np.ndarray  # [m], in the joint child link's frame
-    inertia: np.ndarray  # [kg·m²] about com, in the same frame
-    unknown: bool = False  # some part has unusable numbers (already reported)
-
-
-def _transform(j: Joint) -> tuple[np.ndarray, np.ndarray]:
-    return inr.rpy_matrix(j.origin.rpy), np.asarray(j.origin.xyz, dtype=float)
-
-
-def lump(urdf: Urdf, tree: Tree, joint: Joint) -> Body:
-    """Lump `joint`'s child link with every link fixed to it (directly or in a chain)."""
-    links: dict[str, Link] = {}
-    for lk in urdf.links:
-        links.setdefault(lk.name, lk)  # a duplicate name is reported; the first one counts
-    child = str(joint.child)
-    parts: list[tuple[Link, np.ndarray, np.ndarray]] = [(links[child], np.eye(3), np.zeros(3))]
-    frontier = [parts[0]]
-    while frontier:
-        link, R, p = frontier.pop()
-        for j in tree.parent_joint.values():
-            if j.parent == link.name and j.type == "fixed" and j.child in links:
-                Rj, pj = _transform(j)
-                item = (links[str(j.child)], R @ Rj, p + R @ pj)
-                parts.append(item)
-                frontier.append(item)
-    masses, coms, tensors = [], [], []
-    unknown = False
-    for link, R, p in parts:
-        ine = link.inertial
-        if ine is None:
-            continue
-        if not _finite_inertial(link) or not np.all(np.isfinite(p)) or not np.all(np.isfinite(R)):
-            unknown = True  # reported by the number rules; the body cannot be judged
-            continue
-        assert ine.inertia is not None  # _finite_inertial
-        Ri = R @ inr.rpy_matrix(ine.origin.rpy)
-        masses.append(max(float(ine.mass or 0.0), 0.0))
-        coms.append(p + R @ np.asarray(ine.origin.xyz, dtype=float))
-        tensors.append(inr.rotate(inr.tensor(*ine.inertia), Ri))
-    total = float(sum(masses))
-    com = (
-        sum((m * c for m, c in zip(masses, coms, strict=True)), np.zeros(3)) / total
-        if total > 0
-        else np.zeros(3)
-    )
-    J = np.zeros((3, 3))
-    for m, c, Jc in zip(masses, coms, tensors, strict=True):
-        J += inr.parallel_axis(Jc, m, c - com)
-    return Body(joint.name, child, tuple(lk.name for lk, _, _ in parts), total, com, J, unknown)
-
-
-def _finite_inertial(link: Link) -> bool:
-    ine = link.inertial
-    return (
-        ine is not None
-        and finite(ine.mass)
-        and ine.inertia is not None
-        and finite(*ine.inertia, *ine.origin.xyz, *ine.origin.rpy)
-    )
 
 
 def _massless_consequences(urdf: Urdf, links: Sequence[str]) -> str:
@@ -119,12 +48,14 @@ def _massless_consequences(urdf: Urdf, links: Sequence[str]) -> str:
 
 
 def moving_bodies(urdf: Urdf, tree: Tree) -> list[Body]:
-    """One lumped body per movable joint whose child link exists, in document order."""
-    names = {lk.name for lk in urdf.links}
+    """One lumped body (`robot.bodies`) per movable joint whose child link exists, in order."""
+    links: dict[str, Link] = {}
+    for lk in urdf.links:
+        links.setdefault(lk.name, lk)  # a duplicate name is reported; the first one counts
     return [
-        lump(urdf, tree, j)
+        lump(links, j, tree.parent_joint.values())
         for j in urdf.joints
-        if j.type != "fixed" and j.child in names and tree.parent_joint.get(str(j.child)) is j
+        if j.type != "fixed" and j.child in links and tree.parent_joint.get(str(j.child)) is j
     ]
 
 

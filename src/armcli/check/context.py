@@ -3,9 +3,11 @@
 `run.py` builds one `Context` per URDF and hands it to each family of its registry. A
 family declares the stage it needs: `URDF` (the parsed document and its tree), `MODEL`
 (the Pinocchio model, loaded once and only while no error of a rule that `blocks` the
-model stands) or `DYNAMICS` (also no error of a rule that blocks the dynamics, such as a
-negative mass). Families write findings to `out`, notes to `notes`, and what later ones
-or the summary read (the gravity load in `rows`, the servo joints, the PD verdict) here.
+model stands), `BALANCE` (also valid masses, centres of mass and joint ranges: no negative
+mass, zero axis or limits out of order) or `DYNAMICS` (also no error of a rule that blocks
+the dynamics, such as an inertia tensor that is not positive definite). Families write
+findings to `out`, notes to `notes`, and what later ones or the summary read (the gravity
+load in `rows`, the servo joints, the PD verdict) here.
 """
 
 from __future__ import annotations
@@ -15,28 +17,29 @@ from typing import TYPE_CHECKING, Any, Literal
 
 from armcli.check.rules import RULES, CheckOptions, Collector, JointRow
 from armcli.check.structure import Tree
+from armcli.robot.model import Robot
 from armcli.sim.verdict import StabilityReport
 from armcli.spec.joint_types import position_bounds
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mimic import follow, mimics
-from armcli.urdf.pinocchio import JointRange
 
 if TYPE_CHECKING:  # the balance and reach results: imported by their own families
+    from armcli.analysis.stance import Stance
+    from armcli.analysis.workspace import ReachPoint, Workspace
     from armcli.check.balance import StaticBalance
     from armcli.sim.tipping import ZmpReport
-    from armcli.urdf.stance import Stance
-    from armcli.urdf.workspace import ReachPoint, Workspace
 
-Stage = Literal["urdf", "model", "dynamics"]
+Stage = Literal["urdf", "model", "balance", "dynamics"]
 URDF: Stage = "urdf"
 MODEL: Stage = "model"
+BALANCE: Stage = "balance"
 DYNAMICS: Stage = "dynamics"
 
 # Errors after which the model is not loaded (urdfdom would only repeat them: a NaN mass
 # came back as two parser errors, a nameless <robot> as model-load), and after which the
 # dynamics rules would compute with unusable numbers. Declared per rule in rules.py.
 BLOCKS_MODEL = frozenset(r.id for r in RULES.values() if r.blocks == MODEL)
-BLOCKS_DYNAMICS = BLOCKS_MODEL | {r.id for r in RULES.values() if r.blocks == DYNAMICS}
+BLOCKS_BALANCE = BLOCKS_MODEL | {r.id for r in RULES.values() if r.blocks == BALANCE}
+BLOCKS_DYNAMICS = BLOCKS_BALANCE | {r.id for r in RULES.values() if r.blocks == DYNAMICS}
 MODEL_SKIPPED = "model checks skipped: fix the structure errors first"
 DYNAMICS_SKIPPED = "dynamics checks skipped: fix the number and inertia errors first"
 
@@ -51,9 +54,7 @@ class Context:
     tree: Tree
     notes: list[str] = field(default_factory=list)
     rows: tuple[JointRow, ...] = ()  # the joint table; the gravity rule fills its load
-    model: Any = None  # pinocchio.Model, once loaded
-    data: Any = None  # its pinocchio.Data
-    ranges: list[JointRange] = field(default_factory=list)  # its 1-DoF joints
+    robot: Robot | None = None  # the Pinocchio model and its joint table, once loaded
     samples: list[tuple[dict[str, float], Any]] = field(default_factory=list)  # dynamics
     servo: set[str] = field(default_factory=set)  # joints a position servo drives
     stability: StabilityReport | None = None
@@ -63,6 +64,12 @@ class Context:
     reach: Workspace | None = None  # check/reach.py: the tool point's envelope
     reach_points: tuple[ReachPoint, ...] = ()  # --reach-point verdicts
     stage: Stage | Literal["unloaded", "refused", "no-dynamics"] = "unloaded"
+
+    def loaded(self) -> Robot:
+        """The robot, for the families of the MODEL stage and later (run.py loads it first)."""
+        if self.robot is None:
+            raise RuntimeError("the model is not loaded: this family needs the MODEL stage")
+        return self.robot
 
 
 def joint_rows(urdf: Urdf) -> tuple[JointRow, ...]:
@@ -90,18 +97,20 @@ def joint_rows(urdf: Urdf) -> tuple[JointRow, ...]:
 
 def poses(ctx: Context) -> list[tuple[str, dict[str, float]]]:
     """Named poses of the spec (or q = 0), then every joint at its lower and upper limit."""
+    robot = ctx.robot
+    joints = robot.joints if robot is not None else ()
     out: list[tuple[str, dict[str, float]]] = []
     spec = ctx.opts.spec
     if spec is not None and spec.poses:
-        names = {jr.name for jr in ctx.ranges}
+        names = set(robot.names) if robot is not None else set()
         for name in spec.poses:
             out.append((name, {k: v for k, v in spec.pose(name).items() if k in names}))
     else:
-        out.append(("zero", {jr.name: 0.0 for jr in ctx.ranges}))
-    coupled = mimics(ctx.urdf.joints)  # a mimic joint follows its leader in every pose
-    followers = {m.follower for m in coupled}
-    limited = [jr for jr in ctx.ranges if not jr.continuous and jr.name not in followers]
+        out.append(("zero", {j.name: 0.0 for j in joints}))
+    if robot is None:
+        return out
+    limited = [j for j in robot.leaders if not j.continuous]
     if limited:
-        out.append(("lower", {jr.name: jr.lower for jr in limited}))
-        out.append(("upper", {jr.name: jr.upper for jr in limited}))
-    return [(name, follow(coupled, values)) for name, values in out]
+        out.append(("lower", {j.name: j.span[0] for j in limited}))
+        out.append(("upper", {j.name: j.span[1] for j in limited}))
+    return [(name, robot.follow(values)) for name, values in out]  # followers follow

@@ -8,8 +8,6 @@ self-collision at the spec's named poses (Pinocchio GeometryModel + coal).
 from __future__ import annotations
 
 import itertools
-import random
-from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any
 
@@ -17,21 +15,14 @@ import numpy as np
 
 from armcli.check.rules import CheckOptions, Collector, JointRow, Value
 from armcli.check.structure import finite
-from armcli.errors import InputError
+from armcli.errors import ModelLoadError
+from armcli.robot.model import Robot
 from armcli.sim import stability as stab
 from armcli.sim import verdict as verdicts
 from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
 from armcli.urdf.meshes import mesh_paths
-from armcli.urdf.mimic import Mimic, follow
-from armcli.urdf.pinocchio import collision_model, configuration
 
-GRID_POINTS = 5  # per joint, when the grid has at most MAX_GRID samples
-MAX_GRID = 125
-MAX_CORNERS = 64  # every corner of the range box when there are at most this many
-RANDOM_SAMPLES = 100
-SAMPLE_SEED = 0
 # Shapes must overlap by more than this to count as colliding: links that merely
 # touch by construction (e.g. a link resting on the base top) are not a collision.
 PENETRATION_TOL = 1e-4  # [m]
@@ -49,38 +40,9 @@ def round_up(x: float, digits: int = REMEDY_DIGITS) -> float:
     return float(f"{np.ceil(x / step - 1e-9) * step:.{digits}g}")
 
 
-def samples(
-    model: Any, ranges: list[Any], coupled: Sequence[Mimic] = ()
-) -> list[tuple[dict[str, float], Any]]:
-    """Joint-space sample as (joint values by name, Pinocchio configuration) pairs.
-
-    A full grid for few joints; else the zero pose clamped into range, every corner of the
-    range box (where gravity torques peak for serial arms) when there are few, and seeded
-    draws, so the same URDF always gives the same sample. Mimic joints (`coupled`) are not
-    sampled: they follow their leaders.
-    """
-    followers = {m.follower for m in coupled}
-    ranges = [jr for jr in ranges if jr.name not in followers]
-    n = len(ranges)
-    names = [jr.name for jr in ranges]
-    if n and GRID_POINTS**n <= MAX_GRID:
-        axes = [np.linspace(jr.lower, jr.upper, GRID_POINTS) for jr in ranges]
-        points = [dict(zip(names, map(float, p), strict=True)) for p in itertools.product(*axes)]
-    else:
-        rng = random.Random(SAMPLE_SEED)  # stdlib: numpy.random costs 20 ms of start-up
-        rows = [[min(max(0.0, jr.lower), jr.upper) for jr in ranges]]
-        if 2**n <= MAX_CORNERS:
-            rows += [list(c) for c in itertools.product(*[(jr.lower, jr.upper) for jr in ranges])]
-        rows += [[rng.uniform(jr.lower, jr.upper) for jr in ranges] for _ in range(RANDOM_SAMPLES)]
-        points = [dict(zip(names, r, strict=True)) for r in rows]
-    points = [follow(coupled, p) for p in points]
-    return [(p, configuration(model, p)) for p in points]
-
-
 def gravity(
     urdf: Urdf,
-    model: Any,
-    data: Any,
+    robot: Robot,
     samples: list[Any],
     rows: tuple[JointRow, ...],
     out: Collector,
@@ -92,14 +54,11 @@ def gravity(
     """
     import pinocchio as pin
 
+    model, data = robot.model, robot.data
     worst = np.zeros(model.nv)
     for _, q in samples:
         worst = np.maximum(worst, np.abs(pin.computeGeneralizedGravity(model, data, q)))
-    by_name = {
-        str(model.names[j]): model.joints[j].idx_v
-        for j in range(1, model.njoints)
-        if model.joints[j].nv == 1
-    }
+    by_name = {j.name: j.idx_v for j in robot.joints}
     lines = {j.name: (j.limit.line if j.limit else j.line) for j in urdf.joints}
     new_rows = []
     for r in rows:
@@ -124,10 +83,8 @@ def gravity(
 def stability(
     urdf: Urdf,
     opts: CheckOptions,
-    model: Any,
-    data: Any,
+    robot: Robot,
     samples: list[Any],
-    ranges: list[Any],
     out: Collector,
     notes: list[str],
 ) -> StabilityReport | None:
@@ -140,14 +97,14 @@ def stability(
     spec = opts.spec
     if spec is None or not spec.control.gains:
         return None
-    v_of = {jr.name: jr.idx_v for jr in ranges}
+    v_of = {j.name: j.idx_v for j in robot.joints}
     joints = {j.name: j for j in urdf.joints}
     names = [n for n in spec.control.gains if n in v_of and n in joints]
     if not names:
         notes.append("stability skipped: no controlled joint found in this URDF")
         return None
     gravity = not spec.control.gravity_compensation
-    lin = stab.linearise(model, [q for _, q in samples], gravity=gravity, data=data)
+    lin = stab.linearise(robot.model, [q for _, q in samples], gravity=gravity, data=robot.data)
     gains = [spec.control.gains[n] for n in names]
     pd = stab.PD.of(
         [v_of[n] for n in names],
@@ -189,7 +146,7 @@ def _report_stability(
 def self_collision(
     urdf: Urdf,
     opts: CheckOptions,
-    model: Any,
+    robot: Robot,
     poses: list[tuple[str, dict[str, float]]],
     out: Collector,
     notes: list[str],
@@ -201,17 +158,16 @@ def self_collision(
     """
     import pinocchio as pin
 
-    meshes = mesh_paths(urdf, opts.mesh_search())
-    if any(p is None or not p.is_file() for p in meshes.values()):
+    search = opts.mesh_search()
+    if any(p is None or not p.is_file() for p in mesh_paths(urdf, search).values()):
         notes.append("self-collision skipped: some meshes cannot be found")
         return
-    real = {uri: bounded_mesh_file(p, urdf.source) for uri, p in meshes.items() if p is not None}
-    check_total(real.values(), urdf.source)
     try:  # Pinocchio gets absolute confined paths and no search directories
-        gmodel = collision_model(model, with_real_mesh_paths(urdf.text, real), [])
-    except InputError as exc:
+        gmodel = robot.collision_model(search)
+    except ModelLoadError as exc:
         notes.append(f"self-collision skipped: {exc.message}")
         return
+    model, data = robot.model, robot.data
     link_of = [str(model.frames[g.parentFrame].name) for g in gmodel.geometryObjects]
     adjacent = {frozenset((j.parent, j.child)) for j in urdf.joints}
     pairs = []
@@ -225,10 +181,9 @@ def self_collision(
         # touching counts as colliding.
         meshy = _is_mesh(gmodel, pair.first) or _is_mesh(gmodel, pair.second)
         req.security_margin = 0.0 if meshy else -PENETRATION_TOL
-    data = model.createData()
     named = [p for p in poses if p[0] in (opts.spec.poses if opts.spec else {})]
     for name, values in named:
-        pin.computeCollisions(model, data, gmodel, gdata, configuration(model, values), False)
+        pin.computeCollisions(model, data, gmodel, gdata, robot.q(values), False)
         for k, (a, b) in enumerate(pairs):
             if gdata.collisionResults[k].isCollision():
                 out.add(

@@ -9,9 +9,9 @@ first makes the two commands agree on what a usable model is.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 
-from armcli.check.rules import ERROR, CheckOptions
+from armcli.check.rules import ERROR, RULES, CheckOptions
 from armcli.check.run import check_urdf
 from armcli.errors import ModelRefusedError, RuleViolation
 from armcli.urdf.doc import Urdf
@@ -25,8 +25,23 @@ NOT_SIMULATED = frozenset(
 )  # fmt: skip
 
 
+def bears_on_balance(rule: str) -> bool:
+    """Whether an error of `rule` on the whole robot changes an arm-only run's tip verdict.
+
+    An arm simulated on a fixed base reads the rest of the robot only for its balance:
+    masses, centres of mass and the tree (rules that block the balance stage) and the
+    support polygon; a base link's inertia tensor or a wheel's limits do not enter it.
+    """
+    blocks = getattr(RULES.get(rule), "blocks", None)
+    return blocks in ("model", "balance") or rule in ("com-outside-support", "zmp-outside-support")
+
+
 def refuse_check_errors(
-    urdf: Urdf, options: CheckOptions | None = None, *, ignore: Iterable[str] = ()
+    urdf: Urdf,
+    options: CheckOptions | None = None,
+    *,
+    ignore: Iterable[str] = (),
+    only: Callable[[str], bool] | None = None,
 ) -> None:
     """Raise ModelRefusedError when a check rule that bears on the dynamics reports an error.
 
@@ -39,7 +54,7 @@ def refuse_check_errors(
     errors = [
         RuleViolation(f.rule, f.file, f.line, f.message)
         for f in result.findings
-        if f.severity == ERROR and f.rule not in skip
+        if f.severity == ERROR and f.rule not in skip and (only is None or only(f.rule))
     ]
     if errors:
         raise ModelRefusedError(urdf.source, errors)

@@ -11,8 +11,8 @@ import numpy as np
 
 from armcli.check.rules import Collector
 from armcli.check.structure import Tree, finite
-from armcli.urdf import inertia as inr
-from armcli.urdf import inertia_bounds as bounds
+from armcli.robot import inertia as inr
+from armcli.robot import inertia_bounds as bounds
 from armcli.urdf.doc import Inertial, Link, Shape, Urdf
 
 # Inertia within 5 % (Frobenius, relative) of the solid-body formula counts as
@@ -238,6 +238,8 @@ def _versus_geometry(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -
 def _exceeds(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -> bool:
     """`inertia-exceeds-geometry` for a link made of one primitive; True if it fired.
 
+    `inertia-exceeds-visual` (a warning) when the primitive is a visual without collision.
+
     Every visual and collision element must be that primitive (primitive_shape): a box
     collision next to a mesh visual is a simplification of a body that may reach beyond it
     (example-robot-data's a1 and go1 legs: 165 false errors with the collision alone).
@@ -261,8 +263,10 @@ def _exceeds(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -> bool:
         f"{a}: {ex.centre[i]:.4g} > {ex.bound[i]:.4g}" for a, i in zip(ex.axes, k, strict=True)
     )
     solid = np.asarray(ex.solid)
+    # A shape the simulator collides with is the body; a visual-only one may be a picture
+    # (Go1's rotor discs, whose collisions the file comments out): weaker evidence.
     out.add(
-        "inertia-exceeds-geometry",
+        "inertia-exceeds-geometry" if link.collisions else "inertia-exceeds-visual",
         ine.inertia_line,
         f"link {link.name!r}: moments about its {g.kind} {dims} m centre ({moments}) exceed "
         f"the most {m:g} kg inside that {_role(link)} shape can have (all mass on its extremes); "

@@ -14,13 +14,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from armcli.check.rules import ERROR, RULES, CheckOptions, Finding
-from armcli.check.run import CheckResult, check_urdf
+from armcli.check.run import CheckResult, check_document, check_urdf
 from armcli.check.spec_locate import key_lines, locate
 from armcli.errors import EXIT_FAILED, EXIT_OK, EXIT_UNUSABLE, InputError
 from armcli.io.yaml import load_yaml, read_text
 from armcli.urdf.doc import Urdf
+from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import Trust, read_robot, read_urdf_file
-from armcli.urdf.xacro_args import XacroInputs
+from armcli.xacro.args import XacroInputs
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -115,3 +116,21 @@ def run_check(
             results.append(result)
             notes += [(urdf.source, line) for line in urdf.notes]
     return CheckRun(tuple(results), tuple(unusable), tuple(notes))
+
+
+def spec_document_errors(path: Path, urdfs: dict[str, bytes], spec: RobotSpec) -> list[Finding]:
+    """The errors `check` reports from a spec's built URDFs (`name` -> bytes), model-free.
+
+    Each once, pointing at the spec: what `build` prints.
+    """
+    doc, keys = load_yaml(path), key_lines(read_text(path))
+    out: list[Finding] = []
+    seen: set[tuple[str, str]] = set()
+    for name in sorted(urdfs):
+        urdf = parse_urdf(urdfs[name], f"{path}#{name}")
+        found = check_document(urdf, CheckOptions(spec=spec))
+        for f in locate([f for f in found if f.severity == ERROR], urdf.text, doc, keys):
+            if (f.rule, f.message) not in seen:
+                seen.add((f.rule, f.message))
+                out.append(f)
+    return out

@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from lxml import etree
+
 from armcli.check.rules import Collector
 from armcli.check.structure import finite
 from armcli.spec.joint_types import LIMITED_TYPES, ONE_DOF_TYPES
@@ -24,13 +26,22 @@ DEGREES_STEP = 5.0
 SPEC_LIMIT_TOL = 1e-9
 
 
-def check(urdf: Urdf, spec: RobotSpec | None, out: Collector) -> None:
+def check(
+    urdf: Urdf, spec: RobotSpec | None, out: Collector, notes: list[str] | None = None
+) -> None:
     """Joint rules: axis and limits of each moving joint, then the arm limits against the spec."""
+    driven = driven_joints(urdf.text)
+    passive: list[str] = []
     for j in urdf.joints:
         if j.type in ONE_DOF_TYPES:
             _axis(j, out)
         if j.limit is not None and j.type in LIMITED_TYPES:
-            _limits(j, out)
+            _limits(j, out, passive if driven is not None and j.name not in driven else None)
+    if passive and notes is not None:
+        notes.append(
+            f"passive joint(s) {', '.join(passive)}: effort or velocity limit 0, and no "
+            "<transmission> or <ros2_control> drives them (springs, free wheels): not checked"
+        )
     if spec is not None:
         _spec_limits(urdf, spec, out)
 
@@ -51,7 +62,27 @@ def _axis(j: Joint, out: Collector) -> None:
         )
 
 
-def _limits(j: Joint, out: Collector) -> None:
+def driven_joints(text: bytes) -> set[str] | None:
+    """The joints a `<transmission>` or `<ros2_control>` block drives; None when there is none.
+
+    With none, nothing tells a passive joint from an actuated one, so every joint is held
+    to actuator limits. With some, a joint they leave out is passive (LoCoBot's spring
+    wheel-drop joints: effort and velocity 0 mean "no motor", not a typo).
+    """
+    try:
+        root = etree.fromstring(text, etree.XMLParser(resolve_entities=False, no_network=True))
+    except etree.XMLSyntaxError:
+        return None
+    names = {
+        str(el.get("name", ""))
+        for path in ("transmission/joint", "ros2_control/joint")
+        for el in root.iterfind(path)
+    }
+    return names or None
+
+
+def _limits(j: Joint, out: Collector, passive: list[str] | None = None) -> None:
+    """Order, degrees and actuator limits; `passive` collects a passive joint's zero limits."""
     lim = j.limit
     assert lim is not None
     lo, hi = lim.lower, lim.upper
@@ -78,7 +109,10 @@ def _limits(j: Joint, out: Collector) -> None:
             )
     for attr in ("effort", "velocity"):
         v = getattr(lim, attr)
-        if v is not None and finite(v) and v <= 0:
+        if passive is not None and v == 0:
+            if j.name not in passive:
+                passive.append(j.name)
+        elif v is not None and finite(v) and v <= 0:
             out.add(
                 "limit-effort-velocity",
                 lim.line,

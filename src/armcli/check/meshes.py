@@ -9,7 +9,7 @@ from pathlib import Path
 
 from armcli.check.rules import CheckOptions, Collector
 from armcli.urdf.doc import Urdf
-from armcli.urdf.meshes import confined, resolve
+from armcli.urdf.meshes import confined, mesh_hint, resolve
 
 
 def check(urdf: Urdf, opts: CheckOptions, out: Collector) -> None:
@@ -42,7 +42,11 @@ def check(urdf: Urdf, opts: CheckOptions, out: Collector) -> None:
                 continue
             if path is None or not path.is_file():
                 reported.add(g.filename)
-                why = "unknown package" if path is None else f"no file {path}"
+                why = (
+                    f"unknown package; {mesh_hint(g.filename)}"
+                    if path is None
+                    else f"no file {path}"
+                )
                 out.add(
                     "mesh-missing",
                     g.line,

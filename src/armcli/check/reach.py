@@ -8,21 +8,22 @@ REACH_TOL is an error naming how close it gets and where.
 
 from __future__ import annotations
 
+from armcli.analysis.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 from armcli.check.context import Context
-from armcli.urdf.tool import tool_point
-from armcli.urdf.workspace import REACH_TOL, Chain, envelope, reach_point, sample
+from armcli.robot.load import link_frame
+from armcli.robot.tool import tool_point
 
 
 def check(c: Context) -> None:
     """The workspace of the tool point, and the findings for unreachable points."""
     tool = tool_point(c.urdf, c.opts.spec)
-    if tool is None or not c.model.existFrame(tool.link):
+    if tool is None or link_frame(c.loaded().model, tool.link) is None:
         return
     if c.stance is not None and tool.link in c.stance.ground.links:
         c.notes.append(f"workspace skipped: the tool point {tool.label} touches the ground "
                        "(a base without an arm)")  # fmt: skip
         return
-    chain = Chain(c.model, tool)
+    chain = Chain(c.loaded(), tool)
     if not chain.joints:
         c.notes.append("workspace skipped: no moving joint between the root and the tool point")
         return

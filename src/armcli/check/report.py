@@ -10,7 +10,7 @@ from dataclasses import asdict
 from typing import Any
 
 from armcli.check.balance_report import balance_items, reach_items
-from armcli.check.rules import ERROR, WARNING, Finding
+from armcli.check.rules import ERROR, WARNING, Finding, shown_path
 from armcli.check.run import CheckResult
 from armcli.errors import split_source
 from armcli.io.jsondoc import dumps
@@ -82,6 +82,12 @@ def to_github(findings: Sequence[Finding]) -> str:
     lines = []
     for f in findings:
         path, inner = split_source(f.file)
+        if f.origin is not None:  # a xacro element: the file and line the user wrote
+            props = [f"file={_esc_prop(shown_path(f.origin.file))}", f"line={f.origin.line}"]
+            props.append(f"title={_esc_prop(f'armcli {f.rule}')}")
+            msg = f"{f.message}{f.calls_text}" + (f" (fix: {f.hint})" if f.hint else "")
+            lines.append(f"::{f.severity} {','.join(props)}::{_esc_data(msg)}")
+            continue
         props = [f"file={_esc_prop(path)}"]
         if f.spec is not None and f.spec.line:  # the spec's own line
             props.append(f"line={f.spec.line}")
@@ -154,9 +160,12 @@ def _findings_grid(findings: Sequence[Finding]) -> Any:
             generated = f.file.partition("#")[2]
             body.append(f"  {f.spec}")
             body.append(f" ({generated}:{f.line})" if f.line else "", style="dim")
+        elif f.origin is not None:  # a xacro element: where the user wrote it
+            body.append(f"  {shown_path(f.origin.file)}:{f.origin.line}")
+            body.append(f" (expanded line {f.line})", style="dim")
         elif f.line:
             body.append(f"  line {f.line}")
-        body.append(f"\n{one_line(f.message)}")
+        body.append(f"\n{one_line(f.message + f.calls_text)}")
         if f.hint:
             body.append(f"\nfix: {one_line(f.hint)}", style="dim")
         if f.fix:

@@ -8,12 +8,15 @@ module is the floor they all stand on, so it imports none of them.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from armcli.urdf.meshes import MeshSearch
+from armcli.urdf.source import lookup_for
+from armcli.xacro.lines import Origin
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -21,6 +24,7 @@ if TYPE_CHECKING:
 ERROR = "error"
 WARNING = "warning"
 _MODEL = "model"  # see Rule.blocks
+_BALANCE = "balance"
 _DYNAMICS = "dynamics"
 
 Value = float | int | str | list[float] | None
@@ -31,7 +35,9 @@ class Rule:
     """One check rule: stable id (for --ignore and JSON), severity, title and fix hint.
 
     `blocks`: while an error of this rule stands, the rule families that need the Pinocchio
-    model ("model") or usable dynamics numbers ("dynamics") are skipped (check/context.py).
+    model ("model"), valid masses, centres of mass and joint ranges ("balance": the static
+    balance) or usable dynamics numbers ("dynamics") are skipped (check/context.py). An
+    inertia tensor error blocks only the dynamics: it moves no centre of mass.
     """
 
     id: str
@@ -154,7 +160,7 @@ _RULES = [
         ERROR,
         "negative mass, or a moving body without mass",
         "give the link its real mass",
-        blocks=_DYNAMICS,
+        blocks=_BALANCE,
     ),
     Rule(
         "inertia-not-pd",
@@ -195,6 +201,14 @@ _RULES = [
         "write the inertia of the shape and mass (the value in the message)",
     ),
     Rule(
+        "inertia-exceeds-visual",
+        WARNING,
+        "a moment of inertia above what any mass inside the link's one visual-only primitive "
+        "can have",
+        "a visual without a collision may be only illustrative (Go1's rotors); if it is the "
+        "body, write the inertia of the shape and mass (the value in the message)",
+    ),
+    Rule(
         "inertia-geometry",
         WARNING,
         "inertia differs from the solid-body formula of the geometry",
@@ -212,7 +226,7 @@ _RULES = [
         ERROR,
         "lower limit not below upper limit",
         "swap or fix the limits",
-        blocks=_DYNAMICS,
+        blocks=_BALANCE,
     ),
     Rule(
         "limit-effort-velocity",
@@ -220,7 +234,7 @@ _RULES = [
         "effort or velocity limit <= 0",
         "give the actuator's real effort and velocity limits",
     ),
-    Rule("axis", ERROR, "joint axis zero", "give a unit axis such as 0 0 1", blocks=_DYNAMICS),
+    Rule("axis", ERROR, "joint axis zero", "give a unit axis such as 0 0 1", blocks=_BALANCE),
     Rule("axis-unit", WARNING, "joint axis not unit length", "normalise the axis"),
     Rule(
         "limit-degrees",
@@ -347,6 +361,15 @@ class Finding:
     hint: str = ""
     fix: Mapping[str, Value] = field(default_factory=dict)  # the numbers that would pass
     spec: SpecPlace | None = None  # the spec field behind a generated URDF's element
+    origin: Origin | None = None  # a xacro expansion's element: the line the user wrote
+
+    @property
+    def calls_text(self) -> str:
+        """The `(through the macro call at FILE:LINE, ...)` suffix of a macro's element."""
+        if self.origin is None or not self.origin.calls:
+            return ""
+        at = ", then ".join(f"{shown_path(f)}:{n}" for f, n in self.origin.calls)
+        return f" (through the macro call at {at})"
 
     def to_dict(self) -> dict[str, Any]:
         """The finding as a JSON object in the stable schema of docs/check.md."""
@@ -360,7 +383,20 @@ class Finding:
             "hint": self.hint,
             "fix": dict(self.fix),
             "spec": None if self.spec is None else vars(self.spec).copy(),
+            "origin": None
+            if self.origin is None
+            else {
+                "file": self.origin.file,
+                "line": self.origin.line,
+                "calls": [{"file": f, "line": n} for f, n in self.origin.calls],
+            },
         }
+
+
+def shown_path(path: str) -> str:
+    """A path as a message shows it: relative to the working directory when under it."""
+    rel = os.path.relpath(path) if os.path.isabs(path) else path
+    return path if rel.startswith("..") else rel
 
 
 class Collector:
@@ -444,7 +480,7 @@ class CheckOptions:
 
     def mesh_search(self) -> MeshSearch:
         """The mesh-resolver view of these options (shared with view and render)."""
-        return MeshSearch(self.package_dirs, self.search_paths)
+        return lookup_for(self.spec, MeshSearch(self.package_dirs, self.search_paths))
 
 
 def apply_policy(

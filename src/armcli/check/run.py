@@ -9,7 +9,7 @@ rule family is a module with a function of the `Context` and one line in `FAMILI
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from armcli.check import (
     bodies,
@@ -25,6 +25,8 @@ from armcli.check import (
 from armcli.check import dynamics as dyn
 from armcli.check import zmp as zmp_rules
 from armcli.check.context import (
+    BALANCE,
+    BLOCKS_BALANCE,
     BLOCKS_DYNAMICS,
     BLOCKS_MODEL,
     DYNAMICS,
@@ -40,9 +42,10 @@ from armcli.check.context import (
 from armcli.check.rules import CheckOptions, Collector, Finding
 from armcli.check.summary import Summary
 from armcli.errors import ModelLoadError
+from armcli.robot import sampling
+from armcli.robot.load import parser_problems
+from armcli.robot.model import Robot
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mimic import mimics
-from armcli.urdf.pinocchio import joint_ranges, load_model, parser_problems
 
 
 @dataclass(frozen=True)
@@ -55,7 +58,7 @@ class Family:
 
 
 def _gravity(c: Context) -> None:
-    c.rows = dyn.gravity(c.urdf, c.model, c.data, c.samples, c.rows, c.out)
+    c.rows = dyn.gravity(c.urdf, c.loaded(), c.samples, c.rows, c.out)
 
 
 def _servo(c: Context) -> None:
@@ -66,26 +69,24 @@ def _stability(c: Context) -> None:
     gained = set(c.opts.spec.control.gains) if c.opts.spec is not None else set()
     if c.servo and gained <= c.servo:  # a position servo is not a PD loop
         return
-    c.stability = dyn.stability(
-        c.urdf, c.opts, c.model, c.data, c.samples, c.ranges, c.out, c.notes
-    )
+    c.stability = dyn.stability(c.urdf, c.opts, c.loaded(), c.samples, c.out, c.notes)
 
 
 def _self_collision(c: Context) -> None:
     if c.opts.spec is not None and c.opts.spec.poses:
-        dyn.self_collision(c.urdf, c.opts, c.model, poses(c), c.out, c.notes)
+        dyn.self_collision(c.urdf, c.opts, c.loaded(), poses(c), c.out, c.notes)
 
 
 FAMILIES: tuple[Family, ...] = (
     Family("inertia", URDF, lambda c: inertia.check(c.urdf, c.tree, c.out)),
     Family("bodies", URDF, lambda c: bodies.check(c.urdf, c.tree, c.out)),
-    Family("joints", URDF, lambda c: joints.check(c.urdf, c.opts.spec, c.out)),
+    Family("joints", URDF, lambda c: joints.check(c.urdf, c.opts.spec, c.out, c.notes)),
     Family("meshes", URDF, lambda c: meshes.check(c.urdf, c.opts, c.out)),
     Family("gravity", DYNAMICS, _gravity),
     Family("servo", DYNAMICS, _servo),
     Family("stability", DYNAMICS, _stability),
     Family("self-collision", MODEL, _self_collision),
-    Family("tipover", DYNAMICS, tipover.check),
+    Family("tipover", BALANCE, tipover.check),
     Family("zmp", DYNAMICS, zmp_rules.check),
     Family("reach", MODEL, reach.check),
 )
@@ -109,7 +110,28 @@ def check_urdf(urdf: Urdf, options: CheckOptions | None = None) -> CheckResult:
         if _ready(ctx, family.needs):
             family.run(ctx)
     _ready(ctx, MODEL)  # the summary's poses need the model even without model rules
-    return CheckResult(urdf.source, tuple(out.findings), summary.summarise(ctx))
+    found = tuple(_at_origin(f, urdf) for f in out.findings)
+    return CheckResult(urdf.source, found, summary.summarise(ctx))
+
+
+def _at_origin(f: Finding, urdf: Urdf) -> Finding:
+    """A finding on a xacro expansion's element, with the line the user wrote it on."""
+    origin = urdf.origins.get(f.line) if f.line else None
+    return f if origin is None else replace(f, origin=origin)
+
+
+def check_document(urdf: Urdf, options: CheckOptions | None = None) -> tuple[Finding, ...]:
+    """The findings of the rules that read the document alone (no model loaded).
+
+    Fast: what `build` reports of what `check` will say.
+    """
+    opts = options or CheckOptions()
+    out = Collector(urdf.source)
+    ctx = Context(urdf, opts, out, structure.check(urdf, out), rows=joint_rows(urdf))
+    for family in FAMILIES:
+        if family.needs == URDF:
+            family.run(ctx)
+    return tuple(out.findings)
 
 
 def _ready(ctx: Context, needs: Stage) -> bool:
@@ -123,10 +145,12 @@ def _ready(ctx: Context, needs: Stage) -> bool:
             ctx.notes.append(DYNAMICS_SKIPPED)
             ctx.stage = "no-dynamics"
         else:
-            ctx.samples = dyn.samples(ctx.model, ctx.ranges, mimics(ctx.urdf.joints))
+            ctx.samples = sampling.configurations(ctx.loaded())
             ctx.stage = DYNAMICS
     if needs == MODEL:
-        return ctx.model is not None
+        return ctx.robot is not None
+    if needs == BALANCE:  # masses and centres of mass: an inertia tensor error moves neither
+        return ctx.robot is not None and not ctx.out.has_errors(BLOCKS_BALANCE)
     return ctx.stage == DYNAMICS
 
 
@@ -137,15 +161,13 @@ def _load(ctx: Context) -> None:
         ctx.stage = "refused"
         return
     try:
-        loaded = load_model(ctx.urdf.source, xml=ctx.urdf.text.decode("utf-8"))
+        robot = Robot.from_urdf(ctx.urdf, spec=ctx.opts.spec)
     except ModelLoadError as exc:
         ctx.out.add("model-load", None, exc.message)
         ctx.stage = "refused"
         return
-    for msg in parser_problems(loaded.parser_messages):
+    for msg in parser_problems(robot.parser_messages):
         rule = "parser-error" if msg.lower().startswith("error") else "parser-message"
         ctx.out.add(rule, None, f"Pinocchio/urdfdom: {msg}", text=msg)
-    ctx.model = loaded.model
-    ctx.data = ctx.model.createData()
-    ctx.ranges = joint_ranges(ctx.model)
+    ctx.robot = robot
     ctx.stage = MODEL

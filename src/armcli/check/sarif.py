@@ -69,7 +69,17 @@ def _subject(f: Finding) -> str:
     return ",".join(named) if named else _NUMBER.sub("#", f.message)
 
 
+def _place(path: str, line: int, root: Path) -> dict[str, Any]:
+    uri, relative = artifact_uri(path, root)
+    artifact: dict[str, Any] = {"uri": uri}
+    if relative:
+        artifact["uriBaseId"] = SRCROOT
+    return {"physicalLocation": {"artifactLocation": artifact, "region": {"startLine": line}}}
+
+
 def _location(f: Finding, root: Path) -> tuple[dict[str, Any], str]:
+    if f.origin is not None:  # a xacro element: the file and line the user wrote
+        return _place(f.origin.file, f.origin.line, root), ""
     path, inner = split_source(f.file)
     uri, relative = artifact_uri(path, root)
     artifact: dict[str, Any] = {"uri": uri}
@@ -102,11 +112,16 @@ def to_sarif(findings: Sequence[Finding], root: Path | None = None) -> str:
             "ruleId": f.rule,
             "ruleIndex": index[f.rule],
             "level": f.severity,
-            "message": {"text": f"{prefix}{f.message}"},
+            "message": {"text": f"{prefix}{f.message}{f.calls_text}"},
             "locations": [location],
             "partialFingerprints": {FINGERPRINT_KEY: digest},
             "properties": {"values": dict(f.values), "fix": dict(f.fix), "hint": f.hint},
         }
+        if f.origin is not None and f.origin.calls:  # the macro calls, innermost first
+            result["relatedLocations"] = [
+                {**_place(file, line, base), "id": k, "message": {"text": "macro call"}}
+                for k, (file, line) in enumerate(f.origin.calls)
+            ]
         results.append(result)
     doc = {
         "$schema": SARIF_SCHEMA,

@@ -15,16 +15,16 @@ import numpy as np
 from armcli.check.context import Context, poses
 from armcli.check.rules import CheckOptions, JointRow
 from armcli.check.structure import finite
+from armcli.robot.load import link_frame
+from armcli.robot.tool import tool_point
 from armcli.sim.verdict import StabilityReport
 from armcli.spec.joint_types import total_dof
 from armcli.urdf.doc import Urdf
-from armcli.urdf.pinocchio import configuration
-from armcli.urdf.tool import tool_point
 
 if TYPE_CHECKING:  # the balance and reach results: imported by their own families
+    from armcli.analysis.workspace import ReachPoint, Workspace
     from armcli.check.balance import StaticBalance
     from armcli.sim.tipping import ZmpReport
-    from armcli.urdf.workspace import ReachPoint, Workspace
 
 
 @dataclass(frozen=True)
@@ -71,19 +71,25 @@ def summarise(ctx: Context) -> Summary:
         "reach": ctx.reach,
         "reach_points": ctx.reach_points,
     }
-    if ctx.model is None:
+    if ctx.robot is None or _no_arm(ctx):
         return Summary(**base, end_effector="", poses=())
     import pinocchio as pin
 
-    model, data = ctx.model, ctx.data
+    model, data = ctx.robot.model, ctx.robot.data
     ee_label, ee_frame, ee_offset = _end_effector(urdf, ctx.opts, model)
     pose_rows = []
     for name, values in poses(ctx):
-        q = configuration(model, values)
+        q = ctx.robot.q(values)
         pin.framesForwardKinematics(model, data, q)
         xyz = data.oMf[ee_frame].act(np.asarray(ee_offset, dtype=float))
         pose_rows.append(PoseRow(name, tuple(values.items()), tuple(float(x) for x in xyz)))  # type: ignore[arg-type]
     return Summary(**base, end_effector=ee_label, poses=tuple(pose_rows))
+
+
+def _no_arm(ctx: Context) -> bool:
+    """A base without an arm: the tool point (the deepest link) is a wheel on the ground."""
+    tool = tool_point(ctx.urdf, ctx.opts.spec)
+    return tool is not None and ctx.stance is not None and tool.link in ctx.stance.ground.links
 
 
 def _total_mass(urdf: Urdf) -> float:
@@ -94,9 +100,9 @@ def _total_mass(urdf: Urdf) -> float:
 def _end_effector(
     urdf: Urdf, opts: CheckOptions, model: Any
 ) -> tuple[str, int, tuple[float, float, float]]:
-    """The tool point (armcli.urdf.tool) as (label, Pinocchio frame id, offset [m])."""
+    """The tool point (armcli.robot.tool) as (label, Pinocchio frame id, offset [m])."""
     tool = tool_point(urdf, opts.spec)
-    if tool is None or not model.existFrame(tool.link):
-        name = str(model.frames[0].name)
-        return name, model.getFrameId(name), (0.0, 0.0, 0.0)
-    return tool.label, model.getFrameId(tool.link), tool.xyz
+    frame = link_frame(model, tool.link) if tool is not None else None
+    if tool is None or frame is None:
+        return str(model.frames[0].name), 0, (0.0, 0.0, 0.0)
+    return tool.label, frame, tool.xyz

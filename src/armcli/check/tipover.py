@@ -12,13 +12,13 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+from armcli.analysis.ground import mesh_loader
+from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
 from armcli.check import balance
 from armcli.check.balance import PoseBalance, StaticBalance
 from armcli.check.context import Context, poses
 from armcli.check.rules import Collector, Value
-from armcli.urdf.ground import mesh_loader
-from armcli.urdf.stance import NoStance, Payload, Stance, stance_of
-from armcli.urdf.tool import tool_point
+from armcli.robot.tool import tool_point
 
 NEAR_NAMED = 1e-3  # [m] a range's worst within this of a named pose's is that pose's finding
 
@@ -95,6 +95,12 @@ def round_down(x: float, digits: int = 2) -> float:
     return float(f"{math.floor(x / step + 1e-9) * step:.{digits}g}")
 
 
+NO_ARM_HINT = (
+    "move the base's heavy parts (battery, boards) toward the polygon's centre, or widen the "
+    "support (wheel track, caster position)"
+)
+
+
 def _add(
     b: StaticBalance, p: PoseBalance, where: str, out: Collector, line: int | None,
     holds: float | None,
@@ -123,3 +129,5 @@ def _add(
     out.add(rule, line, text, fix, pose=p.name, margin=p.margin, direction=direction,
             tip_angle_deg=math.degrees(p.tip_angles[e]), com=list(p.com),
             q=[v for _, v in p.q], payload=b.payload)  # fmt: skip
+    if not b.payload_point:  # the rule's hint speaks of an arm this robot does not have
+        out.findings[-1] = replace(out.findings[-1], hint=NO_ARM_HINT)

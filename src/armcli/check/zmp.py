@@ -4,7 +4,9 @@ With `--trajectory` and a spec's gains, the spec's arm is simulated along the fi
 `armcli simulate` does (sim.tipping), and the whole robot's zero-moment point, with the
 base also accelerating and braking at the diff-drive plugin's limit, is measured against
 the support polygon (`check/tipover.py` builds the stance). One finding for the run's
-worst moment, naming the time, the case and the base acceleration that still holds.
+worst moment, naming the time, the case and the base acceleration that still holds. An
+error only when the point stays outside long enough to rotate the robot over the edge
+(sim.excursion, docs/check.md); a shorter excursion lifts a wheel: a warning.
 """
 
 from __future__ import annotations
@@ -37,9 +39,15 @@ def check(c: Context) -> None:
     c.zmp = r
     if r.min_margin >= opts.min_margin:
         return
-    what = (f"{-r.min_margin * 1e3:.1f} mm outside the support polygon: the robot tips"
-            if r.tips else f"only {r.min_margin * 1e3:.1f} mm inside the support polygon "
-            f"(threshold {opts.min_margin * 1e3:g} mm)")  # fmt: skip
+    if r.tips:
+        what = f"{-r.min_margin * 1e3:.1f} mm outside the support polygon: the robot tips"
+    elif r.min_margin < 0:  # too briefly to rotate the robot over the edge (sim.tipping)
+        lift = sum(e.duration for e in r.lifts)
+        what = (f"{-r.min_margin * 1e3:.1f} mm outside the support polygon for {lift:.3f} s: "
+                "a wheel lifts off, too briefly to tip the robot")  # fmt: skip
+    else:
+        what = (f"only {r.min_margin * 1e3:.1f} mm inside the support polygon "
+                f"(threshold {opts.min_margin * 1e3:g} mm)")  # fmt: skip
     holds = r.max_base_accel if r.tips else r.max_base_accel_margin
     fix: dict[str, Value] = {}
     text = (f"trajectory {opts.trajectory.name}: zero-moment point {what}, toward "

@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import Any
 
 import typer
 
 from armcli.commands.flags import flag_errors
 from armcli.commands.options import spec_argument
+from armcli.io.oneline import one_line
 from armcli.spec.discover import find_spec
 
 
@@ -31,12 +33,23 @@ def build_cmd(
     spec = find_spec(spec)
     if check:
         check_fresh(spec, out)
-        sys.stdout.write(f"{out}: up to date with {spec}\n")
+        sys.stdout.write(one_line(f"{out}: up to date with {spec}") + "\n")
         return
     result = build(spec, out, force=force)
-    sys.stdout.write(f"built {len(result.files)} files from {spec} into {out}/\n")
+    sys.stdout.write(one_line(f"built {len(result.files)} files from {spec} into {out}/") + "\n")
     for f in result.files:
-        sys.stdout.write(f"  {f}\n")
+        sys.stdout.write(one_line(f"  {f}") + "\n")
+    _report_check_errors(spec, result.files, result.spec)
+
+
+def _report_check_errors(spec: Path, files: tuple[Path, ...], model: Any) -> None:
+    """What `armcli check` will call an error in the built URDFs, said now (a warning each)."""
+    from armcli.check.inputs import spec_document_errors
+
+    urdfs = {p.name: p.read_bytes() for p in files if p.suffix == ".urdf"}
+    for f in spec_document_errors(spec, urdfs, model):
+        where = str(f.spec) if f.spec is not None else f.file
+        sys.stderr.write(one_line(f"warning: {where}: {f.message} (check: {f.rule})") + "\n")
 
 
 def register(app: typer.Typer) -> None:

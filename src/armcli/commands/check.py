@@ -28,7 +28,7 @@ from armcli.errors import (
 )
 from armcli.io import terminal
 from armcli.spec.discover import find_spec
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 if TYPE_CHECKING:  # the checker is imported when the command runs: `--help` stays light
     from armcli.check.inputs import CheckRun
@@ -97,7 +97,7 @@ def check_cmd(
     payload_link: str = typer.Option(None, "--payload-link", help=PAYLOAD_LINK_HELP),
     contact_links: str = typer.Option(None, "--contact-links", help=CONTACT_LINKS_HELP),
     min_margin: float = typer.Option(
-        0.02, "--min-margin", help="Balance margin [m] below which to warn (default 0.02)."
+        0.02, "--min-margin", help="Balance margin [m] below which to warn."
     ),
     trajectory: Path = typer.Option(None, "--trajectory", "-t", help=TRAJECTORY_HELP),
     base_accel: float = typer.Option(None, "--base-accel", help=BASE_ACCEL_HELP),

@@ -17,8 +17,9 @@ from armcli.commands.xacro_inputs import (
 )
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
+from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 
 def expand_cmd(
@@ -42,7 +43,7 @@ def expand_cmd(
     if robot is None:
         raise InputError("give the xacro file before its NAME:=VALUE arguments", field="FILE")
     if out is not None:
-        check_output_file(out, "--out")  # before any work: nothing is half-written
+        check_output_file(out, "--out", [robot])  # before any work; never over the input
     inputs = xacro_inputs(tokens, env, package_dir)
     xml, used = expand_xacro(robot, trust_xacro=trust_mode(trust_xacro, unsandboxed), inputs=inputs)
     write_notes(used.notes())
@@ -51,7 +52,7 @@ def expand_cmd(
         sys.stdout.flush()
         return
     write_file_atomic(out, xml)
-    sys.stderr.write(f"wrote {out}\n")
+    sys.stderr.write(one_line(f"wrote {out}") + "\n")
 
 
 def register(app: typer.Typer) -> None:

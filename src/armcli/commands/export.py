@@ -19,7 +19,7 @@ from armcli.commands.xacro_inputs import (
 from armcli.defaults import MJCF_BASES
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 export_app = typer.Typer(
     help="Export the robot to other simulators' formats.", no_args_is_help=True
@@ -64,7 +64,7 @@ def mjcf_cmd(
     from armcli.compiler.expand import spec_label  # on use: `--help` stays light
     from armcli.export.mjcf_files import export_mjcf
 
-    check_output_file(out, "--out")  # before any work: nothing else is written
+    check_output_file(out, "--out", parents=True)  # before any work: nothing else is written
     robot, tokens = split_robot(robot, args)
     inputs = xacro_inputs(tokens, env, package_dir)
     robot = find_spec(robot)

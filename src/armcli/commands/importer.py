@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -18,7 +17,9 @@ from armcli.commands.xacro_inputs import (
 )
 from armcli.defaults import SPEC_FILE
 from armcli.errors import InputError
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.io.oneline import one_line
+from armcli.io.terminal import say
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 if TYPE_CHECKING:  # the importer is imported when the command runs: `--help` stays light
     from armcli.importer.run import ImportResult
@@ -46,7 +47,8 @@ def report(result: ImportResult, source: Path, out: Path) -> str:
         lines += [f"  {d}" for d in result.differences]
     else:
         lines.append("round trip: `armcli build` gives back the same URDF (checked)")
-    return "\n".join(lines) + "\n"
+    # every line through the one escaper: passthrough text and differences come from the file
+    return "".join(f"{one_line(line)}\n" for line in lines)
 
 
 @flag_errors({"out": "--out", "arm_root": "--arm-root", "force": "--force"})
@@ -85,7 +87,7 @@ def import_cmd(
         gains=spec_start_gains,
     )
     write_notes(notes)
-    sys.stdout.write(report(result, file, out))
+    say(report(result, file, out))
     if strict and result.differences:
         raise typer.Exit(1)
 

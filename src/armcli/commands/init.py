@@ -13,6 +13,8 @@ from armcli.commands.flags import flag_errors
 from armcli.commands.importer import report
 from armcli.commands.xacro_inputs import write_notes
 from armcli.defaults import SPEC_FILE, TRAJECTORY_DIR
+from armcli.io.oneline import one_line
+from armcli.io.terminal import say
 from armcli.spec.scaffold import DEFAULT_TEMPLATE, TEMPLATES, init_project
 
 
@@ -43,19 +45,19 @@ def init_cmd(
         out = directory / SPEC_FILE
         result, notes = import_file(source, out, gains=spec_start_gains)
         write_notes(notes)
-        sys.stdout.write(report(result, source, out))
+        say(report(result, source, out))
         return
     written = init_project(directory, template)
     where = "." if directory == Path(".") else str(directory)
-    sys.stdout.write(f"wrote {len(written)} files into {where}{os.sep}\n")
+    sys.stdout.write(one_line(f"wrote {len(written)} files into {where}{os.sep}") + "\n")
     for path in written:
-        sys.stdout.write(f"  {path}\n")
-    cd = "" if where == "." else f"cd {where} && "
+        sys.stdout.write(one_line(f"  {path}") + "\n")
     pick = (TRAJECTORY_DIR / "pick.yaml").as_posix()
-    sys.stdout.write(
-        f"next: {cd}armcli build && armcli check && armcli simulate --trajectory {pick}"
-        f"  (commands read ./{SPEC_FILE} when no spec is given)\n"
-    )
+    steps = [] if where == "." else [f"cd {where}"]
+    steps += ["armcli build", "armcli check", f"armcli simulate --trajectory {pick}"]
+    say(f"next (commands read ./{SPEC_FILE} when no spec is given):")
+    for step in steps:  # one command a line: whole, to copy, at any width
+        sys.stdout.write(one_line(f"  {step}") + "\n")
 
 
 def register(app: typer.Typer) -> None:

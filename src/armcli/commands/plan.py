@@ -19,7 +19,7 @@ from armcli.commands.xacro_inputs import (
 )
 from armcli.defaults import PLANNERS
 from armcli.errors import InputError, PlanningError
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 if TYPE_CHECKING:
     from armcli.plan.api import PlanResult

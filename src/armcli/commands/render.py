@@ -23,8 +23,9 @@ from armcli.commands.xacro_inputs import (
 from armcli.errors import InputError
 from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
+from armcli.io.terminal import say
 from armcli.spec.discover import find_spec
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 REACH_HELP = (
     "Also draw where the tool point can reach within the joint limits (sampled forward "
@@ -73,7 +74,7 @@ def render_cmd(
     reach_point: list[str] = typer.Option([], "--reach-point", help=REACH_POINT_HELP),
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
-    from armcli.urdf.workspace import describe, verdict  # on use: `--help` stays light
+    from armcli.analysis.workspace import describe, verdict  # on use: `--help` stays light
     from armcli.view.png import MESH_HINT, load_urdf, render_png
     from armcli.view.scene import load_robot, pose_q
 
@@ -88,7 +89,8 @@ def render_cmd(
     values = pose_q(src, pose, q)
     width, height = _size(size)
     skipped: dict[str, str] = {}
-    urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search, skipped)
+    said: dict[str, str] = {}  # what trimesh said about a mesh it drew (a missing texture)
+    urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search, skipped, said)
     field = "--pose" if pose else "--q"
     lines: list[str] = []
     if reach or targets:
@@ -114,10 +116,14 @@ def render_cmd(
         sys.stderr.write(
             one_line(f"warning: {src.source}: mesh {uri!r} {why}, not drawn{hint}") + "\n"
         )
+    for uri, what in said.items():
+        sys.stderr.write(
+            one_line(f"warning: {src.source}: mesh {uri!r}: {what}; drawn without it") + "\n"
+        )
     drawn = _drawn(src.poses, pose, q)
-    sys.stdout.write(f"wrote {res.path} ({res.width}x{res.height} px) at {drawn};{tip}\n")
+    say(f"wrote {res.path} ({res.width}x{res.height} px) at {drawn};{tip}")
     for line in lines:
-        sys.stdout.write(f"{line}\n")
+        say(line)
 
 
 def _drawn(poses: Mapping[str, Mapping[str, float]], pose: str | None, q: str | None) -> str:

@@ -9,7 +9,9 @@ import typer
 
 from armcli.commands.flags import flag_errors
 from armcli.commands.options import choice, option, out_option, spec_argument
+from armcli.commands.xacro_inputs import package_dir_option
 from armcli.defaults import COLLISION_SAMPLES, ROS_TARGETS
+from armcli.io.terminal import say
 from armcli.spec.discover import find_spec
 
 TARGET_HELP = (
@@ -40,9 +42,11 @@ def ros_package_cmd(
     force: bool = option(
         False, "--force", help="Write into an existing non-empty directory armcli did not create."
     ),
+    package_dir: list[str] = package_dir_option(),
 ) -> None:
     """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
     from armcli.compiler.expand import spec_label  # on use: `--help` stays light
+    from armcli.io.packages import PackageLookup, parse_package_dirs
     from armcli.ros.packages import PackageInfo, write_ros_packages
 
     spec = find_spec(spec)
@@ -56,22 +60,23 @@ def ros_package_cmd(
         info=info,
         target=target,
         force=force,
+        packages=PackageLookup(parse_package_dirs(list(package_dir))),
     )
     n, m = pkgs.names, pkgs.matrix
     counts = {r: sum(d.reason == r for d in m.disabled) for r in ("Adjacent", "Default", "Never")}
-    w = sys.stdout.write
-    w(f"wrote {len(written)} files into {out}/: {n.description}, {n.bringup}, {n.moveit}\n")
-    w(
+    say(f"wrote {len(written)} files into {out}/: {n.description}, {n.bringup}, {n.moveit}")
+    say(
         f"collision matrix ({m.samples} samples, seed {m.seed}): {len(m.links)} links, "
         f"disabled {counts['Adjacent']} Adjacent, {counts['Default']} Default, "
-        f"{counts['Never']} Never; {len(m.enabled)} pair(s) still checked\n"
+        f"{counts['Never']} Never; {len(m.enabled)} pair(s) still checked"
     )
     for p in m.enabled:
-        w(f"  checked: {p.link1} / {p.link2} (in collision in {p.collisions} of {m.samples})\n")
+        say(f"  checked: {p.link1} / {p.link2} (in collision in {p.collisions} of {m.samples})")
     for pose, a, b in m.pose_collisions:
-        sys.stderr.write(
+        say(
             f"warning: named pose {pose!r} puts {a} and {b} in contact; "
-            "MoveIt will report that state as in collision\n"
+            "MoveIt will report that state as in collision",
+            sys.stderr,
         )
 
 

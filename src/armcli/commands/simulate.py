@@ -22,10 +22,10 @@ from armcli.commands.xacro_inputs import (
 from armcli.errors import InputError, ModelRefusedError, UnstableLoopError
 from armcli.io import terminal
 from armcli.io.oneline import one_line
-from armcli.io.outdir import check_output_file
+from armcli.io.outdir import check_output_file, check_png_file
 from armcli.io.together import write_files_together
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 if TYPE_CHECKING:  # the simulator is imported when the command runs: `--help` stays light
     from armcli.sim import job as simjob
@@ -33,14 +33,17 @@ if TYPE_CHECKING:  # the simulator is imported when the command runs: `--help` s
 
 INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
 GRAVITY_HELP = "Add g(q) to the PD torque (default: the spec's control.gravity_compensation)."
-IGNORE_HELP = "Simulate a --urdf despite this `check` rule's error (repeatable)."
+IGNORE_HELP = "Simulate the robot despite this `check` rule's error (repeatable)."
 TRAJECTORY_HELP = "JointTrajectory YAML (a point without time_from_start: previous + 1 s)."
 BASE_ACCEL_HELP = (
-    "Base acceleration and braking [m/s²] for the zero-moment point "
-    "(default: the diff-drive plugin's max_wheel_acceleration)."
+    "Base acceleration and braking [m/s²] for the zero-moment point (default: the base at rest)."
 )
 PAYLOAD_LINK_HELP = "Link carrying --payload at its origin (default: the tool point)."
 CONTACT_LINKS_HELP = "Comma-separated links touching the ground (default: from the geometry)."
+CMD_VEL_HELP = (
+    "Drive the whole robot on its wheels in MuJoCo: /cmd_vel commands YAML (`commands:` "
+    "Twist + time_from_start); --trajectory then optional."
+)
 PROGRESS_AFTER_S = 1.0  # show a progress bar when the run is projected to take longer
 # The library's names for what these flags set (errors name them; commands.flags maps back).
 FLAGS = {
@@ -49,6 +52,24 @@ FLAGS = {
     "joints": "--joints",
     "output": "--output",
 }
+
+
+def _flagged(line: str) -> str:
+    """`SimOptions.message ...` as `--message ...`: a line names the flag the user typed."""
+    source = line.split(" ", 1)[0]
+    return FLAGS.get(source, source) + line[len(source) :]
+
+
+def _diagnose(job: Any) -> None:
+    """Refuse a reference faster than a velocity limit; warn of efforts below gravity."""
+    from armcli.sim.precheck import holding_problems, speed_problems
+
+    fast = speed_problems(job)
+    if fast:
+        more = f" (and {len(fast) - 1} more joint(s))" if len(fast) > 1 else ""
+        raise InputError(_flagged(fast[0]) + more)
+    for line in holding_problems(job):
+        sys.stderr.write(one_line(f"warning: {_flagged(line)}") + "\n")
 
 
 def _floats(text: str | None, option: str) -> list[float] | None:
@@ -89,6 +110,7 @@ def simulate_cmd(
     payload: float = option(0.0, "--payload", help="Payload [kg] at the tool point (ZMP)."),
     payload_link: str = option(None, "--payload-link", help=PAYLOAD_LINK_HELP),
     contact_links: str = option(None, "--contact-links", help=CONTACT_LINKS_HELP),
+    cmd_vel: Path = option(None, "--cmd-vel", help=CMD_VEL_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
     from armcli.check.rules import unknown_rules
@@ -107,7 +129,7 @@ def simulate_cmd(
             states.output_format(output)
         check_output_file(output, "--output")
     if plot is not None:
-        check_output_file(plot, "--plot")
+        check_png_file(plot, "--plot")
     spec_path, spec_obj = None, None
     if spec is not None or urdf is None:  # the spec layers are imported only for a spec
         from armcli.spec.discover import find_spec
@@ -133,7 +155,11 @@ def simulate_cmd(
         xacro=inputs,
     )
     tip_opts = TipOptions(base_accel, payload, payload_link, _names(contact_links))
+    if cmd_vel is not None:
+        _drive(spec_obj, opts, cmd_vel, tuple(ignore), output, plot, tip_opts != TipOptions())
+        return
     job = _prepare(spec_obj, spec_path, opts, tuple(ignore))
+    _diagnose(job)  # the trajectory's own impossibilities before any simulated verdict
     notes: list[str] = []
     tip = tipping.prepare(spec_obj, job, tip_opts, inputs.packages, notes)
     asked = tip_opts != TipOptions()  # an arm on a fixed base is news only when asked about
@@ -147,14 +173,23 @@ def _prepare(
 
     A model `check` reports as an error is not simulated (same rule ids), unless ignored.
     """
-    from armcli.check.gate import refuse_check_errors
+    from armcli.check.gate import bears_on_balance, refuse_check_errors
     from armcli.sim import job as simjob
 
     def gate(doc: Any) -> None:
         refuse_check_errors(doc, ignore=ignore)
 
     try:
-        return simjob.prepare(spec, opts, gate=gate)
+        job = simjob.prepare(spec, opts, gate=gate)
+        if spec is not None and opts.urdf is None:  # a spec's whole robot, as `check` sees it
+            from armcli.sim.tipping import robot_urdf
+
+            whole = robot_urdf(spec, job)
+            if whole is not None and whole is not job.urdf:  # the base: only for the balance
+                refuse_check_errors(whole, ignore=ignore, only=bears_on_balance)
+            elif whole is not None:
+                gate(whole)
+        return job
     except ModelRefusedError as exc:
         flags = " ".join(f"--ignore {r}" for r in exc.rules())
         raise ModelRefusedError(
@@ -174,6 +209,23 @@ def _sources(spec_path: Path | None, opts: SimOptions) -> dict[str, Any]:
         fields = [f for f in fields if not f.startswith("control.")]
     from_spec = any(f.startswith("control.") for f in fields)
     return {"file": spec_path if from_spec else None, "field": ", ".join(fields) or None}
+
+
+def _drive(
+    spec: Any, opts: SimOptions, cmd_vel: Path, ignore: tuple[str, ...], output: Path | None,
+    plot: Path | None, tip_asked: bool,
+) -> None:  # fmt: skip
+    """The whole robot on its wheels (commands.drive); the base-at-rest options do not apply."""
+    from armcli.commands.drive import run_drive
+
+    if tip_asked:
+        raise InputError(
+            "--base-accel, --payload, --payload-link and --contact-links are for the "
+            "fixed-base run; a drive simulates the contacts",
+            field="--cmd-vel",
+        )
+    with _LazyProgress(terminal.console(sys.stderr)) as progress:
+        run_drive(spec, opts, cmd_vel, ignore, output, plot, progress)
 
 
 def _names(text: str | None) -> tuple[str, ...] | None:
@@ -200,7 +252,7 @@ def _run(
     err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
     write_notes([*job.notes, *(notes or [])])
     for w in job.trajectory.warnings:
-        err.print(one_line(f"warning: {w}"), markup=False, highlight=False)
+        err.print(one_line(f"warning: {_flagged(w)}"), markup=False, highlight=False)
     extra = None if tip is None else (lambda steps: tip.steps(job, steps))
     with _LazyProgress(err) as progress:
         res = simjob.run(job, progress, plot=plot is not None, extra=extra)
@@ -226,11 +278,13 @@ def _run(
     out.print(simreport.summary_table(metrics, ee, job.tool_label, res), crop=False)
     balance = tipping.report(tip, series) if tip is not None and series is not None else None
     if balance is not None:
+        for lift in balance.lifts:  # too short to tip the robot: a wheel unloads, a warning
+            err.print(one_line(f"warning: {lift.line()}"), markup=False, highlight=False)
         line = tipping.summary_line(balance)
         out.print(line, style="red" if balance.tips else None, markup=False, highlight=False)
     for path in (output, plot):
         if path is not None:
-            out.print(f"wrote {path}", markup=False, highlight=False)
+            out.print(one_line(f"wrote {path}"), markup=False, highlight=False)
     if balance is not None and balance.tips:
         raise tipping.tip_error(balance)
 

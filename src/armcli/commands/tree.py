@@ -21,9 +21,10 @@ from armcli.commands.xacro_inputs import (
 from armcli.errors import InputError
 from armcli.io import terminal
 from armcli.io.files import write_file_atomic
+from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
 from armcli.spec.discover import find_spec
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 TREE_FORMATS = ("text", "dot")
 
@@ -68,7 +69,7 @@ def tree_cmd(
         sys.stdout.write(text)
     else:
         write_file_atomic(out, text.encode("utf-8"))
-        sys.stdout.write(f"wrote {out}\n")
+        sys.stdout.write(one_line(f"wrote {out}") + "\n")
 
 
 def register(app: typer.Typer) -> None:

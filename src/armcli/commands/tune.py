@@ -13,7 +13,8 @@ from armcli.commands.options import choice, option, spec_argument
 from armcli.defaults import PD_LOOPS, ROBUST_MODES
 from armcli.errors import InputError
 from armcli.io import terminal
-from armcli.io.outdir import check_output_file
+from armcli.io.oneline import one_line
+from armcli.io.outdir import check_output_file, check_png_file
 from armcli.spec.discover import find_spec
 
 if TYPE_CHECKING:  # the tuner is imported when the command runs: `--help` stays light
@@ -102,9 +103,10 @@ def tune_cmd(
         validate(opts)
         if output is not None and output.suffix.lower() != ".json":
             raise InputError("the output file must end in .json", field="--output")
-        for path, name in ((output, "--output"), (plot, "--plot")):
-            if path is not None:
-                check_output_file(path, name)  # before the search: no partial outputs
+        if output is not None:  # before the search: no partial outputs
+            check_output_file(output, "--output")
+        if plot is not None:
+            check_png_file(plot, "--plot")
         if write:
             check_writable(spec_path)
         settings = tjob.TuneSettings(
@@ -174,7 +176,7 @@ def _run(
     write_files_together(files)
     for path in (output, plot, spec_path if write else None):
         if path is not None:
-            out.print(f"wrote {path}", markup=False, highlight=False)
+            out.print(one_line(f"wrote {path}"), markup=False, highlight=False)
 
 
 def _summary(out: Any, outcome: session.Outcome) -> None:

@@ -19,15 +19,18 @@ from armcli.commands.xacro_inputs import (
     xacro_inputs,
 )
 from armcli.errors import InputError
+from armcli.io.oneline import one_line
 from armcli.spec.discover import find_spec
-from armcli.urdf.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 
 @flag_errors({"pose": "--pose", "q": "--q", "port": "--port", "replay": "--replay"})
 def view_cmd(
     robot: Path | None = spec_argument(ROBOT_HELP),
     args: list[str] = args_argument(),
-    replay: Path = typer.Option(None, "--replay", help="A CSV written by `armcli simulate`."),
+    replay: Path = typer.Option(
+        None, "--replay", help="A run written by `armcli simulate -o` (.csv or .mcap)."
+    ),
     pose: str = typer.Option(None, "--pose", help="Start at this named pose."),
     host: str = typer.Option(
         "127.0.0.1", "--host", show_default=False, help="Address to listen on (default: 127.0.0.1)."
@@ -79,7 +82,9 @@ def view_cmd(
     try:  # entered before the URL is printed, so an early Ctrl-C still stops cleanly
         if pose:
             viewer.apply_pose(pose)
-        sys.stdout.write(f"armcli view: {src.name} at {viewer.url}  (Ctrl-C to stop)\n")
+        sys.stdout.write(
+            one_line(f"armcli view: {src.name} at {viewer.url}  (Ctrl-C to stop)") + "\n"
+        )
         sys.stdout.flush()
         viewer.serve_forever()
     except KeyboardInterrupt:

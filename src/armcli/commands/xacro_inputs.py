@@ -4,7 +4,7 @@
 `armcli simulate --urdf FILE NAME:=VALUE ...` take xacro's own `NAME:=VALUE`
 arguments after the file, `--env VAR=VALUE` for `$(env)`/`$(optenv)` and
 `--package-dir NAME=PATH` for `$(find NAME)` and `package://NAME/` (see
-armcli.urdf.packages for the rest of the lookup). What the expansion used is
+armcli.io.packages for the rest of the lookup). What the expansion used is
 printed to stderr as `note:` lines, the same way by every command.
 """
 
@@ -19,8 +19,9 @@ import typer
 
 from armcli.errors import InputError
 from armcli.io.oneline import one_line
-from armcli.urdf.packages import PackageLookup, parse_package_dirs
-from armcli.urdf.xacro_args import ARGS_HELP, ENV_HELP, XacroInputs, is_arg, parse_args, parse_env
+from armcli.io.packages import PackageLookup, parse_package_dirs
+from armcli.io.terminal import say
+from armcli.xacro.args import ARGS_HELP, ENV_HELP, XacroInputs, is_arg, parse_args, parse_env
 
 PACKAGE_DIR_HELP = (
     "NAME=PATH: package NAME is at PATH, for $(find NAME) and package://NAME/ (repeatable); "
@@ -93,4 +94,4 @@ def write_notes(notes: Iterable[str], file: str | None = None) -> None:
     for line in notes:
         label, _, text = line.partition(": ")
         shown = f"{label}: {file}: {text}" if file else line
-        sys.stderr.write(one_line(shown) + "\n")
+        say(one_line(shown), sys.stderr)  # one line in a log; wrapped at a terminal

@@ -9,11 +9,14 @@ refused naming the file.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from armcli.compiler.meshfiles import locate
 from armcli.errors import InputError
+from armcli.io.meshbound import check_mesh_payload
 from armcli.io.userfile import check_regular
 from armcli.spec.model import Inertial, Shape
 
@@ -48,6 +51,10 @@ def _load(path: Path, filename: str, field: str | None) -> object:
         raise InputError(
             f"mesh {filename} is {size} bytes, more than {MAX_MESH_BYTES}", field=field
         )
+    try:  # compressed meshes inflated under a cap, declared triangles counted (issue 27)
+        check_mesh_payload(path, MAX_MESH_BYTES)
+    except InputError as exc:
+        raise InputError(exc.message, field=field) from None
     try:
         mesh = trimesh.load(str(path), force="mesh", process=True)
     except Exception as exc:  # trimesh raises many types for unreadable files
@@ -73,7 +80,30 @@ def mesh_mass_properties(
     filename = mesh_spec.filename
     mesh = _load(locate(filename, base_dir, field), filename, field)
     assert isinstance(mesh, trimesh.Trimesh)
-    scale = np.diag([*mesh_spec.scale, 1.0])
+    with np.errstate(all="ignore"):  # a huge scale overflows: refused below, not warned
+        props = _scaled_properties(mesh, mesh_spec.scale, shape, inertial, filename, field)
+    if not all(math.isfinite(x) for x in (props.mass, *props.com, *props.inertia)):
+        raise InputError(
+            f"mesh {filename} scaled by {list(mesh_spec.scale)} has a non-finite volume or "
+            "inertia (the scale is out of range); give a sensible scale or an explicit inertial",
+            field=field,
+        )
+    return props
+
+
+def _scaled_properties(
+    mesh: Any,
+    scale_xyz: tuple[float, float, float],
+    shape: Shape,
+    inertial: Inertial,
+    filename: str,
+    field: str | None,
+) -> MassProperties:
+    """Mass properties of a loaded mesh under `scale_xyz` (see mesh_mass_properties)."""
+    import numpy as np
+    import trimesh
+
+    scale = np.diag([*scale_xyz, 1.0])
     mesh.apply_transform(scale)
     if not (mesh.is_watertight and mesh.is_winding_consistent):
         unpaired = len(trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1))  # type: ignore[no-untyped-call]

@@ -24,7 +24,8 @@ The rules applied, bottom-up so that a body is judged with what its children gav
   (the URDF's dynamics to within that inertia); a massless one is refused;
 - a clearly negative principal moment or a negative mass on a moving body is refused:
   there is no faithful repair.
-Every change is a `Note` in the export report.
+Every change is a `Note` in the export report. The merging itself (`Mass`, `join`,
+`moved`) is `robot.bodies`', the lumping `check` judges the bodies with.
 """
 
 from __future__ import annotations
@@ -38,7 +39,8 @@ from lxml import etree
 from armcli.compiler.xmlfmt import fmt, vec
 from armcli.errors import ExportRefusedError
 from armcli.export.mjcf_report import Note
-from armcli.urdf import inertia as inr
+from armcli.robot import inertia as inr
+from armcli.robot.bodies import Mass, join, link_mass, moved
 from armcli.urdf.doc import Link, Vec3
 
 MJ_MINVAL = 1e-15  # mjMINVAL: a moving body's mass and principal moments must reach it
@@ -47,15 +49,6 @@ NEGATIVE_RTOL = 1e-9  # a moment below -NEGATIVE_RTOL x the largest is negative,
 TRIANGLE_MARGIN = 1e-9  # relative headroom left by the triangle fix (MuJoCo re-diagonalises)
 DENSITY = 1000.0  # [kg/m³] MuJoCo's default geom density, used by its URDF import
 POINT_RADIUS = 1e-3  # [m] a point mass without geometry becomes a solid sphere this small
-
-
-@dataclass(frozen=True)
-class Mass:
-    """Mass [kg], centre of mass [m] and the tensor about it [kg·m²], in the body frame."""
-
-    mass: float
-    com: np.ndarray  # (3,)
-    J: np.ndarray  # (3, 3)
 
 
 @dataclass(frozen=True)
@@ -80,36 +73,6 @@ class Node:
     moving: bool  # has a hinge, slide or free joint
     collisions: int  # collision geoms the export writes for it
     lost: tuple[str, ...] = ()  # collision meshes it cannot write (missing or unreadable)
-
-
-def urdf_mass(link: Link) -> Mass | None:
-    """The link's inertial in its body frame, or None when it has none or zero mass."""
-    ine = link.inertial
-    if ine is None or ine.mass is None or ine.inertia is None or ine.mass == 0.0:
-        return None
-    J = inr.tensor(*ine.inertia)
-    if any(ine.origin.rpy):
-        J = inr.rotate(J, inr.rpy_matrix(ine.origin.rpy))
-    return Mass(float(ine.mass), np.asarray(ine.origin.xyz, dtype=float), J)
-
-
-def combine(a: Mass | None, b: Mass | None) -> Mass | None:
-    """The composite of two rigidly joined inertials given in one frame."""
-    if a is None or b is None:
-        return a if b is None else b
-    m = a.mass + b.mass
-    c = (a.mass * a.com + b.mass * b.com) / m
-    Ja = inr.parallel_axis(a.J, a.mass, tuple(a.com - c))
-    Jb = inr.parallel_axis(b.J, b.mass, tuple(b.com - c))
-    return Mass(m, c, np.asarray(Ja + Jb))
-
-
-def moved(x: Mass, xyz: Vec3, rpy: Vec3, *, inverse: bool = False) -> Mass:
-    """`x` expressed in the parent's frame (or, inverse, from the parent's into the child's)."""
-    R, p = inr.rpy_matrix(rpy), np.asarray(xyz, dtype=float)
-    if inverse:
-        return Mass(x.mass, R.T @ (x.com - p), inr.rotate(x.J, R.T))
-    return Mass(x.mass, p + R @ x.com, inr.rotate(x.J, R))
 
 
 def classify(x: Mass | None) -> str:
@@ -145,7 +108,7 @@ class _Planner:
     def __init__(self, nodes: Sequence[Node], links: Mapping[str, Link], source: str) -> None:
         self.nodes, self.source = nodes, source
         self.by_link = {n.link: n for n in nodes}
-        self.mass: dict[str, Mass | None] = {n.link: urdf_mass(links[n.link]) for n in nodes}
+        self.mass: dict[str, Mass | None] = {n.link: link_mass(links[n.link]) for n in nodes}
         self.plan: dict[str, Plan] = {}
         self.done: dict[str, list[str]] = {}  # note topic -> per-link details
 
@@ -171,7 +134,7 @@ class _Planner:
         if n.parent is None:
             self.log("welded to the world", f"{n.link} ({why}): dropped, it cannot move")
             return
-        self.mass[n.parent] = combine(self.mass[n.parent], moved(x, n.xyz, n.rpy))
+        self.mass[n.parent] = join(self.mass[n.parent], moved(x, n.xyz, n.rpy))
         self.log("merged into the parent", f"{n.link} ({why}) into {n.parent}")
 
     def moving(self, n: Node) -> None:
@@ -193,13 +156,15 @@ class _Planner:
 
     def massless(self, n: Node, x: Mass | None) -> None:
         """A moving body without usable mass properties (none, zero, point, degenerate)."""
-        holder = self.static_child_with_mass(n)
-        if holder is not None:
+        path = self.static_child_with_mass(n)
+        if path:
+            holder = path[-1].link
             if x is not None:
                 held = self.plan[holder]
                 assert isinstance(held, Mass)
-                child = self.by_link[holder]
-                self.plan[holder] = combine(held, moved(x, child.xyz, child.rpy, inverse=True))
+                for child in path:  # down the fixed joints into the holder's frame
+                    x = moved(x, child.xyz, child.rpy, inverse=True)
+                self.plan[holder] = join(held, x)
                 self.log("merged into a rigid child", f"{n.link} into {holder}")
             self.plan[n.link] = None
             return
@@ -221,14 +186,26 @@ class _Planner:
         what = f"{x.mass:.4g} kg kept" if x is not None else f"{DENSITY:g} kg/m³"
         self.log("inertia from geometry", f"{n.link} ({_why(classify(x), x)}; {what})")
 
-    def static_child_with_mass(self, n: Node) -> str | None:
-        """A rigidly attached child MuJoCo counts for this moving body (direct, valid mass)."""
+    def static_child_with_mass(self, n: Node) -> list[Node]:
+        """The fixed-joint path to a rigidly attached body with valid mass; [] if none.
+
+        MuJoCo counts every body welded to a moving one, however deep: the Gen3 lite's
+        0.14 kg gripper hangs off its massless wrist link through a massless frame
+        (end_effector_link -> dummy_link -> gripper_base_link). Breadth first, so the
+        nearest such body holds the moving link's own inertial.
+        """
+        children: dict[str, list[Node]] = {}
         for c in self.nodes:
-            if c.parent == n.link and not c.moving:
-                x = self.plan.get(c.link)
-                if isinstance(x, Mass) and x.mass >= MJ_MINVAL and classify(x) == "ok":
-                    return c.link  # "ok" means moments >= MJ_EPS > MJ_MINVAL
-        return None
+            if c.parent is not None and not c.moving:
+                children.setdefault(c.parent, []).append(c)
+        paths = [[c] for c in children.get(n.link, [])]
+        while paths:
+            path = paths.pop(0)
+            x = self.plan.get(path[-1].link)
+            if isinstance(x, Mass) and x.mass >= MJ_MINVAL and classify(x) == "ok":
+                return path  # "ok" means moments >= MJ_EPS > MJ_MINVAL
+            paths += [[*path, c] for c in children.get(path[-1].link, [])]
+        return []
 
     def notes(self) -> list[Note]:
         for details in self.done.values():

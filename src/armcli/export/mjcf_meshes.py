@@ -11,30 +11,38 @@ from the faces) refuses the misoriented or open meshes common in robot packages
 the shape MuJoCo collides with), and a flat mesh, whose hull has no volume, its
 surface's (`inertia="shell"`, as MuJoCo's error message advises); a flat mesh cannot
 collide in MuJoCo (no convex hull), so it is drawn but gets no collision geom.
+MuJoCo reads no COLLADA (.dae), which ROS descriptions use for visuals and often for
+collisions too (Doosan's M1013: every collision mesh); trimesh reads it, and the export
+writes it as binary STL, in metres (COLLADA's <unit meter> applied, as ROS's loaders do).
 """
 
 from __future__ import annotations
 
+import io
 import re
 import struct
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
+from typing import Any
 
 import numpy as np
 from lxml import etree
 
 from armcli.compiler.xmlfmt import vec
 from armcli.export.mjcf_report import Note
+from armcli.io.mesh_confine import MAX_MESH_BYTES, bounded_mesh_file, check_total
 from armcli.io.userfile import read_regular
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mesh_confine import MAX_MESH_BYTES, bounded_mesh_file, check_total
+from armcli.urdf.meshlog import quiet_trimesh
 
 MESH_SUFFIXES = (".stl", ".obj", ".msh")  # what MuJoCo loads
+CONVERTED_SUFFIXES = (".dae",)  # what the export converts to binary STL (through trimesh)
 MESH_DIR = "meshes"
 MJ_STL_MAX_FACES = 200_000  # MuJoCo's STL decoder refuses files with more faces
 FLAT_RTOL = 1e-9  # thickness / size below which a mesh is flat (no volume for MuJoCo)
 _STL_HEADER = b"binary STL written by armcli export mjcf from an ASCII STL".ljust(80)
+_STL_HEADER_DAE = b"binary STL written by armcli export mjcf from a COLLADA file".ljust(80)
 _FLOAT = rb"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 _ASCII_VERTEX = re.compile(
     rb"vertex\s+(" + _FLOAT + rb")\s+(" + _FLOAT + rb")\s+(" + _FLOAT + rb")"
@@ -53,7 +61,7 @@ class MeshFile:
     suffix: str  # ".stl" | ".obj" | ".msh"
     faces: int | None  # None where armcli does not parse the format (.msh)
     flat: bool  # all vertices in one plane: MuJoCo needs inertia="shell"
-    converted: bool  # an ASCII STL rewritten as binary
+    converted: bool  # an ASCII STL (or a COLLADA file) rewritten as binary STL
     skip: str | None = None  # why MuJoCo cannot use it
 
 
@@ -68,6 +76,8 @@ def read_mesh(real: Path) -> MeshFile:
     """The mesh at the (bounded, real) path, prepared for MuJoCo."""
     data = read_regular(real, max_bytes=MAX_MESH_BYTES, what="mesh file")
     suffix = real.suffix.lower()
+    if suffix == ".dae":
+        return _collada(data)
     if suffix == ".stl":
         return _stl(data)
     if suffix == ".obj":
@@ -90,6 +100,39 @@ def _stl(data: bytes) -> MeshFile:
     rec["v"] = v.reshape(n, 3, 3)
     binary = _STL_HEADER + struct.pack("<I", n) + rec.tobytes()
     return _checked(binary, n, v, True)
+
+
+def _collada(data: bytes) -> MeshFile:
+    """A COLLADA file as binary STL: every triangle of its scene, placed, in metres."""
+    import trimesh
+
+    try:
+        with quiet_trimesh():  # a missing texture does not change a triangle
+            mesh: Any = trimesh.load(io.BytesIO(data), file_type="dae", force="mesh", process=False)
+        v = np.asarray(mesh.vertices, dtype=np.float64) * _collada_unit(data)
+        f = np.asarray(mesh.faces, dtype=np.int64)
+    except Exception as exc:  # trimesh and pycollada raise many types for bad files
+        return MeshFile(data, ".dae", None, False, False, f"COLLADA not readable: {exc}")
+    if v.ndim != 2 or f.ndim != 2 or not len(f):
+        return MeshFile(data, ".dae", None, False, False, "COLLADA file without triangles")
+    rec = np.zeros(len(f), dtype=_FACET)
+    rec["v"] = v[f]
+    binary = _STL_HEADER_DAE + struct.pack("<I", len(f)) + rec.tobytes()
+    return _checked(binary, len(f), v, True)
+
+
+def _collada_unit(data: bytes) -> float:
+    """COLLADA's <asset><unit meter="..."> (1 when absent or unusable)."""
+    try:
+        root = etree.fromstring(data, etree.XMLParser(resolve_entities=False, no_network=True))
+    except etree.XMLSyntaxError:
+        return 1.0
+    unit = root.find("{*}asset/{*}unit")
+    try:
+        meter = float(unit.get("meter", "1")) if unit is not None else 1.0
+    except ValueError:
+        return 1.0
+    return meter if np.isfinite(meter) and meter > 0 else 1.0
 
 
 _FACET = np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
@@ -132,7 +175,8 @@ def mesh_assets(urdf: Urdf, meshes: Mapping[str, Path | None]) -> Assets:
         if s.geometry is not None and s.geometry.filename
     }
     ok = {u: p for u, p in meshes.items() if p is not None and p.is_file()}
-    ok = {u: p for u, p in ok.items() if p.suffix.lower() in MESH_SUFFIXES}
+    usable = (*MESH_SUFFIXES, *CONVERTED_SUFFIXES)
+    ok = {u: p for u, p in ok.items() if p.suffix.lower() in usable}
     real = real_paths(ok.values(), urdf.source)  # bounded before any is read
     read: dict[Path, MeshFile] = {}
     names: dict[str, str] = {}
@@ -158,7 +202,8 @@ def mesh_assets(urdf: Urdf, meshes: Mapping[str, Path | None]) -> Assets:
         if mf.flat:
             log.setdefault("flat", []).append(uri)
         if mf.converted:
-            log.setdefault("ASCII STL", []).append(uri)
+            kind = "COLLADA" if ok[uri].suffix.lower() == ".dae" else "ASCII STL"
+            log.setdefault(kind, []).append(uri)
         etree.SubElement(asset, "mesh", attrs)
     notes = [Note("meshes", ", ".join(v), _DONE[k]) for k, v in log.items()]
     return Assets(asset, names, files, notes, frozenset(log.get("flat", ())))
@@ -166,6 +211,7 @@ def mesh_assets(urdf: Urdf, meshes: Mapping[str, Path | None]) -> Assets:
 
 _DONE = {
     "missing or not STL/OBJ/MSH": "left out of the model (missing, or convert them to STL or OBJ)",
+    "COLLADA": "converted to binary STL in metres (MuJoCo reads no COLLADA)",
     "not decodable by MuJoCo": "left out of the model (MuJoCo cannot decode them)",
     "flat": 'all vertices in one plane: display only, with inertia="shell" (MuJoCo needs a '
     "volume for the mesh's inertia and a convex hull for contact)",

@@ -4,8 +4,9 @@ The export's own rules (mjcf_mass, mjcf_meshes) follow MuJoCo's compiler, but on
 MuJoCo knows every rule of the version the user runs, so the finished files are
 compiled from memory (the scene, which includes the model, and the meshes as assets):
 a model MuJoCo refuses is never written and the command exits 1 with MuJoCo's reason.
-MuJoCo is a development dependency of armcli, imported only here and only when an
-export runs; without it the report says the model was not compiled.
+MuJoCo is a dependency of armcli (`simulate --cmd-vel` runs on it), imported here only
+when an export runs; an environment without it gets a report saying the model was not
+compiled.
 """
 
 from __future__ import annotations

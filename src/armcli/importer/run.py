@@ -3,23 +3,22 @@
 The import reads links, joints, materials and top-level extensions, decides what the
 spec can type (derived inertials, named materials, Gazebo colours and friction, the
 course's plugins, the arm/base split) and keeps the rest verbatim in `passthrough`.
-It then builds the spec it wrote, in memory with the real xacro, and lists every way
-the result differs from the input (`armcli.importer.compare`): whatever cannot round-trip
-is reported, never silently lost.
+It then builds the spec it wrote, in memory with the safe xacro evaluator `build` uses,
+and lists every way the result differs from the input (`armcli.importer.compare`):
+whatever cannot round-trip is reported, never silently lost.
 """
 
 from __future__ import annotations
 
 import os
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 from lxml import etree
 
-from armcli.compiler.expand import expand_urdfs
 from armcli.compiler.meshfiles import is_path
 from armcli.compiler.xacro_writer import top_level_files
 from armcli.errors import InputError, SpecError
@@ -34,6 +33,7 @@ from armcli.spec.joint_types import ONE_DOF_TYPES
 from armcli.spec.load import loads_spec
 from armcli.spec.model import RobotSpec
 from armcli.urdf.read import parse_root
+from armcli.urdf.source import spec_urdfs
 
 _GAZEBO_NAME = re.compile(r"^[A-Za-z0-9_/]{1,64}$")
 _NOT_NAME = re.compile(r"[^A-Za-z0-9_-]")
@@ -225,11 +225,14 @@ def import_urdf(
     arm_root: str | None = None,
     source_dir: Path | None = None,
     gains: GainSource | None = None,
+    packages: Mapping[str, Path] | None = None,
 ) -> ImportResult:
     """Import URDF bytes (read from `source`) into a spec to be written at `out`.
 
     `source_dir` is where the URDF's relative mesh paths start (default: `source`'s);
-    `gains`, when given, writes start gains for the spec it is shown (`control.gains`).
+    `gains`, when given, writes start gains for the spec it is shown (`control.gains`);
+    `packages`: where the packages its `package://` meshes name were found, recorded in
+    the spec relative to `out` (`packages`), so check, view and ros-package find them.
 
     Raises:
         InputError: the URDF is unusable, or it holds values the spec refuses (listed).
@@ -247,13 +250,19 @@ def import_urdf(
     _colours(parts.links, ext, named)
     split = _choose_split(parts, arm_root, ext)
     data = _assemble(name, parts, named, ext, split)
+    if packages:
+        here = out.parent.absolute()
+        data["packages"] = {
+            n: Path(os.path.relpath(p, here)).as_posix() for n, p in packages.items()
+        }
     header = [
         f"armcli spec imported by `armcli import` from {source}.",
         "`armcli build` turns it back into that URDF; the import listed any difference.",
         "Units: SI (m, kg, s, N, N·m); angles in radians.",
     ]
     comments: dict[str, list[str]] = {
-        "passthrough": [f"Kept verbatim from {source}: elements the spec does not type."]
+        "passthrough": [f"Kept verbatim from {source}: elements the spec does not type."],
+        "packages": ["Where the packages its package:// meshes name are, from this file."],
     }
     text = document(data, header, comments)
     spec = _load(text, out, source)
@@ -267,7 +276,7 @@ def import_urdf(
         ]
         text = document(data, header, comments)
         spec = _load(text, out, source)
-    built = expand_urdfs(spec)
+    built = spec_urdfs(spec)
     main = next(n for n in (f"{spec.name}.urdf", *top_level_files(spec)) if n in built)
     got = etree.fromstring(built[main])
     diffs = compare_urdf(root, got, (base, None))

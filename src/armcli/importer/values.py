@@ -68,8 +68,11 @@ def origin_data(xyz: tuple[float, ...], rpy: tuple[float, ...]) -> dict[str, Any
 
 
 def xml_text(el: etree._Element) -> str:
-    """An element as indented XML text without its tail, for `passthrough`."""
-    copy = etree.fromstring(etree.tostring(el))
-    copy.tail = None
+    """An element as indented XML text without its tail, for `passthrough`.
+
+    The tail (stray text after the element, as in some students' URDFs) is left out
+    before re-parsing: with it the text is not one XML document.
+    """
+    copy = etree.fromstring(etree.tostring(el, with_tail=False))
     etree.indent(copy, space="  ")
     return etree.tostring(copy, encoding="unicode")

@@ -16,6 +16,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from armcli.io.oneline import one_line
 from armcli.spec.expr import eval_expr
 
 PI_DENOMINATORS = (1, 2, 3, 4, 5, 6, 8, 9, 10, 12, 16, 18, 20, 24, 36, 180)
@@ -170,15 +171,16 @@ def document(
 ) -> str:
     """A whole YAML document: `# ` header lines, then the mapping, top-level keys spaced.
 
-    `comments` puts `# ` lines above top-level keys.
+    `comments` puts `# ` lines above top-level keys. Comment text passes through
+    io.oneline (a file name with a newline would otherwise end the comment and add keys).
     """
-    out = [f"# {h}".rstrip() for h in header]
+    out = [f"# {one_line(h)}".rstrip() for h in header]
     first = True
     for key, v in data.items():
         lines = mapping({key: v})
         if not first and len(lines) > 1:
             out.append("")
-        out += [f"# {c}".rstrip() for c in (comments or {}).get(key, ())]
+        out += [f"# {one_line(c)}".rstrip() for c in (comments or {}).get(key, ())]
         out += lines
         first = False
     return "\n".join(out) + "\n"

@@ -20,7 +20,7 @@ import os
 import pwd
 import shutil
 import stat
-from collections.abc import Collection
+from collections.abc import Collection, Sequence
 from pathlib import Path, PurePath, PurePosixPath
 
 from armcli.errors import OutputRefusedError
@@ -108,10 +108,25 @@ def resolve_output_dir(path: str | Path, *, force: bool = False, field: str = "o
     return real
 
 
-def check_output_file(path: str | Path, field: str) -> None:
-    """Refuse an output file path that cannot be written, before any output is written."""
+def check_output_file(
+    path: str | Path, field: str, inputs: Sequence[str | Path] = (), *, parents: bool = False
+) -> None:
+    """Refuse an output file path that cannot be written, before any output is written.
+
+    `inputs`: the files the command reads; writing over one of them (`expand a.xacro -o
+    a.xacro`, hard links and symlinks included) is refused (issue 27).
+    `parents`: the file heads a set written together (export mjcf: model, scene, meshes),
+    whose missing directories are created as `build -o` and `ros-package -o` create theirs.
+    """
     p = Path(path)
     real = Path(os.path.realpath(p))
+    for given in inputs:
+        if os.path.realpath(given) == str(real) or (
+            real.exists() and Path(given).exists() and os.path.samefile(given, real)
+        ):
+            raise OutputRefusedError(
+                f"is the input file {given}; write elsewhere", file=p, field=field
+            )
     if real.is_dir():
         raise OutputRefusedError("is a directory, expected a file path", file=p, field=field)
     if os.path.lexists(real) and not real.is_file():
@@ -120,8 +135,20 @@ def check_output_file(path: str | Path, field: str) -> None:
         )
     if not real.parent.is_dir():  # a typo must not create directories (issue 20)
         _check_parent(real, field)
+        if parents:
+            return
         raise OutputRefusedError(
             f"directory {real.parent} does not exist; create it first", file=p, field=field
+        )
+
+
+def check_png_file(path: str | Path, field: str) -> None:
+    """Refuse a plot path that does not end in .png (the plots are PNG; x.jpg would lie)."""
+    p = Path(path)
+    check_output_file(p, field)
+    if p.suffix.lower() != ".png":
+        raise OutputRefusedError(
+            f"plots are written as PNG; name the file {p.stem or 'plot'}.png", file=p, field=field
         )
 
 

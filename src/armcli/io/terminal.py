@@ -3,8 +3,9 @@
 At a terminal, output fits its width (`COLUMNS` when set, as rich reads it); into a
 file or a pipe it is written at its natural width, never hard-wrapped, so grep and diff
 see whole lines. A `FitTable` keeps every number whole at any width: text columns
-(names) wrap first; when even that cannot fit, each row becomes a block of
-`header value` pairs that wraps between pairs, never inside one.
+(names) wrap first, between words only, so an identifier or a path is never split; when
+even that cannot fit, each row becomes a block of `header value` pairs that wraps between
+pairs, never inside one.
 """
 
 from __future__ import annotations
@@ -14,6 +15,8 @@ import sys
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import IO, Any
+
+from armcli.io.oneline import one_line
 
 UNBOUNDED = 1_000_000  # [columns] "no limit": a file or pipe gets each line whole
 NAME_MIN = 12  # [columns] a wrapped text column keeps at least this many
@@ -66,8 +69,8 @@ class FitTable:
     """A table whose numbers are never cut or ellipsized; see the module docstring.
 
     Cells are strings or rich Text. Number columns are right-aligned and never wrap;
-    text columns wrap (preferably after `_`, `-`, `/`, `.` or a space) down to
-    NAME_MIN; below that, rows are drawn as records. `add_group` starts a group under
+    text columns wrap between words down to their longest word (at least NAME_MIN);
+    below that, rows are drawn as records. `add_group` starts a group under
     a heading line of its own (a joint's name above its rows), which never widens a column.
     """
 
@@ -99,7 +102,8 @@ class FitTable:
         for i, col in enumerate(self.columns):
             head = max(len(line) for line in col.header_lines())
             natural = max([head, *(_len(r[i]) for r in self._rows())])
-            least = natural if col.number else min(natural, max(NAME_MIN, head))
+            word = max([0, *(_longest_word(r[i]) for r in self._rows())])
+            least = natural if col.number else min(natural, max(NAME_MIN, head, word))
             out.append((least, natural))
         return out
 
@@ -195,26 +199,34 @@ class FitTable:
             if kind == "rule":
                 continue
             cols = list(zip(data, self.columns, strict=True))
-            head = Text("  ").join(c for c, col in cols if not col.number and c.plain)
+            names = [c for c, col in cols if not col.number and c.plain]
             pairs = [
                 _text(col.header.replace("\n", " ") + " ").append_text(c)
                 for c, col in cols
                 if col.number
             ]
-            yield Hanging(Text(), head, 0)
+            if names:
+                yield from wrap_parts(names, width, "", "", sep="  ")  # a name is never cut
             yield from wrap_parts(pairs, width, "  ", "  ", sep="   ")
 
 
-BREAK_AFTER = "_-/. "  # a wrapped name is broken after one of these where possible
+BREAK_AFTER = " "  # a wrapped cell breaks between words: never inside a name or a path
+
+
+def _longest_word(cell: Any) -> int:
+    """The longest space-free run of a cell: an identifier or path a column must hold whole."""
+    text = cell.plain if hasattr(cell, "plain") else str(cell)
+    return max((len(w) for w in text.split()), default=0)
 
 
 def fold(cell: Any, width: int) -> list[Any]:
-    """`cell` (rich Text) in lines of at most `width`, broken after BREAK_AFTER if it can."""
+    """`cell` (rich Text) in lines of at most `width`, broken between words if it can."""
     lines = []
     rest = cell.copy()
     while len(rest) > width:
         plain = rest.plain
-        cut = max((i + 1 for i in range(width) if plain[i] in BREAK_AFTER), default=width)
+        # a space at index `width` still ends a line of `width` (the space is dropped)
+        cut = max((i + 1 for i in range(width + 1) if plain[i] in BREAK_AFTER), default=width)
         lines.append(rest[:cut].copy())
         rest = rest[cut:]
         lines[-1].rstrip()
@@ -305,3 +317,35 @@ def _rstrip(line: list[Any]) -> list[Any]:
         last = line[-1]
         return [*line[:-1], Segment(last.text.rstrip(" "), last.style)]
     return line
+
+
+def fit_line(text: str, stream: IO[str] | None = None) -> str:
+    """One plain line for `stream`, wrapped between words at a terminal (or `COLUMNS`).
+
+    Continuation lines are indented two spaces; a word longer than the width (a path) is
+    never cut, so it stays whole on a line of its own. Into a file or pipe the line is
+    whole. Error lines are not for this: they stay one line (`file:line field: problem`).
+    """
+    import textwrap
+
+    width = layout_width(stream)
+    if width is None or len(text) <= width:
+        return text
+    return textwrap.fill(
+        text,
+        width,
+        subsequent_indent="  ",
+        break_long_words=False,
+        break_on_hyphens=False,
+    )
+
+
+def say(text: str, stream: IO[str] | None = None) -> None:
+    """Write `text` (one or more lines) to `stream` (stdout), each escaped and fitted.
+
+    Every line goes through `one_line` (names from files carry no control characters to
+    the terminal or a CI log, issue 27), then `fit_line`.
+    """
+    stream = sys.stdout if stream is None else stream
+    for line in text.rstrip("\n").split("\n"):
+        stream.write(fit_line(one_line(line), stream) + "\n")

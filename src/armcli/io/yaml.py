@@ -77,20 +77,45 @@ def _scan_events(text: str, source: str) -> None:
             if isinstance(ev, yaml.CollectionStartEvent):
                 depth += 1
                 if depth > MAX_YAML_DEPTH:
-                    raise InputError(
-                        f"nesting deeper than {MAX_YAML_DEPTH} levels", file=source, line=line
-                    )
+                    raise _too_deep(source, line)
             elif isinstance(ev, yaml.CollectionEndEvent):
                 depth -= 1
     except yaml.YAMLError as exc:
-        raise _yaml_error(exc, source) from None
+        raise _yaml_error(exc, source, text) from None
 
 
-def _yaml_error(exc: yaml.YAMLError, source: str) -> InputError:
+def _yaml_error(exc: yaml.YAMLError, source: str, text: str = "") -> InputError:
     mark = getattr(exc, "problem_mark", None)
     line = mark.line + 1 if mark is not None else None
     problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+    if "nesting" in problem:  # the parser's own depth guard fired before the event scan's
+        return _too_deep(source, line)
+    if _at_tab(mark, text):  # PyYAML: "found character '\\t' that cannot start any token"
+        where = f", column {mark.column + 1}" if mark is not None else ""
+        return InputError(
+            f"malformed YAML: a tab character{where}; YAML indents with spaces only",
+            file=source,
+            line=line,
+        )
     return InputError(f"malformed YAML: {problem}", file=source, line=line)
+
+
+def _at_tab(mark: Any, text: str) -> bool:
+    """Whether the parser stopped on a tab (libyaml's message hides the character)."""
+    if mark is None:
+        return False
+    lines = text.split("\n")
+    row = lines[mark.line] if 0 <= mark.line < len(lines) else ""
+    return row[mark.column : mark.column + 1] == "\t"
+
+
+# `ros2 topic echo` ends every message with a `---` line: a file saved from it ends so.
+_ECHO_END = re.compile(r"\n---[ \t]*(\n[ \t]*)*\Z")
+
+
+def _too_deep(source: str, line: int | None) -> InputError:
+    """One message for every depth guard (ours, PyYAML's scanner, Python's recursion)."""
+    return InputError(f"nesting deeper than {MAX_YAML_DEPTH} levels", file=source, line=line)
 
 
 def _scalar(node: yaml.ScalarNode, loader: _Loader, path: Path_, doc: YamlDoc) -> Any:
@@ -198,6 +223,7 @@ def loads_yaml(text: str, source: str = "<string>", *, flow_sets: bool = False) 
         raise InputError(f"file larger than {MAX_YAML_BYTES} bytes", file=source)
     if "\x00" in text:
         raise InputError("binary data (NUL byte) in a YAML file", file=source)
+    text = _ECHO_END.sub("\n", text)  # one message saved from `ros2 topic echo`
     _scan_events(text, source)
     loader = _Loader(text)
     doc = YamlDoc(data=None, source=source)
@@ -206,9 +232,9 @@ def loads_yaml(text: str, source: str = "<string>", *, flow_sets: bool = False) 
         if node is not None:
             doc.data = _build(node, loader, (), doc, flow_sets)
     except yaml.YAMLError as exc:
-        raise _yaml_error(exc, source) from None
+        raise _yaml_error(exc, source, text) from None
     except RecursionError:
-        raise InputError("YAML nested too deeply", file=source) from None
+        raise _too_deep(source, None) from None
     finally:
         loader.dispose()
     return doc

@@ -1,6 +1,6 @@
 """Inverse kinematics of the tool point: damped least squares on Pinocchio, random restarts.
 
-The tool point (urdf.tool: the spec's `arm.tool`, else the deepest link) reaches `xyz`
+The tool point (robot.tool: the spec's `arm.tool`, else the deepest link) reaches `xyz`
 [m] in the robot's root frame, and, when `rotation` is given, the tool link's orientation
 matches it. Each attempt iterates dx = Jᵀ (J Jᵀ + λ² I)⁻¹ e from a start (the first
 attempt: `seed_x`; then uniform random joint values from a seeded generator), clipped into

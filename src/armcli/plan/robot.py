@@ -1,7 +1,7 @@
 """The robot a plan moves: Pinocchio model, planned joints and their limits, collision geometry.
 
-`load_plan_robot` is the one place this package loads a model (through urdf.source and
-urdf.pinocchio today; the one Robot of issue 28 once it lands). The whole robot is loaded with
+`load_plan_robot` is the one place this package loads a model (robot.load's checked
+loader; `PlanRobot.q_slow` is `robot.model.Robot.q`). The whole robot is loaded with
 a fixed root, so the arm is checked against its own mobile base. Planned joints are the
 free 1-DoF joints a plan moves; mimic followers follow their leaders; every other joint
 stays at its rest value (0, or the middle of its range when 0 is outside it).
@@ -20,13 +20,13 @@ import numpy as np
 
 from armcli.defaults import DEFAULT_JOINT_ACCELERATION
 from armcli.errors import InputError
+from armcli.robot.load import checked_model
+from armcli.robot.mimic import Mimic, follow, mimics
+from armcli.robot.model import Robot
+from armcli.robot.tool import tool_point
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
-from armcli.urdf.meshes import MeshSearch, mesh_paths
-from armcli.urdf.mimic import Mimic, follow, mimics
-from armcli.urdf.pinocchio import collision_model
-from armcli.urdf.source import RobotFile, checked_model, urdf_text
-from armcli.urdf.tool import tool_point
+from armcli.urdf.meshes import MeshSearch
+from armcli.urdf.source import RobotFile, urdf_text
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -61,33 +61,27 @@ class PlanRobot:
     acceleration_defaulted: tuple[str, ...] = ()  # joints given DEFAULT_JOINT_ACCELERATION
 
     @cached_property
+    def robot(self) -> Robot:
+        """The model's robot handle (`Robot.q` builds the configuration)."""
+        return Robot(self.model)
+
+    @cached_property
     def _layout(self) -> _Layout:
         return _Layout.of(self)
 
     def q(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Pinocchio configuration with the planned joints at `x` and followers following."""
+        """Pinocchio configuration with the planned joints at `x` and followers following.
+
+        Every other 1-DoF joint at its `rest` value; multi-DoF joints stay neutral. Vectorised
+        (`_Layout`, built from and tested against `q_slow`): the planner calls it per state.
+        """
         return self._layout.q(np.asarray(x, dtype=float))
 
     def q_slow(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
-        """`q`, joint by joint through the names (the reference `_Layout` is built from)."""
+        """`q` joint by joint through `Robot.q`."""
         values = dict(self.rest)
         values.update(zip(self.joints, (float(v) for v in x), strict=True))
-        values = follow(self.mimic, values)
-        q = np.zeros(self.model.nq)
-        for jid in range(1, self.model.njoints):
-            jm = self.model.joints[jid]
-            v = values.get(str(self.model.names[jid]), 0.0)
-            if jm.nq == 2 and jm.nv == 1:
-                q[jm.idx_q], q[jm.idx_q + 1] = math.cos(v), math.sin(v)
-            elif jm.nq == 1:
-                q[jm.idx_q] = v
-            else:  # multi-DoF joints stay neutral
-                import pinocchio as pin
-
-                q[jm.idx_q : jm.idx_q + jm.nq] = pin.neutral(self.model)[
-                    jm.idx_q : jm.idx_q + jm.nq
-                ]
-        return q
+        return self.robot.q(follow(self.mimic, values))
 
     def v_indices(self) -> list[int]:
         """Velocity indices of the planned joints in the model (for Jacobians and torques)."""
@@ -177,17 +171,6 @@ def default_joints(urdf: Urdf, spec: RobotSpec | None) -> tuple[str, ...]:
     return tuple(movable)
 
 
-def _collision_geometry(model: Any, urdf: Urdf, search: MeshSearch) -> Any:
-    """The collision shapes, meshes resolved inside the allowed roots only (as `check`)."""
-    meshes = mesh_paths(urdf, search)
-    missing = sorted(uri for uri, p in meshes.items() if p is None or not p.is_file())
-    if missing:
-        raise InputError(f"mesh {missing[0]!r} cannot be found", file=urdf.source)
-    real = {uri: bounded_mesh_file(p, urdf.source) for uri, p in meshes.items() if p is not None}
-    check_total(real.values(), urdf.source)
-    return collision_model(model, with_real_mesh_paths(urdf.text, real), [])
-
-
 def load_plan_robot(
     robot: RobotFile,
     *,
@@ -203,7 +186,7 @@ def load_plan_robot(
     urdf, spec = robot.robot, robot.spec
     model = checked_model(urdf).model
     urdf_text(urdf)  # refuses a non-UTF-8 document before Pinocchio sees it
-    geometry = _collision_geometry(model, urdf, search or MeshSearch())
+    geometry = Robot(model, source=urdf.source, urdf=urdf).collision_model(search or MeshSearch())
     followers = {m.follower for m in mimics(urdf.joints)}
     chosen = tuple(joints) if joints else default_joints(urdf, spec)
     by_name = {j.name: j for j in urdf.joints}

@@ -22,9 +22,9 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import InputError, Problem, SpecError
+from armcli.io.mesh_confine import bounded_mesh_file
+from armcli.io.packages import inside
 from armcli.io.yaml import YamlDoc, dotted, is_finite_number, load_yaml
-from armcli.urdf.mesh_confine import bounded_mesh_file
-from armcli.urdf.packages import inside
 
 WORLD_FRAMES = ("", "world")
 PRIMITIVES = {1: "box", 2: "sphere", 3: "cylinder", 4: "cone"}  # SolidPrimitive constants

@@ -14,17 +14,16 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from armcli.defaults import COLLISION_SAMPLES
 from armcli.errors import BuildError, InputError
+from armcli.robot import sampling
+from armcli.robot.model import Robot
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mimic import Mimic, follow, mimics
-from armcli.urdf.pinocchio import load_model
 from armcli.urdf.read import parse_urdf
 
 DEFAULT_SAMPLES = COLLISION_SAMPLES
@@ -92,40 +91,30 @@ def adjacent_pairs(urdf: Urdf) -> set[tuple[str, str]]:
 
 
 class _Sampler:
-    """Joint configurations for a Pinocchio model: default state and uniform random states.
+    """Joint configurations of a robot: MoveIt's default state and seeded random states.
 
-    Mimic joints (`coupled`) are not drawn: they follow their leaders, as in MoveIt's
-    RobotState.
+    Mimic joints are not drawn: they follow their leaders, as in MoveIt's RobotState.
     """
 
-    def __init__(self, model: Any, coupled: Sequence[Mimic] = ()) -> None:
-        self.model = model
-        self.coupled = list(coupled)
-        followers = {m.follower for m in coupled}
-        self.joints = []  # (name, idx_q, nq, lower, upper) per actuated joint
-        for jid, jm in enumerate(list(model.joints)[1:], start=1):
-            lo = float(model.lowerPositionLimit[jm.idx_q])
-            hi = float(model.upperPositionLimit[jm.idx_q])
-            if jm.nq == 2 and jm.nv == 1:  # continuous revolute joint stored as (cos, sin)
-                lo, hi = -math.pi, math.pi
-            elif jm.nq != 1 or not (math.isfinite(lo) and math.isfinite(hi)):
+    def __init__(self, robot: Robot) -> None:
+        model = robot.model
+        for jm in list(model.joints)[1:]:
+            if jm.nv != 1 or jm.nq not in (1, 2):
                 raise BuildError(f"collision matrix: unsupported joint {jm.shortname()}")
-            self.joints.append((str(model.names[jid]), jm.idx_q, jm.nq, lo, hi))
-        self.free = [j for j in self.joints if j[0] not in followers]
+        for j in robot.joints:
+            if not j.continuous and not (math.isfinite(j.lower) and math.isfinite(j.upper)):
+                raise BuildError(f"collision matrix: joint {j.name!r} has no finite limits")
+        self.robot = robot
+        self.free = robot.leaders
+        self.box = sampling.bounds(self.free)
 
     def _q(self, angles: Iterable[float]) -> np.ndarray:
-        values = follow(self.coupled, {j[0]: x for j, x in zip(self.free, angles, strict=True)})
-        q = np.zeros(self.model.nq)
-        for name, iq, nq, _, _ in self.joints:
-            x = values.get(name, 0.0)
-            if nq == 2:
-                q[iq], q[iq + 1] = math.cos(x), math.sin(x)
-            else:
-                q[iq] = x
-        return q
+        names = (j.name for j in self.free)
+        return self.robot.q(self.robot.follow(dict(zip(names, angles, strict=True))))
 
     def _defaults(self) -> dict[str, float]:
-        return {n: 0.0 if lo <= 0.0 <= hi else 0.5 * (lo + hi) for n, _, _, lo, hi in self.free}
+        return {j.name: 0.0 if lo <= 0.0 <= hi else 0.5 * (lo + hi)
+                for j, (lo, hi) in zip(self.free, self.box, strict=True)}  # fmt: skip
 
     def default(self) -> np.ndarray:
         """MoveIt's default state: 0 where the limits allow it, else the middle of the range."""
@@ -134,24 +123,25 @@ class _Sampler:
     def named(self, values: dict[str, float]) -> np.ndarray:
         """The default state with the named 1-DoF joints set, and their followers."""
         base = self._defaults()
-        one_dof = {n for n, _, nq, _, _ in self.free if nq == 1}
-        base.update((k, v) for k, v in values.items() if k in one_dof)
-        return self._q(base[n] for n, *_ in self.free)
+        base.update((k, v) for k, v in values.items() if k in base)
+        return self._q(base.values())
 
-    def random(self, rng: np.random.Generator) -> np.ndarray:
-        return self._q(rng.uniform(lo, hi) for _, _, _, lo, hi in self.free)
+    def random(self, count: int, seed: int) -> Iterator[np.ndarray]:
+        """`count` seeded uniform states (`robot.sampling.iter_draws`)."""
+        for row in sampling.iter_draws(self.box, count, seed):
+            yield self._q(row)
 
 
 class _Checker:
     """Pinocchio geometry model restricted to candidate link pairs."""
 
-    def __init__(self, xml: str, source: str, candidates: list[tuple[str, str]]) -> None:
+    def __init__(self, robot: Robot, candidates: list[tuple[str, str]]) -> None:
         import pinocchio as pin
 
         self.pin = pin
-        self.model = load_model(source, xml=xml).model
-        self.data = self.model.createData()
-        gmodel = pin.buildGeomFromUrdfString(self.model, xml, pin.GeometryType.COLLISION)
+        self.model = robot.model
+        self.data = robot.data
+        gmodel = robot.collision_model()
         link_of = [self.model.frames[g.parentFrame].name for g in gmodel.geometryObjects]
         wanted = set(candidates)
         self.pair_links: list[tuple[str, str]] = []
@@ -214,8 +204,9 @@ def compute_collision_matrix(
     links = tuple(sorted(lk.name for lk in urdf.links if lk.collisions))
     adjacent = adjacent_pairs(urdf)
     candidates = [p for p in itertools.combinations(links, 2) if p not in adjacent]
-    checker = _Checker(data.decode("utf-8"), source, candidates)
-    sampler = _Sampler(checker.model, mimics(urdf.joints))
+    robot = Robot.from_urdf(urdf)
+    checker = _Checker(robot, candidates)
+    sampler = _Sampler(robot)
     all_k = range(len(checker.pair_links))
     default_hits = checker.colliding(sampler.default(), all_k)
 
@@ -226,9 +217,8 @@ def compute_collision_matrix(
         for a, b in sorted(checker.colliding(sampler.named(values), active))
     ]
     counts = dict.fromkeys(candidates, 0)
-    rng = np.random.default_rng(seed)
-    for _ in range(samples):
-        for key in checker.colliding(sampler.random(rng), active):
+    for q in sampler.random(samples, seed):
+        for key in checker.colliding(q, active):
             counts[key] += 1
     seen = {key for key, c in counts.items() if c > 0} | {(a, b) for _, a, b in in_pose}
     disabled, enabled = _classify(candidates, adjacent, default_hits, seen, counts)

@@ -19,15 +19,13 @@ from typing import Any
 import yaml
 from lxml import etree
 
-from armcli.compiler.expand import expand_urdfs
-from armcli.compiler.massprops import MAX_MESH_BYTES
-from armcli.compiler.meshfiles import MeshNames, package_meshes, package_of, spec_mesh_names
+from armcli.compiler.meshfiles import MeshNames, package_of, spec_mesh_names
 from armcli.compiler.xacro_writer import GENERATED, STANDALONE_ARM, top_level_files, xacro_files
 from armcli.defaults import ROS_TARGETS, STANDALONE_ARM_URDF
 from armcli.errors import InputError
 from armcli.io.files import write_tree_atomic
 from armcli.io.outdir import resolve_output_dir
-from armcli.io.userfile import read_regular
+from armcli.io.packages import PackageLookup
 from armcli.ros import jazzy
 from armcli.ros import moveit as mc
 from armcli.ros.collision_matrix import (
@@ -36,6 +34,7 @@ from armcli.ros.collision_matrix import (
     CollisionMatrix,
     compute_collision_matrix,
 )
+from armcli.ros.copying import mesh_files
 from armcli.ros.jazzy_readme import readme as jazzy_readme
 from armcli.ros.launch import render
 from armcli.ros.ros2_control import moveit_urdf_xacro, ros2_control_xacro
@@ -44,7 +43,9 @@ from armcli.ros.srdf import chain_joints, srdf_bytes
 from armcli.spec.graph import root_links
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
+from armcli.urdf.meshes import localized
 from armcli.urdf.read import parse_urdf
+from armcli.urdf.source import lookup_for, spec_urdfs
 
 FORMAT3_SCHEMA = "http://download.ros.org/schema/package_format3.xsd"
 DISPLAY_RVIZ = "display.rviz"
@@ -233,14 +234,6 @@ def description_files(
     return _package(n.description, about, depends, files, info)
 
 
-def mesh_files(spec: RobotSpec) -> dict[str, bytes]:
-    """The spec's path-named meshes, copied under `meshes/` (bounded regular files)."""
-    out = {}
-    for rel, path in package_meshes(spec).items():
-        out[rel] = read_regular(path, max_bytes=MAX_MESH_BYTES, what="mesh file")
-    return out
-
-
 def bringup_files(n: Names, note: str, info: PackageInfo) -> dict[str, bytes]:
     """The `<name>_bringup` files: a launch file that starts Gazebo with the robot."""
     launch = render("gazebo.launch.py.tmpl", _launch_values(n), note)
@@ -301,11 +294,14 @@ def ros_packages(
     info: PackageInfo = PackageInfo(),
     source: str | None = None,
     target: str = DEFAULT_TARGET,
+    packages: PackageLookup | None = None,
 ) -> RosPackages:
     """All files of the three packages, in memory; deterministic for fixed samples and seed.
 
     `source` (the spec file) is only used to point at it in input errors. `target`
     "jazzy" swaps the Gazebo classic bringup for Gazebo Harmonic + ros2_control.
+    `packages`: where `package://` meshes are (--package-dir, the environment; the spec's
+    recorded `packages` are added), for the collision matrix's geometry.
     """
     if target not in TARGETS:
         raise InputError(f"unknown target {target!r}; known: {', '.join(TARGETS)}")
@@ -313,11 +309,12 @@ def ros_packages(
     mc.controller_update_rate(spec, source)  # refuse bad input before the slow sampling
     if target == "jazzy":
         jazzy.required_gains(spec, source)
-    urdfs = expand_urdfs(spec)
+    urdfs = spec_urdfs(spec)
     urdf_xml = urdfs.get(f"{n.robot}.urdf", urdfs[STANDALONE_ARM_URDF])
     poses = {name: spec.pose(name) for name in spec.poses}
+    local = localized(urdf_xml, source or n.robot_xacro, spec.base_dir, lookup_for(spec, packages))
     matrix = compute_collision_matrix(
-        urdf_xml, samples=samples, seed=seed, source=n.robot_xacro, poses=poses
+        local, samples=samples, seed=seed, source=n.robot_xacro, poses=poses
     )
     note = GENERATED.format(spec=label)
     if target == "jazzy":
@@ -377,6 +374,7 @@ def write_ros_packages(
     info: PackageInfo = PackageInfo(),
     target: str = DEFAULT_TARGET,
     force: bool = False,
+    packages: PackageLookup | None = None,
 ) -> tuple[RosPackages, list[Path]]:
     """Load the spec, build the packages in memory, then write them in one atomic swap."""
     path = Path(spec_path)
@@ -390,5 +388,6 @@ def write_ros_packages(
         info=info,
         source=str(path),
         target=target,
+        packages=packages,
     )
     return pkgs, write_tree_atomic(out_dir, pkgs.files, force=force)

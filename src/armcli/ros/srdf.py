@@ -16,9 +16,9 @@ from __future__ import annotations
 from lxml import etree
 
 from armcli.compiler.xmlfmt import fmt, to_bytes
+from armcli.robot.tool import spec_tool
 from armcli.ros.collision_matrix import CollisionMatrix
 from armcli.spec.model import RobotSpec
-from armcli.urdf.tool import spec_tool
 
 ARM_GROUP = "arm"
 HAND_GROUP = "hand"

@@ -7,8 +7,10 @@ the mapping's keys: ROS 2 sends the distinct keys, in order. So `{0.5, 0.3}` arr
 [0.5, 0.3], but the course's own `{0.0, 0.0}` arrives as [0.0] (the repeated key
 collapses): one position for two joints, which ros2_control's
 joint_trajectory_controller rejects and Gazebo classic's joint_pose_trajectory plugin
-reads past the end of. armcli takes what ROS sends: when it has one value per joint, it is
-used (with a note to write a list); otherwise it is refused with this explanation.
+reads past the end of. The student copied it from the course and means (0, 0), so armcli
+runs the values as written, one per joint, with one warning saying what ROS 2 would send
+and the list to write instead. Only a brace form whose written values do not match the
+joint count (nothing to recover) is refused.
 """
 
 from __future__ import annotations
@@ -29,30 +31,42 @@ def as_list(raw: FlowKeys) -> str:
     return "[" + raw.text.strip()[1:-1].strip() + "]"
 
 
+def _sent_text(sent: list[Any]) -> str:
+    return "[" + ", ".join(str(x) for x in sent) + "]"
+
+
 @dataclass
 class BraceNotes:
     """Reads brace-form vectors of one trajectory and keeps one note for all of them."""
 
     where: list[str] = field(default_factory=list)
     first: str = ""
+    collapsed: bool = False  # the note says a repeated key collapses (the stronger one)
 
     def read(self, raw: FlowKeys, m: int, where: str) -> tuple[list[Any] | None, str]:
-        """(what ROS sends, "") when it has `m` values, else (None, the refusal)."""
-        sent = ros_sends(raw)
-        if len(sent) != m:
-            repeated = " (a repeated key counts once)" if len(sent) < len(raw) else ""
+        """(the values as written, "") when there are `m` of them, else (None, the refusal)."""
+        written, sent = list(raw), ros_sends(raw)
+        if len(written) != m:
             return None, (
-                f"{raw.text} is a YAML mapping, not a list: ROS 2 (`ros2 topic pub`) sends its "
-                f"keys{repeated}, {len(sent)} value(s) for {m} joint(s), which ros2_control's "
-                f"joint_trajectory_controller rejects; write a list: {as_list(raw)}"
+                f"{raw.text} is a YAML mapping, not a list, with {len(written)} value(s) for "
+                f"{m} joint(s) (ROS 2 would send {len(sent)}: {_sent_text(sent)}); "
+                f"write a list of {m} number(s), one per joint name"
             )
-        if not self.where:
+        if len(sent) != len(written) and not self.collapsed:
+            self.collapsed = True
+            self.first = (
+                f"{raw.text} is a YAML mapping, not a list: ROS 2 (`ros2 topic pub`) would "
+                f"send its distinct keys, {len(sent)} value(s) {_sent_text(sent)} for {m} "
+                f"joint(s), which ros2_control's joint_trajectory_controller rejects; armcli "
+                f"runs the {m} values as written; write a list: {as_list(raw)}"
+            )
+        elif not self.where:
             self.first = (
                 f"{raw.text} is a YAML mapping, not a list; ROS 2 (`ros2 topic pub`) sends its "
                 f"keys in order, as armcli reads them; write a list to say so: {as_list(raw)}"
             )
         self.where.append(where)
-        return sent, ""
+        return written, ""
 
     def warnings(self, source: str) -> list[str]:
         """One warning naming every place the brace form was read."""

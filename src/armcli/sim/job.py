@@ -15,6 +15,9 @@ import numpy as np
 
 from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_URDF
 from armcli.errors import InputError
+from armcli.robot.load import checked_model, link_frame
+from armcli.robot.mimic import Mimic, mimics
+from armcli.robot.tool import tool_point
 from armcli.sim.options import SimOptions
 from armcli.sim.plot import plot_steps
 from armcli.sim.reference import Reference, build_reference, coupled
@@ -25,18 +28,15 @@ from armcli.sim.simulate import (
     SimResult,
     arm_from_model,
     check_stability,
-    configuration,
     simulate,
     steps_of,
 )
 from armcli.sim.states import distinct, sample_steps
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.urdf.doc import Urdf
-from armcli.urdf.mimic import Mimic, mimics
 from armcli.urdf.read import parse_urdf
-from armcli.urdf.source import Trust, checked_model, read_urdf_file
-from armcli.urdf.tool import tool_point
-from armcli.urdf.xacro_args import XacroInputs
+from armcli.urdf.source import Trust, read_urdf_file, spec_urdfs
+from armcli.xacro.args import XacroInputs
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -81,9 +81,7 @@ def arm_urdf(
         return read_urdf_file(urdf, trust_xacro=trust_xacro, inputs=inputs)
     if spec is None:
         raise InputError("give a spec or `SimOptions.urdf`", field="SimOptions.urdf")
-    from armcli.compiler.expand import expand_urdfs  # the spec compiler: only for a spec
-
-    return parse_urdf(expand_urdfs(spec)[ARM_URDF], ARM_URDF)
+    return parse_urdf(spec_urdfs(spec)[ARM_URDF], ARM_URDF)
 
 
 def load_arm(
@@ -178,12 +176,13 @@ def _refuse_integral_gain(arm: Arm, spec: RobotSpec | None) -> None:
 
 
 def _tool(arm: Arm, doc: Urdf, spec: RobotSpec | None) -> tuple[int, np.ndarray, str]:
-    """The tool point (armcli.urdf.tool) as (Pinocchio frame id, offset [m], label)."""
+    """The tool point (armcli.robot.tool) as (Pinocchio frame id, offset [m], label)."""
     model = arm.model
     tool = tool_point(doc, spec)
-    if tool is None or not model.existFrame(tool.link):
+    frame = link_frame(model, tool.link) if tool is not None else None
+    if tool is None or frame is None:
         raise InputError("this URDF has no link to report as the end effector", file=doc.source)
-    return model.getFrameId(tool.link), np.array(tool.xyz, dtype=float), tool.label
+    return frame, np.array(tool.xyz, dtype=float), tool.label
 
 
 def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
@@ -248,6 +247,18 @@ def _duration_and_rate(
     return float(total), float(rate)
 
 
+def base_joints(spec: RobotSpec | None) -> dict[str, str]:
+    """The mobile base's joints by name, with what they are (a trajectory may not name them)."""
+    if spec is None or spec.mobile_base is None:
+        return {}
+    return {
+        name: "a wheel joint of the mobile base"
+        if j.type == "continuous"
+        else "a mobile-base joint"
+        for name, j in spec.mobile_base.joints.items()
+    }
+
+
 def prepare(
     spec: RobotSpec | None, opts: SimOptions, *, gate: Callable[[Urdf], None] | None = None
 ) -> SimJob:
@@ -272,10 +283,13 @@ def prepare(
         n: (float(lo), float(hi))
         for n, lo, hi in zip(arm.joint_names, arm.lower, arm.upper, strict=True)
     }
+    others = base_joints(spec)
     if trajectory is not None:
-        traj = load_trajectory(trajectory, limits, clamp=opts.clamp)
+        traj = load_trajectory(trajectory, limits, clamp=opts.clamp, others=others)
     else:
-        traj = loads_trajectory(str(message), limits, source="SimOptions.message", clamp=opts.clamp)
+        traj = loads_trajectory(
+            str(message), limits, source="SimOptions.message", clamp=opts.clamp, others=others
+        )
     pairs = mimic_pairs(doc, arm, traj, str(trajectory) if trajectory else "SimOptions.message")
     q0 = start_state(arm, spec)
     for f, lead, m in pairs:
@@ -308,7 +322,7 @@ def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
     import pinocchio as pin
 
     data = job.arm.model.createData()
-    pin.framesForwardKinematics(job.arm.model, data, configuration(job.arm.model, q))
+    pin.framesForwardKinematics(job.arm.model, data, job.arm.robot.q(q))
     p_root = np.asarray(data.oMf[job.tool_frame].act(job.tool_offset), dtype=float)
     out: np.ndarray = job.T_frame_root[:3, :3] @ p_root + job.T_frame_root[:3, 3]
     return out

@@ -14,7 +14,7 @@ from armcli.errors import InputError
 
 if TYPE_CHECKING:
     from armcli.urdf.source import Trust
-    from armcli.urdf.xacro_args import XacroInputs
+    from armcli.xacro.args import XacroInputs
 
 Integrator = Literal["euler", "rk4"]
 """euler: semi-implicit Euler, Kd and damping implicit (first order; symplectic only for a

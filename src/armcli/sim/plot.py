@@ -29,10 +29,13 @@ def tracking_png(
     res: SimResult,
     effort_limits: np.ndarray | None = None,
     extra_row: Callable[[Sequence[Any]], None] | None = None,
+    rows: int = 1,
+    title: str | None = None,
 ) -> bytes:
     """PNG bytes of a rows = (position, velocity, torque), columns = joints figure.
 
-    `extra_row` draws a fourth row of time plots (the zero-moment point's, sim.tipping).
+    `extra_row` draws `rows` more rows, given their axes row after row (the zero-moment
+    point's, sim.tipping; a drive's path and wheel loads, sim.driveout).
     """
     import matplotlib
 
@@ -40,8 +43,11 @@ def tracking_png(
     import matplotlib.pyplot as plt
 
     n = len(res.joint_names)
-    rows = 3 if extra_row is None else 4
-    fig, axes = plt.subplots(rows, n, figsize=(5.0 * n, 2.5 * rows), sharex=True, squeeze=False)
+    extra = 0 if extra_row is None else rows
+    fig, axes = plt.subplots(3 + extra, n, figsize=(5.0 * n, 2.5 * (3 + extra)), sharex=False,
+                             squeeze=False)  # fmt: skip
+    for ax in axes[: 4 if extra == 1 else 3].ravel()[1:]:  # the time rows (a path is not one)
+        ax.sharex(axes[0, 0])
     t = res.t  # the states the run kept (simulate's plot_steps: dense enough to draw)
     for i, name in enumerate(res.joint_names):
         ax_q, ax_v, ax_t = axes[:3, i]
@@ -65,8 +71,9 @@ def tracking_png(
             ax.grid(True, alpha=0.3)
             ax.legend(loc="best", fontsize=8)
     if extra_row is not None:
-        extra_row(axes[3])
-    fig.suptitle(f"armcli simulate ({res.integrator}, dt = {res.dt:g} s)", fontsize=12)
+        extra_row(list(axes[3:].ravel()) if rows > 1 else axes[3])
+    title = title or f"armcli simulate ({res.integrator}, dt = {res.dt:g} s)"
+    fig.suptitle(title, fontsize=12)
     fig.tight_layout()
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=100, metadata={"Software": None})

@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from armcli.robot.mimic import Mimic
 from armcli.sim.trajectory import Trajectory
-from armcli.urdf.mimic import Mimic
 
 
 @dataclass(frozen=True)

@@ -64,12 +64,20 @@ SUMMARY_HEADERS = (
 
 
 def summary_table(
-    metrics: Sequence[JointMetrics], ee: np.ndarray | None, ee_label: str, res: SimResult
+    metrics: Sequence[JointMetrics],
+    ee: np.ndarray | None,
+    ee_label: str,
+    res: SimResult,
+    engine: str | None = None,
 ) -> Any:
-    """A table (rich renderable, numbers whole at any width); the caller prints it."""
+    """A table (rich renderable, numbers whole at any width); the caller prints it.
+
+    `engine` names another engine than the compiled one (a drive run's MuJoCo).
+    """
+    per_step = f"{res.wall_time * 1e6 / max(1, res.steps):.2f} µs/step"
+    engine = engine or f"{res.integrator}, compiled engine ({per_step})"
     caption = (
-        f"{res.integrator}, dt = {res.dt:g} s, {res.steps} steps, compiled engine "
-        f"({res.wall_time * 1e6 / max(1, res.steps):.2f} µs/step)\n"
+        f"dt = {res.dt:g} s, {res.steps} steps, {engine}\n"
         f"errors q - q_ref; settle: time after the last point until |error| stays "
         f"< {res.settle_tol:g}; stop hits: times a joint stop engaged"
     )

@@ -18,6 +18,7 @@ LocalMessageDefinitionSource does, message encoding `cdr`, and each channel's
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import math
 import re
@@ -32,6 +33,7 @@ import numpy as np
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
 from armcli.io.userfile import open_regular
+from armcli.sim.mcap_guard import check_chunks
 from armcli.sim.simulate import SimResult
 from armcli.sim.states import MAX_REPLAY_ROWS, TIME, Replay, column, sample_states
 from armcli.urdf.doc import Joint, Urdf
@@ -45,6 +47,7 @@ TF_MESSAGE = "tf2_msgs/msg/TFMessage"
 STRING = "std_msgs/msg/String"
 JOINT_STATES, REFERENCE = "/joint_states", "/joint_states_reference"
 TF, TF_STATIC, DESCRIPTION = "/tf", "/tf_static", "/robot_description"
+WORLD = "world"  # a drive's fixed frame: world -> odom -> base is the ground truth
 MAX_REPLAY_BYTES = 1_000_000_000
 
 
@@ -103,7 +106,7 @@ def message_definition(datatype: str) -> str:
 _INFINITE = {"sec": 9223372036, "nsec": 854775807}  # RMW_DURATION_INFINITE
 
 
-def _qos(depth: int, transient_local: bool) -> str:
+def qos(depth: int, transient_local: bool) -> str:
     """`offered_qos_profiles` YAML: reliable, keep last `depth`, volatile or transient local."""
     import yaml
 
@@ -171,14 +174,15 @@ def joint_transform(j: Joint, value: float) -> tuple[np.ndarray, np.ndarray]:
 # -- messages --------------------------------------------------------------------------------
 
 
-def _stamp(ns: int) -> dict[str, int]:
+def stamp(ns: int) -> dict[str, int]:
+    """builtin_interfaces/Time of a time [ns]."""
     return {"sec": ns // 1_000_000_000, "nanosec": ns % 1_000_000_000}
 
 
 def _transform(j: Joint, value: float, ns: int) -> dict[str, Any]:
     t, r = joint_transform(j, value)
     return {
-        "header": {"stamp": _stamp(ns), "frame_id": j.parent},
+        "header": {"stamp": stamp(ns), "frame_id": j.parent},
         "child_frame_id": j.child,
         "transform": {
             "translation": dict(zip("xyz", map(float, t), strict=True)),
@@ -188,7 +192,7 @@ def _transform(j: Joint, value: float, ns: int) -> dict[str, Any]:
 
 
 def _joint_state(ns: int, names: Sequence[str], **arrays: Sequence[float]) -> dict[str, Any]:
-    msg: dict[str, Any] = {"header": {"stamp": _stamp(ns), "frame_id": ""}, "name": list(names)}
+    msg: dict[str, Any] = {"header": {"stamp": stamp(ns), "frame_id": ""}, "name": list(names)}
     for key in ("position", "velocity", "effort"):
         msg[key] = [float(x) for x in arrays.get(key, [])]
     return msg
@@ -208,6 +212,7 @@ def channels(cols: Mapping[str, np.ndarray], names: Sequence[str], urdf: Urdf) -
     """Every topic of the file from the sampled states `cols` (sim.states' columns)."""
     stamps = [round(float(t) * 1e9) for t in cols[TIME]]
     state, ref, tf = [], [], []
+    tracked = [n for n in names if column(n, "reference") in cols]  # a wheel has no reference
     moving = [j for j in urdf.joints if j.type != "fixed" and j.movable]
     for k, ns in enumerate(stamps):
         values = {n: float(cols[column(n, "position")][k]) for n in names}
@@ -215,20 +220,20 @@ def channels(cols: Mapping[str, np.ndarray], names: Sequence[str], urdf: Urdf) -
             ns, names, **{f: [cols[column(n, f)][k] for n in names]
                           for f in ("position", "velocity", "effort")},
         )))  # fmt: skip
-        ref.append((ns, _joint_state(ns, names, position=[cols[column(n, "reference")][k]
-                                                          for n in names])))  # fmt: skip
+        ref.append((ns, _joint_state(ns, tracked, position=[cols[column(n, "reference")][k]
+                                                            for n in tracked])))  # fmt: skip
         tf.append((ns, {"transforms": [_transform(j, values.get(j.name, 0.0), ns)
                                        for j in moving]}))  # fmt: skip
     fixed = [j for j in urdf.joints if j.type == "fixed"]
     start = stamps[0]
     text = urdf.text.decode("utf-8")
     return [
-        Channel(DESCRIPTION, STRING, _qos(1, True), [(start, {"data": text})]),
-        Channel(TF_STATIC, TF_MESSAGE, _qos(1, True),
+        Channel(DESCRIPTION, STRING, qos(1, True), [(start, {"data": text})]),
+        Channel(TF_STATIC, TF_MESSAGE, qos(1, True),
                 [(start, {"transforms": [_transform(j, 0.0, start) for j in fixed]})]),
-        Channel(JOINT_STATES, JOINT_STATE, _qos(10, False), state),
-        Channel(REFERENCE, JOINT_STATE, _qos(10, False), ref),
-        Channel(TF, TF_MESSAGE, _qos(100, False), tf),
+        Channel(JOINT_STATES, JOINT_STATE, qos(10, False), state),
+        Channel(REFERENCE, JOINT_STATE, qos(10, False), ref),
+        Channel(TF, TF_MESSAGE, qos(100, False), tf),
     ]  # fmt: skip
 
 
@@ -301,16 +306,21 @@ def load_replay(path: str | Path, joints: Sequence[str]) -> Replay:
 
     source = str(path)
     rows: dict[str, list[tuple[float, dict[str, float]]]] = {JOINT_STATES: [], REFERENCE: []}
+    bases: dict[int, np.ndarray] = {}
     count = 0
     try:  # a regular file of bounded size (a FIFO blocked open() forever), bounded messages
         with open_regular(path, max_bytes=MAX_REPLAY_BYTES, what="MCAP file") as fh:
+            check_chunks(fh, source)  # chunks inflate within a bound, or one error (issue 27)
             reader = make_reader(fh, decoder_factories=[DecoderFactory()])
             for _, channel, _raw, msg in reader.iter_decoded_messages(
-                topics=[JOINT_STATES, REFERENCE]
+                topics=[JOINT_STATES, REFERENCE, TF]
             ):
                 count += 1
-                if count > 2 * MAX_REPLAY_ROWS:
+                if count > 3 * MAX_REPLAY_ROWS:
                     raise InputError(f"more than {MAX_REPLAY_ROWS:,} states", file=source)
+                if channel.topic == TF:  # a drive's world -> odom -> base: where the robot is
+                    _collect_base(msg, bases)
+                    continue
                 t = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
                 known = {n: float(x) for n, x in zip(msg.name, msg.position, strict=False)}
                 mine = {n: v for n, v in known.items() if n in joints}
@@ -319,11 +329,41 @@ def load_replay(path: str | Path, joints: Sequence[str]) -> Replay:
                     raise InputError(f"{channel.topic} at t = {t:g} s: {bad[0]} is not finite",
                                      file=source)  # fmt: skip
                 rows[channel.topic].append((t, mine))
+    except InputError:
+        raise
     except (McapError, OSError, ValueError, KeyError) as exc:
         raise InputError(f"unreadable MCAP file: {exc}", file=source) from None
+    except Exception as exc:  # the CDR decoder of a crafted message: struct.error, IndexError...
+        why = f"a message does not decode ({type(exc).__name__}: {exc}"[:200] + ")"
+        raise InputError(f"unreadable MCAP file: {why}", file=source) from None
     if not rows[JOINT_STATES]:
         raise InputError(f"no {JOINT_STATES} messages", file=source)
-    return _replay(source, rows[JOINT_STATES], rows[REFERENCE])
+    replay = _replay(source, rows[JOINT_STATES], rows[REFERENCE])
+    stamps = [round(t * 1e9) for t in replay.time]
+    if bases and all(ns in bases for ns in stamps):
+        return dataclasses.replace(replay, base=np.array([bases[ns] for ns in stamps]))
+    return replay
+
+
+def _collect_base(msg: Any, bases: dict[int, np.ndarray]) -> None:
+    """The root's pose (x, y, z, w, x, y, z) from a /tf message holding world -> A -> B."""
+    by_parent = {tr.header.frame_id: tr for tr in msg.transforms}
+    first = by_parent.get(WORLD)
+    second = by_parent.get(first.child_frame_id) if first is not None else None
+    if first is None or second is None:
+        return
+    p1, q1 = _tf_parts(first.transform)
+    p2, q2 = _tf_parts(second.transform)
+    p, q = p1 + _rotate(q1, p2), _quat_mul(q1, q2)
+    values = np.array([*p, q[3], q[0], q[1], q[2]], dtype=float)
+    if np.all(np.isfinite(values)):
+        stamp = first.header.stamp
+        bases[stamp.sec * 1_000_000_000 + stamp.nanosec] = values
+
+
+def _tf_parts(tr: Any) -> tuple[np.ndarray, np.ndarray]:
+    t, r = tr.translation, tr.rotation
+    return np.array([t.x, t.y, t.z], dtype=float), np.array([r.x, r.y, r.z, r.w], dtype=float)
 
 
 def _replay(

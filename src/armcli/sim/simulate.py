@@ -27,19 +27,21 @@ import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
+from functools import cached_property
 from typing import Any
 
 import numpy as np
 
 from armcli.defaults import DEFAULT_DT
 from armcli.errors import InputError, SimulationError
+from armcli.robot.load import mass_matrix
+from armcli.robot.model import Robot
 from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim import stability as stab
 from armcli.sim import verdict as verdicts
 from armcli.sim.options import INTEGRATORS, Integrator
 from armcli.sim.reference import Reference
-from armcli.urdf.pinocchio import mass_matrix
 
 VEL_ABORT_FACTOR = 10.0  # divergence when |v| exceeds this times the URDF velocity limit
 DEFAULT_VABORT = 1000.0  # [rad/s or m/s] when the URDF gives no velocity limit
@@ -63,6 +65,11 @@ class Arm:
     velocity: np.ndarray  # [rad/s or m/s]; <= 0 or inf: none
     damping: np.ndarray  # [N·m·s/rad or N·s/m]
     friction: np.ndarray  # [N·m or N]
+
+    @cached_property
+    def robot(self) -> Robot:
+        """The model's robot handle (`Robot.q` turns the simulator's q into Pinocchio's)."""
+        return Robot(self.model)
 
     def __post_init__(self) -> None:
         n = len(self.joint_names)
@@ -140,18 +147,9 @@ class SimResult:
 
 def arm_from_model(model: Any, joints: Sequence[str] | None = None) -> Arm:
     """Keep `joints` (all by default) movable and lock the others at their neutral value."""
-    import pinocchio as pin
-
-    names = list(model.names)[1:]
-    chosen = list(joints) if joints else names
-    for name in chosen:
-        if name not in names:
-            raise InputError(f"unknown joint {name!r}; valid: {', '.join(names)}", field="joints")
-    if len(set(chosen)) != len(chosen):
-        raise InputError("a joint is listed twice", field="joints")
-    lock = [model.getJointId(nm) for nm in names if nm not in chosen]
-    if lock:
-        model = pin.buildReducedModel(model, lock, pin.neutral(model))
+    robot = Robot(model)
+    robot = robot.reduced(list(joints)) if joints else robot
+    model = robot.model
     for jid in range(1, model.njoints):
         j = model.joints[jid]
         if j.nv != 1 or j.nq not in (1, 2):
@@ -161,43 +159,18 @@ def arm_from_model(model: Any, joints: Sequence[str] | None = None) -> Arm:
                 "to lock it)",
                 field="joints",
             )
-    order = list(model.names)[1:]  # simulated in model (tree) order whatever --joints says
-    iq = [model.idx_qs[j] for j in range(1, model.njoints)]
-    bounded = np.array([model.nqs[j] == 1 for j in range(1, model.njoints)])
-    # a continuous joint's angle is unbounded: no stops (Pinocchio's limits are on cos, sin)
-    lower = np.where(bounded, np.array(model.lowerPositionLimit, dtype=float)[iq], -np.inf)
-    upper = np.where(bounded, np.array(model.upperPositionLimit, dtype=float)[iq], np.inf)
-    effort = np.array(model.effortLimit, dtype=float)
-    effort = np.where((effort > 0) & np.isfinite(effort), effort, np.inf)
+    table = robot.joints  # simulated in model (tree) order whatever --joints says
     return Arm(
         model=model,
-        joint_names=tuple(order),
-        lower=lower,
-        upper=upper,
-        effort=effort,
-        velocity=np.array(model.velocityLimit, dtype=float),
-        damping=np.array(model.damping, dtype=float),
-        friction=np.array(model.friction, dtype=float),
+        joint_names=robot.names,
+        # a continuous joint's angle is unbounded: no stops (Pinocchio's limits are on cos, sin)
+        lower=np.array([j.lower for j in table]),
+        upper=np.array([j.upper for j in table]),
+        effort=np.array([j.effort for j in table]),
+        velocity=np.array([j.velocity for j in table]),
+        damping=np.array([j.damping for j in table]),
+        friction=np.array([j.friction for j in table]),
     )
-
-
-def configuration(model: Any, q: np.ndarray) -> np.ndarray:
-    """Pinocchio's configuration vector of the joint positions `q` [rad or m], one per joint.
-
-    The simulator's state holds a continuous joint's angle, unbounded; Pinocchio holds
-    (cos, sin) of it (nq = 2, nv = 1).
-    """
-    q = np.asarray(q, dtype=float)
-    if model.nq == model.nv:
-        return q
-    out = np.empty(model.nq)
-    for i, jid in enumerate(range(1, model.njoints)):
-        k = model.idx_qs[jid]
-        if model.nqs[jid] == 2:
-            out[k], out[k + 1] = np.cos(q[i]), np.sin(q[i])
-        else:
-            out[k] = q[i]
-    return out
 
 
 def plant_of(arm: Arm, cfg: SimConfig, energy_max: float = np.inf) -> ro.Plant:
@@ -230,7 +203,7 @@ def check_stability(arm: Arm, cfg: SimConfig, configurations: np.ndarray) -> Non
 
     Raises UnstableLoopError, which names no option: the command says where dt came from.
     """
-    qs = [configuration(arm.model, q) for q in configurations]
+    qs = [arm.robot.q(q) for q in configurations]
     lin = stab.linearise(arm.model, qs, gravity=not cfg.gravity_comp)
     pd = stab.PD.of(range(arm.model.nv), cfg.kp, cfg.kd, arm.damping)
     scheme: stab.Scheme = "rk4" if cfg.integrator == "rk4" else "implicit"
@@ -330,7 +303,7 @@ def _run(r: Run, compiled: Any, progress: Callable[[int, int], None] | None) -> 
 
 def _energy_max(arm: Arm, q0: np.ndarray, vabort: np.ndarray) -> float:
     """[J] A kinetic energy no run within the velocity limits reaches: a blow-up beyond it."""
-    M = mass_matrix(arm.model, arm.model.createData(), configuration(arm.model, q0))
+    M = mass_matrix(arm.model, arm.model.createData(), arm.robot.q(q0))
     return float(0.5 * np.max(np.linalg.eigvalsh(M)) * np.sum(vabort**2))
 
 

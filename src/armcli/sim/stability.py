@@ -45,7 +45,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from armcli.urdf.pinocchio import mass_matrix
+from armcli.robot.load import mass_matrix
 
 # The loop counts as stable when its step map does not grow: spectral radius <= 1 + RADIUS_TOL
 # (RK4 and reports), or A + PSD_RTOL * 4M positive definite (Euler). Undamped symplectic

@@ -94,7 +94,8 @@ def output_format(path: Path) -> str:
     ext = path.suffix.lower()
     if ext not in (".csv", ".json"):
         raise InputError(
-            f"unknown output format {ext or '(none)'!r}; use .csv or .json", field="output"
+            f"unknown output format {ext or '(none)'!r}; use .csv, .json or .mcap",
+            field="output",
         )
     return ext[1:]
 
@@ -122,6 +123,7 @@ class Replay:
     time: np.ndarray
     position: dict[str, np.ndarray]
     reference: dict[str, np.ndarray] = field(default_factory=dict)
+    base: np.ndarray | None = None  # (N, 7) root in the world: x, y, z [m], w, x, y, z (a drive)
 
     @property
     def duration(self) -> float:
@@ -131,6 +133,14 @@ class Replay:
     def positions_at(self, t: float) -> dict[str, float]:
         """Linearly interpolated joint positions at time t [s] (clamped to the record)."""
         return {j: float(np.interp(t, self.time, v)) for j, v in self.position.items()}
+
+    def base_at(self, t: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """The root's position [m] and unit quaternion (w, x, y, z) at t, or None (no drive)."""
+        if self.base is None:
+            return None
+        row = np.array([np.interp(t, self.time, self.base[:, i]) for i in range(7)])
+        quat = row[3:] / max(float(np.linalg.norm(row[3:])), 1e-12)
+        return row[:3], quat
 
     def reference_at(self, t: float) -> dict[str, float] | None:
         """The reference pose at t [s], or None where the file gives no reference then."""
@@ -172,4 +182,23 @@ def load_replay(path: str | Path, joints: Sequence[str]) -> Replay:
         time=t,
         position={j: table.values[:, i] for j, i in pos_cols.items()},
         reference={j: table.values[:, i] for j, i in ref_cols.items()},
+        base=_base_pose(header, table.values),
     )
+
+
+BASE_COLUMNS = tuple(f"base.{c}" for c in ("x", "y", "z", "roll", "pitch", "yaw"))
+
+
+def _base_pose(header: Sequence[str], values: np.ndarray) -> np.ndarray | None:
+    """(N, 7) x, y, z, w, x, y, z of a drive's `base.*` columns, else None."""
+    if not all(c in header for c in BASE_COLUMNS):
+        return None
+    x, y, z, roll, pitch, yaw = (values[:, list(header).index(c)] for c in BASE_COLUMNS)
+    cr, sr = np.cos(roll / 2), np.sin(roll / 2)
+    cp, sp = np.cos(pitch / 2), np.sin(pitch / 2)
+    cy, sy = np.cos(yaw / 2), np.sin(yaw / 2)
+    w = cr * cp * cy + sr * sp * sy  # R = Rz(yaw) Ry(pitch) Rx(roll), as URDF's rpy
+    qx = sr * cp * cy - cr * sp * sy
+    qy = cr * sp * cy + sr * cp * sy
+    qz = cr * cp * sy - sr * sp * cy
+    return np.column_stack([x, y, z, w, qx, qy, qz])

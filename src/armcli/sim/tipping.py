@@ -16,19 +16,21 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from armcli.analysis.ground import mesh_loader
+from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
 from armcli.errors import InputError, TipOverError
+from armcli.robot.tool import tool_point
 from armcli.sim import job as simjob
 from armcli.sim import zmp as zmps
+from armcli.sim.excursion import Excursion, excursions
 from armcli.sim.job import SimJob
 from armcli.sim.options import SimOptions
 from armcli.sim.simulate import SimResult
 from armcli.sim.states import sample_steps
 from armcli.urdf.doc import Urdf
-from armcli.urdf.ground import mesh_loader
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_urdf
-from armcli.urdf.stance import NoStance, Payload, Stance, stance_of
-from armcli.urdf.tool import tool_point
+from armcli.urdf.source import lookup_for, spec_urdfs
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -87,10 +89,8 @@ def robot_urdf(spec: RobotSpec | None, job: SimJob) -> Urdf | None:
         and job.urdf.source.endswith(".urdf")
         and (spec.mounted_base() is not None)
     ):
-        from armcli.compiler.expand import expand_urdfs  # the spec compiler: only for a spec
-
         name = f"{spec.name}.urdf"
-        return parse_urdf(expand_urdfs(spec)[name], name)
+        return parse_urdf(spec_urdfs(spec)[name], name)
     return job.urdf
 
 
@@ -111,6 +111,7 @@ def prepare(
     else:
         return None
     missing: list[str] = []
+    search = lookup_for(spec, search)  # the packages the spec records too
     found = stance_of(urdf, candidates=candidates, declared=opts.contact_links,
                       mesh=mesh_loader(urdf, search, missing), payload=payload)  # fmt: skip
     if isinstance(found, NoStance):
@@ -120,7 +121,7 @@ def prepare(
     if missing_joints:
         notes.append(f"no zero-moment point: {', '.join(missing_joints)} not in {urdf.source}")
         return None
-    accel, source = _base_accel(opts, urdf)
+    accel, source = _base_accel(opts, urdf, plugin_default=False)
     return Tipping(found, accel, source, opts.min_margin)
 
 
@@ -144,9 +145,16 @@ def trajectory_zmp(
     return report(tip, tip.series(job, res))
 
 
-def _base_accel(opts: TipOptions, urdf: Urdf) -> tuple[float, str]:
+def _base_accel(opts: TipOptions, urdf: Urdf, plugin_default: bool = True) -> tuple[float, str]:
+    """The base's acceleration: the option's, else a base at rest or the plugin's limit.
+
+    `simulate` assumes no acceleration nobody asked for; `check --trajectory` keeps its
+    worst case (`plugin_default`): the diff-drive plugin's max_wheel_acceleration.
+    """
     if opts.base_accel is not None:
         return opts.base_accel, "--base-accel"
+    if not plugin_default:
+        return 0.0, "a base at rest (--base-accel adds one)"
     limit = zmps.drive_acceleration(urdf)
     if limit is not None:
         return limit, "the diff-drive plugin's max_wheel_acceleration"
@@ -195,11 +203,17 @@ class ZmpReport:
     max_base_accel: float  # [m/s²] the largest that keeps the margin >= 0 at every state
     max_base_accel_margin: float  # [m/s²] the largest that keeps it >= threshold
     impacts: int  # states left out: joint-stop impacts
+    excursions: tuple[Excursion, ...] = ()  # the point outside the polygon, interval by interval
 
     @property
     def tips(self) -> bool:
-        """Whether the point leaves the polygon."""
-        return self.min_margin < 0
+        """Whether an excursion of the point rotates the robot over a support edge."""
+        return any(e.tips for e in self.excursions)
+
+    @property
+    def lifts(self) -> tuple[Excursion, ...]:
+        """The excursions too short to tip the robot: a wheel lifts off for an instant."""
+        return tuple(e for e in self.excursions if not e.tips)
 
     @property
     def when(self) -> str:
@@ -228,6 +242,7 @@ def report(tip: Tipping, series: zmps.ZmpSeries) -> ZmpReport:
         max_base_accel=zmps.max_base_accel(series, poly, 0.0),
         max_base_accel_margin=zmps.max_base_accel(series, poly, tip.threshold),
         impacts=series.impacts,
+        excursions=excursions(tip.stance, series),
     )
 
 
@@ -240,6 +255,9 @@ def summary_line(r: ZmpReport) -> str:
         what = (
             f"TIPS: {-r.min_margin * 1e3:.1f} mm outside the support polygon toward {r.direction}"
         )
+    elif r.min_margin < 0:
+        what = (f"{-r.min_margin * 1e3:.1f} mm outside toward {r.direction} for "
+                f"{sum(e.duration for e in r.lifts):.3f} s: a wheel lifts off, no tip")  # fmt: skip
     else:
         what = f"least margin {r.min_margin * 1e3:.1f} mm toward {r.direction}"
     left = f"; {r.impacts} joint-stop impact(s) left out" if r.impacts else ""
@@ -252,12 +270,15 @@ def summary_line(r: ZmpReport) -> str:
 
 def tip_error(r: ZmpReport) -> TipOverError:
     """The error a run that tips the robot over ends with (after its files are written)."""
+    e = next(e for e in r.excursions if e.tips)
+    accel = f" at {r.base_accel:g} m/s²" if e.case != zmps.CASES[0] else ""
     return TipOverError(
-        f"the robot tips over: its zero-moment point is {-r.min_margin * 1e3:.1f} mm outside "
-        f"the support polygon toward {r.direction} at t = {r.time:.3f} s ({r.when})",
-        time=r.time,
-        margin=r.min_margin,
-        case=r.case,
+        f"the robot tips over: its zero-moment point is up to {e.depth * 1e3:.1f} mm outside "
+        f"the support polygon toward {e.direction} from t = {e.start:.3f} s for "
+        f"{e.duration:.3f} s ({e.case}{accel}), long enough to rotate it over that edge",
+        time=e.start,
+        margin=-e.depth,
+        case=e.case,
     )
 
 

@@ -18,10 +18,12 @@ of 0 would ask for an instantaneous jump.
 
 from __future__ import annotations
 
+import difflib
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -34,6 +36,7 @@ DEFAULT_SEGMENT_S = 1.0  # [s] time given to a point without time_from_start
 MIN_SEGMENT_S = 1e-6  # [s] shorter segments make the interpolated reference overflow
 MAX_TIME_S = 1e6  # [s] ~11.6 days: far beyond any simulation worth running step by step
 LIMIT_TOL = 1e-9  # [rad] slack when comparing positions with joint limits
+CUTOFF = 0.6  # difflib similarity below which no "did you mean" is offered (spec.suggest's)
 _TOP_KEYS = {"header", "joint_names", "points"}
 _POINT_KEYS = {"positions", "velocities", "accelerations", "effort", "time_from_start"}
 _HEADER_KEYS = {"frame_id", "stamp", "seq"}
@@ -59,10 +62,15 @@ class Trajectory:
 
 
 def load_trajectory(
-    path: str | Path, limits: Mapping[str, tuple[float, float]], *, clamp: bool = False
+    path: str | Path,
+    limits: Mapping[str, tuple[float, float]],
+    *,
+    clamp: bool = False,
+    others: Mapping[str, str] = MappingProxyType({}),
 ) -> Trajectory:
     """Read and validate a trajectory file; `limits` maps each valid joint to (lower, upper)."""
-    return parse_trajectory(load_yaml(path, flow_sets=True), limits, clamp=clamp)
+    doc = load_yaml(path, flow_sets=True)
+    return parse_trajectory(doc, limits, clamp=clamp, others=others)
 
 
 def loads_trajectory(
@@ -71,9 +79,11 @@ def loads_trajectory(
     *,
     source: str = "<message>",
     clamp: bool = False,
+    others: Mapping[str, str] = MappingProxyType({}),
 ) -> Trajectory:
     """Validate a trajectory given as text, e.g. the `ros2 topic pub` payload."""
-    return parse_trajectory(loads_yaml(text, source, flow_sets=True), limits, clamp=clamp)
+    doc = loads_yaml(text, source, flow_sets=True)
+    return parse_trajectory(doc, limits, clamp=clamp, others=others)
 
 
 class _Collector:
@@ -81,35 +91,75 @@ class _Collector:
         self.doc = doc
         self.problems: list[Problem] = []
         self.braces = BraceNotes()
+        self.repeats: dict[tuple[str, ...], list[int]] = {}  # one message, counted, per typo
 
     def add(self, path: tuple[str | int, ...], msg: str) -> None:
         self.problems.append(Problem(dotted(path), msg, self.doc.line_of(path)))
 
+    def once(self, path: tuple[str | int, ...], msg: str, key: tuple[str, ...] = ()) -> None:
+        """Add the problem once per `key`, counting the repeats.
+
+        The default key is the place without indices and the message (`points[*].postions`).
+        """
+        shape = key or (*(str(p) for p in path if not isinstance(p, int)), msg)
+        if shape in self.repeats:
+            self.repeats[shape][1] += 1
+            return
+        self.repeats[shape] = [len(self.problems), 0]
+        self.add(path, msg)
+
+    def finish(self) -> list[Problem]:
+        """The problems, each repeated one saying how many more places repeat it."""
+        out = list(self.problems)
+        for index, more in self.repeats.values():
+            if more:
+                p = out[index]
+                out[index] = Problem(p.field, f"{p.message} (and {more} more)", p.line)
+        return out
+
     def unknown_keys(
         self, data: Mapping[str, Any], allowed: set[str], path: tuple[str | int, ...]
-    ) -> None:
+    ) -> set[str]:
+        """Report keys outside `allowed` (did you mean ...?); the keys they suggest."""
+        meant = set()
         for key in data:
             if key not in allowed:
-                self.add((*path, key), f"unknown key; expected one of {', '.join(sorted(allowed))}")
+                close = difflib.get_close_matches(str(key), sorted(allowed), n=1, cutoff=CUTOFF)
+                hint = f"did you mean {close[0]!r}?" if close else "expected one of"
+                meant.update(close)
+                self.once((*path, key), f"unknown key; {hint} {_listed(allowed)}".rstrip())
+        return meant
+
+
+def _listed(allowed: set[str]) -> str:
+    return f"(valid: {', '.join(sorted(allowed))})"
 
 
 def parse_trajectory(
-    doc: YamlDoc, limits: Mapping[str, tuple[float, float]], *, clamp: bool = False
+    doc: YamlDoc,
+    limits: Mapping[str, tuple[float, float]],
+    *,
+    clamp: bool = False,
+    others: Mapping[str, str] = MappingProxyType({}),
 ) -> Trajectory:
-    """Validate parsed YAML into a Trajectory, reporting every problem with its location."""
+    """Validate parsed YAML into a Trajectory, reporting every problem with its location.
+
+    `others`: the robot's joints that are not arm joints, by name, with what they are
+    ("a wheel joint"), so naming one says so rather than "unknown joint".
+    """
     c = _Collector(doc)
     data = doc.data
     if not isinstance(data, dict):
         raise SpecError(doc.source, [Problem("", "a trajectory must be a YAML mapping", 1)])
     c.unknown_keys(data, _TOP_KEYS, ())
     frame_id = _frame_id(data.get("header"), c)
-    names = _joint_names(data.get("joint_names"), limits, c)
+    names = _joint_names(data.get("joint_names"), limits, c, others)
     raw_points = data.get("points")
     if not isinstance(raw_points, list) or not raw_points:
         c.add(("points",), "needs a non-empty list of points")
         raw_points = []
     if c.problems:
-        raise SpecError(doc.source, c.problems)
+        raise SpecError(doc.source, c.finish())
     m = len(names)
     fields: dict[str, list[list[float] | None]] = {
         "positions": [],
@@ -121,21 +171,20 @@ def parse_trajectory(
         if not isinstance(point, dict):
             c.add(("points", k), "a point must be a mapping")
             continue
-        c.unknown_keys(point, _POINT_KEYS, ("points", k))
-        for key in fields:
-            fields[key].append(
-                _vector(point.get(key), m, ("points", k, key), c, key == "positions")
-            )
+        meant = c.unknown_keys(point, _POINT_KEYS, ("points", k))
+        for key in fields:  # a misspelt `positions` is reported once, not also as missing
+            required = key == "positions" and key not in meant
+            fields[key].append(_vector(point.get(key), m, ("points", k, key), c, required))
         if "effort" in point:
             _vector(point["effort"], m, ("points", k, "effort"), c, False)
         times.append(_time(point, times, k, c))
     _consistent(fields, c)
     if c.problems:
-        raise SpecError(doc.source, c.problems)
+        raise SpecError(doc.source, c.finish())
     pos = np.array(fields["positions"], dtype=float)
     warnings = _check_limits(pos, names, limits, clamp, c)
     if c.problems:
-        raise SpecError(doc.source, c.problems)
+        raise SpecError(doc.source, c.finish())
     vel, acc = fields["velocities"], fields["accelerations"]
     return Trajectory(
         joint_names=tuple(names),
@@ -163,15 +212,23 @@ def _frame_id(header: Any, c: _Collector) -> str:
     return frame
 
 
-def _joint_names(raw: Any, limits: Mapping[str, Any], c: _Collector) -> list[str]:
+def _joint_names(
+    raw: Any, limits: Mapping[str, Any], c: _Collector, others: Mapping[str, str]
+) -> list[str]:
     valid = ", ".join(limits)
     if not isinstance(raw, list) or not raw:
         c.add(("joint_names",), f"needs a non-empty list of joint names; valid: {valid}")
         return []
     seen: set[str] = set()
     for i, name in enumerate(raw):
-        if not isinstance(name, str) or name not in limits:
-            c.add(("joint_names", i), f"unknown joint {name!r}; valid: {valid}")
+        if isinstance(name, str) and name in others:
+            c.add(
+                ("joint_names", i), f"{name!r} is {others[name]}, not an arm joint; valid: {valid}"
+            )
+        elif not isinstance(name, str) or name not in limits:
+            close = difflib.get_close_matches(str(name), list(limits), n=1, cutoff=CUTOFF)
+            hint = f"did you mean {close[0]!r}? " if close else ""
+            c.add(("joint_names", i), f"unknown joint {name!r}; {hint}valid: {valid}")
         elif name in seen:
             c.add(("joint_names", i), f"joint {name!r} listed twice")
         seen.add(str(name))
@@ -222,8 +279,14 @@ def _short(x: Any) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
-def _time(point: dict[str, Any], previous: Sequence[float], k: int, c: _Collector) -> float:
-    path: tuple[str | int, ...] = ("points", k, "time_from_start")
+def _time(
+    point: dict[str, Any], previous: Sequence[float], k: int, c: _Collector, key: str = "points"
+) -> float:
+    """`time_from_start` of entry `k` of the list `key` [s] (seconds or {sec, nanosec}).
+
+    Missing: DEFAULT_SEGMENT_S after the previous entry. sim.cmdvel reads its times so too.
+    """
+    path: tuple[str | int, ...] = (key, k, "time_from_start")
     last = previous[-1] if previous else 0.0
     raw = point.get("time_from_start")
     if raw is None:
@@ -252,7 +315,7 @@ def _time(point: dict[str, Any], previous: Sequence[float], k: int, c: _Collecto
     elif t > MAX_TIME_S:
         c.add(path, f"must be <= {MAX_TIME_S:g} s, got {t:g}")
     elif previous and t <= last:
-        c.add(path, f"times must increase: {t:g} s is not after point {k - 1} at {last:g} s")
+        c.add(path, f"times must increase: {t:g} s is not after {key[:-1]} {k - 1} at {last:g} s")
     elif 0 < t - last < MIN_SEGMENT_S:
         c.add(
             path,
@@ -288,6 +351,7 @@ def _check_limits(
     c: _Collector,
 ) -> list[str]:
     warnings = []
+    degrees = _looks_like_degrees(pos, names, limits)
     for k in range(pos.shape[0]):
         for i, name in enumerate(names):
             lo, hi = limits[name]
@@ -296,9 +360,30 @@ def _check_limits(
                 continue
             where = dotted(("points", k, "positions", i))
             msg = f"{x:g} is outside the limits of {name} [{lo:g}, {hi:g}]"
-            if clamp:
+            if degrees:
+                c.once(
+                    ("points", k, "positions", i),
+                    f"{msg}: looks like degrees: {x:g}° = {math.radians(x):.3f} rad; "
+                    "positions are radians",
+                    key=("degrees",),
+                )
+            elif clamp:
                 pos[k, i] = min(max(x, lo), hi)
                 warnings.append(f"{c.doc.source} {where}: {msg}; clamped to {pos[k, i]:g}")
             else:
-                c.add(("points", k, "positions", i), msg + " (use --clamp to clamp)")
+                c.once(
+                    ("points", k, "positions", i), f"{msg} (use --clamp to clamp)", ("limit", name)
+                )
     return warnings
+
+
+def _looks_like_degrees(
+    pos: np.ndarray, names: Sequence[str], limits: Mapping[str, tuple[float, float]]
+) -> bool:
+    """Some position beyond a full turn, and every position within its limits in radians."""
+    if not np.any(np.abs(pos) > 2 * math.pi):
+        return False
+    rad = np.radians(pos)
+    lo = np.array([limits[n][0] for n in names]) - LIMIT_TOL
+    hi = np.array([limits[n][1] for n in names]) + LIMIT_TOL
+    return bool(np.all((rad >= lo) & (rad <= hi)))

@@ -25,16 +25,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from armcli.analysis.stance import Stance
+from armcli.analysis.support import SupportPolygon
+from armcli.robot.model import Joint, Robot
 from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_root
-from armcli.urdf.stance import Stance
-from armcli.urdf.support import SupportPolygon
 
 MAX_SAMPLES = 20_000  # states whose zero-moment point is computed, at most (pairs of steps)
 CASES = ("arm motion", "accelerating", "braking")
@@ -56,6 +57,9 @@ class ZmpSeries:
     threshold: float  # [m] margin below which the report warns
     impacts: int = 0  # kept states left out: a joint hit its hard stop in that step
     shift: NDArray[np.float64] | None = None  # (K,) [m per m/s²] backward x shift per a_b
+    # per state whose point leaves the polygon: the centre of mass [m] and the rotational
+    # inertia about it [kg·m²] (root axes), for the tipping bound (sim.tipping.excursions)
+    bodies: dict[int, tuple[NDArray[np.float64], NDArray[np.float64]]] = field(default_factory=dict)
 
     def worst(self) -> tuple[int, int]:
         """(state index, case index) of the least margin."""
@@ -147,15 +151,16 @@ def zmp_series(
     data = model.createData()
     rows, a = accelerations(np.asarray(step), np.asarray(v), dt, impact)
     skipped = 0 if impact is None else int(np.sum(np.asarray(impact, dtype=bool)))
-    cols = _columns(model, joint_names)
-    q_full = np.asarray(pin.neutral(model), dtype=float)
+    cols = _columns(stance.robot, joint_names)
+    q_full = stance.robot.neutral()
     mass = float(sum(inertia.mass for inertia in model.inertias))
     z0 = stance.ground.height
     zmp = np.empty((len(rows), 3, 2))
     margin = np.empty((len(rows), 3))
     shift = np.empty(len(rows))
+    bodies: dict[int, tuple[NDArray[np.float64], NDArray[np.float64]]] = {}
     for i, r in enumerate(rows):
-        qk, vk, ak = _state(model, cols, q_full, q[r], v[r], a[i])
+        qk, vk, ak = _state(stance.robot, cols, q_full, q[r], v[r], a[i])
         w = np.asarray(pin.rnea(model, data, qk, vk, ak)[:6], dtype=float)
         c = np.asarray(pin.centerOfMass(model, data, qk, False), dtype=float)
         dw = mass * np.array([1.0, 0.0, 0.0, 0.0, c[2], -c[1]])  # d wrench / d a_b
@@ -164,8 +169,11 @@ def zmp_series(
             p = zero_moment_point(w + sign * base_accel * dw, z0)
             zmp[i, j] = p
             margin[i, j] = stance.polygon.margin(p) if np.all(np.isfinite(p)) else -math.inf
+        if np.min(margin[i]) < 0:
+            pin.ccrba(model, data, qk, np.zeros(model.nv))
+            bodies[i] = (c, np.array(data.Ig.inertia, dtype=float))
     return ZmpSeries(np.asarray(t)[rows], np.asarray(step)[rows], zmp, margin,
-                     float(base_accel), float(threshold), skipped, shift)  # fmt: skip
+                     float(base_accel), float(threshold), skipped, shift, bodies)  # fmt: skip
 
 
 def max_base_accel(series: ZmpSeries, polygon: SupportPolygon, threshold: float) -> float:
@@ -201,28 +209,22 @@ def zero_moment_point(wrench: NDArray[Any], ground: float = 0.0) -> NDArray[np.f
     return np.array([-ny / f[2], nx / f[2]])
 
 
-def _columns(model: Any, names: Sequence[str]) -> list[tuple[int, int, bool]]:
-    """(idx_q, idx_v, continuous) in the whole robot of each simulated joint."""
-    out = []
-    for name in names:
-        if not model.existJointName(name):
-            raise ValueError(f"joint {name!r} is not in the whole robot")
-        j = model.joints[model.getJointId(name)]
-        out.append((j.idx_q, j.idx_v, j.nq == 2))
-    return out
+def _columns(robot: Robot, names: Sequence[str]) -> list[Joint]:
+    """Each simulated joint in the whole robot."""
+    known = set(robot.names)
+    missing = [n for n in names if n not in known]
+    if missing:
+        raise ValueError(f"joint {missing[0]!r} is not in the whole robot")
+    return [robot.joint(n) for n in names]
 
 
 def _state(
-    model: Any, cols: list[tuple[int, int, bool]], q0: NDArray[Any], q: NDArray[Any],
+    robot: Robot, cols: list[Joint], q0: NDArray[Any], q: NDArray[Any],
     v: NDArray[Any], a: NDArray[Any],
 ) -> tuple[NDArray[Any], NDArray[Any], NDArray[Any]]:  # fmt: skip
-    qk = q0.copy()
-    vk = np.zeros(model.nv)
-    ak = np.zeros(model.nv)
-    for (iq, iv, cont), x, xd, xdd in zip(cols, q, v, a, strict=True):
-        if cont:
-            qk[iq], qk[iq + 1] = math.cos(x), math.sin(x)
-        else:
-            qk[iq] = x
-        vk[iv], ak[iv] = xd, xdd
+    qk = robot.q(q, joints=cols, base=q0)
+    vk = np.zeros(robot.model.nv)
+    ak = np.zeros(robot.model.nv)
+    iv = [j.idx_v for j in cols]
+    vk[iv], ak[iv] = v, a
     return qk, vk, ak

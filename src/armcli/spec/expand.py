@@ -8,6 +8,7 @@ the spec: the compiler writes them back as xacro macro calls.
 
 from __future__ import annotations
 
+from armcli.defaults import MAX_ROBOT_DOF, MAX_ROBOT_LINKS
 from armcli.errors import Problem
 from armcli.spec.model import Arm, MobileBase, RobotSpec
 from armcli.spec.parts import part_root, placed_joints, placed_links, placed_names
@@ -34,11 +35,38 @@ def _expand_part(
     return holder.model_copy(update={"links": links, "joints": joints})
 
 
+def _size_problem(spec: RobotSpec) -> Problem | None:
+    """The robot's size after expansion, counted before any part is expanded (issue 27).
+
+    100 placements of a 50-link part (a 19 kB spec) kept `build` busy for minutes.
+    """
+    links, dof = len(spec.all_links()), sum(j.type != "fixed" for j in spec.all_joints().values())
+    for p in (*spec.arm.parts, *(spec.mobile_base.parts if spec.mobile_base else [])):
+        part = spec.parts.get(p.part)
+        if part is not None:
+            links += len(part.links)
+            dof += (p.type != "fixed") + sum(j.type != "fixed" for j in part.joints.values())
+    where = "arm.parts" if spec.arm.parts else "mobile_base.parts"
+    if links > MAX_ROBOT_LINKS:
+        return Problem(
+            where, f"the parts expand to {links} links, more than armcli's {MAX_ROBOT_LINKS}"
+        )
+    if dof > MAX_ROBOT_DOF:
+        return Problem(
+            where,
+            f"the parts expand to {dof} degrees of freedom, more than armcli's {MAX_ROBOT_DOF}",
+        )
+    return None
+
+
 def expand_parts(spec: RobotSpec) -> tuple[RobotSpec, list[Problem]]:
     """The spec with every placement's links and joints added, and the problems found."""
     placements = [*spec.arm.parts, *(spec.mobile_base.parts if spec.mobile_base else [])]
     if not placements:
         return spec, []
+    too_big = _size_problem(spec)
+    if too_big is not None:
+        return spec, [too_big]
     out: list[Problem] = []
     base = spec.mobile_base
     taken = set(spec.all_links()) | set(spec.all_joints())

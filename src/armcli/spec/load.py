@@ -16,6 +16,11 @@ from armcli.spec.model import RobotSpec
 from armcli.spec.semantics import semantic_problems
 from armcli.spec.suggest import did_you_mean
 
+MASS_REMEDY = (
+    "; a massless link has no inertia to simulate: give its real mass (a few grams for a "
+    "sensor or frame), or make it a fixed frame without geometry"
+)
+
 
 def _pydantic_problems(exc: ValidationError, doc: YamlDoc) -> list[Problem]:
     out = []
@@ -26,6 +31,8 @@ def _pydantic_problems(exc: ValidationError, doc: YamlDoc) -> list[Problem]:
             msg = msg[len("Value error, ") :]
         if err["type"] == "extra_forbidden":
             msg = "unknown key" + did_you_mean(RobotSpec, loc)
+        elif err["type"] == "greater_than" and loc and loc[-1] == "mass":
+            msg += MASS_REMEDY
         out.append(Problem(dotted(loc), msg, doc.line_of(loc)))
     return out
 

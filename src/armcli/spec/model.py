@@ -10,6 +10,7 @@ cross-references (parents exist, one root, plugin joints exist) are checked in
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -45,7 +46,7 @@ from armcli.spec.shapes import (
     Shape,
     Sphere,
 )
-from armcli.spec.types import Name, NonNeg, Positive, Real, RobotName, UrdfName, Vec3, _Model
+from armcli.spec.types import Name, NonNeg, Positive, Real, RobotName, Text, UrdfName, Vec3, _Model
 
 __all__ = [
     "Arm",
@@ -94,7 +95,7 @@ __all__ = [
 
 
 class DiffDrive(_Model):
-    """gazebo_ros_diff_drive parameters."""
+    """gazebo_ros_diff_drive parameters; `simulate --cmd-vel` drives the robot with them."""
 
     update_rate: Positive = Field(description="plugin update rate [Hz]")
     left_joint: UrdfName = Field(description="left wheel joint name")
@@ -249,12 +250,27 @@ class RobotSpec(_Model):
         [],
         description="URDF elements kept verbatim (what `armcli import` could not type)",
     )
+    packages: dict[UrdfName, Text] = Field(
+        {},
+        description="where the ROS packages named by `package://` meshes are: NAME -> its "
+        "directory (holding its package.xml), relative to this spec; `armcli import` writes "
+        "it; `--package-dir` overrides",
+    )
     _source: Path | None = PrivateAttr(None)
 
     @property
     def base_dir(self) -> Path:
         """The directory relative mesh paths start from: the spec file's (else the cwd)."""
         return self._source.parent if self._source is not None else Path(".")
+
+    @property
+    def source_file(self) -> str:
+        """The spec file's name for messages ("<spec>" when built in memory)."""
+        return str(self._source) if self._source is not None else "<spec>"
+
+    def package_dirs(self) -> dict[str, Path]:
+        """`packages` with each directory from the spec file's directory."""
+        return {name: self.base_dir / rel for name, rel in self.packages.items()}
 
     def with_source(self, path: Path) -> RobotSpec:
         """This spec, remembering the file it was read from (for relative mesh paths)."""
@@ -316,10 +332,14 @@ class RobotSpec(_Model):
 
 
 def _tree_order(joints: dict[str, Joint], root: str) -> Iterator[tuple[str, Joint]]:
-    frontier = [root]
+    """Joints breadth-first from `root`, siblings in spec order (linear in the tree's size)."""
+    below: dict[str, list[tuple[str, Joint]]] = {}
+    for name, j in joints.items():
+        below.setdefault(j.parent, []).append((name, j))
+    frontier, seen = deque([root]), {root}
     while frontier:
-        link = frontier.pop(0)
-        for name, j in joints.items():
-            if j.parent == link:
-                yield name, j
+        for name, j in below.get(frontier.popleft(), ()):
+            yield name, j
+            if j.child not in seen:  # a link with two parents is reported, not looped over
+                seen.add(j.child)
                 frontier.append(j.child)

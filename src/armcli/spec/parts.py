@@ -24,7 +24,9 @@ from armcli.spec.joints import Dynamics, Joint, Limit, Mimic
 from armcli.spec.shapes import Geometry, Inertia, Link, Mesh, Origin, Shape
 from armcli.spec.types import Name, UrdfName, Vec3, _Model
 
-Prefix = Annotated[str, Field(pattern=r"^[A-Za-z0-9_./-]*$", max_length=64)]
+# path-like segments (`left/`), but no segment starts with `.` or `/`: `../../x/` and `/abs_`
+# made names no link may have (issue 27: an internal error instead of the field's)
+Prefix = Annotated[str, Field(pattern=r"^(?:[A-Za-z0-9_][A-Za-z0-9_.-]*/?)*$", max_length=64)]
 
 
 class Part(_Model):

@@ -74,9 +74,15 @@ def template_files(name: str) -> dict[str, bytes]:
         spec=SPEC_FILE.as_posix(),
         pose=t.pose,
         pick=(TRAJECTORY_DIR / "pick.yaml").as_posix(),
-        trajectories=", ".join(f"`{(TRAJECTORY_DIR / f.name).as_posix()}`" for f in trajectories),
+        trajectories=", ".join(_listed(f.name, f.read_text("utf-8")) for f in trajectories),
     ).encode("utf-8")
     return files
+
+
+def _listed(name: str, text: str) -> str:
+    """How the README lists an example: a /cmd_vel command file says what it is for."""
+    path = f"`{(TRAJECTORY_DIR / name).as_posix()}`"
+    return f"{path} (/cmd_vel commands for `simulate --cmd-vel`)" if "\ncommands:" in text else path
 
 
 def init_project(directory: str | Path, template: str = DEFAULT_TEMPLATE) -> list[Path]:

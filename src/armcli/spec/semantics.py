@@ -179,8 +179,15 @@ def _tree_problems(part: str, links: dict[str, Link], joints: dict[str, Joint], 
         add((part, "links"), f"exactly one root link expected, found {len(roots)}: {roots}")
         return
     reached = {roots[0]}
-    for _ in range(len(links)):
-        reached |= {j.child for j in joints.values() if j.parent in reached}
+    below: dict[str, list[str]] = {}
+    for j in joints.values():
+        below.setdefault(j.parent, []).append(j.child)
+    frontier = [roots[0]]  # one pass over the tree: linear in its size
+    while frontier:
+        for child in below.get(frontier.pop(), ()):
+            if child not in reached:
+                reached.add(child)
+                frontier.append(child)
     orphans = sorted(set(links) - reached)
     if orphans:
         add((part, "joints"), f"links not connected to root {roots[0]!r}: {orphans}")

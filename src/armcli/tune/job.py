@@ -14,7 +14,6 @@ from pathlib import Path
 
 import numpy as np
 
-from armcli.compiler.expand import expand_urdfs
 from armcli.errors import InputError
 from armcli.io.yaml import load_yaml
 from armcli.sim.job import ARM_URDF, SETTLE_EXTRA_S, start_state
@@ -30,6 +29,7 @@ from armcli.tune.model_gains import (
     start_gains,
 )
 from armcli.tune.problem import Case, TuneProblem, draw_variants, nominal_arm
+from armcli.urdf.source import spec_urdfs
 
 DEFAULT_ZETA = 1.0  # critically damped
 MAX_ROBUST = 1000  # perturbed models per candidate
@@ -132,7 +132,7 @@ def prepare(
 ) -> TuneJob:
     """Validate every input and build the job; raises InputError/SpecError on bad input."""
     _validate(s)
-    xml = expand_urdfs(spec)[ARM_URDF].decode("utf-8")
+    xml = spec_urdfs(spec)[ARM_URDF].decode("utf-8")
     base = TuneProblem(xml, ARM_URDF, tuple(s.joints or ()), spec.control.dt, "euler",
                        bool(spec.control.gravity_compensation), s.loop, 1.0, (), ())  # fmt: skip
     arm = nominal_arm(base)

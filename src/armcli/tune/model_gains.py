@@ -1,6 +1,7 @@
 """The model-based start: PD gains from the joint-space inertia, no rollouts.
 
-Per joint j, over a sample of the joint range (Pinocchio CRBA), with m_j = max M_jj:
+Per joint j, over a sample of the joint range (`robot.sampling`, the one `check` takes;
+Pinocchio CRBA), with m_j = max M_jj:
 
     kp_j = m_j wn_j²,   kd_j = 2 zeta sqrt(kp_j m_j) = 2 zeta wn_j m_j
 
@@ -21,7 +22,6 @@ The full gain vector is then verified on every sampled M with the verdict of
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -30,15 +30,13 @@ import numpy as np
 
 from armcli.defaults import PD_LOOPS
 from armcli.errors import InputError
+from armcli.robot import sampling
+from armcli.robot.model import span
 from armcli.sim import stability as stab
-from armcli.sim.simulate import Arm, configuration
+from armcli.sim.simulate import Arm
 
 TARGET_RATIO = 10.0  # wn <= 2 pi f_c / TARGET_RATIO for a loop closed at f_c [Hz]
 STABILITY_MARGIN = 2.0  # gains must be stable at this multiple of dt
-GRID_POINTS = 5  # per joint while the grid has at most MAX_GRID samples
-MAX_GRID = 125
-RANDOM_SAMPLES = 100
-SAMPLE_SEED = 0
 WN_BRACKET = (1e-6, 1e9)  # [rad/s] search interval for the stability cap
 SCALE_FLOOR = 1e-9  # smallest common kp scale the coupled check tries
 LOOPS = PD_LOOPS
@@ -78,15 +76,8 @@ class StartGains:
 
 
 def sample_configurations(arm: Arm) -> np.ndarray:
-    """Joint-space sample: a full grid for few joints, else seeded uniform draws."""
-    n = len(arm.joint_names)
-    lo = np.where(np.isfinite(arm.lower), arm.lower, -math.pi)
-    hi = np.where(np.isfinite(arm.upper), arm.upper, math.pi)
-    if GRID_POINTS**n <= MAX_GRID:
-        axes = [np.linspace(a, b, GRID_POINTS) for a, b in zip(lo, hi, strict=True)]
-        return np.array(list(itertools.product(*axes)), dtype=float)
-    rng = np.random.default_rng(SAMPLE_SEED)
-    return np.vstack([np.clip(np.zeros(n), lo, hi), rng.uniform(lo, hi, size=(RANDOM_SAMPLES, n))])
+    """The joint-space sample `check` takes too (`robot.sampling.joint_space`), (N, n)."""
+    return sampling.joint_space([span(lo, hi) for lo, hi in zip(arm.lower, arm.upper, strict=True)])
 
 
 def linearised(arm: Arm, qs: np.ndarray, *, gravity: bool) -> stab.Linearised:
@@ -94,7 +85,7 @@ def linearised(arm: Arm, qs: np.ndarray, *, gravity: bool) -> stab.Linearised:
 
     `gravity=False` (gravity compensation) gives zero stiffness.
     """
-    return stab.linearise(arm.model, [configuration(arm.model, q) for q in qs], gravity=gravity)
+    return stab.linearise(arm.model, [arm.robot.q(q) for q in qs], gravity=gravity)
 
 
 def gravity_max(arm: Arm, qs: np.ndarray) -> np.ndarray:
@@ -106,7 +97,7 @@ def gravity_max(arm: Arm, qs: np.ndarray) -> np.ndarray:
     for q in qs:
         worst = np.maximum(
             worst,
-            np.abs(pin.computeGeneralizedGravity(arm.model, data, configuration(arm.model, q))),
+            np.abs(pin.computeGeneralizedGravity(arm.model, data, arm.robot.q(q))),
         )
     return worst
 

@@ -15,12 +15,12 @@ from typing import Any
 
 import numpy as np
 
+from armcli.robot.load import load_model
 from armcli.sim.options import Integrator
 from armcli.sim.reference import Reference
 from armcli.sim.simulate import Arm, arm_from_model
 from armcli.sim.stability import Linearised
 from armcli.tune.model_gains import linearised, sample_configurations
-from armcli.urdf.pinocchio import load_model
 
 _CACHE: dict[str, tuple[Scored, ...]] = {}
 _LOCK = threading.Lock()

@@ -12,16 +12,25 @@ import math
 
 import numpy as np
 
-from armcli.compiler.expand import expand_urdfs
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import InputError
-from armcli.sim.simulate import arm_from_model
+from armcli.robot.load import load_model
+from armcli.sim.simulate import Arm, arm_from_model
 from armcli.spec.joint_types import LIMITED_TYPES
 from armcli.spec.model import RobotSpec
-from armcli.tune.model_gains import TARGET_RATIO, start_gains
-from armcli.urdf.pinocchio import load_model
+from armcli.tune.model_gains import (
+    TARGET_RATIO,
+    _largest,
+    linearised,
+    loop_stable,
+    sample_configurations,
+    start_gains,
+)
+from armcli.urdf.source import spec_urdfs
 
 STEP_CAP = math.pi / 2  # [rad or m] the largest step the start gains are sized for
+KD_FLOOR = 1e-6  # smallest Kd scale tried for the explicit loop
+KD_MARGIN = 0.4  # below the edge on tune's samples: check samples other points (OMX: x0.48)
 
 
 def spec_start_gains(spec: RobotSpec) -> dict[str, tuple[float, float]]:
@@ -37,7 +46,7 @@ def spec_start_gains(spec: RobotSpec) -> dict[str, tuple[float, float]]:
     ]
     if not joints:
         return {}
-    xml = expand_urdfs(spec)[STANDALONE_ARM_URDF].decode("utf-8")
+    xml = spec_urdfs(spec)[STANDALONE_ARM_URDF].decode("utf-8")
     arm = arm_from_model(load_model(STANDALONE_ARM_URDF, xml=xml).model, joints)
     steps = np.minimum(
         np.where(np.isfinite(arm.upper - arm.lower), arm.upper - arm.lower, STEP_CAP), STEP_CAP
@@ -51,7 +60,25 @@ def spec_start_gains(spec: RobotSpec) -> dict[str, tuple[float, float]]:
         return {}  # an effort limit below gravity: no start gains; tune says why
     except np.linalg.LinAlgError:
         return {}  # a massless chain (singular mass matrix): nothing to size gains on; check says
+    kd = _explicit_kd(arm, start.kp, start.kd, spec.control.dt)
     return {
-        name: (float(kp), float(kd))
-        for name, kp, kd in zip(arm.joint_names, start.kp, start.kd, strict=True)
+        name: (float(kp), float(kd_j))
+        for name, kp, kd_j in zip(arm.joint_names, start.kp, kd, strict=True)
     }
+
+
+def _explicit_kd(arm: Arm, kp: np.ndarray, kd: np.ndarray, dt: float) -> np.ndarray:
+    """kd, lowered until the explicit torque loop (Gazebo's) is stable at dt too.
+
+    `check` judges both loops; the implicit start alone left the imported OpenManipulator-X
+    with `pd-explicit-unstable` (Kd too high for its light links at dt = 1 ms). Lower Kd
+    only makes that loop more stable, and the simulator's implicit loop stays stable.
+    Unchanged when no Kd makes it stable (then `check` says why).
+    """
+    lin = linearised(arm, sample_configurations(arm), gravity=True)
+    if loop_stable(arm, lin, kp, kd, "explicit", dt):
+        return kd
+    if not loop_stable(arm, lin, kp, 0.0 * kd, "explicit", dt):
+        return kd
+    s = _largest(lambda s: loop_stable(arm, lin, kp, s * kd, "explicit", dt), KD_FLOOR, 1.0)
+    return kd * s * KD_MARGIN

@@ -6,9 +6,11 @@ at the line; numbers that did not parse are kept as `NumberProblem`s.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from armcli.spec.joint_types import JOINT_DOF
+from armcli.xacro.lines import Origin
 
 Vec3 = tuple[float, float, float]
 ZERO3: Vec3 = (0.0, 0.0, 0.0)
@@ -79,7 +81,7 @@ class Link:
 
 @dataclass(frozen=True)
 class Limit:
-    """A <limit>: lower/upper [rad or m], effort [N·m or N], velocity, acceleration [rad/s(²)]."""
+    """A <limit>: lower/upper [rad or m], effort [N·m or N], velocity, acceleration [/s, /s²]."""
 
     lower: float | None
     upper: float | None
@@ -140,6 +142,8 @@ class Urdf:
     problems: tuple[NumberProblem, ...] = field(default=())
     line: int | None = None  # the <robot> element's
     notes: tuple[str, ...] = ()  # `note: ...`/`warning: ...` lines: xacro arguments used, ...
+    # a xacro expansion's element lines -> where they were written (xacro.lines); empty else
+    origins: Mapping[int, Origin] = field(default_factory=dict)
 
     def link(self, name: str) -> Link | None:
         """The link called `name`, or None."""

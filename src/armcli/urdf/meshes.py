@@ -1,6 +1,6 @@
 """Mesh URIs -> local files, one resolver for every command (check, view, render, export).
 
-`package://NAME/...` resolves through armcli.urdf.packages (--package-dir,
+`package://NAME/...` resolves through armcli.io.packages (--package-dir,
 AMENT_PREFIX_PATH, ROS_PACKAGE_PATH, the enclosing package); relative URIs start at
 the URDF's directory. A resolved path must lie inside the allowed roots (see
 `confined`), so a hostile URDF cannot make armcli read `/etc/passwd` as a mesh.
@@ -12,17 +12,27 @@ import os
 from pathlib import Path
 from urllib.parse import unquote, urlparse
 
+from armcli.errors import InputError
+from armcli.io.packages import PackageLookup, inside, parse_package_dirs, real_roots
 from armcli.urdf.doc import Urdf
-from armcli.urdf.packages import PackageLookup, inside, parse_package_dirs, real_roots
 from armcli.urdf.source import allowed_roots
 
 # The CLI's package options as the mesh resolver sees them (one lookup for meshes and $(find)).
 MeshSearch = PackageLookup
-__all__ = ["MeshSearch", "confined", "mesh_paths", "package_root", "parse_package_dirs", "resolve"]
+__all__ = [
+    "MeshSearch",
+    "confined",
+    "localized",
+    "mesh_hint",
+    "mesh_paths",
+    "package_root",
+    "parse_package_dirs",
+    "resolve",
+]
 
 
 def package_root(name: str, base_dir: Path, search: MeshSearch) -> Path | None:
-    """Where package `name` lives (armcli.urdf.packages' order), or None."""
+    """Where package `name` lives (armcli.io.packages' order), or None."""
     return search.find(name, base_dir)
 
 
@@ -36,7 +46,10 @@ def resolve(uri: str, base_dir: Path, search: MeshSearch) -> Path | None:
         root = package_root(name, base_dir, search)
         return root / rel if root is not None else None
     if parsed.scheme == "file":
-        return Path(unquote(parsed.path))
+        # file:////abs/path (COBOTTA) is file:///abs/path: POSIX keeps a leading `//` in
+        # a path as a different root, which made the package lookup miss the file.
+        path = unquote(parsed.path)
+        return Path("/" + path.lstrip("/") if path.startswith("/") else path)
     if parsed.scheme:
         return None
     p = Path(uri)
@@ -82,3 +95,42 @@ def confined(uri: str, path: Path, base_dir: Path, search: MeshSearch) -> bool:
     if owner is not None:
         roots += real_roots(owner)
     return inside(path, roots)
+
+
+def mesh_hint(uri: str) -> str:
+    """The option that makes `uri` findable: `--package-dir NAME=PATH` for its package."""
+    parsed = urlparse(uri)
+    if parsed.scheme == "package":
+        name = parsed.netloc or unquote(parsed.path).lstrip("/").partition("/")[0]
+        return (
+            f"pass --package-dir {name}=PATH (the directory holding its package.xml) or "
+            "put it on AMENT_PREFIX_PATH / ROS_PACKAGE_PATH"
+        )
+    return "fix the path (relative paths start at the robot file's directory)"
+
+
+def localized(xml: bytes, source: str, base_dir: Path, search: MeshSearch) -> bytes:
+    """The URDF with every collision mesh URI replaced by its local file, for Pinocchio.
+
+    Pinocchio resolves `package://` its own way (a list of parent directories) and fails
+    with a bare ValueError; armcli's lookup (and confinement) decides instead, and a mesh
+    it cannot find is an InputError naming the mesh and the option that fixes it.
+    """
+    from lxml import etree
+
+    from armcli.io.mesh_confine import _safe_xml, bounded_mesh_file
+
+    root = etree.fromstring(xml, _safe_xml())
+    changed = False
+    collision_meshes = [m for c in root.iter("collision") for m in c.iter("mesh")]
+    for el in collision_meshes:  # visual meshes are not loaded (another package's may be absent)
+        uri = el.get("filename")
+        if not uri:
+            continue
+        path = resolve(uri, base_dir, search)
+        if path is None or not path.is_file() or not confined(uri, path, base_dir, search):
+            why = "its package is unknown" if path is None else f"no file {path}"
+            raise InputError(f"mesh {uri!r} not found ({why}): {mesh_hint(uri)}", file=source)
+        el.set("filename", str(bounded_mesh_file(path, source)))  # size, bombs (issue 27)
+        changed = True
+    return etree.tostring(root) if changed else xml

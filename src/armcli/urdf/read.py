@@ -14,9 +14,12 @@ from pathlib import Path
 
 from lxml import etree
 
+from armcli.defaults import MAX_ROBOT_DOF, MAX_ROBOT_LINKS
 from armcli.errors import InputError, XacroRefusedError
+from armcli.io.oneline import one_line
 from armcli.io.userfile import read_regular
 from armcli.spec.joint_types import total_dof
+from armcli.spec.xacro_names import xacro_use
 from armcli.urdf.doc import (
     ZERO3,
     Geometry,
@@ -37,8 +40,8 @@ MAX_URDF_DEPTH = 32
 # 256 links and ~20 s at 500; Pinocchio's Data grows ~cubically with the DoF (19 MB at
 # 63, 136 MB at 127, 24 GB RSS for `check` at 1000). The largest robot in
 # example-robot-data has 130 links and 101 DoF (tiago_dual).
-MAX_URDF_LINKS = 300
-MAX_URDF_DOF = 128
+MAX_URDF_LINKS = MAX_ROBOT_LINKS
+MAX_URDF_DOF = MAX_ROBOT_DOF
 MAX_URDF_COLLISIONS = 1000  # example-robot-data: at most 113 per robot
 
 
@@ -258,11 +261,6 @@ def _line_at(data: bytes, offset: int) -> int:
     return data.count(b"\n", 0, offset) + 1
 
 
-def _is_xacro(el: etree._Element) -> bool:
-    """Elements in a xacro namespace (www.ros.org/wiki/xacro and wiki.ros.org/xacro both occur)."""
-    return isinstance(el.tag, str) and el.tag.startswith("{") and "xacro" in el.tag.split("}")[0]
-
-
 def parse_root(data: bytes, source: str) -> etree._Element:
     """Parse XML bytes safely and return the <robot> element (InputError otherwise)."""
     if len(data) > MAX_URDF_BYTES:
@@ -302,14 +300,39 @@ def parse_root(data: bytes, source: str) -> etree._Element:
             file=source,
             line=_ln(root),
         )
-    if any(_is_xacro(el) for el in root.iter()):
+    # by namespace URI *and* the literal `xacro` prefix, elements and attributes: xacro acts
+    # on `<xacro:include>` whatever URI the prefix is bound to (issue 27)
+    if xacro_use(root) is not None:
         raise XacroRefusedError(
             "this file uses xacro elements; expanding xacro runs code from the file, "
             "so pass --trust-xacro to expand it (in a sandbox)",
             file=source,
         )
     _check_size(root, source)
+    _check_names(root, source)
     return root
+
+
+NAME_ATTRIBUTES = ("name", "link", "joint", "reference")  # names and references to them
+
+
+def _check_names(root: etree._Element, source: str) -> None:
+    """Refuse names holding line breaks or control characters (issue 27).
+
+    Names are printed by every command (tree, check, simulate, view); a robot named
+    `r&#10;::add-mask::X` printed a GitHub workflow command line of its own, and a C1
+    character (U+009B) is a terminal control sequence.
+    """
+    for el in root.iter():
+        for attr in NAME_ATTRIBUTES:
+            value = el.get(attr)
+            if value is not None and one_line(value) != value:
+                raise InputError(
+                    f"<{el.tag}> {attr}={one_line(value)!r} holds line breaks or control "
+                    "characters; names must be printable",
+                    file=source,
+                    line=_ln(el),
+                )
 
 
 def _check_size(root: etree._Element, source: str) -> None:

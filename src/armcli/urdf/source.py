@@ -3,8 +3,8 @@
 A path given to `check`, `view`, `render`, `tree` (and `simulate --urdf`) is one
 of: a spec YAML (built in memory, nothing written), a URDF (read by urdf.read's
 strict reader) or a xacro file. Xacro runs Python from the file, so a foreign
-one is expanded in safe mode (xacro_safe: no code runs, files confined) unless
-the user passes `--trust-xacro` (xacro itself, sandboxed by xacro_sandbox).
+one is expanded in safe mode (xacro.safe: no code runs, files confined) unless
+the user passes `--trust-xacro` (xacro itself, sandboxed by xacro.sandbox).
 Mesh URIs may only resolve inside the allowed roots, so a hostile URDF cannot make armcli read
 `/etc/passwd` as a "mesh".
 """
@@ -12,19 +12,20 @@ Mesh URIs may only resolve inside the allowed roots, so a hostile URDF cannot ma
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterable
+import threading
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import EXPANDED_TAG, InputError, XacroRefusedError
+from armcli.io.packages import PackageLookup, inside, real_roots
 from armcli.urdf.doc import Urdf
-from armcli.urdf.packages import inside, real_roots
-from armcli.urdf.pinocchio import LoadedModel, load_model, parser_problems
 from armcli.urdf.read import parse_urdf, read_urdf
-from armcli.urdf.trust import Trust as Trust  # re-exported: read_robot and callers share it
-from armcli.urdf.xacro_args import Expansion, XacroInputs
+from armcli.xacro.args import Expansion, XacroInputs
+from armcli.xacro.lines import parse_map
+from armcli.xacro.trust import Trust as Trust  # re-exported: read_robot and callers share it
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -32,14 +33,9 @@ if TYPE_CHECKING:
 SPEC_SUFFIXES = (".yaml", ".yml")
 XACRO_SUFFIX = ".xacro"
 TRUSTED_ENV_REFUSED = ("LD_", "PYTHON")  # --env names that would change how the child runs
-
-
-_PROBLEM = {
-    "missing": "missing number",
-    "not-a-number": "not a number:",
-    "non-finite": "non-finite number",
-    "length": "wrong number of values:",
-}
+COMPILED_KEPT = 4  # specs whose compiled URDFs `spec_urdfs` keeps (a command reads one or two)
+_COMPILED: list[tuple[RobotSpec, dict[str, bytes]]] = []  # (spec, its URDFs), newest last
+_COMPILED_LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
@@ -66,20 +62,47 @@ def read_robot(
 ) -> RobotFile:
     """Spec YAML, URDF or xacro -> RobotFile; InputError when unusable.
 
-    `inputs`: a xacro file's arguments, --env values and package lookup (xacro_args).
+    `inputs`: a xacro file's arguments, --env values and package lookup (xacro.args).
     """
     if path.is_dir():
         raise InputError("is a directory, expected a robot spec, URDF or xacro file", file=path)
     if path.suffix in SPEC_SUFFIXES:
         # the spec layers (pydantic models, ~0.3 s to import) only when a spec is read
-        from armcli.compiler.expand import expand_urdfs
         from armcli.spec.load import load_spec
 
         spec = load_spec(path)
-        urdfs = expand_urdfs(spec)
+        lookup_for(spec, inputs.packages if inputs is not None else None)  # refuse a bad one now
+        urdfs = spec_urdfs(spec)
         docs = tuple(parse_urdf(urdfs[n], f"{path}#{n}") for n in sorted(urdfs))
         return RobotFile(path, docs, spec)
     return RobotFile(path, (read_urdf_file(path, trust_xacro=trust_xacro, inputs=inputs),))
+
+
+def spec_urdfs(spec: RobotSpec) -> dict[str, bytes]:
+    """URDF file name -> expanded bytes of the spec's xacro set, compiled once per spec.
+
+    A spec is frozen (pydantic, `frozen=True`), so its URDFs never change: the last
+    COMPILED_KEPT specs keep theirs, and every command asks here instead of compiling
+    again (`simulate` needs the standalone arm and the whole robot: one expansion).
+    """
+    with _COMPILED_LOCK:
+        hit = next((urdfs for s, urdfs in _COMPILED if s is spec), None)
+    if hit is None:
+        from armcli.compiler.expand import expand_urdfs  # the spec compiler: only for a spec
+
+        hit = expand_urdfs(spec)
+        with _COMPILED_LOCK:
+            _COMPILED.append((spec, hit))
+            del _COMPILED[:-COMPILED_KEPT]
+    return dict(hit)
+
+
+def lookup_for(spec: RobotSpec | None, search: PackageLookup | None = None) -> PackageLookup:
+    """The package lookup for a robot: the CLI's options plus the packages its spec records."""
+    base = search if search is not None else PackageLookup()
+    if spec is None or not spec.packages:
+        return base
+    return base.with_recorded(spec.package_dirs(), spec.source_file)
 
 
 def read_urdf_file(
@@ -87,7 +110,7 @@ def read_urdf_file(
 ) -> Urdf:
     """A URDF or xacro file -> Urdf (xacro by suffix or content).
 
-    A xacro file is expanded in safe mode (xacro_safe: no code from the file runs), or
+    A xacro file is expanded in safe mode (xacro.safe: no code from the file runs), or
     with xacro itself when trusted; `Urdf.notes` says which arguments it used.
     """
     if path.suffix != XACRO_SUFFIX:
@@ -96,7 +119,8 @@ def read_urdf_file(
         except XacroRefusedError:
             pass  # xacro content in a .urdf: expanded like a .xacro file
     xml, used = expand_xacro(path, trust_xacro=trust_xacro, inputs=inputs)
-    return replace(parse_urdf(xml, f"{path}{EXPANDED_TAG}"), notes=used.notes())
+    doc = parse_urdf(xml, f"{path}{EXPANDED_TAG}")
+    return replace(doc, notes=used.notes(), origins=parse_map(used.source_map))
 
 
 def expand_xacro(
@@ -104,12 +128,12 @@ def expand_xacro(
 ) -> tuple[bytes, Expansion]:
     """A xacro file's expansion (the bytes xacro itself writes) and what it used.
 
-    Safe mode (xacro_safe, in a limited child) unless `trust_xacro`: then xacro itself
-    in xacro_sandbox's jail, which reports no argument use.
+    Safe mode (xacro.safe, in a limited child) unless `trust_xacro`: then xacro itself
+    in xacro.sandbox's jail, which reports no argument use.
     """
     # imported here: reading a plain URDF (e.g. simulate --urdf) never loads the xacro stack
-    from armcli.urdf.xacro_safe import request_json
-    from armcli.urdf.xacro_sandbox import run_safe
+    from armcli.xacro.safe import request_json
+    from armcli.xacro.sandbox import run_safe
 
     given = inputs or XacroInputs()
     if trust_xacro:
@@ -122,7 +146,7 @@ def expand_xacro(
 def _expand_trusted(
     path: Path, given: XacroInputs, *, unsandboxed: bool
 ) -> tuple[bytes, Expansion]:
-    """Xacro itself in xacro_sandbox's jail, `$(find)` answered by armcli's package lookup.
+    """Xacro itself in xacro.sandbox's jail, `$(find)` answered by armcli's package lookup.
 
     Every package the lookup knows is passed in with its directories bound read-only
     (the install prefixes' share/ and each package's real roots: a symlink-install tree
@@ -135,7 +159,7 @@ def _expand_trusted(
             "or the loader runs)",
             field="--env",
         )
-    from armcli.urdf.xacro_sandbox import run_trusted
+    from armcli.xacro.sandbox import run_trusted
 
     known = given.packages.known(near=path)
     roots = [*allowed_roots(path.parent), *(p / "share" for p in given.packages.prefixes())]
@@ -149,41 +173,6 @@ def _expand_trusted(
         roots=roots,
     )
     return xml, Expansion.from_dict(report.get("expansion", {}))
-
-
-def load_checked_model(
-    path: Path,
-    *,
-    trust_xacro: Trust = False,
-    gate: Callable[[Urdf], None] | None = None,
-    inputs: XacroInputs | None = None,
-) -> LoadedModel:
-    """A URDF/xacro file -> Pinocchio model, refusing what Pinocchio would silently accept.
-
-    For commands that compute with the model (simulate --urdf): a malformed or
-    non-finite number (Pinocchio turns mass="nan" into 0) or any error the URDF
-    parser prints is an InputError naming the file and line, not a wrong result.
-    """
-    urdf = read_urdf_file(path, trust_xacro=trust_xacro, inputs=inputs)
-    return checked_model(urdf, gate=gate)
-
-
-def checked_model(urdf: Urdf, *, gate: Callable[[Urdf], None] | None = None) -> LoadedModel:
-    """A parsed URDF -> Pinocchio model, refusing what Pinocchio would silently accept.
-
-    `gate`, when given, may refuse the document after the number checks (e.g.
-    check.gate.refuse_check_errors: the model `check` reports as an error).
-    """
-    if urdf.problems:
-        p = urdf.problems[0]
-        raise InputError(f"{p.where}: {_PROBLEM[p.kind]} {p.text!r}", file=urdf.source, line=p.line)
-    if gate is not None:
-        gate(urdf)
-    loaded = load_model(urdf.source, xml=urdf_text(urdf))
-    said = [m for m in parser_problems(loaded.parser_messages) if "error" in m.lower()]
-    if said:
-        raise InputError(f"the URDF parser reported: {said[0]}", file=urdf.source)
-    return loaded
 
 
 def urdf_text(urdf: Urdf) -> str:

@@ -22,11 +22,12 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import InputError
+from armcli.robot.tool import ToolPoint
 from armcli.sim.states import Replay
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_root
-from armcli.urdf.tool import ToolPoint
 from armcli.urdf.tree import parse_tree
+from armcli.view.origin import checked_requests
 from armcli.view.png import (
     full_configuration,
     joint_limits,
@@ -105,7 +106,8 @@ class Viewer:
         self._stop = threading.Event()
         self._playing = False
         check_port_free(host, port)
-        with contextlib.redirect_stdout(io.StringIO()):  # viser prints a banner; the CLI prints
+        # viser prints a banner (the CLI prints its own); Host/Origin checked (view.origin)
+        with contextlib.redirect_stdout(io.StringIO()), checked_requests(host):
             self.server = viser.ViserServer(
                 host=host, port=port, label=f"armcli: {name}", verbose=False
             )
@@ -115,14 +117,19 @@ class Viewer:
         self.host, self.port = host, int(self.server.get_port())
         self._player: threading.Thread | None = None
         try:
-            self._robot = ViserUrdf(self.server, self._urdf, root_node_name="/robot")
+            # a drive's replay moves the whole robot: its URDF hangs from a frame placed at
+            # the base's pose in the world (states' base.*, MCAP's world -> odom -> base)
+            moving = replay is not None and replay.base is not None
+            self._base = self.server.scene.add_frame("/base", show_axes=False) if moving else None
+            root = "/base" if moving else ""
+            self._robot = ViserUrdf(self.server, self._urdf, root_node_name=f"{root}/robot")
             self._ghost = None
             if replay is not None and replay.reference:
                 ghost_xml = moving_parts(urdf_xml, replay.reference, source)
                 self._ghost = ViserUrdf(
                     self.server,
                     load_urdf(ghost_xml, source, mesh_dir, search),
-                    root_node_name="/ghost",
+                    root_node_name=f"{root}/ghost",
                     mesh_color_override=GHOST_RGBA,
                 )
             self._build_scene()
@@ -303,13 +310,22 @@ class Viewer:
         assert self._replay is not None
         t0 = float(self._replay.time[0]) + t
         q = {j: v for j, v in self._replay.positions_at(t0).items() if j in self._sliders}
-        self.set_configuration({j: float(np.clip(v, *self._range(j))) for j, v in q.items()})
+        pose = self._replay.base_at(t0)
+        if pose is not None and self._base is not None:
+            self._base.position, self._base.wxyz = tuple(pose[0]), tuple(pose[1])
+        self.set_configuration({j: self._in_range(j, v) for j, v in q.items()})
         if self._ghost is not None:
             ref = self._replay.reference_at(t0)
             visible = ref is not None and bool(self._ghost_box.value)
             if ref is not None:
                 self._ghost.update_cfg(self._cfg_array({**self.configuration(), **ref}))
             self._ghost.show_visual = visible
+
+    def _in_range(self, joint: str, value: float) -> float:
+        """A bounded joint clipped to its limits; a continuous one (a wheel) wrapped to ±pi."""
+        if self._limits[joint] is None:
+            return float((value + math.pi) % (2.0 * math.pi) - math.pi)
+        return float(np.clip(value, *self._range(joint)))
 
     def _range(self, joint: str) -> tuple[float, float]:
         lim = self._limits[joint]

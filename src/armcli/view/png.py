@@ -20,11 +20,12 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
+from armcli.io.mesh_confine import bounded_mesh_file, check_total
+from armcli.robot.tool import ToolPoint
 from armcli.spec.joint_types import position_bounds
-from armcli.urdf.mesh_confine import bounded_mesh_file, check_total
 from armcli.urdf.meshes import MeshSearch, confined, resolve
+from armcli.urdf.meshlog import MeshLog, quiet_trimesh
 from armcli.urdf.read import parse_root
-from armcli.urdf.tool import ToolPoint
 
 MAX_EDGE = 0.04  # [m] faces are split to this edge length so depth sorting works
 SPLIT_ROUNDS = 8  # halvings at most; longer edges stay longer than MAX_EDGE
@@ -53,10 +54,18 @@ class RenderResult:
 MESH_HINT = "--package-dir NAME=PATH points package://NAME at a folder"
 FALLBACK_RGBA = (0.6, 0.6, 0.6, 1.0)  # meshes whose colour cannot be read
 TITLE_WIDTH = 110  # [characters] per title line, so many joints do not run off the figure
+TITLE_LINES = 4  # of joint values at most: PR2's 40-odd joints end in "... and N more"
+TITLE_FONT = 10  # [pt]
+LINE_SPACING = 1.4  # text line height / font size (matplotlib's default 1.2, plus leading)
+VIEW_TITLE_SPACE = 0.45  # [in] the views' own titles above their axes
 
 
 def _mesh_handler(
-    base: Path, where: MeshSearch, source: str, skipped: dict[str, str] | None
+    base: Path,
+    where: MeshSearch,
+    source: str,
+    skipped: dict[str, str] | None,
+    said: MeshLog | None = None,
 ) -> Callable[[str], str]:
     """Yourdfpy's filename handler: armcli's resolver, confinement and size caps.
 
@@ -66,6 +75,8 @@ def _mesh_handler(
     loaded: set[Path] = set()
 
     def resolve_mesh(fname: str) -> str:
+        if said is not None:
+            said.current = fname  # trimesh loads this file next: its complaints are about it
         path = resolve(fname, base, where)
         why = None
         if path is not None and not confined(fname, path, base, where):  # never read
@@ -95,6 +106,7 @@ def load_urdf(
     mesh_dir: str | Path | None = None,
     search: MeshSearch | None = None,
     skipped: dict[str, str] | None = None,
+    mesh_notes: dict[str, str] | None = None,
 ) -> Any:
     """URDF text -> yourdfpy.URDF with its visual scene.
 
@@ -104,21 +116,41 @@ def load_urdf(
     parser would resolve entities. A mesh file that cannot be found, or lies outside the
     allowed directories (never read), is an InputError where yourdfpy would log and draw
     nothing, unless the caller passes a `skipped` dict: then URI -> why is recorded there
-    and the rest is drawn (render warns).
+    and the rest is drawn (render warns). What trimesh said while loading a mesh (a
+    missing texture image: the mesh is drawn in its plain colour) goes to `mesh_notes`
+    (URI -> message) when given, and never to stderr.
     """
+    parse_root(xml.encode("utf-8"), source)
+    base = Path(mesh_dir or ".")
+    absent: dict[str, str] = {}
+    with quiet_trimesh() as said:
+        resolve_mesh = _mesh_handler(base, search or MeshSearch(), source, absent, said)
+        urdf = _load(xml, source, resolve_mesh)
+    if mesh_notes is not None:
+        mesh_notes.update(said.said)
+
+    if skipped is not None:
+        skipped.update(absent)
+    elif absent:
+        uri, why = next(iter(absent.items()))
+        if why != "not found":
+            raise InputError(f"mesh {uri!r} {why}", file=source)
+        raise InputError(
+            f"mesh file not found: {uri} (searched from {base}; {MESH_HINT})", file=source
+        )
+    return urdf
+
+
+def _load(xml: str, source: str, resolve_mesh: Callable[[str], str]) -> Any:
+    """yourdfpy.URDF.load with its visual meshes; its warnings become our errors."""
     import logging
 
     import yourdfpy
 
-    parse_root(xml.encode("utf-8"), source)
-    base = Path(mesh_dir or ".")
-    absent: dict[str, str] = {}
-    resolve_mesh = _mesh_handler(base, search or MeshSearch(), source, absent)
-
     log = logging.getLogger("yourdfpy")
-    level, log.level = log.level, logging.CRITICAL  # its warnings become our error below
+    level, log.level = log.level, logging.CRITICAL  # its warnings become our error above
     try:
-        urdf = yourdfpy.URDF.load(
+        return yourdfpy.URDF.load(
             io.BytesIO(xml.encode("utf-8")),
             build_collision_scene_graph=False,
             load_collision_meshes=False,
@@ -130,16 +162,6 @@ def load_urdf(
         raise InputError(f"cannot load this URDF: {exc}", file=source) from None
     finally:
         log.level = level
-    if skipped is not None:
-        skipped.update(absent)
-    elif absent:
-        uri, why = next(iter(absent.items()))
-        if why != "not found":
-            raise InputError(f"mesh {uri!r} {why}", file=source)
-        raise InputError(
-            f"mesh file not found: {uri} (searched from {base}; {MESH_HINT})", file=source
-        )
-    return urdf
 
 
 def joint_limits(urdf: Any) -> dict[str, tuple[float, float] | None]:
@@ -268,8 +290,14 @@ def _title(name: str, q: Mapping[str, float], urdf: Any, tip: np.ndarray | None)
     limits = joint_limits(urdf)
     shown = {j: v for j, v in q.items() if v != 0.0 or limits.get(j) is not None} or q
     unit = {j: "m" if urdf.joint_map[j].type == "prismatic" else "rad" for j in shown}
-    joints = ", ".join(f"{j} = {v:.3f} {unit[j]}" for j, v in shown.items())
-    text = textwrap.fill(f"{name}: {joints or 'no movable joints'}", TITLE_WIDTH)
+    entries = [f"{j} = {v:.3f} {unit[j]}" for j, v in shown.items()]
+    rows = textwrap.wrap(f"{name}: {', '.join(entries) or 'no movable joints'}", TITLE_WIDTH)
+    k = len(entries)
+    while len(rows) > TITLE_LINES and k > 0:  # more would run into the views (PR2, G1)
+        k -= 1
+        more = f" ... and {len(entries) - k} more joint(s)"
+        rows = textwrap.wrap(f"{name}: {', '.join(entries[:k])}{more}", TITLE_WIDTH)
+    text = "\n".join(rows)
     if tip is not None:
         text += "\ntool at ({:.3f}, {:.3f}, {:.3f}) m".format(*tip)
     return text
@@ -305,8 +333,14 @@ def render_figure(
             ax.set_yticks([])
             ax.set_ylabel("")
         ax.set_title(title, fontsize=10)
-    fig.suptitle(_title(name, q, urdf, tip), fontsize=10)
-    fig.subplots_adjust(left=0.02, right=0.96, bottom=0.04, top=0.86, wspace=0.12)
+    title = _title(name, q, urdf, tip)
+    fig.suptitle(title, fontsize=TITLE_FONT, y=0.99, va="top")
+    # The views start below the title's lines and their own titles (a fixed top let a long
+    # title overprint them: PR2, G1).
+    height = size[1] / DPI  # [in]
+    used = (title.count("\n") + 1) * TITLE_FONT * LINE_SPACING / 72.0 + VIEW_TITLE_SPACE
+    top = max(0.3, min(0.86, 0.99 - used / height))
+    fig.subplots_adjust(left=0.02, right=0.96, bottom=0.04, top=top, wspace=0.12)
     return fig
 
 

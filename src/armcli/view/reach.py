@@ -20,11 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from armcli.errors import InputError
-from armcli.io.files import write_file_atomic
-from armcli.urdf.pinocchio import load_model
-from armcli.urdf.tool import ToolPoint
-from armcli.urdf.workspace import (
+from armcli.analysis.workspace import (
     Chain,
     ReachPoint,
     Workspace,
@@ -32,6 +28,11 @@ from armcli.urdf.workspace import (
     reach_point,
     sample,
 )
+from armcli.errors import InputError
+from armcli.io.files import write_file_atomic
+from armcli.robot.load import link_frame
+from armcli.robot.model import Robot
+from armcli.robot.tool import ToolPoint
 from armcli.view.png import DEFAULT_SIZE, DPI, RenderResult, full_configuration, render_figure
 
 REACH_SAMPLES = 6000  # drawn points: a filled region at 1200x600 px, ~1 s to draw
@@ -59,10 +60,10 @@ def reach_of(
     samples: int = REACH_SAMPLES,
 ) -> tuple[Chain, NDArray[np.float64], Workspace, tuple[ReachPoint, ...]]:
     """The chain at pose `q`, its sampled tool positions (n, 3) [m], envelope and verdicts."""
-    model = load_model(source, xml=xml).model
-    if not model.existFrame(tool.link):
+    robot = Robot.from_xml(xml, source)
+    if link_frame(robot.model, tool.link) is None:
         raise InputError(f"no link {tool.link!r} for the tool point", file=source)
-    chain = Chain(model, tool, q)
+    chain = Chain(robot, tool, q)
     if not chain.joints:
         raise InputError(
             f"no moving joint between the root and {tool.label}: nothing to reach with",

@@ -11,12 +11,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from armcli.errors import InputError
+from armcli.robot.tool import ToolPoint, tool_point
 from armcli.spec.expr import eval_expr
 from armcli.urdf.meshes import MeshSearch
-from armcli.urdf.source import Trust, read_robot, urdf_text
-from armcli.urdf.tool import ToolPoint, tool_point
+from armcli.urdf.source import Trust, lookup_for, read_robot, urdf_text
 from armcli.urdf.tree import tree_from_urdf
-from armcli.urdf.xacro_args import XacroInputs
+from armcli.xacro.args import XacroInputs
 
 
 @dataclass(frozen=True)
@@ -43,12 +43,12 @@ def load_robot(
     """Spec YAML (built in memory), URDF or xacro file -> RobotSource.
 
     Mesh URIs resolve with armcli.urdf.meshes (honouring `search`, the --package-dir
-    options) and must stay inside the allowed roots; the tool point is armcli.urdf.tool's.
+    options) and must stay inside the allowed roots; the tool point is armcli.robot.tool's.
     `inputs`: a xacro file's NAME:=VALUE arguments, --env and package lookup.
     """
     robot = read_robot(path, trust_xacro=trust_xacro, inputs=inputs)
     spec = robot.spec
-    where = search or MeshSearch()
+    where = lookup_for(spec, search)  # the spec's recorded packages too
     if spec is not None:
         return RobotSource(
             xml=urdf_text(robot.robot),

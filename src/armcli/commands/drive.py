@@ -1,0 +1,90 @@
+"""`armcli simulate SPEC --cmd-vel drive.yaml`: the whole robot on its wheels (sim.drive).
+
+Called by the simulate command; here only what the command prints and writes: the
+files together (never a new CSV beside an old plot), the summary, the warnings, and
+exit 1 when the robot tips over.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from armcli.errors import InputError, ModelRefusedError
+from armcli.io import terminal
+from armcli.io.oneline import one_line
+from armcli.io.together import write_files_together
+from armcli.sim.options import SimOptions
+
+
+def run_drive(
+    spec: Any,
+    opts: SimOptions,
+    cmd_vel: Path,
+    ignore: tuple[str, ...],
+    output: Path | None,
+    plot: Path | None,
+    progress: Callable[[int, int], None] | None = None,
+) -> None:
+    """Prepare, run, write and report a drive run; raises TipOverError when it tips."""
+    from armcli.check.gate import refuse_check_errors
+    from armcli.sim import drive, drivebag, driveout, driveplot, rosbag, states
+    from armcli.sim import job as simjob
+    from armcli.sim import report as simreport
+
+    if spec is None or opts.urdf is not None:
+        raise InputError(
+            "drives a spec's robot (its mobile_base.diff_drive); give a spec instead of --urdf",
+            field="--cmd-vel",
+        )
+    try:
+        job = drive.prepare(
+            spec, opts, cmd_vel, gate=lambda u: refuse_check_errors(u, ignore=ignore)
+        )
+    except ModelRefusedError as exc:
+        flags = " ".join(f"--ignore {r}" for r in exc.rules())
+        raise ModelRefusedError(
+            exc.source, exc.violations, f"drive it anyway with {flags}"
+        ) from None
+    err = terminal.console(sys.stderr)
+    for w in (*job.arm.trajectory.warnings, *job.cmd.warnings, *job.model.notes):
+        err.print(one_line(f"warning: {w}"), markup=False, highlight=False)
+    res_run = drive.run(job, progress)
+    rate = job.arm.rate
+    res = driveout.arm_result(res_run, driveout.plot_steps_of(res_run.steps, job.dt, rate))
+    verdict = driveout.tip_verdict(res_run)
+    files: dict[Path, bytes] = {}
+    if output is not None:
+        cols = driveout.columns(res_run, res, rate)
+        files[output] = (
+            drivebag.mcap_bytes(res_run, cols, rate)
+            if rosbag.is_mcap(output)
+            else states.states_bytes(cols, states.output_format(output))
+        )
+    if plot is not None:
+        files[plot] = driveplot.plot_png(res_run, res, verdict)
+    write_files_together(files)
+    for lift in verdict.lifts:
+        err.print(one_line(f"warning: {lift.line()}"), markup=False, highlight=False)
+    out = terminal.console()
+    metrics = simreport.joint_metrics(res, job.arm.trajectory.duration)
+    ee = simjob.tool_position(job.arm, res.q[-1])
+    engine = f"MuJoCo implicitfast ({res.wall_time * 1e6 / max(1, res.steps):.2f} µs/step)"
+    out.print(simreport.summary_table(metrics, ee, job.arm.tool_label, res, engine), crop=False)
+    o = res_run.odometry
+    L = job.model.layout
+    end = res_run.sensors[-1, L.base_pos]
+    out.print(
+        f"base: odometry ({o.x[-1]:.3f}, {o.y[-1]:.3f}) m, yaw {o.yaw[-1]:.3f} rad; "
+        f"ground truth ({end[0]:.3f}, {end[1]:.3f}) m",
+        markup=False,
+        highlight=False,
+    )
+    out.print(verdict.line(), style="red" if verdict.tips else None, markup=False, highlight=False)
+    for path in (output, plot):
+        if path is not None:
+            out.print(f"wrote {path}", markup=False, highlight=False)
+    if verdict.tips:
+        raise verdict.error()

@@ -1,0 +1,177 @@
+"""URDF -> Pinocchio model; the one place parser quirks are handled.
+
+Pinocchio's URDF parser prints problems to stderr (and e.g. turns mass="nan"
+into 0) instead of raising, so loading captures the C-level stderr and returns
+what it said as warnings for the caller (checks turn them into findings).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from armcli.errors import InputError, ModelLoadError
+from armcli.io.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
+from armcli.urdf.doc import Urdf
+from armcli.urdf.meshes import MeshSearch, mesh_paths
+from armcli.urdf.source import urdf_text
+
+
+@dataclass
+class LoadedModel:
+    """A Pinocchio model plus what the parser said while building it."""
+
+    model: Any  # pinocchio.Model
+    source: str
+    parser_messages: list[str] = field(default_factory=list)
+
+
+def _capture_stderr(fn: Any) -> tuple[Any, list[str]]:
+    """Run fn() with the process-level stderr (fd 2) redirected to a temp file.
+
+    If fn raises, the exception gets the captured lines as `parser_messages`.
+    """
+    with tempfile.TemporaryFile(mode="w+b") as tmp:
+        saved = os.dup(2)
+        error: BaseException | None = None
+        try:
+            os.dup2(tmp.fileno(), 2)
+            result = fn()
+        except BaseException as exc:
+            error = exc
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+        tmp.seek(0)
+        text = tmp.read().decode("utf-8", "replace")
+    lines = [ln for ln in text.splitlines() if ln.strip()]
+    if error is not None:
+        error.parser_messages = lines  # type: ignore[attr-defined]
+        raise error
+    return result, lines
+
+
+def parser_problems(lines: Sequence[str]) -> list[str]:
+    """The urdfdom messages, one per problem: continuation lines (C++ source locations) dropped."""
+    out: list[str] = []
+    for ln in lines:
+        if ln[:1].isspace():
+            continue
+        out.append(" ".join(ln.split()))
+    return out
+
+
+def load_model(path: str | Path, *, xml: str | None = None, floating: bool = False) -> LoadedModel:
+    """Build a fixed-base Pinocchio model from a URDF file (or from `xml` text).
+
+    `floating`: the root link on a free-flyer joint instead (joint 1, nq = 7, nv = 6), so
+    that the root's inertia counts and inverse dynamics gives the wrench holding the base.
+    """
+    import pinocchio as pin
+
+    source = str(path)
+    text = xml if xml is not None else Path(path).read_text(encoding="utf-8")
+    args = (pin.JointModelFreeFlyer(),) if floating else ()
+    try:
+        model, messages = _capture_stderr(lambda: pin.buildModelFromXML(text, *args))
+    except (RuntimeError, ValueError) as exc:
+        said = parser_problems(getattr(exc, "parser_messages", []))
+        detail = f" ({'; '.join(said)})" if said else ""
+        raise ModelLoadError(
+            f"Pinocchio cannot load this URDF: {exc}{detail}", file=source, parser_messages=said
+        ) from None
+    return LoadedModel(model=model, source=source, parser_messages=messages)
+
+
+def mass_matrix(model: Any, data: Any, q: Any) -> NDArray[np.float64]:
+    """The joint-space mass matrix M(q) [kg·m² or kg], symmetric.
+
+    Pinocchio's CRBA fills only the upper triangle; every user needs the whole matrix.
+    """
+    import pinocchio as pin
+
+    M = pin.crba(model, data, q)
+    return np.asarray(np.triu(M) + np.triu(M, 1).T, dtype=np.float64)
+
+
+def collision_model(
+    model: Any, xml: str, package_dirs: list[str] | None = None, source: str = "<urdf>"
+) -> Any:
+    """The URDF's collision geometry as a Pinocchio GeometryModel (meshes need package_dirs).
+
+    ModelLoadError when Pinocchio refuses it (e.g. a mesh it cannot read).
+    """
+    import pinocchio as pin
+
+    try:
+        gmodel, _ = _capture_stderr(
+            lambda: pin.buildGeomFromUrdfString(
+                model, xml, pin.GeometryType.COLLISION, package_dirs=package_dirs or []
+            )
+        )
+    except (RuntimeError, ValueError) as exc:
+        raise ModelLoadError(f"Pinocchio cannot load the collision geometry: {exc}", file=source,
+                             parser_messages=[]) from None  # fmt: skip
+    return gmodel
+
+
+def confined_mesh_xml(urdf: Urdf, search: MeshSearch) -> str:
+    """The URDF text with every mesh named by its confined, bounded real path.
+
+    Meshes are resolved inside the allowed roots (`urdf.meshes`) and checked to be bounded
+    files (`urdf.mesh_confine`). InputError naming a mesh that cannot be found or one
+    over the size caps.
+    """
+    meshes = mesh_paths(urdf, search)
+    missing = sorted(uri for uri, p in meshes.items() if p is None or not p.is_file())
+    if missing:
+        raise InputError(f"mesh {missing[0]!r} cannot be found", file=urdf.source)
+    real = {uri: bounded_mesh_file(p, urdf.source) for uri, p in meshes.items() if p is not None}
+    check_total(real.values(), urdf.source)
+    return with_real_mesh_paths(urdf.text, real)
+
+
+_PROBLEM = {
+    "missing": "missing number",
+    "not-a-number": "not a number:",
+    "non-finite": "non-finite number",
+    "length": "wrong number of values:",
+}
+
+
+def checked_model(urdf: Urdf, *, gate: Callable[[Urdf], None] | None = None) -> LoadedModel:
+    """A parsed URDF -> Pinocchio model, refusing what Pinocchio would silently accept.
+
+    `gate`, when given, may refuse the document after the number checks (e.g.
+    check.gate.refuse_check_errors: the model `check` reports as an error).
+    """
+    if urdf.problems:
+        p = urdf.problems[0]
+        raise InputError(f"{p.where}: {_PROBLEM[p.kind]} {p.text!r}", file=urdf.source, line=p.line)
+    if gate is not None:
+        gate(urdf)
+    loaded = load_model(urdf.source, xml=urdf_text(urdf))
+    said = [m for m in parser_problems(loaded.parser_messages) if "error" in m.lower()]
+    if said:
+        raise InputError(f"the URDF parser reported: {said[0]}", file=urdf.source)
+    return loaded
+
+
+def link_frame(model: Any, name: str) -> int | None:
+    """The Pinocchio frame id of the link `name`, None if there is no such link.
+
+    URDF names links and joints separately (ANYmal C has a link and a joint both called
+    LF_HFE), so a lookup by name alone is ambiguous: a link is the BODY frame.
+    """
+    import pinocchio as pin
+
+    if not model.existFrame(name, pin.BODY):
+        return None
+    return int(model.getFrameId(name, pin.BODY))

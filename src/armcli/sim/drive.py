@@ -1,0 +1,240 @@
+"""Drive the whole robot on its wheels in MuJoCo while the arm follows its trajectory.
+
+What `armcli simulate SPEC --cmd-vel drive.yaml` runs: the robot as `export mjcf` writes
+it (sim.drivemodel) standing on a floor under gravity; its base driven by
+gazebo_ros_diff_drive's controller (sim.diffdrive) from the /cmd_vel commands
+(sim.cmdvel); its arm under the PD law, gains, gravity compensation and reference of
+`simulate` (sim.job prepares them as for the fixed-base engine) through the export's
+position actuators: ctrl = q_ref + (Kd / Kp) v_ref (+ g(q) / Kp with gravity
+compensation, the fixed-base arm's g as the controller computes it), so the actuator
+force Kp (q_ref - q) + Kd (v_ref - v) + g is clipped at the effort limit as a whole.
+
+Every step's sensors are kept (one copy of `sensordata`); odometry, tipping and lift-off
+are computed from them after the run (sim.liftoff), the outputs by sim.driveout.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from armcli.analysis.stance import NoStance, Stance, stance_of
+from armcli.errors import InputError, SimulationError
+from armcli.sim import job as simjob
+from armcli.sim.cmdvel import CmdVel, load_cmd_vel
+from armcli.sim.diffdrive import DiffDriveController, DriveParams, Odometry, encoder_odometry
+from armcli.sim.drivemodel import DriveModel, build_drive_model
+from armcli.sim.job import SimJob
+from armcli.sim.options import SimOptions
+from armcli.sim.simulate import steps_of
+from armcli.sim.tipping import robot_urdf
+from armcli.urdf.doc import Urdf
+
+if TYPE_CHECKING:
+    from armcli.spec.model import RobotSpec
+
+SETTLE_EXTRA_S = 2.0  # [s] simulated after the last command or trajectory point by default
+MAX_DRIVE_STEPS = 600_000  # every step's sensors are kept: ~150 MB for the course robot
+PROGRESS_STEPS = 10_000  # steps between progress reports
+
+
+@dataclass(frozen=True)
+class DriveJob:
+    """Everything a drive run needs, validated."""
+
+    arm: SimJob  # the arm's gains, reference, start, dt, output rate, tool point
+    cmd: CmdVel
+    params: DriveParams
+    model: DriveModel
+    stance: Stance  # the whole robot on its contacts (static tipping angle)
+    robot: Urdf  # the whole robot's URDF (MCAP /robot_description, replay)
+    duration: float  # [s]
+
+    @property
+    def dt(self) -> float:
+        """[s] the time step."""
+        return self.arm.config.dt
+
+
+def prepare(
+    spec: RobotSpec,
+    opts: SimOptions,
+    cmd_vel: Path,
+    *,
+    gate: Callable[[Urdf], None] | None = None,
+) -> DriveJob:
+    """Validate the inputs and build the model; InputError names what is wrong.
+
+    Without a trajectory the arm holds its start pose. `gate` sees the whole robot's URDF
+    first and may refuse it (the command passes check.gate.refuse_check_errors).
+    """
+    params = DriveParams.of(spec)
+    cmd = load_cmd_vel(cmd_vel)
+    rate = opts.rate if opts.rate is not None else params.update_rate
+    if opts.trajectory is None and opts.message is None:
+        opts = replace(opts, message=_hold_message(spec, opts))
+    job = simjob.prepare(spec, replace(opts, rate=rate, duration=opts.duration or 1.0))
+    robot = robot_urdf(spec, job)
+    if robot is None:
+        raise InputError("the spec has no whole robot to drive", field="mobile_base")
+    if gate is not None:
+        gate(robot)
+    duration = opts.duration
+    if duration is None:
+        duration = max(job.trajectory.duration, cmd.duration) + SETTLE_EXTRA_S
+    if duration / job.config.dt > MAX_DRIVE_STEPS:
+        raise InputError(
+            f"{duration:g} s at dt = {job.config.dt:g} s is more than {MAX_DRIVE_STEPS:,} "
+            "steps, the most a drive run records",
+            field="SimOptions.duration",
+        )
+    job = replace(job, duration=float(duration))
+    stance = stance_of(robot, candidates=set(spec.mobile_base.links) if spec.mobile_base else None)
+    if isinstance(stance, NoStance):
+        raise InputError(f"the robot cannot stand: {stance.reason}", field="mobile_base")
+    n = len(job.arm.joint_names)
+    kp = np.broadcast_to(np.asarray(job.config.kp, dtype=float), (n,))
+    kd = np.broadcast_to(np.asarray(job.config.kd, dtype=float), (n,))
+    gains = (kp, kd, np.asarray(job.arm.effort, dtype=float))
+    model = build_drive_model(
+        robot, spec, stance, params, job.arm.joint_names, gains, job.config.dt
+    )
+    return DriveJob(job, cmd, params, model, stance, robot, float(duration))
+
+
+def _hold_message(spec: RobotSpec, opts: SimOptions) -> str:
+    """A one-point trajectory at the start pose: the arm holds still."""
+    import yaml
+
+    arm = simjob.load_arm(spec, None, opts.joints)
+    q0 = simjob.start_state(arm, spec)
+    point = {"positions": [float(x) for x in q0], "time_from_start": 0.0}
+    return str(yaml.safe_dump({"joint_names": list(arm.joint_names), "points": [point]}))
+
+
+@dataclass(frozen=True)
+class DriveRun:
+    """A run's every state: sensors (DriveModel.layout), reference, odometry."""
+
+    job: DriveJob
+    t: np.ndarray  # (N + 1,) [s]
+    sensors: np.ndarray  # (N + 1, layout.size): state k's sensors (forces: of step k)
+    q_ref: np.ndarray  # (N + 1, n) the arm's reference
+    v_ref: np.ndarray
+    wheel_command: np.ndarray  # (N + 1, 2) [rad/s] the joint speeds the plugin set
+    odometry: Odometry
+    wall_time: float  # [s] spent stepping
+
+    @property
+    def steps(self) -> int:
+        """Steps of the run."""
+        return len(self.t) - 1
+
+
+def update_steps(steps: int, dt: float, period: float) -> np.ndarray:
+    """Steps at whose start the plugin updates.
+
+    Gazebo's sim time then is (k + 1) dt, and it acts once at least `period` has passed
+    since its last update (the first: since 0).
+    """
+    out, last = [], 0.0
+    for k in range(steps):
+        now = (k + 1) * dt
+        if now - last >= period - 1e-12:
+            out.append(k)
+            last = now
+    return np.array(out, dtype=np.int64)
+
+
+def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> DriveRun:
+    """Step the model for the job's duration from rest on the floor."""
+    import mujoco
+
+    m, dm, arm = job.model.model, job.model, job.arm
+    d = mujoco.MjData(m)
+    d.qpos[2] = dm.base_z
+    d.qpos[dm.arm_qpos] = arm.q0
+    steps = steps_of(job.duration, job.dt)
+    t = np.arange(steps + 1) * job.dt
+    q_ref, v_ref = arm.reference.sample(t)
+    kp, kd = np.asarray(arm.config.kp, dtype=float), np.asarray(arm.config.kd, dtype=float)
+    ctrl_arm = q_ref + np.divide(kd, kp, out=np.zeros_like(kp), where=kp > 0) * v_ref
+    gravity = _gravity(arm) if arm.config.gravity_comp else None
+    inv_kp = np.divide(1.0, kp, out=np.zeros_like(kp), where=kp > 0)  # Kp 0: no g through ctrl
+    updates = update_steps(steps, job.dt, job.params.period)
+    lin, ang = job.cmd.at((updates + 1) * job.dt)
+    is_update = np.zeros(steps + 1, dtype=bool)
+    is_update[updates] = True
+    rec = np.empty((steps + 1, dm.layout.size))
+    wheel_cmd = np.zeros((steps + 1, 2))
+    controller = DiffDriveController(job.params)
+    wheel_act, wheel_dof = dm.wheel_act, dm.wheel_dof
+    cols = np.nonzero(dm.arm_act >= 0)[0]  # a mimic joint follows its leader: no actuator
+    ctrl_arm, inv_kp = ctrl_arm[:, cols], inv_kp[cols]
+    act = dm.arm_act[cols]
+    arm_act = slice(int(act[0]), int(act[-1]) + 1) if _contiguous(act) else act
+    arm_qpos = dm.arm_qpos
+    ctrl, u, command = d.ctrl, 0, np.zeros(2)
+    mujoco.mj_forward(m, d)
+    start = time.perf_counter()
+    for k in range(steps):
+        if is_update[k]:
+            command = controller.update(lin[u], ang[u], d.qvel[wheel_dof], job.params.period)
+            ctrl[wheel_act] = command
+            u += 1
+        wheel_cmd[k] = command
+        if gravity is None:
+            ctrl[arm_act] = ctrl_arm[k]
+        else:
+            ctrl[arm_act] = ctrl_arm[k] + gravity(d.qpos[arm_qpos])[cols] * inv_kp
+        mujoco.mj_step(m, d)
+        rec[k] = d.sensordata
+        if progress is not None and k % PROGRESS_STEPS == 0 and k:
+            progress(k, steps)
+    mujoco.mj_forward(m, d)
+    rec[steps], wheel_cmd[steps] = d.sensordata, command
+    wall = time.perf_counter() - start
+    _refuse_reset(d, rec, job.dt)
+    wl = rec[:-1, dm.layout.wheel_vel]
+    odom = encoder_odometry(wl[:, 0], wl[:, 1], job.dt, job.params.radius, job.params.separation)
+    return DriveRun(job, t, rec, q_ref, v_ref, wheel_cmd, odom, wall)
+
+
+def _refuse_reset(d: Any, rec: np.ndarray, dt: float) -> None:
+    """MuJoCo resets a state that became non-finite and goes on: such a run is no result."""
+    import mujoco
+
+    W = mujoco.mjtWarning
+    bad = [w for w in (W.mjWARN_BADQACC, W.mjWARN_BADQPOS, W.mjWARN_BADQVEL)
+           if d.warning[w].number > 0]  # fmt: skip
+    if bad:
+        rows = np.nonzero(~np.all(np.isfinite(rec), axis=1))[0]
+        step = int(rows[0]) if rows.size else None
+        raise SimulationError(
+            "MuJoCo's state became non-finite and was reset",
+            time=step * dt if step is not None else None,
+            step=step,
+            cause="gains too high for dt, or a model MuJoCo cannot integrate (try a smaller --dt)",
+        )
+
+
+def _contiguous(ids: np.ndarray) -> bool:
+    return len(ids) > 0 and bool(np.all(np.diff(ids) == 1))
+
+
+def _gravity(arm: SimJob) -> Callable[[np.ndarray], np.ndarray]:
+    """g(q) [N·m] of the fixed-base arm, as `simulate`'s controller adds it."""
+    import pinocchio as pin
+
+    robot = arm.arm.robot
+    model, data = robot.model, robot.model.createData()
+
+    def g(q: np.ndarray) -> Any:
+        return pin.computeGeneralizedGravity(model, data, robot.q(q))
+
+    return g

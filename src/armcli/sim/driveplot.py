@@ -1,0 +1,64 @@
+"""A drive run's plot: the tracking plot with the path seen from above and the wheel loads."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from armcli.sim.drive import DriveRun
+from armcli.sim.liftoff import TipVerdict
+from armcli.sim.simulate import SimResult
+
+LOAD_WINDOW_S = 0.01  # [s] the wheel loads are drawn as means over this (a single step chatters)
+
+
+def plot_png(run: DriveRun, res: SimResult, verdict_: TipVerdict) -> bytes:
+    """The tracking plot with two more rows: the path seen from above, the wheel loads."""
+    from armcli.sim.plot import tracking_png
+
+    title = f"armcli simulate --cmd-vel (MuJoCo, dt = {res.dt:g} s)"
+    return tracking_png(res, run.job.arm.arm.effort, _drive_rows(run, verdict_), 2, title)
+
+
+def _drive_rows(run: DriveRun, verdict_: TipVerdict) -> Callable[[Sequence[Any]], None]:
+    job, L, s = run.job, run.job.model.layout, run.sensors
+    step = max(1, run.steps // 4000)
+    window = max(1, round(LOAD_WINDOW_S / job.dt))
+
+    def wide(row: Sequence[Any]) -> Any:
+        """One axes across the figure in place of a row's per-joint axes."""
+        spec = row[0].get_subplotspec()
+        grid, fig = spec.get_gridspec(), row[0].figure
+        for a in row:
+            a.remove()
+        return fig.add_subplot(grid[spec.rowspan.start, :])
+
+    def draw(axes: Sequence[Any]) -> None:
+        half = len(axes) // 2
+        ax, load = wide(axes[:half]), wide(axes[half:])
+        pos = s[::step, L.base_pos]
+        ax.plot(pos[:, 0], pos[:, 1], color="C0", lw=1.5, label=f"truth ({job.params.base_frame})")
+        ax.plot(run.odometry.x[::step], run.odometry.y[::step], "--", color="C1", lw=1.2,
+                label="odometry (wheel encoders)")  # fmt: skip
+        ax.plot(pos[0, 0], pos[0, 1], "o", color="k", ms=4, label="start")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_title("path seen from above", fontsize=11)
+        ax.legend(loc="best", fontsize=8)
+        ax.grid(True, alpha=0.3)
+        n = (len(s) // window) * window
+        t = run.t[:n].reshape(-1, window).mean(axis=1)
+        force = s[:n, L.touch].reshape(-1, window, len(job.model.contacts)).mean(axis=1)
+        for i, link in enumerate(job.model.contacts):
+            load.plot(t, force[:, i], lw=1.0, label=link)
+        for lift in verdict_.lifts:
+            load.axvspan(lift.start, lift.start + lift.duration, color="C3", alpha=0.25)
+        load.set_xlabel("time [s]")
+        load.set_ylabel("normal force [N]")
+        load.set_title(f"wheel and caster loads ({LOAD_WINDOW_S * 1e3:g} ms means; shaded: "
+                       "lift-off)", fontsize=11)  # fmt: skip
+        load.legend(loc="best", fontsize=8)
+        load.grid(True, alpha=0.3)
+
+    return draw

@@ -1,0 +1,147 @@
+"""armcli.robot.model: the joint table, `Robot.q` against a hand-built configuration and
+closed-form kinematics, the reduced model and the collision model on demand."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from armcli.errors import InputError
+from armcli.robot.model import Robot
+from armcli.robot.tool import ToolPoint
+from armcli.urdf.meshes import MeshSearch
+from armcli.urdf.read import parse_urdf
+from tests.meshes import prism_triangles, write_stl
+
+EXACT = 1e-12  # same arithmetic, only rounding of cos/sin and one rotation product
+
+# A base, a continuous yaw joint (axis z), a revolute pitch joint (axis y), a prismatic
+# slide (axis x), a fixed tool flange and a mimic finger. Each link 1 kg, box collision.
+URDF = b"""<robot name="t">
+  <link name="base"><collision><geometry><box size="0.2 0.2 0.1"/></geometry></collision></link>
+  <link name="turret"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
+    ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <link name="arm"><inertial><origin xyz="0.25 0 0"/><mass value="1"/><inertia ixx="0.01"
+    iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="slider"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"
+    ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="finger"><inertial><mass value="0.1"/><inertia ixx="0.001" iyy="0.001"
+    izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="flange"/>
+  <joint name="yaw" type="continuous"><parent link="base"/><child link="turret"/>
+    <origin xyz="0 0 0.1"/><axis xyz="0 0 1"/><dynamics damping="0.5" friction="0.2"/>
+    <limit effort="10" velocity="3"/></joint>
+  <joint name="pitch" type="revolute"><parent link="turret"/><child link="arm"/>
+    <origin xyz="0 0 0.2"/><axis xyz="0 1 0"/><limit lower="-1" upper="2" effort="20"
+    velocity="2"/></joint>
+  <joint name="slide" type="prismatic"><parent link="arm"/><child link="slider"/>
+    <origin xyz="0.5 0 0"/><axis xyz="1 0 0"/><limit lower="0" upper="0.3" effort="0"
+    velocity="1"/></joint>
+  <joint name="grip" type="prismatic"><parent link="slider"/><child link="finger"/>
+    <axis xyz="0 1 0"/><limit lower="0" upper="0.1" effort="5" velocity="1"/>
+    <mimic joint="slide" multiplier="0.5" offset="0.01"/></joint>
+  <joint name="flange_joint" type="fixed"><parent link="slider"/><child link="flange"/>
+    <origin xyz="0.1 0 0"/></joint>
+</robot>"""
+
+
+@pytest.fixture(scope="module")
+def robot() -> Robot:
+    return Robot.from_urdf(parse_urdf(URDF, "t.urdf"))
+
+
+def test_joint_table_reads_the_urdf(robot: Robot) -> None:
+    # every number below is the URDF text's above
+    assert robot.names == ("yaw", "pitch", "slide", "grip")
+    yaw, pitch, slide, _ = robot.joints
+    assert yaw.continuous and (yaw.lower, yaw.upper) == (-math.inf, math.inf)
+    assert yaw.span == (-math.pi, math.pi)
+    assert (yaw.damping, yaw.friction, yaw.effort, yaw.velocity) == (0.5, 0.2, 10.0, 3.0)
+    assert not pitch.continuous and (pitch.lower, pitch.upper) == (-1.0, 2.0) == pitch.span
+    assert slide.effort == math.inf  # effort="0": no limit
+    assert [j.idx_v for j in robot.joints] == [0, 1, 2, 3]
+    assert [j.idx_q for j in robot.joints] == [0, 2, 3, 4]  # yaw takes (cos, sin)
+
+
+def test_mimics_tool_and_leaders(robot: Robot) -> None:
+    assert [(m.follower, m.leader) for m in robot.mimics] == [("grip", "slide")]
+    assert [j.name for j in robot.leaders] == ["yaw", "pitch", "slide"]
+    assert robot.follow({"slide": 0.2}) == {"slide": 0.2, "grip": 0.5 * 0.2 + 0.01}
+    # the deepest link, first in file order on ties (robot.tool's rule): finger, 4 joints deep
+    assert robot.tool == ToolPoint("finger")
+
+
+def test_q_matches_a_hand_built_configuration(robot: Robot) -> None:
+    x = {"yaw": 2.5, "pitch": -0.7, "slide": 0.12, "grip": 0.03}
+    expected = np.array([math.cos(2.5), math.sin(2.5), -0.7, 0.12, 0.03])  # (cos, sin) layout
+    assert np.array_equal(robot.q(x), expected)
+    assert np.array_equal(robot.q([2.5, -0.7, 0.12, 0.03]), expected)  # by tree order
+    pitch = robot.joint("pitch")
+    assert np.array_equal(robot.q([0.4], joints=[pitch], base=expected),
+                          np.array([*expected[:2], 0.4, *expected[3:]]))  # fmt: skip
+    assert np.array_equal(robot.q({"nope": 1.0}), robot.neutral())  # unknown names ignored
+
+
+def test_q_poses_the_robot_like_closed_form_kinematics(robot: Robot) -> None:
+    """Flange at (yaw, pitch, s): Rz(yaw) [0, 0, 0.3] + Rz(yaw) Ry(pitch) [0.6 + s, 0, 0]."""
+    yaw, pitch, s = 2.0, 0.5, 0.2
+    q = robot.q({"yaw": yaw, "pitch": pitch, "slide": s})
+    pin.framesForwardKinematics(robot.model, robot.data, q)
+    got = robot.data.oMf[robot.model.getFrameId("flange")].translation
+    Rz = np.array(
+        [[math.cos(yaw), -math.sin(yaw), 0], [math.sin(yaw), math.cos(yaw), 0], [0, 0, 1]]
+    )
+    Ry = np.array([[math.cos(pitch), 0, math.sin(pitch)], [0, 1, 0],
+                   [-math.sin(pitch), 0, math.cos(pitch)]])  # fmt: skip
+    expected = Rz @ np.array([0, 0, 0.3]) + Rz @ Ry @ np.array([0.5 + s + 0.1, 0, 0])
+    assert np.allclose(got, expected, atol=EXACT)
+
+
+def test_reduced_locks_the_others_at_neutral(robot: Robot) -> None:
+    arm = robot.reduced(["pitch", "slide"])
+    assert arm.names == ("pitch", "slide") and arm.model.nq == 2
+    assert arm.mimics == ()  # grip is locked: no coupling left
+    assert robot.reduced(robot.names) is robot
+    with pytest.raises(InputError, match="unknown joint 'elbow'; valid: yaw, pitch") as err:
+        robot.reduced(["elbow"])
+    assert err.value.field == "joints"
+    with pytest.raises(InputError, match="listed twice"):
+        robot.reduced(["pitch", "pitch"])
+
+
+def test_joint_lists_the_valid_names(robot: Robot) -> None:
+    with pytest.raises(InputError, match="valid: yaw, pitch, slide, grip"):
+        robot.joint("elbow")
+
+
+def test_collision_model_on_demand(robot: Robot) -> None:
+    gm = robot.collision_model()
+    links = sorted(robot.model.frames[g.parentFrame].name for g in gm.geometryObjects)
+    assert links == ["base", "turret"]  # the two <collision> elements of URDF
+    with pytest.raises(InputError, match="no URDF text"):
+        Robot(robot.model).collision_model()
+
+
+def test_mass_and_data(robot: Robot) -> None:
+    assert robot.mass == pytest.approx(3.1, abs=EXACT)  # 1 + 1 + 1 + 0.1 kg in URDF
+    assert robot.data is robot.data
+
+
+def test_collision_model_resolves_meshes_inside_the_allowed_roots(tmp_path: Path) -> None:
+    write_stl(tmp_path / "meshes" / "box.stl", prism_triangles(0.05, 0.1, 4))
+    mesh = b'<mesh filename="meshes/box.stl"/>'
+    text = URDF.replace(b'<box size="0.1 0.1 0.1"/>', mesh)
+    (tmp_path / "t.urdf").write_bytes(text)
+    robot = Robot.from_urdf(parse_urdf(text, str(tmp_path / "t.urdf")))
+    gm = robot.collision_model(MeshSearch())
+    real = (tmp_path / "meshes" / "box.stl").resolve()
+    assert [g.meshPath for g in gm.geometryObjects if g.meshPath.endswith(".stl")] == [str(real)]
+    gone = Robot.from_urdf(parse_urdf(text.replace(b"box.stl", b"gone.stl"),
+                                      str(tmp_path / "t.urdf")))  # fmt: skip
+    with pytest.raises(InputError, match=r"mesh 'meshes/gone\.stl' cannot be found"):
+        gone.collision_model(MeshSearch())
