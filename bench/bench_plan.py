@@ -218,6 +218,7 @@ def panda(count: int) -> None:
         ok = [0, 0, 0]
         straight = 0
         violations = 0
+        failed: dict[str, int] = {}
         cert: list[float] = []
         for k, (a, b) in enumerate(qs):
             mine = None
@@ -229,8 +230,11 @@ def panda(count: int) -> None:
                     cert.append(res.certify_time_s)
                     mine = res.path
                     straight += len(res.path) == 2
+                else:
+                    failed["over 1 s"] = failed.get("over 1 s", 0) + 1
             except PlanningError as exc:
                 violations += exc.kind == "certify"
+                failed[exc.kind] = failed.get(exc.kind, 0) + 1
             dt, path = rb.plan(a, b, k)
             if path is not None and dt <= TIMEOUT_S:
                 ok[1] += 1
