@@ -33,11 +33,11 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
 from armcli.errors import PlanningError  # noqa: E402
+from armcli.io.packages import PackageLookup  # noqa: E402
 from armcli.plan.api import PlanningContext, PlanOptions, plan_motion  # noqa: E402
 from armcli.plan.ik import solve_ik, tool_pose  # noqa: E402
 from armcli.plan.inputs import Loaded, load_context  # noqa: E402
 from armcli.plan.scene import Scene  # noqa: E402
-from armcli.urdf.packages import PackageLookup  # noqa: E402
 from armcli.urdf.source import read_robot  # noqa: E402
 
 SPEC = ROOT / "specs" / "my_robot.yaml"
@@ -112,11 +112,15 @@ class Roboplan:
         color = np.array([0.5, 0.5, 0.5, 1.0])
         shapes = {"box": lambda d: Box(*d), "sphere": lambda d: Sphere(d[0]),
                   "cylinder": lambda d: Cylinder(d[1], d[0])}  # fmt: skip
+        names = [f"{o.id}_{k}" for o in obstacles.objects for k in range(len(o.shapes))]
         for obj in obstacles.objects:
             for k, shape in enumerate(obj.shapes):
                 adder = getattr(self.scene, f"add{shape.kind.capitalize()}Geometry")
                 adder(f"{obj.id}_{k}", "universe", shapes[shape.kind](shape.dimensions),
                       np.asfortranarray(shape.T_frame_shape), color)  # fmt: skip
+        pairs = [(a, b) for i, a in enumerate(names) for b in names[i + 1 :]]
+        if pairs:  # obstacles touching each other are no collision of the robot's
+            self.scene.setCollisions(pairs, False)
         opts = RRTOptions(group_name="arm", rrt_connect=True, max_planning_time=TIMEOUT_S,
                           max_nodes=100000, collision_check_step_size=STEP)  # fmt: skip
         self.rrt = RRT(self.scene, opts)
@@ -183,7 +187,7 @@ def floor_plan(
     path = None
     if setup.haveExactSolutionPath():
         p = setup.getSolutionPath()
-        og.PathSimplifier(info).shortcutPath(p)
+        og.PathSimplifier(info).reduceVertices(p)
         path = np.array([[p.getState(k)[i] for i in range(n)] for k in range(p.getStateCount())])
     dt = time.perf_counter() - t0
     setup.clear()
@@ -214,6 +218,7 @@ def panda(count: int) -> None:
         ok = [0, 0, 0]
         straight = 0
         violations = 0
+        failed: dict[str, int] = {}
         cert: list[float] = []
         for k, (a, b) in enumerate(qs):
             mine = None
@@ -225,8 +230,11 @@ def panda(count: int) -> None:
                     cert.append(res.certify_time_s)
                     mine = res.path
                     straight += len(res.path) == 2
+                else:
+                    failed["over 1 s"] = failed.get("over 1 s", 0) + 1
             except PlanningError as exc:
                 violations += exc.kind == "certify"
+                failed[exc.kind] = failed.get(exc.kind, 0) + 1
             dt, path = rb.plan(a, b, k)
             if path is not None and dt <= TIMEOUT_S:
                 ok[1] += 1

@@ -110,3 +110,12 @@ def test_fast_configuration_matches_the_joint_by_joint_one(panda: Loaded, course
         for _ in range(5):
             x = rng.uniform(robot.lower, robot.upper)
             assert np.array_equal(robot.q(x), robot.q_slow(x))
+
+
+def test_bisection_order_checks_every_step_once() -> None:
+    from armcli.plan.collision import bisection_order
+
+    for n in (1, 2, 3, 7, 50, 64):
+        order = bisection_order(n)
+        assert sorted(order) == list(range(1, n + 1))  # each intermediate point exactly once
+        assert order[0] == n

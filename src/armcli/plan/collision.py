@@ -165,9 +165,32 @@ class CollisionChecker:
         )
 
     def motion_free(self, xa: np.ndarray, xb: np.ndarray, step: float) -> bool:
-        """Whether the straight joint-space segment is free, checked every `step` [rad or m]."""
+        """Whether the straight joint-space segment is free, checked every `step` [rad or m].
+
+        The end first, then midpoints by bisection (as OMPL's discrete motion validator and
+        roboplan do): a blocked segment is usually refused after a few checks.
+        """
         n = max(1, math.ceil(float(np.max(np.abs(xb - xa))) / step))
-        return all(self.free(xa + (xb - xa) * (k / n)) for k in range(1, n + 1))
+        return all(self.free(xa + (xb - xa) * (k / n)) for k in bisection_order(n))
+
+
+def bisection_order(n: int) -> list[int]:
+    """1..n, the end first, then the midpoints of ever smaller intervals (each once)."""
+    out, seen = [n], {0, n}
+    intervals = [(0, n)]
+    while intervals:
+        nxt = []
+        for lo, hi in intervals:
+            mid = (lo + hi) // 2
+            if mid not in seen:
+                seen.add(mid)
+                out.append(mid)
+            if mid - lo > 1:
+                nxt.append((lo, mid))
+            if hi - mid > 1:
+                nxt.append((mid, hi))
+        intervals = nxt
+    return out
 
 
 def _key(a: str, b: str) -> tuple[str, str]:

@@ -1,7 +1,7 @@
 """The robot a plan moves: Pinocchio model, planned joints and their limits, collision geometry.
 
 `load_plan_robot` is the one place this package loads a model (robot.load's checked
-loader; `PlanRobot.q` is `robot.model.Robot.q`). The whole robot is loaded with
+loader; `PlanRobot.q_slow` is `robot.model.Robot.q`). The whole robot is loaded with
 a fixed root, so the arm is checked against its own mobile base. Planned joints are the
 free 1-DoF joints a plan moves; mimic followers follow their leaders; every other joint
 stays at its rest value (0, or the middle of its range when 0 is outside it).
@@ -72,12 +72,13 @@ class PlanRobot:
     def q(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
         """Pinocchio configuration with the planned joints at `x` and followers following.
 
-        Every other 1-DoF joint at its `rest` value; multi-DoF joints stay neutral.
+        Every other 1-DoF joint at its `rest` value; multi-DoF joints stay neutral. Vectorised
+        (`_Layout`, built from and tested against `q_slow`): the planner calls it per state.
         """
         return self._layout.q(np.asarray(x, dtype=float))
 
     def q_slow(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
-        """`q` through the names and `Robot.q` (the reference `_Layout` is built from)."""
+        """`q` joint by joint through `Robot.q`."""
         values = dict(self.rest)
         values.update(zip(self.joints, (float(v) for v in x), strict=True))
         return self.robot.q(follow(self.mimic, values))
