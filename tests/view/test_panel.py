@@ -214,3 +214,10 @@ def test_cli_robot_without_joints_gets_the_viewer_without_a_panel(
     assert proc.returncode == 0, err
     assert out == "viewer stopped\n"
     assert err.startswith("note: no planning panel: ") and err.count("\n") == 1, err
+
+
+def test_cli_unknown_planning_joint_is_refused(root: Path) -> None:
+    proc = run_cli(["view", "--port", "0", "--joints", "elbow"], root)
+    assert proc.returncode == 2
+    assert proc.stderr.startswith("error: --joints: unknown joint 'elbow'; valid: "), proc.stderr
+    assert "arm_base_forearm_joint" in proc.stderr and proc.stdout == ""

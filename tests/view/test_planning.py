@@ -88,6 +88,17 @@ def test_plan_draws_a_trail_from_start_to_goal(session: PlanningSession) -> None
     assert np.allclose(trail.tool_path[:, 1], 0.0, atol=FK_TOL)  # planar arm: y stays 0
 
 
+def test_a_joint_subset_plans_only_those(robot, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    session = load_session(robot.file, joints=["forearm_hand_joint"], save_dir=tmp_path)
+    assert session.joints == ("forearm_hand_joint",)
+    session.set_goal([math.pi / 4])
+    assert session.plan() is not None
+    # the forearm stays upright (rest 0): the tool swings on a 0.3 m circle about the elbow
+    elbow = PIVOT + np.array([0.0, 0.0, LINK])
+    radius = np.linalg.norm(session.trail().tool_path - elbow, axis=1)
+    assert radius == pytest.approx(np.full(len(radius), LINK), abs=FK_TOL)
+
+
 def test_a_failed_plan_is_one_line_and_no_trail(boxed: PlanningSession) -> None:
     boxed.set_goal(boxed.pose("reach"))  # the hand ends inside the box
     assert boxed.plan() is None

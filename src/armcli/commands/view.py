@@ -32,10 +32,13 @@ if TYPE_CHECKING:
 
 SCENE_HELP = "Obstacles for the planning panel: YAML like moveit_msgs/PlanningScene."
 SRDF_HELP = "SRDF of a URDF: its named poses (group_state) and disabled collision pairs."
+JOINTS_HELP = "Joints the planning panel plans, comma-separated (default: the arm's)."
 SAVE_HELP = "Directory the planning panel's Save writes into (default: the current one)."
 
 
-@flag_errors({"pose": "--pose", "q": "--q", "port": "--port", "replay": "--replay"})
+@flag_errors(
+    {"pose": "--pose", "q": "--q", "port": "--port", "replay": "--replay", "joints": "--joints"}
+)
 def view_cmd(
     robot: Path | None = spec_argument(ROBOT_HELP),
     args: list[str] = args_argument(),
@@ -54,6 +57,7 @@ def view_cmd(
     ),
     scene: Path = typer.Option(None, "--scene", help=SCENE_HELP),
     srdf: Path = typer.Option(None, "--srdf", help=SRDF_HELP),
+    joints: str = typer.Option(None, "--joints", help=JOINTS_HELP),
     save_dir: Path = typer.Option(Path("."), "--save-dir", show_default=False, help=SAVE_HELP),
     package_dir: list[str] = package_dir_option(),
     env: list[str] = env_option(),
@@ -81,7 +85,8 @@ def view_cmd(
         names = list(joint_limits(load_urdf(src.xml, src.source, src.mesh_dir, src.search)))
         load = rosbag.load_replay if rosbag.is_mcap(replay) else load_replay
         run = load(replay, names)
-    session = _session(src, scene, srdf, save_dir, trust, inputs)  # before the server starts
+    chosen = [j.strip() for j in joints.split(",") if j.strip()] if joints else None
+    session = _session(src, (scene, srdf, chosen), save_dir, trust, inputs)  # before serving
     viewer = Viewer(
         src.xml,
         name=src.name,
@@ -116,8 +121,7 @@ def view_cmd(
 
 def _session(
     src: RobotSource,
-    scene: Path | None,
-    srdf: Path | None,
+    planning: tuple[Path | None, Path | None, list[str] | None],
     save_dir: Path,
     trust: Trust,
     inputs: XacroInputs,
@@ -126,16 +130,17 @@ def _session(
     from armcli.sim.options import SimOptions
     from armcli.view.planning import load_session
 
+    scene, srdf, joints = planning
     if not save_dir.is_dir():
         raise InputError(f"{save_dir} is not a directory", field="--save-dir")
     assert src.file is not None
     sim = SimOptions(urdf=None if src.file.spec else src.file.path, trust_xacro=trust,
                      xacro=inputs)  # fmt: skip
     try:
-        session = load_session(src.file, srdf=srdf, scene=scene, search=src.search, sim=sim,
-                               save_dir=save_dir)  # fmt: skip
+        session = load_session(src.file, srdf=srdf, scene=scene, joints=joints,
+                               search=src.search, sim=sim, save_dir=save_dir)  # fmt: skip
     except InputError as exc:
-        if scene is not None or srdf is not None:
+        if any(given is not None for given in planning):  # asked for planning: refuse
             raise
         sys.stderr.write(f"note: no planning panel: {exc}\n")
         return None

@@ -277,11 +277,12 @@ def load_session(
     *,
     srdf: Path | None = None,
     scene: Path | None = None,
+    joints: Sequence[str] | None = None,
     search: MeshSearch | None = None,
     sim: SimOptions | None = None,
     save_dir: Path = Path("."),
 ) -> PlanningSession:
     """A session for a robot file, its SRDF (a URDF's) and a scene file: what `view` builds."""
-    loaded = load_context(robot_file, srdf=srdf, scene=scene, search=search)
+    loaded = load_context(robot_file, srdf=srdf, scene=scene, joints=joints, search=search)
     return PlanningSession(loaded.context, robot_file, scene=loaded.scene, sim=sim,
                            search=search, save_dir=save_dir)  # fmt: skip
