@@ -58,6 +58,7 @@ class PlanResult:
     timed: Timed  # as read back from `document`
     document: bytes  # JointTrajectory YAML
     planning_time_s: float  # planning + shortcutting + parameterisation
+    path_time_s: float  # planning + shortcutting (the geometric path alone)
     certify_time_s: float
     margin: float  # the limit scale TOPP-RA used
 
@@ -142,6 +143,7 @@ def plan_motion(
     t0 = time.perf_counter()
     path = plan_path(ctx.checker, robot.lower, robot.upper, xs, xg, planner=options.planner,
                      timeout=options.timeout, seed=options.seed, step=options.step)  # fmt: skip
+    t_path = time.perf_counter() - t0
     t_plan, t_cert, last = 0.0, 0.0, None
     for margin in MARGINS if len(path) == 2 else MARGINS_CORNERS:
         timed = parameterise(robot, path, margin)
@@ -152,7 +154,7 @@ def plan_motion(
         last = certify(robot, ctx.checker, back)
         t_cert += time.perf_counter() - t1
         if last is None:
-            return PlanResult(robot.joints, path, back, doc, t_plan, t_cert, margin)
+            return PlanResult(robot.joints, path, back, doc, t_plan, t_path, t_cert, margin)
         if last.kind == "collision":
             break
     assert last is not None
