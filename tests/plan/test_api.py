@@ -100,3 +100,22 @@ def test_goal_outside_the_limits(course: Loaded) -> None:
     with pytest.raises(PlanningError, match="forearm_hand_joint = 2") as info:
         plan_motion(course.context, [0.0, 0.0], [0.5, 2.0], PlanOptions())
     assert info.value.kind == "goal-limits"
+
+
+def test_fast_configuration_matches_the_joint_by_joint_one(panda: Loaded, course: Loaded) -> None:
+    # the Panda's finger joint 2 mimics joint 1 (locked); the course arm has continuous wheels
+    for loaded in (panda, course):
+        robot = loaded.context.robot
+        rng = np.random.default_rng(0)
+        for _ in range(5):
+            x = rng.uniform(robot.lower, robot.upper)
+            assert np.array_equal(robot.q(x), robot.q_slow(x))
+
+
+def test_bisection_order_checks_every_step_once() -> None:
+    from armcli.plan.collision import bisection_order
+
+    for n in (1, 2, 3, 7, 50, 64):
+        order = bisection_order(n)
+        assert sorted(order) == list(range(1, n + 1))  # each intermediate point exactly once
+        assert order[0] == n

@@ -8,6 +8,7 @@ import pytest
 import yaml
 from lxml import etree
 
+from armcli.defaults import DEFAULT_JOINT_ACCELERATION
 from armcli.errors import InputError
 from armcli.ros import moveit as mc
 from armcli.spec.load import load_spec, loads_spec
@@ -55,6 +56,20 @@ def test_joint_limits_come_from_the_urdf(spec: RobotSpec, built_dir: Path) -> No
         assert limits[name]["max_velocity"] == float(lim.get("velocity", "nan"))
         assert limits[name]["max_effort"] == float(lim.get("effort", "nan"))
         assert isinstance(limits[name]["max_acceleration"], float)  # MoveIt reads a double
+        # the course spec gives no acceleration: the default `plan` uses for it too
+        assert limits[name]["has_acceleration_limits"] is True
+        assert limits[name]["max_acceleration"] == DEFAULT_JOINT_ACCELERATION
+
+
+def test_joint_limits_take_the_urdf_acceleration() -> None:
+    text = (
+        b'<robot name="r"><link name="a"/><link name="b"/>'
+        b'<joint name="j" type="revolute"><parent link="a"/><child link="b"/>'
+        b'<limit lower="-1" upper="1" effort="5" velocity="2" acceleration="7.5"/></joint>'
+        b"</robot>"
+    )
+    limits = mc.joint_limits(parse_urdf(text, "r.urdf"), ["j"])["joint_limits"]
+    assert limits["j"]["max_acceleration"] == 7.5  # URDF 1.2's attribute, as written
 
 
 def test_ros2_controllers(spec: RobotSpec, urdf_root: etree._Element) -> None:

@@ -149,6 +149,7 @@ def _summary(
     doc: dict[str, Any] = {
         "status": "planned",
         "planning_time_s": r.planning_time_s,
+        "path_time_s": r.path_time_s,
         "certify_time_s": r.certify_time_s,
         "duration_s": r.duration_s,
         "path_length_rad": r.path_length_rad,

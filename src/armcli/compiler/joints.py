@@ -20,6 +20,8 @@ def _limit(el: etree._Element, joint: Joint) -> None:
     if lim.upper is not None:
         attrs["upper"] = fmt(lim.upper)
     attrs.update(effort=fmt(lim.effort), velocity=fmt(lim.velocity))
+    if lim.acceleration is not None:  # URDF 1.2; written only when the spec gives it
+        attrs["acceleration"] = fmt(lim.acceleration)
     sub(el, "limit", **attrs)
 
 

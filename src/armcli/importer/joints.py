@@ -20,6 +20,9 @@ def _limit(el: etree._Element, jtype: str, reader: Reader) -> dict[str, Any]:
             out[key] = Num(v or 0.0)
     for key in ("effort", "velocity"):
         out[key] = Num(reader.one(el, key, 0.0) or 0.0)
+    acceleration = reader.one(el, "acceleration")  # URDF 1.2, optional
+    if acceleration is not None:
+        out["acceleration"] = Num(acceleration)
     return out
 
 

@@ -30,7 +30,11 @@ from armcli.plan.robot import PlanRobot
 from armcli.plan.scene import Scene
 from armcli.plan.timing import Timed, parameterise
 
-MARGINS = (0.78, 0.6, 0.45)  # TOPP-RA limit scales tried until the certification passes
+# TOPP-RA limit scales tried until the certification passes: the output spline overshoots
+# an acceleration jump by up to ~27 % (plan.timing); a stop at a corner of the path is a
+# jump of twice the limit, so paths with corners start lower.
+MARGINS = (0.78, 0.6, 0.45)
+MARGINS_CORNERS = (0.6, 0.45, 0.3)
 LIMIT_SLACK = 1e-9  # [rad or m] a start or goal may sit this far beyond a limit (rounding)
 
 
@@ -54,6 +58,7 @@ class PlanResult:
     timed: Timed  # as read back from `document`
     document: bytes  # JointTrajectory YAML
     planning_time_s: float  # planning + shortcutting + parameterisation
+    path_time_s: float  # planning + shortcutting (the geometric path alone)
     certify_time_s: float
     margin: float  # the limit scale TOPP-RA used
 
@@ -138,8 +143,9 @@ def plan_motion(
     t0 = time.perf_counter()
     path = plan_path(ctx.checker, robot.lower, robot.upper, xs, xg, planner=options.planner,
                      timeout=options.timeout, seed=options.seed, step=options.step)  # fmt: skip
+    t_path = time.perf_counter() - t0
     t_plan, t_cert, last = 0.0, 0.0, None
-    for margin in MARGINS:
+    for margin in MARGINS if len(path) == 2 else MARGINS_CORNERS:
         timed = parameterise(robot, path, margin)
         t_plan = time.perf_counter() - t0
         doc = trajectory_yaml(robot.joints, timed, frame_id=frame, comment=options.comment)
@@ -148,7 +154,7 @@ def plan_motion(
         last = certify(robot, ctx.checker, back)
         t_cert += time.perf_counter() - t1
         if last is None:
-            return PlanResult(robot.joints, path, back, doc, t_plan, t_cert, margin)
+            return PlanResult(robot.joints, path, back, doc, t_plan, t_path, t_cert, margin)
         if last.kind == "collision":
             break
     assert last is not None

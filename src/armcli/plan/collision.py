@@ -18,6 +18,7 @@ import numpy as np
 
 from armcli.plan.robot import PlanRobot
 from armcli.plan.scene import Scene, Shape
+from armcli.robot.load import link_frame
 
 GROUND_ID = "ground"  # the name the ground plane has in collision reports
 PADDING = 0.005  # [m] clearance the planner keeps (CollisionChecker.pad)
@@ -83,7 +84,7 @@ class CollisionChecker:
             for g in gmodel.geometryObjects
         ]
         for obj in scene.objects:
-            fid = self.model.getFrameId(obj.frame) if obj.frame else 0
+            fid = _frame(self.model, obj.frame) if obj.frame else 0
             joint = frames[fid].parentJoint if obj.frame else 0
             T_joint_frame = frames[fid].placement if obj.frame else pin.SE3.Identity()
             for k, shape in enumerate(obj.shapes):
@@ -102,10 +103,12 @@ class CollisionChecker:
         self.pairs = self._pairs(gmodel, {_key(a, b) for a, b in disabled})
         self.gmodel = gmodel
         self.gdata_all = pin.GeometryData(gmodel)
-        self.gdata = pin.GeometryData(gmodel)
+        self.gdata = pin.GeometryData(gmodel)  # moving pairs, padded: the planner's
+        self.gdata_moving = pin.GeometryData(gmodel)  # moving pairs, exact
         for k, (i, j) in enumerate(self.pairs):
             if self.bodies[i].moves_with == self.bodies[j].moves_with:
                 self.gdata.deactivateCollisionPair(k)  # their relative pose never changes
+                self.gdata_moving.deactivateCollisionPair(k)
 
     def _pairs(self, gmodel: Any, disabled: set[tuple[str, str]]) -> list[tuple[int, int]]:
         pairs = []
@@ -141,8 +144,11 @@ class CollisionChecker:
                     req.security_margin = 0.0
 
     def first_collision(self, x: np.ndarray, *, every_pair: bool = False) -> tuple[str, str] | None:
-        """The first colliding pair at planned joint values `x` (names), or None."""
-        gdata = self.gdata_all if every_pair else self.gdata
+        """The first colliding pair at planned joint values `x` (names), or None.
+
+        Exact geometry (no padding); `every_pair` also checks the pairs no planned joint moves.
+        """
+        gdata = self.gdata_all if every_pair else self.gdata_moving
         q = self.robot.q(x)
         if not self.pin.computeCollisions(self.model, self.data, self.gmodel, gdata, q, True):
             return None
@@ -160,10 +166,39 @@ class CollisionChecker:
         )
 
     def motion_free(self, xa: np.ndarray, xb: np.ndarray, step: float) -> bool:
-        """Whether the straight joint-space segment is free, checked every `step` [rad or m]."""
+        """Whether the straight joint-space segment is free, checked every `step` [rad or m].
+
+        The end first, then midpoints by bisection (as OMPL's discrete motion validator and
+        roboplan do): a blocked segment is usually refused after a few checks.
+        """
         n = max(1, math.ceil(float(np.max(np.abs(xb - xa))) / step))
-        return all(self.free(xa + (xb - xa) * (k / n)) for k in range(1, n + 1))
+        return all(self.free(xa + (xb - xa) * (k / n)) for k in bisection_order(n))
+
+
+def bisection_order(n: int) -> list[int]:
+    """1..n, the end first, then the midpoints of ever smaller intervals (each once)."""
+    out, seen = [n], {0, n}
+    intervals = [(0, n)]
+    while intervals:
+        nxt = []
+        for lo, hi in intervals:
+            mid = (lo + hi) // 2
+            if mid not in seen:
+                seen.add(mid)
+                out.append(mid)
+            if mid - lo > 1:
+                nxt.append((lo, mid))
+            if hi - mid > 1:
+                nxt.append((mid, hi))
+        intervals = nxt
+    return out
 
 
 def _key(a: str, b: str) -> tuple[str, str]:
     return (a, b) if a <= b else (b, a)
+
+
+def _frame(model: Any, name: str) -> int:
+    """The frame an object's `frame_id` names: the link first (a joint may share its name)."""
+    found = link_frame(model, name)
+    return found if found is not None else int(model.getFrameId(name))

@@ -1,7 +1,7 @@
 """The robot a plan moves: Pinocchio model, planned joints and their limits, collision geometry.
 
 `load_plan_robot` is the one place this package loads a model (robot.load's checked
-loader; `PlanRobot.q` is `robot.model.Robot.q`). The whole robot is loaded with
+loader; `PlanRobot.q_slow` is `robot.model.Robot.q`). The whole robot is loaded with
 a fixed root, so the arm is checked against its own mobile base. Planned joints are the
 free 1-DoF joints a plan moves; mimic followers follow their leaders; every other joint
 stays at its rest value (0, or the middle of its range when 0 is outside it).
@@ -20,7 +20,7 @@ import numpy as np
 
 from armcli.defaults import DEFAULT_JOINT_ACCELERATION
 from armcli.errors import InputError
-from armcli.robot.load import checked_model
+from armcli.robot.load import checked_model, link_frame
 from armcli.robot.mimic import Mimic, follow, mimics
 from armcli.robot.model import Robot
 from armcli.robot.tool import tool_point
@@ -65,11 +65,20 @@ class PlanRobot:
         """The model's robot handle (`Robot.q` builds the configuration)."""
         return Robot(self.model)
 
+    @cached_property
+    def _layout(self) -> _Layout:
+        return _Layout.of(self)
+
     def q(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
         """Pinocchio configuration with the planned joints at `x` and followers following.
 
-        Every other 1-DoF joint at its `rest` value; multi-DoF joints stay neutral.
+        Every other 1-DoF joint at its `rest` value; multi-DoF joints stay neutral. Vectorised
+        (`_Layout`, built from and tested against `q_slow`): the planner calls it per state.
         """
+        return self._layout.q(np.asarray(x, dtype=float))
+
+    def q_slow(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
+        """`q` joint by joint through `Robot.q`."""
         values = dict(self.rest)
         values.update(zip(self.joints, (float(v) for v in x), strict=True))
         return self.robot.q(follow(self.mimic, values))
@@ -90,6 +99,62 @@ class PlanRobot:
         """A planned joint's default value: 0 clipped into its range."""
         i = self.joints.index(joint)
         return float(np.clip(0.0, self.lower[i], self.upper[i]))
+
+
+@dataclass(frozen=True)
+class _Layout:
+    """Where planned joints and their followers sit in q, for a vectorised `PlanRobot.q`."""
+
+    template: np.ndarray  # q with the planned joints at 0
+    lin: tuple[np.ndarray, np.ndarray]  # (q index, x index) of 1-nq planned joints
+    cont: tuple[np.ndarray, np.ndarray]  # (q index of cos, x index) of continuous ones
+    followers: tuple[tuple[int, bool, str, str, float, float], ...]  # q index, cos/sin, names
+    joints: tuple[str, ...]
+    rest: Mapping[str, float]
+
+    @staticmethod
+    def of(robot: PlanRobot) -> _Layout:
+        model = robot.model
+        lin_q: list[int] = []
+        lin_x: list[int] = []
+        cont_q: list[int] = []
+        cont_x: list[int] = []
+        for k, name in enumerate(robot.joints):
+            jm = model.joints[model.getJointId(name)]
+            (cont_q if jm.nq == 2 else lin_q).append(jm.idx_q)
+            (cont_x if jm.nq == 2 else lin_x).append(k)
+        followers = []
+        for m in robot.mimic:
+            if model.existJointName(m.follower):
+                jm = model.joints[model.getJointId(m.follower)]
+                followers.append(
+                    (int(jm.idx_q), jm.nq == 2, m.follower, m.leader, m.multiplier, m.offset)
+                )
+        return _Layout(
+            robot.q_slow(np.zeros(len(robot.joints))),
+            (np.array(lin_q, dtype=int), np.array(lin_x, dtype=int)),
+            (np.array(cont_q, dtype=int), np.array(cont_x, dtype=int)),
+            tuple(followers),
+            robot.joints,
+            robot.rest,
+        )
+
+    def q(self, x: np.ndarray) -> np.ndarray:
+        q = self.template.copy()
+        q[self.lin[0]] = x[self.lin[1]]
+        if len(self.cont[0]):
+            q[self.cont[0]] = np.cos(x[self.cont[1]])
+            q[self.cont[0] + 1] = np.sin(x[self.cont[1]])
+        if self.followers:
+            values = dict(zip(self.joints, x.tolist(), strict=True))
+            for iq, cs, follower, leader, mult, offset in self.followers:  # leaders first
+                v = mult * values.get(leader, self.rest.get(leader, 0.0)) + offset
+                values[follower] = v
+                if cs:
+                    q[iq], q[iq + 1] = math.cos(v), math.sin(v)
+                else:
+                    q[iq] = v
+        return q
 
 
 def _rest(lo: float, hi: float) -> float:
@@ -161,7 +226,8 @@ def load_plan_robot(
         if j.type in MOVABLE and j.name not in chosen
     }
     tool = tool_point(urdf, spec)
-    if tool is None or not model.existFrame(tool.link):
+    tool_frame = link_frame(model, tool.link) if tool is not None else None
+    if tool is None or tool_frame is None:  # a link, not a joint of the same name (ANYmal C)
         raise InputError("this URDF has no link to use as the tool point", file=urdf.source)
     poses: dict[str, Mapping[str, float]] = dict(group_states or {})
     if spec is not None:
@@ -176,7 +242,7 @@ def load_plan_robot(
         velocity=np.array(vel),
         acceleration=np.array(acc),
         effort=np.array(eff),
-        tool_frame=int(model.getFrameId(tool.link)),
+        tool_frame=tool_frame,
         tool_offset=np.array(tool.xyz, dtype=float),
         tool_label=tool.label,
         poses=poses,

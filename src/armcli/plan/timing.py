@@ -25,7 +25,7 @@ import numpy as np
 from armcli.errors import PlanningError
 from armcli.plan.robot import PlanRobot
 
-GRID_PER_SEGMENT = 40  # TOPP-RA grid intervals per polyline segment
+GRID_PER_SEGMENT = 30  # TOPP-RA grid intervals per polyline segment
 OUTPUT_RATE_HZ = 100.0  # [Hz] trajectory points written (the course's controller rate)
 UNLIMITED = 1e9  # stands for a limit the URDF does not give (TOPP-RA needs finite numbers)
 

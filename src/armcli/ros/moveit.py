@@ -13,6 +13,7 @@ from typing import Any
 
 import yaml
 
+from armcli.defaults import DEFAULT_JOINT_ACCELERATION
 from armcli.errors import InputError
 from armcli.ros.interfaces import HUMBLE, trajectory_interface
 from armcli.ros.srdf import ARM_GROUP, chain_joints
@@ -56,18 +57,23 @@ def kinematics(spec: RobotSpec) -> dict[str, Any]:
 
 
 def joint_limits(urdf: Urdf, joints: list[str]) -> dict[str, Any]:
-    """MoveIt joint_limits.yaml: velocity and effort limits copied from the URDF."""
+    """MoveIt joint_limits.yaml: velocity, acceleration and effort limits from the URDF.
+
+    A joint without `<limit acceleration>` gets DEFAULT_JOINT_ACCELERATION, the limit
+    `armcli plan` uses for it, so MoveIt and `plan` time motions under the same limits.
+    """
     by_name = {j.name: j for j in urdf.joints}
     limits: dict[str, Any] = {}
     for name in joints:
         lim = by_name[name].limit
         vel = lim.velocity if lim is not None else None
         eff = lim.effort if lim is not None else None
+        acc = lim.acceleration if lim is not None else None
         limits[name] = {
             "has_velocity_limits": vel is not None,
             "max_velocity": float(vel or 0.0),
-            "has_acceleration_limits": False,  # a URDF has none; MoveIt then uses its default
-            "max_acceleration": 0.0,
+            "has_acceleration_limits": True,
+            "max_acceleration": float(acc or DEFAULT_JOINT_ACCELERATION),
             "has_effort_limits": eff is not None,
             "max_effort": float(eff or 0.0),
         }

@@ -13,7 +13,9 @@ from armcli.spec.types import NonNeg, Real, UrdfName, Vec3, _Model
 
 
 class Limit(_Model):
-    """Joint limits: `lower`/`upper` [rad or m], `effort` [N·m or N], `velocity` [rad/s or m/s].
+    """Joint limits: `lower`/`upper`, `effort`, `velocity` and an optional `acceleration`.
+
+    Units: [rad or m], [N·m or N], [rad/s or m/s], [rad/s² or m/s²].
 
     Revolute and prismatic joints need `lower` and `upper`; a continuous joint has none
     (a URDF may still write them, and they are kept). An effort or velocity of 0 is what
@@ -24,6 +26,11 @@ class Limit(_Model):
     upper: Real | None = Field(None, description="upper position limit [rad or m], >= lower")
     effort: NonNeg = Field(description="largest motor torque or force [N·m or N]")
     velocity: NonNeg = Field(description="largest speed [rad/s or m/s]")
+    acceleration: NonNeg | None = Field(
+        None,
+        description="largest acceleration [rad/s² or m/s²] (URDF 1.2's `<limit acceleration>`); "
+        "`plan` and the MoveIt joint_limits.yaml use 1.0 when absent (MoveIt's default)",
+    )
 
 
 class Dynamics(_Model):

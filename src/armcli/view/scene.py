@@ -11,10 +11,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from armcli.errors import InputError
+from armcli.io.names import did_you_mean
 from armcli.robot.tool import ToolPoint, tool_point
 from armcli.spec.expr import eval_expr
 from armcli.urdf.meshes import MeshSearch
-from armcli.urdf.source import Trust, lookup_for, read_robot, urdf_text
+from armcli.urdf.source import RobotFile, Trust, lookup_for, read_robot, urdf_text
 from armcli.urdf.tree import tree_from_urdf
 from armcli.xacro.args import XacroInputs
 
@@ -32,6 +33,7 @@ class RobotSource:
     tool: ToolPoint | None = None
     search: MeshSearch = field(default_factory=MeshSearch)  # --package-dir
     notes: tuple[str, ...] = ()  # what reading a xacro file reported (Urdf.notes)
+    file: RobotFile | None = None  # what was read (the planning panel loads its model from it)
 
 
 def load_robot(
@@ -59,6 +61,7 @@ def load_robot(
             poses={p: spec.pose(p) for p in spec.poses},
             tool=tool_point(robot.robot, spec),
             search=where,
+            file=robot,
         )
     urdf = robot.robot
     tree = tree_from_urdf(urdf)
@@ -71,6 +74,7 @@ def load_robot(
         tool=tool_point(urdf),
         search=where,
         notes=urdf.notes,
+        file=robot,
     )
 
 
@@ -101,6 +105,9 @@ def pose_q(robot: RobotSource, pose: str | None, q: str | None) -> dict[str, flo
     if pose is not None:
         if pose not in robot.poses:
             known = ", ".join(robot.poses) or "(none: a URDF has no named poses)"
-            raise InputError(f"unknown pose {pose!r}; known: {known}", field="pose")
+            raise InputError(
+                f"unknown pose {pose!r}; {did_you_mean(pose, robot.poses)}known: {known}",
+                field="pose",
+            )
         return dict(robot.poses[pose])
     return parse_q(q, robot) if q is not None else {}
