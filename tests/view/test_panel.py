@@ -157,7 +157,7 @@ def test_plan_and_execute_through_the_page(panel: PlanningPanel, browser: Any) -
     click(dev, "Save")
     text = wait_text(dev, "wrote ", PAINT_TIMEOUT_S)
     saved = panel.session.save_dir / "plan.yaml"
-    assert saved.read_bytes() == panel.session.result.document  # type: ignore[union-attr]
+    assert saved.read_bytes() == panel.session.result.document
 
 
 def test_cli_refuses_a_missing_save_dir_before_serving(root: Path, tmp_path: Path) -> None:

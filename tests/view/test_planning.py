@@ -40,17 +40,17 @@ def tip(q: np.ndarray) -> np.ndarray:
 
 
 @pytest.fixture(scope="module")
-def robot(default_spec_path: Path):  # type: ignore[no-untyped-def]
+def robot(default_spec_path: Path):
     return load_robot(default_spec_path)
 
 
 @pytest.fixture
-def session(robot, tmp_path: Path) -> PlanningSession:  # type: ignore[no-untyped-def]
+def session(robot, tmp_path: Path) -> PlanningSession:
     return load_session(robot.file, save_dir=tmp_path)
 
 
 @pytest.fixture
-def boxed(robot, tmp_path: Path) -> PlanningSession:  # type: ignore[no-untyped-def]
+def boxed(robot, tmp_path: Path) -> PlanningSession:
     """The course robot with a 0.1 m box around the tool point of its `reach` pose."""
     x, _, z = (float(v) for v in tip(np.array([math.pi / 4, math.pi / 4])))
     scene = tmp_path / "scene.yaml"
@@ -88,7 +88,7 @@ def test_plan_draws_a_trail_from_start_to_goal(session: PlanningSession) -> None
     assert np.allclose(trail.tool_path[:, 1], 0.0, atol=FK_TOL)  # planar arm: y stays 0
 
 
-def test_a_joint_subset_plans_only_those(robot, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+def test_a_joint_subset_plans_only_those(robot, tmp_path: Path) -> None:
     session = load_session(robot.file, joints=["forearm_hand_joint"], save_dir=tmp_path)
     assert session.joints == ("forearm_hand_joint",)
     session.set_goal([math.pi / 4])
@@ -110,7 +110,7 @@ def test_a_failed_plan_is_one_line_and_no_trail(boxed: PlanningSession) -> None:
 
 def test_dragging_the_tool_solves_ik_or_keeps_the_goal(session: PlanningSession) -> None:
     target = tip(np.array([0.3, 0.9]))  # reachable by construction, collision-free
-    outcome = session.drag_goal(target)
+    outcome = session.drag_goal(list(target))
     assert outcome.x is not None and outcome.text() == "goal: tool point reached"
     assert tip(session.goal) == pytest.approx(target, abs=IK_TOL)  # closed form, not Pinocchio
     before = session.goal.copy()
@@ -127,7 +127,7 @@ def test_execute_simulates_the_plan_and_keeps_its_states(session: PlanningSessio
     assert not done.broken, done.problems
     states = done.states
     assert states is not None
-    assert states.duration >= session.result.duration_s  # type: ignore[union-attr]
+    assert states.duration >= session.result.duration_s
     end = states.positions_at(float(states.time[-1]))
     ref = states.reference_at(float(states.time[-1]))
     assert ref is not None
@@ -161,7 +161,7 @@ def test_save_writes_the_document_inside_the_save_dir_only(
 
 
 def test_scene_obstacles_become_meshes_where_the_scene_puts_them(
-    robot,  # type: ignore[no-untyped-def]
+    robot,
     tmp_path: Path,
 ) -> None:
     scene = tmp_path / "scene.yaml"
@@ -182,7 +182,7 @@ def test_scene_obstacles_become_meshes_where_the_scene_puts_them(
 
 
 @pytest.fixture
-def panel(robot, boxed: PlanningSession) -> Iterator[PlanningPanel]:  # type: ignore[no-untyped-def]
+def panel(robot, boxed: PlanningSession) -> Iterator[PlanningPanel]:
     viewer = Viewer(robot.xml, name=robot.name, poses=robot.poses, tool=robot.tool, port=0)
     p = PlanningPanel(viewer, boxed, robot.xml, source=robot.source)
     try:
@@ -215,7 +215,7 @@ def test_panel_widgets_drive_the_session(panel: PlanningPanel) -> None:
     assert session.start == pytest.approx(folded, abs=END_TOL)
     assert panel.status.startswith("planned: ") and panel.status.endswith("; certified")
     saved = panel.save()
-    assert saved is not None and saved.read_bytes() == session.result.document  # type: ignore[union-attr]
+    assert saved is not None and saved.read_bytes() == session.result.document
 
 
 def test_panda_drag_solves_position_and_orientation(tmp_path: Path) -> None:
