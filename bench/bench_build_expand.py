@@ -24,6 +24,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
 import xacro  # noqa: E402
+
 from armcli.compiler.expand import expand_urdfs  # noqa: E402
 from armcli.compiler.xacro_writer import top_level_files, xacro_files  # noqa: E402
 from armcli.spec.load import load_spec, loads_spec  # noqa: E402

@@ -13,8 +13,8 @@ import sys
 from pathlib import Path
 
 import pytest
-
 import xacro
+
 from tests.helpers import (
     ARM_PACKAGE,
     DEMO_ARM,

@@ -133,6 +133,7 @@ def test_sensor_mistakes(sensor: str, fragment: str) -> None:
 
 def test_sdformat_accepts_the_harmonic_description(project: Path, tmp_path: Path) -> None:
     import xacro
+
     from armcli.ros.packages import ros_packages
 
     spec = load_spec(project / "armcli.yaml")

@@ -336,9 +336,8 @@ def test_rviz_configs(files: Mapping[str, bytes], urdf: etree._Element) -> None:
 
 def _expand(path: Path, out_dir: Path, monkeypatch: pytest.MonkeyPatch) -> etree._Element:
     """Run the real xacro, resolving $(find pkg) to the generated packages."""
-    import xacro.substitution_args
-
     import xacro
+    import xacro.substitution_args
 
     monkeypatch.setattr(xacro.substitution_args, "_eval_find", lambda pkg: str(out_dir / pkg))
     doc = xacro.process_file(str(path))

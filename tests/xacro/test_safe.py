@@ -18,8 +18,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-
 import xacro
+
 from armcli.errors import InputError, XacroRefusedError
 from armcli.io.packages import PackageLookup
 from armcli.urdf.source import allowed_roots
