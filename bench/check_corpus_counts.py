@@ -29,7 +29,7 @@ def run() -> dict[str, object]:
     from armcli.errors import ArmcliError
 
     try:  # the package layout since the subpackage refactor
-        from armcli.check.rules import CheckOptions
+        from armcli.check.options import CheckOptions
         from armcli.check.run import check_urdf
         from armcli.urdf.read import read_urdf
     except ImportError:  # an older checkout's flat modules (for the "before" counts)

@@ -16,7 +16,8 @@ import pinocchio as pin
 import pytest
 from lxml import etree
 
-from armcli.check.rules import ERROR, CheckOptions
+from armcli.check.options import CheckOptions
+from armcli.check.rules import ERROR
 from armcli.check.run import check_urdf
 from armcli.cli import main
 from armcli.compiler.expand import build

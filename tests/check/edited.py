@@ -7,7 +7,8 @@ from typing import Any
 
 from lxml import etree
 
-from armcli.check.rules import CheckOptions, Finding
+from armcli.check.findings import Finding
+from armcli.check.options import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.urdf.read import parse_urdf
 from tests.helpers import ROOT

@@ -18,7 +18,7 @@ import pytest
 
 from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
 from armcli.check.balance import analyse
-from armcli.check.rules import CheckOptions, TipoverOptions
+from armcli.check.options import CheckOptions, TipoverOptions
 from armcli.check.run import check_urdf
 from armcli.compiler.expand import expand_urdfs
 from armcli.spec.load import load_spec

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import pytest
 
-from armcli.check.rules import CheckOptions
+from armcli.check.options import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.urdf.read import parse_urdf
 

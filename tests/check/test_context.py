@@ -16,7 +16,8 @@ from armcli.check.context import (
     Context,
     Stage,
 )
-from armcli.check.rules import ERROR, RULES, CheckOptions
+from armcli.check.options import CheckOptions
+from armcli.check.rules import ERROR, RULES
 from armcli.urdf.read import parse_urdf, read_urdf
 from tests.helpers import ROOT
 

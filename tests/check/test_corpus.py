@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from lxml import etree
 
-from armcli.check.rules import CheckOptions
+from armcli.check.options import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.errors import ArmcliError
 from armcli.urdf.read import read_urdf

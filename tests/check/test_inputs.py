@@ -8,7 +8,7 @@ import shutil
 from pathlib import Path
 
 from armcli.check.inputs import run_check
-from armcli.check.rules import CheckOptions
+from armcli.check.options import CheckOptions
 from armcli.errors import EXIT_FAILED, EXIT_OK, EXIT_UNUSABLE
 from tests.cli.test_check import armcli
 from tests.helpers import ROOT

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from armcli.check import interface as ci
-from armcli.check.rules import CheckOptions
+from armcli.check.options import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.ros.packages import ros_packages
 from armcli.spec.load import load_spec

@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from armcli.check.findings import Finding
 from armcli.check.report import to_github
-from armcli.check.rules import Finding
 from armcli.errors import split_source
 from armcli.io.oneline import one_line
 from tests.cli.test_check import armcli

@@ -11,7 +11,9 @@ from typing import Any
 import pytest
 from lxml import etree
 
-from armcli.check.rules import RULES, CheckOptions, TipoverOptions, apply_policy
+from armcli.check.findings import apply_policy
+from armcli.check.options import CheckOptions, TipoverOptions
+from armcli.check.rules import RULES
 from armcli.check.run import check_urdf
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec

@@ -8,9 +8,10 @@ from pathlib import Path
 
 import pytest
 
+from armcli.check.findings import Finding
 from armcli.check.inputs import run_check
+from armcli.check.options import CheckOptions
 from armcli.check.report import to_github, to_json
-from armcli.check.rules import CheckOptions, Finding
 from armcli.check.sarif import to_sarif
 from tests.helpers import COURSE_GAINS, DEFAULT_SPEC, SPECS, gains_text
 

@@ -92,7 +92,7 @@ def test_mujoco_compiles(built: Path) -> None:
 
 
 def test_check_does_not_flag_the_mimic_gripper(built: Path) -> None:
-    from armcli.check.rules import CheckOptions
+    from armcli.check.options import CheckOptions
     from armcli.check.run import check_urdf
     from armcli.spec.load import load_spec
     from armcli.urdf.read import read_urdf

@@ -16,7 +16,7 @@ import pytest
 import trimesh
 
 import armcli.robot.model
-from armcli.check.rules import CheckOptions
+from armcli.check.options import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.io.mesh_confine import MAX_MESH_BYTES
 from armcli.robot.load import collision_model

@@ -53,7 +53,8 @@ def test_chains_resolve_leaders_first_and_cycles_drop_out() -> None:
 
 def test_check_samples_and_poses_set_followers_from_leaders() -> None:
     from armcli.check.context import Context, poses
-    from armcli.check.rules import CheckOptions, Collector
+    from armcli.check.findings import Collector
+    from armcli.check.options import CheckOptions
     from armcli.check.structure import check
     from armcli.robot import sampling
     from armcli.robot.model import Robot

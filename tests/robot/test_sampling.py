@@ -87,7 +87,7 @@ def chain_urdf(n: int) -> bytes:
 def test_check_and_tune_draw_identical_samples(monkeypatch: pytest.MonkeyPatch) -> None:
     """`check` (gravity, PD stability) and `tune` (start gains) size their verdicts on the
     same configurations: both ask `sampling.joint_space`, with the same box."""
-    from armcli.check.rules import CheckOptions
+    from armcli.check.options import CheckOptions
     from armcli.check.run import check_urdf
     from armcli.robot.load import load_model
     from armcli.sim.simulate import arm_from_model

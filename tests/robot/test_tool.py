@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from armcli.check.rules import CheckOptions
+from armcli.check.options import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.robot.tool import ToolPoint, spec_tool, tool_point
 from armcli.ros.srdf import arm_chain

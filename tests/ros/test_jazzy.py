@@ -25,7 +25,7 @@ import yaml
 from catkin_pkg.package import parse_package_string
 from lxml import etree
 
-from armcli.check.rules import CheckOptions
+from armcli.check.options import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.compiler.xacro_writer import WORLD_JOINT
 from armcli.errors import InputError

@@ -19,7 +19,7 @@ import math
 import numpy as np
 import pytest
 
-from armcli.check.rules import CheckOptions
+from armcli.check.options import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.robot.load import load_model
 from armcli.sim import pdloop

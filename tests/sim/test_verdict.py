@@ -19,7 +19,7 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from armcli.check.rules import CheckOptions
+from armcli.check.options import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.errors import UnstableLoopError
 from armcli.robot import sampling

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from armcli.check.rules import CheckOptions
+from armcli.check.options import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.robot.load import load_model
 from armcli.spec.joint_types import position_bounds, total_dof

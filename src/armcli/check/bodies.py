@@ -14,8 +14,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from armcli.check.findings import Collector
 from armcli.check.inertia import MIN_MOMENT
-from armcli.check.rules import Collector
 from armcli.check.structure import Tree, finite
 from armcli.robot import inertia as inr
 from armcli.robot.bodies import Body, lump

@@ -15,7 +15,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
-from armcli.check.rules import RULES, CheckOptions, Collector, JointRow
+from armcli.check.findings import Collector, JointRow
+from armcli.check.options import CheckOptions
+from armcli.check.rules import RULES
 from armcli.check.structure import Tree
 from armcli.robot.model import Robot
 from armcli.sim.verdict import StabilityReport

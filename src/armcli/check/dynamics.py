@@ -13,7 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from armcli.check.rules import CheckOptions, Collector, JointRow, Value
+from armcli.check.findings import Collector, JointRow, Value
+from armcli.check.options import CheckOptions
 from armcli.check.structure import finite
 from armcli.errors import ModelLoadError
 from armcli.robot.model import Robot

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 
-from armcli.check.rules import ERROR, RULES, CheckOptions
+from armcli.check.options import CheckOptions
+from armcli.check.rules import ERROR, RULES
 from armcli.check.run import check_urdf
 from armcli.errors import ModelRefusedError, RuleViolation
 from armcli.urdf.doc import Urdf

@@ -9,7 +9,7 @@ import itertools
 
 import numpy as np
 
-from armcli.check.rules import Collector
+from armcli.check.findings import Collector
 from armcli.check.structure import Tree, finite
 from armcli.robot import inertia as inr
 from armcli.robot import inertia_bounds as bounds

@@ -13,7 +13,9 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from armcli.check.rules import ERROR, RULES, CheckOptions, Finding
+from armcli.check.findings import Finding
+from armcli.check.options import CheckOptions
+from armcli.check.rules import ERROR, RULES
 from armcli.check.run import CheckResult, check_document, check_urdf
 from armcli.check.spec_locate import key_lines, locate
 from armcli.errors import EXIT_FAILED, EXIT_OK, EXIT_UNUSABLE, InputError

@@ -19,7 +19,8 @@ from dataclasses import dataclass
 
 from lxml import etree
 
-from armcli.check.rules import CheckOptions, Collector, Value
+from armcli.check.findings import Collector, Value
+from armcli.check.options import CheckOptions
 
 GZ_SYSTEMS = ("gz_ros2_control/GazeboSimSystem", "ign_ros2_control/IgnitionSystem")
 GZ_PLUGIN_FILES = ("gz_ros2_control-system", "ign_ros2_control-system")

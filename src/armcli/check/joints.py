@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 from lxml import etree
 
-from armcli.check.rules import Collector
+from armcli.check.findings import Collector
 from armcli.check.structure import finite
 from armcli.spec.joint_types import LIMITED_TYPES, ONE_DOF_TYPES
 from armcli.urdf.doc import Joint, Urdf

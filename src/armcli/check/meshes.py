@@ -7,7 +7,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from armcli.check.rules import CheckOptions, Collector
+from armcli.check.findings import Collector
+from armcli.check.options import CheckOptions
 from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import confined, mesh_hint, resolve
 

@@ -10,7 +10,8 @@ from dataclasses import asdict
 from typing import Any
 
 from armcli.check.balance_report import balance_items, reach_items
-from armcli.check.rules import ERROR, WARNING, Finding, shown_path
+from armcli.check.findings import Finding, shown_path
+from armcli.check.rules import ERROR, WARNING
 from armcli.check.run import CheckResult
 from armcli.errors import split_source
 from armcli.io.jsondoc import dumps

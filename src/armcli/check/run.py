@@ -39,7 +39,8 @@ from armcli.check.context import (
     joint_rows,
     poses,
 )
-from armcli.check.rules import CheckOptions, Collector, Finding
+from armcli.check.findings import Collector, Finding
+from armcli.check.options import CheckOptions
 from armcli.check.summary import Summary
 from armcli.errors import ModelLoadError
 from armcli.robot import sampling

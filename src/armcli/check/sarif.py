@@ -25,7 +25,8 @@ from typing import Any
 from urllib.parse import quote
 
 from armcli import __version__
-from armcli.check.rules import RULES, Finding, Rule
+from armcli.check.findings import Finding
+from armcli.check.rules import RULES, Rule
 from armcli.errors import split_source
 from armcli.io.jsondoc import dumps
 

@@ -22,7 +22,7 @@ from typing import Any
 
 from lxml import etree
 
-from armcli.check.rules import Finding, SpecPlace
+from armcli.check.findings import Finding, SpecPlace
 from armcli.io.yaml import YamlDoc, dotted
 
 Path_ = tuple[str | int, ...]

@@ -10,7 +10,7 @@ import math
 from collections import Counter
 from dataclasses import dataclass
 
-from armcli.check.rules import Collector
+from armcli.check.findings import Collector
 from armcli.spec.graph import root_links
 from armcli.spec.joint_types import JOINT_TYPES, LIMITED_TYPES
 from armcli.urdf.doc import Joint, Link, Urdf

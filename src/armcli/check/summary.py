@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from armcli.check.context import Context, poses
-from armcli.check.rules import CheckOptions, JointRow
+from armcli.check.findings import JointRow
+from armcli.check.options import CheckOptions
 from armcli.check.structure import finite
 from armcli.robot.load import link_frame
 from armcli.robot.tool import tool_point

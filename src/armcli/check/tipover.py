@@ -17,7 +17,7 @@ from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
 from armcli.check import balance
 from armcli.check.balance import PoseBalance, StaticBalance
 from armcli.check.context import Context, poses
-from armcli.check.rules import Collector, Value
+from armcli.check.findings import Collector, Value
 from armcli.robot.tool import tool_point
 
 NEAR_NAMED = 1e-3  # [m] a range's worst within this of a named pose's is that pose's finding

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 from armcli.check.context import Context
-from armcli.check.rules import Value
+from armcli.check.findings import Value
 from armcli.check.tipover import round_down
 from armcli.errors import ArmcliError
 

@@ -32,7 +32,7 @@ from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 if TYPE_CHECKING:  # the checker is imported when the command runs: `--help` stays light
     from armcli.check.inputs import CheckRun
-    from armcli.check.rules import TipoverOptions
+    from armcli.check.options import TipoverOptions
 
 FORMATS = ("table", "json", "github", "sarif")
 PAYLOAD_LINK_HELP = "Link carrying --payload at its origin (default: the tool point)."
@@ -54,7 +54,7 @@ def tipover_options(
     reach_points: list[str],
 ) -> TipoverOptions:
     """The balance and reach options, refused here when they are not usable numbers."""
-    from armcli.check.rules import TipoverOptions
+    from armcli.check.options import TipoverOptions
 
     for flag, x in (("--payload", payload), ("--min-margin", min_margin),
                     ("--base-accel", 0.0 if base_accel is None else base_accel)):  # fmt: skip
@@ -105,9 +105,11 @@ def check_cmd(
 ) -> None:
     """Check robot descriptions for physical sanity; exit 1 on error findings."""
     from armcli.check import report
+    from armcli.check.findings import apply_policy
     from armcli.check.inputs import run_check
+    from armcli.check.options import CheckOptions
     from armcli.check.report import counts
-    from armcli.check.rules import RULES, CheckOptions, apply_policy, unknown_rules
+    from armcli.check.rules import RULES, unknown_rules
 
     unknown = unknown_rules(ignore)
     if unknown:
