@@ -23,7 +23,6 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
 import xacro  # noqa: E402
-
 from armcli.xacro.jail import sandbox_problem  # noqa: E402
 from armcli.xacro.safe import expand_safe  # noqa: E402
 from armcli.xacro.sandbox import expand_foreign, expand_untrusted  # noqa: E402

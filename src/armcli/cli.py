@@ -182,6 +182,11 @@ def main(argv: list[str] | None = None) -> None:
     # `--trust-xacro=unsandboxed` is the documented spelling; a bool flag cannot take a value
     args = [UNSANDBOXED_FLAG if a == "--trust-xacro=unsandboxed" else a for a in args]
     debug = _debug_requested(args)
+    status = None
+    if sys.stderr.isatty():  # at a terminal: one line if the command stays silent
+        from armcli.commands.status import start_status  # a command module: loaded on use
+
+        status = start_status(args)
     try:
         app(args=args, prog_name="armcli")
     except SystemExit as exc:  # typer turns Ctrl-C into a silent exit 130: say it once
@@ -204,6 +209,9 @@ def main(argv: list[str] | None = None) -> None:
             "(rerun with --debug for a traceback)\n"
         )
         raise SystemExit(EXIT_FAILED) from None
+    finally:
+        if status is not None:
+            status.stop()
 
 
 if __name__ == "__main__":

@@ -134,3 +134,21 @@ def test_everyday_output_fits_80_columns(
         assert not long, (args, long)
     code, out, _ = run_main(["init", "b"], capsys)
     assert "\n  armcli simulate --trajectory trajectories/pick.yaml\n" in out  # whole, to copy
+
+
+def test_names_get_a_did_you_mean(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run_main(
+        ["render", DEFAULT_SPEC, "--pose", "foldd", "-o", tmp_path / "x.png"], capsys
+    )
+    assert code == 2 and "unknown pose 'foldd'; did you mean 'folded'?" in err
+    args = ["check", DEFAULT_SPEC, "--payload", "1", "--payload-link", "hand_lnk"]
+    code, _, err = run_main(args, capsys)
+    assert code == 2 and "did you mean 'hand_link'?" in err
+    spec = tmp_path / "p.yaml"
+    spec.write_text(
+        DEFAULT_SPEC.read_text().replace(
+            "home: {arm_base_forearm_joint: 0", "home: {arm_base_forearm_jont: 0"
+        )
+    )
+    code, _, err = run_main(["check", spec], capsys)
+    assert code == 2 and "unknown arm joint; did you mean 'arm_base_forearm_joint'?" in err

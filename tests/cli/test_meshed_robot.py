@@ -91,3 +91,18 @@ def test_relative_package_dir_starts_at_the_working_directory(
     assert f'name="{project / "ws" / "mesh_arm_clone"}"' in Path("r.urdf").read_text()
     code, _, err = run_main(["expand", xacro, "--package-dir", f"{PACKAGE}=nowhere"], capsys)
     assert code == 2 and "--package-dir" in err and "nowhere is not a directory" in err
+
+
+def test_relative_ros_package_path_starts_at_the_working_directory(
+    project: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    xacro = Path("robots", "arm.urdf.xacro")
+    xacro.parent.mkdir()
+    xacro.write_text(
+        '<robot xmlns:xacro="http://www.ros.org/wiki/xacro" name="r">'
+        f'<link name="$(find {PACKAGE})"/></robot>'
+    )
+    monkeypatch.setenv("ROS_PACKAGE_PATH", "ws")  # crawled from here, not from robots/
+    code, _, err = run_main(["expand", xacro, "-o", "r.urdf"], capsys)
+    assert code == 0, err
+    assert f'name="{project / "ws" / "mesh_arm_clone"}"' in Path("r.urdf").read_text()

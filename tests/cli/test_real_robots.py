@@ -33,6 +33,13 @@ def test_a_link_and_a_joint_sharing_a_name_simulate_and_check(
     assert code == 0, err
     assert "internal error" not in err
     assert "reach of knee" in out
+    # `plan` looks the tool up too (its default tool point is the link `knee`).
+    code, out, err = run_main(
+        ["plan", "--urdf", SHARED, "--from", "0,0", "--to", "0.5,0.5", "--joints", "hip,knee"],
+        capsys,
+    )
+    assert code == 0, err
+    assert "certified" in out
 
 
 def test_stray_text_after_a_kept_element_imports(
@@ -94,11 +101,12 @@ def test_wheels_on_passive_spring_joints_stand_on_the_ground(
     assert code == 0, err
     assert "limit-effort-velocity" not in out + err
     assert "passive joint(s) wheel_drop_left_joint, wheel_drop_right_joint" in out
-    # The base cylinder is 0.32 m across: 2 % of it is 6.4 mm, which takes the wheels 2.45 mm
-    # above the caster; the report says so.
+    # The lowest points within 5 mm: the caster's bottom and the wheels' tread edges at
+    # y = ±(0.117 + 0.01) m, 0.254 m across; 2 % of it is 5.1 mm, which takes the wheels
+    # 2.45 mm above the caster; the report says so.
     assert (
         "static balance on caster_link, left_wheel, right_wheel "
-        "(the links within 6.4 mm of the lowest point at q = 0)"
+        "(the links within 5.1 mm of the lowest point at q = 0)"
     ) in out
     # The polygon: the caster's bottom (-0.12, 0) and the wheels below their axles (0, ±0.117).
     assert "support polygon (-0.120, 0.000) (0.000, -0.117) (0.000, 0.117) m" in out
@@ -172,3 +180,32 @@ def test_xacro_findings_land_on_the_users_own_lines(
     (called,) = result["relatedLocations"]
     assert called["physicalLocation"]["artifactLocation"]["uri"] == "robot.urdf.xacro"
     assert called["physicalLocation"]["region"] == {"startLine": call}
+
+
+def test_long_arms_do_not_widen_the_contact_tolerance(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A dual-arm Tiago spans 2.5 m at the zero pose: 2 % of that took its base's underside,
+    49 mm up, as a ground contact (and its round outline made the balance search 12 s)."""
+    arms = """
+  <joint name="arms_joint" type="fixed">
+    <parent link="base_link"/>
+    <child link="arms"/>
+    <origin xyz="0 0 0.5"/>
+  </joint>
+  <link name="arms">
+    <collision><geometry><box size="3.0 0.05 0.05"/></geometry></collision>
+    <inertial>
+      <mass value="0.1"/>
+      <inertia ixx="4e-05" ixy="0" ixz="0" iyy="0.075" iyz="0" izz="0.075"/>
+    </inertial>
+  </link>
+</robot>"""
+    wide = tmp_path / "wide.urdf"  # the base cylinder's bottom is 50 mm above the ground
+    wide.write_text((REAL / "wheel_drop.urdf").read_text().replace("</robot>", arms))
+    code, out, err = run_main(["check", wide], capsys)
+    assert code == 0, err
+    assert (
+        "static balance on caster_link, left_wheel, right_wheel "
+        "(the links within 5.1 mm of the lowest point at q = 0)"
+    ) in out

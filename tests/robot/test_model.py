@@ -72,8 +72,9 @@ def test_mimics_tool_and_leaders(robot: Robot) -> None:
     assert [(m.follower, m.leader) for m in robot.mimics] == [("grip", "slide")]
     assert [j.name for j in robot.leaders] == ["yaw", "pitch", "slide"]
     assert robot.follow({"slide": 0.2}) == {"slide": 0.2, "grip": 0.5 * 0.2 + 0.01}
-    # the deepest link, first in file order on ties (robot.tool's rule): finger, 4 joints deep
-    assert robot.tool == ToolPoint("finger")
+    # robot.tool's rule: the mimic finger does not count (issue 31); slider and flange are
+    # 3 movable joints deep, and the flange is named as a tool frame
+    assert robot.tool == ToolPoint("flange")
 
 
 def test_q_matches_a_hand_built_configuration(robot: Robot) -> None:

@@ -105,3 +105,32 @@ def test_a_spec_without_tool_and_moveit_end_at_the_same_link() -> None:
     assert tool_point(robot.robot, bare) == ToolPoint(tip)
     # the deepest arm link of my_robot.yaml: arm_base_link -> forearm_link -> hand_link
     assert tip == "hand_link"
+
+
+def test_a_gripper_finger_is_never_the_tool() -> None:
+    """OpenManipulator-X's shape (issue 31): link5 carries two prismatic fingers (the right
+    one a mimic) and a fixed end_effector_link; the fingers were the tool point, 5 joints
+    deep, and the reach swept the gripper's stroke."""
+    links = ["world", "link1", "link2", "link5", "gripper_left_link", "gripper_right_link",
+             "end_effector_link"]  # fmt: skip
+    right = _joint("gripper_right_joint", "prismatic", "link5", "gripper_right_link")
+    right = right.replace("</joint>", '<mimic joint="gripper_left_joint"/></joint>')
+    urdf = parse_urdf(
+        (
+            '<robot name="omx">'
+            + "".join(_link(n) for n in links)
+            + _joint("joint1", "revolute", "world", "link1")
+            + _joint("joint2", "revolute", "link1", "link2")
+            + _joint("joint4", "revolute", "link2", "link5")
+            + _joint("gripper_left_joint", "prismatic", "link5", "gripper_left_link")
+            + right
+            + _joint("end_effector_joint", "fixed", "link5", "end_effector_link")
+            + "</robot>"
+        ).encode(),
+        "omx.urdf",
+    )
+    # link5 and end_effector_link are both 3 movable joints deep; the second is named a tool
+    assert tool_point(urdf) == ToolPoint("end_effector_link")
+    summary = check_urdf(urdf, CheckOptions()).summary
+    assert summary is not None and summary.reach is not None
+    assert "gripper_left_joint" not in summary.reach.joints  # the reach is the arm's

@@ -4,10 +4,11 @@ At the neutral pose (every joint at zero) each link's collision shapes are place
 Pinocchio's forward kinematics in the root link's frame; the ground plane is the lowest
 point of all of them, and a link touches it when its own lowest point is within a
 tolerance of that plane (rigid bodies on flat ground, the root frame upright): 2 % of the
-robot's footprint (the larger horizontal extent of its collision geometry), at least
-5 mm. Real bases are not exact at the zero pose: LoCoBot's wheels sit 2.45 mm above its
-caster and a Dingo's 2.24 mm, both resting on a spring or tyre that gives that much. A
-user may name the contact links instead (`--contact-links`).
+robot's footprint (the larger horizontal extent of the lowest points within 5 mm of the
+plane), at least 5 mm and at most 10 mm. Real bases are not exact at the zero pose:
+LoCoBot's wheels sit 2.45 mm above its caster and a Dingo's 2.24 mm, both resting on a
+spring or tyre that gives that much. A user may name the contact links instead
+(`--contact-links`).
 
 Contact points. A rolling link (a wheel: the child of a revolute or continuous joint
 whose axis is horizontal) touches the ground at one point, the middle of its tread below
@@ -22,21 +23,20 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from armcli.io.mesh_confine import bounded_mesh_file
 from armcli.robot.inertia import rpy_matrix
 from armcli.spec.joint_types import ROTARY_TYPES
 from armcli.urdf.doc import Shape, Urdf, Vec3
+from armcli.urdf.mesh_points import read_vertices
 from armcli.urdf.meshes import MeshSearch, mesh_paths
-from armcli.urdf.meshlog import quiet_trimesh
 
 CONTACT_TOL = 0.005  # [m] a link within this of the lowest point touches the ground, at least
 CONTACT_RTOL = 0.02  # of the robot's footprint: a 0.35 m base takes links within 7 mm
+CONTACT_MAX_TOL = 0.01  # [m] at most: a base's underside 49 mm up is not on the ground (Tiago)
 HORIZONTAL_TOL = 0.1  # |axis_z| below this: a wheel's axle (about 6 deg from level)
 CIRCLE_POINTS = 32  # an upright cylinder's bottom rim: within 0.5 % of its radius
 
@@ -200,7 +200,8 @@ def find_ground(
         return None
     floor = min(float(p[:, 2].min()) for p in lowest.values())
     if tol is None:
-        tol = contact_tol(np.vstack(list(lowest.values())))
+        near = np.vstack([c[c[:, 2] <= floor + CONTACT_TOL] for c in lowest.values()])
+        tol = contact_tol(near)
     rolling = _rolling_links(urdf, poses)
     contacts = []
     for name, cloud in lowest.items():
@@ -218,12 +219,14 @@ def find_ground(
 
 
 def contact_tol(points: NDArray[Any]) -> float:
-    """The contact tolerance [m] for a robot whose collision geometry has these points (n, 3).
+    """The contact tolerance [m] for a robot whose lowest points are these (n, 3).
 
-    CONTACT_RTOL of the footprint (the larger of its x and y extents), at least CONTACT_TOL.
+    CONTACT_RTOL of the footprint (the larger of their x and y extents), within
+    CONTACT_TOL..CONTACT_MAX_TOL. The points are those near the floor, not the whole robot:
+    a dual-arm Tiago's arms span 2.5 m at the zero pose, its base 0.5 m.
     """
     extent = np.ptp(points[:, :2], axis=0) if len(points) else np.zeros(2)
-    return max(CONTACT_TOL, CONTACT_RTOL * float(np.max(extent)))
+    return min(CONTACT_MAX_TOL, max(CONTACT_TOL, CONTACT_RTOL * float(np.max(extent))))
 
 
 def has_wheels(ground: Ground | None) -> bool:
@@ -242,24 +245,10 @@ def mesh_loader(urdf: Urdf, search: MeshSearch, missing: list[str]) -> MeshVerti
 
     def vertices(uri: str, scale: Vec3) -> NDArray[np.float64] | None:
         if uri not in cache:
-            cache[uri] = _read_vertices(paths.get(uri), urdf.source)
+            cache[uri] = read_vertices(paths.get(uri), urdf.source)
             if cache[uri] is None:
                 missing.append(uri)
         v = cache[uri]
         return None if v is None else v * np.asarray(scale, dtype=float)
 
     return vertices
-
-
-def _read_vertices(path: Path | None, source: str) -> NDArray[np.float64] | None:
-    import trimesh
-
-    if path is None or not path.is_file():
-        return None
-    try:
-        with quiet_trimesh():  # a missing texture does not move a vertex
-            mesh = trimesh.load(str(bounded_mesh_file(path, source)), force="mesh", process=False)
-    except Exception:  # trimesh raises many types for unreadable files
-        return None
-    v = np.asarray(getattr(mesh, "vertices", np.empty((0, 3))), dtype=float)
-    return v if v.ndim == 2 and v.shape[1] == 3 and len(v) else None

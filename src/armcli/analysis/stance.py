@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from armcli.analysis.ground import Ground, MeshVertices, find_ground, has_wheels
 from armcli.analysis.support import SupportPolygon, support_polygon
 from armcli.errors import InputError
+from armcli.io.names import did_you_mean
 from armcli.robot import sampling
 from armcli.robot.load import link_frame
 from armcli.robot.model import Joint, Robot
@@ -135,7 +136,8 @@ def stance_of(
         unknown = [n for n in declared if n not in names]
         if unknown:
             raise InputError(
-                f"unknown contact link(s) {', '.join(unknown)}; links: {', '.join(sorted(names))}",
+                f"unknown contact link(s) {', '.join(unknown)}; {did_you_mean(unknown[0], names)}"
+                f"links: {', '.join(sorted(names))}",
                 file=urdf.source,
                 field="contact_links",
             )
@@ -147,7 +149,11 @@ def stance_of(
         links = ", ".join(ground.links)
         return NoStance(f"the ground contacts ({links}) span no area: no support polygon")
     if payload is not None and link_frame(model, payload.link) is None:
-        raise InputError(f"unknown link {payload.link!r} for the payload", field="payload_link")
+        raise InputError(
+            f"unknown link {payload.link!r} for the payload; "
+            f"{did_you_mean(payload.link, names)}links: {', '.join(sorted(names))}",
+            field="payload_link",
+        )
     return Stance(robot, ground, polygon, payload, _free_joints(robot, ground.links))
 
 

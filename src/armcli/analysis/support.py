@@ -9,6 +9,7 @@ Each edge is a tipping axis; its outward normal names the direction the robot ti
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -59,12 +60,12 @@ class SupportPolygon:
     vertices: tuple[tuple[float, float], ...]
     edges: tuple[Edge, ...]
 
-    @property
+    @functools.cached_property  # read at every state of a run's zero-moment-point series
     def normals(self) -> NDArray[np.float64]:
         """(k, 2) outward unit normals, one per edge."""
         return np.array([e.normal for e in self.edges], dtype=float)
 
-    @property
+    @functools.cached_property
     def offsets(self) -> NDArray[np.float64]:
         """(k,) edge offsets: normal · p <= offset inside."""
         return np.array([e.offset for e in self.edges], dtype=float)

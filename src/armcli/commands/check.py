@@ -108,7 +108,6 @@ def check_cmd(
     from armcli.check.inputs import run_check
     from armcli.check.report import counts
     from armcli.check.rules import RULES, CheckOptions, apply_policy, unknown_rules
-    from armcli.spec.load import load_spec
 
     unknown = unknown_rules(ignore)
     if unknown:
@@ -119,7 +118,9 @@ def check_cmd(
         payload, payload_link, contact_links, min_margin, trajectory, base_accel, reach_point
     )
     base = CheckOptions(package_dirs=inputs.packages.package_dirs, tipover=tip)
-    if spec is not None:
+    if spec is not None:  # the spec layers (pydantic, ~0.4 s to import) only for a spec
+        from armcli.spec.load import load_spec
+
         base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs, tipover=tip)
     trust = trust_mode(trust_xacro, unsandboxed)
     run = run_check(files or [find_spec(None)], base, trust_xacro=trust, inputs=inputs)

@@ -18,6 +18,7 @@ import numpy as np
 
 from armcli.plan.robot import PlanRobot
 from armcli.plan.scene import Scene, Shape
+from armcli.robot.load import link_frame
 
 GROUND_ID = "ground"  # the name the ground plane has in collision reports
 PADDING = 0.005  # [m] clearance the planner keeps (CollisionChecker.pad)
@@ -83,7 +84,7 @@ class CollisionChecker:
             for g in gmodel.geometryObjects
         ]
         for obj in scene.objects:
-            fid = self.model.getFrameId(obj.frame) if obj.frame else 0
+            fid = _frame(self.model, obj.frame) if obj.frame else 0
             joint = frames[fid].parentJoint if obj.frame else 0
             T_joint_frame = frames[fid].placement if obj.frame else pin.SE3.Identity()
             for k, shape in enumerate(obj.shapes):
@@ -195,3 +196,9 @@ def bisection_order(n: int) -> list[int]:
 
 def _key(a: str, b: str) -> tuple[str, str]:
     return (a, b) if a <= b else (b, a)
+
+
+def _frame(model: Any, name: str) -> int:
+    """The frame an object's `frame_id` names: the link first (a joint may share its name)."""
+    found = link_frame(model, name)
+    return found if found is not None else int(model.getFrameId(name))

@@ -20,7 +20,7 @@ import numpy as np
 
 from armcli.defaults import DEFAULT_JOINT_ACCELERATION
 from armcli.errors import InputError
-from armcli.robot.load import checked_model
+from armcli.robot.load import checked_model, link_frame
 from armcli.robot.mimic import Mimic, follow, mimics
 from armcli.robot.model import Robot
 from armcli.robot.tool import tool_point
@@ -226,7 +226,8 @@ def load_plan_robot(
         if j.type in MOVABLE and j.name not in chosen
     }
     tool = tool_point(urdf, spec)
-    if tool is None or not model.existFrame(tool.link):
+    tool_frame = link_frame(model, tool.link) if tool is not None else None
+    if tool is None or tool_frame is None:  # a link, not a joint of the same name (ANYmal C)
         raise InputError("this URDF has no link to use as the tool point", file=urdf.source)
     poses: dict[str, Mapping[str, float]] = dict(group_states or {})
     if spec is not None:
@@ -241,7 +242,7 @@ def load_plan_robot(
         velocity=np.array(vel),
         acceleration=np.array(acc),
         effort=np.array(eff),
-        tool_frame=int(model.getFrameId(tool.link)),
+        tool_frame=tool_frame,
         tool_offset=np.array(tool.xyz, dtype=float),
         tool_label=tool.label,
         poses=poses,

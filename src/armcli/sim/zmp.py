@@ -184,15 +184,18 @@ def max_base_accel(series: ZmpSeries, polygon: SupportPolygon, threshold: float)
     bounds a_b in closed form; 0 when the arm motion alone leaves too little margin.
     """
     assert series.shift is not None
-    best = math.inf
-    for p, s in zip(series.zmp[:, 0], series.shift, strict=True):
-        d = polygon.edge_distances(p) - threshold
-        if np.any(d < 0):
-            return 0.0
-        for n_x, slack in zip(polygon.normals[:, 0], d, strict=True):
-            if abs(n_x) > 1e-12 and s > 0:  # both signs of a_b: either side's edges
-                best = min(best, slack / (s * abs(n_x)))
-    return best
+    if len(series.shift) == 0:
+        return math.inf
+    p = np.asarray(series.zmp[:, 0], dtype=float)  # (n, 2), all states at once
+    d = polygon.offsets[None, :] - p @ polygon.normals.T - threshold  # (n, k) slack per edge
+    if np.any(d < 0):  # NaN (lifted off) compares false, as it did state by state
+        return 0.0
+    s = np.asarray(series.shift, dtype=float)[:, None]
+    n_x = np.abs(polygon.normals[:, 0])[None, :]
+    use = (n_x > 1e-12) & (s > 0) & ~np.isnan(d)  # both signs of a_b: either side's edges
+    with np.errstate(divide="ignore", invalid="ignore"):
+        bound = np.where(use, d / (s * n_x), math.inf)
+    return float(np.min(bound))
 
 
 def zero_moment_point(wrench: NDArray[Any], ground: float = 0.0) -> NDArray[np.float64]:

@@ -11,6 +11,7 @@ from collections.abc import Callable
 from typing import Any
 
 from armcli.errors import Problem
+from armcli.io.names import did_you_mean
 from armcli.io.yaml import dotted
 from armcli.spec.graph import root_links
 from armcli.spec.joint_types import ONE_DOF_TYPES
@@ -52,7 +53,7 @@ def semantic_problems(spec: RobotSpec) -> list[Problem]:
     _sensor_problems(spec, add)
     for jname in spec.control.gains:
         if jname not in spec.arm.joints:
-            add(("control", "gains", jname), f"unknown arm joint; known: {_names(spec.arm.joints)}")
+            add(("control", "gains", jname), _unknown("arm joint", jname, spec.arm.joints))
         elif (m := spec.arm.joints[jname].mimic) is not None:
             add(("control", "gains", jname), f"mimics {m.joint}: give gains to the lead joint")
     _pose_problems(spec, arm_movable, add)
@@ -117,7 +118,7 @@ def _sensor_problems(spec: RobotSpec, add: Callable[..., None]) -> None:
         for role in ("link", "frame"):
             value = getattr(s, role)
             if value is not None and value not in links:
-                add(("sensors", name, role), f"unknown link {value!r}; known: {_names(links)}")
+                add(("sensors", name, role), _unknown("link", value, links, named=True))
         if s.topic in topics:
             add(("sensors", name, "topic"), f"{s.topic!r} is already sensor {topics[s.topic]}'s")
         topics[s.topic] = name
@@ -130,7 +131,7 @@ def _mount_problems(spec: RobotSpec, all_joints: dict[str, Joint], add: Any) -> 
         if spec.mobile_base is None:
             add(("mount",), "a mount needs a mobile_base")
         elif spec.mount.parent not in base_links:
-            add(("mount", "parent"), f"unknown link; known: {_names(base_links)}")
+            add(("mount", "parent"), _unknown("link", spec.mount.parent, base_links))
         if spec.mount.joint in all_joints:
             add(("mount", "joint"), "joint name already used")
     elif spec.mobile_base is not None:
@@ -143,7 +144,7 @@ def _pose_problems(spec: RobotSpec, arm_movable: set[str], add: Any) -> None:
         for jname, value in pose.items():
             j = spec.arm.joints.get(jname)
             if j is None or (arm_movable and jname not in arm_movable):
-                add(("poses", pname, jname), f"unknown arm joint; known: {_names(spec.arm.joints)}")
+                add(("poses", pname, jname), _unknown("arm joint", jname, spec.arm.joints))
             elif j.mimic is not None:
                 add(("poses", pname, jname), f"mimics {j.mimic.joint}: give the lead joint")
             elif (
@@ -162,7 +163,7 @@ def _tree_problems(part: str, links: dict[str, Link], joints: dict[str, Joint], 
     for jname, j in joints.items():
         for role in ("parent", "child"):
             if getattr(j, role) not in links:
-                add((part, "joints", jname, role), f"unknown link; known: {_names(links)}")
+                add((part, "joints", jname, role), _unknown("link", getattr(j, role), links))
         if j.child in children:
             add(
                 (part, "joints", jname, "child"),
@@ -220,3 +221,9 @@ def _plugin_problems(spec: RobotSpec, all_joints: dict[str, Joint], add: Any) ->
 
 def _names(d: Any) -> str:
     return ", ".join(sorted(d)) or "(none)"
+
+
+def _unknown(what: str, name: object, known: Any, *, named: bool = False) -> str:
+    """`unknown link; did you mean 'hand_link'? known: ...` (`named`: the name in the text)."""
+    label = f"unknown {what} {name!r}" if named else f"unknown {what}"
+    return f"{label}; {did_you_mean(name, known)}known: {_names(known)}"

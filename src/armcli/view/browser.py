@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import InputError
+from armcli.io.names import did_you_mean
 from armcli.robot.tool import ToolPoint
 from armcli.sim.states import Replay
 from armcli.urdf.meshes import MeshSearch
@@ -175,7 +176,10 @@ class Viewer:
         """Move to a named pose of the spec (joints it does not name go to `neutral`)."""
         if name not in self._poses:
             known = ", ".join(self._poses) or "(none)"
-            raise InputError(f"unknown pose {name!r}; known: {known}", field="pose")
+            raise InputError(
+                f"unknown pose {name!r}; {did_you_mean(name, self._poses)}known: {known}",
+                field="pose",
+            )
         pose = self._poses[name]
         self.set_configuration({j: pose.get(j, neutral(lim)) for j, lim in self._limits.items()})
 

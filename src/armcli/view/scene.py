@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from armcli.errors import InputError
+from armcli.io.names import did_you_mean
 from armcli.robot.tool import ToolPoint, tool_point
 from armcli.spec.expr import eval_expr
 from armcli.urdf.meshes import MeshSearch
@@ -101,6 +102,9 @@ def pose_q(robot: RobotSource, pose: str | None, q: str | None) -> dict[str, flo
     if pose is not None:
         if pose not in robot.poses:
             known = ", ".join(robot.poses) or "(none: a URDF has no named poses)"
-            raise InputError(f"unknown pose {pose!r}; known: {known}", field="pose")
+            raise InputError(
+                f"unknown pose {pose!r}; {did_you_mean(pose, robot.poses)}known: {known}",
+                field="pose",
+            )
         return dict(robot.poses[pose])
     return parse_q(q, robot) if q is not None else {}
