@@ -60,7 +60,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     ),
     "view": (
         "armcli.commands.view",
-        "Open a browser 3-D viewer with joint sliders, named poses and simulation replay.",
+        "Open a browser 3-D viewer: joint sliders, named poses, replay, motion planning.",
     ),
     "render": (
         "armcli.commands.render",

@@ -1,9 +1,10 @@
-"""`armcli view`: a browser 3-D viewer with sliders, named poses and replay."""
+"""`armcli view`: a browser 3-D viewer with sliders, named poses, replay and a planning panel."""
 
 from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
@@ -23,8 +24,21 @@ from armcli.io.oneline import one_line
 from armcli.spec.discover import find_spec
 from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
+if TYPE_CHECKING:
+    from armcli.view.planning import PlanningSession
+    from armcli.view.scene import RobotSource
+    from armcli.xacro.args import XacroInputs
+    from armcli.xacro.trust import Trust
 
-@flag_errors({"pose": "--pose", "q": "--q", "port": "--port", "replay": "--replay"})
+SCENE_HELP = "Obstacles for the planning panel: YAML like moveit_msgs/PlanningScene."
+SRDF_HELP = "SRDF of a URDF: its named poses (group_state) and disabled collision pairs."
+JOINTS_HELP = "Joints the planning panel plans, comma-separated (default: the arm's)."
+SAVE_HELP = "Directory the planning panel's Save writes into (default: the current one)."
+
+
+@flag_errors(
+    {"pose": "--pose", "q": "--q", "port": "--port", "replay": "--replay", "joints": "--joints"}
+)
 def view_cmd(
     robot: Path | None = spec_argument(ROBOT_HELP),
     args: list[str] = args_argument(),
@@ -41,23 +55,27 @@ def view_cmd(
         show_default=False,
         help="Port to listen on (default: 8080; 0: any free port).",
     ),
+    scene: Path = typer.Option(None, "--scene", help=SCENE_HELP),
+    srdf: Path = typer.Option(None, "--srdf", help=SRDF_HELP),
+    joints: str = typer.Option(None, "--joints", help=JOINTS_HELP),
+    save_dir: Path = typer.Option(Path("."), "--save-dir", show_default=False, help=SAVE_HELP),
     package_dir: list[str] = package_dir_option(),
     env: list[str] = env_option(),
     trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
     unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
-    """Open a browser 3-D viewer with joint sliders, named poses and simulation replay."""
+    """Open a browser 3-D viewer: joint sliders, named poses, replay, motion planning."""
     from armcli.sim import rosbag  # on use: `--help` stays light
     from armcli.sim.states import load_replay
     from armcli.view.browser import Viewer
+    from armcli.view.panel import PlanningPanel
     from armcli.view.png import joint_limits, load_urdf
     from armcli.view.scene import load_robot, pose_q
 
     robot, tokens = split_robot(robot, args)
     inputs = xacro_inputs(tokens, env, package_dir)
-    src = load_robot(
-        find_spec(robot), trust_mode(trust_xacro, unsandboxed), inputs.packages, inputs
-    )
+    trust = trust_mode(trust_xacro, unsandboxed)
+    src = load_robot(find_spec(robot), trust, inputs.packages, inputs)
     write_notes(src.notes)
     pose_q(src, pose, None)  # validate before starting the server
     if not 0 <= port <= 65535:
@@ -67,6 +85,8 @@ def view_cmd(
         names = list(joint_limits(load_urdf(src.xml, src.source, src.mesh_dir, src.search)))
         load = rosbag.load_replay if rosbag.is_mcap(replay) else load_replay
         run = load(replay, names)
+    chosen = [j.strip() for j in joints.split(",") if j.strip()] if joints else None
+    session = _session(src, (scene, srdf, chosen), save_dir, trust, inputs)  # before serving
     viewer = Viewer(
         src.xml,
         name=src.name,
@@ -79,7 +99,11 @@ def view_cmd(
         host=host,
         port=port,
     )
+    panel = None
     try:  # entered before the URL is printed, so an early Ctrl-C still stops cleanly
+        if session is not None:
+            panel = PlanningPanel(viewer, session, src.xml, source=src.source,
+                                  mesh_dir=src.mesh_dir, search=src.search)  # fmt: skip
         if pose:
             viewer.apply_pose(pose)
         sys.stdout.write(
@@ -90,7 +114,37 @@ def view_cmd(
     except KeyboardInterrupt:
         sys.stdout.write("viewer stopped\n")
     finally:
+        if panel is not None:
+            panel.close()
         viewer.close()
+
+
+def _session(
+    src: RobotSource,
+    planning: tuple[Path | None, Path | None, list[str] | None],
+    save_dir: Path,
+    trust: Trust,
+    inputs: XacroInputs,
+) -> PlanningSession | None:
+    """The planning panel's session; a robot that cannot be planned for gets none (a note)."""
+    from armcli.sim.options import SimOptions
+    from armcli.view.planning import load_session
+
+    scene, srdf, joints = planning
+    if not save_dir.is_dir():
+        raise InputError(f"{save_dir} is not a directory", field="--save-dir")
+    assert src.file is not None
+    sim = SimOptions(urdf=None if src.file.spec else src.file.path, trust_xacro=trust,
+                     xacro=inputs)  # fmt: skip
+    try:
+        session = load_session(src.file, srdf=srdf, scene=scene, joints=joints,
+                               search=src.search, sim=sim, save_dir=save_dir)  # fmt: skip
+    except InputError as exc:
+        if any(given is not None for given in planning):  # asked for planning: refuse
+            raise
+        sys.stderr.write(f"note: no planning panel: {exc}\n")
+        return None
+    return session
 
 
 def register(app: typer.Typer) -> None:

@@ -18,9 +18,11 @@ from armcli.sim import job as simjob
 from armcli.sim import report as simreport
 from armcli.sim import tipping
 from armcli.sim.options import SimOptions
+from armcli.sim.states import Replay
 from armcli.urdf.meshes import MeshSearch
 
 if TYPE_CHECKING:
+    from armcli.sim.simulate import SimResult
     from armcli.spec.model import RobotSpec
 
 VELOCITY_TOL = 1e-9  # relative slack on the velocity limit
@@ -38,6 +40,7 @@ class Execution:
     joints: tuple[str, ...]
     tip_margin: float | None  # [m] least zero-moment-point margin; None: fixed base
     problems: tuple[str, ...]  # why the executed motion is broken (empty: it is not)
+    states: Replay | None = None  # the executed positions and references (view replays them)
 
     @property
     def broken(self) -> bool:
@@ -76,4 +79,15 @@ def execute(
         if rep.tips:
             problems.append(tipping.tip_error(rep).args[0])
     return Execution(metrics, peak_tau, arm.effort, peak_v, vlim, arm.joint_names, margin,
-                     tuple(problems))  # fmt: skip
+                     tuple(problems), _states(res))  # fmt: skip
+
+
+def _states(res: SimResult) -> Replay:
+    """The kept states as a Replay (time, positions, references) for the viewer."""
+    names = res.joint_names
+    return Replay(
+        "<execute>",
+        res.t.copy(),
+        {j: res.q[:, i].copy() for i, j in enumerate(names)},
+        {j: res.q_ref[:, i].copy() for i, j in enumerate(names)},
+    )

@@ -15,7 +15,7 @@ from armcli.io.names import did_you_mean
 from armcli.robot.tool import ToolPoint, tool_point
 from armcli.spec.expr import eval_expr
 from armcli.urdf.meshes import MeshSearch
-from armcli.urdf.source import Trust, lookup_for, read_robot, urdf_text
+from armcli.urdf.source import RobotFile, Trust, lookup_for, read_robot, urdf_text
 from armcli.urdf.tree import tree_from_urdf
 from armcli.xacro.args import XacroInputs
 
@@ -33,6 +33,7 @@ class RobotSource:
     tool: ToolPoint | None = None
     search: MeshSearch = field(default_factory=MeshSearch)  # --package-dir
     notes: tuple[str, ...] = ()  # what reading a xacro file reported (Urdf.notes)
+    file: RobotFile | None = None  # what was read (the planning panel loads its model from it)
 
 
 def load_robot(
@@ -60,6 +61,7 @@ def load_robot(
             poses={p: spec.pose(p) for p in spec.poses},
             tool=tool_point(robot.robot, spec),
             search=where,
+            file=robot,
         )
     urdf = robot.robot
     tree = tree_from_urdf(urdf)
@@ -72,6 +74,7 @@ def load_robot(
         tool=tool_point(urdf),
         search=where,
         notes=urdf.notes,
+        file=robot,
     )
 
 
