@@ -100,3 +100,14 @@ def test_bad_scene_names_file_and_line(tmp_path: Path, capsys: pytest.CaptureFix
     code, _, err = plan(["--to", "reach", "--scene", scene], capsys)
     assert code == 2
     assert f"{scene}:3 collision_objects[0].primitives[0].type: unknown primitive 7" in err
+
+
+def test_plan_for_a_urdf(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out_file = tmp_path / "t.yaml"
+    urdf = FIXTURES / "plan" / "two_link.urdf"  # no poses: --from is required
+    code, _, err = run_main(["plan", "--urdf", urdf, "--to", "1,0"], capsys)
+    assert code == 2 and "--from" in err
+    args = ["plan", "--urdf", urdf, "--from", "0,0", "--to", "1.0,-0.5", "-o", out_file]
+    code, out, err = run_main(args, capsys)
+    assert code == 0, err
+    assert "joints: shoulder, elbow" in out and out_file.is_file()

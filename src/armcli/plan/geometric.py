@@ -20,7 +20,8 @@ from armcli.defaults import PLANNERS
 from armcli.errors import InputError, PlanningError
 from armcli.plan.collision import CollisionChecker
 
-SHORTCUT_TRIES = 100  # random shortcut attempts after the greedy pass
+SHORTCUT_TRIES = 20  # random shortcut attempts after the greedy pass
+SHORTCUT_PATIENCE = 5  # stop after this many failed attempts in a row (as roboplan does)
 _OMPL_NAMES = {
     "rrtconnect": "RRTConnect",
     "rrt": "RRT",
@@ -101,15 +102,18 @@ def shortcut(
     """A shorter path with the same ends: greedy pass, then seeded random shortcuts."""
     path = _greedy(path, ok)
     rng = np.random.default_rng(seed)
+    misses = 0
     for _ in range(SHORTCUT_TRIES):
-        if len(path) < 3:
+        if len(path) < 3 or misses >= SHORTCUT_PATIENCE:
             break
         cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
         d1, d2 = np.sort(rng.uniform(0.0, cum[-1], 2))
         k1, p1 = _point_at(path, cum, d1)
         k2, p2 = _point_at(path, cum, d2)
         if k1 == k2 or not ok(p1, p2):
+            misses += 1
             continue
+        misses = 0
         path = np.vstack([path[: k1 + 1], p1, p2, path[k2 + 1 :]])
         path = _drop_repeats(path)
     return _greedy(path, ok)
