@@ -91,3 +91,15 @@ def test_no_import_cycles() -> None:
     for node in sorted(graph):
         if node not in state:
             visit(node, [])
+
+
+MAX_MODULE_LINES = 400  # issue 28: one concept per module; past this a module holds two
+
+
+def test_no_module_is_over_the_line_budget() -> None:
+    long = {
+        str(p.relative_to(SRC)): n
+        for p in SRC.rglob("*.py")
+        if (n := len(p.read_text().splitlines())) > MAX_MODULE_LINES
+    }
+    assert not long, long

@@ -24,7 +24,6 @@ is bounded too (`child_main` is that child's entry point).
 from __future__ import annotations
 
 import contextlib
-import glob
 import json
 import os
 import re
@@ -38,133 +37,17 @@ from typing import Any, NoReturn
 import yaml
 
 from armcli.errors import InputError, XacroRefusedError
-from armcli.io.packages import PackageLookup, real_roots
-from armcli.io.userfile import read_regular
+from armcli.io.packages import PackageLookup
 from armcli.xacro.args import Expansion, XacroInputs
 from armcli.xacro.expr import Evaluator, ExprRefusedError
 from armcli.xacro.lines import annotate, collect, expand_call, source_map
+from armcli.xacro.state import ExpansionState, ProblemError
 from armcli.xacro.yaml_tags import YamlRefusedError
 from armcli.xacro.yaml_tags import load_yaml as read_yaml
 
-MAX_XACRO_FILE_BYTES = 2_000_000  # one xacro or YAML file read during expansion
 MAX_MACRO_CALLS = 20_000  # tiago_dual-sized robots make a few hundred
 MAX_SECONDS = 15.0  # wall clock inside the expansion (the child's own limit is above)
 REFUSED_HINT = "; pass --trust-xacro to expand it with xacro itself (in a sandbox)"
-
-
-class _ProblemError(Exception):
-    """Raised inside xacro; carries a refusal or failure out through xacro's wrapping."""
-
-    def __init__(
-        self,
-        message: str,
-        needle: str | None = None,
-        *,
-        refused: bool = True,
-        file: str | None = None,
-        line: int | None = None,
-    ) -> None:
-        super().__init__(message)
-        self.message = message
-        self.needle = needle  # text to find in the files read, for the line
-        self.refused = refused
-        self.file = file  # known exactly (a YAML mark), else found from needle
-        self.line = line
-
-
-class _Recorded(dict[str, str]):
-    """xacro's argument mapping, remembering which names the file declared or read."""
-
-    def __init__(self, given: dict[str, str]) -> None:
-        super().__init__(given)
-        self.seen: set[str] = set()
-
-    def __contains__(self, key: object) -> bool:
-        self.seen.add(str(key))
-        return super().__contains__(key)
-
-    def __getitem__(self, key: str) -> str:
-        self.seen.add(key)
-        return super().__getitem__(key)
-
-
-class _State:
-    """Roots, inputs, files read, counters and findings of one expansion."""
-
-    def __init__(self, top: Path, roots: Sequence[Path], inputs: XacroInputs) -> None:
-        self.top = top
-        self.roots = [Path(os.path.realpath(r)) for r in roots]
-        self.inputs = inputs
-        self.args = _Recorded(dict(inputs.args))
-        self.files: dict[str, str] = {}
-        self.calls = 0
-        self.start = time.monotonic()
-        self.warnings: list[str] = []
-        self.optenv_defaults: list[str] = []
-        self.sources: list[str] = []  # files parsed, in order: xacro.lines' file indices
-
-    def add_package(self, root: Path) -> None:
-        for r in real_roots(root):
-            if r not in self.roots:
-                self.roots.append(r)
-
-    def confine(self, path: str, what: str) -> Path:
-        real = Path(os.path.realpath(path))
-        if not any(real.is_relative_to(r) for r in self.roots):
-            raise _ProblemError(
-                f"{what} {path!r} is outside the allowed directories", os.path.basename(path)
-            )
-        return real
-
-    def read(self, path: str, what: str) -> str:
-        """The text of a confined file: UTF-8 only, no DOCTYPE or entity declarations.
-
-        In UTF-16 a DOCTYPE hides from a byte search and the XML parser follows the file's
-        own encoding, so the text is decoded strictly and handed on as str (issue 20).
-        """
-        real = self.confine(path, what)
-        data = read_regular(real, max_bytes=MAX_XACRO_FILE_BYTES, what=what)
-        try:
-            text = data.decode("utf-8")
-        except UnicodeDecodeError:
-            raise _ProblemError(f"{what} {path!r} is not UTF-8 text", path) from None
-        if "\x00" in text:  # UTF-16 without a byte-order mark is valid UTF-8 full of NULs
-            raise _ProblemError(f"{what} {path!r} holds NUL characters", path)
-        if "<!DOCTYPE" in text or "<!ENTITY" in text:
-            raise _ProblemError(f"{what} {path!r} declares a DOCTYPE/entities", path)
-        self.files[str(real)] = text
-        return text
-
-    def include_files(self, spec: str) -> list[str]:
-        """The files an include names, a glob matched only inside the allowed roots.
-
-        The pattern's literal directory must be inside a root, and matches outside the
-        roots (through symlinks) are dropped without a word: an error naming them told
-        the file's author which files exist elsewhere (`/root/.*rc` -> `/root/.bashrc`).
-        """
-        if not glob.has_magic(spec):
-            return [spec]
-        literal = spec[: min(spec.find(c) for c in "*?[" if c in spec)]
-        self.confine(os.path.dirname(literal) or ".", "include pattern")
-        inside = [f for f in sorted(glob.glob(spec)) if self.inside(f)]
-        if not inside:
-            self.warnings.append(f"include pattern {spec!r} matches no file")
-        return inside
-
-    def inside(self, path: str) -> bool:
-        """Whether `path` (symlinks resolved) lies in one of the allowed roots."""
-        real = Path(os.path.realpath(path))
-        return any(real.is_relative_to(r) for r in self.roots)
-
-    def expansion(self) -> Expansion:
-        given = tuple(self.inputs.args)
-        return Expansion(
-            args=dict(self.args),
-            given=given,
-            unused=tuple(n for n in given if n not in self.args.seen),
-            optenv_defaults=tuple(dict.fromkeys(self.optenv_defaults)),
-            warnings=tuple(dict.fromkeys(self.warnings)),
-        )
 
 
 def find_package(name: str, start: Path, packages: PackageLookup | None = None) -> Path | None:
@@ -172,14 +55,14 @@ def find_package(name: str, start: Path, packages: PackageLookup | None = None) 
     return (packages or PackageLookup()).find(name, start)
 
 
-def _current(xacro: Any, state: _State) -> Path:
+def _current(xacro: Any, state: ExpansionState) -> Path:
     return Path(xacro.filestack[-1] if xacro.filestack and xacro.filestack[-1] else state.top)
 
 
-def _find(state: _State, xacro: Any, name: str, text: str) -> str:
+def _find(state: ExpansionState, xacro: Any, name: str, text: str) -> str:
     found = state.inputs.packages.find(name, _current(xacro, state))
     if found is None:
-        raise _ProblemError(
+        raise ProblemError(
             f"$(find {name}): no package {name!r} (looked in --package-dir, "
             "AMENT_PREFIX_PATH, ROS_PACKAGE_PATH and the packages enclosing the file); "
             f"pass --package-dir {name}=PATH or source the workspace that has it",
@@ -190,21 +73,21 @@ def _find(state: _State, xacro: Any, name: str, text: str) -> str:
     return str(found)
 
 
-def _env(state: _State, args: list[str], text: str, optional: bool) -> str:
+def _env(state: ExpansionState, args: list[str], text: str, optional: bool) -> str:
     name = args[0]
     if name in state.inputs.env:
         return state.inputs.env[name]
     if optional:
         state.optenv_defaults.append(name)
         return " ".join(args[1:])
-    raise _ProblemError(
+    raise ProblemError(
         f"$(env {name}): armcli does not read its own environment; pass --env {name}=VALUE",
         text,
         refused=False,
     )
 
 
-def _declared_later(state: _State, xacro: Any, name: str) -> str:
+def _declared_later(state: ExpansionState, xacro: Any, name: str) -> str:
     """Why a default the file declares does not apply: its <xacro:arg> comes after the use.
 
     UR's ur.urdf.xacro reads `name` in its <robot> tag, a line above `default="ur"`;
@@ -222,12 +105,12 @@ def _declared_later(state: _State, xacro: Any, name: str) -> str:
     )
 
 
-def _extension(state: _State, xacro: Any, text: str) -> str:
+def _extension(state: ExpansionState, xacro: Any, text: str) -> str:
     inner = text[2:-1].split()
     cmd, args = (inner[0], inner[1:]) if inner else ("", [])
     if cmd == "arg" and len(args) == 1:
         if args[0] not in state.args:
-            raise _ProblemError(
+            raise ProblemError(
                 f"undefined xacro argument {args[0]!r}: pass {args[0]}:=VALUE after the file"
                 + _declared_later(state, xacro, args[0]),
                 text,
@@ -241,13 +124,13 @@ def _extension(state: _State, xacro: Any, text: str) -> str:
     if cmd in ("env", "optenv") and (len(args) == 1 or (cmd == "optenv" and args)):
         return _env(state, args, text, optional=cmd == "optenv")
     if cmd in ("eval", "cwd", "anon"):
-        raise _ProblemError(
+        raise ProblemError(
             f"$({cmd} ...) is not allowed (it runs Python or reads the machine)", f"$({cmd}"
         )
-    raise _ProblemError(f"{text}: unknown or malformed substitution", text, refused=False)
+    raise ProblemError(f"{text}: unknown or malformed substitution", text, refused=False)
 
 
-def _messages(state: _State, xacro: Any) -> dict[Any, Any]:
+def _messages(state: ExpansionState, xacro: Any) -> dict[Any, Any]:
     """The functions xacro exposes to expressions -> safe versions (keyed by the original)."""
     ns = xacro._global_symbols["xacro"]
 
@@ -260,7 +143,7 @@ def _messages(state: _State, xacro: Any) -> dict[Any, Any]:
         return record
 
     def fatal(*args: Any) -> None:
-        raise _ProblemError(f"xacro.fatal: {' '.join(map(str, args))}", "fatal", refused=False)
+        raise ProblemError(f"xacro.fatal: {' '.join(map(str, args))}", "fatal", refused=False)
 
     out = {ns[k]: said(k) for k in ("message", "warning", "error") if k in ns}
     out[ns["fatal"]] = fatal
@@ -275,7 +158,7 @@ def _messages(state: _State, xacro: Any) -> dict[Any, Any]:
     return out
 
 
-def _patches(state: _State, xacro: Any) -> dict[str, Any]:
+def _patches(state: ExpansionState, xacro: Any) -> dict[str, Any]:
     """Replacements for xacro's module-level functions that could run code or read files."""
     import xml.dom.minidom
 
@@ -287,14 +170,14 @@ def _patches(state: _State, xacro: Any) -> dict[str, Any]:
         try:
             return Evaluator(lambda name: symbols[name], calls)(expr)
         except ExprRefusedError as exc:
-            raise _ProblemError(f"expression ${{{expr.strip()}}}: {exc}", expr.strip()) from None
+            raise ProblemError(f"expression ${{{expr.strip()}}}: {exc}", expr.strip()) from None
         except Exception as exc:
             inner = _unwrap(exc)
-            if isinstance(inner, _ProblemError):  # from a property evaluated lazily inside
+            if isinstance(inner, ProblemError):  # from a property evaluated lazily inside
                 raise inner from None
             # NameError, TypeError, ...: the file's own mistake
             text = f"expression ${{{expr.strip()}}}: {type(inner).__name__}: {inner}"
-            raise _ProblemError(text, expr.strip(), refused=False) from None
+            raise ProblemError(text, expr.strip(), refused=False) from None
 
     def load_yaml(filename: str) -> Any:
         path = xacro.abs_filename_spec(filename)
@@ -309,12 +192,12 @@ def _patches(state: _State, xacro: Any) -> dict[str, Any]:
                 state.warnings.append,
             )
         except YamlRefusedError as exc:
-            raise _ProblemError(exc.message, file=path, line=exc.line) from None
+            raise ProblemError(exc.message, file=path, line=exc.line) from None
         except yaml.YAMLError as exc:
             mark = getattr(exc, "problem_mark", None)
             why = getattr(exc, "problem", None) or str(exc).splitlines()[0]
             line = mark.line + 1 if mark is not None else None
-            raise _ProblemError(
+            raise ProblemError(
                 f"malformed YAML: {why}", refused=False, file=path, line=line
             ) from None
         finally:
@@ -348,9 +231,9 @@ def _patches(state: _State, xacro: Any) -> dict[str, Any]:
     def handle_macro_call(node: Any, macros: Any, symbols: Any) -> Any:
         state.calls += 1
         if state.calls > MAX_MACRO_CALLS:
-            raise _ProblemError(f"more than {MAX_MACRO_CALLS} macro calls")
+            raise ProblemError(f"more than {MAX_MACRO_CALLS} macro calls")
         if time.monotonic() - state.start > MAX_SECONDS:
-            raise _ProblemError(f"expansion took longer than {MAX_SECONDS:g} s")
+            raise ProblemError(f"expansion took longer than {MAX_SECONDS:g} s")
         return expand_call(node, lambda: real_macro_call(node, macros, symbols))
 
     def warning(*args: Any, **_: Any) -> None:
@@ -368,7 +251,7 @@ def _patches(state: _State, xacro: Any) -> dict[str, Any]:
 
 
 @contextlib.contextmanager
-def _patched(state: _State) -> Iterator[Any]:
+def _patched(state: ExpansionState) -> Iterator[Any]:
     import xacro
 
     patches = _patches(state, xacro)
@@ -398,7 +281,7 @@ def _blank(match: re.Match[str]) -> str:
 
 
 def _line_of(
-    state: _State, needle: str | None, first: Sequence[str] = ()
+    state: ExpansionState, needle: str | None, first: Sequence[str] = ()
 ) -> tuple[str, int | None]:
     """The file and line where `needle` (an expression or path) first appears.
 
@@ -425,11 +308,11 @@ def _context(xacro: Any) -> list[str]:
     return files
 
 
-def _raise(state: _State, xacro: Any, exc: Exception, path: Path) -> NoReturn:
+def _raise(state: ExpansionState, xacro: Any, exc: Exception, path: Path) -> NoReturn:
     """The InputError (XacroRefusedError for a refusal) a failed expansion stands for."""
     inner = _unwrap(exc)
     where = _context(xacro)
-    if isinstance(inner, _ProblemError):
+    if isinstance(inner, ProblemError):
         if inner.file is not None:
             file, line = inner.file, inner.line
         else:
@@ -457,7 +340,7 @@ def expand_safe_report(
     path: Path, roots: Sequence[Path], inputs: XacroInputs
 ) -> tuple[bytes, Expansion]:
     """The expanded URDF bytes and what the expansion used (arguments, warnings)."""
-    state = _State(path, roots, inputs)
+    state = ExpansionState(path, roots, inputs)
     with _patched(state) as xacro:
         try:
             doc = xacro.process_file(str(path), mappings=state.args)
