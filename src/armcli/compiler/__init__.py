@@ -1,4 +1,5 @@
-"""Spec -> xacro set -> URDFs expanded by the real xacro package, with one XML formatter.
+"""Spec -> xacro set -> URDFs expanded by armcli's safe xacro evaluator, one XML formatter.
 
-May import `armcli.spec` and below.
+May import `armcli.xacro` and below (never xacro's Python `eval`: real xacro is the tests'
+oracle).
 """
