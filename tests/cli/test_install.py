@@ -197,3 +197,13 @@ def test_simulate_drives_the_whole_robot(installed: Installed) -> None:
     with Reader(installed.project / "run.mcap") as reader:
         topics = {c.topic for c in reader.connections}
     assert {"/odom", "/tf", "/joint_states", "/cmd_vel"} <= topics
+
+
+def test_plan_then_simulate(installed: Installed) -> None:
+    # the README's Plan & Execute loop, from the wheel: OMPL and TOPP-RA are runtime deps
+    r = installed.run("plan", "--from", "home", "--to", "reach", "-o", "planned.yaml")
+    assert r.returncode == 0, r.stderr
+    doc = yaml.safe_load((installed.project / "planned.yaml").read_text())
+    assert doc["joint_names"] == ["arm_base_forearm_joint", "forearm_hand_joint"]
+    r = installed.run("simulate", "--trajectory", "planned.yaml")
+    assert r.returncode == 0, r.stderr
