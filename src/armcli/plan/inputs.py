@@ -48,7 +48,7 @@ def load_context(
     )
     links = [lk.name for lk in robot.urdf.links]
     obstacles = load_scene(scene, links) if scene is not None else Scene()
-    ctx = planning_context(robot, obstacles, allowed_pairs(robot_file, parsed))
+    ctx = planning_context(robot, obstacles, allowed_pairs(robot_file, parsed, search))
     return Loaded(ctx, robot_file, obstacles)
 
 

@@ -15,7 +15,9 @@ from typing import Any
 from armcli.defaults import COLLISION_SAMPLES
 from armcli.errors import InputError
 from armcli.io.userfile import read_regular
+from armcli.robot.load import confined_mesh_xml
 from armcli.ros.collision_matrix import DEFAULT_SEED, compute_collision_matrix
+from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_root
 from armcli.urdf.source import RobotFile
 
@@ -66,13 +68,20 @@ def read_srdf(path: Path) -> Srdf:
     return Srdf(tuple(disabled), states)
 
 
-def allowed_pairs(robot: RobotFile, srdf: Srdf | None) -> tuple[tuple[str, str], ...]:
-    """Link pairs never checked against each other: the SRDF's, else ros-package's matrix."""
+def allowed_pairs(
+    robot: RobotFile, srdf: Srdf | None, search: MeshSearch | None = None
+) -> tuple[tuple[str, str], ...]:
+    """Link pairs never checked against each other: the SRDF's, else ros-package's matrix.
+
+    `search`: the package lookup the collision meshes are resolved with (the same the
+    planner's own geometry uses), so a `package://` mesh loads here too.
+    """
     if srdf is not None:
         return srdf.disabled
     poses = {n: robot.spec.pose(n) for n in robot.spec.poses} if robot.spec is not None else None
+    text = robot.robot.text if search is None else confined_mesh_xml(robot.robot, search)
     matrix = compute_collision_matrix(
-        robot.robot.text,
+        text,
         samples=COLLISION_SAMPLES,
         seed=DEFAULT_SEED,
         source=robot.robot.source,
