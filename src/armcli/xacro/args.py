@@ -10,7 +10,7 @@ The package lookup (`$(find)`, `package://`) travels with them.
 
 `Expansion` is what came back: every argument with its value, which were given and
 which took the file's default, variables that took their `$(optenv)` default, and the
-expansion's warnings (duplicate YAML keys, `xacro.warning(...)`), as note lines that
+expansion's warnings (duplicate YAML keys, the xacro library's `warning(...)`), as note lines that
 every command prints the same way.
 """
 

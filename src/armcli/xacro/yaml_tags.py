@@ -1,4 +1,4 @@
-"""`xacro.load_yaml` in safe mode: the YAML xacro reads, without xacro's `eval`.
+"""The xacro library's `load_yaml` in safe mode: its YAML, without xacro's `eval`.
 
 xacro reads YAML with PyYAML's `safe_load` plus its unit tags (`!degrees 90`,
 `!radians pi/2`, `!millimeters 35`, ...), whose text it evaluates as an
