@@ -47,6 +47,12 @@ def test_import_check_ros_package_at_once(
     code, out, err = run_main(["ros-package", spec, "-o", "proj/ros", "--samples", "50"], capsys)
     assert code == 0, err
     assert "internal error" not in err
+    # plan reads the spec's recorded packages too (it used only --package-dir and the
+    # environment: "mesh 'package://mesh_arm_description/...' cannot be found")
+    code, out, err = run_main(["plan", spec, "--from", "0,0", "--to", "0.5,0.5",
+                               "-o", "proj/t.yaml"], capsys)  # fmt: skip
+    assert code == 0, err
+    assert Path("proj", "t.yaml").is_file()
 
 
 def test_missing_mesh_is_an_input_error_naming_the_option(

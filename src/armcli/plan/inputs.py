@@ -18,7 +18,7 @@ from armcli.plan.robot import load_plan_robot
 from armcli.plan.scene import Scene, load_scene
 from armcli.plan.srdf import allowed_pairs, read_srdf
 from armcli.urdf.meshes import MeshSearch
-from armcli.urdf.source import RobotFile
+from armcli.urdf.source import RobotFile, lookup_for
 
 
 @dataclass(frozen=True)
@@ -38,7 +38,12 @@ def load_context(
     joints: Sequence[str] | None = None,
     search: MeshSearch | None = None,
 ) -> Loaded:
-    """The planning context of a robot file, an optional SRDF and an optional scene file."""
+    """The planning context of a robot file, an optional SRDF and an optional scene file.
+
+    `search`: the package lookup (--package-dir, the environment); a spec's recorded
+    `packages` are added to it, as for every command that reads meshes.
+    """
+    search = lookup_for(robot_file.spec, search)
     parsed = read_srdf(srdf) if srdf is not None else None
     robot = load_plan_robot(
         robot_file,
