@@ -14,10 +14,8 @@ import json
 import math
 import os
 import shutil
-import signal
 import socket
 import subprocess
-import sys
 import tempfile
 import time
 import urllib.request
@@ -34,6 +32,7 @@ from armcli.sim.states import load_replay
 from armcli.view.browser import Viewer, moving_parts
 from armcli.view.scene import load_robot
 from tests.helpers import run_cli
+from tests.view.viewer_process import view_then_ctrl_c
 
 TIP_TOL = 1e-6  # [m] forward kinematics vs closed form
 INTERP_TOL = 1e-12  # [rad] linear interpolation of a linear record is exact
@@ -195,24 +194,9 @@ def test_cli_view_port_taken_exits_2(root: Path) -> None:
 
 
 def test_cli_view_stops_cleanly_on_ctrl_c(root: Path) -> None:
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "armcli.cli", "view", "--port", "0"],
-        cwd=root,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-    )
-    try:
-        first = proc.stdout.readline() if proc.stdout else ""
-        assert first.startswith("armcli view: my_robot at http://127.0.0.1:"), first
-        proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=30)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
-    assert proc.returncode == 0, err
+    first, code, out, err = view_then_ctrl_c(["--port", "0"], root)
+    assert first.startswith("armcli view: my_robot at http://127.0.0.1:"), first
+    assert code == 0, err
     assert out == "viewer stopped\n"
     assert err == ""
 

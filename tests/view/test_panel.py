@@ -9,9 +9,6 @@ executing replays the simulated motion onto the robot.
 from __future__ import annotations
 
 import json
-import signal
-import subprocess
-import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -34,6 +31,7 @@ from tests.view.test_browser import (  # noqa: F401  (the fixture is used by nam
     save,
     wait_for,
 )
+from tests.view.viewer_process import view_then_ctrl_c
 
 PLAN_TIMEOUT_S = 60.0  # first plan: OMPL/TOPP-RA imports and seven ghost robots on 2 cores
 EXECUTE_TIMEOUT_S = 90.0  # simulation (~1 s alone) plus the replay of the ~2.5 s motion
@@ -194,24 +192,9 @@ def test_cli_robot_without_joints_gets_the_viewer_without_a_panel(
         '<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"'
         ' ixy="0" ixz="0" iyz="0"/></inertial></link></robot>'
     )
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "armcli.cli", "view", str(urdf), "--port", "0"],
-        cwd=root,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-    )
-    try:
-        first = proc.stdout.readline() if proc.stdout else ""
-        assert first.startswith("armcli view: block at http://127.0.0.1:"), first
-        proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=30)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
-    assert proc.returncode == 0, err
+    first, code, out, err = view_then_ctrl_c([str(urdf), "--port", "0"], root)
+    assert first.startswith("armcli view: block at http://127.0.0.1:"), first
+    assert code == 0, err
     assert out == "viewer stopped\n"
     assert err.startswith("note: no planning panel: ") and err.count("\n") == 1, err
 
