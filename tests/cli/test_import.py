@@ -79,7 +79,7 @@ def test_refuses_to_overwrite_and_bad_arguments(
     code, _, err = run(["import", str(STUDENT), "-o", str(spec)], capsys)
     assert code == 2 and "exists; pass --force" in err and spec.read_text() == "mine\n"
     code, _, err = run(["import", str(STUDENT), "ur_type", "-o", str(tmp_path / "x.yaml")], capsys)
-    assert code == 2 and "expected NAME:=VALUE" in err, err
+    assert code == 2 and "only xacro arguments NAME:=VALUE may follow" in err, err
     code, _, err = run(
         ["import", str(tmp_path / "missing.urdf"), "-o", str(tmp_path / "y.yaml")], capsys
     )

@@ -16,10 +16,12 @@ import numpy as np
 import pytest
 
 from armcli.errors import InputError, OutputRefusedError, PlanningError
+from armcli.urdf.source import RobotInput
 from armcli.view.browser import Viewer
 from armcli.view.panel import DRAGGED, PlanningPanel
 from armcli.view.planning import PlanningSession, load_session
 from armcli.view.scene import load_robot
+from armcli.xacro.args import XacroInputs
 
 PIVOT = np.array([0.15, 0.0, 0.32])  # [m] arm_base_forearm_joint in base_footprint (brief)
 LINK = 0.3  # [m] forearm and hand lengths (brief)
@@ -226,9 +228,8 @@ def test_panda_drag_solves_position_and_orientation(tmp_path: Path) -> None:
 
     if not PANDA.is_dir():
         pytest.skip("example-robot-data's Panda is not installed")
-    src = load_robot(
-        PANDA / "urdf" / "panda.urdf", search=PackageLookup({"example-robot-data": ERD})
-    )
+    packages = PackageLookup({"example-robot-data": ERD})
+    src = load_robot(RobotInput((PANDA / "urdf" / "panda.urdf",), XacroInputs(packages=packages)))
     assert src.file is not None and src.tool is not None
     session = load_session(src.file, srdf=PANDA / "srdf" / "panda.srdf", search=src.search,
                            save_dir=tmp_path)  # fmt: skip

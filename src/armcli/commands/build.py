@@ -4,19 +4,22 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
 from armcli.commands.flags import flag_errors
-from armcli.commands.options import spec_argument
+from armcli.commands.robot_input import robot_options
 from armcli.io.oneline import one_line
-from armcli.spec.discover import find_spec
+
+if TYPE_CHECKING:
+    from armcli.urdf.source import RobotInput
 
 
 @flag_errors({"out_dir": "--out"})  # the library names its parameter
+@robot_options("spec", xacro=False, packages=False)
 def build_cmd(
-    spec: Path | None = spec_argument(),
+    robot: RobotInput,
     out: Path = typer.Option(
         Path("urdf"), "-o", "--out", show_default=False, help="Output directory (default: urdf)."
     ),
@@ -30,7 +33,7 @@ def build_cmd(
     """Compile SPEC into the course's xacro set and the expanded URDFs."""
     from armcli.compiler.expand import build, check_fresh  # on use: `--help` stays light
 
-    spec = find_spec(spec)
+    spec = robot.file()
     if check:
         check_fresh(spec, out)
         sys.stdout.write(one_line(f"{out}: up to date with {spec}") + "\n")

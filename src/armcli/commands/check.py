@@ -10,14 +10,8 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from armcli.commands.options import choice
-from armcli.commands.points import REACH_POINT_HELP, point_option
-from armcli.commands.xacro_inputs import (
-    env_option,
-    package_dir_option,
-    split_paths,
-    write_notes,
-    xacro_inputs,
-)
+from armcli.commands.robot_input import robot_options, write_notes
+from armcli.commands.values import REACH_POINT_HELP, Names, Numbers, names, point
 from armcli.errors import (
     EXIT_FAILED,
     EXIT_UNUSABLE,
@@ -27,12 +21,11 @@ from armcli.errors import (
     UnusableInputsError,
 )
 from armcli.io import terminal
-from armcli.spec.discover import find_spec
-from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 if TYPE_CHECKING:  # the checker is imported when the command runs: `--help` stays light
     from armcli.check.inputs import CheckRun
     from armcli.check.options import TipoverOptions
+    from armcli.urdf.source import RobotInput
 
 FORMATS = ("table", "json", "github", "sarif")
 PAYLOAD_LINK_HELP = "Link carrying --payload at its origin (default: the tool point)."
@@ -47,11 +40,11 @@ BASE_ACCEL_HELP = (
 def tipover_options(
     payload: float,
     payload_link: str | None,
-    contact_links: str | None,
+    contact_links: Names | None,
     min_margin: float,
     trajectory: Path | None,
     base_accel: float | None,
-    reach_points: list[str],
+    reach_points: list[Numbers],
 ) -> TipoverOptions:
     """The balance and reach options, refused here when they are not usable numbers."""
     from armcli.check.options import TipoverOptions
@@ -62,46 +55,39 @@ def tipover_options(
             raise InputError(f"must be a finite number >= 0, got {x:g}", field=flag)
     if trajectory is not None and not trajectory.is_file():
         raise InputError("no such file", file=trajectory, field="--trajectory")
-    names = None
-    if contact_links is not None:
-        names = tuple(n.strip() for n in contact_links.split(",") if n.strip())
     return TipoverOptions(
         payload=payload,
         payload_link=payload_link,
-        contact_links=names,
+        contact_links=contact_links,
         min_margin=min_margin,
         trajectory=trajectory,
         base_accel=base_accel,
-        reach_points=tuple(point_option(p, "--reach-point") for p in reach_points),
+        reach_points=tuple((p[0], p[1], p[2]) for p in reach_points),
     )
 
 
+@robot_options("paths")
 def check_cmd(
-    paths: list[str] = typer.Argument(
-        None,
-        metavar="[PATHS]... [NAME:=VALUE]...",
-        help="URDF or xacro files, spec YAMLs (built in memory) or directories (every *.urdf); "
-        "default: ./armcli.yaml, else the spec in specs/. NAME:=VALUE: xacro arguments.",
-    ),
+    robot: RobotInput,
     spec: Path | None = typer.Option(
         None, "--spec", help="Spec to compare limits with; also gives gains, dt, poses, tool."
     ),
     fmt: str = choice("table", FORMATS, "--format", help="Report format (default: table)."),
     strict: bool = typer.Option(False, "--strict", help="Treat warnings as errors."),
     ignore: list[str] = typer.Option([], "--ignore", help="Silence a rule id (repeatable)."),
-    package_dir: list[str] = package_dir_option(),
-    env: list[str] = env_option(),
-    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
-    unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
     payload: float = typer.Option(0.0, "--payload", help="Payload [kg] at the tool point."),
     payload_link: str = typer.Option(None, "--payload-link", help=PAYLOAD_LINK_HELP),
-    contact_links: str = typer.Option(None, "--contact-links", help=CONTACT_LINKS_HELP),
+    contact_links: Names = typer.Option(
+        None, "--contact-links", parser=names, metavar="LINK,...", help=CONTACT_LINKS_HELP
+    ),
     min_margin: float = typer.Option(
         0.02, "--min-margin", help="Balance margin [m] below which to warn."
     ),
     trajectory: Path = typer.Option(None, "--trajectory", "-t", help=TRAJECTORY_HELP),
     base_accel: float = typer.Option(None, "--base-accel", help=BASE_ACCEL_HELP),
-    reach_point: list[str] = typer.Option([], "--reach-point", help=REACH_POINT_HELP),
+    reach_point: list[Numbers] = typer.Option(
+        [], "--reach-point", parser=point("--reach-point"), metavar="X,Y,Z", help=REACH_POINT_HELP
+    ),
 ) -> None:
     """Check robot descriptions for physical sanity; exit 1 on error findings."""
     from armcli.check import report
@@ -114,18 +100,15 @@ def check_cmd(
     unknown = unknown_rules(ignore)
     if unknown:
         raise InputError(f"unknown rule(s) {unknown}; known: {', '.join(RULES)}", field="--ignore")
-    files, args = split_paths(paths or [])
-    inputs = xacro_inputs(args, env, package_dir)
     tip = tipover_options(
         payload, payload_link, contact_links, min_margin, trajectory, base_accel, reach_point
     )
-    base = CheckOptions(package_dirs=inputs.packages.package_dirs, tipover=tip)
+    base = CheckOptions(package_dirs=robot.packages.package_dirs, tipover=tip)
     if spec is not None:  # the spec layers (pydantic, ~0.4 s to import) only for a spec
         from armcli.spec.load import load_spec
 
         base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs, tipover=tip)
-    trust = trust_mode(trust_xacro, unsandboxed)
-    run = run_check(files or [find_spec(None)], base, trust_xacro=trust, inputs=inputs)
+    run = run_check(robot.files(), base, trust_xacro=robot.trust, inputs=robot.xacro)
     for file, note in run.notes:
         write_notes([note], file.removesuffix(EXPANDED_TAG))
     everything = [f for r in run.results for f in r.findings]

@@ -4,34 +4,25 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
-from armcli.commands.xacro_inputs import (
-    args_argument,
-    env_option,
-    package_dir_option,
-    split_robot,
-    write_notes,
-    xacro_inputs,
-)
-from armcli.errors import InputError
+from armcli.commands.robot_input import robot_options, write_notes
 from armcli.io.files import write_file_atomic
 from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
-from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+
+if TYPE_CHECKING:
+    from armcli.urdf.source import RobotInput
 
 
+@robot_options("file", help="The xacro file to expand.")
 def expand_cmd(
-    file: Path = typer.Argument(..., show_default=False, help="The xacro file to expand."),
-    args: list[str] = args_argument(),
+    robot: RobotInput,
     out: Path = typer.Option(
         None, "-o", "--out", show_default=False, help="Write the URDF here (default: stdout)."
     ),
-    env: list[str] = env_option(),
-    package_dir: list[str] = package_dir_option(),
-    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
-    unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Expand a xacro file like `xacro FILE NAME:=VALUE...`, without running its code.
 
@@ -39,13 +30,10 @@ def expand_cmd(
     """
     from armcli.urdf.source import expand_xacro  # on use: `--help` imports no numpy or lxml
 
-    robot, tokens = split_robot(file, args)
-    if robot is None:
-        raise InputError("give the xacro file before its NAME:=VALUE arguments", field="FILE")
+    path = robot.file()
     if out is not None:
-        check_output_file(out, "--out", [robot])  # before any work; never over the input
-    inputs = xacro_inputs(tokens, env, package_dir)
-    xml, used = expand_xacro(robot, trust_xacro=trust_mode(trust_xacro, unsandboxed), inputs=inputs)
+        check_output_file(out, "--out", [path])  # before any work; never over the input
+    xml, used = expand_xacro(path, trust_xacro=robot.trust, inputs=robot.xacro)
     write_notes(used.notes())
     if out is None:
         sys.stdout.buffer.write(xml)

@@ -4,22 +4,17 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from armcli.commands.options import choice
-from armcli.commands.xacro_inputs import (
-    args_argument,
-    env_option,
-    package_dir_option,
-    split_robot,
-    write_notes,
-    xacro_inputs,
-)
+from armcli.commands.robot_input import robot_options, write_notes
 from armcli.defaults import MJCF_BASES
 from armcli.io.outdir import check_output_file
-from armcli.spec.discover import find_spec
-from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+
+if TYPE_CHECKING:
+    from armcli.urdf.source import RobotInput
 
 export_app = typer.Typer(
     help="Export the robot to other simulators' formats.", no_args_is_help=True
@@ -27,14 +22,9 @@ export_app = typer.Typer(
 
 
 @export_app.command("mjcf")
+@robot_options()
 def mjcf_cmd(
-    robot: Path | None = typer.Argument(
-        None,
-        show_default=False,
-        help="Robot spec YAML, URDF or xacro file (default: ./armcli.yaml, else the spec in "
-        "specs/).",
-    ),
-    args: list[str] = args_argument(),
+    robot: RobotInput,
     out: Path = typer.Option(
         Path("robot.xml"),
         "-o",
@@ -51,10 +41,6 @@ def mjcf_cmd(
     whole_robot: bool = typer.Option(
         False, "--whole-robot", help="For a spec: the whole robot instead of the arm alone."
     ),
-    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
-    unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
-    package_dir: list[str] = package_dir_option(),
-    env: list[str] = env_option(),
 ) -> None:
     """Write a MuJoCo MJCF model of ROBOT to OUT, with scene.xml (floor, light) beside it.
 
@@ -65,18 +51,16 @@ def mjcf_cmd(
     from armcli.export.mjcf_files import export_mjcf
 
     check_output_file(out, "--out", parents=True)  # before any work: nothing else is written
-    robot, tokens = split_robot(robot, args)
-    inputs = xacro_inputs(tokens, env, package_dir)
-    robot = find_spec(robot)
+    path = robot.file()
     res = export_mjcf(
-        robot,
+        path,
         out,
         base=base,
         whole_robot=whole_robot,
-        trust_xacro=trust_mode(trust_xacro, unsandboxed),
-        search=inputs.packages,
-        label=spec_label(robot),
-        inputs=inputs,
+        trust_xacro=robot.trust,
+        search=robot.packages,
+        label=spec_label(path),
+        inputs=robot.xacro,
     )
     write_notes(res.notes)
     exp = res.export

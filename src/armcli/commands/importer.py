@@ -9,20 +9,14 @@ import typer
 
 from armcli.commands.flags import flag_errors
 from armcli.commands.options import option
-from armcli.commands.xacro_inputs import (
-    env_option,
-    package_dir_option,
-    write_notes,
-    xacro_inputs,
-)
+from armcli.commands.robot_input import robot_options, write_notes
 from armcli.defaults import SPEC_FILE
-from armcli.errors import InputError
 from armcli.io.oneline import one_line
 from armcli.io.terminal import say
-from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 if TYPE_CHECKING:  # the importer is imported when the command runs: `--help` stays light
     from armcli.importer.run import ImportResult
+    from armcli.urdf.source import RobotInput
 
 
 def report(result: ImportResult, source: Path, out: Path) -> str:
@@ -52,11 +46,9 @@ def report(result: ImportResult, source: Path, out: Path) -> str:
 
 
 @flag_errors({"out": "--out", "arm_root": "--arm-root", "force": "--force"})
+@robot_options("file", help="URDF or xacro file to import.")
 def import_cmd(
-    file: Path = typer.Argument(..., help="URDF or xacro file to import."),
-    args: list[str] = typer.Argument(
-        None, help="xacro arguments NAME:=VALUE (safe mode or --trust-xacro)."
-    ),
+    robot: RobotInput,
     out: Path = option(SPEC_FILE, "-o", "--out", help="Spec file to write"),
     arm_root: str | None = option(
         None, "--arm-root", help="Link where the arm starts (default: found from the joints)."
@@ -65,23 +57,17 @@ def import_cmd(
     strict: bool = typer.Option(
         False, "--strict", help="Exit 1 when the round trip is not exact (the spec is written)."
     ),
-    package_dir: list[str] = package_dir_option(),
-    env: list[str] = env_option(),
-    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
-    unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Import a URDF or xacro file into a spec that builds the same URDF back."""
     from armcli.importer.file import import_file
     from armcli.tune.spec_start import spec_start_gains
 
-    stray = [a for a in args or [] if ":=" not in a]
-    if stray:
-        raise InputError(f"unexpected argument {stray[0]!r}: expected NAME:=VALUE", field="ARGS")
+    file = robot.file()
     result, notes = import_file(
         file,
         out,
-        inputs=xacro_inputs(args or [], env, package_dir),
-        trust_xacro=trust_mode(trust_xacro, unsandboxed),
+        inputs=robot.xacro,
+        trust_xacro=robot.trust,
         arm_root=arm_root,
         force=force,
         gains=spec_start_gains,

@@ -11,7 +11,7 @@ import typer
 
 from armcli.commands.flags import flag_errors
 from armcli.commands.importer import report
-from armcli.commands.xacro_inputs import write_notes
+from armcli.commands.robot_input import write_notes
 from armcli.defaults import SPEC_FILE, TRAJECTORY_DIR
 from armcli.io.oneline import one_line
 from armcli.io.terminal import say

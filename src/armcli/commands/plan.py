@@ -3,27 +3,24 @@
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import typer
 
 from armcli.commands.flags import flag_errors
-from armcli.commands.options import choice, option, spec_argument
-from armcli.commands.xacro_inputs import (
-    args_argument,
-    env_option,
-    package_dir_option,
-    split_robot,
-    xacro_inputs,
-)
+from armcli.commands.options import choice, option
+from armcli.commands.robot_input import robot_options
+from armcli.commands.values import Names, Numbers, names, numbers
 from armcli.defaults import PLANNERS
-from armcli.errors import InputError, PlanningError
-from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+from armcli.errors import PlanningError
+from armcli.io.terminal import say
 
 if TYPE_CHECKING:
     from armcli.plan.api import PlanResult
     from armcli.plan.execute import Execution
+    from armcli.urdf.source import RobotInput
 
 FORMATS = ("text", "json")
 FROM_HELP = "Start: a named pose (spec poses, SRDF group states) or q1,q2,... [rad]."
@@ -42,23 +39,39 @@ FLAGS = {
     "pose": "--from/--to",
     "to-xyz": "--to-xyz",
     "to-rpy": "--to-rpy",
+    "to_xyz": "--to-xyz",
+    "to_rpy": "--to-rpy",
     "planner": "--planner",
     "timeout": "--timeout",
 }
 
 
 @flag_errors(FLAGS)
+@robot_options("spec")
 def plan_cmd(
-    spec: Path | None = spec_argument(),
-    args: list[str] = args_argument(),
+    robot: RobotInput,
     start: str = option(None, "--from", help=FROM_HELP + " Default: home."),
     goal: str = option(None, "--to", help=TO_HELP),
-    to_xyz: str = option(None, "--to-xyz", help=XYZ_HELP),
-    to_rpy: str = option(None, "--to-rpy", help=RPY_HELP),
+    to_xyz: Numbers = option(
+        None, "--to-xyz", parser=numbers("--to-xyz", 3, "x,y,z [m]"), metavar="X,Y,Z", help=XYZ_HELP
+    ),
+    to_rpy: Numbers = option(
+        None,
+        "--to-rpy",
+        parser=numbers("--to-rpy", 3, "r,p,y [rad]"),
+        metavar="R,P,Y",
+        help=RPY_HELP,
+    ),
     urdf: Path = option(None, "--urdf", help="Plan for this URDF or xacro file instead of a spec."),
     srdf: Path = option(None, "--srdf", help=SRDF_HELP),
     scene: Path = option(None, "--scene", help=SCENE_HELP),
-    joints: str = option(None, "--joints", help="Comma-separated joints to plan (default: arm)."),
+    joints: Names = option(
+        None,
+        "--joints",
+        parser=names,
+        metavar="JOINT,...",
+        help="Comma-separated joints to plan (default: arm).",
+    ),
     planner: str = choice(
         "rrtconnect", PLANNERS, "--planner", help="OMPL planner (default: rrtconnect)."
     ),
@@ -67,51 +80,21 @@ def plan_cmd(
     output: Path = option(None, "--output", "-o", help="JointTrajectory YAML to write."),
     fmt: str = choice("text", FORMATS, "--format", help="Output format (default: text)."),
     execute: bool = option(False, "--execute", help=EXECUTE_HELP),
-    package_dir: list[str] = package_dir_option(),
-    env: list[str] = env_option(),
-    trust_xacro: bool = option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
-    unsandboxed: bool = option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Plan a collision-free motion, time it within the limits, certify it, write it."""
     from armcli.io.outdir import check_output_file
-    from armcli.plan.api import PlanOptions, plan_motion, solve_goal
-    from armcli.plan.inputs import configuration, load_context, numbers
-    from armcli.urdf.source import read_robot
+    from armcli.plan.api import PlanOptions
+    from armcli.plan.request import PlanRequest, plan_request
 
-    spec, tokens = split_robot(spec, args)
-    inputs = xacro_inputs(tokens, env, package_dir)
-    if (goal is None) == (to_xyz is None):
-        raise InputError("give exactly one goal: --to POSE|q1,q2,... or --to-xyz x,y,z",
-                         field="--to")  # fmt: skip
-    if to_rpy is not None and to_xyz is None:
-        raise InputError("--to-rpy needs --to-xyz", field="--to-rpy")
+    request = PlanRequest(start, goal, to_xyz, to_rpy, srdf, scene, joints or None)
     if output is not None:
         check_output_file(output, "--output")
-    trust = trust_mode(trust_xacro, unsandboxed)
-    if urdf is not None:
-        robot_file = read_robot(urdf, trust_xacro=trust, inputs=inputs)
-    else:
-        from armcli.spec.discover import find_spec
-
-        robot_file = read_robot(find_spec(spec))
-    chosen = [j.strip() for j in joints.split(",") if j.strip()] if joints else None
-    loaded = load_context(robot_file, srdf=srdf, scene=scene, joints=chosen,
-                          search=inputs.packages)  # fmt: skip
-    ctx = loaded.context
-    if start is None and "home" not in ctx.robot.poses:
-        raise InputError("this robot has no `home` pose: give --from", field="--from")
-    x_start = configuration(ctx, start or "home", "--from")
-    xyz = numbers(to_xyz, 3, "--to-xyz")
-    rpy = numbers(to_rpy, 3, "--to-rpy")
-    x_goal = configuration(ctx, goal, "--to") if goal is not None else None
-    what = f"from {start or 'home'} to {goal or 'xyz ' + str(to_xyz)}"
+    robot_file = robot.read(urdf)
+    what = request.describe()
     opts = PlanOptions(planner=planner, timeout=timeout, seed=seed,
                        comment=f"armcli plan {what}, {planner}, seed {seed}")  # fmt: skip
     try:
-        if x_goal is None:
-            assert xyz is not None
-            x_goal = solve_goal(ctx, xyz, rpy, start=x_start, seed=seed)
-        result = plan_motion(ctx, x_start, x_goal, opts)
+        result = plan_request(robot_file, replace(request, options=opts), robot.packages)
     except PlanningError as exc:
         if fmt == "json":
             _json({"status": "failed", "output": None, "reason": exc.reason})
@@ -123,7 +106,7 @@ def plan_cmd(
         write_file_atomic(output, result.document)
     done = None
     if execute:
-        done = _execute(robot_file, urdf, inputs, trust, result)
+        done = _execute(robot_file, urdf, robot, result)
     if fmt == "json":
         _json(_summary(result, output, planner, seed, done))
     else:
@@ -133,14 +116,14 @@ def plan_cmd(
 
 
 def _execute(
-    robot_file: Any, urdf: Path | None, inputs: Any, trust: Any, result: PlanResult
+    robot_file: Any, urdf: Path | None, robot: RobotInput, result: PlanResult
 ) -> Execution:
     from armcli.plan.execute import execute
     from armcli.sim.options import SimOptions
 
-    opts = SimOptions(message=result.document.decode("utf-8"), urdf=urdf, trust_xacro=trust,
-                      xacro=inputs)  # fmt: skip
-    return execute(robot_file.spec, opts, inputs.packages)
+    opts = SimOptions(message=result.document.decode("utf-8"), urdf=urdf, trust_xacro=robot.trust,
+                      xacro=robot.xacro)  # fmt: skip
+    return execute(robot_file.spec, opts, robot.packages)
 
 
 def _summary(
@@ -199,7 +182,7 @@ def _print(
         lines += [f"    broken: {p}" for p in done.problems]
     if output is not None:
         lines.append(f"wrote {output}")
-    sys.stdout.write("\n".join(lines) + "\n")
+    say("\n".join(lines))  # one line each in a log; wrapped at a terminal
 
 
 def register(app: typer.Typer) -> None:

@@ -5,27 +5,20 @@ from __future__ import annotations
 import sys
 from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from armcli.commands.flags import flag_errors
-from armcli.commands.help_text import ROBOT_HELP
-from armcli.commands.options import spec_argument
-from armcli.commands.points import REACH_POINT_HELP, point_option
-from armcli.commands.xacro_inputs import (
-    args_argument,
-    env_option,
-    package_dir_option,
-    split_robot,
-    write_notes,
-    xacro_inputs,
-)
+from armcli.commands.robot_input import robot_options, write_notes
+from armcli.commands.values import REACH_POINT_HELP, Numbers, point, size
 from armcli.errors import InputError
 from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
 from armcli.io.terminal import say
-from armcli.spec.discover import find_spec
-from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+
+if TYPE_CHECKING:
+    from armcli.urdf.source import RobotInput
 
 REACH_HELP = (
     "Also draw where the tool point can reach within the joint limits (sampled forward "
@@ -33,20 +26,10 @@ REACH_HELP = (
 )
 
 
-def _size(text: str) -> tuple[int, int]:
-    try:
-        w, h = (int(x) for x in text.lower().split("x"))
-    except ValueError:
-        raise InputError(f"{text!r}: expected WIDTHxHEIGHT in pixels", field="--size") from None
-    if not (100 <= w <= 8000 and 100 <= h <= 8000):
-        raise InputError(f"{text!r}: each side must be 100..8000 px", field="--size")
-    return w, h
-
-
 @flag_errors({"pose": "--pose", "q": "--q"})
+@robot_options()
 def render_cmd(
-    robot: Path | None = spec_argument(ROBOT_HELP),
-    args: list[str] = args_argument(),
+    robot: RobotInput,
     pose: str = typer.Option(None, "--pose", help="A named pose of the spec."),
     q: str = typer.Option(
         None,
@@ -60,18 +43,17 @@ def render_cmd(
         show_default=False,
         help="PNG to write (default: robot.png).",
     ),
-    size: str = typer.Option(
+    image_size: Numbers = typer.Option(
         "1200x600",
         "--size",
+        parser=size,
         show_default=False,
         help="Image size WIDTHxHEIGHT in pixels (default: 1200x600).",
     ),
-    package_dir: list[str] = package_dir_option(),
-    env: list[str] = env_option(),
-    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
-    unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
     reach: bool = typer.Option(False, "--reach", help=REACH_HELP),
-    reach_point: list[str] = typer.Option([], "--reach-point", help=REACH_POINT_HELP),
+    reach_point: list[Numbers] = typer.Option(
+        [], "--reach-point", parser=point("--reach-point"), metavar="X,Y,Z", help=REACH_POINT_HELP
+    ),
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
     from armcli.analysis.workspace import describe, verdict  # on use: `--help` stays light
@@ -79,27 +61,22 @@ def render_cmd(
     from armcli.view.scene import load_robot, pose_q
 
     check_output_file(out, "--out")  # before any work: nothing else is written
-    targets = [point_option(p, "--reach-point") for p in reach_point]
-    robot, tokens = split_robot(robot, args)
-    inputs = xacro_inputs(tokens, env, package_dir)
-    src = load_robot(
-        find_spec(robot), trust_mode(trust_xacro, unsandboxed), inputs.packages, inputs
-    )
+    src = load_robot(robot)
     write_notes(src.notes)
     values = pose_q(src, pose, q)
-    width, height = _size(size)
+    width, height = image_size
     skipped: dict[str, str] = {}
     said: dict[str, str] = {}  # what trimesh said about a mesh it drew (a missing texture)
     urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search, skipped, said)
     field = "--pose" if pose else "--q"
     lines: list[str] = []
-    if reach or targets:
+    if reach or reach_point:
         if src.tool is None:
             raise InputError("the robot has no links: no tool point to reach with", field="--reach")
         from armcli.view.reach import render_reach_png  # Pinocchio: only for --reach
 
         pic = render_reach_png(urdf, src.xml, src.source, values, out, tool=src.tool,
-                               name=src.name, size=(width, height), targets=targets,
+                               name=src.name, size=(width, height), targets=list(reach_point),
                                field=field)  # fmt: skip
         res = pic.render
         lines = [describe(pic.workspace), *(verdict(p) for p in pic.points)]

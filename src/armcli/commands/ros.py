@@ -4,15 +4,18 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from armcli.commands.flags import flag_errors
-from armcli.commands.options import choice, option, out_option, spec_argument
-from armcli.commands.xacro_inputs import package_dir_option
+from armcli.commands.options import choice, option, out_option
+from armcli.commands.robot_input import robot_options
 from armcli.defaults import COLLISION_SAMPLES, ROS_TARGETS
 from armcli.io.terminal import say
-from armcli.spec.discover import find_spec
+
+if TYPE_CHECKING:
+    from armcli.urdf.source import RobotInput
 
 TARGET_HELP = (
     "humble-classic: the course's ROS 2 Humble + Gazebo classic (default); jazzy: ROS 2 Jazzy "
@@ -22,8 +25,9 @@ MAX_SAMPLES = 1_000_000  # ~100x the default: minutes of coal queries, not days
 
 
 @flag_errors({"out_dir": "--out"})  # the library names its parameter
+@robot_options("spec", xacro=False)
 def ros_package_cmd(
-    spec: Path | None = spec_argument(),
+    robot: RobotInput,
     out: Path = out_option(Path("ros"), "Output directory"),
     samples: int = option(
         COLLISION_SAMPLES,
@@ -42,14 +46,12 @@ def ros_package_cmd(
     force: bool = option(
         False, "--force", help="Write into an existing non-empty directory armcli did not create."
     ),
-    package_dir: list[str] = package_dir_option(),
 ) -> None:
     """Write ROS 2 packages for SPEC: <name>_description, <name>_bringup, <name>_moveit_config."""
     from armcli.compiler.expand import spec_label  # on use: `--help` stays light
-    from armcli.io.packages import PackageLookup, parse_package_dirs
     from armcli.ros.packages import PackageInfo, write_ros_packages
 
-    spec = find_spec(spec)
+    spec = robot.file()
     info = PackageInfo(maintainer=maintainer, email=email, license=license_)
     pkgs, written = write_ros_packages(
         spec,
@@ -60,7 +62,7 @@ def ros_package_cmd(
         info=info,
         target=target,
         force=force,
-        packages=PackageLookup(parse_package_dirs(list(package_dir))),
+        packages=robot.packages,
     )
     n, m = pkgs.names, pkgs.matrix
     counts = {r: sum(d.reason == r for d in m.disabled) for r in ("Adjacent", "Default", "Never")}

@@ -10,26 +10,20 @@ from typing import TYPE_CHECKING, Any, cast
 import typer
 
 from armcli.commands.flags import flag_errors, option_flags
-from armcli.commands.options import choice, option, spec_argument
-from armcli.commands.xacro_inputs import (
-    args_argument,
-    env_option,
-    package_dir_option,
-    split_robot,
-    write_notes,
-    xacro_inputs,
-)
+from armcli.commands.options import choice, option
+from armcli.commands.robot_input import robot_options, write_notes
+from armcli.commands.values import Names, Numbers, names, numbers
 from armcli.errors import InputError, ModelRefusedError, UnstableLoopError
 from armcli.io import terminal
 from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file, check_png_file
 from armcli.io.together import write_files_together
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
-from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 if TYPE_CHECKING:  # the simulator is imported when the command runs: `--help` stays light
     from armcli.sim import job as simjob
     from armcli.sim import tipping
+    from armcli.urdf.source import RobotInput
 
 INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
 GRAVITY_HELP = "Add g(q) to the PD torque (default: the spec's control.gravity_compensation)."
@@ -72,25 +66,34 @@ def _diagnose(job: Any) -> None:
         sys.stderr.write(one_line(f"warning: {_flagged(line)}") + "\n")
 
 
-def _floats(text: str | None, option: str) -> list[float] | None:
-    if text is None:
-        return None
-    try:
-        return [float(x) for x in text.split(",") if x.strip()]
-    except ValueError:
-        raise InputError(f"expected comma-separated numbers, got {text!r}", field=option) from None
-
-
 @flag_errors(FLAGS)
+@robot_options("spec")
 def simulate_cmd(
-    spec: Path | None = spec_argument(),
-    args: list[str] = args_argument(),
+    robot: RobotInput,
     trajectory: Path = option(None, "--trajectory", "-t", help=TRAJECTORY_HELP),
     message: str = option(None, "--message", "-m", help="JointTrajectory as YAML text."),
     urdf: Path = option(None, "--urdf", help="Simulate this URDF instead of the spec's arm."),
-    joints: str = option(None, "--joints", help="Comma-separated joints to move; others locked."),
-    kp: str = option(None, "--kp", help="P gain(s): one value or one per joint [N·m/rad]."),
-    kd: str = option(None, "--kd", help="D gain(s): one value or one per joint [N·m·s/rad]."),
+    joints: Names = option(
+        None,
+        "--joints",
+        parser=names,
+        metavar="JOINT,...",
+        help="Comma-separated joints to move; others locked.",
+    ),
+    kp: Numbers = option(
+        None,
+        "--kp",
+        parser=numbers("--kp"),
+        metavar="KP,...",
+        help="P gain(s): one value or one per joint [N·m/rad].",
+    ),
+    kd: Numbers = option(
+        None,
+        "--kd",
+        parser=numbers("--kd"),
+        metavar="KD,...",
+        help="D gain(s): one value or one per joint [N·m·s/rad].",
+    ),
     gravity_comp: bool = option(None, "--gravity-comp/--no-gravity-comp", help=GRAVITY_HELP),
     dt: float = option(None, "--dt", help="Time step [s] (default: the spec's control.dt)."),
     integrator: str = choice("euler", INTEGRATORS, "--integrator", help=INTEGRATOR_HELP),
@@ -101,15 +104,13 @@ def simulate_cmd(
     ),
     plot: Path = option(None, "--plot", help="Write a tracking plot PNG."),
     rate: float = option(None, "--rate", help="Output rate [Hz] (default: the spec's publisher)."),
-    package_dir: list[str] = package_dir_option(),
-    env: list[str] = env_option(),
-    trust_xacro: bool = option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
-    unsandboxed: bool = option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
     ignore: list[str] = option([], "--ignore", help=IGNORE_HELP),
     base_accel: float = option(None, "--base-accel", help=BASE_ACCEL_HELP),
     payload: float = option(0.0, "--payload", help="Payload [kg] at the tool point (ZMP)."),
     payload_link: str = option(None, "--payload-link", help=PAYLOAD_LINK_HELP),
-    contact_links: str = option(None, "--contact-links", help=CONTACT_LINKS_HELP),
+    contact_links: Names = option(
+        None, "--contact-links", parser=names, metavar="LINK,...", help=CONTACT_LINKS_HELP
+    ),
     cmd_vel: Path = option(None, "--cmd-vel", help=CMD_VEL_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
@@ -120,8 +121,6 @@ def simulate_cmd(
     unknown = unknown_rules(ignore)
     if unknown:
         raise InputError(f"unknown rule(s) {', '.join(unknown)}", field="--ignore")
-    spec, tokens = split_robot(spec, args)
-    inputs = xacro_inputs(tokens, env, package_dir)
     if output is not None:
         from armcli.sim import rosbag  # the MCAP writer: imported by runs that write a file
 
@@ -131,37 +130,35 @@ def simulate_cmd(
     if plot is not None:
         check_png_file(plot, "--plot")
     spec_path, spec_obj = None, None
-    if spec is not None or urdf is None:  # the spec layers are imported only for a spec
-        from armcli.spec.discover import find_spec
+    if robot.path is not None or urdf is None:  # the spec layers are imported only for a spec
         from armcli.spec.load import load_spec
 
-        spec_path = find_spec(spec)
+        spec_path = robot.file()
         spec_obj = load_spec(spec_path)
-    kp_values, kd_values = _floats(kp, "--kp"), _floats(kd, "--kd")
     opts = SimOptions(
         trajectory=trajectory,
         message=message,
         urdf=urdf,
-        joints=tuple(j.strip() for j in joints.split(",") if j.strip()) if joints else None,
-        kp=tuple(kp_values) if kp_values is not None else None,
-        kd=tuple(kd_values) if kd_values is not None else None,
+        joints=joints or None,
+        kp=kp,
+        kd=kd,
         gravity_comp=gravity_comp,
         dt=dt,
         integrator=cast(Integrator, integrator),
         duration=duration,
         clamp=clamp,
         rate=rate,
-        trust_xacro=trust_mode(trust_xacro, unsandboxed),
-        xacro=inputs,
+        trust_xacro=robot.trust,
+        xacro=robot.xacro,
     )
-    tip_opts = TipOptions(base_accel, payload, payload_link, _names(contact_links))
+    tip_opts = TipOptions(base_accel, payload, payload_link, contact_links)
     if cmd_vel is not None:
         _drive(spec_obj, opts, cmd_vel, tuple(ignore), output, plot, tip_opts != TipOptions())
         return
     job = _prepare(spec_obj, spec_path, opts, tuple(ignore))
     _diagnose(job)  # the trajectory's own impossibilities before any simulated verdict
     notes: list[str] = []
-    tip = tipping.prepare(spec_obj, job, tip_opts, inputs.packages, notes)
+    tip = tipping.prepare(spec_obj, job, tip_opts, robot.packages, notes)
     asked = tip_opts != TipOptions()  # an arm on a fixed base is news only when asked about
     _run(job, output, plot, tip, notes if asked else [])
 
@@ -226,10 +223,6 @@ def _drive(
         )
     with _LazyProgress(terminal.console(sys.stderr)) as progress:
         run_drive(spec, opts, cmd_vel, ignore, output, plot, progress)
-
-
-def _names(text: str | None) -> tuple[str, ...] | None:
-    return None if text is None else tuple(n.strip() for n in text.split(",") if n.strip())
 
 
 def _run(

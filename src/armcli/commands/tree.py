@@ -5,55 +5,38 @@ from __future__ import annotations
 import io
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
-from armcli.commands.help_text import ROBOT_HELP
-from armcli.commands.options import choice, spec_argument
-from armcli.commands.xacro_inputs import (
-    args_argument,
-    env_option,
-    package_dir_option,
-    split_robot,
-    write_notes,
-    xacro_inputs,
-)
-from armcli.errors import InputError
+from armcli.commands.options import choice
+from armcli.commands.robot_input import robot_options, write_notes
 from armcli.io import terminal
 from armcli.io.files import write_file_atomic
 from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
-from armcli.spec.discover import find_spec
-from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
+
+if TYPE_CHECKING:
+    from armcli.urdf.source import RobotInput
 
 TREE_FORMATS = ("text", "dot")
 
 
+@robot_options()
 def tree_cmd(
-    robot: Path | None = spec_argument(ROBOT_HELP),
-    args: list[str] = args_argument(),
+    robot: RobotInput,
     fmt: str = choice(
         "text", TREE_FORMATS, "--format", help="text (a tree, the default) or dot (Graphviz)."
     ),
     out: Path = typer.Option(None, "-o", "--out", help="Write to this file instead of stdout."),
-    package_dir: list[str] = package_dir_option(),
-    env: list[str] = env_option(),
-    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
-    unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Print the kinematic tree: links, and joints with their types and limits."""
     from armcli.urdf.tree import parse_tree, to_dot, to_rich  # on use: `--help` stays light
     from armcli.view.scene import load_robot
 
-    if fmt not in TREE_FORMATS:
-        raise InputError(f"unknown format {fmt!r}; known: text, dot", field="--format")
     if out is not None:
         check_output_file(out, "--out")
-    robot, tokens = split_robot(robot, args)
-    inputs = xacro_inputs(tokens, env, package_dir)
-    src = load_robot(
-        find_spec(robot), trust_mode(trust_xacro, unsandboxed), inputs.packages, inputs
-    )
+    src = load_robot(robot)
     write_notes(src.notes)
     tree = parse_tree(src.xml, src.source)
     if fmt == "dot":

@@ -9,19 +9,21 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from armcli.commands.flags import flag_errors, option_flags
-from armcli.commands.options import choice, option, spec_argument
+from armcli.commands.options import choice, option
+from armcli.commands.robot_input import robot_options
+from armcli.commands.values import Names, Numbers, names, numbers
 from armcli.defaults import PD_LOOPS, ROBUST_MODES
 from armcli.errors import InputError
 from armcli.io import terminal
 from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file, check_png_file
-from armcli.spec.discover import find_spec
 
 if TYPE_CHECKING:  # the tuner is imported when the command runs: `--help` stays light
     from armcli.tune import job as tjob
     from armcli.tune import session
     from armcli.tune.engine import Engine
     from armcli.tune.search import SearchOptions
+    from armcli.urdf.source import RobotInput
 
 
 TRAJECTORY_HELP = (
@@ -55,19 +57,17 @@ def flags() -> dict[str, str]:
     }
 
 
-def _pair(text: str, name: str) -> tuple[float, float]:
-
-    try:
-        a, b = (float(x) for x in text.split(","))
-    except ValueError:
-        raise InputError(f"expected two numbers 'a,b', got {text!r}", field=name) from None
-    return a, b
-
-
+@robot_options("spec", xacro=False, packages=False)
 def tune_cmd(
-    spec: Path | None = spec_argument(),
+    robot: RobotInput,
     trajectory: list[Path] = option(None, "--trajectory", "-t", help=TRAJECTORY_HELP),
-    joints: str = option(None, "--joints", help="Comma-separated joints; others locked."),
+    joints: Names = option(
+        None,
+        "--joints",
+        parser=names,
+        metavar="JOINT,...",
+        help="Comma-separated joints; others locked.",
+    ),
     loop: str = choice("implicit", PD_LOOPS, "--loop", help=LOOP_HELP),
     zeta: float = option(1.0, "--zeta", help="Damping ratio of the start gains"),
     wn: float = option(
@@ -79,8 +79,20 @@ def tune_cmd(
     span: float = option(4.0, "--span", help="Search kp, kd in [start/span, start*span]"),
     settle: float = option(2.0, "--settle", help="Simulated time after the last point [s]"),
     robust: int = option(0, "--robust", help="Score every candidate on N perturbed models"),
-    mass_scale: str = option("0.8,1.2", "--mass-scale", help="Mass/inertia scale range"),
-    friction_scale: str = option("0.5,2", "--friction-scale", help="Friction scale range"),
+    mass_scale: Numbers = option(
+        "0.8,1.2",
+        "--mass-scale",
+        parser=numbers("--mass-scale", 2),
+        metavar="LO,HI",
+        help="Mass/inertia scale range",
+    ),
+    friction_scale: Numbers = option(
+        "0.5,2",
+        "--friction-scale",
+        parser=numbers("--friction-scale", 2),
+        metavar="LO,HI",
+        help="Friction scale range",
+    ),
     robust_mode: str = choice("worst", ROBUST_MODES, "--robust-mode", help=ROBUST_MODE_HELP),
     quantile: float = option(0.9, "--quantile", help="Quantile for --robust-mode quantile"),
     jobs: int = option(None, "--jobs", "-j", help="Local threads (default: every core)."),
@@ -98,7 +110,7 @@ def tune_cmd(
     from armcli.tune.write import check_writable
 
     with flag_errors(flags()):
-        spec_path = find_spec(spec)
+        spec_path = robot.file()
         opts = SearchOptions(trials, batch, seed, span, robust_mode, quantile)
         validate(opts)
         if output is not None and output.suffix.lower() != ".json":
@@ -110,14 +122,14 @@ def tune_cmd(
         if write:
             check_writable(spec_path)
         settings = tjob.TuneSettings(
-            tuple(j.strip() for j in joints.split(",") if j.strip()) if joints else None,
+            joints or None,
             loop,
             zeta,
             wn,
             settle,
             robust,
-            _pair(mass_scale, "--mass-scale"),
-            _pair(friction_scale, "--friction-scale"),
+            (mass_scale[0], mass_scale[1]),
+            (friction_scale[0], friction_scale[1]),
             seed,
         )
         job = tjob.prepare(load_spec(spec_path), spec_path, trajectory or [], settings)

@@ -9,26 +9,15 @@ from typing import TYPE_CHECKING
 import typer
 
 from armcli.commands.flags import flag_errors
-from armcli.commands.help_text import ROBOT_HELP
-from armcli.commands.options import spec_argument
-from armcli.commands.xacro_inputs import (
-    args_argument,
-    env_option,
-    package_dir_option,
-    split_robot,
-    write_notes,
-    xacro_inputs,
-)
+from armcli.commands.robot_input import robot_options, write_notes
+from armcli.commands.values import Names, names
 from armcli.errors import InputError
 from armcli.io.oneline import one_line
-from armcli.spec.discover import find_spec
-from armcli.xacro.trust import TRUST_XACRO_HELP, UNSANDBOXED_HELP, trust_mode
 
 if TYPE_CHECKING:
+    from armcli.urdf.source import RobotInput
     from armcli.view.planning import PlanningSession
     from armcli.view.scene import RobotSource
-    from armcli.xacro.args import XacroInputs
-    from armcli.xacro.trust import Trust
 
 SCENE_HELP = "Obstacles for the planning panel: YAML like moveit_msgs/PlanningScene."
 SRDF_HELP = "SRDF of a URDF: its named poses (group_state) and disabled collision pairs."
@@ -39,9 +28,9 @@ SAVE_HELP = "Directory the planning panel's Save writes into (default: the curre
 @flag_errors(
     {"pose": "--pose", "q": "--q", "port": "--port", "replay": "--replay", "joints": "--joints"}
 )
+@robot_options()
 def view_cmd(
-    robot: Path | None = spec_argument(ROBOT_HELP),
-    args: list[str] = args_argument(),
+    robot: RobotInput,
     replay: Path = typer.Option(
         None, "--replay", help="A run written by `armcli simulate -o` (.csv or .mcap)."
     ),
@@ -57,12 +46,10 @@ def view_cmd(
     ),
     scene: Path = typer.Option(None, "--scene", help=SCENE_HELP),
     srdf: Path = typer.Option(None, "--srdf", help=SRDF_HELP),
-    joints: str = typer.Option(None, "--joints", help=JOINTS_HELP),
+    joints: Names = typer.Option(
+        None, "--joints", parser=names, metavar="JOINT,...", help=JOINTS_HELP
+    ),
     save_dir: Path = typer.Option(Path("."), "--save-dir", show_default=False, help=SAVE_HELP),
-    package_dir: list[str] = package_dir_option(),
-    env: list[str] = env_option(),
-    trust_xacro: bool = typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP),
-    unsandboxed: bool = typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
 ) -> None:
     """Open a browser 3-D viewer: joint sliders, named poses, replay, motion planning."""
     from armcli.sim import rosbag  # on use: `--help` stays light
@@ -72,10 +59,7 @@ def view_cmd(
     from armcli.view.png import joint_limits, load_urdf
     from armcli.view.scene import load_robot, pose_q
 
-    robot, tokens = split_robot(robot, args)
-    inputs = xacro_inputs(tokens, env, package_dir)
-    trust = trust_mode(trust_xacro, unsandboxed)
-    src = load_robot(find_spec(robot), trust, inputs.packages, inputs)
+    src = load_robot(robot)
     write_notes(src.notes)
     pose_q(src, pose, None)  # validate before starting the server
     if not 0 <= port <= 65535:
@@ -85,8 +69,8 @@ def view_cmd(
         names = list(joint_limits(load_urdf(src.xml, src.source, src.mesh_dir, src.search)))
         load = rosbag.load_replay if rosbag.is_mcap(replay) else load_replay
         run = load(replay, names)
-    chosen = [j.strip() for j in joints.split(",") if j.strip()] if joints else None
-    session = _session(src, (scene, srdf, chosen), save_dir, trust, inputs)  # before serving
+    chosen = list(joints) if joints else None
+    session = _session(src, (scene, srdf, chosen), save_dir, robot)  # before serving
     viewer = Viewer(
         src.xml,
         name=src.name,
@@ -123,8 +107,7 @@ def _session(
     src: RobotSource,
     planning: tuple[Path | None, Path | None, list[str] | None],
     save_dir: Path,
-    trust: Trust,
-    inputs: XacroInputs,
+    robot: RobotInput,
 ) -> PlanningSession | None:
     """The planning panel's session; a robot that cannot be planned for gets none (a note)."""
     from armcli.sim.options import SimOptions
@@ -134,8 +117,8 @@ def _session(
     if not save_dir.is_dir():
         raise InputError(f"{save_dir} is not a directory", field="--save-dir")
     assert src.file is not None
-    sim = SimOptions(urdf=None if src.file.spec else src.file.path, trust_xacro=trust,
-                     xacro=inputs)  # fmt: skip
+    sim = SimOptions(urdf=None if src.file.spec else src.file.path, trust_xacro=robot.trust,
+                     xacro=robot.xacro)  # fmt: skip
     try:
         session = load_session(src.file, srdf=srdf, scene=scene, joints=joints,
                                search=src.search, sim=sim, save_dir=save_dir)  # fmt: skip

@@ -74,17 +74,3 @@ def configuration(ctx: PlanningContext, text: str, field: str) -> np.ndarray:
             field=field,
         ) from None
     return values(ctx, numbers, field)
-
-
-def numbers(text: str | None, count: int, field: str) -> list[float] | None:
-    """`x,y,z`-style option values: exactly `count` finite numbers."""
-    if text is None:
-        return None
-    try:
-        out = [float(p) for p in text.split(",")]
-    except ValueError:
-        raise InputError(f"expected {count} comma-separated numbers, got {text!r}",
-                         field=field) from None  # fmt: skip
-    if len(out) != count or not all(np.isfinite(out)):
-        raise InputError(f"expected {count} finite numbers, got {text!r}", field=field)
-    return out

@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 import threading
 from collections.abc import Iterable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -55,6 +55,44 @@ class RobotFile:
                 if found is not None:
                     return found
         return self.urdfs[0]
+
+
+@dataclass(frozen=True)
+class RobotInput:
+    """The robot a command was given: its file(s), xacro's inputs and how far xacro is trusted.
+
+    What the shared option group of the commands parses (`commands.robot_input`), so a
+    library caller names a robot the same way: `RobotInput(Path("r.urdf.xacro")).read()`.
+    No file means the spec found from the working directory (armcli.spec.discover).
+    """
+
+    paths: tuple[Path, ...] = ()  # `check` takes several; the other commands one or none
+    xacro: XacroInputs = field(default_factory=XacroInputs)
+    trust: Trust = False
+
+    @property
+    def path(self) -> Path | None:
+        """The one file named, or None (the spec is found)."""
+        return self.paths[0] if self.paths else None
+
+    @property
+    def packages(self) -> PackageLookup:
+        """Where `$(find NAME)` and `package://NAME/` resolve (--package-dir, the environment)."""
+        return self.xacro.packages
+
+    def files(self) -> list[Path]:
+        """The files named, or the spec found: ./armcli.yaml, else the one in specs/."""
+        from armcli.spec.discover import find_spec  # light: no pydantic
+
+        return list(self.paths) or [find_spec(None)]
+
+    def file(self) -> Path:
+        """The one file named, or the spec found."""
+        return self.files()[0]
+
+    def read(self, path: Path | None = None) -> RobotFile:
+        """The robot's documents (`read_robot`), of `path` or of `file()`."""
+        return read_robot(path or self.file(), trust_xacro=self.trust, inputs=self.xacro)
 
 
 def read_robot(

@@ -15,9 +15,8 @@ from armcli.io.names import did_you_mean
 from armcli.robot.tool import ToolPoint, tool_point
 from armcli.spec.expr import eval_expr
 from armcli.urdf.meshes import MeshSearch
-from armcli.urdf.source import RobotFile, Trust, lookup_for, read_robot, urdf_text
+from armcli.urdf.source import RobotFile, RobotInput, lookup_for, urdf_text
 from armcli.urdf.tree import tree_from_urdf
-from armcli.xacro.args import XacroInputs
 
 
 @dataclass(frozen=True)
@@ -36,21 +35,19 @@ class RobotSource:
     file: RobotFile | None = None  # what was read (the planning panel loads its model from it)
 
 
-def load_robot(
-    path: Path,
-    trust_xacro: Trust = False,
-    search: MeshSearch | None = None,
-    inputs: XacroInputs | None = None,
-) -> RobotSource:
+def load_robot(given: RobotInput | Path) -> RobotSource:
     """Spec YAML (built in memory), URDF or xacro file -> RobotSource.
 
-    Mesh URIs resolve with armcli.urdf.meshes (honouring `search`, the --package-dir
-    options) and must stay inside the allowed roots; the tool point is armcli.robot.tool's.
-    `inputs`: a xacro file's NAME:=VALUE arguments, --env and package lookup.
+    Mesh URIs resolve with armcli.urdf.meshes (honouring the --package-dir options in
+    `given.packages`) and must stay inside the allowed roots; the tool point is
+    armcli.robot.tool's. A bare path is read in safe mode with no xacro arguments.
     """
-    robot = read_robot(path, trust_xacro=trust_xacro, inputs=inputs)
+    if not isinstance(given, RobotInput):
+        given = RobotInput((given,))
+    path = given.file()
+    robot = given.read(path)
     spec = robot.spec
-    where = lookup_for(spec, search)  # the spec's recorded packages too
+    where = lookup_for(spec, given.packages)  # the spec's recorded packages too
     if spec is not None:
         return RobotSource(
             xml=urdf_text(robot.robot),

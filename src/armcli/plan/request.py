@@ -1,0 +1,70 @@
+"""One planning request, stated as a user states it: start and goal by name, values or a point.
+
+`plan_request` is the library call behind `armcli plan`: load the planning context of
+a robot file (its SRDF, a scene), turn the named start and goal into joint values
+(inverse kinematics for a point), plan, time and certify. Errors name the request's
+fields (`start`, `goal`, `to_xyz`, `to_rpy`, `joints`); the command maps them to flags.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from armcli.errors import InputError
+from armcli.plan.api import PlanOptions, PlanResult, plan_motion, solve_goal
+from armcli.plan.inputs import configuration, load_context
+from armcli.urdf.meshes import MeshSearch
+from armcli.urdf.source import RobotFile
+
+HOME = "home"  # the start when none is given (the course's named pose)
+
+
+@dataclass(frozen=True)
+class PlanRequest:
+    """Where to move from and to, among which obstacles, with which joints and planner."""
+
+    start: str | None = None  # a named pose or "q1,q2,..."; None: `home`
+    goal: str | None = None  # a named pose or "q1,q2,..." (exactly one of goal, to_xyz)
+    to_xyz: tuple[float, ...] | None = None  # the tool point's goal [m], root frame
+    to_rpy: tuple[float, ...] | None = None  # with to_xyz: the tool link's orientation [rad]
+    srdf: Path | None = None
+    scene: Path | None = None
+    joints: tuple[str, ...] | None = None  # None: the arm's
+    options: PlanOptions = field(default_factory=PlanOptions)
+
+    def __post_init__(self) -> None:
+        if (self.goal is None) == (self.to_xyz is None):
+            raise InputError("give exactly one goal: `goal` (a named pose or joint values) "
+                             "or `to_xyz` (a point for the tool)", field="goal")  # fmt: skip
+        if self.to_rpy is not None and self.to_xyz is None:
+            raise InputError("`to_rpy` needs `to_xyz`", field="to_rpy")
+
+    def describe(self) -> str:
+        """`from home to reach`, `from home to xyz 0.2,0,0.15`: the request in words."""
+        goal = self.goal
+        if goal is None:
+            goal = "xyz " + ",".join(f"{v:g}" for v in self.to_xyz or ())
+        return f"from {self.start or HOME} to {goal}"
+
+
+def plan_request(
+    robot: RobotFile, request: PlanRequest, search: MeshSearch | None = None
+) -> PlanResult:
+    """Plan, time and certify `request` for `robot`; PlanningError when no motion is found.
+
+    `search`: the package lookup for meshes (--package-dir, the environment).
+    """
+    loaded = load_context(robot, srdf=request.srdf, scene=request.scene,
+                          joints=request.joints, search=search)  # fmt: skip
+    ctx = loaded.context
+    if request.start is None and HOME not in ctx.robot.poses:
+        raise InputError(f"this robot has no `{HOME}` pose: give `start`", field="start")
+    x_start = configuration(ctx, request.start or HOME, "start")
+    if request.goal is not None:
+        x_goal = configuration(ctx, request.goal, "goal")
+    else:
+        assert request.to_xyz is not None  # __post_init__: exactly one goal
+        x_goal = solve_goal(ctx, request.to_xyz, request.to_rpy, start=x_start,
+                            seed=request.options.seed)  # fmt: skip
+    return plan_motion(ctx, x_start, x_goal, request.options)
