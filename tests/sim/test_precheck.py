@@ -55,4 +55,4 @@ def test_an_effort_below_gravity_is_named() -> None:
 def test_simulate_says_the_cause_first(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     code, out, err = run_main(["simulate", DEFAULT_SPEC, "--message", _fast(0.001)], capsys)
     assert code == 2 and out == "" and "zero-moment" not in err
-    assert err.startswith("error: --message points[0]: arm_base_forearm_joint moves at up to")
+    assert err.startswith("error: --message: points[0]: arm_base_forearm_joint moves at up to")

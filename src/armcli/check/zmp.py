@@ -1,7 +1,7 @@
 """Rules `zmp-outside-support` and `zmp-margin`: does a trajectory tip the robot over?
 
 With `--trajectory` and a spec's gains, the spec's arm is simulated along the file as
-`armcli simulate` does (sim.tipping), and the whole robot's zero-moment point, with the
+`armcli simulate` does (sim.armrun), and the whole robot's zero-moment point, with the
 base also accelerating and braking at the diff-drive plugin's limit, is measured against
 the support polygon (`check/tipover.py` builds the stance). One finding for the run's
 worst moment, naming the time, the case and the base acceleration that still holds. An
@@ -28,10 +28,10 @@ def check(c: Context) -> None:
         c.notes.append("zero-moment point skipped: the trajectory needs a spec's PD gains "
                        "to be simulated (give --spec)")  # fmt: skip
         return
-    from armcli.sim import tipping  # the simulator's stack: only with --trajectory (~60 ms)
+    from armcli.sim import armrun  # the simulator's stack: only with --trajectory (~60 ms)
 
     try:
-        r = tipping.trajectory_zmp(spec, c.urdf, c.stance, opts.trajectory,
+        r = armrun.trajectory_zmp(spec, c.urdf, c.stance, opts.trajectory,
                                    opts.base_accel, opts.min_margin)  # fmt: skip
     except ArmcliError as exc:
         c.notes.append(f"zero-moment point skipped: {exc}")

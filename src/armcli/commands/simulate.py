@@ -21,8 +21,8 @@ from armcli.io.together import write_files_together
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 
 if TYPE_CHECKING:  # the simulator is imported when the command runs: `--help` stays light
-    from armcli.sim import job as simjob
-    from armcli.sim import tipping
+    from armcli.sim.armrun import ArmRun
+    from armcli.sim.tipping import TipOptions
     from armcli.urdf.source import RobotInput
 
 INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
@@ -52,18 +52,6 @@ def _flagged(line: str) -> str:
     """`SimOptions.message ...` as `--message ...`: a line names the flag the user typed."""
     source = line.split(" ", 1)[0]
     return FLAGS.get(source, source) + line[len(source) :]
-
-
-def _diagnose(job: Any) -> None:
-    """Refuse a reference faster than a velocity limit; warn of efforts below gravity."""
-    from armcli.sim.precheck import holding_problems, speed_problems
-
-    fast = speed_problems(job)
-    if fast:
-        more = f" (and {len(fast) - 1} more joint(s))" if len(fast) > 1 else ""
-        raise InputError(_flagged(fast[0]) + more)
-    for line in holding_problems(job):
-        sys.stderr.write(one_line(f"warning: {_flagged(line)}") + "\n")
 
 
 @flag_errors(FLAGS)
@@ -115,7 +103,7 @@ def simulate_cmd(
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
     from armcli.check.rules import unknown_rules
-    from armcli.sim import states, tipping
+    from armcli.sim import states
     from armcli.sim.tipping import TipOptions
 
     unknown = unknown_rules(ignore)
@@ -155,38 +143,32 @@ def simulate_cmd(
     if cmd_vel is not None:
         _drive(spec_obj, opts, cmd_vel, tuple(ignore), output, plot, tip_opts != TipOptions())
         return
-    job = _prepare(spec_obj, spec_path, opts, tuple(ignore))
-    _diagnose(job)  # the trajectory's own impossibilities before any simulated verdict
-    notes: list[str] = []
-    tip = tipping.prepare(spec_obj, job, tip_opts, robot.packages, notes)
     asked = tip_opts != TipOptions()  # an arm on a fixed base is news only when asked about
-    _run(job, output, plot, tip, notes if asked else [])
+    with _LazyProgress(terminal.console(sys.stderr)) as progress:
+        run = _simulate(spec_obj, spec_path, opts, tip_opts, robot, tuple(ignore), progress,
+                        plot is not None)  # fmt: skip
+    _report(run, output, plot, asked)
 
 
-def _prepare(
-    spec: Any, spec_path: Path | None, opts: SimOptions, ignore: tuple[str, ...]
-) -> simjob.SimJob:
-    """The job, with library refusals told in the command's terms (options, spec fields).
+def _simulate(
+    spec: Any, spec_path: Path | None, opts: SimOptions, tip_opts: TipOptions,
+    robot: RobotInput, ignore: tuple[str, ...], progress: _LazyProgress, plot: bool,
+) -> ArmRun:  # fmt: skip
+    """The run, with library refusals told in the command's terms (options, spec fields).
 
     A model `check` reports as an error is not simulated (same rule ids), unless ignored.
     """
     from armcli.check.gate import bears_on_balance, refuse_check_errors
-    from armcli.sim import job as simjob
-
-    def gate(doc: Any) -> None:
-        refuse_check_errors(doc, ignore=ignore)
+    from armcli.sim.armrun import simulate_arm
 
     try:
-        job = simjob.prepare(spec, opts, gate=gate)
-        if spec is not None and opts.urdf is None:  # a spec's whole robot, as `check` sees it
-            from armcli.sim.tipping import robot_urdf
-
-            whole = robot_urdf(spec, job)
-            if whole is not None and whole is not job.urdf:  # the base: only for the balance
-                refuse_check_errors(whole, ignore=ignore, only=bears_on_balance)
-            elif whole is not None:
-                gate(whole)
-        return job
+        return simulate_arm(
+            spec, opts, tip_opts, robot.packages,
+            gate=lambda doc: refuse_check_errors(doc, ignore=ignore),
+            balance_gate=lambda doc: refuse_check_errors(doc, ignore=ignore,
+                                                         only=bears_on_balance),
+            progress=progress, plot=plot,
+        )  # fmt: skip
     except ModelRefusedError as exc:
         flags = " ".join(f"--ignore {r}" for r in exc.rules())
         raise ModelRefusedError(
@@ -225,51 +207,26 @@ def _drive(
         run_drive(spec, opts, cmd_vel, ignore, output, plot, progress)
 
 
-def _run(
-    job: simjob.SimJob,
-    output: Path | None,
-    plot: Path | None,
-    tip: tipping.Tipping | None = None,
-    notes: list[str] | None = None,
-) -> None:
-    """Run the prepared job with a progress bar, write the files, print the summary.
+def _report(run: ArmRun, output: Path | None, plot: Path | None, asked: bool) -> None:
+    """Write the files together, print the summary; a run that tips the robot exits 1.
 
-    With a robot standing on a base (`tip`), also its zero-moment point: in the states
-    file, the plot's fourth row and the summary; a run that tips it over exits 1.
+    With a robot standing on a base, its zero-moment point is in the states file, the
+    plot's fourth row and the summary. Why there is none is news only when `asked`.
     """
     from armcli.sim import job as simjob
     from armcli.sim import report as simreport
-    from armcli.sim import states, tipping
-    from armcli.sim.plot import tracking_png
+    from armcli.sim import tipping
 
     err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
-    write_notes([*job.notes, *(notes or [])])
-    for w in job.trajectory.warnings:
+    job, res, balance = run.job, run.result, run.balance
+    write_notes([*run.notes, *(run.balance_notes if asked else ())])
+    for w in run.warnings:
         err.print(one_line(f"warning: {_flagged(w)}"), markup=False, highlight=False)
-    extra = None if tip is None else (lambda steps: tip.steps(job, steps))
-    with _LazyProgress(err) as progress:
-        res = simjob.run(job, progress, plot=plot is not None, extra=extra)
-    series = tip.series(job, res) if tip is not None else None
+    write_files_together(run.files(output, plot))  # never a new CSV beside an old plot
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
-    files: dict[Path, bytes] = {}  # written together: never a new CSV beside an old plot
-    if output is not None:
-        from armcli.sim import rosbag
-
-        if rosbag.is_mcap(output):
-            files[output] = rosbag.run_mcap_bytes(res, job.rate, job.urdf)
-        else:
-            cols = states.sample_states(res, job.rate)
-            if series is not None:
-                cols = {**cols, **tipping.columns(series, res, job.rate)}
-            files[output] = states.states_bytes(cols, states.output_format(output))
-    if plot is not None:
-        row = tipping.plot_row(series) if series is not None else None
-        files[plot] = tracking_png(res, job.arm.effort, row)
-    write_files_together(files)
     out = terminal.console()
     out.print(simreport.summary_table(metrics, ee, job.tool_label, res), crop=False)
-    balance = tipping.report(tip, series) if tip is not None and series is not None else None
     if balance is not None:
         for lift in balance.lifts:  # too short to tip the robot: a wheel unloads, a warning
             err.print(one_line(f"warning: {lift.line()}"), markup=False, highlight=False)
@@ -289,14 +246,19 @@ class _LazyProgress:
         self.console = console
         self.bar: Any = None
         self.task: Any = None
-        self.start = time.perf_counter()
+        self.start: float | None = None  # the first call: the run starts (not its set-up)
+        self.first = 0
 
     def __enter__(self) -> _LazyProgress:
         return self
 
     def __call__(self, done: int, total: int) -> None:
+        if self.start is None:
+            self.start, self.first = time.perf_counter(), done
+            return
         elapsed = time.perf_counter() - self.start
-        if self.bar is None and done < total and elapsed / done * total > PROGRESS_AFTER_S:
+        rate = elapsed / max(1, done - self.first)
+        if self.bar is None and done < total and rate * (total - self.first) > PROGRESS_AFTER_S:
             from rich.progress import Progress
 
             self.bar = Progress(console=self.console, transient=True)

@@ -17,6 +17,7 @@ import numpy as np
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
 from armcli.sim import tipping
+from armcli.sim.armrun import run_balanced
 from armcli.sim.options import SimOptions
 from armcli.sim.states import Replay
 from armcli.urdf.meshes import MeshSearch
@@ -55,12 +56,8 @@ def execute(
     job = simjob.prepare(spec, opts)
     notes: list[str] = []
     tip = tipping.prepare(spec, job, tipping.TipOptions(), search or MeshSearch(), notes)
-
-    def keep(steps: int) -> np.ndarray:
-        every = np.arange(steps + 1)
-        return every if tip is None else np.union1d(every, tip.steps(job, steps))
-
-    res = simjob.run(job, extra=keep)
+    run = run_balanced(job, tip, every_step=True)
+    res = run.result
     metrics = tuple(simreport.joint_metrics(res, job.trajectory.duration))
     arm = job.arm
     peak_tau = np.max(np.abs(res.tau), axis=0)
@@ -73,11 +70,10 @@ def execute(
         if peak_v[i] > vlim[i] * (1 + VELOCITY_TOL):
             problems.append(f"{name} moves at {peak_v[i]:.4g}, beyond its limit {vlim[i]:g}")
     margin = None
-    if tip is not None:
-        rep = tipping.report(tip, tip.series(job, res))
-        margin = rep.min_margin
-        if rep.tips:
-            problems.append(tipping.tip_error(rep).args[0])
+    if run.balance is not None:
+        margin = run.balance.min_margin
+        if run.balance.tips:
+            problems.append(tipping.tip_error(run.balance).args[0])
     return Execution(metrics, peak_tau, arm.effort, peak_v, vlim, arm.joint_names, margin,
                      tuple(problems), _states(res))  # fmt: skip
 

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -20,11 +19,9 @@ from armcli.analysis.ground import mesh_loader
 from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
 from armcli.errors import InputError, TipOverError
 from armcli.robot.tool import tool_point
-from armcli.sim import job as simjob
 from armcli.sim import zmp as zmps
 from armcli.sim.excursion import Excursion, excursions
 from armcli.sim.job import SimJob
-from armcli.sim.options import SimOptions
 from armcli.sim.simulate import SimResult
 from armcli.sim.states import sample_steps
 from armcli.urdf.doc import Urdf
@@ -121,31 +118,13 @@ def prepare(
     if missing_joints:
         notes.append(f"no zero-moment point: {', '.join(missing_joints)} not in {urdf.source}")
         return None
-    accel, source = _base_accel(opts, urdf, plugin_default=False)
+    accel, source = base_acceleration(opts, urdf, plugin_default=False)
     return Tipping(found, accel, source, opts.min_margin)
 
 
-def trajectory_zmp(
-    spec: RobotSpec,
-    urdf: Urdf,
-    stance: Stance,
-    trajectory: Path,
-    base_accel: float | None,
-    threshold: float,
-) -> ZmpReport:
-    """Simulate the spec's arm along a trajectory file; the whole robot's zero-moment point.
-
-    What `simulate` reports, for `check --trajectory`. Raises what `sim.job.prepare` raises
-    (bad trajectory, gains the integrator refuses) and SimulationError.
-    """
-    job = simjob.prepare(spec, SimOptions(trajectory=trajectory))
-    accel, source = _base_accel(TipOptions(base_accel=base_accel), urdf)
-    tip = Tipping(stance, accel, source, threshold)
-    res = simjob.run(job, extra=lambda steps: tip.steps(job, steps))
-    return report(tip, tip.series(job, res))
-
-
-def _base_accel(opts: TipOptions, urdf: Urdf, plugin_default: bool = True) -> tuple[float, str]:
+def base_acceleration(
+    opts: TipOptions, urdf: Urdf, plugin_default: bool = True
+) -> tuple[float, str]:
     """The base's acceleration: the option's, else a base at rest or the plugin's limit.
 
     `simulate` assumes no acceleration nobody asked for; `check --trajectory` keeps its
