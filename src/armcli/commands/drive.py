@@ -12,7 +12,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from armcli.errors import InputError, ModelRefusedError
+from armcli.errors import ModelRefusedError
 from armcli.io import terminal
 from armcli.io.oneline import one_line
 from armcli.io.together import write_files_together
@@ -28,44 +28,25 @@ def run_drive(
     plot: Path | None,
     progress: Callable[[int, int], None] | None = None,
 ) -> None:
-    """Prepare, run, write and report a drive run; raises TipOverError when it tips."""
+    """Drive, write and report; raises TipOverError when the robot tips over."""
     from armcli.check.gate import refuse_check_errors
-    from armcli.sim import drive, drivebag, driveout, driveplot, rosbag, states
     from armcli.sim import job as simjob
     from armcli.sim import report as simreport
+    from armcli.sim.driving import drive_robot
 
-    if spec is None or opts.urdf is not None:
-        raise InputError(
-            "drives a spec's robot (its mobile_base.diff_drive); give a spec instead of --urdf",
-            field="--cmd-vel",
-        )
     try:
-        job = drive.prepare(
-            spec, opts, cmd_vel, gate=lambda u: refuse_check_errors(u, ignore=ignore)
-        )
+        driven = drive_robot(spec, opts, cmd_vel, progress=progress,
+                             gate=lambda u: refuse_check_errors(u, ignore=ignore))  # fmt: skip
     except ModelRefusedError as exc:
         flags = " ".join(f"--ignore {r}" for r in exc.rules())
         raise ModelRefusedError(
             exc.source, exc.violations, f"drive it anyway with {flags}"
         ) from None
     err = terminal.console(sys.stderr)
-    for w in (*job.arm.trajectory.warnings, *job.cmd.warnings, *job.model.notes):
+    for w in driven.warnings:
         err.print(one_line(f"warning: {w}"), markup=False, highlight=False)
-    res_run = drive.run(job, progress)
-    rate = job.arm.rate
-    res = driveout.arm_result(res_run, driveout.plot_steps_of(res_run.steps, job.dt, rate))
-    verdict = driveout.tip_verdict(res_run)
-    files: dict[Path, bytes] = {}
-    if output is not None:
-        cols = driveout.columns(res_run, res, rate)
-        files[output] = (
-            drivebag.mcap_bytes(res_run, cols, rate)
-            if rosbag.is_mcap(output)
-            else states.states_bytes(cols, states.output_format(output))
-        )
-    if plot is not None:
-        files[plot] = driveplot.plot_png(res_run, res, verdict)
-    write_files_together(files)
+    write_files_together(driven.files(output, plot))  # never a new CSV beside an old plot
+    job, res, res_run, verdict = driven.job, driven.arm, driven.run, driven.verdict
     for lift in verdict.lifts:
         err.print(one_line(f"warning: {lift.line()}"), markup=False, highlight=False)
     out = terminal.console()

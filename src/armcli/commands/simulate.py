@@ -45,6 +45,7 @@ FLAGS = {
     "SimConfig.dt": "--dt",
     "joints": "--joints",
     "output": "--output",
+    "cmd_vel": "--cmd-vel",
 }
 
 

@@ -1,0 +1,77 @@
+"""A drive of the whole robot as one library call: what `simulate --cmd-vel` runs.
+
+`drive_robot` prepares (sim.drive: the exported MuJoCo model, the check gate a caller
+passes), runs, and turns the run into the arm's `SimResult` and the tip-over verdict;
+`Driven.files` gives the states file (.csv, .json, .mcap) and the plot as bytes, for the
+caller to write together.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from armcli.errors import InputError
+from armcli.sim import drive, driveout
+from armcli.sim.drive import DriveJob, DriveRun
+from armcli.sim.liftoff import TipVerdict
+from armcli.sim.options import SimOptions
+from armcli.sim.simulate import SimResult
+from armcli.urdf.doc import Urdf
+
+if TYPE_CHECKING:
+    from armcli.spec.model import RobotSpec
+
+
+@dataclass(frozen=True)
+class Driven:
+    """A finished drive: the run, the arm's part of it, whether it tipped, what to say."""
+
+    job: DriveJob
+    run: DriveRun
+    arm: SimResult  # at the output rate and the plot's steps
+    verdict: TipVerdict
+    warnings: tuple[str, ...]  # the trajectory's, the commands', the model's
+
+    def files(self, output: Path | None, plot: Path | None) -> dict[Path, bytes]:
+        """The states file and the plot, as bytes by path."""
+        from armcli.sim import drivebag, rosbag, states
+
+        files: dict[Path, bytes] = {}
+        rate = self.job.arm.rate
+        if output is not None:
+            cols = driveout.columns(self.run, self.arm, rate)
+            files[output] = (
+                drivebag.mcap_bytes(self.run, cols, rate)
+                if rosbag.is_mcap(output)
+                else states.states_bytes(cols, states.output_format(output))
+            )
+        if plot is not None:
+            from armcli.sim import driveplot  # matplotlib: only for a plot
+
+            files[plot] = driveplot.plot_png(self.run, self.arm, self.verdict)
+        return files
+
+
+def drive_robot(
+    spec: RobotSpec | None,
+    opts: SimOptions,
+    cmd_vel: Path,
+    *,
+    gate: Callable[[Urdf], None] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> Driven:
+    """Drive the spec's whole robot by the /cmd_vel commands in `cmd_vel` (sim.drive)."""
+    if spec is None or opts.urdf is not None:
+        raise InputError(
+            "drives a spec's robot (its mobile_base.diff_drive); give a spec instead of "
+            "`SimOptions.urdf`",
+            field="cmd_vel",
+        )
+    job = drive.prepare(spec, opts, cmd_vel, gate=gate)
+    warnings = (*job.arm.trajectory.warnings, *job.cmd.warnings, *job.model.notes)
+    run = drive.run(job, progress)
+    arm = driveout.arm_result(run, driveout.plot_steps_of(run.steps, job.dt, job.arm.rate))
+    return Driven(job, run, arm, driveout.tip_verdict(run), warnings)
