@@ -28,14 +28,14 @@ ROOT = Path(__file__).resolve().parents[1]
 OFF = ("armcli.check.tipover", "armcli.check.zmp", "armcli.check.reach")
 REPORT = "armcli.check.balance_report"
 THEIRS = (  # loaded only for the balance and reach families
-    "armcli.check.balance",
+    "armcli.analysis.balance",
     "armcli.analysis.stance",
     "armcli.analysis.ground",
     "armcli.analysis.support",
     "armcli.analysis.workspace",
     "armcli.analysis.boxsearch",
+    "armcli.analysis.zmp",
     "armcli.sim.tipping",
-    "armcli.sim.zmp",
 )
 BUDGET_S = 0.3  # [s] the bound
 

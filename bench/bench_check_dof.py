@@ -2,9 +2,9 @@
 
 Chains of N revolute joints (30, 60, 120 and 128, the documented limit) are written as
 specs into a temporary directory. Per N it prints the whole `armcli check` process (a
-fresh process, as CI runs it) and the stability analysis alone (`armcli.sim.verdict.analyse`
+fresh process, as CI runs it) and the stability analysis alone (`armcli.analysis.verdict.analyse`
 on check's own samples), beside the eigenvalue computation it replaced
-(tests/sim/stability_reference.py: spectral radius of the 2n x 2n step map at every
+(tests/analysis/stability_reference.py: spectral radius of the 2n x 2n step map at every
 sample, bisection on it for the largest stable dt) on the same samples, up to
 `--reference-dof` joints (default 30: above that the old computation takes minutes), and
 the ratio. Run with `make bench` or `python bench/bench_check_dof.py`. Not a test:
@@ -26,14 +26,14 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT / "src"), str(ROOT)]
 
-from tests.sim import stability_reference as ref  # noqa: E402
+from tests.analysis import stability_reference as ref  # noqa: E402
 
+from armcli.analysis import pdloop  # noqa: E402
+from armcli.analysis import verdict as verdicts  # noqa: E402
 from armcli.compiler.expand import expand_urdfs  # noqa: E402
 from armcli.defaults import STANDALONE_ARM_URDF  # noqa: E402
 from armcli.robot import sampling  # noqa: E402
 from armcli.robot.model import Robot  # noqa: E402
-from armcli.sim import pdloop  # noqa: E402
-from armcli.sim import verdict as verdicts  # noqa: E402
 from armcli.spec.load import load_spec  # noqa: E402
 
 DOFS = (30, 60, 120, 128)

@@ -30,7 +30,7 @@ def _imports(path: Path) -> set[str]:
     for node in ast.walk(ast.parse(path.read_text())):
         if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("armcli"):
             for alias in node.names:
-                full = f"{node.module}.{alias.name}"  # `from armcli.sim import stability`
+                full = f"{node.module}.{alias.name}"  # `from armcli.analysis import stability`
                 as_path = SRC.parent / full.replace(".", "/")
                 is_module = as_path.with_suffix(".py").exists() or as_path.is_dir()
                 out.add(full if is_module else node.module)

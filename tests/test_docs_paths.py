@@ -1,6 +1,6 @@
 """Every module the docs name exists: docs/*.md, README.md and the source's docstrings.
 
-Names are dotted (`armcli.sim.stability`, maybe ending in an attribute such as
+Names are dotted (`armcli.analysis.stability`, maybe ending in an attribute such as
 `armcli.check.rules.RULES`) or paths (`sim/states.py`, relative to the repository,
 `src/armcli/`, `tests/` or `bench/`). In the source's docstrings and comments, a name
 relative to the package in backticks or parentheses (`(`urdf.tree`)`, `(sim.rollout: ...`)

@@ -131,7 +131,7 @@ class SpecError(InputError):
 
 
 class UnstableLoopError(InputError):
-    """The PD gains diverge at the time step (armcli.sim.verdict); carries the one remedy.
+    """The PD gains diverge at the time step (armcli.analysis.verdict); carries the one remedy.
 
     The library names no option: the command layer says where dt and the gains came from
     (`located`).

@@ -9,8 +9,8 @@ from typing import Any, cast
 
 import pytest
 
+from armcli.analysis.verdict import round_down
 from armcli.check.dynamics import EFFORT_MARGIN, round_up
-from armcli.sim.verdict import round_down
 from armcli.spec.load import load_spec
 from tests.check.edited import findings, joint
 from tests.helpers import course_gains_spec

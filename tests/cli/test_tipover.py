@@ -4,7 +4,7 @@ only a robot that tips fails.
 The seed spec's fast swing (tests/fixtures/tipover/swing.yaml) leaves 73.7 mm of margin from
 the arm's reaction alone; with the base accelerating at 5 m/s² the zero-moment point leaves
 the polygon toward the rear for 0.12 s (the largest acceleration that holds is 3.46 m/s²,
-tests/sim/test_zmp.py checks the point against closed forms and MuJoCo): too briefly to
+tests/analysis/test_zmp.py checks the point against closed forms and MuJoCo): too briefly to
 rotate the robot over its wheels, so a lift-off warning. A 10 kg hand swung straight
 forward puts the centre of mass itself past the caster: that robot tips (as MuJoCo's
 contact simulation agrees, tests/sim/test_drive.py).

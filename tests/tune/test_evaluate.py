@@ -13,15 +13,15 @@ from typing import Any
 import numpy as np
 import pytest
 
-from armcli.sim import pdloop
-from armcli.sim import stability as stab
+from armcli.analysis import pdloop
+from armcli.analysis import stability as stab
 from armcli.sim.reference import Reference
 from armcli.spec.load import load_spec
 from armcli.tune import evaluate, problem
 from armcli.tune import job as tjob
 from armcli.tune.objective import Weights
+from tests.analysis import stability_reference as ref
 from tests.helpers import ROOT
-from tests.sim import stability_reference as ref
 
 SPEC = ROOT / "specs" / "my_robot.yaml"
 PICK = ROOT / "specs" / "trajectories" / "pick.yaml"

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from armcli.sim import pdloop
-from armcli.sim.verdict import analyse
+from armcli.analysis import pdloop
+from armcli.analysis.verdict import analyse
 from armcli.spec.load import load_spec
 from armcli.tune import job as tjob
 from armcli.tune import session

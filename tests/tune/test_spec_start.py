@@ -32,7 +32,7 @@ def test_kd_lowered_to_the_explicit_bound(arm: Arm) -> None:
     assert not loop_stable(arm, lin, kp, kd, "explicit", DT)  # the case the import hit
     got = _explicit_kd(arm, kp, kd, DT)
     # One mode, semi-implicit Euler with explicit damping D = Kd + d is stable while
-    # 4 m - dt² kp - 2 dt D > 0 (the Jury bound in armcli.sim.stability): Kd < kd_edge.
+    # 4 m - dt² kp - 2 dt D > 0 (the Jury bound in armcli.analysis.stability): Kd < kd_edge.
     kd_edge = (4.0 * M_PENDULUM - DT**2 * kp[0]) / (2.0 * DT) - arm.damping[0]
     assert got[0] == pytest.approx(KD_MARGIN * kd_edge, rel=BISECT_REL_TOL)
     assert loop_stable(arm, lin, kp, got, "explicit", DT)

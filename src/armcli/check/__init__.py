@@ -1,5 +1,5 @@
 """`armcli check`: physical-sanity rules on one URDF, their findings and reports.
 
-May import `armcli.urdf` and below, and `armcli.sim.stability` / `armcli.sim.verdict` (one PD bound,
-one verdict per loop, for both) and `armcli.sim.tipping` (one zero-moment-point verdict).
+May import `armcli.sim` and below: the PD verdicts are `armcli.analysis.verdict`'s and the
+trajectory's zero-moment-point verdict is `armcli.sim.tipping`'s, the ones `simulate` uses.
 """

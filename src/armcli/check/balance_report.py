@@ -10,8 +10,8 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
+from armcli.analysis.balance import StaticBalance
 from armcli.analysis.workspace import ReachPoint, Workspace, describe, verdict
-from armcli.check.balance import StaticBalance
 from armcli.io.terminal import Column, FitTable
 
 if TYPE_CHECKING:

@@ -15,19 +15,19 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
+from armcli.analysis.verdict import StabilityReport
 from armcli.check.findings import Collector, JointRow
 from armcli.check.options import CheckOptions
 from armcli.check.rules import RULES
 from armcli.check.structure import Tree
 from armcli.robot.model import Robot
-from armcli.sim.verdict import StabilityReport
 from armcli.spec.joint_types import position_bounds
 from armcli.urdf.doc import Urdf
 
 if TYPE_CHECKING:  # the balance and reach results: imported by their own families
+    from armcli.analysis.balance import StaticBalance
     from armcli.analysis.stance import Stance
     from armcli.analysis.workspace import ReachPoint, Workspace
-    from armcli.check.balance import StaticBalance
     from armcli.sim.tipping import ZmpReport
 
 Stage = Literal["urdf", "model", "balance", "dynamics"]

@@ -1,7 +1,7 @@
 """Rules on the Pinocchio model: gravity versus effort, PD stability, self-collision.
 
 The worst gravity torque over a sample of the joint range is compared with the effort
-limit, PD stability is checked at the spec's time step (armcli.sim.stability), and
+limit, PD stability is checked at the spec's time step (armcli.analysis.stability), and
 self-collision at the spec's named poses (Pinocchio GeometryModel + coal).
 """
 
@@ -13,14 +13,14 @@ from typing import Any
 
 import numpy as np
 
+from armcli.analysis import pdloop
+from armcli.analysis import verdict as verdicts
+from armcli.analysis.verdict import StabilityReport
 from armcli.check.findings import Collector, JointRow, Value
 from armcli.check.options import CheckOptions
 from armcli.check.structure import finite
 from armcli.errors import ModelLoadError
 from armcli.robot.model import Robot
-from armcli.sim import pdloop
-from armcli.sim import verdict as verdicts
-from armcli.sim.verdict import StabilityReport
 from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import mesh_paths
 
@@ -28,7 +28,7 @@ from armcli.urdf.meshes import mesh_paths
 # touch by construction (e.g. a link resting on the base top) are not a collision.
 PENETRATION_TOL = 1e-4  # [m]
 # Remedy: an effort limit covering the worst gravity torque with this margin (payload,
-# acceleration), rounded up to 2 significant digits (stability remedies: sim.stability).
+# acceleration), rounded up to 2 significant digits (stability remedies: analysis.stability).
 EFFORT_MARGIN = 1.5
 REMEDY_DIGITS = 2
 
@@ -91,7 +91,7 @@ def stability(
 ) -> StabilityReport | None:
     """Rules `pd-explicit-unstable` and `pd-unstable`: the spec's PD gains at its time step.
 
-    M(q) and gravity's stiffness at every sample bound the gains (armcli.sim.stability).
+    M(q) and gravity's stiffness at every sample bound the gains (armcli.analysis.stability).
     Returns None without a spec that has gains, and adds a note when no controlled joint
     is in the URDF.
     """

@@ -12,19 +12,19 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from armcli.analysis.verdict import StabilityReport
 from armcli.check.context import Context, poses
 from armcli.check.findings import JointRow
 from armcli.check.options import CheckOptions
 from armcli.check.structure import finite
 from armcli.robot.load import link_frame
 from armcli.robot.tool import tool_point
-from armcli.sim.verdict import StabilityReport
 from armcli.spec.joint_types import total_dof
 from armcli.urdf.doc import Urdf
 
 if TYPE_CHECKING:  # the balance and reach results: imported by their own families
+    from armcli.analysis.balance import StaticBalance
     from armcli.analysis.workspace import ReachPoint, Workspace
-    from armcli.check.balance import StaticBalance
     from armcli.sim.tipping import ZmpReport
 
 

@@ -1,7 +1,7 @@
 """Rules `com-outside-support` and `support-margin`: will the robot tip over standing still?
 
 The robot's support polygon (its wheels' and caster's ground contacts, `analysis.ground`)
-and its centre of mass with the payload (`check.balance`), at every named pose and at
+and its centre of mass with the payload (`analysis.balance`), at every named pose and at
 the worst configuration of the joint range. A robot whose base is bolted down (an arm
 alone: no wheel touches the ground) is skipped with a note, unless contact links are
 named. Each finding names the pose and the payload that still holds there.
@@ -12,10 +12,10 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+from armcli.analysis import balance
+from armcli.analysis.balance import PoseBalance, StaticBalance
 from armcli.analysis.ground import mesh_loader
 from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
-from armcli.check import balance
-from armcli.check.balance import PoseBalance, StaticBalance
 from armcli.check.context import Context, poses
 from armcli.check.findings import Collector, Value
 from armcli.robot.tool import tool_point

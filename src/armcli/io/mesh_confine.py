@@ -5,8 +5,9 @@ search directory it is given, which reaches paths armcli never checked (a
 symlink `pkg/etc/pkg -> /` turns `package://pkg/etc/passwd` into /etc/passwd).
 So armcli resolves each mesh URI itself (urdf/meshes.py `resolve`), follows
 symlinks, requires the real path to be inside the allowed roots, and then
-rewrites the URDF so that every mesh filename is that absolute real path;
-Pinocchio gets no search directories at all. A package root found by walking
+rewrites the URDF so that every mesh filename is that absolute real path
+(urdf/meshes.py `confined_mesh_xml`, with this module's bounds); Pinocchio gets
+no search directories at all. A package root found by walking
 up from the URDF only counts when its package.xml names the package, so that
 any parent folder's name does not become a root. Mesh files are regular files
 under a size cap, and the total per robot is capped too.
@@ -15,7 +16,7 @@ under a size cap, and the total per robot is capped too.
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -95,21 +96,3 @@ def check_total(paths: Iterable[Path], source: str) -> None:
             f"the robot's meshes are {total} bytes, more than the {MAX_MESH_TOTAL_BYTES}-byte cap",
             file=source,
         )
-
-
-def with_real_mesh_paths(xml: bytes, real: Mapping[str, Path]) -> str:
-    """The URDF text with each mesh filename replaced by its resolved real path.
-
-    `real` maps every mesh URI of the document to its confined real path; a URI
-    missing from it is an error rather than something a parser may resolve.
-    """
-    from lxml import etree
-
-    root = etree.fromstring(xml, _safe_xml())
-    for mesh in root.iter("mesh"):
-        uri = mesh.get("filename", "")
-        if uri not in real:
-            raise InputError(f"mesh {uri!r} was not resolved by armcli; not loaded")
-        mesh.set("filename", str(real[uri]))
-    text: str = etree.tostring(root, encoding="unicode")
-    return text

@@ -15,9 +15,8 @@ from typing import Any
 from armcli.defaults import COLLISION_SAMPLES
 from armcli.errors import InputError
 from armcli.io.userfile import read_regular
-from armcli.robot.load import confined_mesh_xml
 from armcli.ros.collision_matrix import DEFAULT_SEED, compute_collision_matrix
-from armcli.urdf.meshes import MeshSearch
+from armcli.urdf.meshes import MeshSearch, confined_mesh_xml
 from armcli.urdf.read import parse_root
 from armcli.urdf.source import RobotFile
 
@@ -79,7 +78,8 @@ def allowed_pairs(
     if srdf is not None:
         return srdf.disabled
     poses = {n: robot.spec.pose(n) for n in robot.spec.poses} if robot.spec is not None else None
-    text = robot.robot.text if search is None else confined_mesh_xml(robot.robot, search)
+    urdf = robot.robot
+    text = urdf.text if search is None else confined_mesh_xml(urdf.text, urdf.source, search)
     matrix = compute_collision_matrix(
         text,
         samples=COLLISION_SAMPLES,

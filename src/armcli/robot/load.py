@@ -18,9 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from armcli.errors import InputError, ModelLoadError
-from armcli.io.mesh_confine import bounded_mesh_file, check_total, with_real_mesh_paths
 from armcli.urdf.doc import Urdf
-from armcli.urdf.meshes import MeshSearch, mesh_paths
 from armcli.urdf.source import urdf_text
 
 
@@ -120,22 +118,6 @@ def collision_model(
         raise ModelLoadError(f"Pinocchio cannot load the collision geometry: {exc}", file=source,
                              parser_messages=[]) from None  # fmt: skip
     return gmodel
-
-
-def confined_mesh_xml(urdf: Urdf, search: MeshSearch) -> str:
-    """The URDF text with every mesh named by its confined, bounded real path.
-
-    Meshes are resolved inside the allowed roots (`urdf.meshes`) and checked to be bounded
-    files (`io.mesh_confine`). InputError naming a mesh that cannot be found or one
-    over the size caps.
-    """
-    meshes = mesh_paths(urdf, search)
-    missing = sorted(uri for uri, p in meshes.items() if p is None or not p.is_file())
-    if missing:
-        raise InputError(f"mesh {missing[0]!r} cannot be found", file=urdf.source)
-    real = {uri: bounded_mesh_file(p, urdf.source) for uri, p in meshes.items() if p is not None}
-    check_total(real.values(), urdf.source)
-    return with_real_mesh_paths(urdf.text, real)
 
 
 _PROBLEM = {

@@ -19,14 +19,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from armcli.errors import InputError
-from armcli.robot.load import collision_model, confined_mesh_xml, load_model
+from armcli.robot.load import collision_model, load_model
 from armcli.robot.mimic import Mimic, follow, mimics
 from armcli.robot.tool import ToolPoint, tool_point
+from armcli.urdf.meshes import MeshSearch, confined_mesh_xml
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
     from armcli.urdf.doc import Urdf
-    from armcli.urdf.meshes import MeshSearch
 
 
 @dataclass(frozen=True)
@@ -249,13 +249,13 @@ class Robot:
         """The URDF's collision geometry, a pinocchio.GeometryModel, built on demand.
 
         With `search` (the package lookup), every mesh is resolved inside the allowed
-        roots and bounded first (`load.confined_mesh_xml`: `check`, `plan`); without it
+        roots and bounded first (`urdf.meshes.confined_mesh_xml`: `check`, `plan`); without it
         the URDF text is read as it is (its meshes already resolved by the caller).
         InputError without a URDF (text) or for a mesh not found or over the size caps;
         ModelLoadError when Pinocchio refuses the geometry.
         """
         if search is not None and self.urdf is not None:
-            text: str | None = confined_mesh_xml(self.urdf, search)
+            text: str | None = confined_mesh_xml(self.urdf.text, self.urdf.source, search)
         elif search is not None:
             raise InputError("no URDF document to resolve meshes in", file=self.source)
         else:

@@ -43,7 +43,7 @@ from armcli.ros.srdf import chain_joints, srdf_bytes
 from armcli.spec.graph import root_links
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
-from armcli.urdf.meshes import localized
+from armcli.urdf.meshes import confined_mesh_xml
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import lookup_for, spec_urdfs
 
@@ -312,7 +312,13 @@ def ros_packages(
     urdfs = spec_urdfs(spec)
     urdf_xml = urdfs.get(f"{n.robot}.urdf", urdfs[STANDALONE_ARM_URDF])
     poses = {name: spec.pose(name) for name in spec.poses}
-    local = localized(urdf_xml, source or n.robot_xacro, spec.base_dir, lookup_for(spec, packages))
+    local = confined_mesh_xml(
+        urdf_xml,
+        source or n.robot_xacro,
+        lookup_for(spec, packages),
+        base_dir=spec.base_dir,
+        collision_only=True,  # visual meshes may be another package's, not installed here
+    )
     matrix = compute_collision_matrix(
         local, samples=samples, seed=seed, source=n.robot_xacro, poses=poses
     )

@@ -27,8 +27,8 @@ from armcli.urdf.meshes import MeshSearch
 
 if TYPE_CHECKING:
     from armcli.analysis.stance import Stance
+    from armcli.analysis.zmp import ZmpSeries
     from armcli.sim.tipping import Tipping, ZmpReport
-    from armcli.sim.zmp import ZmpSeries
     from armcli.spec.model import RobotSpec
 
 Gate = Callable[[Urdf], None]  # refuses a model (ModelRefusedError): check's error rules

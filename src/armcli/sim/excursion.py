@@ -14,8 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from armcli.analysis import zmp as zmps
 from armcli.analysis.stance import Stance
-from armcli.sim import zmp as zmps
 
 G = 9.81  # [m/s²] Pinocchio's gravity
 

@@ -18,7 +18,7 @@ reference velocity jumps; it treats everything explicitly, so dt (Kd + D) λ_max
 stay below ~2.8.
 
 Gains the integrator cannot handle at dt are refused before the run with `check`'s verdict
-for the same loop (`sim/stability.py`, `sim/verdict.py`).
+for the same loop (`analysis/stability.py`, `analysis/verdict.py`).
 """
 
 from __future__ import annotations
@@ -32,13 +32,14 @@ from typing import Any
 
 import numpy as np
 
+from armcli.analysis import pdloop
+from armcli.analysis import verdict as verdicts
 from armcli.defaults import DEFAULT_DT
 from armcli.errors import InputError, SimulationError
 from armcli.robot.load import mass_matrix
 from armcli.robot.model import Robot
-from armcli.sim import native, pdloop
+from armcli.sim import native
 from armcli.sim import rollout as ro
-from armcli.sim import verdict as verdicts
 from armcli.sim.options import INTEGRATORS, Integrator
 from armcli.sim.reference import Reference
 
@@ -197,7 +198,7 @@ def plant_of(arm: Arm, cfg: SimConfig, energy_max: float = np.inf) -> ro.Plant:
 def check_stability(arm: Arm, cfg: SimConfig, configurations: np.ndarray) -> None:
     """Refuse gains/dt the integrator cannot handle: `check`'s verdict for this loop.
 
-    The verdict and its remedy come from armcli.sim.verdict (Euler steps damping
+    The verdict and its remedy come from armcli.analysis.verdict (Euler steps damping
     implicitly, RK4 explicitly).
 
     Raises UnstableLoopError, which names no option: the command says where dt came from.

@@ -2,7 +2,7 @@
 
 From a prepared simulation (`sim.job`): the whole robot standing on its contacts
 (`analysis.stance`: the spec's full URDF, or a given URDF whose wheels touch the ground),
-the steps the run must keep for the zero-moment point (`sim.zmp`), and after the run
+the steps the run must keep for the zero-moment point (`analysis.zmp`), and after the run
 the series, its worst moment, the states-file columns and the summary line.
 """
 
@@ -15,11 +15,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from armcli.analysis import zmp as zmps
 from armcli.analysis.ground import mesh_loader
 from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
 from armcli.errors import InputError, TipOverError
 from armcli.robot.tool import tool_point
-from armcli.sim import zmp as zmps
 from armcli.sim.excursion import Excursion, excursions
 from armcli.sim.job import SimJob
 from armcli.sim.simulate import SimResult

@@ -11,13 +11,13 @@ zeta. wn_j is the smallest of three caps, and the binding one is reported:
 - `target`: the requested wn, by default a decade under the controller's update rate
   (2 pi f_c / TARGET_RATIO), the usual rule for a sampled loop;
 - `stability`: the loop chosen by `--loop` stays stable at STABILITY_MARGIN * dt, by the
-  scalar-mode bound of `armcli.sim.stability` (`implicit_dt_max` for armcli's simulator,
+  scalar-mode bound of `armcli.analysis.stability` (`implicit_dt_max` for armcli's simulator,
   `explicit_dt_max` for an explicitly stepped torque loop such as Gazebo's effort
   controller) with lambda_j = max (M^-1)_jj over the sample, the joint's own mode;
 - `effort`: kp_j * (largest step of joint j) + max |g_j(q)| stays within the effort limit.
 
 The full gain vector is then verified on every sampled M with the verdict of
-`armcli.sim.stability` (spectral radius of the real step maps, `worst_radius`).
+`armcli.analysis.stability` (spectral radius of the real step maps, `worst_radius`).
 """
 
 from __future__ import annotations
@@ -29,12 +29,12 @@ from typing import Literal
 
 import numpy as np
 
+from armcli.analysis import pdloop
+from armcli.analysis import stability as stab
 from armcli.defaults import PD_LOOPS
 from armcli.errors import InputError
 from armcli.robot import sampling
 from armcli.robot.model import span
-from armcli.sim import pdloop
-from armcli.sim import stability as stab
 from armcli.sim.simulate import Arm
 
 TARGET_RATIO = 10.0  # wn <= 2 pi f_c / TARGET_RATIO for a loop closed at f_c [Hz]
@@ -111,7 +111,7 @@ def lambda_max(Ms: Sequence[np.ndarray]) -> float:
 
 
 def dt_max(loop: str, kp: float, d: float, lam: float) -> float:
-    """Largest stable dt for one mode, from `armcli.sim.stability` [s]."""
+    """Largest stable dt for one mode, from `armcli.analysis.stability` [s]."""
     bound = stab.implicit_dt_max if loop == "implicit" else stab.explicit_dt_max
     return float(bound(kp, d, lam))
 
@@ -207,7 +207,7 @@ def _effort_cap(name: str, effort: float, g: float, step: float, m: float) -> fl
 def loop_stable(
     arm: Arm, lin: pdloop.Linearised, kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
 ) -> bool:
-    """The verdict of `armcli.sim.stability` at every sample, for `loop` at dt."""
+    """The verdict of `armcli.analysis.stability` at every sample, for `loop` at dt."""
     pd = pdloop.PD.of(range(len(kp)), kp, kd, arm.damping)
     scheme: pdloop.Scheme = "implicit" if loop == "implicit" else "explicit"
     return stab.stable(lin, pd, dt, scheme)

@@ -15,10 +15,10 @@ from typing import Any
 
 import numpy as np
 
+from armcli.analysis.pdloop import Linearised
 from armcli.defaults import PdLoop
 from armcli.robot.load import load_model
 from armcli.sim.options import Integrator
-from armcli.sim.pdloop import Linearised
 from armcli.sim.reference import Reference
 from armcli.sim.simulate import Arm, arm_from_model
 from armcli.tune.model_gains import linearised, sample_configurations

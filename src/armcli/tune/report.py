@@ -5,7 +5,7 @@ The JSON schema is in docs/tune.md; `SCHEMA_VERSION` changes on breaking changes
 Per-joint figures come from the nominal model and aggregate the trajectories: RMS is the
 mean over trajectories, max and |final| the largest, settle the longest, saturated the
 mean share of steps. The stability margin is dt_max / dt for the chosen loop
-(scalar-mode bound of `armcli.sim.stability` with the joint's lambda_j = max (M^-1)_jj).
+(scalar-mode bound of `armcli.analysis.stability` with the joint's lambda_j = max (M^-1)_jj).
 """
 
 from __future__ import annotations

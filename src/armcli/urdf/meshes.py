@@ -22,7 +22,7 @@ MeshSearch = PackageLookup
 __all__ = [
     "MeshSearch",
     "confined",
-    "localized",
+    "confined_mesh_xml",
     "mesh_hint",
     "mesh_paths",
     "package_root",
@@ -109,28 +109,58 @@ def mesh_hint(uri: str) -> str:
     return "fix the path (relative paths start at the robot file's directory)"
 
 
-def localized(xml: bytes, source: str, base_dir: Path, search: MeshSearch) -> bytes:
-    """The URDF with every collision mesh URI replaced by its local file, for Pinocchio.
+def confined_mesh_xml(
+    xml: bytes,
+    source: str,
+    search: MeshSearch,
+    *,
+    base_dir: Path | None = None,
+    collision_only: bool = False,
+) -> str:
+    """The URDF text with its mesh filenames replaced by confined, bounded real paths.
 
-    Pinocchio resolves `package://` its own way (a list of parent directories) and fails
-    with a bare ValueError; armcli's lookup (and confinement) decides instead, and a mesh
-    it cannot find is an InputError naming the mesh and the option that fixes it.
+    The one route from a URDF to the text Pinocchio reads its geometry from (`check`,
+    `plan` through `Robot.collision_model`, `ros-package`'s collision matrix). Pinocchio
+    resolves `package://` its own way (the URI path appended to each search directory,
+    which reaches paths armcli never checked) and fails with a bare ValueError; here every
+    mesh URI is resolved (`resolve`), must be a file inside the allowed roots
+    (`confined`), and is replaced by its absolute, symlink-free path, checked to be a
+    bounded regular file (`io.mesh_confine.bounded_mesh_file`: size, compressed bombs,
+    triangle counts) with all of them under the per-robot total (`check_total`); Pinocchio
+    then needs no search directories. A mesh not found or outside the roots is an
+    InputError naming it (the first by URI) and the option that fixes it (`mesh_hint`).
+
+    `base_dir`: where relative URIs start; by default the directory of `source` (the URDF
+    file). A URDF compiled in memory from a spec passes the spec's directory.
+    `collision_only`: only the meshes inside `<collision>` are required and rewritten;
+    visual meshes keep their URIs (`ros-package`: a visual mesh may be another package's,
+    absent on this machine, and only collision geometry is loaded). Otherwise every
+    `<mesh>` of the document must resolve, so no URI is left for a parser to resolve.
     """
     from lxml import etree
 
-    from armcli.io.mesh_confine import _safe_xml, bounded_mesh_file
+    from armcli.io.mesh_confine import _safe_xml, bounded_mesh_file, check_total
 
+    base = Path(source).parent if base_dir is None else base_dir
     root = etree.fromstring(xml, _safe_xml())
-    changed = False
-    collision_meshes = [m for c in root.iter("collision") for m in c.iter("mesh")]
-    for el in collision_meshes:  # visual meshes are not loaded (another package's may be absent)
-        uri = el.get("filename")
-        if not uri:
-            continue
-        path = resolve(uri, base_dir, search)
-        if path is None or not path.is_file() or not confined(uri, path, base_dir, search):
-            why = "its package is unknown" if path is None else f"no file {path}"
-            raise InputError(f"mesh {uri!r} not found ({why}): {mesh_hint(uri)}", file=source)
-        el.set("filename", str(bounded_mesh_file(path, source)))  # size, bombs (issue 27)
-        changed = True
-    return etree.tostring(root) if changed else xml
+    scopes = root.iter("collision") if collision_only else [root]
+    elements = [m for scope in scopes for m in scope.iter("mesh")]
+    found: dict[str, Path] = {}
+    missing: dict[str, str] = {}
+    for uri in dict.fromkeys(el.get("filename", "") for el in elements):
+        path = resolve(uri, base, search)
+        if path is None or not path.is_file() or not confined(uri, path, base, search):
+            missing[uri] = "its package is unknown" if path is None else f"no file {path}"
+        else:
+            found[uri] = path
+    if missing:
+        uri = min(missing)
+        raise InputError(
+            f"mesh {uri!r} cannot be found ({missing[uri]}): {mesh_hint(uri)}", file=source
+        )
+    real = {uri: bounded_mesh_file(path, source) for uri, path in found.items()}
+    check_total(real.values(), source)
+    for el in elements:
+        el.set("filename", str(real[el.get("filename", "")]))
+    text: str = etree.tostring(root, encoding="unicode")
+    return text

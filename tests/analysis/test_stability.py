@@ -10,10 +10,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from armcli.analysis import pdloop
+from armcli.analysis import stability as stab
+from armcli.analysis import verdict as verdicts
 from armcli.errors import UnstableLoopError
-from armcli.sim import pdloop
-from armcli.sim import stability as stab
-from armcli.sim import verdict as verdicts
 from armcli.sim.job import load_arm
 from armcli.sim.simulate import Arm, SimConfig, check_stability
 from armcli.spec.load import load_spec

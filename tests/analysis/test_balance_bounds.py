@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from armcli.analysis import balance
 from armcli.analysis.stance import Stance
-from armcli.check import balance
 from armcli.check.run import check_urdf
 from armcli.urdf.read import read_urdf
 

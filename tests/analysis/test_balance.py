@@ -16,8 +16,8 @@ import math
 import numpy as np
 import pytest
 
+from armcli.analysis.balance import analyse
 from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
-from armcli.check.balance import analyse
 from armcli.check.options import CheckOptions, TipoverOptions
 from armcli.check.run import check_urdf
 from armcli.compiler.expand import expand_urdfs

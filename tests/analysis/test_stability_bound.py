@@ -2,7 +2,7 @@
 
 Seeded random arms of 1-4 joints (free joints included), gains from undamped to heavily
 damped, gravity's stiffness positive semidefinite, time steps on both sides of the edge;
-the reference is tests/sim/stability_reference.py (spectral radius of the real step map).
+the reference is tests/analysis/stability_reference.py (spectral radius of the real step map).
 """
 
 from __future__ import annotations
@@ -12,9 +12,9 @@ import math
 import numpy as np
 import pytest
 
-from armcli.sim import pdloop
-from armcli.sim import stability as stab
-from tests.sim import stability_reference as ref
+from armcli.analysis import pdloop
+from armcli.analysis import stability as stab
+from tests.analysis import stability_reference as ref
 
 CASES = 60
 NEAR_EDGE = 1e-6  # verdicts are compared only where the reference radius is this far from 1

@@ -27,7 +27,7 @@ own, which is what a smaller dt can fix.
 A is decreasing in dt (A / dt² = 4 M / dt² + 2 c D / dt - K), so the stable time steps
 are an interval [0, dt_max], found by bisection; A is affine in a common gain scale s, so
 the largest stable scale is a generalised eigenvalue (closed form). `suggest` turns both
-into the remedy that `check` reports and `simulate` prints (armcli.sim.verdict).
+into the remedy that `check` reports and `simulate` prints (armcli.analysis.verdict).
 
 RK4 has no implicit damping: its step map is the 4th-order Taylor polynomial p(h mu) of
 the continuous modes mu (eigenvalues of the linearised loop), stable where |p| <= 1.
@@ -43,7 +43,7 @@ from functools import partial
 import numpy as np
 from numpy.typing import NDArray
 
-from armcli.sim.pdloop import PD, Array, Linearised, Scaled, Scheme
+from armcli.analysis.pdloop import PD, Array, Linearised, Scaled, Scheme
 
 # The loop counts as stable when its step map does not grow: spectral radius <= 1 + RADIUS_TOL
 # (RK4 and reports), or A + PSD_RTOL * 4M positive definite (Euler). Undamped symplectic

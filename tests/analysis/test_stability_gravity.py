@@ -19,11 +19,11 @@ import math
 import numpy as np
 import pytest
 
+from armcli.analysis import pdloop
+from armcli.analysis import stability as stab
 from armcli.check.options import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.robot.load import load_model
-from armcli.sim import pdloop
-from armcli.sim import stability as stab
 from armcli.sim.reference import build_reference
 from armcli.sim.simulate import SimConfig, arm_from_model, simulate
 from armcli.sim.trajectory import loads_trajectory

@@ -1,7 +1,7 @@
 """The PD loop that the stability bound judges, as data.
 
 Its gains (`PD`), the arm linearised at its operating points (`linearise`), and how the
-loop is stepped (`Scheme`); `sim.stability` decides whether that is stable.
+loop is stepped (`Scheme`); `analysis.stability` decides whether that is stable.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """The eigenvalue computation armcli used before the A >= 0 bound, kept as the reference.
 
 Spectral radius of the real 2n x 2n step map of semi-implicit Euler at every sample, and
-bisection on it for the largest stable dt and gain scale (armcli.sim.stability up to
+bisection on it for the largest stable dt and gain scale (armcli.analysis.stability up to
 commit 27d99ba, extended with gravity's stiffness: K = Kp + G). Slow (O(n³) on 2n per
 probe, 60 probes per bisection) and independent of the Cholesky bound it checks.
 """

@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from armcli.analysis import zmp as zmps
 from armcli.analysis.stance import Payload, Stance, stance_of
 from armcli.compiler.expand import expand_urdfs
-from armcli.sim import zmp as zmps
 from armcli.spec.load import load_spec
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf

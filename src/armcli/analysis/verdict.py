@@ -18,10 +18,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from armcli.analysis import pdloop
+from armcli.analysis import stability as stab
+from armcli.analysis.pdloop import PD, Linearised, Scaled, Scheme
 from armcli.errors import UnstableLoopError
-from armcli.sim import pdloop
-from armcli.sim import stability as stab
-from armcli.sim.pdloop import PD, Linearised, Scaled, Scheme
 
 # Remedies: a time step or gains this fraction inside the strict bound, rounded down to
 # REMEDY_DIGITS significant digits (a rounded remedy stays stable: A grows as dt or a gain
