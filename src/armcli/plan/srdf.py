@@ -79,7 +79,11 @@ def allowed_pairs(
         return srdf.disabled
     poses = {n: robot.spec.pose(n) for n in robot.spec.poses} if robot.spec is not None else None
     urdf = robot.robot
-    text = urdf.text if search is None else confined_mesh_xml(urdf.text, urdf.source, search)
+    text = (
+        urdf.text
+        if search is None
+        else confined_mesh_xml(urdf.text, urdf.source, search, collision_only=True)
+    )
     matrix = compute_collision_matrix(
         text,
         samples=COLLISION_SAMPLES,

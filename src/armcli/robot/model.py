@@ -248,14 +248,17 @@ class Robot:
     def collision_model(self, search: MeshSearch | None = None) -> Any:
         """The URDF's collision geometry, a pinocchio.GeometryModel, built on demand.
 
-        With `search` (the package lookup), every mesh is resolved inside the allowed
-        roots and bounded first (`urdf.meshes.confined_mesh_xml`: `check`, `plan`); without it
+        With `search` (the package lookup), every collision mesh is resolved inside the
+        allowed roots and bounded first (visual meshes are not loaded: one in a package
+        absent here does not matter) (`urdf.meshes.confined_mesh_xml`: `check`, `plan`); without it
         the URDF text is read as it is (its meshes already resolved by the caller).
         InputError without a URDF (text) or for a mesh not found or over the size caps;
         ModelLoadError when Pinocchio refuses the geometry.
         """
         if search is not None and self.urdf is not None:
-            text: str | None = confined_mesh_xml(self.urdf.text, self.urdf.source, search)
+            text: str | None = confined_mesh_xml(
+                self.urdf.text, self.urdf.source, search, collision_only=True
+            )
         elif search is not None:
             raise InputError("no URDF document to resolve meshes in", file=self.source)
         else:

@@ -133,8 +133,9 @@ def confined_mesh_xml(
     `base_dir`: where relative URIs start; by default the directory of `source` (the URDF
     file). A URDF compiled in memory from a spec passes the spec's directory.
     `collision_only`: only the meshes inside `<collision>` are required and rewritten;
-    visual meshes keep their URIs (`ros-package`: a visual mesh may be another package's,
-    absent on this machine, and only collision geometry is loaded). Otherwise every
+    visual meshes keep their URIs (`ros-package`, `Robot.collision_model`, plan's
+    collision matrix: a visual mesh may be another package's, absent on this machine, and
+    only collision geometry is loaded). Otherwise every
     `<mesh>` of the document must resolve, so no URI is left for a parser to resolve.
     """
     from lxml import etree
