@@ -249,9 +249,9 @@ class Robot:
         """The URDF's collision geometry, a pinocchio.GeometryModel, built on demand.
 
         With `search` (the package lookup), every collision mesh is resolved inside the
-        allowed roots and bounded first (visual meshes are not loaded: one in a package
-        absent here does not matter) (`urdf.meshes.confined_mesh_xml`: `check`, `plan`); without it
-        the URDF text is read as it is (its meshes already resolved by the caller).
+        allowed roots and bounded first (`urdf.meshes.confined_mesh_xml`: `check`, `plan`;
+        visual meshes are not loaded, so one in a package absent here does not matter);
+        without it the URDF text is read as it is (its meshes resolved by the caller).
         InputError without a URDF (text) or for a mesh not found or over the size caps;
         ModelLoadError when Pinocchio refuses the geometry.
         """
