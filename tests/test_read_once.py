@@ -1,11 +1,13 @@
 """Issue 28's "each robot fact built once", checked on the source.
 
-One kinematic-tree type (urdf/tree.py) that check builds on.
+One kinematic-tree type (urdf/tree.py) that check builds on; the URDF's mimic joints and
+simulator extensions read once, into the typed document (urdf/read.py, urdf/extensions.py).
 """
 
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 from tests.helpers import ROOT
@@ -46,3 +48,29 @@ def test_check_builds_on_the_tree_type() -> None:
     assert structure.check.__annotations__["return"] == "KinematicTree"
     assert Context.__annotations__["tree"] == "KinematicTree"
     assert "class Tree" not in Path(structure.__file__).read_text()
+
+
+EXTENSION_READ = re.compile(
+    r"\.(find|findall|findtext|iter|iterfind|xpath)\(\s*[\"'][^\"']*"
+    r"\b(mimic|gazebo|ros2_control|plugin|transmission)\b"
+)
+READERS = ("urdf/read.py", "urdf/extensions.py")  # the one reading, into urdf/doc.py's types
+NOT_CONSUMERS = {
+    "importer/": "transcribes every element of a foreign URDF into a spec, unknown ones verbatim",
+    "compiler/": "walks the xacro it writes itself",
+    "sim/zmp.py": "being moved to analysis/ (drive_acceleration: to read `Urdf.plugins`)",
+    "analysis/zmp.py": "the same module after that move",
+}
+
+
+def test_extensions_are_read_once() -> None:
+    """check/interface.py, check/joints.py, export/mjcf_report.py and sim/drivemodel.py each
+    parsed `<ros2_control>`, `<transmission>`, `<gazebo>` or `<mimic>` again with lxml."""
+    found = [
+        f"{rel}:{i}: {line.strip()}"
+        for p in sorted(SRC.rglob("*.py"))
+        if not (rel := p.relative_to(SRC).as_posix()).startswith((*READERS, *NOT_CONSUMERS))
+        for i, line in enumerate(p.read_text().splitlines(), 1)
+        if EXTENSION_READ.search(line)
+    ]
+    assert not found, "read them from the typed `Urdf` (urdf/doc.py):\n" + "\n".join(found)
