@@ -1,7 +1,8 @@
 """Issue 28's "each robot fact built once", checked on the source.
 
 One kinematic-tree type (urdf/tree.py) that check builds on; the URDF's mimic joints and
-simulator extensions read once, into the typed document (urdf/read.py, urdf/extensions.py).
+simulator extensions read once, into the typed document (urdf/read.py, urdf/extensions.py);
+one time-step rule (spec/types.py's `time_step`).
 """
 
 from __future__ import annotations
@@ -74,3 +75,21 @@ def test_extensions_are_read_once() -> None:
         if EXTENSION_READ.search(line)
     ]
     assert not found, "read them from the typed `Urdf` (urdf/doc.py):\n" + "\n".join(found)
+
+
+DT_TEST = re.compile(  # isfinite(dt), 0 < dt, dt > 0, dt <= 0 on anything named dt
+    r"isfinite\([^)]*\bdt\b|\b0(\.0)?\s*<\s*[\w.]*\bdt\b|\bdt\s*(>|<=)\s*0(\.0)?\b"
+)
+
+
+def test_the_time_step_is_validated_by_one_rule() -> None:
+    """sim/simulate.py (finite, > 0) and sim/job.py (in (0, 0.1]) each had a rule of their
+    own, and the spec a third (> 0); tests/cli/test_flags.py checks each entry uses this one."""
+    found = [
+        f"{rel}:{i}: {line.strip()}"
+        for p in sorted(SRC.rglob("*.py"))
+        if (rel := p.relative_to(SRC).as_posix()) != "spec/types.py"
+        for i, line in enumerate(p.read_text().splitlines(), 1)
+        if DT_TEST.search(line)
+    ]
+    assert not found, "call armcli.spec.types.time_step:\n" + "\n".join(found)
