@@ -22,6 +22,7 @@ STANDALONE_ARM_URDF = f"{STANDALONE_ARM}.urdf"
 MAX_ROBOT_LINKS = 300
 MAX_ROBOT_DOF = 128
 DEFAULT_DT = 0.001  # [s] control and simulation step when the spec gives none
+MAX_DT = 0.1  # [s] the largest time step (spec/types.py's `time_step`, the one rule)
 DEFAULT_STATE_RATE_HZ = 10.0  # [Hz] joint-state output without a joint_state_publisher
 
 # Choices and defaults of command options whose `--help` must not import their library.

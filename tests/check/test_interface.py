@@ -68,7 +68,7 @@ def _servo(gain: float) -> tuple[bool, bool]:
 
 
 def test_effort_interface_keeps_the_pd_bound(gz_urdf: bytes, tmp_path: Path) -> None:
-    ifaces = ci.read_interfaces(gz_urdf)
+    ifaces = ci.read_interfaces(parse_urdf(gz_urdf, "gz.urdf"))
     assert ifaces is not None and ifaces.gazebo and ifaces.position_joints() == []
     course = load_spec(course_gains_spec(tmp_path))  # Kd 5: the explicit loop diverges
     res = check_urdf(parse_urdf(gz_urdf, "gz.urdf"), CheckOptions(spec=course))
@@ -101,6 +101,7 @@ def test_servo_verdict_matches_the_simulated_law(
 
 def test_mock_hardware_and_no_block_are_left_to_the_pd_bound(gz_urdf: bytes) -> None:
     mock = _position(gz_urdf).replace(ci.GZ_SYSTEMS[0].encode(), b"mock_components/GenericSystem")
-    assert ci.read_interfaces(mock) is not None
-    assert not ci.read_interfaces(mock).gazebo
-    assert ci.read_interfaces(b"<robot name='r'><link name='a'/></robot>") is None
+    ifaces = ci.read_interfaces(parse_urdf(mock, "mock.urdf"))
+    assert ifaces is not None and not ifaces.gazebo
+    bare = parse_urdf(b"<robot name='r'><link name='a'/></robot>", "bare.urdf")
+    assert ci.read_interfaces(bare) is None

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
+from pathlib import Path
 
+import numpy as np
 import pytest
 
 from armcli.cli import main
@@ -12,6 +15,7 @@ from armcli.commands.flags import flag_errors, option_flags
 from armcli.errors import InputError, Problem, SpecError
 from armcli.sim import job as simjob
 from armcli.sim.options import SimOptions
+from armcli.sim.simulate import SimConfig
 from armcli.spec.load import load_spec
 from tests.helpers import DEFAULT_SPEC, ROOT
 
@@ -79,3 +83,31 @@ def test_option_flags_refuses_an_override_for_a_missing_field() -> None:
     assert option_flags(Opts) == {"Opts.some_value": "--some-value"}
     with pytest.raises(ValueError, match="no field other"):
         option_flags(Opts, other="--other")
+
+
+@pytest.mark.parametrize(
+    ("dt", "yaml"),
+    [(0.0, "0"), (-1e-3, "-0.001"), (math.nan, ".nan"), (math.inf, ".inf"), (0.5, "0.5")],
+)
+def test_one_time_step_rule_names_each_entry(
+    dt: float, yaml: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """control.dt, SimOptions.dt (simulate's and drive's --dt) and SimConfig.dt once had three
+    rules (> 0; finite and > 0; in (0, 0.1]): now spec/types.py's one, naming the user's field."""
+    rule = f"must be finite and in (0, 0.1] s, got {dt:g}"
+    spec_file = tmp_path / "robot.yaml"
+    spec_file.write_text(DEFAULT_SPEC.read_text().replace("  dt: 0.001", f"  dt: {yaml}"))
+    with pytest.raises(SpecError) as spec_err:
+        load_spec(spec_file)
+    assert spec_err.value.problems[0].field == "control.dt"
+    assert spec_err.value.problems[0].message == rule
+    spec = load_spec(DEFAULT_SPEC)
+    with pytest.raises(InputError) as opt_err:
+        simjob.prepare(spec, SimOptions(message=MESSAGE, dt=dt))
+    assert (opt_err.value.field, opt_err.value.message) == ("SimOptions.dt", rule)
+    with pytest.raises(InputError) as cfg_err:
+        SimConfig(np.ones(1), np.ones(1), dt=dt)
+    assert (cfg_err.value.field, cfg_err.value.message) == ("SimConfig.dt", rule)
+    with pytest.raises(SystemExit):
+        main(["simulate", str(DEFAULT_SPEC), "-m", MESSAGE, "--dt", str(dt)])
+    assert capsys.readouterr().err == f"error: --dt: {rule}\n"

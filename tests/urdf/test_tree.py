@@ -10,11 +10,14 @@ from pathlib import Path
 
 import pytest
 
+from armcli.check.findings import Collector
+from armcli.check.structure import check as check_structure
 from armcli.errors import InputError
 from armcli.spec.load import load_spec
-from armcli.urdf.tree import parse_tree, to_dot, to_rich
+from armcli.urdf.read import parse_urdf
+from armcli.urdf.tree import KinematicTree, parse_tree, to_dot, to_rich, tree_from_urdf
 from armcli.view.scene import load_robot
-from tests.helpers import run_cli
+from tests.helpers import BAD_INPUTS, run_cli
 
 LIMIT_TOL = 1e-9  # [rad] limits pass through xacro as shortest-repr decimals of the spec value
 CHAIN = ("arm_base_link", "forearm_link", "hand_link")  # the seed's arm, root to tip
@@ -141,3 +144,63 @@ def test_cli_tree_text_dot_and_bad_format(root: Path, tmp_path: Path) -> None:
     bad = run_cli(["tree", "--format", "svg"], root)
     assert bad.returncode == 2
     assert bad.stderr.strip() == "error: --format: unknown value 'svg'; valid: text, dot"
+
+
+Names = tuple[str, ...]
+
+
+def _joint(name: str, parent: str, child: str, kind: str = "revolute") -> str:
+    return (
+        f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+        '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+    )
+
+
+def _links(*names: str) -> str:
+    return "".join(f'<link name="{n}"/>' for n in names)
+
+
+@pytest.mark.parametrize(
+    ("body", "roots", "orphans", "extra", "refused"),
+    [
+        (_links("b", "a"), ("b", "a"), (), (), "exactly one root link, found b, a"),
+        (_links("a", "b") + _joint("j", "a", "b") + _joint("k", "b", "a"), (), (), (), "none"),
+        (_links("a", "zz") + _joint("j", "a", "missing"), ("a", "zz"), (), (), "unknown child"),
+        (  # a cycle no root reaches
+            _links("a", "b", "c", "d") + _joint("j", "a", "b")
+            + _joint("k", "c", "d") + _joint("l", "d", "c"),
+            ("a",), ("c", "d"), (), "not one tree",
+        ),
+        (  # a link held by a second joint that loops back to it: `tree` once never ended
+            _links("a", "b") + _joint("j", "a", "b") + _joint("k", "b", "b"),
+            ("a",), (), ("k",), "not one tree",
+        ),
+        (_links("a", "b", "b") + _joint("j", "a", "b"), ("a",), (), (), "'b' is defined more"),
+    ],
+)  # fmt: skip
+def test_one_tree_type_describes_malformed_trees_and_the_strict_one_refuses_them(
+    body: str, roots: Names, orphans: Names, extra: Names, refused: str
+) -> None:
+    urdf = parse_urdf(_urdf(body).encode(), "bad.urdf")
+    tree = KinematicTree.of(urdf)
+    assert (tree.roots, tree.orphans) == (roots, orphans)
+    assert tuple(j.name for j in tree.extra_parents) == extra
+    assert tree.root == (min(roots) if roots else None)
+    walked = [j.name for _, j in tree.walk()]  # it ends: one parent joint per link
+    assert len(walked) == len(set(walked)) <= len(tree.parent_joint)
+    assert check_structure(urdf, Collector("bad.urdf")) == tree  # check's tree is this one
+    with pytest.raises(InputError, match=refused):
+        tree_from_urdf(urdf)
+
+
+def test_check_and_tree_build_the_same_tree_for_every_bad_urdf() -> None:
+    for path in sorted((BAD_INPUTS / "urdf").glob("*.urdf")):
+        try:
+            urdf = parse_urdf(path.read_bytes(), str(path))
+        except InputError:
+            continue  # refused before any tree: not a URDF, too large, ...
+        tree = check_structure(urdf, Collector(str(path)))
+        assert tree == KinematicTree.of(urdf), path.name
+        if not tree.extra_parents and not tree.orphans and len(tree.roots) == 1:
+            reached = {tree.root} | {str(j.child) for _, j in tree.walk()}
+            assert reached == set(tree.links), path.name

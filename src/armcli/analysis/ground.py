@@ -33,6 +33,7 @@ from armcli.spec.joint_types import ROTARY_TYPES
 from armcli.urdf.doc import Shape, Urdf, Vec3
 from armcli.urdf.mesh_points import read_vertices
 from armcli.urdf.meshes import MeshSearch, mesh_paths
+from armcli.urdf.tree import KinematicTree
 
 CONTACT_TOL = 0.005  # [m] a link within this of the lowest point touches the ground, at least
 CONTACT_RTOL = 0.02  # of the robot's footprint: a 0.35 m base takes links within 7 mm
@@ -143,7 +144,7 @@ def _rolling_links(urdf: Urdf, poses: dict[str, NDArray[np.float64]]) -> set[str
     the neutral pose (example-robot-data's UR5) turns about a horizontal axis too, but
     behind rotary joints: it is not a wheel.
     """
-    by_child = {j.child: j for j in urdf.joints if j.child is not None}
+    by_child = KinematicTree.of(urdf).parent_joint
 
     def on_base(link: str | None) -> bool:
         seen: set[str] = set()

@@ -16,10 +16,11 @@ from collections.abc import Sequence
 
 from armcli.check.findings import Collector
 from armcli.check.inertia import MIN_MOMENT
-from armcli.check.structure import Tree, finite
+from armcli.check.structure import finite
 from armcli.robot import inertia as inr
 from armcli.robot.bodies import Body, lump
 from armcli.urdf.doc import Link, Urdf
+from armcli.urdf.tree import KinematicTree
 
 # A moving body lighter than this fraction of the robot makes the dynamics stiff.
 TINY_MASS_RATIO = 1e-4
@@ -47,7 +48,7 @@ def _massless_consequences(urdf: Urdf, links: Sequence[str]) -> str:
     return "MuJoCo refuses it (a moving body needs mass), Gazebo drops or destabilises it"
 
 
-def moving_bodies(urdf: Urdf, tree: Tree) -> list[Body]:
+def moving_bodies(urdf: Urdf, tree: KinematicTree) -> list[Body]:
     """One lumped body (`robot.bodies`) per movable joint whose child link exists, in order."""
     links: dict[str, Link] = {}
     for lk in urdf.links:
@@ -59,7 +60,7 @@ def moving_bodies(urdf: Urdf, tree: Tree) -> list[Body]:
     ]
 
 
-def check(urdf: Urdf, tree: Tree, out: Collector) -> None:
+def check(urdf: Urdf, tree: KinematicTree, out: Collector) -> None:
     """Rules on moving bodies: no mass, a singular inertia, or a tiny share of the robot mass.
 
     Bodies with unusable numbers are skipped: the number rules already reported them.

@@ -19,10 +19,10 @@ from armcli.analysis.verdict import StabilityReport
 from armcli.check.findings import Collector, JointRow
 from armcli.check.options import CheckOptions
 from armcli.check.rules import RULES
-from armcli.check.structure import Tree
 from armcli.robot.model import Robot
 from armcli.spec.joint_types import position_bounds
 from armcli.urdf.doc import Urdf
+from armcli.urdf.tree import KinematicTree
 
 if TYPE_CHECKING:  # the balance and reach results: imported by their own families
     from armcli.analysis.balance import StaticBalance
@@ -53,7 +53,7 @@ class Context:
     urdf: Urdf
     opts: CheckOptions
     out: Collector
-    tree: Tree
+    tree: KinematicTree
     notes: list[str] = field(default_factory=list)
     rows: tuple[JointRow, ...] = ()  # the joint table; the gravity rule fills its load
     robot: Robot | None = None  # the Pinocchio model and its joint table, once loaded

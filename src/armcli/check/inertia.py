@@ -10,10 +10,11 @@ import itertools
 import numpy as np
 
 from armcli.check.findings import Collector
-from armcli.check.structure import Tree, finite
+from armcli.check.structure import finite
 from armcli.robot import inertia as inr
 from armcli.robot import inertia_bounds as bounds
 from armcli.urdf.doc import Inertial, Link, Shape, Urdf
+from armcli.urdf.tree import KinematicTree
 
 # Inertia within 5 % (Frobenius, relative) of the solid-body formula counts as
 # "from the geometry"; real macro bugs (permuted axes, 4x) are off by >= 50 %.
@@ -33,7 +34,7 @@ MIN_MOMENT = 1e-15
 ZERO_RTOL = 1e-9
 
 
-def check(urdf: Urdf, tree: Tree, out: Collector) -> None:
+def check(urdf: Urdf, tree: KinematicTree, out: Collector) -> None:
     """Per-link rules; the bodies the joints move are checked in check/bodies.py."""
     for link in urdf.links:
         ine = link.inertial

@@ -17,10 +17,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from lxml import etree
-
 from armcli.check.findings import Collector, Value
 from armcli.check.options import CheckOptions
+from armcli.urdf.doc import Plugin, Urdf
 
 GZ_SYSTEMS = ("gz_ros2_control/GazeboSimSystem", "ign_ros2_control/IgnitionSystem")
 GZ_PLUGIN_FILES = ("gz_ros2_control-system", "ign_ros2_control-system")
@@ -48,10 +47,10 @@ class Interfaces:
         return [j for j, names in self.command.items() if "position" in names]
 
 
-def _gain(root: etree._Element) -> float:
-    for plugin in root.iter("plugin"):
-        if plugin.get("filename") in GZ_PLUGIN_FILES:
-            text = plugin.findtext("position_proportional_gain")
+def _gain(plugins: tuple[Plugin, ...]) -> float:
+    for plugin in plugins:
+        if plugin.filename in GZ_PLUGIN_FILES:
+            text = plugin.params.get("position_proportional_gain")
             if text is not None:
                 try:
                     return float(text)
@@ -60,31 +59,22 @@ def _gain(root: etree._Element) -> float:
     return DEFAULT_GAIN
 
 
-def read_interfaces(text: bytes) -> Interfaces | None:
-    """Parse the `<ros2_control>` blocks; None when the URDF has none."""
-    try:
-        root = etree.fromstring(text, etree.XMLParser(resolve_entities=False, no_network=True))
-    except etree.XMLSyntaxError:
-        return None
-    blocks = root.findall("ros2_control")
+def read_interfaces(urdf: Urdf) -> Interfaces | None:
+    """The `<ros2_control>` blocks, reduced; None when the URDF has none."""
+    blocks = urdf.ros2_control
     if not blocks:
         return None
-    hardware = tuple((b.findtext("hardware/plugin") or "").strip() for b in blocks)
-    command: dict[str, tuple[str, ...]] = {}
-    for b in blocks:
-        for j in b.findall("joint"):
-            names = tuple(c.get("name", "") for c in j.findall("command_interface"))
-            command[j.get("name", "")] = names
-    line = blocks[0].sourceline
-    return Interfaces(hardware, command, _gain(root), line if isinstance(line, int) else None)
+    command = {j: names for b in blocks for j, names in b.commands.items()}
+    hardware = tuple(b.hardware for b in blocks)
+    return Interfaces(hardware, command, _gain(urdf.plugins), blocks[0].line)
 
 
-def check(text: bytes, opts: CheckOptions, out: Collector, notes: list[str]) -> set[str]:
+def check(urdf: Urdf, opts: CheckOptions, out: Collector, notes: list[str]) -> set[str]:
     """Report the servo bound for position-commanded gz joints; return those joints.
 
     The caller skips the PD bound when every controlled joint is among them.
     """
-    ifaces = read_interfaces(text)
+    ifaces = read_interfaces(urdf)
     if ifaces is None or not ifaces.gazebo:
         return set()
     joints = ifaces.position_joints()

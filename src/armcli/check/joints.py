@@ -5,8 +5,6 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from lxml import etree
-
 from armcli.check.findings import Collector
 from armcli.check.structure import finite
 from armcli.spec.joint_types import LIMITED_TYPES, ONE_DOF_TYPES
@@ -30,7 +28,7 @@ def check(
     urdf: Urdf, spec: RobotSpec | None, out: Collector, notes: list[str] | None = None
 ) -> None:
     """Joint rules: axis and limits of each moving joint, then the arm limits against the spec."""
-    driven = driven_joints(urdf.text)
+    driven = driven_joints(urdf)
     passive: list[str] = []
     for j in urdf.joints:
         if j.type in ONE_DOF_TYPES:
@@ -62,22 +60,15 @@ def _axis(j: Joint, out: Collector) -> None:
         )
 
 
-def driven_joints(text: bytes) -> set[str] | None:
+def driven_joints(urdf: Urdf) -> set[str] | None:
     """The joints a `<transmission>` or `<ros2_control>` block drives; None when there is none.
 
     With none, nothing tells a passive joint from an actuated one, so every joint is held
     to actuator limits. With some, a joint they leave out is passive (LoCoBot's spring
     wheel-drop joints: effort and velocity 0 mean "no motor", not a typo).
     """
-    try:
-        root = etree.fromstring(text, etree.XMLParser(resolve_entities=False, no_network=True))
-    except etree.XMLSyntaxError:
-        return None
-    names = {
-        str(el.get("name", ""))
-        for path in ("transmission/joint", "ros2_control/joint")
-        for el in root.iterfind(path)
-    }
+    names = {j for t in urdf.transmissions for j in t.joints}
+    names |= {j for b in urdf.ros2_control for j in b.commands}
     return names or None
 
 

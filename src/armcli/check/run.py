@@ -63,7 +63,7 @@ def _gravity(c: Context) -> None:
 
 
 def _servo(c: Context) -> None:
-    c.servo = interface.check(c.urdf.text, c.opts, c.out, c.notes)
+    c.servo = interface.check(c.urdf, c.opts, c.out, c.notes)
 
 
 def _stability(c: Context) -> None:

@@ -1,19 +1,19 @@
 """Structure and number rules: names, tree shape, joint types, limits, sizes, colours.
 
-Also returns the kinematic tree (root, parent joint of each link, which links
-move) that the inertia, joint and model rules build on.
+Also returns the kinematic tree (urdf/tree.py's `KinematicTree`: root, parent joint of
+each link, which links move) that the inertia, joint and model rules build on; the
+rules here report what that tree records as malformed.
 """
 
 from __future__ import annotations
 
 import math
 from collections import Counter
-from dataclasses import dataclass
 
 from armcli.check.findings import Collector
-from armcli.spec.graph import root_links
 from armcli.spec.joint_types import JOINT_TYPES, LIMITED_TYPES
 from armcli.urdf.doc import Joint, Link, Urdf
+from armcli.urdf.tree import KinematicTree
 
 NUMBER_RULES = {
     "missing": "number-syntax",
@@ -23,20 +23,7 @@ NUMBER_RULES = {
 }
 
 
-@dataclass(frozen=True)
-class Tree:
-    """The kinematic tree as far as it is well formed."""
-
-    root: str | None
-    parent_joint: dict[str, Joint]  # child link -> the joint above it
-    moving: frozenset[str]  # links below at least one movable joint
-
-    def is_moving(self, link: str) -> bool:
-        """Whether `link` is below at least one movable joint."""
-        return link in self.moving
-
-
-def check(urdf: Urdf, out: Collector) -> Tree:
+def check(urdf: Urdf, out: Collector) -> KinematicTree:
     """Run the structure and number rules and return the tree."""
     for p in urdf.problems:
         what = {
@@ -56,7 +43,7 @@ def check(urdf: Urdf, out: Collector) -> Tree:
     links = {lk.name for lk in urdf.links}
     for j in urdf.joints:
         _joint_shape(j, links, {jj.name for jj in urdf.joints}, out)
-    tree = _tree(urdf, links, out)
+    tree = _tree(urdf, out)
     for link in urdf.links:
         if tree.is_moving(link.name) and link.visuals and not link.collisions:
             out.add(
@@ -207,36 +194,23 @@ def _joint_shape(j: Joint, links: set[str], joints: set[str], out: Collector) ->
         )
 
 
-def _tree(urdf: Urdf, links: set[str], out: Collector) -> Tree:
-    parent_joint: dict[str, Joint] = {}
-    for j in urdf.joints:
-        if j.child is None or j.child not in links:
-            continue
-        if j.child in parent_joint:
-            out.add(
-                "multiple-parents",
-                j.line,
-                f"link {j.child!r} is the child of {parent_joint[j.child].name!r} and {j.name!r}",
-                link=j.child,
-            )
-            continue
-        parent_joint[j.child] = j
-    roots = sorted(root_links(links, parent_joint))
+def _tree(urdf: Urdf, out: Collector) -> KinematicTree:
+    """The tree, with a finding for each way it is not one: parents, roots, cycles."""
+    tree = KinematicTree.of(urdf)
+    for j in tree.extra_parents:
+        first = tree.parent_joint[str(j.child)]
+        out.add(
+            "multiple-parents",
+            j.line,
+            f"link {j.child!r} is the child of {first.name!r} and {j.name!r}",
+            link=j.child,
+        )
+    roots = sorted(tree.roots)
     if len(roots) != 1:
         line = urdf.links[0].line if urdf.links else None
-        out.add(
-            "root-count",
-            line,
-            _root_message(roots, bool(links)),
-            roots=", ".join(roots),
-        )
-        return Tree(roots[0] if roots else None, parent_joint, frozenset())
-    moving, reached = _reach(roots[0], parent_joint)
-    # Links hanging from a joint whose parent is unknown were reported as unknown-link.
-    dangling = {c for c, j in parent_joint.items() if j.parent not in links}
-    _, below = _reach_all(dangling, parent_joint)
-    orphans = sorted(links - reached - below)
-    if orphans:
+        out.add("root-count", line, _root_message(roots, bool(tree.links)), roots=", ".join(roots))
+    elif tree.orphans:
+        orphans = list(tree.orphans)
         line = next((lk.line for lk in urdf.links if lk.name == orphans[0]), None)
         out.add(
             "disconnected",
@@ -244,37 +218,7 @@ def _tree(urdf: Urdf, links: set[str], out: Collector) -> Tree:
             f"links not connected to root {roots[0]!r} (cycle?): {orphans}",
             links=", ".join(orphans),
         )
-    return Tree(roots[0], parent_joint, frozenset(moving))
-
-
-def _reach_all(starts: set[str], parent_joint: dict[str, Joint]) -> tuple[set[str], set[str]]:
-    moving: set[str] = set()
-    reached: set[str] = set()
-    for s in starts:
-        m, r = _reach(s, parent_joint)
-        moving |= m
-        reached |= r
-    return moving, reached
-
-
-def _reach(root: str, parent_joint: dict[str, Joint]) -> tuple[set[str], set[str]]:
-    children: dict[str, list[Joint]] = {}
-    for j in parent_joint.values():
-        children.setdefault(str(j.parent), []).append(j)
-    moving: set[str] = set()
-    reached = {root}
-    frontier = [(root, False)]
-    while frontier:
-        link, is_moving = frontier.pop()
-        for j in children.get(link, []):
-            child_moving = is_moving or j.type != "fixed"
-            if j.child in reached:
-                continue
-            reached.add(str(j.child))
-            if child_moving:
-                moving.add(str(j.child))
-            frontier.append((str(j.child), child_moving))
-    return moving, reached
+    return tree
 
 
 def finite(*values: float | None) -> bool:

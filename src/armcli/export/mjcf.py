@@ -37,7 +37,6 @@ from armcli.export.mjcf_report import Extras, Note, scan, text
 from armcli.spec.joint_types import position_bounds
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Joint, Link, Pose, Shape, Urdf
-from armcli.urdf.read import parse_root
 
 BASES = MJCF_BASES
 FREE_JOINT = "root"
@@ -282,7 +281,7 @@ def build_mjcf(
     if urdf.problems:
         p = urdf.problems[0]
         raise InputError(f"{p.where}: bad number {p.text!r}", file=urdf.source, line=p.line)
-    b = _Builder(urdf, spec, scan(parse_root(urdf.text, urdf.source)))
+    b = _Builder(urdf, spec, scan(urdf))
     name = urdf.name or "robot"
     root = etree.Element("mujoco", model=name)
     assets = mesh_assets(urdf, meshes or {})  # first: the mesh geoms decide the masses

@@ -164,13 +164,13 @@ def excludes(root: etree._Element, urdf: Urdf, bodies: set[str]) -> None:
 
 def equalities(root: etree._Element, extras: Extras, joints: set[str]) -> None:
     """Mimic joints as joint equality constraints: q1 = offset + multiplier * q2."""
-    pairs = [(f, m) for f, m in sorted(extras.mimic.items()) if f in joints and m.joint in joints]
+    pairs = [(f, m) for f, m in sorted(extras.mimic.items()) if f in joints and m.leader in joints]
     if not pairs:
         return
     eq = etree.SubElement(root, "equality")
     for follower, m in pairs:
         poly = vec((m.offset, m.multiplier, 0.0, 0.0, 0.0))
-        etree.SubElement(eq, "joint", joint1=follower, joint2=m.joint, polycoef=poly)
+        etree.SubElement(eq, "joint", joint1=follower, joint2=m.leader, polycoef=poly)
 
 
 def notes(
@@ -192,7 +192,7 @@ def notes(
         )
     if extras.mimic:
         names = ", ".join(
-            f"{f} = {m.multiplier:g} {m.joint} + {m.offset:g}"
+            f"{f} = {m.multiplier:g} {m.leader} + {m.offset:g}"
             for f, m in sorted(extras.mimic.items())
         )
         out.append(

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from lxml import etree
+from armcli.robot.mimic import Mimic
+from armcli.urdf.doc import Urdf
 
 EXTRA_TAGS = ("gazebo", "transmission", "ros2_control")
 
@@ -25,52 +26,39 @@ class Note:
 
 
 @dataclass(frozen=True)
-class Mimic:
-    """`<mimic joint= multiplier= offset=>`: q = multiplier * q_joint + offset."""
-
-    joint: str
-    multiplier: float
-    offset: float
-
-
-@dataclass(frozen=True)
 class Extras:
-    """URDF content outside urdfdoc's typed view that the export needs."""
+    """What the export needs of the URDF's mimic joints and simulator extensions."""
 
-    mimic: dict[str, Mimic] = field(default_factory=dict)  # follower -> leader
+    mimic: dict[str, Mimic] = field(default_factory=dict)  # follower -> its coupling
     mu1: dict[str, float] = field(default_factory=dict)  # link -> Gazebo friction coefficient
     tags: dict[str, int] = field(default_factory=dict)  # extra tag -> count
 
 
 def _float(text: str | None, default: float) -> float:
     try:
-        return float(text) if text is not None else default
+        return float(text) if text else default
     except ValueError:
         return default
 
 
-def _mu1(el: etree._Element) -> float | None:
-    mu = el.find("mu1")
-    if mu is None:
-        return None
-    return _float(mu.get("value", mu.text), 1.0)
-
-
-def scan(root: etree._Element) -> Extras:
+def scan(urdf: Urdf) -> Extras:
     """Mimic parameters, Gazebo `mu1` per link and the counts of simulator-specific tags."""
-    mimic = {}
-    for j in root.findall("joint"):
-        m = j.find("mimic")
-        if m is not None and m.get("joint"):
-            mimic[j.get("name", "")] = Mimic(
-                str(m.get("joint")), _float(m.get("multiplier"), 1.0), _float(m.get("offset"), 0.0)
-            )
-    mu1 = {}
-    for g in root.findall("gazebo"):
-        value = _mu1(g)
-        if g.get("reference") and value is not None:
-            mu1[str(g.get("reference"))] = value
-    tags = {t: n for t in EXTRA_TAGS if (n := len(root.findall(t)))}
+    mimic = {
+        j.name: Mimic(j.name, j.mimic, j.mimic_multiplier, j.mimic_offset)
+        for j in urdf.joints
+        if j.mimic
+    }
+    mu1 = {
+        g.reference: _float(g.values["mu1"], 1.0)
+        for g in urdf.gazebo
+        if g.reference and "mu1" in g.values
+    }
+    counts = {
+        "gazebo": len(urdf.gazebo),
+        "transmission": len(urdf.transmissions),
+        "ros2_control": len(urdf.ros2_control),
+    }
+    tags = {t: n for t in EXTRA_TAGS if (n := counts[t])}
     return Extras(mimic, mu1, tags)
 
 

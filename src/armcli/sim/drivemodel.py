@@ -278,14 +278,12 @@ def _qpos(model: Any, joints: tuple[str, ...]) -> np.ndarray:
 
 def _mu2_notes(urdf: Urdf) -> list[str]:
     """Links whose Gazebo mu2 differs from mu1: MuJoCo's friction is isotropic."""
-    from armcli.urdf.read import parse_root
-
     out = []
-    for g in parse_root(urdf.text, urdf.source).findall("gazebo"):
-        mu1, mu2 = g.findtext("mu1"), g.findtext("mu2")
-        if mu1 is not None and mu2 is not None and mu1.strip() != mu2.strip():
+    for g in urdf.gazebo:
+        mu1, mu2 = g.values.get("mu1"), g.values.get("mu2")
+        if mu1 is not None and mu2 is not None and mu1 != mu2:
             out.append(
-                f"{g.get('reference')}: Gazebo mu2 {mu2.strip()} differs from mu1 "
-                f"{mu1.strip()}; MuJoCo's friction is isotropic, mu1 is used"
+                f"{g.reference}: Gazebo mu2 {mu2} differs from mu1 "
+                f"{mu1}; MuJoCo's friction is isotropic, mu1 is used"
             )
     return out

@@ -33,6 +33,7 @@ from armcli.sim.simulate import (
 )
 from armcli.sim.states import distinct, sample_steps
 from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
+from armcli.spec.types import time_step
 from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import Trust, read_urdf_file, spec_urdfs
@@ -275,8 +276,7 @@ def prepare(
         )
     dt_field = "SimOptions.dt" if dt is not None else "control.dt"  # else the spec's, checked
     dt = dt if dt is not None else (spec.control.dt if spec is not None else DEFAULT_DT)
-    if not (np.isfinite(dt) and 0 < dt <= 0.1):
-        raise InputError(f"must be in (0, 0.1] s, got {dt:g}", field=dt_field)
+    dt = time_step(dt, dt_field)
     doc = arm_urdf(spec, opts.urdf, trust_xacro=opts.trust_xacro, inputs=opts.xacro)
     arm = arm_from_model(checked_model(doc, gate=gate if opts.urdf else None).model, opts.joints)
     limits = {

@@ -42,6 +42,7 @@ from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim.options import INTEGRATORS, Integrator
 from armcli.sim.reference import Reference
+from armcli.spec.types import time_step
 
 VEL_ABORT_FACTOR = 10.0  # divergence when |v| exceeds this times the URDF velocity limit
 DEFAULT_VABORT = 1000.0  # [rad/s or m/s] when the URDF gives no velocity limit
@@ -115,8 +116,7 @@ class SimConfig:
             g = np.asarray(getattr(self, name), dtype=float)
             if not (np.all(np.isfinite(g)) and np.all(g >= 0.0)):
                 raise InputError(f"{name} gains must be finite and >= 0, got {g.tolist()}")
-        if not (np.isfinite(self.dt) and self.dt > 0.0):
-            raise InputError(f"time step must be finite and > 0, got {self.dt:g} s")
+        time_step(self.dt, "SimConfig.dt")
         if self.integrator not in INTEGRATORS:
             raise InputError(
                 f"unknown integrator {self.integrator!r}; valid: {', '.join(INTEGRATORS)}"

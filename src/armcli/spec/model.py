@@ -16,7 +16,7 @@ from pathlib import Path
 
 from pydantic import Field, PrivateAttr
 
-from armcli.defaults import DEFAULT_DT
+from armcli.defaults import DEFAULT_DT, MAX_DT
 from armcli.spec.control import Hardware, Interface, JointControl, Ros2Control
 from armcli.spec.graph import root_links
 from armcli.spec.joint_types import JointType
@@ -46,7 +46,18 @@ from armcli.spec.shapes import (
     Shape,
     Sphere,
 )
-from armcli.spec.types import Name, NonNeg, Positive, Real, RobotName, Text, UrdfName, Vec3, _Model
+from armcli.spec.types import (
+    Name,
+    NonNeg,
+    Positive,
+    Real,
+    RobotName,
+    Text,
+    TimeStep,
+    UrdfName,
+    Vec3,
+    _Model,
+)
 
 __all__ = [
     "Arm",
@@ -210,7 +221,9 @@ class Control(_Model):
     `controller_update_rate` the ros2_control rate [Hz].
     """
 
-    dt: Positive = Field(DEFAULT_DT, description="control and simulation time step [s]")
+    dt: TimeStep = Field(
+        DEFAULT_DT, description=f"control and simulation time step [s], in (0, {MAX_DT:g}]"
+    )
     gains: dict[UrdfName, Gains] = Field({}, description="PD gains per arm joint")
     controller_update_rate: Positive = Field(
         100.0, description="ros2_control controller manager rate [Hz]"

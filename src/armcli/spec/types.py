@@ -11,6 +11,8 @@ from typing import Annotated, Any
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field
 
+from armcli.defaults import MAX_DT
+from armcli.errors import InputError
 from armcli.spec.expr import eval_expr
 
 
@@ -29,7 +31,34 @@ def _finite(v: float) -> float:
     return v
 
 
+def time_step_problem(dt: float) -> str | None:
+    """Why `dt` [s] is no usable time step (the one rule: finite, in (0, MAX_DT]), or None."""
+    if math.isfinite(dt) and 0.0 < dt <= MAX_DT:
+        return None
+    return f"must be finite and in (0, {MAX_DT:g}] s, got {dt:g}"
+
+
+def time_step(dt: float, field: str) -> float:
+    """`dt` [s] when it is a usable time step; else InputError naming `field`, the user's.
+
+    `control.dt` (the spec), `SimOptions.dt` (simulate's and drive's `--dt`), `SimConfig.dt`
+    (every rollout: simulate, tune, plan) all pass through this rule.
+    """
+    problem = time_step_problem(float(dt))
+    if problem is not None:
+        raise InputError(problem, field=field)
+    return float(dt)
+
+
+def _time_step(v: float) -> float:
+    problem = time_step_problem(v)
+    if problem is not None:
+        raise ValueError(problem)
+    return v
+
+
 Real = Annotated[float, BeforeValidator(_number), AfterValidator(_finite)]
+TimeStep = Annotated[float, BeforeValidator(_number), AfterValidator(_time_step)]  # [s]
 Positive = Annotated[Real, Field(gt=0)]
 NonNeg = Annotated[Real, Field(ge=0)]
 Unit = Annotated[Real, Field(ge=0, le=1)]

@@ -131,8 +131,50 @@ class Material:
 
 
 @dataclass(frozen=True)
+class Plugin:
+    """A <plugin> anywhere in the document: a Gazebo system's, or ros2_control hardware's."""
+
+    filename: str | None
+    name: str | None
+    params: Mapping[str, str]  # child tag -> its stripped text, the first of each tag
+    line: int | None
+
+
+@dataclass(frozen=True)
+class Gazebo:
+    """A top-level <gazebo>: the link or joint it is about (None: the robot) and its values.
+
+    `values` maps each child tag (`mu1`, `mu2`, `material`, ...) to its `value` attribute,
+    else its stripped text, the first of each tag.
+    """
+
+    reference: str | None
+    values: Mapping[str, str]
+    line: int | None
+
+
+@dataclass(frozen=True)
+class Ros2Control:
+    """A top-level <ros2_control>: its hardware plugin and the joints' command interfaces."""
+
+    name: str
+    hardware: str  # <hardware><plugin> class, stripped ("" when there is none)
+    commands: Mapping[str, tuple[str, ...]]  # joint -> command interface names
+    line: int | None
+
+
+@dataclass(frozen=True)
+class Transmission:
+    """A top-level <transmission>: the joints it drives."""
+
+    name: str
+    joints: tuple[str, ...]
+    line: int | None
+
+
+@dataclass(frozen=True)
 class Urdf:
-    """What `check` needs from one URDF document."""
+    """One URDF document: links, joints, materials, and the Gazebo/ros2_control extensions."""
 
     name: str
     source: str
@@ -145,6 +187,11 @@ class Urdf:
     notes: tuple[str, ...] = ()  # `note: ...`/`warning: ...` lines: xacro arguments used, ...
     # a xacro expansion's element lines -> where they were written (xacro.lines); empty else
     origins: Mapping[int, Origin] = field(default_factory=dict)
+    # the simulator extensions, read once by urdf/extensions.py
+    gazebo: tuple[Gazebo, ...] = ()
+    ros2_control: tuple[Ros2Control, ...] = ()
+    transmissions: tuple[Transmission, ...] = ()
+    plugins: tuple[Plugin, ...] = ()  # every <plugin>, in document order
 
     def link(self, name: str) -> Link | None:
         """The link called `name`, or None."""

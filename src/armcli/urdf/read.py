@@ -20,6 +20,7 @@ from armcli.io.oneline import one_line
 from armcli.io.userfile import read_regular
 from armcli.spec.joint_types import total_dof
 from armcli.spec.xacro_names import xacro_use
+from armcli.urdf import extensions as ext
 from armcli.urdf.doc import (
     ZERO3,
     Geometry,
@@ -375,6 +376,10 @@ def parse_urdf(data: bytes, source: str) -> Urdf:
         materials,
         tuple(num.problems),
         _ln(root),
+        gazebo=ext.gazebo(root),
+        ros2_control=ext.ros2_control(root),
+        transmissions=ext.transmissions(root),
+        plugins=ext.plugins(root),
     )
 
 

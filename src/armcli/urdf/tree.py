@@ -1,5 +1,11 @@
 """The kinematic tree of a URDF: links, joints with types and limits, as text or Graphviz.
 
+One tree type for every reader of a URDF's structure: `KinematicTree.of` builds it from
+any parsed document, however malformed (several roots, cycles, a link with two parents,
+joints naming missing links), and records what is wrong; `check` reports that as
+findings (check/structure.py), `tree_from_urdf` accepts only one sound tree (what `tree`,
+`view` and `render` draw).
+
 `armcli tree` is the stand-in for `check_urdf` and `urdf_to_graphviz`, which
 most armcli users do not have; the DOT output follows urdf_to_graphviz's
 layout (links as boxes, joints as blue ellipses, origins on the edges, children
@@ -8,8 +14,9 @@ in joint-name order) so the same tooling can read it.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from dataclasses import dataclass
+from collections import Counter
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import dataclass, replace
 from typing import Any
 
 from armcli.errors import InputError
@@ -22,19 +29,86 @@ from armcli.urdf.read import parse_urdf
 
 @dataclass(frozen=True)
 class KinematicTree:
-    """Links and joints of one robot, with its single root link."""
+    """The links and joints of one robot, as far as they form a tree.
+
+    Each link hangs from the first joint naming it as child (`parent_joint`); a later
+    one is in `extra_parents`, a joint naming a missing link is no edge. `roots` are the
+    links no joint holds (a tree has exactly one); with one root, `orphans` are the
+    links it does not reach (a cycle) apart from those below a joint whose parent link
+    is missing, and `moving` the links below at least one joint that is not fixed.
+    Walking follows `parent_joint` only, so it ends on any input.
+    """
 
     robot: str
-    root: str
-    links: tuple[str, ...]
-    joints: tuple[Joint, ...]  # validated: known type, parent and child links of this tree
+    links: tuple[str, ...]  # unique names, in document order
+    joints: tuple[Joint, ...]  # every joint of the document
+    parent_joint: Mapping[str, Joint]  # child link -> the joint above it
+    roots: tuple[str, ...]  # links no joint holds, in document order
+    extra_parents: tuple[Joint, ...] = ()  # joints naming a child that already has a parent
+    orphans: tuple[str, ...] = ()  # sorted; found only when there is one root
+    moving: frozenset[str] = frozenset()  # empty unless there is one root
+
+    @classmethod
+    def of(cls, urdf: Urdf) -> KinematicTree:
+        """The tree of a parsed URDF, whatever its shape; never raises."""
+        links = tuple(dict.fromkeys(lk.name for lk in urdf.links))
+        known = set(links)
+        parent_joint: dict[str, Joint] = {}
+        extra: list[Joint] = []
+        for j in urdf.joints:
+            if j.child is None or j.child not in known:
+                continue
+            if j.child in parent_joint:
+                extra.append(j)
+            else:
+                parent_joint[j.child] = j
+        roots = tuple(root_links(links, parent_joint))
+        tree = cls(urdf.name, links, urdf.joints, parent_joint, roots, tuple(extra))
+        if len(roots) != 1:
+            return tree
+        moving, reached = tree._reach([roots[0]])
+        # links below a joint whose parent link is missing are that joint's problem
+        _, below = tree._reach(c for c, j in parent_joint.items() if j.parent not in known)
+        orphans = tuple(sorted(known - reached - below))
+        return replace(tree, orphans=orphans, moving=frozenset(moving))
+
+    def _reach(self, starts: Iterable[str]) -> tuple[set[str], set[str]]:
+        """(links below a joint that is not fixed, links reached) from `starts`."""
+        moving: set[str] = set()
+        reached: set[str] = set()
+        for start in starts:
+            reached.add(start)
+            frontier = [(start, False)]
+            while frontier:
+                link, below_moving = frontier.pop()
+                for j in self.children(link):
+                    if j.child in reached:
+                        continue
+                    reached.add(str(j.child))
+                    if below_moving or j.type != "fixed":
+                        moving.add(str(j.child))
+                    frontier.append((str(j.child), below_moving or j.type != "fixed"))
+        return moving, reached
+
+    @property
+    def root(self) -> str | None:
+        """The root link; with several (a malformed tree) the first by name, with none None."""
+        return min(self.roots) if self.roots else None
+
+    def is_moving(self, link: str) -> bool:
+        """Whether `link` is below at least one joint that is not fixed."""
+        return link in self.moving
 
     def children(self, link: str) -> list[Joint]:
-        """Joints whose parent is `link`, in name order (as urdfdom stores them)."""
-        return sorted((j for j in self.joints if j.parent == link), key=lambda j: j.name)
+        """The joints holding a link below `link`, in name order (as urdfdom stores them)."""
+        return sorted(
+            (j for j in self.parent_joint.values() if j.parent == link), key=lambda j: j.name
+        )
 
     def walk(self) -> Iterator[tuple[int, Joint]]:
-        """Depth-first (depth, joint) pairs from the root."""
+        """Depth-first (depth, joint) pairs from the root (none without one)."""
+        if self.root is None:
+            return
         stack = [(1, j) for j in reversed(self.children(self.root))]
         while stack:
             depth, j = stack.pop()
@@ -69,10 +143,11 @@ def tree_from_urdf(urdf: Urdf) -> KinematicTree:
     if urdf.problems:
         p = urdf.problems[0]
         raise InputError(f"{p.where}: {p.kind} number {p.text!r}", file=source, line=p.line)
-    links = tuple(lk.name for lk in urdf.links)
-    joints = tuple(_valid(j, source) for j in urdf.joints)
-    known = set(links)
-    for j in joints:
+    for j in urdf.joints:
+        _valid(j, source)
+    tree = KinematicTree.of(urdf)
+    known = set(tree.links)
+    for j in urdf.joints:
         for role in ("parent", "child"):
             if getattr(j, role) not in known:
                 raise InputError(
@@ -80,17 +155,16 @@ def tree_from_urdf(urdf: Urdf) -> KinematicTree:
                     file=source,
                     line=j.line,
                 )
-    children = [str(j.child) for j in joints]
-    roots = root_links(links, children)
-    if not links:
+    if not tree.links:
         raise InputError("no <link> elements: not a robot description", file=source)
-    if len(roots) != 1:
-        found = ", ".join(roots) if roots else "none: the joints form a cycle"
+    if len(tree.roots) != 1:
+        found = ", ".join(tree.roots) if tree.roots else "none: the joints form a cycle"
         raise InputError(f"expected exactly one root link, found {found}", file=source)
-    tree = KinematicTree(urdf.name, roots[0], links, joints)
-    reached = {tree.root} | {str(j.child) for _, j in tree.walk()}
-    if len(reached) != len(known) or len(set(children)) != len(children):
+    if tree.extra_parents or tree.orphans:
         raise InputError("links are not one tree (a link has two parents, or a cycle)", file=source)
+    twice = [n for n, k in Counter(lk.name for lk in urdf.links).items() if k > 1]
+    if twice:
+        raise InputError(f"link {twice[0]!r} is defined more than once", file=source)
     return tree
 
 
@@ -147,9 +221,10 @@ class TreeView:
         from rich.text import Text
 
         t = self.tree
-        yield Text.assemble((t.root, "bold"), ("  ", ""), (f"(robot {t.robot})", "dim"))
+        root = t.root or ""  # tree_from_urdf's trees have one
+        yield Text.assemble((root, "bold"), ("  ", ""), (f"(robot {t.robot})", "dim"))
         width = options.max_width
-        yield from self._below(t.root, "", width)
+        yield from self._below(root, "", width)
 
     def _below(self, link: str, prefix: str, width: int) -> Any:
         from rich.text import Text
@@ -181,7 +256,8 @@ def to_dot(tree: KinematicTree) -> str:
     """Graphviz text in urdf_to_graphviz's layout, joint nodes labelled with type and limits."""
     out = ["digraph G {", "node [shape=box];"]
     out += [
-        f"{_q(n)} [label={_q(n)}];" for n in [tree.root, *(str(j.child) for _, j in tree.walk())]
+        f"{_q(n)} [label={_q(n)}];"
+        for n in [tree.root or "", *(str(j.child) for _, j in tree.walk())]
     ]
     out.append("node [shape=ellipse, color=blue, fontcolor=blue];")
     for _, j in tree.walk():
