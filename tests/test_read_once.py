@@ -59,8 +59,6 @@ READERS = ("urdf/read.py", "urdf/extensions.py")  # the one reading, into urdf/d
 NOT_CONSUMERS = {
     "importer/": "transcribes every element of a foreign URDF into a spec, unknown ones verbatim",
     "compiler/": "walks the xacro it writes itself",
-    "sim/zmp.py": "being moved to analysis/ (drive_acceleration: to read `Urdf.plugins`)",
-    "analysis/zmp.py": "the same module after that move",
 }
 
 

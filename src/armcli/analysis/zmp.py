@@ -35,7 +35,6 @@ from armcli.analysis.stance import Stance
 from armcli.analysis.support import SupportPolygon
 from armcli.robot.model import Joint, Robot
 from armcli.urdf.doc import Urdf
-from armcli.urdf.read import parse_root
 
 MAX_SAMPLES = 20_000  # states whose zero-moment point is computed, at most (pairs of steps)
 Case = Literal["arm motion", "accelerating", "braking"]
@@ -75,10 +74,9 @@ class ZmpSeries:
 
 def drive_acceleration(urdf: Urdf) -> float | None:
     """The diff-drive plugin's acceleration limit [m/s²] in the URDF's <gazebo>, if any."""
-    root = parse_root(urdf.text, urdf.source)
-    for plugin in root.iter("plugin"):
+    for plugin in urdf.plugins:  # read once with the document (urdf.extensions)
         for tag in DRIVE_ACCEL_TAGS:
-            text = plugin.findtext(tag)
+            text = plugin.params.get(tag)
             if text is not None:
                 try:
                     value = float(text)
