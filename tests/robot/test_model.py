@@ -88,6 +88,20 @@ def test_q_matches_a_hand_built_configuration(robot: Robot) -> None:
     assert np.array_equal(robot.q({"nope": 1.0}), robot.neutral())  # unknown names ignored
 
 
+def test_joint_map_builds_the_same_q_vectorised(robot: Robot) -> None:
+    # the planner's per-state map: chosen joints from x, the others at rest, followers follow
+    rest = {"pitch": 0.3}
+    fast = robot.joint_map(["yaw", "slide"], rest)
+    rng = np.random.default_rng(0)
+    for x in rng.uniform(-3.0, 3.0, size=(50, 2)):
+        slow = robot.q(robot.follow({**rest, "yaw": x[0], "slide": x[1]}))
+        np.testing.assert_array_equal(fast(x), slow)
+    q = fast(np.array([math.pi / 2, 0.2]))
+    yaw, grip = robot.joint("yaw"), robot.joint("grip")
+    assert q[yaw.idx_q : yaw.idx_q + 2] == pytest.approx([0.0, 1.0], abs=1e-15)
+    assert q[grip.idx_q] == pytest.approx(0.5 * 0.2 + 0.01)  # the mimic coupling by hand
+
+
 def test_q_poses_the_robot_like_closed_form_kinematics(robot: Robot) -> None:
     """Flange at (yaw, pitch, s): Rz(yaw) [0, 0, 0.3] + Rz(yaw) Ry(pitch) [0.6 + s, 0, 0]."""
     yaw, pitch, s = 2.0, 0.5, 0.2

@@ -22,7 +22,7 @@ from armcli.defaults import DEFAULT_JOINT_ACCELERATION
 from armcli.errors import InputError
 from armcli.robot.load import checked_model, link_frame
 from armcli.robot.mimic import Mimic, follow, mimics
-from armcli.robot.model import Robot
+from armcli.robot.model import JointMap, Robot
 from armcli.robot.tool import tool_point
 from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import MeshSearch
@@ -63,19 +63,19 @@ class PlanRobot:
     @cached_property
     def robot(self) -> Robot:
         """The model's robot handle (`Robot.q` builds the configuration)."""
-        return Robot(self.model)
+        return Robot(self.model, mimics=self.mimic)
 
     @cached_property
-    def _layout(self) -> _Layout:
-        return _Layout.of(self)
+    def _map(self) -> JointMap:
+        return self.robot.joint_map(self.joints, self.rest)
 
     def q(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
         """Pinocchio configuration with the planned joints at `x` and followers following.
 
         Every other 1-DoF joint at its `rest` value; multi-DoF joints stay neutral. Vectorised
-        (`_Layout`, built from and tested against `q_slow`): the planner calls it per state.
+        (`Robot.joint_map`, tested against `q_slow`): the planner calls it per state.
         """
-        return self._layout.q(np.asarray(x, dtype=float))
+        return self._map(np.asarray(x, dtype=float))
 
     def q_slow(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
         """`q` joint by joint through `Robot.q`."""
@@ -99,62 +99,6 @@ class PlanRobot:
         """A planned joint's default value: 0 clipped into its range."""
         i = self.joints.index(joint)
         return float(np.clip(0.0, self.lower[i], self.upper[i]))
-
-
-@dataclass(frozen=True)
-class _Layout:
-    """Where planned joints and their followers sit in q, for a vectorised `PlanRobot.q`."""
-
-    template: np.ndarray  # q with the planned joints at 0
-    lin: tuple[np.ndarray, np.ndarray]  # (q index, x index) of 1-nq planned joints
-    cont: tuple[np.ndarray, np.ndarray]  # (q index of cos, x index) of continuous ones
-    followers: tuple[tuple[int, bool, str, str, float, float], ...]  # q index, cos/sin, names
-    joints: tuple[str, ...]
-    rest: Mapping[str, float]
-
-    @staticmethod
-    def of(robot: PlanRobot) -> _Layout:
-        model = robot.model
-        lin_q: list[int] = []
-        lin_x: list[int] = []
-        cont_q: list[int] = []
-        cont_x: list[int] = []
-        for k, name in enumerate(robot.joints):
-            jm = model.joints[model.getJointId(name)]
-            (cont_q if jm.nq == 2 else lin_q).append(jm.idx_q)
-            (cont_x if jm.nq == 2 else lin_x).append(k)
-        followers = []
-        for m in robot.mimic:
-            if model.existJointName(m.follower):
-                jm = model.joints[model.getJointId(m.follower)]
-                followers.append(
-                    (int(jm.idx_q), jm.nq == 2, m.follower, m.leader, m.multiplier, m.offset)
-                )
-        return _Layout(
-            robot.q_slow(np.zeros(len(robot.joints))),
-            (np.array(lin_q, dtype=int), np.array(lin_x, dtype=int)),
-            (np.array(cont_q, dtype=int), np.array(cont_x, dtype=int)),
-            tuple(followers),
-            robot.joints,
-            robot.rest,
-        )
-
-    def q(self, x: np.ndarray) -> np.ndarray:
-        q = self.template.copy()
-        q[self.lin[0]] = x[self.lin[1]]
-        if len(self.cont[0]):
-            q[self.cont[0]] = np.cos(x[self.cont[1]])
-            q[self.cont[0] + 1] = np.sin(x[self.cont[1]])
-        if self.followers:
-            values = dict(zip(self.joints, x.tolist(), strict=True))
-            for iq, cs, follower, leader, mult, offset in self.followers:  # leaders first
-                v = mult * values.get(leader, self.rest.get(leader, 0.0)) + offset
-                values[follower] = v
-                if cs:
-                    q[iq], q[iq + 1] = math.cos(v), math.sin(v)
-                else:
-                    q[iq] = v
-        return q
 
 
 def _rest(lo: float, hi: float) -> float:

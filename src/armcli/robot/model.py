@@ -50,6 +50,41 @@ class Joint:
         return span(self.lower, self.upper)
 
 
+def _put(q: NDArray[np.float64], joint: Joint, x: float) -> None:
+    """Set one joint in q: the angle of a continuous joint as its (cos, sin) pair."""
+    if joint.continuous:
+        q[joint.idx_q], q[joint.idx_q + 1] = math.cos(x), math.sin(x)
+    else:
+        q[joint.idx_q] = x
+
+
+@dataclass(frozen=True)
+class JointMap:
+    """Where chosen joints and their mimic followers sit in q (`Robot.joint_map`)."""
+
+    template: NDArray[np.float64]  # q with the chosen joints at 0, the others at rest
+    lin: NDArray[np.int64]  # rows (q index, x index) of the chosen 1-nq joints
+    cont: NDArray[np.int64]  # rows (q index of cos, x index) of the continuous ones
+    followers: tuple[tuple[Joint, Mimic], ...]  # in coupling order: leaders first
+    joints: tuple[str, ...]
+    rest: Mapping[str, float]
+
+    def __call__(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The configuration with the chosen joints at `x` [rad or m]."""
+        q = self.template.copy()
+        q[self.lin[:, 0]] = x[self.lin[:, 1]]
+        if len(self.cont):
+            q[self.cont[:, 0]] = np.cos(x[self.cont[:, 1]])
+            q[self.cont[:, 0] + 1] = np.sin(x[self.cont[:, 1]])
+        if self.followers:
+            values = dict(zip(self.joints, x.tolist(), strict=True))
+            for joint, m in self.followers:
+                v = m.position(values.get(m.leader, self.rest.get(m.leader, 0.0)))
+                values[joint.name] = v
+                _put(q, joint, v)
+        return q
+
+
 def span(lower: float, upper: float) -> tuple[float, float]:
     """A joint range to sample over [rad or m]: [lower, upper], else [-pi, pi].
 
@@ -217,12 +252,25 @@ class Robot:
             chosen = self.joints if joints is None else joints
             pairs = zip(chosen, np.asarray(values, dtype=float).reshape(-1), strict=True)
         for j, x in pairs:
-            x = float(x)
-            if j.continuous:
-                q[j.idx_q], q[j.idx_q + 1] = math.cos(x), math.sin(x)
-            else:
-                q[j.idx_q] = x
+            _put(q, j, float(x))
         return q
+
+    def joint_map(self, joints: Sequence[str], rest: Mapping[str, float] | None = None) -> JointMap:
+        """`x` (values of `joints`, in order) -> q, vectorised: for a caller building q per state.
+
+        A planner's validity check calls it per state. Other joints at `rest` (else
+        neutral), followers following their leaders: the same q as `q(follow(...))`.
+        """
+        rest = dict(rest or {})
+        chosen = [self.joint(n) for n in joints]
+        template = self.q(self.follow({**rest, **{j.name: 0.0 for j in chosen}}))
+        lin = [(j.idx_q, k) for k, j in enumerate(chosen) if not j.continuous]
+        cont = [(j.idx_q, k) for k, j in enumerate(chosen) if j.continuous]
+        followers = tuple((self._by_name[m.follower], m) for m in self.mimics
+                          if m.follower in self._by_name)  # fmt: skip
+        return JointMap(template, np.array(lin, dtype=int).reshape(-1, 2),
+                        np.array(cont, dtype=int).reshape(-1, 2), followers, tuple(joints),
+                        rest)  # fmt: skip
 
     def reduced(self, joints: Sequence[str]) -> Robot:
         """The robot with only `joints` movable; the others locked at their neutral value.
