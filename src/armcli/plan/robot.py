@@ -75,7 +75,7 @@ class PlanRobot:
         Every other 1-DoF joint at its `rest` value; multi-DoF joints stay neutral. Vectorised
         (`Robot.joint_map`, tested against `q_slow`): the planner calls it per state.
         """
-        return self._map(np.asarray(x, dtype=float))
+        return self._map.q(np.asarray(x, dtype=float))
 
     def q_slow(self, x: Sequence[float] | np.ndarray) -> np.ndarray:
         """`q` joint by joint through `Robot.q`."""

@@ -63,25 +63,28 @@ class JointMap:
     """Where chosen joints and their mimic followers sit in q (`Robot.joint_map`)."""
 
     template: NDArray[np.float64]  # q with the chosen joints at 0, the others at rest
-    lin: NDArray[np.int64]  # rows (q index, x index) of the chosen 1-nq joints
-    cont: NDArray[np.int64]  # rows (q index of cos, x index) of the continuous ones
-    followers: tuple[tuple[Joint, Mimic], ...]  # in coupling order: leaders first
+    lin: tuple[NDArray[np.int64], NDArray[np.int64]]  # (q, x) indices of 1-nq chosen joints
+    cont: tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]  # (cos, sin, x)
+    followers: tuple[tuple[int, bool, str, str, float, float], ...]  # as `Robot.joint_map`
     joints: tuple[str, ...]
     rest: Mapping[str, float]
 
-    def __call__(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+    def q(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """The configuration with the chosen joints at `x` [rad or m]."""
-        q = self.template.copy()
-        q[self.lin[:, 0]] = x[self.lin[:, 1]]
-        if len(self.cont):
-            q[self.cont[:, 0]] = np.cos(x[self.cont[:, 1]])
-            q[self.cont[:, 0] + 1] = np.sin(x[self.cont[:, 1]])
+        q = self.template.copy()  # index arrays kept apart: the planner calls this per state
+        q[self.lin[0]] = x[self.lin[1]]
+        if len(self.cont[2]):
+            q[self.cont[0]] = np.cos(x[self.cont[2]])
+            q[self.cont[1]] = np.sin(x[self.cont[2]])
         if self.followers:
             values = dict(zip(self.joints, x.tolist(), strict=True))
-            for joint, m in self.followers:
-                v = m.position(values.get(m.leader, self.rest.get(m.leader, 0.0)))
-                values[joint.name] = v
-                _put(q, joint, v)
+            for iq, continuous, name, leader, mult, offset in self.followers:  # leaders first
+                v = mult * values.get(leader, self.rest.get(leader, 0.0)) + offset
+                values[name] = v
+                if continuous:  # as `_put`, inlined: per state
+                    q[iq], q[iq + 1] = math.cos(v), math.sin(v)
+                else:
+                    q[iq] = v
         return q
 
 
@@ -264,13 +267,18 @@ class Robot:
         rest = dict(rest or {})
         chosen = [self.joint(n) for n in joints]
         template = self.q(self.follow({**rest, **{j.name: 0.0 for j in chosen}}))
-        lin = [(j.idx_q, k) for k, j in enumerate(chosen) if not j.continuous]
-        cont = [(j.idx_q, k) for k, j in enumerate(chosen) if j.continuous]
-        followers = tuple((self._by_name[m.follower], m) for m in self.mimics
-                          if m.follower in self._by_name)  # fmt: skip
-        return JointMap(template, np.array(lin, dtype=int).reshape(-1, 2),
-                        np.array(cont, dtype=int).reshape(-1, 2), followers, tuple(joints),
-                        rest)  # fmt: skip
+
+        def indices(continuous: bool) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+            pairs = [(j.idx_q, k) for k, j in enumerate(chosen) if j.continuous == continuous]
+            table = np.array(pairs, dtype=np.int64).reshape(-1, 2)
+            return table[:, 0].copy(), table[:, 1].copy()
+
+        (lq, lx), (cq, cx) = indices(False), indices(True)
+        by_name = self._by_name
+        followers = tuple((by_name[m.follower].idx_q, by_name[m.follower].continuous, m.follower,
+                           m.leader, m.multiplier, m.offset)
+                          for m in self.mimics if m.follower in by_name)  # fmt: skip
+        return JointMap(template, (lq, lx), (cq, cq + 1, cx), followers, tuple(joints), rest)
 
     def reduced(self, joints: Sequence[str]) -> Robot:
         """The robot with only `joints` movable; the others locked at their neutral value.
