@@ -13,7 +13,6 @@ from typing import Any
 
 import typer
 
-from armcli.defaults import SPEC_HELP
 from armcli.errors import InputError
 
 
@@ -35,11 +34,6 @@ def choice(default: str, choices: Sequence[str], *names: str, help: str) -> Any:
         callback=check,
         help=help,
     )
-
-
-def spec_argument(help: str = SPEC_HELP) -> Any:
-    """The optional SPEC argument; None means "find it" (armcli.spec.discover)."""
-    return typer.Argument(None, show_default=False, help=help)
 
 
 def out_option(default: Path, help: str) -> Any:

@@ -24,7 +24,7 @@ from typing import Any, Literal, TypeVar
 
 import typer
 
-from armcli.commands.help_text import ROBOT_HELP
+from armcli.defaults import SPEC_HELP
 from armcli.errors import InputError
 from armcli.io.oneline import one_line
 from armcli.io.packages import PackageLookup, parse_package_dirs
@@ -39,6 +39,10 @@ KEYWORD_ONLY = inspect.Parameter.KEYWORD_ONLY  # typer passes every parameter by
 F = TypeVar("F", bound=Callable[..., Any])
 Kind = Literal["robot", "spec", "file", "paths"]  # what the positional argument names
 
+ROBOT_HELP = (
+    "Robot spec YAML, URDF file, or xacro file (expanded in safe mode); "
+    "default: ./armcli.yaml, else the spec in specs/."
+)
 PACKAGE_DIR_HELP = (
     "NAME=PATH: package NAME is at PATH, for $(find NAME) and package://NAME/ (repeatable); "
     "otherwise AMENT_PREFIX_PATH, ROS_PACKAGE_PATH and the package enclosing the file."
@@ -50,7 +54,7 @@ PATHS_HELP = (
 FILE_HELP = "URDF or xacro file."
 _POSITIONAL = {  # kind -> (metavar, required, help)
     "robot": ("ROBOT", False, ROBOT_HELP),
-    "spec": ("SPEC", False, "Robot spec YAML (default: ./armcli.yaml, else the one in specs/)."),
+    "spec": ("SPEC", False, SPEC_HELP),
     "file": ("FILE", True, FILE_HELP),
 }
 _GROUP = ("robot_file", "xacro_args", "package_dir", "env", "trust_xacro", "unsandboxed")
@@ -81,7 +85,7 @@ def _parameters(
                                   help=ARGS_HELP)  # fmt: skip
             positional.append(param("xacro_args", list[str] | None, rest))
     pkg = typer.Option([], "--package-dir", metavar="NAME=PATH", help=PACKAGE_DIR_HELP)
-    options = [param("package_dir", list[str], pkg)] if packages or xacro else []
+    options = [param("package_dir", list[str], pkg)] if packages or xacro else []  # xacro: both
     if xacro:
         options += [
             param("env", list[str], typer.Option([], "--env", metavar="VAR=VALUE", help=ENV_HELP)),
@@ -106,9 +110,7 @@ def robot_options(
     def decorate(fn: F) -> F:
         hints = _hints(fn)
         own = [
-            p.replace(
-                kind=inspect.Parameter.KEYWORD_ONLY, annotation=hints.get(p.name, p.annotation)
-            )
+            p.replace(kind=KEYWORD_ONLY, annotation=hints.get(p.name, p.annotation))
             for p in inspect.signature(fn).parameters.values()
             if p.name != "robot"
         ]
