@@ -30,7 +30,8 @@ RPY_HELP = (
     "With --to-xyz: the tool link's roll,pitch,yaw [rad] (default: position only < 6 joints)."
 )
 SCENE_HELP = "Obstacles: YAML shaped like moveit_msgs/PlanningScene world.collision_objects."
-SRDF_HELP = "SRDF of a --urdf: its disable_collisions and group_state entries."
+SRDF_HELP = "SRDF of a --urdf: its disable_collisions, group_state and group entries."
+GROUP_HELP = "Plan the joints of this planning group of --srdf (MoveIt's), e.g. arm."
 EXECUTE_HELP = "Simulate the plan right away; exit 1 if it breaks a limit or tips over."
 FLAGS = {
     "start": "--from",
@@ -42,6 +43,8 @@ FLAGS = {
     "to_xyz": "--to-xyz",
     "to_rpy": "--to-rpy",
     "planner": "--planner",
+    "group": "--group",
+    "srdf": "--srdf",
     "timeout": "--timeout",
 }
 
@@ -72,6 +75,7 @@ def plan_cmd(
         metavar="JOINT,...",
         help="Comma-separated joints to plan (default: arm).",
     ),
+    group: str = option(None, "--group", help=GROUP_HELP),
     planner: str = choice(
         "rrtconnect", PLANNERS, "--planner", help="OMPL planner (default: rrtconnect)."
     ),
@@ -86,7 +90,7 @@ def plan_cmd(
     from armcli.plan.api import PlanOptions
     from armcli.plan.request import PlanRequest, plan_request
 
-    request = PlanRequest(start, goal, to_xyz, to_rpy, srdf, scene, joints or None)
+    request = PlanRequest(start, goal, to_xyz, to_rpy, srdf, scene, joints or None, group)
     if output is not None:
         check_output_file(output, "--output")
     robot_file = robot.read(urdf)

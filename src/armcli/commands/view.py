@@ -22,11 +22,20 @@ if TYPE_CHECKING:
 SCENE_HELP = "Obstacles for the planning panel: YAML like moveit_msgs/PlanningScene."
 SRDF_HELP = "SRDF of a URDF: its named poses (group_state) and disabled collision pairs."
 JOINTS_HELP = "Joints the planning panel plans, comma-separated (default: the arm's)."
+GROUP_HELP = "The planning panel plans this planning group of --srdf (MoveIt's), e.g. arm."
 SAVE_HELP = "Directory the planning panel's Save writes into (default: the current one)."
 
 
 @flag_errors(
-    {"pose": "--pose", "q": "--q", "port": "--port", "replay": "--replay", "joints": "--joints"}
+    {
+        "pose": "--pose",
+        "q": "--q",
+        "port": "--port",
+        "replay": "--replay",
+        "joints": "--joints",
+        "group": "--group",
+        "srdf": "--srdf",
+    }
 )
 @robot_options()
 def view_cmd(
@@ -49,6 +58,7 @@ def view_cmd(
     joints: Names = typer.Option(
         None, "--joints", parser=names, metavar="JOINT,...", help=JOINTS_HELP
     ),
+    group: str = typer.Option(None, "--group", help=GROUP_HELP),
     save_dir: Path = typer.Option(Path("."), "--save-dir", show_default=False, help=SAVE_HELP),
 ) -> None:
     """Open a browser 3-D viewer: joint sliders, named poses, replay, motion planning."""
@@ -70,7 +80,7 @@ def view_cmd(
         load = rosbag.load_replay if rosbag.is_mcap(replay) else load_replay
         run = load(replay, names)
     chosen = list(joints) if joints else None
-    session = _session(src, (scene, srdf, chosen), save_dir, robot)  # before serving
+    session = _session(src, (scene, srdf, chosen, group), save_dir, robot)  # before serving
     viewer = Viewer(
         src.xml,
         name=src.name,
@@ -105,7 +115,7 @@ def view_cmd(
 
 def _session(
     src: RobotSource,
-    planning: tuple[Path | None, Path | None, list[str] | None],
+    planning: tuple[Path | None, Path | None, list[str] | None, str | None],
     save_dir: Path,
     robot: RobotInput,
 ) -> PlanningSession | None:
@@ -113,14 +123,14 @@ def _session(
     from armcli.sim.options import SimOptions
     from armcli.view.planning import load_session
 
-    scene, srdf, joints = planning
+    scene, srdf, joints, group = planning
     if not save_dir.is_dir():
         raise InputError(f"{save_dir} is not a directory", field="--save-dir")
     assert src.file is not None
     sim = SimOptions(urdf=None if src.file.spec else src.file.path, trust_xacro=robot.trust,
                      xacro=robot.xacro)  # fmt: skip
     try:
-        session = load_session(src.file, srdf=srdf, scene=scene, joints=joints,
+        session = load_session(src.file, srdf=srdf, scene=scene, joints=joints, group=group,
                                search=src.search, sim=sim, save_dir=save_dir)  # fmt: skip
     except InputError as exc:
         if any(given is not None for given in planning):  # asked for planning: refuse

@@ -14,9 +14,9 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.plan.api import PlanningContext, planning_context, values
-from armcli.plan.robot import load_plan_robot
+from armcli.plan.robot import default_joints, load_plan_robot
 from armcli.plan.scene import Scene, load_scene
-from armcli.plan.srdf import allowed_pairs, read_srdf
+from armcli.plan.srdf import Srdf, allowed_pairs, read_srdf
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import RobotFile, lookup_for
 
@@ -37,14 +37,19 @@ def load_context(
     scene: Path | None = None,
     joints: Sequence[str] | None = None,
     search: MeshSearch | None = None,
+    group: str | None = None,
 ) -> Loaded:
     """The planning context of a robot file, an optional SRDF and an optional scene file.
 
-    `search`: the package lookup (--package-dir, the environment); a spec's recorded
-    `packages` are added to it, as for every command that reads meshes.
+    `joints` or `group` (a planning group of the SRDF) names the planned joints; neither:
+    the spec's arm, or every movable joint of a URDF. `search`: the package lookup
+    (--package-dir, the environment); a spec's recorded `packages` are added to it, as for
+    every command that reads meshes.
     """
     search = lookup_for(robot_file.spec, search)
     parsed = read_srdf(srdf) if srdf is not None else None
+    if group is not None:
+        joints = _group_joints(robot_file, parsed, group, joints)
     robot = load_plan_robot(
         robot_file,
         joints=joints,
@@ -55,6 +60,21 @@ def load_context(
     obstacles = load_scene(scene, links) if scene is not None else Scene()
     ctx = planning_context(robot, obstacles, allowed_pairs(robot_file, parsed, search))
     return Loaded(ctx, robot_file, obstacles)
+
+
+def _group_joints(
+    robot_file: RobotFile, srdf: Srdf | None, group: str, joints: Sequence[str] | None
+) -> list[str]:
+    """The movable joints of an SRDF planning group (fixed joints and mimic followers left out)."""
+    if joints:
+        raise InputError("give `joints` or `group`, not both", field="group")
+    if srdf is None:
+        raise InputError("a planning group is read from an SRDF: give `srdf` too", field="group")
+    movable = set(default_joints(robot_file.robot, None))
+    chosen = [j for j in srdf.group_joints(group, robot_file.robot) if j in movable]
+    if not chosen:
+        raise InputError(f"planning group {group!r} has no movable joint", field="group")
+    return chosen
 
 
 def configuration(ctx: PlanningContext, text: str, field: str) -> np.ndarray:

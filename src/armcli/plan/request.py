@@ -3,7 +3,8 @@
 `plan_request` is the library call behind `armcli plan`: load the planning context of
 a robot file (its SRDF, a scene), turn the named start and goal into joint values
 (inverse kinematics for a point), plan, time and certify. Errors name the request's
-fields (`start`, `goal`, `to_xyz`, `to_rpy`, `joints`); the command maps them to flags.
+fields (`start`, `goal`, `to_xyz`, `to_rpy`, `joints`, `group`, `srdf`); the command
+maps them to flags.
 """
 
 from __future__ import annotations
@@ -30,7 +31,8 @@ class PlanRequest:
     to_rpy: tuple[float, ...] | None = None  # with to_xyz: the tool link's orientation [rad]
     srdf: Path | None = None
     scene: Path | None = None
-    joints: tuple[str, ...] | None = None  # None: the arm's
+    joints: tuple[str, ...] | None = None  # None: the arm's (or the group's)
+    group: str | None = None  # a planning group of `srdf` (MoveIt's), instead of `joints`
     options: PlanOptions = field(default_factory=PlanOptions)
 
     def __post_init__(self) -> None:
@@ -56,7 +58,7 @@ def plan_request(
     `search`: the package lookup for meshes (--package-dir, the environment).
     """
     loaded = load_context(robot, srdf=request.srdf, scene=request.scene,
-                          joints=request.joints, search=search)  # fmt: skip
+                          joints=request.joints, search=search, group=request.group)  # fmt: skip
     ctx = loaded.context
     if request.start is None and HOME not in ctx.robot.poses:
         raise InputError(f"this robot has no `{HOME}` pose: give `start`", field="start")

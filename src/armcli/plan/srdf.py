@@ -16,6 +16,7 @@ from armcli.defaults import COLLISION_SAMPLES
 from armcli.errors import InputError
 from armcli.io.userfile import read_regular
 from armcli.ros.collision_matrix import DEFAULT_SEED, compute_collision_matrix
+from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import MeshSearch, confined_mesh_xml
 from armcli.urdf.read import parse_root
 from armcli.urdf.source import RobotFile
@@ -24,11 +25,67 @@ MAX_SRDF_BYTES = 8 * 1024 * 1024
 
 
 @dataclass(frozen=True)
+class Group:
+    """A planning group as the SRDF writes it: joints, links, chains and other groups."""
+
+    name: str
+    joints: tuple[str, ...] = ()
+    links: tuple[str, ...] = ()  # each stands for the joint above it
+    chains: tuple[tuple[str, str], ...] = ()  # (base_link, tip_link)
+    groups: tuple[str, ...] = ()  # subgroups by name
+    line: int | None = None
+
+
+@dataclass(frozen=True)
 class Srdf:
-    """An SRDF's disabled collision pairs and named joint states (group_state)."""
+    """An SRDF's disabled collision pairs, named joint states and planning groups."""
 
     disabled: tuple[tuple[str, str], ...] = ()
     group_states: dict[str, dict[str, float]] = field(default_factory=dict)
+    groups: dict[str, Group] = field(default_factory=dict)
+    source: str = "<srdf>"
+
+    def group_joints(self, name: str, urdf: Urdf) -> tuple[str, ...]:
+        """The joints of planning group `name` in `urdf`, in document order.
+
+        As MoveIt resolves them: listed joints, the joint above each listed link, every
+        joint of a chain from base to tip, and the subgroups'. InputError naming an
+        unknown group or joint, or a chain whose tip is not below its base.
+        """
+        if name not in self.groups:
+            valid = ", ".join(self.groups) or "none"
+            raise InputError(f"unknown planning group {name!r}; valid: {valid}", field="group")
+        above = {j.child: j for j in urdf.joints if j.child}
+        known = {j.name for j in urdf.joints}
+        found: set[str] = set()
+        todo, seen = [name], set()
+        while todo:
+            g = self.groups.get(todo.pop())
+            if g is None or g.name in seen:
+                continue
+            seen.add(g.name)
+            todo.extend(g.groups)
+
+            def refuse(message: str, g: Group = g) -> InputError:
+                return InputError(message, file=self.source, line=g.line, field=f"group {g.name}")
+
+            for j in g.joints:
+                if j not in known:
+                    raise refuse(f"joint {j!r} is not in {urdf.source}")
+                found.add(j)
+            found.update(above[lk].name for lk in g.links if lk in above)
+            for base, tip in g.chains:
+                link: str | None = tip  # walked up to the base
+                chain: list[str] = []
+                for _ in range(len(above) + 1):  # bounded: a malformed tree may loop
+                    if link == base or link not in above:
+                        break
+                    chain.append(above[link].name)
+                    link = above[link].parent
+                if link != base:
+                    raise refuse(f"chain tip {tip!r} is not below base {base!r}")
+                found.update(chain)
+        return tuple(j.name for j in urdf.joints if j.name in found)
 
 
 def _line(el: Any) -> int | None:
@@ -64,7 +121,32 @@ def read_srdf(path: Path) -> Srdf:
                                  file=path, line=_line(j),
                                  field=f"group_state {name}")  # fmt: skip
             values[jname] = value
-    return Srdf(tuple(disabled), states)
+    return Srdf(tuple(disabled), states, _groups(root, path), str(path))
+
+
+def _groups(root: Any, path: Path) -> dict[str, Group]:
+    """The top-level <group> elements by name."""
+    out: dict[str, Group] = {}
+    for el in root.findall("group"):
+        name = el.get("name")
+        if not name:
+            raise InputError("needs a name", file=path, line=_line(el), field="<group>")
+        chains = []
+        for c in el.findall("chain"):
+            base, tip = c.get("base_link"), c.get("tip_link")
+            if not base or not tip:
+                raise InputError("a chain needs base_link and tip_link", file=path,
+                                 line=_line(c), field=f"group {name}")  # fmt: skip
+            chains.append((base, tip))
+        out[name] = Group(
+            name,
+            tuple(n for j in el.findall("joint") if (n := j.get("name"))),
+            tuple(n for lk in el.findall("link") if (n := lk.get("name"))),
+            tuple(chains),
+            tuple(n for g in el.findall("group") if (n := g.get("name"))),
+            _line(el),
+        )
+    return out
 
 
 def allowed_pairs(

@@ -281,8 +281,13 @@ def load_session(
     search: MeshSearch | None = None,
     sim: SimOptions | None = None,
     save_dir: Path = Path("."),
+    group: str | None = None,
 ) -> PlanningSession:
-    """A session for a robot file, its SRDF (a URDF's) and a scene file: what `view` builds."""
-    loaded = load_context(robot_file, srdf=srdf, scene=scene, joints=joints, search=search)
+    """A session for a robot file, its SRDF (a URDF's) and a scene file: what `view` builds.
+
+    `joints` or `group` (a planning group of the SRDF) names the planned joints.
+    """
+    loaded = load_context(robot_file, srdf=srdf, scene=scene, joints=joints, search=search,
+                          group=group)  # fmt: skip
     return PlanningSession(loaded.context, robot_file, scene=loaded.scene, sim=sim,
                            search=search, save_dir=save_dir)  # fmt: skip
