@@ -129,8 +129,8 @@ def simulate_arm(
     reference faster than a velocity limit; the effort limits gravity exceeds are warnings.
     """
     job = simjob.prepare(spec, opts, gate=gate)
+    whole = tipping.robot_urdf(spec, job)  # parsed once: the gate and the balance read it
     if spec is not None and opts.urdf is None:  # a spec's whole robot, as `check` sees it
-        whole = tipping.robot_urdf(spec, job)
         if whole is not None and whole is not job.urdf and balance_gate is not None:
             balance_gate(whole)
         elif whole is not None and gate is not None:
@@ -138,7 +138,7 @@ def simulate_arm(
     _refuse_too_fast(job, opts)
     notes: list[str] = []
     tip = tipping.prepare(spec, job, balance or tipping.TipOptions(), search or MeshSearch(),
-                          notes)  # fmt: skip
+                          notes, whole)  # fmt: skip
     warnings = (*precheck.holding_problems(job), *job.trajectory.warnings)
     run = run_balanced(job, tip, progress, plot=plot)
     return replace(run, notes=job.notes, balance_notes=tuple(notes), warnings=warnings)

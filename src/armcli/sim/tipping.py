@@ -92,10 +92,18 @@ def robot_urdf(spec: RobotSpec | None, job: SimJob) -> Urdf | None:
 
 
 def prepare(
-    spec: RobotSpec | None, job: SimJob, opts: TipOptions, search: MeshSearch, notes: list[str]
+    spec: RobotSpec | None,
+    job: SimJob,
+    opts: TipOptions,
+    search: MeshSearch,
+    notes: list[str],
+    whole: Urdf | None = None,
 ) -> Tipping | None:
-    """The run's balance set-up, or None (with a note) for a robot on a fixed base."""
-    urdf = robot_urdf(spec, job)
+    """The run's balance set-up, or None (with a note) for a robot on a fixed base.
+
+    `whole`: the whole robot's `robot_urdf`, when the caller has parsed it already.
+    """
+    urdf = whole if whole is not None else robot_urdf(spec, job)
     if urdf is None:
         return None
     base = spec.mounted_base() if spec is not None else None
