@@ -46,9 +46,10 @@ def _coal_shape(shape: Shape) -> Any:
     if shape.kind == "cone":
         return coal.Cone(d[1], d[0])
     assert shape.vertices is not None and shape.triangles is not None
-    bvh = coal.BVHModelOBBRSS()
+    bvh = coal.BVHModelOBBRSS()  # addSubModel takes std::vectors, not arrays (issue 42)
     bvh.beginModel(len(shape.triangles), len(shape.vertices))
-    bvh.addSubModel(shape.vertices, shape.triangles)
+    bvh.addVertices(np.asarray(shape.vertices, dtype=np.float64))
+    bvh.addTriangles(np.asarray(shape.triangles, dtype=np.int64))
     bvh.endModel()
     return bvh
 
