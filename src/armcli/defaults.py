@@ -36,5 +36,11 @@ ROBUST_MODES = ("worst", "quantile")  # `tune --robust-mode` over the perturbed 
 # [rad/s² or m/s²] a joint's acceleration limit when neither the spec nor the URDF gives one:
 # MoveIt's time-optimal parameterisation uses the same 1.0 (DEFAULT_ACCELERATION_LIMIT).
 DEFAULT_JOINT_ACCELERATION = 1.0
+# Random seeds (`plan`, `tune`, `ros-package --seed`) are 0 <= seed < SEED_LIMIT: what NumPy's
+# and OMPL's generators take (-1 and 2**64 were internal errors; issue 42)
+SEED_LIMIT = 2**32
+# `plan --timeout` at most this [s]: an unreachable goal with `--timeout 1e9` ran forever
+# (MoveIt's default planning time is 5 s; issue 42)
+MAX_PLAN_TIMEOUT_S = 300.0
 # `plan --planner`: OMPL geometric planners (RRT-Connect first: MoveIt's default)
 PLANNERS = ("rrtconnect", "rrt", "rrtstar", "informedrrtstar", "aorrtc")

@@ -58,9 +58,7 @@ def test_rate_equal_to_one_per_step_writes_every_step(
     assert len(out.read_text().splitlines()) == 101 + 1
 
 
-@pytest.mark.parametrize(
-    ("option", "value"), [("--samples", "1000000001"), ("--samples", "0"), ("--seed", "-1")]
-)
+@pytest.mark.parametrize(("option", "value"), [("--samples", "1000000001"), ("--samples", "0")])
 def test_ros_package_counts_bounded(
     option: str, value: str, tmp_path: Path, root: Path, default_spec_path: Path
 ) -> None:
@@ -69,3 +67,32 @@ def test_ros_package_counts_bounded(
     assert proc.returncode == 2, proc.stderr
     assert f"Invalid value for '{option}'" in proc.stderr
     assert not out.exists()
+
+
+@pytest.mark.parametrize("command", ["plan", "tune", "ros-package"])
+@pytest.mark.parametrize("seed", ["-1", str(2**32), str(2**64)])
+def test_seed_refused_where_it_is_parsed(
+    command: str, seed: str, tmp_path: Path, default_spec_path: Path
+) -> None:
+    """Issue 42: `--seed -1` or `2**64` was an internal error (tune), click's three lines
+    (ros-package) or a plan (plan); now one line before any file is read."""
+    extra = ["--to", "reach"] if command == "plan" else []
+    proc = run_cli([command, str(default_spec_path), *extra, "--seed", seed], tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr == (
+        f"error: --seed: must be an integer from 0 to {2**32 - 1} (0 <= seed < 2**32), got {seed}\n"
+    )
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("timeout", ["1e9", "301", "nan", "0"])
+def test_plan_timeout_capped(timeout: str, tmp_path: Path, default_spec_path: Path) -> None:
+    """Issue 42: `--timeout 1e9` with an unreachable goal planned forever; the cap is in --help."""
+    out = tmp_path / "p.yaml"
+    args = ["plan", str(default_spec_path), "--to", "reach", "--timeout", timeout, "-o", str(out)]
+    proc = run_cli(args, tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.startswith("error: --timeout: must be in (0, 300] s, got ")
+    assert len(proc.stderr.splitlines()) == 1 and not out.exists()
+    helped = run_cli(["plan", "--help"], tmp_path, env={"COLUMNS": "200"})
+    assert "Planning time limit [s], at most 300" in helped.stdout

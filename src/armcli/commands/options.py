@@ -13,6 +13,7 @@ from typing import Any
 
 import typer
 
+from armcli.defaults import SEED_LIMIT
 from armcli.errors import InputError
 
 
@@ -50,3 +51,17 @@ def option(default: Any, *names: str, help: str, **kwargs: Any) -> Any:
     )
     text = help if unset else f"{help} (default: {default})."
     return typer.Option(default, *names, show_default=False, help=text, **kwargs)
+
+
+def seed_option(help: str) -> Any:
+    """`--seed`, refused where click parses it unless 0 <= seed < 2**32 (issue 42)."""
+
+    def check(value: int) -> int:
+        if not 0 <= value < SEED_LIMIT:
+            raise InputError(
+                f"must be an integer from 0 to {SEED_LIMIT - 1} (0 <= seed < 2**32), got {value}",
+                field="--seed",
+            )
+        return value
+
+    return option(0, "--seed", callback=check, metavar="0..2**32-1", help=help)

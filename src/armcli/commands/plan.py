@@ -10,10 +10,10 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from armcli.commands.flags import flag_errors
-from armcli.commands.options import choice, option
+from armcli.commands.options import choice, option, seed_option
 from armcli.commands.robot_input import robot_options
 from armcli.commands.values import Names, Numbers, names, numbers
-from armcli.defaults import PLANNERS
+from armcli.defaults import MAX_PLAN_TIMEOUT_S, PLANNERS
 from armcli.errors import PlanningError
 from armcli.io.terminal import say
 
@@ -32,6 +32,7 @@ RPY_HELP = (
 SCENE_HELP = "Obstacles: YAML shaped like moveit_msgs/PlanningScene world.collision_objects."
 SRDF_HELP = "SRDF of a --urdf: its disable_collisions, group_state and group entries."
 GROUP_HELP = "Plan the joints of this planning group of --srdf (MoveIt's), e.g. arm."
+TIMEOUT_HELP = f"Planning time limit [s], at most {MAX_PLAN_TIMEOUT_S:g}"
 EXECUTE_HELP = "Simulate the plan right away; exit 1 if it breaks a limit or tips over."
 FLAGS = {
     "start": "--from",
@@ -79,8 +80,8 @@ def plan_cmd(
     planner: str = choice(
         "rrtconnect", PLANNERS, "--planner", help="OMPL planner (default: rrtconnect)."
     ),
-    timeout: float = option(1.0, "--timeout", help="Planning time limit [s]"),
-    seed: int = option(0, "--seed", help="Random seed: same inputs and seed, same bytes"),
+    timeout: float = option(1.0, "--timeout", help=TIMEOUT_HELP),
+    seed: int = seed_option("Random seed: same inputs and seed, same bytes"),
     output: Path = option(None, "--output", "-o", help="JointTrajectory YAML to write."),
     fmt: str = choice("text", FORMATS, "--format", help="Output format (default: text)."),
     execute: bool = option(False, "--execute", help=EXECUTE_HELP),

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from armcli.commands.flags import flag_errors
-from armcli.commands.options import choice, option, out_option
+from armcli.commands.options import choice, option, out_option, seed_option
 from armcli.commands.robot_input import robot_options
 from armcli.defaults import COLLISION_SAMPLES, ROS_TARGETS
 from armcli.io.terminal import say
@@ -36,9 +36,7 @@ def ros_package_cmd(
         max=MAX_SAMPLES,
         help="Random states for the collision matrix",
     ),
-    seed: int = option(
-        0, "--seed", min=0, max=2**32 - 1, help="Seed of the collision-matrix sampling"
-    ),
+    seed: int = seed_option("Seed of the collision-matrix sampling"),
     maintainer: str = option("armcli", "--maintainer", help="package.xml maintainer"),
     email: str = option("armcli@example.com", "--email", help="Maintainer e-mail"),
     license_: str = option("TODO", "--license", help="package.xml license"),

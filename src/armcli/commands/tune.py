@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from armcli.commands.flags import flag_errors, option_flags
-from armcli.commands.options import choice, option
+from armcli.commands.options import choice, option, seed_option
 from armcli.commands.robot_input import robot_options
 from armcli.commands.values import Names, Numbers, names, numbers
 from armcli.defaults import PD_LOOPS, ROBUST_MODES
@@ -75,7 +75,7 @@ def tune_cmd(
     ),
     trials: int = option(60, "--trials", help="Candidates to evaluate (Optuna trials)"),
     batch: int = option(8, "--batch", help="Candidates per batch (the result depends on it)"),
-    seed: int = option(0, "--seed", help="Seed of the sampler and of the perturbed models"),
+    seed: int = seed_option("Seed of the sampler and of the perturbed models"),
     span: float = option(4.0, "--span", help="Search kp, kd in [start/span, start*span]"),
     settle: float = option(2.0, "--settle", help="Simulated time after the last point [s]"),
     robust: int = option(0, "--robust", help="Score every candidate on N perturbed models"),

@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from armcli.defaults import MAX_PLAN_TIMEOUT_S
 from armcli.errors import InputError
 from armcli.plan.api import PlanOptions, PlanResult, plan_motion, solve_goal
 from armcli.plan.inputs import configuration, load_context
@@ -41,6 +42,10 @@ class PlanRequest:
                              "or `to_xyz` (a point for the tool)", field="goal")  # fmt: skip
         if self.to_rpy is not None and self.to_xyz is None:
             raise InputError("`to_rpy` needs `to_xyz`", field="to_rpy")
+        timeout = self.options.timeout
+        if not 0 < timeout <= MAX_PLAN_TIMEOUT_S:  # NaN fails too
+            raise InputError(f"must be in (0, {MAX_PLAN_TIMEOUT_S:g}] s, got {timeout:g}",
+                             field="timeout")  # fmt: skip
 
     def describe(self) -> str:
         """`from home to reach`, `from home to xyz 0.2,0,0.15`: the request in words."""
