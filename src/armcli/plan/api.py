@@ -23,6 +23,7 @@ import numpy as np
 from armcli.errors import InputError, PlanningError
 from armcli.plan.certify import certify
 from armcli.plan.collision import PADDING, CollisionChecker
+from armcli.plan.duration import check_motion_time
 from armcli.plan.geometric import plan_path
 from armcli.plan.ik import IkResult, solve_ik
 from armcli.plan.output import read_back, trajectory_yaml
@@ -138,12 +139,14 @@ def plan_motion(
     limits = {n: (float(lo), float(hi)) for n, lo, hi in zip(robot.joints, robot.lower,
                                                             robot.upper, strict=True)}  # fmt: skip
     frame = str(robot.model.frames[1].name) if robot.model.nframes > 1 else ""
+    check_motion_time(robot, np.array([xs, xg]))  # no path is faster than the straight one
     ctx.checker.pad(PADDING, (xs, xg))
     _import_planners()  # their import (~0.5 s) is not planning time
     t0 = time.perf_counter()
     path = plan_path(ctx.checker, robot.lower, robot.upper, xs, xg, planner=options.planner,
                      timeout=options.timeout, seed=options.seed, step=options.step)  # fmt: skip
     t_path = time.perf_counter() - t0
+    check_motion_time(robot, path)
     t_plan, t_cert, last = 0.0, 0.0, None
     for margin in MARGINS if len(path) == 2 else MARGINS_CORNERS:
         timed = parameterise(robot, path, margin)

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import PlanningError
+from armcli.plan.duration import check_duration
 from armcli.plan.robot import PlanRobot
 
 GRID_PER_SEGMENT = 30  # TOPP-RA grid intervals per polyline segment
@@ -166,6 +167,7 @@ def parameterise(robot: PlanRobot, waypoints: np.ndarray, margin: float) -> Time
         pieces.append(traj)
         starts.append(starts[-1] + float(traj.duration))
     duration = starts[-1]
+    check_duration(duration)  # before sampling it at OUTPUT_RATE_HZ (issue 42)
     n_out = max(2, int(np.ceil(duration * OUTPUT_RATE_HZ)) + 1)
     times = np.linspace(0.0, duration, n_out)
     seg = np.clip(np.searchsorted(starts, times, side="right") - 1, 0, len(pieces) - 1)
