@@ -36,6 +36,9 @@ ROBUST_MODES = ("worst", "quantile")  # `tune --robust-mode` over the perturbed 
 # [rad/s² or m/s²] a joint's acceleration limit when neither the spec nor the URDF gives one:
 # MoveIt's time-optimal parameterisation uses the same 1.0 (DEFAULT_ACCELERATION_LIMIT).
 DEFAULT_JOINT_ACCELERATION = 1.0
+# [m] the largest coordinate, size or scaled vertex a point or scene may have (`plan --to-xyz`,
+# scene poses and meshes): no robot reaches 10 km; 1e308 overflowed to inf (issue 42)
+MAX_COORDINATE_M = 1e4
 # Random seeds (`plan`, `tune`, `ros-package --seed`) are 0 <= seed < SEED_LIMIT: what NumPy's
 # and OMPL's generators take (-1 and 2**64 were internal errors; issue 42)
 SEED_LIMIT = 2**32

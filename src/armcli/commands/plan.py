@@ -12,7 +12,7 @@ import typer
 from armcli.commands.flags import flag_errors
 from armcli.commands.options import choice, option, seed_option
 from armcli.commands.robot_input import robot_options
-from armcli.commands.values import Names, Numbers, names, numbers
+from armcli.commands.values import Names, Numbers, names, numbers, point
 from armcli.defaults import MAX_PLAN_TIMEOUT_S, PLANNERS
 from armcli.errors import PlanningError
 from armcli.io.terminal import say
@@ -57,7 +57,7 @@ def plan_cmd(
     start: str = option(None, "--from", help=FROM_HELP + " Default: home."),
     goal: str = option(None, "--to", help=TO_HELP),
     to_xyz: Numbers = option(
-        None, "--to-xyz", parser=numbers("--to-xyz", 3, "x,y,z [m]"), metavar="X,Y,Z", help=XYZ_HELP
+        None, "--to-xyz", parser=point("--to-xyz"), metavar="X,Y,Z", help=XYZ_HELP
     ),
     to_rpy: Numbers = option(
         None,

@@ -12,6 +12,7 @@ import math
 from collections.abc import Callable
 from typing import NewType
 
+from armcli.defaults import MAX_COORDINATE_M
 from armcli.errors import InputError
 
 Names = NewType("Names", tuple)  # type: ignore[type-arg]  # tuple[str, ...]; typer needs a class
@@ -48,8 +49,17 @@ def numbers(flag: str, count: int | None = None, what: str = "") -> Callable[[st
 
 
 def point(flag: str) -> Callable[[str], Numbers]:
-    """A parser of the point `x,y,z` [m]."""
-    return numbers(flag, 3, "x,y,z in metres")
+    """A parser of the point `x,y,z` [m], each within ±MAX_COORDINATE_M (1e308 overflowed)."""
+    parse_numbers = numbers(flag, 3, "x,y,z in metres")
+
+    def parse(text: str) -> Numbers:
+        values = parse_numbers(text)
+        if not all(abs(v) <= MAX_COORDINATE_M for v in values):
+            raise InputError(f"each coordinate must be within ±{MAX_COORDINATE_M:g} m, "
+                             f"got {text!r}", field=flag)  # fmt: skip
+        return values
+
+    return parse
 
 
 def size(text: str) -> Numbers:

@@ -11,7 +11,12 @@ with SolidPrimitive's `dimensions`) with one `primitive_poses` entry each, and/o
 (a `path` to a mesh file inside the scene file's directory, or a shape_msgs/Mesh's
 `triangles` and `vertices`) with `mesh_poses`. Poses are geometry_msgs/Pose
 (`position` x y z [m], `orientation` quaternion x y z w). Nothing outside the scene's
-directory is read.
+directory is read, and no file a mesh names (io.scenemesh).
+
+A scene is bounded before it costs anything (issue 42: 40 objects naming one 19.9 MB PLY
+reached 2.8 GB, ~8,700 small boxes did not finish in 90 s): at most MAX_SCENE_SHAPES
+primitives and meshes and MAX_SCENE_TRIANGLES triangles in all (counted from what each
+file declares before it is parsed), every coordinate and size within MAX_COORDINATE_M.
 """
 
 from __future__ import annotations
@@ -24,11 +29,14 @@ from typing import Any
 
 import numpy as np
 
+from armcli.defaults import MAX_COORDINATE_M
 from armcli.errors import InputError, Problem, SpecError
-from armcli.io.mesh_confine import bounded_mesh_file
 from armcli.io.packages import inside
+from armcli.io.scenemesh import OverBudgetError, read_scene_mesh
 from armcli.io.yaml import YamlDoc, dotted, is_finite_number, load_yaml
 
+MAX_SCENE_SHAPES = 1000  # primitives and meshes: plan took 6 s with 1000 boxes, 77 s with 3000
+MAX_SCENE_TRIANGLES = 500_000  # all meshes: ~0.85 kB each in plan's collision model (~0.4 GB)
 WORLD_FRAMES = ("", "world")
 PRIMITIVES = {1: "box", 2: "sphere", 3: "cylinder", 4: "cone"}  # SolidPrimitive constants
 DIMENSIONS = {"box": 3, "sphere": 1, "cylinder": 2, "cone": 2}  # [x y z], [r], [h r], [h r]
@@ -72,15 +80,47 @@ class Scene:
     source: str = ""
 
 
+class _StopError(Exception):
+    """A budget is spent: stop reading (the problem is recorded)."""
+
+
 class _Reader:
     def __init__(self, doc: YamlDoc, links: Sequence[str]) -> None:
         self.doc = doc
         self.links = list(links)
         self.base = Path(doc.source).parent
         self.problems: list[Problem] = []
+        self.shapes_read = 0
+        self.triangles = 0  # read so far, against MAX_SCENE_TRIANGLES
 
     def add(self, path: Path_, message: str) -> None:
         self.problems.append(Problem(dotted(path), message, self.doc.line_of(path)))
+
+    def stop(self, path: Path_, message: str) -> _StopError:
+        self.add(path, message)
+        return _StopError()
+
+    def count(self, path: Path_) -> None:
+        """One more shape against the scene's budget; stop past it."""
+        self.shapes_read += 1
+        if self.shapes_read > MAX_SCENE_SHAPES:
+            raise self.stop(path, f"the scene holds more than {MAX_SCENE_SHAPES} primitives and "
+                            "meshes, armcli's bound on a scene")  # fmt: skip
+
+    def spend(self, path: Path_, triangles: int) -> None:
+        """A mesh's triangles against the scene's budget; stop past it."""
+        self.triangles += triangles
+        if self.triangles > MAX_SCENE_TRIANGLES:
+            raise self.stop(path, f"the scene's meshes hold more than {MAX_SCENE_TRIANGLES} "
+                            "triangles, armcli's bound on a scene")  # fmt: skip
+
+    def bounded(self, values: np.ndarray, path: Path_, what: str) -> bool:
+        """Whether every value is finite and within ±MAX_COORDINATE_M; a problem if not."""
+        with np.errstate(over="ignore", invalid="ignore"):
+            ok = bool(np.all(np.abs(values) <= MAX_COORDINATE_M))
+        if not ok:
+            self.add(path, f"{what} must stay within ±{MAX_COORDINATE_M:g} m")
+        return ok
 
     def keys(self, data: Mapping[str, Any], allowed: set[str], path: Path_) -> None:
         for key in data:
@@ -111,6 +151,7 @@ class _Reader:
         self.keys(pos, {"x", "y", "z"}, (*path, "position"))
         self.keys(ori, {"x", "y", "z", "w"}, (*path, "orientation"))
         T[:3, 3] = [self.number(pos.get(k), (*path, "position", k), 0.0) for k in "xyz"]
+        self.bounded(T[:3, 3], (*path, "position"), "a position")
         q = [self.number(ori.get(k), (*path, "orientation", k), 0.0) for k in "xyzw"]
         if "w" not in ori and not any(k in ori for k in "xyz"):
             q[3] = 1.0
@@ -146,6 +187,7 @@ class _Reader:
         values = tuple(self.number(d, (*path, "dimensions", i)) for i, d in enumerate(dims))
         if any(v <= 0 for v in values):
             self.add((*path, "dimensions"), f"must all be > 0 [m], got {list(values)}")
+        self.bounded(np.array(values), (*path, "dimensions"), "dimensions")
         return str(kind), values
 
     def mesh(self, raw: Any, path: Path_) -> tuple[np.ndarray, np.ndarray] | None:
@@ -159,6 +201,7 @@ class _Reader:
         if not isinstance(tris, list) or not isinstance(verts, list) or not tris or not verts:
             self.add(path, "needs `path`, or non-empty `triangles` and `vertices`")
             return None
+        self.spend((*path, "triangles"), len(tris))  # before any array is built
         v = np.array(
             [[self.number(p.get(k) if isinstance(p, dict) else None, (*path, "vertices", i, k))
               for k in "xyz"] for i, p in enumerate(verts)]
@@ -172,6 +215,8 @@ class _Reader:
                 self.add((*path, "triangles", i), f"needs vertex_indices: 3 of 0..{len(v) - 1}")
                 return None
             f.append(idx)
+        if not self.bounded(v, (*path, "vertices"), "vertices"):
+            return None
         return v, np.array(f, dtype=int)
 
     def mesh_file(
@@ -187,21 +232,32 @@ class _Reader:
             self.add((*path, "scale"), "must be [sx, sy, sz]")
             return None
         s = np.array([self.number(x, (*path, "scale", i)) for i, x in enumerate(scale)])
+        if not np.all(s != 0):
+            self.add((*path, "scale"), f"must be three nonzero numbers, got {scale}")
+            return None
         file = (self.base / name).resolve()
         if not inside(file, (self.base.resolve(),)) or not file.is_file():
             self.add((*path, "path"), f"{name!r} is not a file inside {self.base}")
             return None
-        import trimesh
-
-        bounded_mesh_file(file, self.doc.source)
         try:
-            loaded = trimesh.load(str(file), force="mesh", process=False)
-        except Exception as exc:  # trimesh raises many kinds on a bad file
-            self.add((*path, "path"), f"cannot read the mesh: {exc}")
+            vertices, faces = read_scene_mesh(
+                file, self.doc.source, MAX_SCENE_TRIANGLES - self.triangles
+            )
+        except OverBudgetError as exc:
+            raise self.stop((*path, "path"), f"{name!r} {exc} of the scene's "
+                            f"{MAX_SCENE_TRIANGLES}-triangle bound") from None  # fmt: skip
+        except InputError as exc:
+            self.add((*path, "path"), f"{name!r}: {exc.message}")
             return None
-        vertices = np.array(getattr(loaded, "vertices", []), dtype=np.float64)
-        faces = np.array(getattr(loaded, "faces", []), dtype=np.int64)
-        return vertices * s, faces
+        if not len(faces):
+            self.add((*path, "path"), f"{name!r} holds no triangles")
+            return None
+        self.spend((*path, "path"), len(faces))
+        with np.errstate(over="ignore", invalid="ignore"):
+            scaled = vertices * s  # 1e308 overflows to inf: refused below, never a warning
+        if not self.bounded(scaled, (*path, "scale"), "the scaled vertices"):
+            return None
+        return scaled, faces
 
     def shapes(self, obj: Mapping[str, Any], path: Path_) -> list[Shape]:
         out = []
@@ -215,6 +271,7 @@ class _Reader:
                 self.add((*path, pose_key), f"needs one pose per entry of {key} ({len(items)})")
                 continue
             for i, (item, raw_pose) in enumerate(zip(items, poses, strict=True)):
+                self.count((*path, key, i))
                 T = T_obj @ self.pose(raw_pose, (*path, pose_key, i))
                 if key == "primitives":
                     prim = self.primitive(item, (*path, key, i))
@@ -277,7 +334,14 @@ def parse_scene(doc: YamlDoc, links: Sequence[str]) -> Scene:
         r.add(prefix, "must be a list of collision objects")
         raw = []
     seen: set[str] = set()
-    objects = [r.obj(o, (*prefix, i), seen) for i, o in enumerate(raw)]
+    objects: list[SceneObject | None] = []
+    try:
+        if len(raw) > MAX_SCENE_SHAPES:  # each object holds a shape at least
+            raise r.stop(prefix, f"{len(raw)} collision objects, more than the {MAX_SCENE_SHAPES}"
+                         " primitives and meshes armcli reads in a scene")  # fmt: skip
+        objects = [r.obj(o, (*prefix, i), seen) for i, o in enumerate(raw)]
+    except _StopError:
+        pass  # the problem is recorded
     if r.problems:
         raise SpecError(doc.source, r.problems)
     return Scene(tuple(o for o in objects if o is not None), doc.source)

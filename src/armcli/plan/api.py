@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from armcli.defaults import MAX_COORDINATE_M
 from armcli.errors import InputError, PlanningError
 from armcli.io.scene import Scene
 from armcli.plan.certify import certify
@@ -189,8 +190,9 @@ def solve_goal(
 
     robot = ctx.robot
     target = np.asarray(list(xyz), dtype=float)
-    if target.shape != (3,) or not np.all(np.isfinite(target)):
-        raise InputError("give x,y,z: three finite numbers [m]", field="to-xyz")
+    if target.shape != (3,) or not np.all(np.abs(target) <= MAX_COORDINATE_M):  # NaN too
+        raise InputError(f"give x,y,z: three numbers within ±{MAX_COORDINATE_M:g} m",
+                         field="to-xyz")  # fmt: skip
     x0 = values(ctx, start, "start") if start is not None else None
     rotation = None
     if rpy is not None:

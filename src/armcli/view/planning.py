@@ -11,6 +11,7 @@ over `PlanningSession`, which the tests drive directly.
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -18,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from armcli.defaults import MAX_COORDINATE_M
 from armcli.errors import InputError, OutputRefusedError, PlanningError
 from armcli.io.files import write_file_atomic
 from armcli.io.outdir import check_output_file, relative_inside
@@ -150,9 +152,12 @@ class PlanningSession:
         Seeded at the current goal; without a solution the goal stays where it was.
         """
         checker = self.context.checker
+        target = np.asarray(xyz, dtype=float)
+        if target.shape != (3,) or not np.all(np.abs(target) <= MAX_COORDINATE_M):
+            return IkOutcome(None, math.inf)  # a client's 1e308 would overflow in IK
         res = solve_ik(
             self.context.robot,
-            np.asarray(xyz, dtype=float),
+            target,
             rotation,
             seed_x=self.goal,
             seed=self._options.seed,
