@@ -145,3 +145,65 @@ def test_wrong_schema_and_lying_sequences_are_one_input_error(tmp_path: Path) ->
             except InputError:
                 refused += 1
     assert refused > 0  # and no other exception escaped
+
+
+def _tf_mcap(path: Path, transforms: int, messages: int = 1) -> Path:
+    """/joint_states plus /tf messages of `transforms` transforms each (chunked, zstd)."""
+    from mcap_ros2.writer import Writer
+
+    tf = {
+        "header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": "a"},
+        "child_frame_id": "b",
+        "transform": {"translation": {"x": 0, "y": 0, "z": 0},
+                      "rotation": {"x": 0, "y": 0, "z": 0, "w": 1}},
+    }  # fmt: skip
+    with path.open("wb") as fh:
+        writer = Writer(fh)
+        states = writer.register_msgdef(
+            rosbag.JOINT_STATE, rosbag.message_definition(rosbag.JOINT_STATE)
+        )
+        tfs = writer.register_msgdef(
+            rosbag.TF_MESSAGE, rosbag.message_definition(rosbag.TF_MESSAGE)
+        )
+        for k in range(messages):
+            stamp = {"sec": k, "nanosec": 0}
+            state = {"header": {"stamp": stamp, "frame_id": ""}, "name": [JOINT],
+                     "position": [0.0], "velocity": [], "effort": []}  # fmt: skip
+            writer.write_message(rosbag.JOINT_STATES, states, state, log_time=k, publish_time=k)
+            writer.write_message(rosbag.TF, tfs, {"transforms": [tf] * transforms},
+                                 log_time=k, publish_time=k)  # fmt: skip
+        writer.finish()
+    return path
+
+
+def test_too_many_messages_are_refused_before_any_is_parsed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Issue 42: 9 chunks of 450k tiny messages (a 9 MB file) took over 60 s and 2.5 GB.
+
+    The bound is lowered for the test (a million messages take a minute to write); the count
+    comes from the chunks' records, before the mcap reader parses or decodes anything.
+    """
+    from armcli.sim import mcap_guard
+
+    path = _mcap(tmp_path / "many.mcap", [0.1 * k for k in range(101)])
+    monkeypatch.setattr(mcap_guard, "MAX_MESSAGES", 100)
+    monkeypatch.setattr("mcap.reader.make_reader", None)  # never reached
+    with pytest.raises(InputError, match="more than 100 messages, armcli's bound on a replay"):
+        rosbag.load_replay(path, [JOINT])
+
+
+def test_one_huge_tf_message_is_refused_before_it_is_decoded(tmp_path: Path) -> None:
+    """Issue 42: one /tf message of 750k transforms loaded to 1 GB; here ~1.3 MB of them."""
+    path = _tf_mcap(tmp_path / "tf.mcap", transforms=15_000)
+    with pytest.raises(InputError, match=r"a message at byte \d+ is \d+ bytes, more than"):
+        rosbag.load_replay(path, [JOINT])
+
+
+def test_transforms_are_bounded_per_replay(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    path = _tf_mcap(tmp_path / "tf.mcap", transforms=40, messages=3)
+    monkeypatch.setattr(rosbag, "MAX_REPLAY_TRANSFORMS", 100)
+    with pytest.raises(InputError, match="more than 100 /tf transforms"):
+        rosbag.load_replay(path, [JOINT])
+    monkeypatch.setattr(rosbag, "MAX_REPLAY_TRANSFORMS", 120)
+    assert rosbag.load_replay(path, [JOINT]).duration == pytest.approx(2.0)
