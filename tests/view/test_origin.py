@@ -40,7 +40,7 @@ def _upgrade(v: Viewer, host: str, origin: str | None) -> int:
         "Sec-WebSocket-Protocol": f"viser-v{viser.__version__}",  # else viser prints a warning
         **({"Origin": origin} if origin is not None else {}),
     }
-    conn.request("GET", "/", headers=headers)
+    conn.request("GET", f"/?token={v.token}", headers=headers)  # the token: test_token.py
     status = conn.getresponse().status
     conn.close()
     return status
@@ -57,7 +57,7 @@ def test_foreign_host_is_refused(viewer: Viewer) -> None:
     evil = f"evil.example:{viewer.port}"
     assert _upgrade(viewer, evil, f"http://{evil}") == 403
     conn = http.client.HTTPConnection("127.0.0.1", viewer.port, timeout=10)
-    conn.request("GET", "/", headers={"Host": evil})
+    conn.request("GET", f"/?token={viewer.token}", headers={"Host": evil})
     assert conn.getresponse().status == 403  # the page itself is not served either
     conn.close()
 

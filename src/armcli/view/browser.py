@@ -28,7 +28,7 @@ from armcli.sim.states import Replay
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_root
 from armcli.urdf.tree import parse_tree
-from armcli.view.origin import checked_requests
+from armcli.view.origin import TOKEN_PARAM, checked_requests, new_token
 from armcli.view.png import (
     full_configuration,
     joint_limits,
@@ -107,8 +107,9 @@ class Viewer:
         self._stop = threading.Event()
         self._playing = False
         check_port_free(host, port)
-        # viser prints a banner (the CLI prints its own); Host/Origin checked (view.origin)
-        with contextlib.redirect_stdout(io.StringIO()), checked_requests(host):
+        self.token = new_token()  # every request must carry it (view.origin)
+        # viser prints a banner (the CLI prints its own); Host, Origin, token checked
+        with contextlib.redirect_stdout(io.StringIO()), checked_requests(host, self.token):
             self.server = viser.ViserServer(
                 host=host, port=port, label=f"armcli: {name}", verbose=False
             )
@@ -147,8 +148,8 @@ class Viewer:
     # -- public API ------------------------------------------------------------------
     @property
     def url(self) -> str:
-        """Address of the viewer page."""
-        return f"http://{self.host}:{self.port}"
+        """Address of the viewer page, with the run's token (the page sets it as a cookie)."""
+        return f"http://{self.host}:{self.port}/?{TOKEN_PARAM}={self.token}"
 
     @property
     def joint_names(self) -> tuple[str, ...]:
