@@ -249,3 +249,41 @@ def test_panda_drag_solves_position_and_orientation(tmp_path: Path) -> None:
     assert session.plan() is not None, session.reason
     with pytest.raises(InputError, match=r"no PD gains to simulate with: .*armcli import"):
         session.execute()  # a URDF carries no gains
+
+
+def test_save_names_from_the_page_are_refused_in_one_line(session: PlanningSession) -> None:
+    """Issue 42: a NUL byte was a ValueError, 5,000 characters an OSError: never answered."""
+    session.set_goal(session.pose("reach"))
+    assert session.plan() is not None
+    for name, why in [
+        ("a\0b.yaml", "control characters or NUL"),
+        ("x" * 5000 + ".yaml", "too long"),
+        ("line\nbreak.yaml", "control characters"),
+    ]:
+        with pytest.raises(OutputRefusedError, match=why):
+            session.save(name)
+    assert sorted(p.name for p in session.save_dir.iterdir()) == []
+
+
+def test_save_replaces_only_what_the_viewer_wrote_unless_confirmed(
+    session: PlanningSession,
+) -> None:
+    """Issue 42: Save overwrote any file in the save directory (root's `roots-notes.yaml`)."""
+    notes = session.save_dir / "roots-notes.yaml"
+    notes.write_text("my notes\n")
+    session.set_goal(session.pose("reach"))
+    result = session.plan()
+    assert result is not None
+    with pytest.raises(OutputRefusedError, match="exists and this viewer did not write it"):
+        session.save("roots-notes.yaml")
+    assert notes.read_text() == "my notes\n"
+    plan = session.save("plan.yaml")
+    assert session.save("plan.yaml") == plan  # its own file: saved again without asking
+    plan.write_text("edited elsewhere\n")  # changed since: no longer what the viewer wrote
+    with pytest.raises(OutputRefusedError, match="did not write it"):
+        session.save("plan.yaml")
+    assert plan.read_text() == "edited elsewhere\n"
+    assert session.save("plan.yaml", overwrite=True).read_bytes() == result.document
+    os.replace(notes, plan)  # another file in its place
+    with pytest.raises(OutputRefusedError, match="did not write it"):
+        session.save("plan.yaml")

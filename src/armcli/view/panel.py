@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from armcli.errors import ArmcliError
+from armcli.errors import ArmcliError, InputError
 from armcli.urdf.meshes import MeshSearch
 from armcli.view.browser import FRAME_RATE, moving_parts
 from armcli.view.planning import PlanningSession
@@ -155,13 +155,21 @@ class PlanningPanel:
         return not done.broken
 
     def save(self) -> Path | None:
-        """Write the plan's trajectory YAML under the name in the File box."""
+        """Write the plan's trajectory YAML under the name in the File box.
+
+        Over a file the viewer did not write only with Overwrite ticked (unticked after).
+        """
         with self._lock:
             try:
-                path = self.session.save(str(self._file_box.value))
+                overwrite = bool(self._overwrite_box.value)
+                path = self.session.save(str(self._file_box.value), overwrite=overwrite)
             except ArmcliError as exc:
                 self._set_status(f"not saved: {exc}")
                 return None
+            except Exception as exc:  # the page's input must never kill the answer
+                self._set_status(f"not saved: {type(exc).__name__}: {exc}")
+                return None
+            self._quietly(lambda: setattr(self._overwrite_box, "value", False))
             self._set_status(f"wrote {path}")
             return path
 
@@ -186,6 +194,7 @@ class PlanningPanel:
             self._plan_button: Any = gui.add_button("Plan")
             self._execute_button: Any = gui.add_button("Execute", disabled=True)
             self._file_box: Any = gui.add_text("File", initial_value="plan.yaml")
+            self._overwrite_box: Any = gui.add_checkbox("Overwrite", initial_value=False)
             self._save_button: Any = gui.add_button("Save", disabled=True)
             self._status: Any = gui.add_markdown("drag the tool point or pick a goal, then Plan")
         self._start_box.on_update(lambda _e: self._on_start())
@@ -214,7 +223,10 @@ class PlanningPanel:
         with self._lock:
             name = str(self._start_box.value)
             if name != CURRENT:
-                self.session.set_start(self.session.pose(name))
+                x = self._named(name)
+                if x is None:
+                    return
+                self.session.set_start(x)
                 self.viewer.set_configuration(self.session.as_dict(self.session.start))
             self._hide_trail()
 
@@ -222,9 +234,23 @@ class PlanningPanel:
         if self._quiet or self._goal_box.value == DRAGGED:
             return
         with self._lock:
-            self.session.set_goal(self.session.pose(str(self._goal_box.value)))
+            x = self._named(str(self._goal_box.value))
+            if x is None:
+                return
+            self.session.set_goal(x)
             self._hide_trail()
             self._show_goal()
+
+    def _named(self, name: str) -> np.ndarray | None:
+        """A named pose's values, or None and the reason in the status line.
+
+        A page may send any name, not only the dropdown's (issue 42: a traceback before).
+        """
+        try:
+            return self.session.pose(name)
+        except ArmcliError as exc:
+            self._set_status(f"not changed: {exc.message if isinstance(exc, InputError) else exc}")
+            return None
 
     def _buttons(self, *, busy: bool) -> None:
         """Plan while idle; Execute and Save once there is a plan."""

@@ -15,12 +15,12 @@ import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
 import numpy as np
 
 from armcli.defaults import MAX_COORDINATE_M
-from armcli.errors import InputError, OutputRefusedError, PlanningError
+from armcli.errors import BuildError, InputError, OutputRefusedError, PlanningError
 from armcli.io.files import write_file_atomic
 from armcli.io.outdir import check_output_file, relative_inside
 from armcli.io.scene import Scene, Shape
@@ -36,6 +36,8 @@ LIVE_IK_ATTEMPTS = 16  # seeded at the goal, then restarts (Panda: ~0.1 s; 4 mis
 TRAIL_POSES = 7  # ghost poses drawn along a plan, both ends included
 TRAIL_POINTS = 60  # tool-point samples of the drawn path
 SAVE_SUFFIXES = (".yaml", ".yml")
+NAME_MAX = 255  # [bytes] one file name (Linux's NAME_MAX)
+MAX_SAVE_NAME_BYTES = 1024  # a name with its subdirectories
 
 
 @dataclass(frozen=True)
@@ -93,6 +95,7 @@ class PlanningSession:
         self._sim = sim or SimOptions(urdf=None if robot_file.spec else robot_file.path)
         self._search = search
         self.save_dir = Path(save_dir)
+        self._written: dict[str, tuple[int, ...]] = {}  # path -> _identity of what Save wrote
         self._options = options or PlanOptions()
         robot = context.robot
         self._data = robot.model.createData()
@@ -219,8 +222,23 @@ class PlanningSession:
         return self.execution
 
     def save_path(self, name: str) -> Path:
-        """Where Save writes `name`: inside `save_dir` only, a .yaml file, never through a link."""
+        """Where Save writes `name`: inside `save_dir` only, a .yaml file, never through a link.
+
+        A name is text from the page: control characters (NUL included) and names longer
+        than a file system takes are refused here, as one line (issue 42: they were
+        exceptions the panel never answered).
+        """
         name = name.strip()
+        if any(ord(c) < 32 or ord(c) == 127 for c in name):
+            raise OutputRefusedError("a file name cannot hold control characters or NUL",
+                                     field="save")  # fmt: skip
+        try:
+            parts = [len(os.fsencode(p)) for p in PurePosixPath(name).parts]
+        except UnicodeError:
+            raise OutputRefusedError("the file name is not valid text", field="save") from None
+        if sum(parts) > MAX_SAVE_NAME_BYTES or any(n > NAME_MAX for n in parts):
+            raise OutputRefusedError(f"the file name is too long ({len(name)} characters)",
+                                     field="save")  # fmt: skip
         rel = relative_inside(name)
         if Path(name).suffix not in SAVE_SUFFIXES:
             raise OutputRefusedError(
@@ -233,11 +251,33 @@ class PlanningSession:
         check_output_file(path, "save")
         return path
 
-    def save(self, name: str) -> Path:
-        """Write the last plan's JointTrajectory YAML as `name` in the save directory."""
+    def save(self, name: str, *, overwrite: bool = False) -> Path:
+        """Write the last plan's JointTrajectory YAML as `name` in the save directory.
+
+        A file this session did not write itself is replaced only with `overwrite` (the
+        panel's confirmation), so a stray click never replaces the user's own file.
+        """
         if self.result is None:
             raise PlanningError("no-plan", "nothing planned yet: click Plan first")
-        return write_file_atomic(self.save_path(name), self.result.document)
+        path = self.save_path(name)
+        if os.path.lexists(path) and not overwrite and not self._wrote(path):
+            raise OutputRefusedError(f"{name.strip()!r} exists and this viewer did not write it; "
+                                     "tick Overwrite to replace it", field="save")  # fmt: skip
+        try:
+            written = write_file_atomic(path, self.result.document)
+            st = os.stat(written)
+        except OSError as exc:
+            raise BuildError(f"{path}: cannot write: {exc.strerror}") from None
+        self._written[str(written)] = _identity(st)
+        return written
+
+    def _wrote(self, path: Path) -> bool:
+        """Whether `path` is still the file this session's Save wrote there, unchanged."""
+        try:
+            st = os.stat(path)
+        except OSError:
+            return False
+        return self._written.get(str(path)) == _identity(st)
 
     def obstacles(self) -> list[ObstacleMesh]:
         """The scene's shapes as meshes in the root frame (link-fixed ones at the start pose)."""
@@ -255,6 +295,11 @@ class PlanningSession:
                 M = T @ shape.T_frame_shape
                 out.append(ObstacleMesh(obj.id, v @ M[:3, :3].T + M[:3, 3], f))
         return out
+
+
+def _identity(st: os.stat_result) -> tuple[int, ...]:
+    """A file's identity and version: device, inode, size, modification time [ns]."""
+    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
 
 
 def _triangles(shape: Shape) -> tuple[np.ndarray, np.ndarray]:
