@@ -50,8 +50,8 @@ def mjcf_cmd(
     from armcli.compiler.expand import spec_label  # on use: `--help` stays light
     from armcli.export.mjcf_files import export_mjcf
 
-    check_output_file(out, "--out", parents=True)  # before any work: nothing else is written
     path = robot.file()
+    check_output_file(out, "--out", [path], parents=True)  # before any work; never over it
     res = export_mjcf(
         path,
         out,

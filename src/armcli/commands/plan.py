@@ -92,8 +92,9 @@ def plan_cmd(
     from armcli.plan.request import PlanRequest, plan_request
 
     request = PlanRequest(start, goal, to_xyz, to_rpy, srdf, scene, joints or None, group)
-    if output is not None:
-        check_output_file(output, "--output")
+    if output is not None:  # never over a file it reads (issue 42; hard links too)
+        inputs = [p for p in (urdf or robot.file(), srdf, scene) if p is not None]
+        check_output_file(output, "--output", inputs)
     robot_file = robot.read(urdf)
     what = request.describe()
     opts = PlanOptions(planner=planner, timeout=timeout, seed=seed,

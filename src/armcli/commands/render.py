@@ -60,7 +60,7 @@ def render_cmd(
     from armcli.view.png import MESH_HINT, load_urdf, render_png
     from armcli.view.scene import load_robot, pose_q
 
-    check_output_file(out, "--out")  # before any work: nothing else is written
+    check_output_file(out, "--out", robot.files())  # before any work; never over the robot
     src = load_robot(robot)
     write_notes(src.notes)
     values = pose_q(src, pose, q)

@@ -116,14 +116,16 @@ def simulate_cmd(
     unknown = unknown_rules(ignore)
     if unknown:
         raise InputError(f"unknown rule(s) {', '.join(unknown)}", field="--ignore")
+    read = [*robot.paths] or ([robot.file()] if urdf is None else [])  # the spec
+    read += [p for p in (urdf, trajectory, cmd_vel, world) if p is not None]
     if output is not None:
         from armcli.sim import rosbag  # the MCAP writer: imported by runs that write a file
 
         if not rosbag.is_mcap(output):
             states.output_format(output)
-        check_output_file(output, "--output")
+        check_output_file(output, "--output", read)  # never over an input (issue 42)
     if plot is not None:
-        check_png_file(plot, "--plot")
+        check_png_file(plot, "--plot", read)
     spec_path, spec_obj = None, None
     if robot.path is not None or urdf is None:  # the spec layers are imported only for a spec
         from armcli.spec.load import load_spec

@@ -35,7 +35,7 @@ def tree_cmd(
     from armcli.view.scene import load_robot
 
     if out is not None:
-        check_output_file(out, "--out")
+        check_output_file(out, "--out", robot.files())  # never over the robot file
     src = load_robot(robot)
     write_notes(src.notes)
     tree = parse_tree(src.xml, src.source)

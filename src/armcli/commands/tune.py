@@ -115,10 +115,11 @@ def tune_cmd(
         validate(opts)
         if output is not None and output.suffix.lower() != ".json":
             raise InputError("the output file must end in .json", field="--output")
+        read = [spec_path, *(trajectory or [])]  # never written over (issue 42)
         if output is not None:  # before the search: no partial outputs
-            check_output_file(output, "--output")
+            check_output_file(output, "--output", read)
         if plot is not None:
-            check_png_file(plot, "--plot")
+            check_png_file(plot, "--plot", read)
         if write:
             check_writable(spec_path)
         settings = tjob.TuneSettings(

@@ -10,6 +10,7 @@ from armcli.errors import ExistingFileError, InputError
 from armcli.importer.run import GainSource, ImportResult, import_urdf
 from armcli.io.files import write_file_atomic
 from armcli.io.mesh_confine import package_xml_name
+from armcli.io.outdir import check_output_file
 from armcli.io.packages import PackageLookup
 from armcli.urdf.doc import Urdf
 from armcli.urdf.source import Trust, read_urdf_file
@@ -54,6 +55,7 @@ def import_file(
         ExistingFileError: `out` exists and `force` is not set (nothing was read or written).
         InputError: the file is unusable or holds what a spec cannot.
     """
+    check_output_file(out, "out", [path])  # never over the file it imports, --force or not
     if out.exists() and not force:
         raise ExistingFileError(f"{out} exists; pass `force` to replace it", file=out)
     if out.is_dir():

@@ -142,10 +142,10 @@ def check_output_file(
         )
 
 
-def check_png_file(path: str | Path, field: str) -> None:
+def check_png_file(path: str | Path, field: str, inputs: Sequence[str | Path] = ()) -> None:
     """Refuse a plot path that does not end in .png (the plots are PNG; x.jpg would lie)."""
     p = Path(path)
-    check_output_file(p, field)
+    check_output_file(p, field, inputs)
     if p.suffix.lower() != ".png":
         raise OutputRefusedError(
             f"plots are written as PNG; name the file {p.stem or 'plot'}.png", file=p, field=field
