@@ -112,6 +112,33 @@ class Problem:
     line: int | None = None
 
 
+_VALUES = re.compile(r"'[^']*'|\"[^\"]*\"|[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
+_INDICES = re.compile(r"\[\d+\]")
+
+
+def one_per_kind(problems: Sequence[Problem], extra: Sequence[int] = ()) -> list[Problem]:
+    """The first problem of each kind, saying how many more there are (`(and N more)`).
+
+    A kind is the field without its list indices (`commands[*].linear.x`) and the message
+    without the values it quotes: 25,000 bad commands are one line, not 25,000 (issue 42).
+    `extra`: repeats already counted per problem (a reader's own `once`).
+    """
+    counts = [*extra, *([0] * (len(problems) - len(extra)))]
+    first: dict[tuple[str, str], int] = {}
+    for i, p in enumerate(problems):
+        kind = (_INDICES.sub("[*]", p.field), _VALUES.sub("_", p.message))
+        if kind in first:
+            counts[first[kind]] += 1 + counts[i]
+        else:
+            first[kind] = i
+    out = []
+    for i in first.values():
+        p = problems[i]
+        out.append(Problem(p.field, f"{p.message} (and {counts[i]} more)", p.line) if counts[i]
+                   else p)  # fmt: skip
+    return out
+
+
 class SpecError(InputError):
     """A spec (or other structured YAML input) failed validation; one line per problem."""
 

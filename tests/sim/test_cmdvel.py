@@ -56,3 +56,19 @@ def test_bad_files_name_line_and_field(text: str, line: int, field: str) -> None
 def test_the_shipped_example_loads() -> None:
     cmd = load_cmd_vel(ROOT / "specs" / "trajectories" / "drive.yaml")
     assert cmd.times.tolist() == [0.5, 3.0, 5.5, 7.0] and cmd.warnings == ()
+
+
+def test_many_bad_commands_are_one_line_per_kind() -> None:
+    """Issue 42: 25,000 bad commands printed 25,001 error lines (2 MB)."""
+    body = "".join(
+        "- {linear: {x: b}, time_from_start: 0}\n" if k % 2 else "- {linear: {x: b}}\n"
+        for k in range(25_000)
+    )  # every command a bad number; every second one also back at 0 s
+    with pytest.raises(SpecError) as info:
+        loads_cmd_vel("commands:\n" + body)
+    lines = info.value.lines()
+    assert len(lines) == 2, lines[:5]
+    first = "<cmd_vel>:2 commands[0].linear.x: must be a finite number, got 'b'"
+    assert lines[0] == f"{first} (and 24999 more)"
+    assert lines[1].startswith("<cmd_vel>:3 commands[1].time_from_start: times must increase")
+    assert lines[1].endswith("(and 12499 more)")

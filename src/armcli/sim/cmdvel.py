@@ -83,7 +83,7 @@ def parse_cmd_vel(doc: YamlDoc) -> CmdVel:
             parts[part].append(_vector3(cmd.get(part), ("commands", k, part), c))
         times.append(_time(cmd, times, k, c, key="commands"))
     if c.problems:
-        raise SpecError(doc.source, c.problems)
+        raise SpecError(doc.source, c.finish())  # one line per kind of problem
     linear, angular = np.array(parts["linear"]), np.array(parts["angular"])
     return CmdVel(
         times=np.array(times, dtype=float),

@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from armcli.errors import Problem, SpecError
+from armcli.errors import Problem, SpecError, one_per_kind
 from armcli.io.yaml import FlowKeys, YamlDoc, dotted, load_yaml, loads_yaml
 from armcli.sim.brace import BraceNotes
 
@@ -109,13 +109,11 @@ class _Collector:
         self.add(path, msg)
 
     def finish(self) -> list[Problem]:
-        """The problems, each repeated one saying how many more places repeat it."""
-        out = list(self.problems)
+        """One problem per kind, saying how many more places repeat it (errors.one_per_kind)."""
+        extra = [0] * len(self.problems)
         for index, more in self.repeats.values():
-            if more:
-                p = out[index]
-                out[index] = Problem(p.field, f"{p.message} (and {more} more)", p.line)
-        return out
+            extra[index] = more
+        return one_per_kind(self.problems, extra)
 
     def unknown_keys(
         self, data: Mapping[str, Any], allowed: set[str], path: tuple[str | int, ...]
