@@ -230,3 +230,16 @@ def test_a_world_without_a_drive_is_exit_2(
     world.write_text("collision_objects: []\n")
     code, _, err = run_main(["simulate", DEFAULT_SPEC, "-t", PICK, "--world", world], capsys)
     assert code == 2 and "--world" in err
+
+
+@pytest.mark.parametrize("duration", ["0", "-1"])
+def test_a_drive_of_no_time_is_refused_like_any_run(duration: str, tmp_path: Path) -> None:
+    """Issue 42: `--duration 0` with `--cmd-vel` ran a drive of 0 s and wrote its files."""
+    from tests.helpers import run_cli
+
+    out = tmp_path / "run.csv"
+    args: list[str | Path] = ["simulate", DEFAULT_SPEC, "--cmd-vel", DRIVE, "--duration", duration]
+    proc = run_cli([*args, "-o", out], tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr == f"error: --duration: must be in (0, 3600] s, got {duration}\n"
+    assert not out.exists()

@@ -83,7 +83,8 @@ def prepare(
     rate = opts.rate if opts.rate is not None else params.update_rate
     if opts.trajectory is None and opts.message is None:
         opts = replace(opts, message=_hold_message(spec, opts))
-    job = simjob.prepare(spec, replace(opts, rate=rate, duration=opts.duration or 1.0))
+    hold = opts.duration if opts.duration is not None else 1.0  # 0 is refused, as elsewhere
+    job = simjob.prepare(spec, replace(opts, rate=rate, duration=hold))
     robot = robot_urdf(spec, job)
     if robot is None:
         raise InputError("the spec has no whole robot to drive", field="mobile_base")
