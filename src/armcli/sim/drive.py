@@ -167,7 +167,9 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
     gravity = _gravity(arm) if arm.config.gravity_comp else None
     inv_kp = np.divide(1.0, kp, out=np.zeros_like(kp), where=kp > 0)  # Kp 0: no g through ctrl
     updates = update_steps(steps, job.dt, job.params.period)
-    lin, ang = job.cmd.at((updates + 1) * job.dt)
+    now = (updates + 1) * job.dt  # Gazebo's sim time at each update
+    lin, ang = job.cmd.at(now)
+    elapsed = np.diff(now, prepend=0.0)  # the plugin's seconds_since_last_update
     is_update = np.zeros(steps + 1, dtype=bool)
     is_update[updates] = True
     rec = np.empty((steps + 1, dm.layout.size))
@@ -184,7 +186,7 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
     start = time.perf_counter()
     for k in range(steps):
         if is_update[k]:
-            command = controller.update(lin[u], ang[u], d.qvel[wheel_dof], job.params.period)
+            command = controller.update(lin[u], ang[u], d.qvel[wheel_dof], elapsed[u])
             ctrl[wheel_act] = command
             u += 1
         wheel_cmd[k] = command
