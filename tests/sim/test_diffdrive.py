@@ -24,7 +24,7 @@ def test_the_spec_gives_the_plugins_parameters() -> None:
     p = DriveParams.of(load_spec(DEFAULT_SPEC))
     assert (p.left_joint, p.right_joint) == ("base_left_wheel_joint", "base_right_wheel_joint")
     assert (p.separation, p.radius, p.update_rate) == (0.45, 0.1, 50.0)
-    assert (p.max_torque, p.max_accel) == (20.0, 1.0)  # the plugin's defaults in the spec model
+    assert (p.max_torque, p.max_accel) == (20.0, 1.0)  # the spec model's defaults
 
 
 def test_a_spec_without_the_plugin_is_refused() -> None:

@@ -78,14 +78,40 @@ def _plugin_reference(job: drive.DriveJob) -> tuple[float, float, float]:
     return float(d.qpos[0]), float(d.qpos[1]), float(yaw)
 
 
-def test_an_arc_follows_the_ros2_plugin(tmp_path: Path) -> None:
-    job = drive.prepare(
-        load_spec(DEFAULT_SPEC), SimOptions(duration=ARC_S + 1.0), _arc_file(tmp_path)
-    )
-    run = drive.run(job)
+def _arc(spec: Path, tmp_path: Path) -> tuple[drive.DriveJob, drive.DriveRun]:
+    job = drive.prepare(load_spec(spec), SimOptions(duration=ARC_S + 1.0), _arc_file(tmp_path))
+    return job, drive.run(job)
+
+
+def _spec_with(tmp_path: Path, old: str, new: str) -> Path:
+    text = DEFAULT_SPEC.read_text()
+    assert text.count(old) == 1
+    path = tmp_path / "my_robot.yaml"
+    path.write_text(text.replace(old, new))
+    return path
+
+
+def _assert_follows_the_plugin(job: drive.DriveJob, run: drive.DriveRun) -> None:
     L = job.model.layout
     x, y, _ = run.sensors[-1, L.base_pos]
     yaw = roll_pitch_yaw(run.sensors[-1:, L.base_quat])[2][0]
     rx, ry, ryaw = _plugin_reference(job)
     assert (x, y) == pytest.approx((rx, ry), abs=SAME_RUN_M)
     assert yaw == pytest.approx(ryaw, abs=SAME_RUN_RAD)
+
+
+def test_an_arc_follows_the_ros2_plugin(tmp_path: Path) -> None:
+    _assert_follows_the_plugin(*_arc(DEFAULT_SPEC, tmp_path))
+
+
+def test_max_wheel_acceleration_0_is_no_limit(tmp_path: Path) -> None:
+    """The plugin's default (`max_wheel_acceleration` absent: 0): targets at once."""
+    spec = _spec_with(tmp_path, "    wheel_diameter: 0.2\n",
+                      "    wheel_diameter: 0.2\n    max_wheel_acceleration: 0\n")  # fmt: skip
+    job, run = _arc(spec, tmp_path)
+    assert job.params.max_accel == 0.0
+    _assert_follows_the_plugin(job, run)
+    first = drive.update_steps(run.steps, job.dt, job.params.period)[0]
+    r, half = job.params.radius, job.params.separation / 2.0
+    # the first update commands the targets themselves, no ramp
+    assert run.wheel_command[first] == pytest.approx([(V - W * half) / r, (V + W * half) / r])
