@@ -16,6 +16,7 @@ the only thing compared is the controller and its timing. Its rules, from the so
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -33,6 +34,7 @@ V, W, ARC_S = 0.2, 0.4, 5.0  # [m/s], [rad/s], [s]: the issue's arc
 # (The ROS 1 rule, "either wheel at speed", ends the arc 11.7 mm and 0.028 rad away.)
 SAME_RUN_M, SAME_RUN_RAD = 1e-6, 1e-6
 REACHED = 0.01  # [m/s] the plugin's literal
+SCENE_AGREES = 1e-6  # [m, rad] the same bodies and contacts from the files (measured: equal)
 
 
 def _arc_file(tmp_path: Path) -> Path:
@@ -44,36 +46,53 @@ def _arc_file(tmp_path: Path) -> Path:
     return path
 
 
-def _plugin_reference(job: drive.DriveJob) -> tuple[float, float, float]:
-    """The base's final (x, y, yaw) with the ROS 2 plugin's controller (module docstring)."""
+Commands = tuple[tuple[float, float, float], ...]  # (from time [s], linear.x, angular.z)
+ARC: Commands = ((0.0, V, W), (ARC_S, 0.0, 0.0))
+
+
+def _plugin_reference(job: drive.DriveJob, commands: Commands = ARC, model: Any = None) -> Any:
+    """The final MjData of the plugin's controller (module docstring) driving `model`.
+
+    `model`: the drive's own (default) or another compiled model with the same joint and
+    actuator names (the exported scene); the arm holds its start pose (Kd * 0).
+    """
     import mujoco
 
     dm, p, dt = job.model, job.params, job.dt
-    m = dm.model
+    m = dm.model if model is None else model
     d = mujoco.MjData(m)
+    wheels = (p.left_joint, p.right_joint)
+    wheel_dof = [m.jnt_dofadr[m.joint(j).id] for j in wheels]
+    wheel_act = [m.actuator(f"{j}_motor").id for j in wheels]
     d.qpos[2] = dm.base_z
-    d.qpos[dm.arm_qpos] = job.arm.q0
-    held = dm.arm_act >= 0
-    d.ctrl[dm.arm_act[held]] = job.arm.q0[held]  # the arm holds its start pose (Kd * 0)
+    for j, q in zip(job.arm.arm.joint_names, job.arm.q0, strict=True):
+        d.qpos[m.jnt_qposadr[m.joint(j).id]] = q
+    for i in dm.arm_act[dm.arm_act >= 0]:
+        name = dm.model.actuator(int(i)).name
+        d.ctrl[m.actuator(name).id] = job.arm.q0[list(dm.arm_act).index(i)]
     r, half = p.radius, p.separation / 2.0
     instructed = np.zeros(2)  # wheel_speed_instr_ [m/s]
     last = 0.0
-    steps = round(job.duration / dt)
-    for k in range(steps):
+    for k in range(round(job.duration / dt)):
         now = (k + 1) * dt  # Gazebo's sim time when OnUpdate runs before step k
         elapsed = now - last
         if elapsed >= p.period - 1e-12:
-            lin, ang = (V, W) if now < ARC_S else (0.0, 0.0)
+            lin, ang = next(((v, w) for t0, v, w in reversed(commands) if now >= t0), (0, 0))
             target = np.array([lin - ang * half, lin + ang * half])
-            current = d.qvel[dm.wheel_dof] * r
+            current = d.qvel[wheel_dof] * r
             if p.max_accel == 0 or np.all(np.abs(target - current) < REACHED):
-                d.ctrl[dm.wheel_act] = target / r
+                d.ctrl[wheel_act] = target / r
             else:
                 step = p.max_accel * elapsed
                 instructed += np.clip(target - current, -step, step)
-                d.ctrl[dm.wheel_act] = instructed / r
+                d.ctrl[wheel_act] = instructed / r
             last = now
         mujoco.mj_step(m, d)
+    return d
+
+
+def _pose(d: Any) -> tuple[float, float, float]:
+    """(x, y, yaw) of the free base."""
     yaw = roll_pitch_yaw(d.qpos[3:7].reshape(1, 4))[2][0]
     return float(d.qpos[0]), float(d.qpos[1]), float(yaw)
 
@@ -95,7 +114,7 @@ def _assert_follows_the_plugin(job: drive.DriveJob, run: drive.DriveRun) -> None
     L = job.model.layout
     x, y, _ = run.sensors[-1, L.base_pos]
     yaw = roll_pitch_yaw(run.sensors[-1:, L.base_quat])[2][0]
-    rx, ry, ryaw = _plugin_reference(job)
+    rx, ry, ryaw = _pose(_plugin_reference(job))
     assert (x, y) == pytest.approx((rx, ry), abs=SAME_RUN_M)
     assert yaw == pytest.approx(ryaw, abs=SAME_RUN_RAD)
 
@@ -115,3 +134,40 @@ def test_max_wheel_acceleration_0_is_no_limit(tmp_path: Path) -> None:
     r, half = job.params.radius, job.params.separation / 2.0
     # the first update commands the targets themselves, no ramp
     assert run.wheel_command[first] == pytest.approx([(V - W * half) / r, (V + W * half) / r])
+
+
+def _exported_scene(job: drive.DriveJob, spec: Path, tmp_path: Path) -> Any:
+    """`export mjcf --whole-robot --base free`'s scene.xml, with the drive's wheel motors."""
+    import mujoco
+
+    from armcli.export.mjcf_files import export_mjcf
+
+    export_mjcf(spec, tmp_path / "out" / "robot.xml", base="free", whole_robot=True)
+    ms = mujoco.MjSpec.from_file(str(tmp_path / "out" / "scene.xml"))
+    ms.option.timestep = job.dt
+    dm = job.model.model
+    for joint in (job.params.left_joint, job.params.right_joint):
+        for act in ms.actuators:  # a user replaces any export actuator on a wheel
+            if act.target == joint:
+                act.gainprm[0], act.biasprm[:3] = 0.0, 0.0
+        motor = dm.actuator(f"{joint}_motor")
+        act = ms.add_actuator(name=motor.name, target=joint, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        act.set_to_velocity(kv=float(motor.gainprm[0]))
+        act.forcelimited = 1
+        act.forcerange = motor.forcerange
+    return ms.compile()
+
+
+def test_the_exported_scene_drives_as_simulate_cmd_vel(tmp_path: Path) -> None:
+    """The floor rule: the caster's mu 0.1 counts in both (export.mjcf_scene.FLOOR_FRICTION)."""
+    straight = ((0.0, 0.3, 0.0), (4.0, 0.0, 0.0))  # the issue's 1.2 m
+    path = tmp_path / "straight.yaml"
+    path.write_text("commands:\n  - {linear: {x: 0.3}, time_from_start: 0}\n"
+                    "  - {time_from_start: 4.0}\n")  # fmt: skip
+    job = drive.prepare(load_spec(DEFAULT_SPEC), SimOptions(duration=5.0), path)
+    x, y, yaw = _pose(_plugin_reference(job, straight))
+    assert x == pytest.approx(1.2, rel=0.02)  # the commanded distance
+    sx, sy, syaw = _pose(
+        _plugin_reference(job, straight, _exported_scene(job, DEFAULT_SPEC, tmp_path))
+    )
+    assert (sx, sy, syaw) == pytest.approx((x, y, yaw), abs=SCENE_AGREES)

@@ -5,10 +5,11 @@ collision geoms, the arm's `position` actuators (Kp, Kd, effort limit) and Gazeb
 `mu1` as sliding friction. Added here through MuJoCo's model editor (MjSpec):
 
 - contacts of time constant CONTACT_TIME;
-- a ground plane at z = 0, the robot's lowest contact point on it (analysis.stance), with sliding
-  friction 0 so that each contact takes the robot geom's own coefficient (MuJoCo
-  combines two geoms by the larger one; Gazebo's ODE by the smaller, and its ground
-  plane's mu is 100, so in both the robot's coefficient counts). A collision without
+- a ground plane at z = 0, the robot's lowest contact point on it (analysis.stance), with
+  the exported scene's floor friction (export.mjcf_scene.FLOOR_FRICTION: 0, so that each
+  contact takes the robot geom's own coefficient; MuJoCo combines two geoms by the larger
+  one, Gazebo's ODE by the smaller, and its ground plane's mu is 100, so in both the
+  robot's coefficient counts). A collision without
   Gazebo `mu1` keeps MuJoCo's default 1, which is Gazebo's default `mu` too. MuJoCo's
   friction is isotropic: a link whose `mu2` differs from `mu1` is noted, `mu1` is used;
 - one `velocity` actuator per drive wheel: the plugin's joint motor (ODE `vel` with
@@ -33,6 +34,7 @@ import numpy as np
 from armcli.analysis.stance import Stance
 from armcli.errors import InputError
 from armcli.export.mjcf import FREE_JOINT, build_mjcf
+from armcli.export.mjcf_scene import FLOOR_FRICTION
 from armcli.sim.diffdrive import DriveParams
 from armcli.urdf.doc import Urdf
 
@@ -110,7 +112,7 @@ def build_drive_model(
         name="floor",
         type=mujoco.mjtGeom.mjGEOM_PLANE,
         size=[0.0, 0.0, 0.05],
-        friction=[0.0, 0.0, 0.0],
+        friction=list(FLOOR_FRICTION),
     )
     root = _root_body(ms)
     wheel_inertia = _wheel_motors(ms, params, stance, dt)
