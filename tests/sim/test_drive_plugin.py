@@ -63,7 +63,7 @@ def _plugin_reference(job: drive.DriveJob, commands: Commands = ARC, model: Any 
     d = mujoco.MjData(m)
     wheels = (p.left_joint, p.right_joint)
     wheel_dof = [m.jnt_dofadr[m.joint(j).id] for j in wheels]
-    wheel_act = [m.actuator(f"{j}_motor").id for j in wheels]
+    rotor = [m.jnt_dofadr[m.joint(f"{j}_rotor").id] for j in wheels]  # the motors' speed
     d.qpos[2] = dm.base_z
     for j, q in zip(job.arm.arm.joint_names, job.arm.q0, strict=True):
         d.qpos[m.jnt_qposadr[m.joint(j).id]] = q
@@ -72,6 +72,7 @@ def _plugin_reference(job: drive.DriveJob, commands: Commands = ARC, model: Any 
         d.ctrl[m.actuator(name).id] = job.arm.q0[list(dm.arm_act).index(i)]
     r, half = p.radius, p.separation / 2.0
     instructed = np.zeros(2)  # wheel_speed_instr_ [m/s]
+    vel = np.zeros(2)  # the joints' motor speed [rad/s]: SetParam("vel")
     last = 0.0
     for k in range(round(job.duration / dt)):
         now = (k + 1) * dt  # Gazebo's sim time when OnUpdate runs before step k
@@ -81,12 +82,13 @@ def _plugin_reference(job: drive.DriveJob, commands: Commands = ARC, model: Any 
             target = np.array([lin - ang * half, lin + ang * half])
             current = d.qvel[wheel_dof] * r
             if p.max_accel == 0 or np.all(np.abs(target - current) < REACHED):
-                d.ctrl[wheel_act] = target / r
+                vel = target / r
             else:
                 step = p.max_accel * elapsed
                 instructed += np.clip(target - current, -step, step)
-                d.ctrl[wheel_act] = instructed / r
+                vel = instructed / r
             last = now
+        d.qvel[rotor] = vel
         mujoco.mj_step(m, d)
     return d
 
@@ -137,24 +139,16 @@ def test_max_wheel_acceleration_0_is_no_limit(tmp_path: Path) -> None:
 
 
 def _exported_scene(job: drive.DriveJob, spec: Path, tmp_path: Path) -> Any:
-    """`export mjcf --whole-robot --base free`'s scene.xml, with the drive's wheel motors."""
+    """`export mjcf --whole-robot --base free`'s scene.xml, with the plugin's wheel motors."""
     import mujoco
 
     from armcli.export.mjcf_files import export_mjcf
+    from armcli.sim.wheelmotor import add_wheel_motors
 
     export_mjcf(spec, tmp_path / "out" / "robot.xml", base="free", whole_robot=True)
     ms = mujoco.MjSpec.from_file(str(tmp_path / "out" / "scene.xml"))
-    ms.option.timestep = job.dt
-    dm = job.model.model
-    for joint in (job.params.left_joint, job.params.right_joint):
-        for act in ms.actuators:  # a user replaces any export actuator on a wheel
-            if act.target == joint:
-                act.gainprm[0], act.biasprm[:3] = 0.0, 0.0
-        motor = dm.actuator(f"{joint}_motor")
-        act = ms.add_actuator(name=motor.name, target=joint, trntype=mujoco.mjtTrn.mjTRN_JOINT)
-        act.set_to_velocity(kv=float(motor.gainprm[0]))
-        act.forcelimited = 1
-        act.forcerange = motor.forcerange
+    p = job.params
+    add_wheel_motors(ms, (p.left_joint, p.right_joint), p.max_torque, job.dt)
     return ms.compile()
 
 
@@ -171,3 +165,77 @@ def test_the_exported_scene_drives_as_simulate_cmd_vel(tmp_path: Path) -> None:
         _plugin_reference(job, straight, _exported_scene(job, DEFAULT_SPEC, tmp_path))
     )
     assert (sx, sy, syaw) == pytest.approx((x, y, yaw), abs=SCENE_AGREES)
+
+
+FAST = "commands:\n  - {linear: {x: 1.0}, time_from_start: 0.5}\n  - {time_from_start: 2.5}\n"
+HOLDS = 5e-4  # relative: ODE's motor holds its speed exactly; the clutch measured 4e-5
+NEWTON = 0.10  # relative: the ramp's torque against m a r / 2 + I a / r (measured 5 %)
+# relative: the motor's stand-in parameters x0.01-x100 move the 2 m drive by <= 0.1 %
+# (measured); the velocity actuator it replaced drove 6.5 % further at twice its gain
+STAND_IN = 2e-3
+
+
+def _fast(tmp_path: Path) -> drive.DriveRun:
+    path = tmp_path / "fast.yaml"
+    path.write_text(FAST)
+    return drive.run(drive.prepare(load_spec(DEFAULT_SPEC), SimOptions(duration=3.5), path))
+
+
+def test_the_wheels_hold_their_speed_and_carry_newtons_torque(tmp_path: Path) -> None:
+    """1 m/s after a 1 m/s² ramp (the spec's max_wheel_acceleration), held for 1 s."""
+    run = _fast(tmp_path)
+    job, s, t = run.job, run.sensors, run.t
+    L = job.model.layout
+    hold = (t > 1.7) & (t < 2.4)
+    speed = np.mean(s[hold][:, L.wheel_vel], axis=0)
+    assert speed == pytest.approx([1.0 / job.params.radius] * 2, rel=HOLDS)
+    # the encoder integral of the plugin's symmetric ramps: the commanded 1 m/s x 2 s
+    assert run.odometry.x[-1] == pytest.approx(2.0, rel=HOLDS)
+    ramp = (t > 0.7) & (t < 1.4)
+    x = s[:, L.base_pos][:, 0]
+    accel = np.polyfit(t[ramp], np.gradient(x, t)[ramp], 1)[0]  # [m/s²] the base's, measured
+    r, mass = job.params.radius, job.stance.mass
+    inertia = _wheel_inertia(job)
+    newton = (mass / 2.0 * r + inertia / r) * accel  # each wheel: half the robot, its own spin
+    extra = np.mean(s[ramp][:, L.wheel_force], axis=0) - np.mean(s[hold][:, L.wheel_force], axis=0)
+    assert extra == pytest.approx([newton] * 2, rel=NEWTON)
+
+
+def _wheel_inertia(job: drive.DriveJob) -> float:
+    """[kg·m²] the left wheel body's inertia about its axis (MuJoCo's model)."""
+    import mujoco
+
+    m = job.model.model
+    jid = m.joint(job.params.left_joint).id
+    body = m.jnt_bodyid[jid]
+    axis = m.jnt_axis[jid]  # in the body frame; body inertia in its inertial frame
+    R = np.zeros(9)
+    mujoco.mju_quat2Mat(R, m.body_iquat[body])
+    a = R.reshape(3, 3).T @ axis
+    return float(a @ (m.body_inertia[body] * a))
+
+
+@pytest.mark.parametrize(
+    ("armature", "solref", "solimp"),
+    [(10.0, 2.0, None), (1e5, 2.0, None), (1e3, 4.0, None), (1e3, 2.0, (0.9, 0.95))],
+    ids=["armature/100", "armature*100", "solref*2", "mujoco-solimp"],
+)
+def test_the_motor_stand_in_parameters_do_not_matter(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    armature: float,
+    solref: float,
+    solimp: tuple[float, float] | None,
+) -> None:
+    from armcli.sim import wheelmotor
+
+    base = _fast(tmp_path)
+    monkeypatch.setattr(wheelmotor, "ROTOR_ARMATURE", armature)
+    monkeypatch.setattr(wheelmotor, "CLUTCH_SOLREF", solref)
+    if solimp is not None:
+        monkeypatch.setattr(wheelmotor, "CLUTCH_SOLIMP", (*solimp, 0.001, 0.5, 2.0))
+    other = _fast(tmp_path)
+    L = base.job.model.layout
+    x0 = base.sensors[-1, L.base_pos][0] - base.sensors[0, L.base_pos][0]
+    x1 = other.sensors[-1, L.base_pos][0] - other.sensors[0, L.base_pos][0]
+    assert x1 == pytest.approx(x0, rel=STAND_IN)

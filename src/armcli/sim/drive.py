@@ -33,6 +33,7 @@ from armcli.sim.job import SimJob
 from armcli.sim.options import SimOptions
 from armcli.sim.simulate import steps_of
 from armcli.sim.tipping import robot_urdf
+from armcli.sim.wheelmotor import clutch_torque, spin
 from armcli.urdf.doc import Urdf
 
 if TYPE_CHECKING:
@@ -175,31 +176,34 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
     rec = np.empty((steps + 1, dm.layout.size))
     wheel_cmd = np.zeros((steps + 1, 2))
     controller = DiffDriveController(job.params)
-    wheel_act, wheel_dof = dm.wheel_act, dm.wheel_dof
+    wheel_dof, rotor, wheel_force = dm.wheel_dof, dm.wheel_rotor, dm.layout.wheel_force
     cols = np.nonzero(dm.arm_act >= 0)[0]  # a mimic joint follows its leader: no actuator
     ctrl_arm, inv_kp = ctrl_arm[:, cols], inv_kp[cols]
     act = dm.arm_act[cols]
     arm_act = slice(int(act[0]), int(act[-1]) + 1) if _contiguous(act) else act
     arm_qpos = dm.arm_qpos
     ctrl, u, command = d.ctrl, 0, np.zeros(2)
+    spin(d, rotor, command)
     mujoco.mj_forward(m, d)
     start = time.perf_counter()
     for k in range(steps):
         if is_update[k]:
             command = controller.update(lin[u], ang[u], d.qvel[wheel_dof], elapsed[u])
-            ctrl[wheel_act] = command
             u += 1
         wheel_cmd[k] = command
+        spin(d, rotor, command)  # the plugin's motor speed (its "vel")
         if gravity is None:
             ctrl[arm_act] = ctrl_arm[k]
         else:
             ctrl[arm_act] = ctrl_arm[k] + gravity(d.qpos[arm_qpos])[cols] * inv_kp
         mujoco.mj_step(m, d)
         rec[k] = d.sensordata
+        rec[k, wheel_force] = -d.qfrc_constraint[rotor]  # sim.wheelmotor.clutch_torque
         if progress is not None and k % PROGRESS_STEPS == 0 and k:
             progress(k, steps)
     mujoco.mj_forward(m, d)
     rec[steps], wheel_cmd[steps] = d.sensordata, command
+    rec[steps, wheel_force] = clutch_torque(d, rotor)
     wall = time.perf_counter() - start
     _refuse_reset(d, rec, job.dt)
     wl = rec[:-1, dm.layout.wheel_vel]
