@@ -27,6 +27,7 @@ def run_drive(
     output: Path | None,
     plot: Path | None,
     progress: Callable[[int, int], None] | None = None,
+    world: Path | None = None,
 ) -> None:
     """Drive, write and report; raises TipOverError when the robot tips over."""
     from armcli.check.gate import refuse_check_errors
@@ -35,7 +36,7 @@ def run_drive(
     from armcli.sim.driving import drive_robot
 
     try:
-        driven = drive_robot(spec, opts, cmd_vel, progress=progress,
+        driven = drive_robot(spec, opts, cmd_vel, progress=progress, world=world,
                              gate=lambda u: refuse_check_errors(u, ignore=ignore))  # fmt: skip
     except ModelRefusedError as exc:
         flags = " ".join(f"--ignore {r}" for r in exc.rules())

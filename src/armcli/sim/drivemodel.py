@@ -19,7 +19,8 @@ collision geoms, the arm's `position` actuators (Kp, Kd, effort limit) and Gazeb
   joints' position, velocity and actuator force (a wheel's slot is filled by the run
   with its clutch torque, which no sensor reads), the root body's pose, and per
   ground-contact link its normal force (a `touch` site enclosing the link's geoms)
-  and its height.
+  and its height;
+- the world's objects of a scene file (sim.world), static bodies with contact.
 """
 
 from __future__ import annotations
@@ -34,8 +35,10 @@ from armcli.analysis.stance import Stance
 from armcli.errors import InputError
 from armcli.export.mjcf import FREE_JOINT, build_mjcf
 from armcli.export.mjcf_scene import FLOOR_FRICTION
+from armcli.io.scene import Scene
 from armcli.sim.diffdrive import DriveParams
 from armcli.sim.wheelmotor import add_wheel_motors, rotor_dofs
+from armcli.sim.world import WorldGeom, add_scene
 from armcli.urdf.doc import Urdf
 
 # [s] MuJoCo's contact time constant (solref, critically damped): its default, as the
@@ -78,6 +81,7 @@ class DriveModel:
     layout: Layout
     base_z: float  # [m] the root body's height with the lowest contact on the floor
     notes: tuple[str, ...]
+    world: tuple[WorldGeom, ...] = ()  # the scene's objects (sim.world)
 
 
 def build_drive_model(
@@ -89,11 +93,12 @@ def build_drive_model(
     gains: tuple[np.ndarray, np.ndarray, np.ndarray],
     dt: float,
     meshes: dict[str, bytes] | None = None,
+    world: Scene | None = None,
 ) -> DriveModel:
     """Compile the export's free-base model with floor, wheel motors and sensors.
 
     `gains`: the arm's (Kp, Kd, effort limit) as the run uses them (the spec's or the
-    options'; effort inf: none).
+    options'; effort inf: none). `world`: obstacles placed by sim.world.add_scene.
     """
     import mujoco
 
@@ -119,6 +124,7 @@ def build_drive_model(
     driven = _arm_actuators(ms, arm_joints, gains)
     _sensors(ms, root, arm_joints, params, stance.ground.links)
     notes = [*_mu2_notes(urdf), *motor_notes]
+    geoms = add_scene(ms, world) if world is not None else ()
     model = ms.compile()
     model.geom_solref[:] = (CONTACT_TIME, 1.0)
     arm_act = np.array([model.actuator(driven[j]).id if j in driven else -1
@@ -138,6 +144,7 @@ def build_drive_model(
         layout=_layout(len(arm_joints), len(stance.ground.links)),
         base_z=-stance.ground.height,
         notes=tuple(notes),
+        world=geoms,
     )
 
 
