@@ -15,7 +15,7 @@ from armcli.check.rules import ERROR, WARNING
 from armcli.check.run import CheckResult
 from armcli.errors import split_source
 from armcli.io.jsondoc import dumps
-from armcli.io.oneline import one_line
+from armcli.io.oneline import decodable, one_line
 from armcli.io.terminal import Column, FitTable, Hanging
 
 JSON_SCHEMA = "armcli.check/1"
@@ -66,7 +66,8 @@ def to_json(
 
 
 def _esc_data(s: str) -> str:
-    return s.replace("%", "%25").replace("\r", "%0D").replace("\n", "%0A")
+    r"""A workflow command's text: `%`, CR, LF escaped as GitHub reads them; raw bytes `\xff`."""
+    return decodable(s).replace("%", "%25").replace("\r", "%0D").replace("\n", "%0A")
 
 
 def _esc_prop(s: str) -> str:
@@ -162,7 +163,7 @@ def _findings_grid(findings: Sequence[Finding]) -> Any:
             body.append(f"  {f.spec}")
             body.append(f" ({generated}:{f.line})" if f.line else "", style="dim")
         elif f.origin is not None:  # a xacro element: where the user wrote it
-            body.append(f"  {shown_path(f.origin.file)}:{f.origin.line}")
+            body.append(f"  {one_line(shown_path(f.origin.file))}:{f.origin.line}")
             body.append(f" (expanded line {f.line})", style="dim")
         elif f.line:
             body.append(f"  line {f.line}")

@@ -29,6 +29,7 @@ from armcli.check.findings import Finding
 from armcli.check.rules import RULES, Rule
 from armcli.errors import split_source
 from armcli.io.jsondoc import dumps
+from armcli.io.oneline import decodable
 
 SARIF_VERSION = "2.1.0"
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -60,8 +61,8 @@ def artifact_uri(path: str, root: Path) -> tuple[str, bool]:
     """(URI, relative?): a POSIX path relative to root when the file is under it."""
     absolute = Path(os.path.abspath(path))  # as the user named it: symlinks kept
     for a, r in ((absolute, Path(os.path.abspath(root))), (absolute.resolve(), root.resolve())):
-        if a.is_relative_to(r):
-            return quote(PurePosixPath(*a.relative_to(r).parts).as_posix()), True
+        if a.is_relative_to(r):  # the name's bytes: a non-UTF-8 one is %FF, not an error
+            return quote(os.fsencode(PurePosixPath(*a.relative_to(r).parts).as_posix())), True
     return absolute.resolve().as_uri(), False
 
 
@@ -113,7 +114,7 @@ def to_sarif(findings: Sequence[Finding], root: Path | None = None) -> str:
             "ruleId": f.rule,
             "ruleIndex": index[f.rule],
             "level": f.severity,
-            "message": {"text": f"{prefix}{f.message}{f.calls_text}"},
+            "message": {"text": decodable(f"{prefix}{f.message}{f.calls_text}")},
             "locations": [location],
             "partialFingerprints": {FINGERPRINT_KEY: digest},
             "properties": {"values": dict(f.values), "fix": dict(f.fix), "hint": f.hint},

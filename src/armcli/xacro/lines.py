@@ -16,6 +16,7 @@ xacro would warn about an unknown attribute; they produce no URDF element.
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -136,7 +137,7 @@ def source_map(expanded: bytes, tags: Sequence[str], files: Sequence[str]) -> st
             continue
         seen.add(line)
         out.append(f"{line}={tag}")
-    head = "\n".join(files)
+    head = json.dumps(list(files))  # one line whatever the names hold (a newline: issue 42)
     return head + "\n\n" + "|".join(out)
 
 
@@ -145,7 +146,12 @@ def parse_map(text: str) -> dict[int, Origin]:
     head, sep, body = text.partition("\n\n")
     if not sep:
         return {}
-    files = head.split("\n")
+    try:
+        files = json.loads(head)
+    except ValueError:
+        return {}
+    if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
+        return {}
     out: dict[int, Origin] = {}
     for item in filter(None, body.split("|")):
         try:
