@@ -16,6 +16,7 @@ from lxml import etree
 
 from armcli.defaults import MAX_ROBOT_DOF, MAX_ROBOT_LINKS
 from armcli.errors import InputError, XacroRefusedError
+from armcli.io.doctype import doctype_offset
 from armcli.io.oneline import one_line
 from armcli.io.userfile import read_regular
 from armcli.spec.joint_types import total_dof
@@ -253,11 +254,6 @@ def _check_depth(root: etree._Element, source: str) -> None:
         stack.extend((c, depth + 1) for c in el)
 
 
-def _line_of(data: bytes, needle: bytes) -> int | None:
-    i = data.find(needle)
-    return data.count(b"\n", 0, i) + 1 if i >= 0 else None
-
-
 def _line_at(data: bytes, offset: int) -> int:
     return data.count(b"\n", 0, offset) + 1
 
@@ -267,16 +263,17 @@ def parse_root(data: bytes, source: str) -> etree._Element:
     if len(data) > MAX_URDF_BYTES:
         raise InputError(f"file is larger than {MAX_URDF_BYTES} bytes", file=source)
     try:  # first: in UTF-16 the DOCTYPE test below would not see "<!DOCTYPE"
-        data.decode("utf-8")
+        text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise InputError(
             "not UTF-8 text (URDF files are UTF-8)", file=source, line=_line_at(data, exc.start)
         ) from None
-    if b"<!DOCTYPE" in data or b"<!ENTITY" in data:
+    at = doctype_offset(text)  # the prolog's: a comment that names one declares nothing
+    if at is not None:
         raise InputError(
             "DOCTYPE/entity declarations are not allowed in URDF input",
             file=source,
-            line=_line_of(data, b"<!"),
+            line=text.count("\n", 0, at) + 1,
         )
     parser = etree.XMLParser(
         resolve_entities=False,

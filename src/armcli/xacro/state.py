@@ -13,6 +13,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
+from armcli.io.doctype import declares_doctype
 from armcli.io.packages import real_roots
 from armcli.io.userfile import read_regular
 from armcli.xacro.args import Expansion, XacroInputs
@@ -100,7 +101,7 @@ class ExpansionState:
             raise ProblemError(f"{what} {path!r} is not UTF-8 text", path) from None
         if "\x00" in text:  # UTF-16 without a byte-order mark is valid UTF-8 full of NULs
             raise ProblemError(f"{what} {path!r} holds NUL characters", path)
-        if "<!DOCTYPE" in text or "<!ENTITY" in text:
+        if declares_doctype(text):  # its prolog's: a comment naming one declares nothing
             raise ProblemError(f"{what} {path!r} declares a DOCTYPE/entities", path)
         self.files[str(real)] = text
         return text
