@@ -12,6 +12,7 @@ from armcli.commands.robot_input import robot_options, write_notes
 from armcli.io.files import write_file_atomic
 from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file
+from armcli.io.workflow import no_workflow_commands
 
 if TYPE_CHECKING:
     from armcli.urdf.source import RobotInput
@@ -34,6 +35,7 @@ def expand_cmd(
     if out is not None:
         check_output_file(out, "--out", [path])  # before any work; never over the input
     xml, used = expand_xacro(path, trust_xacro=robot.trust, inputs=robot.xacro)
+    xml = no_workflow_commands(xml)  # no line of it a CI log reads as a command (issue 42)
     write_notes(used.notes())
     if out is None:
         sys.stdout.buffer.write(xml)
