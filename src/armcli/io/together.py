@@ -5,10 +5,10 @@ than one file that is not one directory tree; `files.write_tree_atomic` swaps a
 whole tree) used to write each file as soon as it was ready: a run killed while
 drawing the plot left a new CSV beside an old plot. Here every file is staged
 completely (written and fsynced to a hidden temporary file beside its target)
-before any target changes. Then a journal naming each (staged file, target) pair
-is written into every target directory, the targets are renamed in one after
-another with SIGINT, SIGTERM, SIGHUP and SIGQUIT blocked, and the journals are
-removed.
+before any target changes. Then each target directory gets a journal naming its
+targets (io.journal: plain names, the staged files' names follow from the journal's),
+the targets are renamed in one after another with SIGINT, SIGTERM, SIGHUP and SIGQUIT
+blocked, and the journals are removed.
 
 A kill before the journals exist leaves every target untouched (the staged files
 are removed by the next write into that directory); a SIGKILL in the microseconds
