@@ -79,7 +79,7 @@ def test_failure_as_json(capsys: pytest.CaptureFixture[str]) -> None:
         (["--to", "nowhere"], "--to: unknown pose 'nowhere'"),
         (["--to", "0.1,0.2,0.3"], "--to: give 2 value(s)"),
         (["--to", "reach", "--to-xyz", "1,2,3"], "--to: give exactly one goal"),
-        (["--to-xyz", "1,2"], "--to-xyz: expected x,y,z [m]"),
+        (["--to-xyz", "1,2"], "--to-xyz: expected x,y,z in metres"),
         (["--to", "reach", "--joints", "wheel"], "--joints: unknown joint 'wheel'"),
         (["--to", "reach", "--planner", "prm"], "--planner: unknown value 'prm'"),
     ],

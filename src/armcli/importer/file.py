@@ -55,7 +55,7 @@ def import_file(
         ExistingFileError: `out` exists and `force` is not set (nothing was read or written).
         InputError: the file is unusable or holds what a spec cannot.
     """
-    check_output_file(out, "out", [path])  # never over the file it imports, --force or not
+    check_output_file(out, "out", [path], parents=True)  # never over the file it imports
     if out.exists() and not force:
         raise ExistingFileError(f"{out} exists; pass `force` to replace it", file=out)
     if out.is_dir():
