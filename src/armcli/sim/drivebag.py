@@ -3,7 +3,8 @@
 /joint_states with the wheels, /odom (nav_msgs/msg/Odometry: the plugin's encoder
 odometry at each output time, its covariance), /cmd_vel (geometry_msgs/msg/Twist at each
 command's time) and in /tf `odom -> base` plus `world -> odom`: the drift a perfect
-localiser would remove, so that `world -> base` is the ground truth (as map -> odom in ROS).
+localiser would remove, so that `world -> base` is the ground truth (as map -> odom in ROS);
+then the sensors' topics (sim.sensors.messages).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import numpy as np
 from armcli.sim import rosbag
 from armcli.sim.diffdrive import yaw_quaternion
 from armcli.sim.drive import DriveRun
+from armcli.sim.sensors.messages import channels as sensor_channels
 from armcli.sim.states import TIME, sample_steps
 
 WORLD = rosbag.WORLD
@@ -50,6 +52,7 @@ def mcap_bytes(run: DriveRun, cols: dict[str, np.ndarray], rate: float) -> bytes
     k = sample_steps(run.steps, job.dt, rate)
     chans.append(rosbag.Channel(ODOM, ODOMETRY, rosbag.qos(10, False), _odometry(run, k, stamps)))
     chans.append(rosbag.Channel(CMD_VEL, TWIST, rosbag.qos(10, False), _cmd_vel(run)))
+    chans += sensor_channels(run.readings)
     return rosbag.mcap_bytes(chans)
 
 

@@ -20,6 +20,8 @@ collision geoms, the arm's `position` actuators (Kp, Kd, effort limit) and Gazeb
   joints' position, velocity and actuator force, the root body's pose, and per
   ground-contact link its normal force (a `touch` site enclosing the link's geoms)
   and its height;
+- the spec's sensors (sim.sensors.model): a site each, an IMU's MuJoCo sensors after
+  the drive's, a camera's MuJoCo camera;
 - the world's objects of a scene file (sim.world), static bodies with contact.
 """
 
@@ -36,6 +38,7 @@ from armcli.errors import InputError
 from armcli.export.mjcf import FREE_JOINT, build_mjcf
 from armcli.io.scene import Scene
 from armcli.sim.diffdrive import DriveParams
+from armcli.sim.sensors.model import add_sensors
 from armcli.sim.world import WorldGeom, add_scene
 from armcli.urdf.doc import Urdf
 
@@ -121,6 +124,7 @@ def build_drive_model(
     wheel_inertia = _wheel_motors(ms, params, stance, dt)
     driven = _arm_actuators(ms, arm_joints, gains)
     _sensors(ms, root, arm_joints, params, stance.ground.links)
+    add_sensors(ms, getattr(spec, "sensors", {}))  # after the drive's: its Layout holds
     notes = [*_mu2_notes(urdf), *wheel_inertia]
     geoms = add_scene(ms, world) if world is not None else ()
     model = ms.compile()
