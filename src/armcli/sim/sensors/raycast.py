@@ -7,10 +7,21 @@ the box, as in Gazebo (`check` warns). All rays of a sensor leave one point, so
 mj_multiRay casts them together; a ray whose first hit lies nearer than where it starts
 (a lidar's range_min, a camera's near plane) is cast again from its start with mj_ray.
 A distance is +inf where nothing is hit before the ray's end.
+
+A depth camera's rays are many (19,200 for 160 x 120) and leave one point through a
+regular grid: the compiled caster (sim/_native/raycast.cpp) tests each primitive geom
+only on the pixels it can cover, with MuJoCo's shapes and the same "first surface at or
+beyond the start" rule; the pixels a mesh may cover are cast by mj_multiRay as above.
+Without the extension every ray goes through mj_multiRay (the same depths, slower).
 """
 
 from __future__ import annotations
 
+import hashlib
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -46,3 +57,79 @@ def cast(
         dist[i] = start[i] + again if again >= 0.0 else -1.0
     dist[(dist < 0.0) | (dist > stop)] = np.inf
     return dist
+
+
+# -- the compiled pinhole caster (sim/_native/raycast.cpp) ----------------------------------
+
+SOURCE = Path(__file__).parents[1] / "_native" / "raycast.cpp"
+_state: dict[str, Any] = {}
+
+
+def native() -> ModuleType | None:
+    """armcli.sim._raycast, or None (not built, stale, or ARMCLI_NO_NATIVE set)."""
+    if "module" not in _state:
+        _state["module"] = _import()
+    mod: ModuleType | None = _state["module"]
+    return mod
+
+
+def _import() -> ModuleType | None:
+    if os.environ.get("ARMCLI_NO_NATIVE"):
+        return None
+    try:
+        from armcli.sim import _raycast
+    except ImportError:
+        return None
+    if SOURCE.is_file() and hashlib.sha256(SOURCE.read_bytes()).hexdigest() != getattr(
+        _raycast, "SOURCE_SHA256", ""
+    ):
+        return None  # built from another raycast.cpp: `make native`
+    return _raycast
+
+
+@dataclass(frozen=True)
+class SeenGeoms:
+    """The geoms rays can hit (SEEN_GROUPS, not transparent), as the caster takes them."""
+
+    ids: np.ndarray  # (n,) int32
+    types: np.ndarray  # (n,) int32
+    sizes: np.ndarray  # (n, 3)
+    rbound: np.ndarray  # (n,)
+
+    @classmethod
+    def of(cls, model: Any) -> SeenGeoms:
+        """The model's geoms in SEEN_GROUPS whose alpha is not 0 (mj_ray skips those)."""
+        ok = (SEEN_GROUPS[model.geom_group] == 1) & (model.geom_rgba[:, 3] != 0.0)
+        ids = np.nonzero(ok)[0].astype(np.int32)
+        sizes = np.ascontiguousarray(model.geom_size[ids])
+        return cls(ids, model.geom_type[ids].astype(np.int32), sizes, model.geom_rbound[ids].copy())
+
+
+def cast_pinhole(
+    mod: ModuleType, model: Any, data: Any, geoms: SeenGeoms, cam: PinholeCast
+) -> tuple[np.ndarray, np.ndarray]:
+    """(depth [m] per pixel, +inf for none; pixels MuJoCo must cast: meshes) from the caster."""
+    n = cam.width * cam.height
+    depth, geom, other = np.empty(n), np.empty(n, dtype=np.int32), np.empty(n, dtype=np.uint8)
+    mod.cast_pinhole(cam.origin, cam.R.ravel(), cam.fx, cam.fy, cam.cx, cam.cy, cam.width,
+                     cam.height, cam.near, cam.far, geoms.types, geoms.sizes,
+                     np.ascontiguousarray(data.geom_xpos[geoms.ids]),
+                     np.ascontiguousarray(data.geom_xmat[geoms.ids]), geoms.rbound, geoms.ids,
+                     depth, geom, other)  # fmt: skip
+    return depth, other.astype(bool)
+
+
+@dataclass(frozen=True)
+class PinholeCast:
+    """One depth image to cast: the optical frame in the world, the pinhole, the clip planes."""
+
+    origin: np.ndarray  # (3,) [m]
+    R: np.ndarray  # (3, 3) R_world_optical
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+    width: int
+    height: int
+    near: float
+    far: float

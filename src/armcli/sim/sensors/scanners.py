@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from armcli.sim.sensors.model import site_name
-from armcli.sim.sensors.raycast import cast
+from armcli.sim.sensors.raycast import PinholeCast, SeenGeoms, cast, cast_pinhole, native
 from armcli.sim.sensors.rays import R_SENSOR_OPTICAL, Pinhole, lidar_directions
 from armcli.sim.sensors.reading import Reading, gaussian, quantise, rng
 from armcli.spec.sensors import Sensor
@@ -78,16 +78,33 @@ class DepthSampler:
         self.site = int(model.site(site_name(name)).id)
         self.depth = np.empty((len(steps), cam.height, cam.width), dtype=np.float32)
         self.rng = rng(name)
+        self.native, self.geoms = native(), SeenGeoms.of(model)
 
     def sample(self, j: int, model: Any, data: Any) -> None:
         """One depth image from the site's pose."""
         origin, R = _pose(data, self.site)
-        z = cast(model, data, origin, self.dirs @ R.T, self.start, self.stop) / self.norm
+        if self.native is None:
+            z = cast(model, data, origin, self.dirs @ R.T, self.start, self.stop) / self.norm
+        else:
+            z = self._fast(model, data, origin, R)
         noise = self.sensor.noise
         if noise is not None:
             hit = np.isfinite(z)
             z[hit] += gaussian(self.rng, noise.mean, noise.stddev, int(hit.sum()))
         self.depth[j] = z.reshape(self.depth.shape[1:])
+
+    def _fast(self, model: Any, data: Any, origin: np.ndarray, R: np.ndarray) -> np.ndarray:
+        """The compiled caster's depths; the pixels a mesh may cover through mj_multiRay."""
+        assert self.native is not None and self.sensor.camera is not None
+        p, cam = self.pinhole, self.sensor.camera
+        frame = PinholeCast(origin, R @ R_SENSOR_OPTICAL, p.fx, p.fy, p.cx, p.cy, p.width,
+                            p.height, cam.near, cam.far)  # fmt: skip
+        z, other = cast_pinhole(self.native, model, data, self.geoms, frame)
+        if other.any():
+            dist = cast(model, data, origin, self.dirs[other] @ R.T, self.start[other],
+                        self.stop[other])  # fmt: skip
+            z[other] = dist / self.norm[other]
+        return z
 
     def reading(self, dt: float, record: np.ndarray) -> Reading:
         """The depth images and their times."""
