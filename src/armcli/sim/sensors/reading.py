@@ -21,7 +21,8 @@ from armcli.spec.sensors import Sensor
 class Reading:
     """One sensor's samples: at `steps` (times `time` [s]), arrays by kind in `data`.
 
-    lidar: `ranges` (n, rings, samples) [m]; depth_camera: `depth` (n, h, w) [m];
+    lidar: `ranges` (n, rings, samples) [m] and `pose` (n, 12): the sensor's origin [m] and
+    rotation (rows) in the world when it scanned; depth_camera: `depth` (n, h, w) [m];
     camera: `image` (n, h, w, channels) uint8; imu: `imu` (n, 10): quaternion (x, y, z, w),
     angular velocity [rad/s], linear acceleration [m/s²], in the sensor frame.
     """

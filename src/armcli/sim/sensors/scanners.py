@@ -40,11 +40,13 @@ class LidarSampler:
         self.stop = np.full(len(self.dirs), li.range_max)
         self.shape = (li.vertical_samples, li.samples)
         self.ranges = np.empty((len(steps), *self.shape), dtype=np.float32)
+        self.poses = np.empty((len(steps), 12))  # the sensor in the world: origin, R (rows)
         self.rng = rng(name)
 
     def sample(self, j: int, model: Any, data: Any) -> None:
         """Scan once from the site's pose."""
         origin, R = _pose(data, self.site)
+        self.poses[j, :3], self.poses[j, 3:] = origin, R.ravel()
         r = cast(model, data, origin, self.dirs @ R.T, self.start, self.stop)
         li, noise = self.sensor.lidar, self.sensor.noise
         assert li is not None
@@ -58,7 +60,7 @@ class LidarSampler:
     def reading(self, dt: float, record: np.ndarray) -> Reading:
         """The scans and their times."""
         return Reading(self.name, self.sensor, self.steps, self.steps * dt,
-                       {"ranges": self.ranges})  # fmt: skip
+                       {"ranges": self.ranges, "pose": self.poses})  # fmt: skip
 
 
 class DepthSampler:
