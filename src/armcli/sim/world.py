@@ -199,8 +199,8 @@ def marker_array(model: Any, data: Any, geoms: Sequence[WorldGeom]) -> dict[str,
             pos, quat = data.geom_xpos[gid], np.zeros(4)
             mujoco.mju_mat2Quat(quat, data.geom_xmat[gid])
         size = model.geom_size[gid]
-        scale = {"box": 2 * size, "sphere": [2 * size[0]] * 3,
-                 "cylinder": [2 * size[0], 2 * size[0], 2 * size[1]]}.get(kind, [1.0] * 3)  # fmt: skip
+        d = 2 * size
+        scale = {"box": d, "sphere": [d[0]] * 3, "cylinder": [d[0], d[0], d[1]]}.get(kind, [1] * 3)
         r, gr, b, a = (float(c) for c in model.geom_rgba[gid])
         marker = {
             "header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": g.frame or "world"},

@@ -67,7 +67,8 @@ def _outline(model: Any, data: Any, gid: int) -> np.ndarray:
     elif kind in (G.mjGEOM_CYLINDER, G.mjGEOM_SPHERE, G.mjGEOM_CAPSULE):
         r, h = size[0], size[1] if kind != G.mjGEOM_SPHERE else 0.0
         rim = np.column_stack([r * np.cos(a), r * np.sin(a), np.zeros(RIM)])
-        local = np.vstack([rim + [0, 0, h], rim - [0, 0, h]])
+        up = np.array([0.0, 0.0, h])
+        local = np.vstack([rim + up, rim - up])
     else:  # a mesh: its vertices
         mesh = int(model.geom_dataid[gid])
         v0, nv = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
