@@ -313,6 +313,38 @@ _RULES = [
         "a --reach-point the tool point cannot reach within the joint limits",
         "move the point or the arm's mount (the message says how close the arm gets)",
     ),
+    # sensors (check/sensors.py)
+    Rule(
+        "sensor-link",
+        ERROR,
+        "a sensor's <gazebo reference> is not a link of the robot",
+        "name one of the robot's links (Gazebo drops the sensor)",
+    ),
+    Rule(
+        "sensor-rate",
+        ERROR,
+        "a sensor updates faster than the physics steps",
+        "lower the sensor's rate to at most 1 / dt, or lower dt",
+    ),
+    Rule(
+        "sensor-fov",
+        ERROR,
+        "a sensor's field of view is empty (equal angles, or a camera fov not in (0, pi))",
+        "give min_angle < max_angle for several rays, a horizontal_fov in (0, pi)",
+    ),
+    Rule(
+        "sensor-range",
+        ERROR,
+        "a sensor's range ends before it starts (range_min >= range_max, near >= far)",
+        "give range_min < range_max (near < far)",
+    ),
+    Rule(
+        "sensor-sees-robot",
+        WARNING,
+        "a lidar's rays start inside the robot's own collision shapes: it sees itself",
+        "move the lidar clear of the collision shapes (e.g. on top of the base) or raise "
+        "range_min past them",
+    ),
     # inputs
     Rule(
         "input-unusable",

@@ -38,8 +38,16 @@ def spread(lo: float, hi: float, n: int) -> np.ndarray:
 
 def lidar_directions(li: Lidar) -> np.ndarray:
     """(rings * samples, 3) unit rays in the sensor frame, ring by ring."""
-    h = spread(li.min_angle, li.max_angle, li.samples)
-    v = spread(li.vertical_min_angle, li.vertical_max_angle, li.vertical_samples)
+    vertical = (li.vertical_samples, li.vertical_min_angle, li.vertical_max_angle)
+    return ray_directions((li.samples, li.min_angle, li.max_angle), vertical)
+
+
+def ray_directions(
+    horizontal: tuple[float, float, float], vertical: tuple[float, float, float]
+) -> np.ndarray:
+    """(rings * samples, 3) unit rays of scans given as (samples, min angle, max angle)."""
+    h = spread(horizontal[1], horizontal[2], int(horizontal[0]))
+    v = spread(vertical[1], vertical[2], int(vertical[0]))
     cv, sv = np.cos(v)[:, None], np.sin(v)[:, None]
     out = np.stack(
         [cv * np.cos(h)[None, :], cv * np.sin(h)[None, :], np.broadcast_to(sv, (len(v), len(h)))],
