@@ -37,9 +37,12 @@ def test_template_files_are_the_examples(template: str) -> None:
     assert trajectories, "a template without trajectories"
     for f in trajectories:
         assert files[f"trajectories/{f.name}"] == f.read_bytes()
+    extras = sorted((EXAMPLES / t.extras).iterdir()) if t.extras else []
+    for f in extras:  # beside the spec: a world, a Foxglove layout
+        assert files[f.name] == f.read_bytes()
     assert set(files) == {"armcli.yaml", "README.md"} | {
         f"trajectories/{f.name}" for f in trajectories
-    }
+    } | {f.name for f in extras}
 
 
 @pytest.mark.parametrize("template", sorted(TEMPLATES))

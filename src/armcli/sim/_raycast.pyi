@@ -23,10 +23,28 @@ def cast_pinhole(
     sizes: NDArray[np.float64],
     pos: NDArray[np.float64],
     mats: NDArray[np.float64],
-    rbound: NDArray[np.float64],
+    aabb: NDArray[np.float64],
     ids: NDArray[np.int32],
     depth: NDArray[np.float64],
     geom: NDArray[np.int32],
     other: NDArray[np.uint8],
 ) -> None:
     """Cast a pinhole's rays against primitive geoms, in place (see raycast.cpp)."""
+
+def cast_rays(
+    origin: NDArray[np.float64],
+    dirs: NDArray[np.float64],
+    start: NDArray[np.float64],
+    stop: NDArray[np.float64],
+    types: NDArray[np.int32],
+    sizes: NDArray[np.float64],
+    pos: NDArray[np.float64],
+    mats: NDArray[np.float64],
+    aabb: NDArray[np.float64],
+    rbound: NDArray[np.float64],
+    ids: NDArray[np.int32],
+    dist: NDArray[np.float64],
+    geom: NDArray[np.int32],
+    other: NDArray[np.uint8],
+) -> None:
+    """Cast rays from one point against primitive geoms, in place (see raycast.cpp)."""

@@ -108,3 +108,19 @@ def test_a_mesh_is_left_to_mujoco() -> None:
     fast, other, slow = _both(model, data, origin, R)
     assert other.any()
     assert _differ(fast[~other], slow[~other]).sum() <= EDGE_PIXELS  # the primitives: as above
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_lidar_rays_from_their_start_equal_mujocos(seed: int) -> None:
+    if raycast.native() is None:
+        pytest.skip("armcli.sim._raycast is not built (make native)")
+    model, data = _world(seed, mesh=True)
+    rng = np.random.default_rng(200 + seed)
+    dirs = rng.normal(size=(500, 3))
+    dirs /= np.linalg.norm(dirs, axis=1)[:, None]
+    start, stop = rng.uniform(0.0, 1.0, 500), rng.uniform(2.0, 6.0, 500)
+    origin = np.array([0.0, 0.0, 0.6])
+    fast = raycast.cast(model, data, origin, dirs, start, stop, raycast.SeenGeoms.of(model))
+    slow = raycast.cast(model, data, origin, dirs, start, stop)  # mj_multiRay, mj_ray
+    assert not _differ(fast, slow).any()
+    assert 0 < np.isfinite(fast).sum() < len(fast)

@@ -1,11 +1,15 @@
-// armcli.sim._raycast: a depth camera's rays cast against MuJoCo's primitive geoms.
+// armcli.sim._raycast: a sensor's rays cast against MuJoCo's primitive geoms.
 //
 // mj_multiRay tests every ray against every geom; a 160 x 120 depth image is 19,200 rays and
 // cost 3-6x a drive's 100 physics steps. A pinhole's rays leave one point through a regular
-// grid, so each geom is tested only on the pixels its bounding sphere projects onto (a z-buffer
-// over geoms). The ray of pixel (u, v) is o + t (x_n, y_n, 1) in the optical frame, so t is
-// the depth along the optical axis itself; a pixel keeps the first surface crossing with
-// near <= t <= far (from inside a shape: its exit, as MuJoCo's rays see it).
+// grid, so each geom is tested only on the pixels its bounding box (MuJoCo's geom_aabb)
+// projects onto, and not at all when the box lies before the near plane (the robot behind
+// the camera); a z-buffer over geoms. The ray of pixel (u, v) is o + t (x_n, y_n, 1) in the
+// optical frame, so t is the depth along the optical axis itself; a pixel keeps the first
+// surface crossing with near <= t <= far (from inside a shape: its exit, as MuJoCo's rays
+// see it). A lidar's rays (cast_rays) each start at range_min: mj_multiRay casts from the
+// origin and a lidar inside its own housing would have every ray cast again; here a ray
+// tests a geom only where its segment [start, stop] passes the geom's bounding sphere.
 //
 // Shapes are MuJoCo's, in each geom's frame (geom_xpos, geom_xmat): plane (z = 0, seen from
 // +z only, bounded by size[0], size[1] unless 0), sphere, capsule, ellipsoid, cylinder (radius
@@ -148,82 +152,160 @@ struct Camera {
   int width, height;
 };
 
-// Pixels [u0, u1) x [v0, v1) a sphere (centre c in the optical frame, radius rb) covers.
-void footprint(const Camera& cam, const double* c, double rb, int* box4) {
-  box4[0] = 0, box4[1] = cam.width, box4[2] = 0, box4[3] = cam.height;
-  const double z = c[2] - rb;
-  if (z <= 1e-9) return;  // the camera is in (or level with) the sphere: every pixel
-  const double lo[2] = {c[0] - rb, c[1] - rb}, hi[2] = {c[0] + rb, c[1] + rb};
+struct Geom {  // one geom in the world: MuJoCo's type, size, pose and local bounding box
+  int type;
+  const double *size, *pos, *mat, *aabb;  // aabb: centre (3), half sizes (3), geom frame
+};
+
+// Pixels [u0, u1) x [v0, v1) the geom's bounding box may cover; false when it lies wholly
+// before the near plane (behind the camera: the robot's own base, the camera's housing).
+bool footprint(const Camera& cam, const Geom& g, int* fp) {
+  fp[0] = 0, fp[1] = cam.width, fp[2] = 0, fp[3] = cam.height;
+  if (g.type == PLANE) return true;
+  double A[9], c[3], w[3];  // A = R^T mat: geom axes in the optical frame; c: box centre
+  for (int i = 0; i < 3; ++i) {
+    w[i] = g.pos[i] - cam.o[i];
+    for (int k = 0; k < 3; ++k) w[i] += g.mat[3 * i + k] * g.aabb[k];
+  }
+  for (int i = 0; i < 3; ++i) {
+    c[i] = cam.R[i] * w[0] + cam.R[3 + i] * w[1] + cam.R[6 + i] * w[2];
+    for (int k = 0; k < 3; ++k)
+      A[3 * i + k] = cam.R[i] * g.mat[k] + cam.R[3 + i] * g.mat[3 + k] + cam.R[6 + i] * g.mat[6 + k];
+  }
+  double ez = 0.0;
+  for (int k = 0; k < 3; ++k) ez += std::abs(A[6 + k]) * g.aabb[3 + k];
+  if (c[2] + ez < cam.near) return false;
+  if (c[2] - ez <= 1e-9) return true;  // reaches behind the camera: every pixel
+  double lo[2] = {INF, INF}, hi[2] = {-INF, -INF};
+  for (int corner = 0; corner < 8; ++corner) {
+    double p[3];
+    for (int i = 0; i < 3; ++i) {
+      p[i] = c[i];
+      for (int k = 0; k < 3; ++k) p[i] += A[3 * i + k] * ((corner >> k & 1) ? 1 : -1) * g.aabb[3 + k];
+    }
+    for (int a = 0; a < 2; ++a) lo[a] = std::min(lo[a], p[a] / p[2]), hi[a] = std::max(hi[a], p[a] / p[2]);
+  }
   const double f[2] = {cam.fx, cam.fy}, ctr[2] = {cam.cx, cam.cy};
   const int n[2] = {cam.width, cam.height};
-  for (int a = 0; a < 2; ++a) {  // x / z over z in [z, z + 2 rb] is extreme at an end
-    const double small = std::min(lo[a] / z, lo[a] / (c[2] + rb));
-    const double large = std::max(hi[a] / z, hi[a] / (c[2] + rb));
-    box4[2 * a] = std::max(0, static_cast<int>(std::floor(ctr[a] + f[a] * small)));
-    box4[2 * a + 1] = std::min(n[a], static_cast<int>(std::ceil(ctr[a] + f[a] * large)) + 1);
+  for (int a = 0; a < 2; ++a) {
+    fp[2 * a] = std::max(0, static_cast<int>(std::floor(ctr[a] + f[a] * lo[a])));
+    fp[2 * a + 1] = std::min(n[a], static_cast<int>(std::ceil(ctr[a] + f[a] * hi[a])) + 1);
+  }
+  return fp[0] < fp[1] && fp[2] < fp[3];
+}
+
+// The ray origin in the geom's frame, and M = mat^T R: a direction R d in the geom's frame.
+void to_geom(const double* o, const double* R, const Geom& g, double* og, double* M) {
+  double rel[3];
+  for (int i = 0; i < 3; ++i) rel[i] = o[i] - g.pos[i];
+  for (int i = 0; i < 3; ++i) {
+    og[i] = g.mat[i] * rel[0] + g.mat[3 + i] * rel[1] + g.mat[6 + i] * rel[2];
+    for (int j = 0; j < 3; ++j)
+      M[3 * i + j] = g.mat[i] * R[j] + g.mat[3 + i] * R[3 + j] + g.mat[6 + i] * R[6 + j];
   }
 }
 
-void cast_geom(const Camera& cam, int type, const double* size, const double* pos,
-               const double* mat, double* depth, int32_t* geom, uint8_t* other, int id,
-               double rbound) {
-  double rel[3], c[3];
-  for (int i = 0; i < 3; ++i) rel[i] = pos[i] - cam.o[i];
-  for (int i = 0; i < 3; ++i)
-    c[i] = cam.R[i] * rel[0] + cam.R[3 + i] * rel[1] + cam.R[6 + i] * rel[2];
-  int fp[4] = {0, cam.width, 0, cam.height};
-  if (type != PLANE) {
-    if (c[2] + rbound < cam.near) return;  // behind the near plane
-    footprint(cam, c, rbound, fp);
-  }
-  if (!cast_here(type)) {
+void cast_geom(const Camera& cam, const Geom& g, double* depth, int32_t* geom, uint8_t* other,
+               int id) {
+  int fp[4];
+  if (!footprint(cam, g, fp)) return;
+  if (!cast_here(g.type)) {
     for (int v = fp[2]; v < fp[3]; ++v)
       for (int u = fp[0]; u < fp[1]; ++u) other[v * cam.width + u] = 1;
     return;
   }
   Ray r;
-  double M[9];  // optical -> geom: mat^T R, columns the optical axes in the geom frame
-  for (int i = 0; i < 3; ++i) {
-    r.o[i] = -(mat[i] * rel[0] + mat[3 + i] * rel[1] + mat[6 + i] * rel[2]);
-    for (int j = 0; j < 3; ++j)
-      M[3 * i + j] = mat[i] * cam.R[j] + mat[3 + i] * cam.R[3 + j] + mat[6 + i] * cam.R[6 + j];
-  }
+  double M[9];
+  to_geom(cam.o, cam.R, g, r.o, M);
   for (int v = fp[2]; v < fp[3]; ++v) {
     const double yn = (v - cam.cy) / cam.fy;
     for (int u = fp[0]; u < fp[1]; ++u) {
       const double xn = (u - cam.cx) / cam.fx;
       for (int i = 0; i < 3; ++i) r.d[i] = M[3 * i] * xn + M[3 * i + 1] * yn + M[3 * i + 2];
       const int p = v * cam.width + u;
-      const double t = hit(type, r, size, cam.near);
+      const double t = hit(g.type, r, g.size, cam.near);
       if (t <= cam.far && t < depth[p]) depth[p] = t, geom[p] = id;
     }
   }
 }
 
+void check_sizes(size_t n, const In<double>& sizes, const In<double>& pos, const In<double>& mats,
+                 const In<double>& aabb, const In<int32_t>& ids) {
+  if (sizes.size() != 3 * n || pos.size() != 3 * n || mats.size() != 9 * n ||
+      aabb.size() != 6 * n || ids.size() != n)
+    throw std::invalid_argument("raycast: geom array sizes disagree");
+}
+
+Geom geom_at(size_t g, const In<int32_t>& types, const In<double>& sizes, const In<double>& pos,
+             const In<double>& mats, const In<double>& aabb) {
+  return Geom{types.data()[g], sizes.data() + 3 * g, pos.data() + 3 * g, mats.data() + 9 * g,
+              aabb.data() + 6 * g};
+}
+
 // Depth [m] (+inf: nothing between near and far), the geom hit (-1), pixels left to MuJoCo.
 void cast_pinhole(In<double> origin, In<double> R, double fx, double fy, double cx, double cy,
-                       int width, int height, double near, double far, In<int32_t> types,
-                       In<double> sizes, In<double> pos, In<double> mats, In<double> rbound,
-                       In<int32_t> ids, Out<double> depth, Out<int32_t> geom, Out<uint8_t> other) {
+                  int width, int height, double near, double far, In<int32_t> types,
+                  In<double> sizes, In<double> pos, In<double> mats, In<double> aabb,
+                  In<int32_t> ids, Out<double> depth, Out<int32_t> geom, Out<uint8_t> other) {
   Camera cam{};
   std::copy_n(origin.data(), 3, cam.o);
   std::copy_n(R.data(), 9, cam.R);
   cam.fx = fx, cam.fy = fy, cam.cx = cx, cam.cy = cy, cam.near = near, cam.far = far;
   cam.width = width, cam.height = height;
   const size_t n = types.size(), pixels = static_cast<size_t>(width) * height;
-  if (sizes.size() != 3 * n || pos.size() != 3 * n || mats.size() != 9 * n ||
-      rbound.size() != n || ids.size() != n || depth.size() != pixels || geom.size() != pixels ||
-      other.size() != pixels)
-    throw std::invalid_argument("cast_pinhole: array sizes disagree");
-  {
-    nb::gil_scoped_release release;
-    std::fill_n(depth.data(), pixels, INF);
-    std::fill_n(geom.data(), pixels, -1);
-    std::fill_n(other.data(), pixels, 0);
-    for (size_t g = 0; g < n; ++g)
-      cast_geom(cam, types.data()[g], sizes.data() + 3 * g, pos.data() + 3 * g,
-                mats.data() + 9 * g, depth.data(), geom.data(), other.data(), ids.data()[g],
-                rbound.data()[g]);
+  check_sizes(n, sizes, pos, mats, aabb, ids);
+  if (depth.size() != pixels || geom.size() != pixels || other.size() != pixels)
+    throw std::invalid_argument("cast_pinhole: image array sizes disagree");
+  nb::gil_scoped_release release;
+  std::fill_n(depth.data(), pixels, INF);
+  std::fill_n(geom.data(), pixels, -1);
+  std::fill_n(other.data(), pixels, 0);
+  for (size_t g = 0; g < n; ++g)
+    cast_geom(cam, geom_at(g, types, sizes, pos, mats, aabb), depth.data(), geom.data(),
+              other.data(), ids.data()[g]);
+}
+
+// Rays from one origin along unit `dirs`, each seeing only [start, stop]: the distance to the
+// first surface there (+inf: none), the geom (-1), rays a non-primitive may meet (for MuJoCo).
+void cast_rays(In<double> origin, In<double> dirs, In<double> start, In<double> stop,
+               In<int32_t> types, In<double> sizes, In<double> pos, In<double> mats,
+               In<double> aabb, In<double> rbound, In<int32_t> ids, Out<double> dist,
+               Out<int32_t> geom, Out<uint8_t> other) {
+  const size_t n = types.size(), rays = start.size();
+  check_sizes(n, sizes, pos, mats, aabb, ids);
+  if (dirs.size() != 3 * rays || stop.size() != rays || dist.size() != rays ||
+      geom.size() != rays || other.size() != rays || rbound.size() != n)
+    throw std::invalid_argument("cast_rays: ray array sizes disagree");
+  nb::gil_scoped_release release;
+  const double* o = origin.data();
+  std::fill_n(dist.data(), rays, INF);
+  std::fill_n(geom.data(), rays, -1);
+  std::fill_n(other.data(), rays, 0);
+  const double identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  for (size_t k = 0; k < n; ++k) {
+    const Geom g = geom_at(k, types, sizes, pos, mats, aabb);
+    const double rb = rbound.data()[k];
+    double c[3];  // the bounding sphere's centre relative to the origin
+    for (int i = 0; i < 3; ++i) c[i] = g.pos[i] - o[i];
+    Ray r;
+    double M[9];
+    to_geom(o, identity, g, r.o, M);
+    for (size_t j = 0; j < rays; ++j) {
+      const double* d = dirs.data() + 3 * j;
+      const double lo = start.data()[j], hi = std::min(stop.data()[j], dist.data()[j]);
+      if (g.type != PLANE) {  // the ray's segment [lo, hi] must pass the bounding sphere
+        const double along = c[0] * d[0] + c[1] * d[1] + c[2] * d[2];
+        const double off = c[0] * c[0] + c[1] * c[1] + c[2] * c[2] - along * along;
+        if (off > rb * rb || along + rb < lo || along - rb > hi) continue;
+      }
+      if (!cast_here(g.type)) {
+        other.data()[j] = 1;
+        continue;
+      }
+      for (int i = 0; i < 3; ++i) r.d[i] = M[3 * i] * d[0] + M[3 * i + 1] * d[1] + M[3 * i + 2] * d[2];
+      const double t = hit(g.type, r, g.size, lo);
+      if (t <= hi) dist.data()[j] = t, geom.data()[j] = ids.data()[k];
+    }
   }
 }
 
@@ -236,7 +318,12 @@ NB_MODULE(_raycast, m) {
   m.def("cast_pinhole", &cast_pinhole, nb::arg("origin"), nb::arg("R"), nb::arg("fx"),
         nb::arg("fy"), nb::arg("cx"), nb::arg("cy"), nb::arg("width"), nb::arg("height"),
         nb::arg("near"), nb::arg("far"), nb::arg("types"), nb::arg("sizes"), nb::arg("pos"),
-        nb::arg("mats"), nb::arg("rbound"), nb::arg("ids"), nb::arg("depth"), nb::arg("geom"),
+        nb::arg("mats"), nb::arg("aabb"), nb::arg("ids"), nb::arg("depth"), nb::arg("geom"),
         nb::arg("other"),
         "Cast a pinhole's rays against primitive geoms, in place (see raycast.cpp).");
+  m.def("cast_rays", &cast_rays, nb::arg("origin"), nb::arg("dirs"), nb::arg("start"),
+        nb::arg("stop"), nb::arg("types"), nb::arg("sizes"), nb::arg("pos"), nb::arg("mats"),
+        nb::arg("aabb"), nb::arg("rbound"), nb::arg("ids"), nb::arg("dist"), nb::arg("geom"),
+        nb::arg("other"),
+        "Cast rays from one point against primitive geoms, in place (see raycast.cpp).");
 }

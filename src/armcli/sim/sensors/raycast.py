@@ -8,11 +8,12 @@ mj_multiRay casts them together; a ray whose first hit lies nearer than where it
 (a lidar's range_min, a camera's near plane) is cast again from its start with mj_ray.
 A distance is +inf where nothing is hit before the ray's end.
 
-A depth camera's rays are many (19,200 for 160 x 120) and leave one point through a
-regular grid: the compiled caster (sim/_native/raycast.cpp) tests each primitive geom
-only on the pixels it can cover, with MuJoCo's shapes and the same "first surface at or
-beyond the start" rule; the pixels a mesh may cover are cast by mj_multiRay as above.
-Without the extension every ray goes through mj_multiRay (the same depths, slower).
+The compiled caster (sim/_native/raycast.cpp) does the same for the primitive geoms with
+MuJoCo's shapes and the same "first surface at or beyond the start" rule, testing a geom
+only on the rays that can meet it: a depth camera's pixels its bounding box covers, a
+lidar's rays whose segment passes its bounding sphere; the rays a mesh may meet are cast
+by MuJoCo. Without the extension every ray goes through mj_multiRay (the same ranges,
+slower).
 """
 
 from __future__ import annotations
@@ -34,12 +35,39 @@ SEEN_GROUPS[[FLOOR_GROUP, WORLD_GROUP, COLLISION_GROUP]] = 1
 
 
 def cast(
-    model: Any, data: Any, origin: np.ndarray, dirs: np.ndarray, start: np.ndarray, stop: np.ndarray
+    model: Any,
+    data: Any,
+    origin: np.ndarray,
+    dirs: np.ndarray,
+    start: np.ndarray,
+    stop: np.ndarray,
+    geoms: SeenGeoms | None = None,
 ) -> np.ndarray:
     """[m] from `origin` along each unit ray of `dirs` (n, 3, world) to its first hit.
 
     Only hits between `start` and `stop` [m] (per ray) count; +inf where there is none.
+    With `geoms` and the compiled caster, the primitives are cast there and only the rays
+    that may meet a mesh by MuJoCo.
     """
+    mod = native()
+    if mod is None or geoms is None:
+        return _multiray(model, data, origin, dirs, start, stop)
+    n = len(dirs)
+    dist, geom, other = np.empty(n), np.empty(n, dtype=np.int32), np.empty(n, dtype=np.uint8)
+    mod.cast_rays(np.ascontiguousarray(origin, dtype=np.float64),
+                  np.ascontiguousarray(dirs, dtype=np.float64), start, stop, geoms.types,
+                  geoms.sizes, np.ascontiguousarray(data.geom_xpos[geoms.ids]),
+                  np.ascontiguousarray(data.geom_xmat[geoms.ids]), geoms.aabb, geoms.rbound,
+                  geoms.ids, dist, geom, other)  # fmt: skip
+    for i in np.nonzero(other)[0]:
+        dist[i] = _from_start(model, data, origin, dirs[i], start[i], stop[i])
+    return dist
+
+
+def _multiray(
+    model: Any, data: Any, origin: np.ndarray, dirs: np.ndarray, start: np.ndarray, stop: np.ndarray
+) -> np.ndarray:
+    """mj_multiRay from the origin; a ray hitting before its start is cast again from there."""
     import mujoco
 
     n = len(dirs)
@@ -49,14 +77,21 @@ def cast(
     pnt = np.ascontiguousarray(origin, dtype=np.float64)
     mujoco.mj_multiRay(model, data, pnt, vec, SEEN_GROUPS, 1, -1, geom, dist, None, n,
                        float(np.max(stop)))  # fmt: skip
-    early = np.nonzero((dist >= 0.0) & (dist < start))[0]
-    one = np.empty(1, dtype=np.int32)
-    for i in early:  # the ray begins beyond this hit: cast it again from where it starts
-        again = mujoco.mj_ray(model, data, pnt + start[i] * dirs[i], dirs[i], SEEN_GROUPS, 1, -1,
-                              one)  # fmt: skip
-        dist[i] = start[i] + again if again >= 0.0 else -1.0
     dist[(dist < 0.0) | (dist > stop)] = np.inf
+    for i in np.nonzero(dist < start)[0]:  # the ray begins beyond this hit
+        dist[i] = _from_start(model, data, pnt, dirs[i], start[i], stop[i])
     return dist
+
+
+def _from_start(
+    model: Any, data: Any, origin: np.ndarray, d: np.ndarray, start: float, stop: float
+) -> float:
+    """mj_ray of one ray from where it starts: its distance from `origin`, or +inf."""
+    import mujoco
+
+    one = np.empty(1, dtype=np.int32)
+    hit = mujoco.mj_ray(model, data, origin + start * d, d, SEEN_GROUPS, 1, -1, one)
+    return start + hit if 0.0 <= hit <= stop - start else float(np.inf)
 
 
 # -- the compiled pinhole caster (sim/_native/raycast.cpp) ----------------------------------
@@ -94,7 +129,8 @@ class SeenGeoms:
     ids: np.ndarray  # (n,) int32
     types: np.ndarray  # (n,) int32
     sizes: np.ndarray  # (n, 3)
-    rbound: np.ndarray  # (n,)
+    aabb: np.ndarray  # (n, 6): MuJoCo's bounding box in the geom frame (centre, half sizes)
+    rbound: np.ndarray  # (n,): MuJoCo's bounding sphere about the geom frame's origin
 
     @classmethod
     def of(cls, model: Any) -> SeenGeoms:
@@ -102,7 +138,9 @@ class SeenGeoms:
         ok = (SEEN_GROUPS[model.geom_group] == 1) & (model.geom_rgba[:, 3] != 0.0)
         ids = np.nonzero(ok)[0].astype(np.int32)
         sizes = np.ascontiguousarray(model.geom_size[ids])
-        return cls(ids, model.geom_type[ids].astype(np.int32), sizes, model.geom_rbound[ids].copy())
+        aabb = np.ascontiguousarray(model.geom_aabb[ids])
+        return cls(ids, model.geom_type[ids].astype(np.int32), sizes, aabb,
+                   model.geom_rbound[ids].copy())  # fmt: skip
 
 
 def cast_pinhole(
@@ -114,7 +152,7 @@ def cast_pinhole(
     mod.cast_pinhole(cam.origin, cam.R.ravel(), cam.fx, cam.fy, cam.cx, cam.cy, cam.width,
                      cam.height, cam.near, cam.far, geoms.types, geoms.sizes,
                      np.ascontiguousarray(data.geom_xpos[geoms.ids]),
-                     np.ascontiguousarray(data.geom_xmat[geoms.ids]), geoms.rbound, geoms.ids,
+                     np.ascontiguousarray(data.geom_xmat[geoms.ids]), geoms.aabb, geoms.ids,
                      depth, geom, other)  # fmt: skip
     return depth, other.astype(bool)
 

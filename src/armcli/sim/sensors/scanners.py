@@ -42,12 +42,13 @@ class LidarSampler:
         self.ranges = np.empty((len(steps), *self.shape), dtype=np.float32)
         self.poses = np.empty((len(steps), 12))  # the sensor in the world: origin, R (rows)
         self.rng = rng(name)
+        self.geoms: SeenGeoms | None = SeenGeoms.of(model)  # None: mj_multiRay alone
 
     def sample(self, j: int, model: Any, data: Any) -> None:
         """Scan once from the site's pose."""
         origin, R = _pose(data, self.site)
         self.poses[j, :3], self.poses[j, 3:] = origin, R.ravel()
-        r = cast(model, data, origin, self.dirs @ R.T, self.start, self.stop)
+        r = cast(model, data, origin, self.dirs @ R.T, self.start, self.stop, self.geoms)
         li, noise = self.sensor.lidar, self.sensor.noise
         assert li is not None
         hit = np.isfinite(r)
@@ -104,7 +105,7 @@ class DepthSampler:
         z, other = cast_pinhole(self.native, model, data, self.geoms, frame)
         if other.any():
             dist = cast(model, data, origin, self.dirs[other] @ R.T, self.start[other],
-                        self.stop[other])  # fmt: skip
+                        self.stop[other], self.geoms)  # fmt: skip
             z[other] = dist / self.norm[other]
         return z
 
