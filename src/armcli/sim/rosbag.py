@@ -281,12 +281,14 @@ def _messages(chans: Sequence[Channel]) -> Iterator[tuple[int, int, int, Any]]:
             yield ns, rank, k, msg
 
 
-def run_mcap_bytes(res: SimResult, rate: float, urdf: Urdf | None) -> bytes:
-    """The run sampled at `rate` [Hz] as the bytes of a rosbag2 MCAP file."""
+def run_mcap_bytes(
+    res: SimResult, rate: float, urdf: Urdf | None, extra: Sequence[Channel] = ()
+) -> bytes:
+    """The run sampled at `rate` [Hz] (and `extra` topics) as the bytes of an MCAP file."""
     if urdf is None:
         raise ValueError("an MCAP file needs the simulated robot description")
     cols = sample_states(res, rate)
-    return mcap_bytes(channels(cols, res.joint_names, urdf))
+    return mcap_bytes([*channels(cols, res.joint_names, urdf), *extra])
 
 
 def write_mcap(path: Path, res: SimResult, rate: float, urdf: Urdf | None) -> None:
