@@ -139,3 +139,16 @@ def test_a_bad_sensor_is_exit_2_naming_file_and_field(
     assert code == 2
     assert str(spec) in err and field in err
     assert not out.exists()
+
+
+def test_the_foxglove_layout_names_topics_the_run_has(bag: dict[str, Any]) -> None:
+    import json
+
+    layout = json.loads((SPECS / "rover" / "foxglove_layout.json").read_text())
+    named = set()
+    for panel in layout["configById"].values():
+        named |= set(panel.get("topics", {}))
+        mode = panel.get("imageMode", {})
+        named |= {mode[k] for k in ("imageTopic", "calibrationTopic") if k in mode}
+        named |= {p["value"].split(".")[0] for p in panel.get("paths", [])}
+    assert named and named <= set(bag["msgs"])

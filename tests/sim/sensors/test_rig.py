@@ -71,6 +71,6 @@ def test_sensors_keeping_too_much_are_refused_before_the_run(tmp_path: Path) -> 
     big = {"type": "depth_camera", "link": "base_link", "rate": 1000, "topic": "depth",
            "camera": {"width": 4000, "height": 3000, "horizontal_fov": 1.0}}  # fmt: skip
     spec = course_with(tmp_path, {"depth": big})
-    with pytest.raises(InputError, match="more than the 1 GB a run keeps") as exc:
+    with pytest.raises(InputError, match="more than the 250 MB a run keeps") as exc:
         run(spec, "commands:\n  - {linear: {x: 0.0}, time_from_start: 0.0}\n", 1.0)
     assert exc.value.field == "sensors.depth"

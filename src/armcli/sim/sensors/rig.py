@@ -25,7 +25,9 @@ from armcli.sim.sensors.scanners import DepthSampler, LidarSampler
 from armcli.sim.states import sample_steps
 from armcli.spec.sensors import Sensor
 
-MAX_SENSOR_BYTES = 1_000_000_000  # what a run keeps of its sensors' readings
+# what a run keeps of its sensors' readings; their MCAP messages take up to 4x more (a depth
+# image's point cloud is 3 floats a pixel) until the file is written
+MAX_SENSOR_BYTES = 250_000_000
 
 
 def sample_bytes(sensor: Sensor) -> int:
@@ -96,8 +98,8 @@ def _refuse_big(sensors: Mapping[str, Sensor], steps: int, dt: float) -> None:
         total += len(sample_steps(steps, dt, s.rate)) * sample_bytes(s)
         if total > MAX_SENSOR_BYTES:
             raise InputError(
-                f"the sensors would keep {total / 1e9:.1f} GB over {steps * dt:g} s, more than "
-                f"the {MAX_SENSOR_BYTES / 1e9:g} GB a run keeps (sensor {name!r} and those "
+                f"the sensors would keep {total / 1e6:.0f} MB over {steps * dt:g} s, more than "
+                f"the {MAX_SENSOR_BYTES / 1e6:g} MB a run keeps (sensor {name!r} and those "
                 "before it): lower a rate or an image size, or simulate less time",
                 field=f"sensors.{name}",
             )
