@@ -14,7 +14,7 @@ own, the engine's motion being smooth (no contact chatter to average away).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -25,8 +25,10 @@ from armcli.sim.sensors.rig import make_rig
 from armcli.sim.simulate import SimResult
 from armcli.sim.states import sample_steps
 from armcli.sim.world import add_scene
-from armcli.spec.sensors import Sensor
 from armcli.urdf.doc import Urdf
+
+if TYPE_CHECKING:  # pydantic models: annotations only
+    from armcli.spec.sensors import Sensor
 
 
 def arm_sensors(sensors: Mapping[str, Sensor], urdf: Urdf) -> dict[str, Sensor]:

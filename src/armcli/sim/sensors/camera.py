@@ -9,14 +9,16 @@ The GL context is the one `gl` found (EGL or OSMesa); without one there is no sa
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from armcli.sim.sensors import gl
 from armcli.sim.sensors.model import site_name
 from armcli.sim.sensors.reading import Reading, gaussian, rng
-from armcli.spec.sensors import Sensor
+
+if TYPE_CHECKING:  # pydantic models: annotations only
+    from armcli.spec.sensors import Sensor
 
 ENCODINGS = {"R8G8B8": "rgb8", "RGB_INT8": "rgb8", "B8G8R8": "bgr8", "L8": "mono8"}
 LUMA = np.array([0.299, 0.587, 0.114])  # ITU-R BT.601, for a mono camera

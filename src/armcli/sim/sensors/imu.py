@@ -18,13 +18,15 @@ during the run: the sampler reads them afterwards.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from armcli.sim.sensors.model import imu_addresses
 from armcli.sim.sensors.reading import Reading, gaussian, rng
-from armcli.spec.sensors import Sensor
+
+if TYPE_CHECKING:  # pydantic models: annotations only
+    from armcli.spec.sensors import Sensor
 
 
 class ImuSampler:

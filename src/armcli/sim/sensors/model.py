@@ -15,20 +15,31 @@ Added to the model editor (MjSpec) before it compiles, on the body of the sensor
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from armcli.errors import InputError
-from armcli.export.mjcf import quat
 from armcli.sim.sensors.rays import Pinhole
-from armcli.spec.sensors import Sensor
+
+if TYPE_CHECKING:  # the pydantic models: not loaded by a run that reads no spec
+    from armcli.spec.sensors import Sensor
 
 PREFIX = "sensor/"
 IMU_PARTS = ("gyro", "accelerometer", "framequat")  # in sensordata order: 3, 3, 4 numbers
 SITE_GROUP = 5  # hidden in MuJoCo's viewer by default, as the drive's touch sites
 # columns: a MuJoCo camera's x (right), y (up), z (backward) in the sensor frame
 R_SENSOR_MJCAMERA = np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+
+
+def quat(rpy: tuple[float, float, float]) -> tuple[float, float, float, float]:
+    """(w, x, y, z) of URDF's roll-pitch-yaw about fixed axes (R = Rz Ry Rx), as MuJoCo's."""
+    import mujoco
+
+    q = np.zeros(4)
+    mujoco.mju_euler2Quat(q, np.asarray(rpy, dtype=float), "XYZ")
+    w, x, y, z = (float(v) for v in q)
+    return w, x, y, z
 
 
 def site_name(sensor: str) -> str:

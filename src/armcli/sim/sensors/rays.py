@@ -20,10 +20,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from armcli.spec.sensors import Camera, Lidar
+if TYPE_CHECKING:  # pydantic models: annotations only
+    from armcli.spec.sensors import Camera, Lidar
 
 # columns: the optical frame's x, y, z in the sensor frame (x right = -y, y down = -z, z = x)
 R_SENSOR_OPTICAL = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])

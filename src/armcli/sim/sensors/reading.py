@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import zlib
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
-from armcli.spec.sensors import Sensor
+if TYPE_CHECKING:  # pydantic models: annotations only
+    from armcli.spec.sensors import Sensor
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -23,7 +23,9 @@ from armcli.sim.sensors.imu import ImuSampler
 from armcli.sim.sensors.reading import Reading, Sampler
 from armcli.sim.sensors.scanners import DepthSampler, LidarSampler
 from armcli.sim.states import sample_steps
-from armcli.spec.sensors import Sensor
+
+if TYPE_CHECKING:  # pydantic models: annotations only
+    from armcli.spec.sensors import Sensor
 
 # what a run keeps of its sensors' readings; their MCAP messages take up to 4x more (a depth
 # image's point cloud is 3 floats a pixel) until the file is written

@@ -9,7 +9,7 @@ hit between the near and far planes, plus noise, or +inf with nothing there (REP
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -17,7 +17,9 @@ from armcli.sim.sensors.model import site_name
 from armcli.sim.sensors.raycast import PinholeCast, SeenGeoms, cast, cast_pinhole, native
 from armcli.sim.sensors.rays import R_SENSOR_OPTICAL, Pinhole, lidar_directions
 from armcli.sim.sensors.reading import Reading, gaussian, quantise, rng
-from armcli.spec.sensors import Sensor
+
+if TYPE_CHECKING:  # pydantic models: annotations only
+    from armcli.spec.sensors import Sensor
 
 
 def _pose(data: Any, site: int) -> tuple[np.ndarray, np.ndarray]:
