@@ -161,7 +161,8 @@ def _unique(findings: Iterable[Finding]) -> list[Finding]:
     seen: set[tuple[object, ...]] = set()
     out = []
     for f in findings:
-        key = (f.rule, f.file, f.line, f.message)
+        where = (f.origin.file, f.origin.line) if f.origin is not None else (f.file, f.line)
+        key = (f.rule, *where, f.message)  # an element of several expansions: one finding
         if key not in seen:
             seen.add(key)
             out.append(f)

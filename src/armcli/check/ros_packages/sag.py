@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from armcli.analysis.sag import Hold, Sag, passing_kp, settle
 from armcli.check.ros_packages.context import PackageContext
 from armcli.check.ros_packages.launch_model import Where
+from armcli.check.ros_packages.moveit import MoveItConfig
 from armcli.check.ros_packages.params import JTC, Controller
 from armcli.check.ros_packages.srdf_names import read
 from armcli.robot.model import Robot
@@ -98,9 +99,7 @@ def _tolerances(
     ctx: PackageContext, c: Controller, urdf: Urdf, joints: list[str]
 ) -> tuple[dict[str, float], dict[str, str]]:
     """Per joint the tightest of MoveIt's start tolerance and the JTC goal tolerance."""
-    moveit = [
-        cfg for cfg in ctx.moveit if (u := ctx.moveit_urdf(cfg)) is not None and u.name == urdf.name
-    ]
+    moveit = _configs(ctx, joints)
     start = moveit[0].tolerance.value if moveit else None
     constraints = c.params.get("constraints")
     out: dict[str, float] = {}
@@ -118,12 +117,24 @@ def _tolerances(
     return out, why
 
 
+def _configs(ctx: PackageContext, joints: list[str]) -> list[MoveItConfig]:
+    """The MoveIt configs planning for these joints: their URDF has every one of them.
+
+    (Not by the robot's name: a Gazebo top-level xacro may call the robot otherwise.)
+    """
+    out = []
+    for cfg in ctx.moveit:
+        u = ctx.moveit_urdf(cfg)
+        if u is not None and set(joints) <= {j.name for j in u.joints}:
+            out.append(cfg)
+    return out
+
+
 def poses(ctx: PackageContext, urdf: Urdf, joints: list[str]) -> list[Pose]:
     """The named poses for this robot: SRDF group states, then the spec's."""
     out: list[Pose] = []
-    for cfg in ctx.moveit:
-        robot = ctx.moveit_urdf(cfg)
-        found = read(ctx, cfg) if robot is not None and robot.name == urdf.name else None
+    for cfg in _configs(ctx, joints):
+        found = read(ctx, cfg)
         if found is None or cfg.srdf is None:
             continue
         srdf, _ = found
