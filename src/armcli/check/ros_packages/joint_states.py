@@ -88,7 +88,8 @@ def publishers(ctx: PackageContext, run: Run) -> list[Publisher]:
     for u in ctx.urdfs(run.descriptions) if CLASSIC in run.sims else ():  # only when it runs
         for plug in u.plugins:
             if (plug.filename or "").rsplit("/", 1)[-1] == PLUGIN:
-                where = Where(u.source, plug.line)
+                origin = u.origins.get(plug.line) if plug.line else None
+                where = Where(origin.file, origin.line) if origin else Where(u.source, plug.line)
                 out.append(
                     Publisher("Gazebo's joint_state_publisher plugin", where, 1, u, plug.line)
                 )
