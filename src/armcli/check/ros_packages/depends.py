@@ -7,7 +7,8 @@ not found". Used are: node packages, the packages of included launch files and o
 `$(find-pkg-share)` / `get_package_share_directory` / `FindPackageShare`, `xacro` for a
 xacro command, and the ROS Python modules a launch file imports (not launch, launch_ros
 and ament_index_python: `ros2 launch` itself needs them). Any of `depend`,
-`exec_depend`, `build_export_depend` (or format 1's `run_depend`) satisfies it. The
+`exec_depend`, `build_export_depend` (or format 1's `run_depend`) satisfies it, and so
+does a metapackage that lists it (`gazebo_ros_pkgs`, `ros2_control`, `ros2_controllers`). The
 finding is on package.xml, where the dependency goes.
 """
 
@@ -29,6 +30,23 @@ MODULE_PACKAGES = {
     "launch_param_builder": "launch_param_builder",
     "nav2_common": "nav2_common",
 }
+# Metapackages (their package.xml's exec_depends, Humble to Rolling): depending on one
+# brings what it lists, which a launch file then uses.
+METAPACKAGES = {
+    "gazebo_ros_pkgs": ("gazebo_dev", "gazebo_msgs", "gazebo_plugins", "gazebo_ros"),
+    "ros2_control": ("controller_interface", "controller_manager", "hardware_interface",
+                     "joint_limits", "ros2controlcli", "transmission_interface"),
+    "ros2_controllers": ("admittance_controller", "diff_drive_controller",
+                         "effort_controllers", "force_torque_sensor_broadcaster",
+                         "forward_command_controller", "gripper_controllers",
+                         "imu_sensor_broadcaster", "joint_state_broadcaster",
+                         "joint_trajectory_controller", "position_controllers",
+                         "tricycle_controller", "velocity_controllers"),
+    "ros_gz": ("ros_gz_bridge", "ros_gz_image", "ros_gz_interfaces", "ros_gz_sim"),
+    "moveit": ("moveit_core", "moveit_planners", "moveit_plugins", "moveit_ros",
+               "moveit_setup_assistant", "moveit_ros_move_group",
+               "moveit_ros_visualization", "moveit_simple_controller_manager"),
+}  # fmt: skip
 ALWAYS_THERE = frozenset(
     {"launch", "launch_ros", "launch_xml", "launch_yaml", "ament_index_python"}
 )
@@ -43,8 +61,9 @@ def check(ctx: PackageContext) -> None:
             if doc is not None:
                 for name, line in used(ctx, doc).items():
                     needs.setdefault(name, (path, line))
+        have = {*pkg.depends, *(m for d in pkg.depends for m in METAPACKAGES.get(d, ()))}
         for name, (path, line) in sorted(needs.items()):
-            if name == pkg.name or name in pkg.depends or name in ALWAYS_THERE:
+            if name == pkg.name or name in have or name in ALWAYS_THERE:
                 continue
             rel = path.relative_to(pkg.root)
             ctx.add(
