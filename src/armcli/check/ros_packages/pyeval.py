@@ -5,8 +5,8 @@ assigned once (anywhere in the module, or to the same value each time), `__file_
 launch arguments (`LaunchConfiguration`) at the value passed or their literal default, and
 the substitutions and helpers launch files build paths and robot descriptions with
 (`get_package_share_directory`, `FindPackageShare`, `os.path.join`, `PathJoinSubstitution`,
-`Command`, `process_file` of the xacro module, `open(...).read()`, `ParameterValue`, `PythonExpression`
-of literals, `MoveItConfigsBuilder`). Everything else is UNKNOWN (or a HOLE in a string).
+`Command`, the xacro module's `process_file`, `open(...).read()`, `ParameterValue`,
+`PythonExpression` of literals, `MoveItConfigsBuilder`). Everything else is UNKNOWN (or a HOLE in a string).
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ class Cmd:
 
 @dataclass(frozen=True)
 class XacroDoc:
-    """`process_file(FILE, mappings=...)` of the xacro module: a robot description expanded in the launch."""
+    """The xacro module's `process_file(FILE, mappings=...)`: a description expanded there."""
 
     file: object
     mappings: object
