@@ -6,7 +6,8 @@ launch arguments (`LaunchConfiguration`) at the value passed or their literal de
 the substitutions and helpers launch files build paths and robot descriptions with
 (`get_package_share_directory`, `FindPackageShare`, `os.path.join`, `PathJoinSubstitution`,
 `Command`, the xacro module's `process_file`, `open(...).read()`, `ParameterValue`,
-`PythonExpression` of literals, `MoveItConfigsBuilder`). Everything else is UNKNOWN (or a HOLE in a string).
+`PythonExpression` of literals, `MoveItConfigsBuilder`). Everything else is UNKNOWN (or a
+HOLE in a string).
 """
 
 from __future__ import annotations
