@@ -163,3 +163,12 @@ def test_nothing_in_the_file_runs(tmp_path: Path) -> None:
     """
     doc = read(source)
     assert doc.problems == () and not planted.exists()
+
+
+def test_doubling_names_stay_bounded() -> None:
+    """`a1 = a0 + a0; a2 = a1 + a1; ...`: 60 doublings are 2**60 characters if followed."""
+    chain = "\n".join(f"a{k + 1} = a{k} + a{k}" for k in range(60))
+    source = f"a0 = 'x'\n{chain}\ndef generate_launch_description():\n"
+    source += "    return LaunchDescription([Node(package='p', executable=a60)])\n"
+    (node,) = read(source).nodes
+    assert node.executable is None  # too long to be a literal; and it took no time

@@ -87,3 +87,11 @@ def test_malformed_xml_and_yaml_are_one_problem_each(tmp_path: Path) -> None:
     assert q.file.endswith("bad.launch.yaml") and q.line == 3 and "tab" in q.message
     ent = read(tmp_path, "ent.launch.xml", '<!DOCTYPE l [<!ENTITY x "y">]>\n<launch/>\n')
     assert "DOCTYPE" in ent.problems[0].message
+
+
+def test_doubling_lets_stay_bounded(tmp_path: Path) -> None:
+    lets = "".join(f'  <let name="a{k + 1}" value="$(var a{k})$(var a{k})"/>\n' for k in range(40))
+    node_xml = '  <node pkg="p" exec="$(var a40)"/>\n'
+    text = f'<launch>\n  <let name="a0" value="x"/>\n{lets}{node_xml}</launch>\n'
+    (node,) = read(tmp_path, "big.launch.xml", text).nodes
+    assert node.executable is None  # 2**40 characters: not a literal

@@ -105,9 +105,9 @@ class _Reader:
         looped: set[int] = set()
         for call, bindings in self._loops():
             looped.add(id(call))
-            self.ev.bindings = bindings
+            self.ev.bind(bindings)
             self._action(call)
-        self.ev.bindings = {}
+        self.ev.bind({})
         for node in ast.walk(self.tree):
             if isinstance(node, ast.Call) and id(node) not in looped:
                 self._action(node)

@@ -27,6 +27,8 @@ from armcli.check.ros_packages.substitute import (
 )
 
 MAX_DEPTH = 40  # nested evaluation (a name defined through names through names ...)
+MAX_TEXT = 100_000  # [characters] a longer string (`a = b + b` doubling) is not literal
+MAX_ITEMS = 10_000  # a longer list is not literal
 SHARE_CALLS = ("get_package_share_directory", "get_package_share_path", "FindPackageShare")
 
 
@@ -80,6 +82,12 @@ class Evaluator:
     declared: dict[str, ast.expr | None] = field(default_factory=dict)
     bindings: dict[str, object] = field(default_factory=dict)  # loop/comprehension variables
     _busy: set[str] = field(default_factory=set)
+    _known: dict[str, object] = field(default_factory=dict)  # names evaluated (one each)
+
+    def bind(self, bindings: dict[str, object]) -> None:
+        """Loop variables for the next evaluations (names evaluated before are forgotten)."""
+        self.bindings = bindings
+        self._known.clear()
 
     def __post_init__(self) -> None:
         for node in ast.walk(self.tree):
@@ -148,6 +156,8 @@ class Evaluator:
             return self.bindings[name]
         if name == "__file__":
             return str(self.path)
+        if name in self._known:  # once per name: `a = b + b; b = c + c; ...` stays linear
+            return self._known[name]
         exprs = self.names.get(name)
         if not exprs or name in self._busy:
             return UNKNOWN
@@ -157,15 +167,18 @@ class Evaluator:
         finally:
             self._busy.discard(name)
         first = values[0]
-        return first if all(_same(v, first) for v in values[1:]) else UNKNOWN
+        found = first if all(_same(v, first) for v in values[1:]) else UNKNOWN
+        self._known[name] = found
+        return found
 
     def _binop(self, node: ast.BinOp, depth: int) -> object:
         a, b = self.value(node.left, depth), self.value(node.right, depth)
         if isinstance(node.op, ast.Add):
             if isinstance(a, list) and isinstance(b, list):
-                return a + b
+                return a + b if len(a) + len(b) <= MAX_ITEMS else UNKNOWN
             if isinstance(a, str) or isinstance(b, str):
-                return as_text(a) + as_text(b)
+                text = as_text(a) + as_text(b)
+                return text if len(text) <= MAX_TEXT else HOLE
         if isinstance(node.op, ast.Div) and isinstance(a, str) and isinstance(b, str):
             return join_path([a, b])  # pathlib's `/`
         return UNKNOWN
@@ -204,7 +217,8 @@ def as_text(v: object) -> str:
     if isinstance(v, str):
         return v
     if isinstance(v, list):
-        return "".join(as_text(x) for x in v)
+        text = "".join(as_text(x) for x in v[:MAX_ITEMS])
+        return text if len(text) <= MAX_TEXT else HOLE
     if isinstance(v, bool | int | float) and not isinstance(v, bool):
         return str(v)
     if isinstance(v, bool):

@@ -18,6 +18,7 @@ from armcli.check.ros_packages.launch_model import Description, Where, package_u
 HOLE = "\x00"  # stands for a part of a string the file does not state literally
 XACRO_EXECUTABLES = ("xacro", "xacro.py")
 MAX_SUBSTITUTION_DEPTH = 8
+MAX_TEXT = 100_000  # [characters] a longer substituted value is not literal
 DIRNAME = "\x00dirname"  # the variables' key for $(dirname): the launch file's directory
 
 
@@ -42,6 +43,8 @@ class Shares:
 
 def join_path(parts: list[str]) -> str:
     """os.path.join of the parts (kept lexical: nothing is looked up)."""
+    if sum(len(p) for p in parts) > MAX_TEXT:
+        return HOLE
     return os.path.join(*parts) if parts else ""
 
 
@@ -141,7 +144,8 @@ def expand(
         inner = text[start + 2 : end]
         out.append(_one(inner, variables, shares, line, depth, command))
         i = end + 1
-    return "".join(out)
+    result = "".join(out)
+    return result if len(result) <= MAX_TEXT else HOLE  # `$(var b)$(var b)` doubling
 
 
 def _closing(text: str, i: int) -> int:
