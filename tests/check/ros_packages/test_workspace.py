@@ -45,6 +45,8 @@ def test_packages_by_manifest_name_ignores_and_duplicates(tmp_path: Path) -> Non
     assert ws.packages["beta"].insert_line == 9
     assert any("found twice" in n for n in ws.notes)
     (tmp_path / "docs").mkdir()
+    (tmp_path / "docs" / "old.urdf").write_text("<robot name='r'/>")  # outside every package
+    assert discover(tmp_path).loose == (tmp_path / "docs" / "old.urdf",)
     assert has_packages(tmp_path) and not has_packages(tmp_path / "docs")
 
 

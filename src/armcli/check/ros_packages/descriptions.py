@@ -44,13 +44,9 @@ def lookup(ws: Workspace, extra: Mapping[str, Path]) -> PackageLookup:
 
 
 def urdf_files(ws: Workspace) -> list[Description]:
-    """Every `.urdf` file of the packages (a plain URDF needs no arguments)."""
-    return [
-        Description(str(f))
-        for p in ws.packages.values()
-        for f in p.files
-        if f.name.endswith(URDF_SUFFIXES)
-    ]
+    """Every `.urdf` file under DIR, in packages or not (a plain URDF needs no arguments)."""
+    inside = [f for p in ws.packages.values() for f in p.files if f.name.endswith(URDF_SUFFIXES)]
+    return [Description(str(f)) for f in [*inside, *ws.loose]]
 
 
 def load(

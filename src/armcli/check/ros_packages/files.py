@@ -44,7 +44,7 @@ class Problem:
 class Jail:
     """The directory the checker may read: DIR, by its real path."""
 
-    root: Path  # as the user named it (absolute)
+    root: Path  # as the user named it
 
     @property
     def real(self) -> Path:

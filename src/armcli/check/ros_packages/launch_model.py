@@ -11,6 +11,7 @@ it rather than guess.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -53,10 +54,15 @@ class Description:
     With its xacro arguments (only the literal ones; `dropped` names the others).
     """
 
-    file: str  # absolute path under DIR, or a package:// URI outside it
+    file: str  # a path under DIR, or a package:// URI outside it
     args: Mapping[str, str] = field(default_factory=dict)
     dropped: tuple[str, ...] = ()
     where: Where | None = None
+
+    def __post_init__(self) -> None:
+        """One spelling per file (`a/./b/../c` is `a/c`), so a file is expanded once."""
+        if not self.file.startswith(PACKAGE_URI) and self.file:
+            object.__setattr__(self, "file", os.path.normpath(self.file))
 
     @property
     def key(self) -> tuple[str, tuple[tuple[str, str], ...]]:

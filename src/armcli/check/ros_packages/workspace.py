@@ -54,6 +54,7 @@ class Workspace:
     problems: tuple[Problem, ...] = ()
     notes: tuple[str, ...] = ()
     dirs: Mapping[str, Path] = field(default_factory=dict)  # name -> root, for $(find)
+    loose: tuple[Path, ...] = ()  # *.urdf files under DIR outside every package
 
     def find(self, name: str) -> Path | None:
         """The root of package `name` under DIR, or None."""
@@ -95,11 +96,12 @@ def _kept(here: Path, dirs: list[str]) -> list[str]:
 
 def discover(root: Path) -> Workspace:
     """Every package under `root` with its files; unreadable manifests as problems."""
-    jail = Jail(Path(os.path.abspath(root)))
+    jail = Jail(root)  # paths as the user named DIR: reports show them so (GitHub, SARIF)
     found: dict[str, Package] = {}
     problems: list[Problem] = []
     notes: list[str] = []
-    for directory, files in _package_dirs(jail.root, notes):
+    loose: list[Path] = []
+    for directory, files in _package_dirs(jail.root, notes, loose):
         try:
             pkg = read_manifest(jail, directory / MANIFEST)
         except InputError as exc:
@@ -122,11 +124,17 @@ def discover(root: Path) -> Workspace:
         tuple(problems),
         tuple(notes),
         {n: p.root for n, p in found.items()},
+        tuple(loose),
     )
 
 
-def _package_dirs(root: Path, notes: list[str]) -> list[tuple[Path, tuple[Path, ...]]]:
-    """(package directory, its files), shallowest first; bounded walk that follows no link."""
+def _package_dirs(
+    root: Path, notes: list[str], loose: list[Path]
+) -> list[tuple[Path, tuple[Path, ...]]]:
+    """(package directory, its files), shallowest first; bounded walk that follows no link.
+
+    `loose` collects the `*.urdf` files outside every package (checked as before packages).
+    """
     packages: list[tuple[Path, list[Path]]] = []
     visited = listed = 0
     for here_s, dirs, files in os.walk(root, followlinks=False):
@@ -143,6 +151,7 @@ def _package_dirs(root: Path, notes: list[str]) -> list[tuple[Path, tuple[Path, 
             owner = (here, [])
             packages.append(owner)
         if owner is None:
+            loose += [here / f for f in sorted(files) if f.endswith(".urdf")]
             continue
         for f in sorted(files):
             listed += 1
