@@ -5,8 +5,9 @@ joint_state_publisher GUI's sliders at their zeros beside Gazebo's joint-state p
 joint_state_broadcaster) the two streams alternate and the arm flickers in RViz. Counted
 per launch run (includes and MoveIt generators merged), only what certainly starts:
 joint_state_publisher[_gui] nodes, spawners (or `ros2 control load_controller`) of
-a joint_state_broadcaster, and Gazebo classic's `libgazebo_ros_joint_state_publisher.so`
-in a robot description the launch loads into the Gazebo it starts. A publisher remapped
+a joint_state_broadcaster, Gazebo classic's `libgazebo_ros_joint_state_publisher.so`
+in a robot description the launch loads into the Gazebo it starts, and a ros_gz_bridge
+bringing Gazebo's joint states to `/joint_states`. A publisher remapped
 or namespaced away from `/joint_states` does not count. The finding is on the publisher to remove: a
 joint_state_publisher node first (the simulator or ros2_control knows the real state).
 """
@@ -26,6 +27,7 @@ TOPIC = "/joint_states"
 GUI_PACKAGES = ("joint_state_publisher", "joint_state_publisher_gui")
 SPAWNERS = ("spawner", "spawner.py", "load_controller")
 PLUGIN = "libgazebo_ros_joint_state_publisher.so"
+BRIDGES = ("ros_gz_bridge", "ros_ign_bridge")
 BROADCASTER_NAMES = ("joint_state_broadcaster", "joint_state_controller")
 
 
@@ -79,6 +81,8 @@ def publishers(ctx: PackageContext, run: Run) -> list[Publisher]:
             for c in (a for a in n.arguments if a and a in broadcasters and a not in seen):
                 seen.add(c)
                 out.append(Publisher(f"the {c} spawner", n.where, 2))
+        elif n.package in BRIDGES and _bridges_joint_states(ctx, n):
+            out.append(Publisher("ros_gz_bridge's /joint_states from Gazebo", n.where, 1))
     for p in run.processes:
         tokens = [t for t in p.cmd if t]
         if "load_controller" in tokens:
@@ -94,6 +98,28 @@ def publishers(ctx: PackageContext, run: Run) -> list[Publisher]:
                     Publisher("Gazebo's joint_state_publisher plugin", where, 1, u, plug.line)
                 )
     return out
+
+
+def _bridges_joint_states(ctx: PackageContext, n: Node) -> bool:
+    """Whether a ros_gz_bridge node brings Gazebo's joint states to /joint_states.
+
+    By an argument `/joint_states@sensor_msgs/msg/JointState[gz.msgs.Model` (`[` or `@`:
+    Gazebo to ROS) or an entry of its `config_file` (direction GZ_TO_ROS or BIDIRECTIONAL).
+    """
+    for a in n.arguments:
+        topic, sep, rest = (a or "").partition("@")
+        if sep and topic.lstrip("/") == TOPIC[1:] and ("[" in rest or "@" in rest):
+            return True
+    config = n.params.get("config_file")
+    local = ctx.local(config) if isinstance(config, str) else None
+    doc = ctx.yaml(local) if local is not None else None
+    entries = doc.data if doc is not None and isinstance(doc.data, list) else []
+    return any(
+        isinstance(e, dict)
+        and str(e.get("ros_topic_name", "")).lstrip("/") == TOPIC[1:]
+        and e.get("direction", "BIDIRECTIONAL") in ("GZ_TO_ROS", "BIDIRECTIONAL")
+        for e in entries
+    )
 
 
 def _topic(n: Node) -> str:
