@@ -165,7 +165,9 @@ def _report(
     joint, dev, tol = worst
     k = hold.joints.index(joint)
     at = f" ({pose.where.file.rsplit('/', 1)[-1]}:{pose.where.line})" if pose.where else ""
-    gains = f"p {hold.kp[k]:g}, integral up to {hold.i_max[k]:g} N·m"
+    cap = hold.i_max[k]
+    integral = "no integral term" if cap == 0 else f"integral up to {cap:g} N·m"
+    gains = f"p {hold.kp[k]:g}, {integral}"
     need = passing_kp(robot, {**{j: 0.0 for j in hold.joints}, **pose.q}, hold, tol)
     torque = abs(sag.torque[joint])
     fix: dict[str, float] = {"p": need} if math.isfinite(need) else {}
