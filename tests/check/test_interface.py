@@ -21,7 +21,7 @@ from armcli.spec.model import RobotSpec
 from armcli.urdf.read import parse_urdf
 from tests.helpers import ROOT, course_gains_spec
 
-RATE = 100.0  # [Hz] the spec's controller_update_rate
+RATE = 1000.0  # [Hz] the spec's controller_update_rate
 PERIODS = 200  # control periods simulated per gain
 GAINS = [0.05, 0.1, 0.5, 0.99, 1.0, 1.01, 1.5, 1.99, 2.01, 2.5, -0.1]
 

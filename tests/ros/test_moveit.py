@@ -92,7 +92,7 @@ def test_ros2_controllers(spec: RobotSpec, urdf_root: etree._Element) -> None:
 
 def test_fractional_update_rate_is_refused(default_spec_path: Path) -> None:
     text = default_spec_path.read_text().replace(
-        "controller_update_rate: 100", "controller_update_rate: 100.5"
+        "controller_update_rate: 1000", "controller_update_rate: 1000.5"
     )
     spec = loads_spec(text, "edited.yaml")
     with pytest.raises(InputError) as err:
