@@ -91,7 +91,7 @@ def test_points_gravity_tips_are_left_out() -> None:
     lin = pdloop.Linearised(np.array([[[1.0]], [[1.0]]]), np.array([[[-2.0]], [[0.5]]]))
     pid = _pid(1.0, 0.5)
     h = zoh.reduce(lin, pid)
-    assert h.held.tolist() == [False, True]
+    assert h.holds(pid).tolist() == [False, True]
     assert zoh.radii(h, pid, 0.01)[0] == 0.0 and zoh.stable(h, pid, 0.01)
 
 

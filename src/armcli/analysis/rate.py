@@ -71,7 +71,7 @@ def rate_verdict(lin: Linearised, pid: Pid, rate: float) -> RateVerdict:
         ok = bool(np.all(rho <= 1.0 + zoh.RADIUS_TOL))
         edge, worst = zoh.hold_max(h, pid, hold)
         remedy = None if ok else _remedy(h, pid, hold, edge)
-    left = int(np.count_nonzero(~h.held))
+    left = int(np.count_nonzero(~h.holds(pid)))
     return RateVerdict(rate, ok, edge, float(rho.max(initial=0.0)), worst, left, remedy)
 
 
@@ -95,13 +95,14 @@ def _remedy(h: zoh.Held, pid: Pid, hold: float, edge: float) -> Remedy:
                 break
             want = r / STABLE_MARGIN
     s = zoh.gain_scale(h, pid, hold)
+    held = h.take(h.holds(pid))  # lower gains must hold the arm where these do
     for _ in range(RETRIES if s is not None else 0):
         assert s is not None
         kp, kd, ki = (
             tuple(round_down(float(x)) for x in g) for g in _gains(pid.scaled(STABLE_MARGIN * s))
         )
         rounded = Pid(pdloop.PD.of(pid.pd.idx, kp, kd, pid.pd.damping), np.array(ki, dtype=float))
-        if zoh.stable(h, rounded, hold):
+        if zoh.holds_stably(held, rounded, hold):
             return Remedy(rate, STABLE_MARGIN * s, kp, kd, ki)
         s *= STABLE_MARGIN
     return Remedy(rate, None, None, None, None)

@@ -52,14 +52,21 @@ class Held:
 
     Mc_inv: Array  # (S, n, n) (M^-1)_cc [1/(kg·m²)]
     Gc: Array  # (S, n, n) gravity's stiffness on the controlled joints [N·m/rad]
-    held: NDArray[np.bool_]  # (S,) Kp + G_c >= 0 there: the gains can hold the arm
     index: NDArray[np.bool_]  # (S0,) which of the original points these are
 
     def take(self, mask: NDArray[np.bool_]) -> Held:
         """The points where `mask` is true."""
         index = self.index.copy()
         index[np.flatnonzero(index)[~mask]] = False
-        return Held(self.Mc_inv[mask], self.Gc[mask], self.held[mask], index)
+        return Held(self.Mc_inv[mask], self.Gc[mask], index)
+
+    def holds(self, pid: Pid) -> NDArray[np.bool_]:
+        """(S,) where Kp + G_c >= 0: the gains can hold the arm there (else left out)."""
+        K = self.Gc + np.diag(pid.pd.kp)
+        scale = max(1.0, float(np.abs(pid.pd.kp).max(initial=0.0)))
+        low = np.linalg.eigvalsh(0.5 * (K + np.swapaxes(K, 1, 2)))[:, 0]
+        out: NDArray[np.bool_] = low >= -PSD_RTOL * scale
+        return out
 
 
 @dataclass(frozen=True)
@@ -83,15 +90,12 @@ class Pid:
 
 
 def reduce(lin: Linearised, pid: Pid) -> Held:
-    """The controlled joints' inverse inertia and stiffness at every point."""
+    """The controlled joints' inverse inertia and stiffness at every point (`pid`: which)."""
     idx = list(pid.pd.idx)
     Minv = np.asarray(np.linalg.inv(lin.M), dtype=float)[:, idx][:, :, idx]
     Mc_inv: Array = 0.5 * (Minv + np.swapaxes(Minv, 1, 2))
     Gc = lin.G[:, idx][:, :, idx]
-    K = Gc + np.diag(pid.pd.kp)
-    scale = np.maximum(1.0, np.abs(pid.pd.kp).max(initial=0.0))
-    held = np.linalg.eigvalsh(0.5 * (K + np.swapaxes(K, 1, 2)))[:, 0] >= -PSD_RTOL * scale
-    return Held(Mc_inv, Gc, held, np.ones(len(held), dtype=bool))
+    return Held(Mc_inv, Gc, np.ones(len(lin), dtype=bool))
 
 
 def closed_loop(h: Held, pid: Pid, hold: float) -> Array:
@@ -146,10 +150,12 @@ def expm(A: Array) -> Array:
 
 def radii(h: Held, pid: Pid, hold: float) -> Array:
     """(S,) the spectral radius of the closed loop at each point (0 where left out)."""
-    if not np.any(h.held):
-        return np.zeros(len(h.held))
-    rho = np.max(np.abs(np.linalg.eigvals(closed_loop(h, pid, hold))), axis=1)
-    return np.where(h.held, rho, 0.0)
+    held = h.holds(pid)
+    out = np.zeros(len(held))
+    if np.any(held):
+        loop = closed_loop(h.take(held), pid, hold)
+        out[held] = np.max(np.abs(np.linalg.eigvals(loop)), axis=1)
+    return out
 
 
 def stable(h: Held, pid: Pid, hold: float) -> bool:
@@ -179,21 +185,32 @@ def hold_max(h: Held, pid: Pid, start: float) -> tuple[float, int]:
     return lo, int(worst)
 
 
+def holds_stably(h: Held, pid: Pid, hold: float) -> bool:
+    """Whether `pid` holds the arm at every point of `h` (Kp + G_c >= 0) and stably there.
+
+    What lower gains must do at the points the configured gains hold: gains that gravity
+    beats are no remedy, though `stable` would leave those points out.
+    """
+    return bool(np.all(h.holds(pid))) and stable(h, pid, hold)
+
+
 def gain_scale(h: Held, pid: Pid, hold: float) -> float | None:
     """The largest factor s <= 1 (Pid.scaled) stable at `hold`; None when none >= SCALE_FLOOR is.
 
-    1.0 when the gains are stable. Lower gains are not always stable here (a hold needs some
+    1.0 when the gains are stable. Lower gains must still hold the arm where these do
+    (`holds_stably` on those points). They are not always stable here (a hold needs some
     damping: Kd > Kp T / 2), so the search starts from the smallest factor that is.
     """
     if stable(h, pid, hold):
         return 1.0
+    h = h.take(h.holds(pid))
     s = 0.5
-    while not stable(h, pid.scaled(s), hold):
+    while not holds_stably(h, pid.scaled(s), hold):
         s *= 0.5
         if s < SCALE_FLOOR:
             return None
     lo, hi = s, min(1.0, 2.0 * s)
     for _ in range(BISECT_STEPS):
         mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if stable(h, pid.scaled(mid), hold) else (lo, mid)
+        lo, hi = (mid, hi) if holds_stably(h, pid.scaled(mid), hold) else (lo, mid)
     return lo
