@@ -184,17 +184,22 @@ RICH = FIXTURES / "spec" / "rich_arm.yaml"
 FINGER_GAIN = "    left_finger_joint: {kp: 200, kd: 5}\n"
 RICH_TARGET = {"shoulder_lift_joint": 0.5, "elbow_joint": -0.8, "left_finger_joint": 0.02}
 # What `check` finds in rich_arm, by design of the fixture: a 4 kg root link (KDL ignores
-# it), Kp = 400 with Kd = 20 too stiff for an explicit loop at 1 ms, and lidars 0.1 m off
-# the axis of base_link's collision cylinder (r 0.08): the rays heading back start, range_min
+# it), Kp = 400 with Kd = 20 too stiff for an explicit loop at 1 ms, and so for the
+# ros2_control controller holding its effort for 10 ms (the default 100 Hz), and lidars 0.1 m
+# off the axis of base_link's collision cylinder (r 0.08): the rays heading back start, range_min
 # out, inside it: the lidar sees the base (check/sensors.py); nothing else.
-RICH_FINDINGS = {("root-inertia", "warning"), ("pd-explicit-unstable", "warning"),
-                 ("sensor-sees-robot", "warning")}  # fmt: skip
+RICH_FINDINGS = {
+    ("root-inertia", "warning"),
+    ("pd-explicit-unstable", "warning"),
+    ("sensor-sees-robot", "warning"),
+    ("ros-controller-unstable", "error"),
+}
 
 
-def _run(argv: list[str]) -> None:
+def _run(argv: list[str], code: int = 0) -> None:
     with pytest.raises(SystemExit) as info:
         main(argv)
-    assert info.value.code in (0, None), argv
+    assert (info.value.code or 0) == code, argv
 
 
 @pytest.fixture(scope="module")
@@ -233,7 +238,7 @@ def test_rich_spec_check_finds_what_the_fixture_holds(
     rich: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     capsys.readouterr()
-    _run(["check", str(rich), "--format", "json"])  # warnings only: exit 0
+    _run(["check", str(rich), "--format", "json"], code=1)  # one error finding: exit 1
     doc = json.loads(capsys.readouterr().out)
     found = {(f["rule"], f["severity"]) for file in doc["files"] for f in file["findings"]}
     assert found == RICH_FINDINGS

@@ -21,7 +21,7 @@ from armcli.spec.model import RobotSpec
 from armcli.urdf.read import parse_urdf
 from tests.helpers import ROOT, course_gains_spec
 
-RATE = 100.0  # [Hz] the spec's controller_update_rate
+RATE = 1000.0  # [Hz] the spec's controller_update_rate
 PERIODS = 200  # control periods simulated per gain
 GAINS = [0.05, 0.1, 0.5, 0.99, 1.0, 1.01, 1.5, 1.99, 2.01, 2.5, -0.1]
 
@@ -84,8 +84,8 @@ def test_position_interface_reports_the_servo_bound_instead(
     rules = {f.rule for f in res.findings}
     assert not rules & {"pd-explicit-unstable", "pd-unstable", "servo-unstable"}
     note = next(n for n in res.summary.notes if "first-order servo" in n)
-    # default gain 0.1 at the spec's 100 Hz: v = 10/s x error, error x 0.9 per period
-    assert "0.1 x error" in note and "(10/s)" in note and "factor 0.9 " in note
+    # default gain 0.1 at the spec's 1000 Hz: v = 100/s x error, error x 0.9 per period
+    assert "0.1 x error" in note and "(100/s)" in note and "factor 0.9 " in note
 
 
 @pytest.mark.parametrize("gain", GAINS)

@@ -3,8 +3,9 @@
 Independent of armcli's engine: a few lines of Pinocchio forward dynamics (ABA) stepped
 by semi-implicit Euler at 0.25 ms, the controller's PID (p, d, i with its clamp, as
 control_toolbox computes it) held over each controller period, joint damping applied.
-The period is the spec's `control.dt` (1 ms), the explicit torque loop `check` judges
-stable (pd-explicit-unstable; docs/check.md). Reference values: the PD loop alone comes
+The period is the controller's, 1/`control.controller_update_rate` (1 ms in both example
+specs), as gz_ros2_control holds the effort between updates (ros-controller-unstable
+judges that loop stable: tests/analysis/test_rate.py). Reference values: the PD loop alone comes
 to rest where analysis.sag says (0.028 rad off at `reach`), and with the integral term at
 the commanded pose.
 """
@@ -77,9 +78,9 @@ def test_written_pid_settles_at_every_pose(spec_name: str) -> None:
     pd = {j: (g[0], g[1], 0.0, 0.0) for j, g in gains.items()}
     for name in spec.poses:
         pose = spec.pose(name)
-        assert hold(robot, pose, gains, spec.control.dt) < SETTLED, name
+        assert hold(robot, pose, gains, 1.0 / spec.control.controller_update_rate) < SETTLED, name
         expected = settle(robot, pose, Hold.pd(list(pd), [g[0] for g in pd.values()])).worst[1]
-        got = hold(robot, pose, pd, spec.control.dt)
+        got = hold(robot, pose, pd, 1.0 / spec.control.controller_update_rate)
         assert got == pytest.approx(expected, rel=PD_AGREEMENT, abs=1e-6), name
 
 

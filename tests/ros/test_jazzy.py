@@ -113,7 +113,9 @@ def test_default_target_is_the_course_output_unchanged(spec: RobotSpec) -> None:
     # for this spec, label, sample count and seed; since then the standalone arm has a
     # massless `world` root (issue 23) and the `folded` pose stops at 1.5 rad, off the base
     # (issue 31: the SRDF's group state, and base_link/forearm_link never collide), and
-    # joint_limits.yaml has acceleration limits (issue 29: 1.0 rad/s², `plan`'s default)
+    # joint_limits.yaml has acceleration limits (issue 29: 1.0 rad/s², `plan`'s default), and
+    # ros2_controllers.yaml's update_rate is the spec's 1000 Hz (was 100: gz_ros2_control holds
+    # the effort for 1/update_rate, and the gains diverge when held for 10 ms)
     want = dict(
         line.split("  ")[::-1]
         for line in (GOLDEN / "humble_classic.sha256").read_text().splitlines()

@@ -75,8 +75,8 @@ def test_joint_limits_take_the_urdf_acceleration() -> None:
 def test_ros2_controllers(spec: RobotSpec, urdf_root: etree._Element) -> None:
     c = _roundtrip(mc.ros2_controllers(spec))
     cm = c["controller_manager"]["ros__parameters"]
-    # specs/my_robot.yaml: control.controller_update_rate: 100; an int, as controller_manager wants
-    assert cm["update_rate"] == 100 and isinstance(cm["update_rate"], int)
+    # specs/my_robot.yaml: control.controller_update_rate: 1000; an int, as controller_manager wants
+    assert cm["update_rate"] == 1000 and isinstance(cm["update_rate"], int)
     assert cm["joint_state_broadcaster"]["type"] == "joint_state_broadcaster/JointStateBroadcaster"
     assert cm["arm_controller"]["type"] == "joint_trajectory_controller/JointTrajectoryController"
     arm = c["arm_controller"]["ros__parameters"]
@@ -92,7 +92,7 @@ def test_ros2_controllers(spec: RobotSpec, urdf_root: etree._Element) -> None:
 
 def test_fractional_update_rate_is_refused(default_spec_path: Path) -> None:
     text = default_spec_path.read_text().replace(
-        "controller_update_rate: 100", "controller_update_rate: 100.5"
+        "controller_update_rate: 1000", "controller_update_rate: 1000.5"
     )
     spec = loads_spec(text, "edited.yaml")
     with pytest.raises(InputError) as err:

@@ -402,7 +402,7 @@ def test_command_writes_the_tree_and_rewrites_identically(root: Path, tmp_path: 
 def test_bad_spec_gives_one_line_and_no_output(root: Path, tmp_path: Path) -> None:
     bad = tmp_path / "bad.yaml"
     text = (root / "specs" / "my_robot.yaml").read_text()
-    bad.write_text(text.replace("controller_update_rate: 100", "controller_update_rate: 99.5"))
+    bad.write_text(text.replace("controller_update_rate: 1000", "controller_update_rate: 999.5"))
     out = tmp_path / "ros"
     proc = run_cli(["ros-package", str(bad), "-o", str(out)], root)
     assert proc.returncode == 2

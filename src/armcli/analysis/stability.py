@@ -7,10 +7,11 @@ Linearised at an operating point q*, the arm obeys M dq'' = -K dq - D dq' with
     D = Kd + damping on the controlled joints (free joints: neither).
 
 One semi-implicit Euler step, v+ = v + dt M_e^-1 (-K q - D v), q+ = q + dt v+, with
-M_e = M (damping explicit, as a torque loop such as a ros2_control effort controller in
-Gazebo) or M_e = M + dt D (damping implicit, as armcli's simulator steps it). Its
-characteristic polynomial z² M_e - z (2 M_e - dt D - dt² K) + (M_e - dt D), under the
-bilinear map z = (1 + s) / (1 - s) (|z| <= 1 iff Re s <= 0), becomes
+M_e = M (damping explicit, as a torque controller updated at every physics step dt, e.g.
+ros2_control at 1/dt in Gazebo; a slower controller holds its torque: analysis.zoh) or
+M_e = M + dt D (damping implicit, as armcli's simulator steps it). Its characteristic
+polynomial z² M_e - z (2 M_e - dt D - dt² K) + (M_e - dt D), under the bilinear map
+z = (1 + s) / (1 - s) (|z| <= 1 iff Re s <= 0), becomes
 
     s² A + s (2 dt D) + dt² K,   A = 4 M + 2 c dt D - dt² K,   c = +1 implicit, -1 explicit.
 

@@ -32,7 +32,7 @@ LIST_GAINS = 4  # a remedy names each joint's gains up to this many joints
 
 LOOP_NAMES: dict[str, str] = {
     "implicit": "armcli simulate (damping implicit)",
-    "explicit": "explicit torque loop (ros2_control effort controller, e.g. in Gazebo)",
+    "explicit": "explicit torque loop (a torque controller updated every dt, e.g. in Gazebo)",
     "rk4": "armcli simulate --integrator rk4",
 }
 

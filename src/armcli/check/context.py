@@ -15,6 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
+from armcli.analysis.rate import RateVerdict
 from armcli.analysis.verdict import StabilityReport
 from armcli.check.findings import Collector, JointRow
 from armcli.check.options import CheckOptions
@@ -60,6 +61,7 @@ class Context:
     samples: list[tuple[dict[str, float], Any]] = field(default_factory=list)  # dynamics
     servo: set[str] = field(default_factory=set)  # joints a position servo drives
     stability: StabilityReport | None = None
+    rate: RateVerdict | None = None  # check/controller_rate.py: the ros2_control loop
     balance: StaticBalance | None = None  # check/tipover.py
     stance: Stance | None = None  # the robot on its support polygon (check/tipover.py)
     zmp: ZmpReport | None = None  # check/zmp.py: the trajectory's zero-moment point

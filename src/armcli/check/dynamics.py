@@ -21,6 +21,7 @@ from armcli.check.options import CheckOptions
 from armcli.check.structure import finite
 from armcli.errors import ModelLoadError
 from armcli.robot.model import Robot
+from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import mesh_paths
 
@@ -98,14 +99,27 @@ def stability(
     spec = opts.spec
     if spec is None or not spec.control.gains:
         return None
+    controlled = spec_pd(urdf, spec, robot)
+    if controlled is None:
+        notes.append("stability skipped: no controlled joint found in this URDF")
+        return None
+    names, pd = controlled
+    gravity = not spec.control.gravity_compensation
+    lin = pdloop.linearise(robot.model, [q for _, q in samples], gravity=gravity, data=robot.data)
+    qs = [[p[n] for n in names] for p, _ in samples]
+    rep = verdicts.analyse(lin, qs, pd, spec.control.dt)
+    line = next((j.line for j in urdf.joints if j.name == names[0]), None)
+    _report_stability(rep, names, qs, line, out)
+    return rep
+
+
+def spec_pd(urdf: Urdf, spec: RobotSpec, robot: Robot) -> tuple[list[str], pdloop.PD] | None:
+    """The spec's gained joints that this URDF has, and their PD gains (None: none of them)."""
     v_of = {j.name: j.idx_v for j in robot.joints}
     joints = {j.name: j for j in urdf.joints}
     names = [n for n in spec.control.gains if n in v_of and n in joints]
     if not names:
-        notes.append("stability skipped: no controlled joint found in this URDF")
         return None
-    gravity = not spec.control.gravity_compensation
-    lin = pdloop.linearise(robot.model, [q for _, q in samples], gravity=gravity, data=robot.data)
     gains = [spec.control.gains[n] for n in names]
     pd = pdloop.PD.of(
         [v_of[n] for n in names],
@@ -113,11 +127,7 @@ def stability(
         [g.kd for g in gains],
         [joints[n].damping for n in names],
     )
-    qs = [[p[n] for n in names] for p, _ in samples]
-    rep = verdicts.analyse(lin, qs, pd, spec.control.dt)
-    line = next((j.line for j in urdf.joints if j.name == names[0]), None)
-    _report_stability(rep, names, qs, line, out)
-    return rep
+    return names, pd
 
 
 def _report_stability(

@@ -9,6 +9,7 @@ from collections.abc import Sequence
 from dataclasses import asdict
 from typing import Any
 
+from armcli.analysis.rate import round_up
 from armcli.check.balance_report import balance_items, reach_items
 from armcli.check.findings import Finding, shown_path
 from armcli.check.rules import ERROR, WARNING
@@ -229,14 +230,14 @@ def _summary(r: CheckResult) -> list[Any]:
             t.add_row(p.name, *(f"{v:.4f}" for v in p.xyz))
         out.append(t)
     if s.stability is not None:
-        out.append(_stability_text(s.stability))
+        out.append(_stability_text(s.stability, s.rate))
     out.extend(balance_items(s.balance, s.zmp))
     out.extend(reach_items(s.reach, s.reach_points))
     out.extend(Text(n, style="dim") for n in s.notes)
     return out
 
 
-def _stability_text(st: Any) -> Any:
+def _stability_text(st: Any, rate: Any) -> Any:
     from rich.text import Text
 
     t = Text(
@@ -252,6 +253,12 @@ def _stability_text(st: Any) -> Any:
         t.append(f"\n  {v.loop}: ")
         t.append("stable" if v.stable else "UNSTABLE", "green" if v.stable else "red")
         t.append(_loop_bounds(v))
+    if rate is not None:
+        t.append(f"\n  ros2_control controller at {rate.rate:g} Hz (effort held "
+                 f"{rate.hold * 1e3:.3g} ms): ")  # fmt: skip
+        t.append("stable" if rate.stable else "UNSTABLE", "green" if rate.stable else "red")
+        edge = "any hold" if rate.hold_max == float("inf") else f"{rate.hold_max * 1e3:.3g} ms"
+        t.append(f" (up to a hold of {edge}: update_rate >= {round_up(rate.rate_min, 3):g} Hz)")
     return t
 
 

@@ -3,37 +3,23 @@
 Each rule has a stable id (used by `--ignore`, the JSON schema and CI
 annotations), one severity and a one-line fix hint. The rules themselves live
 in one module per topic beside this one and `run.py` runs them in order; this
-module, `findings.py` (what a rule reports) and `options.py` (what a run is asked)
-are the floor they all stand on, so they import none of them.
+module (with `rule.py`, the `Rule` record, and `ros_rules.py`, the package rules' table),
+`findings.py` (what a rule reports) and `options.py` (what a run is asked) are the floor
+they all stand on, so they import none of them.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
 
-ERROR = "error"
-WARNING = "warning"
+from armcli.check.ros_rules import ROS_RULES
+from armcli.check.rule import ERROR, WARNING, Rule
+
+__all__ = ["ERROR", "RULES", "WARNING", "Rule", "unknown_rules"]
+
 _MODEL = "model"  # see Rule.blocks
 _BALANCE = "balance"
 _DYNAMICS = "dynamics"
-
-
-@dataclass(frozen=True)
-class Rule:
-    """One check rule: stable id (for --ignore and JSON), severity, title and fix hint.
-
-    `blocks`: while an error of this rule stands, the rule families that need the Pinocchio
-    model ("model"), valid masses, centres of mass and joint ranges ("balance": the static
-    balance) or usable dynamics numbers ("dynamics") are skipped (check/context.py). An
-    inertia tensor error blocks only the dynamics: it moves no centre of mass.
-    """
-
-    id: str
-    severity: str
-    title: str
-    hint: str
-    blocks: str | None = None
 
 
 _SENSOR_RULES = [  # check/sensors.py; in _RULES before the ROS packages'
@@ -263,7 +249,7 @@ _RULES = [
     Rule(
         "pd-explicit-unstable",
         WARNING,
-        "PD loop unstable at dt in an explicit torque loop (ros2_control effort controller)",
+        "PD loop unstable at dt in an explicit torque loop (a torque controller updated every dt)",
         "lower dt or Kd (`armcli tune --loop explicit` picks gains for this loop)",
     ),
     Rule(
@@ -322,67 +308,7 @@ _RULES = [
         "move the point or the arm's mount (the message says how close the arm gets)",
     ),
     *_SENSOR_RULES,
-    # ROS packages (check DIR over package.xml directories: check/ros_packages/)
-    Rule(
-        "ros-joint-states-twice",
-        ERROR,
-        "more than one publisher of /joint_states in one launch (joint_state_publisher[_gui] "
-        "beside a joint_state_broadcaster spawner or Gazebo's joint-state plugin)",
-        "remove the extra publisher (the message says which one stays)",
-    ),
-    Rule(
-        "ros-control-node-with-sim",
-        ERROR,
-        "ros2_control_node launched for a robot whose <ros2_control> hardware is a simulator's "
-        "system (gz_ros2_control, gazebo_ros2_control), which runs its own controller manager",
-        "remove the ros2_control_node; spawn the controllers on the simulator's controller manager",
-    ),
-    Rule(
-        "ros-wheel-geometry",
-        ERROR,
-        "diff-drive wheel separation or radius (plugin or controller YAML) more than 1 % from "
-        "the URDF's wheels, or a diff_drive_controller parameter the distro no longer has",
-        "write the URDF's value (in the message)",
-    ),
-    Rule(
-        "ros-unknown-joint",
-        ERROR,
-        "a controller, <ros2_control> block or MoveIt YAML names a joint the URDF lacks",
-        "use the URDF's joint name (the message suggests the closest)",
-    ),
-    Rule(
-        "ros-srdf-unknown",
-        ERROR,
-        "an SRDF group, chain, end effector, group state, passive joint or collision entry "
-        "names a joint, link or group the robot lacks",
-        "use the URDF's name (the message suggests the closest)",
-    ),
-    Rule(
-        "ros-classic-plugin",
-        ERROR,
-        "a Gazebo plugin the launch's simulator does not load (Gazebo classic's in Gazebo "
-        "Harmonic or the reverse, or another distro's name)",
-        "use the plugin of the simulator the launch starts",
-    ),
-    Rule(
-        "ros-sim-time",
-        WARNING,
-        "a node of a launch that starts Gazebo without use_sim_time: true",
-        "give the node use_sim_time: true (or SetParameter use_sim_time for the launch)",
-    ),
-    Rule(
-        "ros-start-sag",
-        WARNING,
-        "at a named pose the arm, held by its controller's gains, settles farther from the "
-        "command than MoveIt's allowed_start_tolerance or the goal tolerance: Execute fails",
-        "raise p (the message gives the value that holds) or add an integral term",
-    ),
-    Rule(
-        "ros-missing-depend",
-        WARNING,
-        "a launch file uses a package its package.xml does not depend on",
-        "add the <exec_depend> to package.xml",
-    ),
+    *ROS_RULES,
     # inputs
     Rule(
         "input-unusable",

@@ -13,6 +13,7 @@ from dataclasses import dataclass, replace
 
 from armcli.check import (
     bodies,
+    controller_rate,
     inertia,
     interface,
     joints,
@@ -87,6 +88,7 @@ FAMILIES: tuple[Family, ...] = (
     Family("gravity", DYNAMICS, _gravity),
     Family("servo", DYNAMICS, _servo),
     Family("stability", DYNAMICS, _stability),
+    Family("controller rate", DYNAMICS, controller_rate.check),
     Family("self-collision", MODEL, _self_collision),
     Family("tipover", BALANCE, tipover.check),
     Family("zmp", DYNAMICS, zmp_rules.check),

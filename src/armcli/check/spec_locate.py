@@ -9,7 +9,8 @@ element from the field of the same name below it (`<limit>` -> `.limit`, `<inert
 `.inertial` or `.mass`, `<visual>` -> `.visual[i]` or `.geometry`, ...), and the number a
 finding is about from its values (`upper` -> `.limit.upper`). Among the candidate paths the
 deepest one that the spec file really has wins, with the line armcli's YAML reader recorded
-for it; PD findings point at `control.gains.<joint>` (or `control.dt`). The URDF location
+for it; PD findings point at `control.gains.<joint>` (or `control.dt`), the controller's
+rate finding at `control.controller_update_rate`. The URDF location
 stays on the finding as secondary information.
 """
 
@@ -48,6 +49,7 @@ _CHILD_KEYS: dict[str, tuple[str, ...]] = {
 }
 _PD_RULE_PREFIX = "pd-"
 _SENSOR_RULE_PREFIX = "sensor-"  # check/sensors.py: about the spec's sensor named
+_RATE_RULE = "ros-controller-unstable"  # check/controller_rate.py: the spec's controller rate
 # check/tipover.py and check/zmp.py: about a pose or the base's drive, not a URDF element
 _BALANCE_RULES = frozenset({"com-outside-support", "support-margin", "zmp-outside-support",
                             "zmp-margin"})  # fmt: skip
@@ -147,8 +149,16 @@ def _sensor_path(f: Finding, doc: YamlDoc) -> Path_ | None:
     return None
 
 
+def _rate_path(doc: YamlDoc) -> Path_ | None:
+    """The controller's rate (where the spec writes it), else its gains."""
+    paths: list[Path_] = [("control", "controller_update_rate"), ("control", "gains"), ("control",)]
+    return next((p for p in paths if p in doc.lines), None)
+
+
 def spec_path(f: Finding, root: Any, doc: YamlDoc) -> Path_ | None:
     """The spec field a finding in the URDF `root` (lxml tree of the generated text) is about."""
+    if f.rule == _RATE_RULE:
+        return _rate_path(doc)
     if f.rule.startswith(_PD_RULE_PREFIX):
         return _pd_path(f, doc)
     if f.rule.startswith(_SENSOR_RULE_PREFIX) and "sensor" in f.values:

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from armcli.analysis.rate import RateVerdict
 from armcli.analysis.verdict import StabilityReport
 from armcli.check.context import Context, poses
 from armcli.check.findings import JointRow
@@ -54,6 +55,7 @@ class Summary:
     zmp: ZmpReport | None = None  # the --trajectory's zero-moment point
     reach: Workspace | None = None  # the tool point's reach envelope
     reach_points: tuple[ReachPoint, ...] = ()  # the --reach-point verdicts
+    rate: RateVerdict | None = None  # the ros2_control controller at its update rate
 
 
 def summarise(ctx: Context) -> Summary:
@@ -71,6 +73,7 @@ def summarise(ctx: Context) -> Summary:
         "zmp": ctx.zmp,
         "reach": ctx.reach,
         "reach_points": ctx.reach_points,
+        "rate": ctx.rate,
     }
     if ctx.robot is None or _no_arm(ctx):
         return Summary(**base, end_effector="", poses=())

@@ -8,7 +8,11 @@ its first named pose, so they can be pasted as they are.
 
 from __future__ import annotations
 
+import math
+
+from armcli.analysis.rate import round_up
 from armcli.compiler.xmlfmt import fmt
+from armcli.ros.controller_rate import Control
 from armcli.ros.jazzy import GZ_PLUGIN_NAME, MOCK_ARG, controllers_file
 from armcli.ros.moveit import ARM_CONTROLLER
 from armcli.ros.srdf import chain_joints
@@ -36,12 +40,34 @@ def _trajectory(spec: RobotSpec) -> str:
     )
 
 
-def _gains_table(spec: RobotSpec) -> list[str]:
-    rows = ["| joint | p [N·m/rad] | d [N·m·s/rad] | i |", "|---|---|---|---|"]
+def _gains_table(spec: RobotSpec, control: Control | None) -> list[str]:
+    """The gains as the controllers YAML has them (the integral term of ros/holding.py too)."""
+    holding = control.holding if control is not None else {}
+    rows = ["| joint | p [N·m/rad] | d [N·m·s/rad] | i [N·m/(rad·s)] |", "|---|---|---|---|"]
     for j in chain_joints(spec):
         g = spec.control.gains[j]
-        rows.append(f"| {j} | {fmt(g.kp)} | {fmt(g.kd)} | {fmt(g.ki)} |")
+        i = holding[j].i if j in holding else g.ki
+        rows.append(f"| {j} | {fmt(g.kp)} | {fmt(g.kd)} | {fmt(i)} |")
     return rows
+
+
+def _rate(spec: RobotSpec, control: Control | None) -> list[str]:
+    """How far the controller's rate is from the edge of its loop (analysis.zoh)."""
+    v = control.rate if control is not None else None
+    if v is None:
+        return []
+    hold = f"{fmt(round(v.hold * 1e3, 6))} ms"
+    least = f"update_rate >= {round_up(v.rate_min, 3):g} Hz"
+    edge = (
+        "any hold" if math.isinf(v.hold_max) else f"a hold up to {v.hold_max * 1e3:.3g} ms, {least}"
+    )
+    return [
+        f"gz_ros2_control updates the controller every {hold} and holds its effort in between; "
+        f"with these gains that loop is stable for {edge} (`armcli check`: "
+        "ros-controller-unstable). A lower `control.controller_update_rate` or stiffer gains "
+        "beyond it make the arm oscillate or diverge.",
+        "",
+    ]
 
 
 def _moving(spec: RobotSpec) -> list[str]:
@@ -69,7 +95,7 @@ def _moving(spec: RobotSpec) -> list[str]:
     ]
 
 
-def _control(spec: RobotSpec) -> list[str]:
+def _control(spec: RobotSpec, control: Control | None) -> list[str]:
     tol = spec.control.tolerances
     return [
         "## Control",
@@ -79,8 +105,9 @@ def _control(spec: RobotSpec) -> list[str]:
         "**effort** interface. Its torque is `p (q_ref - q) + d (v_ref - v) + i ∫e` "
         "(`ff_velocity_scale` 0), the PD loop `armcli check` bounds and `armcli simulate` runs:",
         "",
-        *_gains_table(spec),
+        *_gains_table(spec, control),
         "",
+        *_rate(spec, control),
         f"Constraints (spec `control.tolerances`): goal {fmt(tol.goal)} rad, trajectory "
         f"{fmt(tol.trajectory)} rad (0 = not checked), goal_time {fmt(tol.goal_time)} s, "
         f"stopped_velocity_tolerance {fmt(tol.stopped_velocity_tolerance)} rad/s. Without "
@@ -108,8 +135,10 @@ NOT_RUN = [
 ]
 
 
-def readme(spec: RobotSpec, bringup: str, launch: str, moveit: str, note: str) -> bytes:
-    """The whole README text, deterministic for a given spec."""
+def readme(
+    spec: RobotSpec, bringup: str, launch: str, moveit: str, note: str, control: Control | None
+) -> bytes:
+    """The whole README text, deterministic for a given spec (and its `control`)."""
     lines = [
         f"# {bringup}: {spec.name} in Gazebo Harmonic with ros2_control (ROS 2 Jazzy)",
         "",
@@ -130,7 +159,7 @@ def readme(spec: RobotSpec, bringup: str, launch: str, moveit: str, note: str) -
         f"and `{ARM_CONTROLLER}` once that is active.",
         "",
         *_moving(spec),
-        *_control(spec),
+        *_control(spec, control),
         *NOT_RUN,
     ]
     return "\n".join(lines).encode("utf-8")

@@ -33,8 +33,8 @@ from armcli.ros.collision_matrix import (
     CollisionMatrix,
     compute_collision_matrix,
 )
+from armcli.ros.controller_rate import Control, jazzy_control
 from armcli.ros.copying import mesh_files
-from armcli.ros.holding import Integral, integral_terms
 from armcli.ros.jazzy_readme import readme as jazzy_readme
 from armcli.ros.launch import render
 from armcli.ros.ros2_control import moveit_urdf_xacro, ros2_control_xacro
@@ -312,6 +312,7 @@ def ros_packages(
     urdfs = spec_urdfs(spec)
     urdf_xml = urdfs.get(f"{n.robot}.urdf", urdfs[STANDALONE_ARM_URDF])
     poses = {name: spec.pose(name) for name in spec.poses}
+    control = jazzy_control(spec, urdf_xml, source) if target == "jazzy" else None
     local = confined_mesh_xml(
         urdf_xml,
         source or n.robot_xacro,
@@ -323,8 +324,8 @@ def ros_packages(
         local, samples=samples, seed=seed, source=n.robot_xacro, poses=poses
     )
     note = GENERATED.format(spec=label)
-    if target == "jazzy":
-        files = jazzy_files(spec, n, label, info, source, integral_terms(spec, urdf_xml))
+    if control is not None:
+        files = jazzy_files(spec, n, label, info, source, control)
     else:
         files = {**description_files(spec, n, label, info), **bringup_files(n, note, info)}
     files.update(moveit_files(spec, n, urdf_xml, matrix, note, info, target))
@@ -337,9 +338,9 @@ def jazzy_files(
     label: str,
     info: PackageInfo,
     source: str | None,
-    holding: Mapping[str, Integral] | None = None,
+    control: Control | None = None,
 ) -> dict[str, bytes]:
-    """Description (course xacro + Jazzy top levels), Gazebo Harmonic bringup (`holding`)."""
+    """Description (course xacro + Jazzy top levels), Gazebo Harmonic bringup (`control`)."""
     note = GENERATED.format(spec=label)
     tops = jazzy.description_xacros(spec, n.bringup, note)
     whole = jazzy.TOP.format(name=n.robot)
@@ -356,11 +357,11 @@ def jazzy_files(
     }
     files = {
         f"config/{jazzy.controllers_file(n.robot)}": mc.dump_yaml(
-            jazzy.controllers(spec, source, holding), note
+            jazzy.controllers(spec, source, control.holding if control else None), note
         ),
         f"config/{jazzy.bridge_file(n.robot)}": jazzy.bridge_yaml(spec, note),
         f"launch/{launch}": jazzy.bringup_launch(values, note),
-        "README.md": jazzy_readme(spec, n.bringup, launch, n.moveit, note),
+        "README.md": jazzy_readme(spec, n.bringup, launch, n.moveit, note, control),
     }
     about = f"Gazebo Harmonic + ros2_control bringup of {n.robot} (ROS 2 Jazzy). {note}"
     return {

@@ -87,6 +87,12 @@ def _no_integral(root: Path) -> None:
     path.write_text(re.sub(r"(\n\s+i_clamp): [0-9.]+", r"\1: 0.0", text))
 
 
+def _slow_controller(root: Path) -> None:
+    """The controllers at 100 Hz (controller_manager's default, the specs' rate before) with
+    gains made for the 1 ms physics step: gz_ros2_control holds their effort for 10 ms."""
+    edit(root / CONTROLLERS, "update_rate: 1000", "update_rate: 100")
+
+
 def _no_depend(root: Path) -> None:
     edit(
         root / f"{BRINGUP}/package.xml", "  <exec_depend>robot_state_publisher</exec_depend>\n", ""
@@ -103,6 +109,12 @@ CASES: dict[str, tuple[str, Callable[[Path], None], str, set[str]]] = {
     "ros-classic-plugin": ("jazzy", _classic_plugin, "my_robot_gz.urdf.xacro", set()),
     "ros-sim-time": ("jazzy", _wall_clock, GZ_LAUNCH, {"use_sim_time"}),
     "ros-start-sag": ("jazzy", _no_integral, CONTROLLERS, {"p"}),
+    "ros-controller-unstable": (
+        "jazzy",
+        _slow_controller,
+        CONTROLLERS,
+        {"update_rate", "p", "d", "i"},
+    ),
     "ros-missing-depend": ("jazzy", _no_depend, f"{BRINGUP}/package.xml", {"exec_depend"}),
 }
 

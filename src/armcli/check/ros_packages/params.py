@@ -69,6 +69,7 @@ class ControllerFile:
     doc: YamlDoc = field(repr=False)
     controllers: Mapping[str, Controller]
     update_rate: float | None = None
+    manager_line: int | None = None  # the line of update_rate, else of the manager's block
 
 
 def node_key(key: str) -> str:
@@ -125,9 +126,9 @@ def controller_file(path: Path, doc: YamlDoc) -> ControllerFile | None:
             name, kind if isinstance(kind, str) else None, str(path), p, doc, b_at, type_line
         )
     rate = params.get("update_rate")
-    return ControllerFile(
-        path, doc, controllers, float(rate) if isinstance(rate, int | float) else None
-    )
+    value = float(rate) if isinstance(rate, int | float) and not isinstance(rate, bool) else None
+    line = doc.line_of((*at, "update_rate"))  # else the closest ancestor's
+    return ControllerFile(path, doc, controllers, value, line)
 
 
 def _declares_controllers(params: Mapping[str, object]) -> bool:

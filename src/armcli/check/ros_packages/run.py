@@ -17,6 +17,7 @@ from armcli.check.findings import Finding
 from armcli.check.options import CheckOptions
 from armcli.check.ros_packages import (
     control_node,
+    controller_rate,
     depends,
     joint_names,
     joint_states,
@@ -48,6 +49,7 @@ RULE_FAMILIES: tuple[tuple[str, Callable[[PackageContext], None]], ...] = (
     ("ros-classic-plugin", plugins.check),
     ("ros-sim-time", sim_time.check),
     ("ros-start-sag", sag.check),
+    ("ros-controller-unstable", controller_rate.check),
     ("ros-missing-depend", depends.check),
 )
 

@@ -16,14 +16,14 @@ the spec's, with --spec). The message gives the sag and the p gain that would ho
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 
 from armcli.analysis.sag import Hold, Sag, passing_kp, settle
 from armcli.check.ros_packages.context import PackageContext
 from armcli.check.ros_packages.launch_model import Where
 from armcli.check.ros_packages.moveit import MoveItConfig
-from armcli.check.ros_packages.params import JTC, Controller
+from armcli.check.ros_packages.params import JTC, Controller, ControllerFile
 from armcli.check.ros_packages.srdf_names import read
 from armcli.robot.model import Robot
 from armcli.urdf.doc import Urdf
@@ -43,17 +43,40 @@ class Pose:
 
 def check(ctx: PackageContext) -> None:
     """Every effort-commanded JTC of a robot that is not mock hardware, at every pose."""
+    for _, c, urdf in effort_controllers(ctx):
+        _controller(ctx, c, urdf)
+
+
+def effort_controllers(ctx: PackageContext) -> Iterator[tuple[ControllerFile, Controller, Urdf]]:
+    """Each effort-commanded JointTrajectoryController with the robot it drives, once.
+
+    Robots on mock hardware are left out: mock_components only mirrors the commands.
+    """
     done: set[tuple[str, str]] = set()
     for path, robots in ctx.owners().items():
         cf = ctx.controllers(path)
-        for c in cf.controllers.values() if cf is not None else ():
+        if cf is None:
+            continue
+        for c in cf.controllers.values():
             if c.type != JTC or "effort" not in _list(c.params.get("command_interfaces")):
                 continue
             for urdf in robots:
                 if (c.file, c.name) in done or _mock(urdf):
                     continue
                 done.add((c.file, c.name))
-                _controller(ctx, c, urdf)
+                yield cf, c, urdf
+
+
+def joint_gains(c: Controller, joints: list[str]) -> list[dict[str, object]]:
+    """Each joint's block under the controller's `gains` ({} where it has none)."""
+    raw = c.params.get("gains")
+    gains: dict[str, object] = raw if isinstance(raw, dict) else {}
+    return [g if isinstance(g := gains.get(j), dict) else {} for j in joints]
+
+
+def number(x: object) -> float:
+    """A YAML number as a float; 0 for anything else (a missing or malformed gain)."""
+    return float(x) if isinstance(x, int | float) and not isinstance(x, bool) else 0.0
 
 
 def _list(x: object) -> list[str]:
@@ -69,13 +92,8 @@ def _controller(ctx: PackageContext, c: Controller, urdf: Urdf) -> None:
     joints = [j for j in _list(c.params.get("joints")) if robot is not None and j in robot.names]
     if robot is None or not joints:
         return
-    raw = c.params.get("gains")
-    gains: dict[str, object] = raw if isinstance(raw, dict) else {}
-    per: list[dict[str, object]] = []
-    for j in joints:
-        g = gains.get(j)
-        per.append(g if isinstance(g, dict) else {})
-    kp = tuple(_num(g.get("p")) for g in per)
+    per = joint_gains(c, joints)
+    kp = tuple(number(g.get("p")) for g in per)
     hold = Hold(tuple(joints), kp, tuple(ctx.distro.integral_cap(g) for g in per))
     tolerances, why = _tolerances(ctx, c, urdf, joints)
     if not tolerances:
@@ -89,10 +107,6 @@ def _controller(ctx: PackageContext, c: Controller, urdf: Urdf) -> None:
         ]
         if over:
             _report(ctx, c, robot, hold, sag, pose, max(over, key=lambda o: o[1] / o[2]), why)
-
-
-def _num(x: object) -> float:
-    return float(x) if isinstance(x, int | float) and not isinstance(x, bool) else 0.0
 
 
 def _tolerances(
@@ -109,7 +123,7 @@ def _tolerances(
         if start is not None and start > 0:
             options.append((start, f"MoveIt's allowed_start_tolerance {start:g} rad"))
         goal = constraints.get(j) if isinstance(constraints, dict) else None
-        g = _num(goal.get("goal")) if isinstance(goal, dict) else 0.0
+        g = number(goal.get("goal")) if isinstance(goal, dict) else 0.0
         if g > 0:
             options.append((g, f"{c.name}'s goal tolerance {g:g} rad"))
         if options:
