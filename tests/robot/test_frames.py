@@ -60,3 +60,16 @@ def test_simulate_two_joints_of_a_robot_with_shared_names(tmp_path: Path) -> Non
                     "--trajectory", traj], ROOT)  # fmt: skip
     assert proc.returncode == 0, proc.stderr  # was: internal error: Several frames match
     assert "HFE" in proc.stdout and "KFE" in proc.stdout
+
+
+def test_every_lookup_by_name_goes_through_robot_frames() -> None:
+    """Pinocchio's name lookups and its reduction live in robot/frames.py only."""
+    calls = ("getFrameId(", "existFrame(", "buildReducedModel(")
+    found = [
+        f"{path.relative_to(ROOT)}:{n}"
+        for path in sorted((ROOT / "src" / "armcli").rglob("*.py"))
+        if path.name != "frames.py" or path.parent.name != "robot"
+        for n, line in enumerate(path.read_text().splitlines(), 1)
+        if any(c in line for c in calls)
+    ]
+    assert found == []
