@@ -56,3 +56,20 @@ def test_bad_files_name_line_and_field(text: str, line: int, field: str) -> None
 def test_the_shipped_example_loads() -> None:
     cmd = load_cmd_vel(ROOT / "specs" / "trajectories" / "drive.yaml")
     assert cmd.times.tolist() == [0.5, 3.0, 5.5, 7.0] and cmd.warnings == ()
+
+
+@pytest.mark.parametrize(
+    ("text", "words"),
+    [
+        # the valid names once, not "expected one of (valid: ...)"
+        ("commands:\n  - {linear: {w: 1}, time_from_start: 0}\n", "unknown key; valid: x, y, z"),
+        ("commands:\n  - {lineer: {x: 1}}\n",
+         "unknown key; did you mean 'linear'? valid: angular, linear, time_from_start"),
+        # a list at the top: the key the file needs, with an example
+        ("- {linear: {x: 0.2}}\n", "must be a YAML mapping with a `commands:` list"),
+    ],
+)  # fmt: skip
+def test_error_wording_says_it_once(text: str, words: str) -> None:
+    with pytest.raises(SpecError) as info:
+        loads_cmd_vel(text, source="drive.yaml")
+    assert any(words in line for line in info.value.lines()), info.value.lines()
