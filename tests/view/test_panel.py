@@ -224,6 +224,7 @@ def test_a_drive_replay_carries_the_panel_and_the_tool_dot_with_the_base(
     proc = run_cli(["simulate", default_spec_path, "--cmd-vel", cmd, "-o", states])
     assert proc.returncode == 0, proc.stderr
     src = load_robot(default_spec_path)
+    assert src.file is not None
     names = list(joint_limits(load_urdf(src.xml, src.source, src.mesh_dir, src.search)))
     run = load_replay(states, names)  # as `armcli view --replay` reads it
     assert run.base is not None  # a drive's states file: the base moves
