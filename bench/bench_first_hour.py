@@ -1,9 +1,13 @@
-"""Benchmark: the everyday commands a newcomer runs, whole process, as ratios (issue 31).
+"""Benchmark: the everyday commands a newcomer runs, whole process, as ratios (issues 31, 40).
 
 1. `armcli check` of the course spec next to `urdf_validate` (pip urdf-validator, a
    peer that validates URDFs with physics) on the URDF that spec builds (urdf/my_robot.urdf).
-2. `armcli simulate --plot` of the course spec along pick.yaml next to the same run
-   without a plot: what the plot costs.
+2. Issue 40's everyday commands on the course robot, each beside its old figure (CPU
+   seconds measured on a fresh machine when the issue was filed, OLD) and beside a peer
+   where one exists: `simulate` along pick.yaml next to a bare MuJoCo script stepping the
+   exported arm as long (BARE); `simulate --plot` next to `simulate` (what the plot costs);
+   `render`; a 5 s drive with `--plot` next to the bare script stepping the exported
+   whole robot as long; `view` until it prints its address (its start-up).
 3. `armcli check` of every example-robot-data URDF next to `urdf_validate` on the same
    file: the median of the per-file ratios, and the sums.
 
@@ -22,6 +26,7 @@ from __future__ import annotations
 import argparse
 import importlib.metadata
 import os
+import signal
 import statistics
 import subprocess
 import sys
@@ -31,6 +36,18 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
 ENV = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+# [CPU s] issue 40's figures, measured on a fresh machine (wall ~ CPU there)
+OLD = {"simulate": 2.0, "simulate --plot": 4.0, "render": 3.4, "drive --plot": 2.8, "view": 3.1}
+BARE = """
+import sys
+import mujoco
+m = mujoco.MjModel.from_xml_path(sys.argv[1])
+m.opt.timestep = float(sys.argv[3])
+d = mujoco.MjData(m)
+for _ in range(round(float(sys.argv[2]) / m.opt.timestep)):
+    mujoco.mj_step(m, d)
+"""
+DRIVE = "commands:\n  - {linear: {x: 0.3}, time_from_start: 0.5}\n  - {time_from_start: 3.5}\n"
 
 
 def cpu(cmd: list[str]) -> float:
@@ -50,6 +67,50 @@ def paired(a: list[str], b: list[str], repeats: int) -> tuple[float, float, floa
     return statistics.median(ta), statistics.median(tb), statistics.median(ratios)
 
 
+def view_startup(cmd: list[str]) -> float:
+    """CPU seconds of `armcli view` from its start until it prints its address, then Ctrl-C."""
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=ENV,
+                            text=True)  # fmt: skip
+    assert proc.stdout is not None
+    proc.stdout.readline()  # `armcli view: NAME at http://...`
+    proc.send_signal(signal.SIGINT)
+    _, _, usage = os.wait4(proc.pid, 0)
+    return float(usage.ru_utime + usage.ru_stime)
+
+
+def everyday(armcli: str, tmp: Path, reps: int) -> None:
+    """Issue 40's commands beside their OLD figures and their peers (module docstring)."""
+    spec, pick = ROOT / "specs" / "my_robot.yaml", ROOT / "specs" / "trajectories" / "pick.yaml"
+    arm, whole = tmp / "arm" / "arm.xml", tmp / "whole" / "robot.xml"
+    cpu([armcli, "export", "mjcf", str(spec), "-o", str(arm)])
+    cpu([armcli, "export", "mjcf", str(spec), "--whole-robot", "--base", "free", "-o", str(whole)])
+    drive = tmp / "drive.yaml"
+    drive.write_text(DRIVE)
+    sim = [armcli, "simulate", str(spec), "--trajectory", str(pick)]
+    bare = [sys.executable, "-c", BARE]
+    rows = [
+        ("simulate", sim, [*bare, str(arm.parent / "scene.xml"), "7.0", "0.001"], "MuJoCo"),
+        ("simulate --plot", [*sim, "--plot", str(tmp / "t.png")], sim, "simulate"),
+        ("render", [armcli, "render", str(spec), "-o", str(tmp / "r.png")], None, ""),
+        ("drive --plot", [armcli, "simulate", str(spec), "--cmd-vel", str(drive), "--plot",
+                          str(tmp / "d.png")],
+         [*bare, str(whole.parent / "scene.xml"), "5.5", "0.001"], "MuJoCo"),
+    ]  # fmt: skip
+    for name, ours, peer, label in rows:
+        cpu(ours)  # untimed: warm the caches
+        if peer is None:
+            a = statistics.median(cpu(ours) for _ in range(reps))
+            print(f"{name}: {a:.2f} CPU s (was {OLD[name]:.1f}, x{a / OLD[name]:.2f})")
+            continue
+        a, b, r = paired(ours, peer, reps)
+        print(f"{name}: {a:.2f} CPU s (was {OLD[name]:.1f}, x{a / OLD[name]:.2f}); {label} "
+              f"{b:.2f} CPU s; ratio {r:.2f}")  # fmt: skip
+    view = [armcli, "view", str(spec), "--port", "0", "--save-dir", str(tmp)]
+    view_startup(view)
+    a = statistics.median(view_startup(view) for _ in range(reps))
+    print(f"view start-up: {a:.2f} CPU s (was {OLD['view']:.1f}, x{a / OLD['view']:.2f})")
+
+
 def corpus() -> list[Path]:
     """Every robots/**/*.urdf of the example-robot-data distribution."""
     dist = importlib.metadata.distribution("example-robot-data")
@@ -63,7 +124,7 @@ def main() -> None:
     args = ap.parse_args()
     reps = 1 if args.quick else 3
     armcli, validate = str(BIN / "armcli"), str(BIN / "urdf_validate")
-    spec, pick = ROOT / "specs" / "my_robot.yaml", ROOT / "specs" / "trajectories" / "pick.yaml"
+    spec = ROOT / "specs" / "my_robot.yaml"
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory() as tmp:
         ENV["PYTHONPYCACHEPREFIX"] = str(Path(tmp) / "pycache")
@@ -77,10 +138,7 @@ def main() -> None:
         cpu([armcli, "check", str(spec)]), cpu(peer(built))  # untimed: warm the caches
         a, b, r = paired([armcli, "check", str(spec)], peer(built), reps)
         print(f"check course spec: {a:.2f} CPU s; urdf_validate {b:.2f} CPU s; ratio {r:.2f}")
-        sim = [armcli, "simulate", str(spec), "--trajectory", str(pick)]
-        plot = [*sim, "--plot", str(Path(tmp) / "tracking.png")]
-        a, b, r = paired(plot, sim, reps)
-        print(f"simulate --plot: {a:.2f} CPU s; without a plot {b:.2f} CPU s; ratio {r:.2f}")
+        everyday(armcli, Path(tmp), reps)
         files = corpus()[:: 5 if args.quick else 1]
         ratios, ours, theirs = [], 0.0, 0.0
         for urdf in files:

@@ -21,6 +21,7 @@ import typer.main
 
 from armcli.errors import EXIT_FAILED, ArmcliError, ArmcliWarning
 from armcli.io.oneline import one_line
+from armcli.io.terminal import say_line
 
 UNSANDBOXED_FLAG = "--trust-xacro-unsandboxed"  # what `--trust-xacro=unsandboxed` becomes
 
@@ -155,8 +156,28 @@ def _print_error(exc: ArmcliError) -> None:
     A newline in a file name or value is escaped (`one_line`): a line of its own could be
     a workflow command such as `::add-mask::` to GitHub Actions, which reads stderr too.
     """
-    for line in map(one_line, exc.lines()):
-        sys.stderr.write(f"{exc.label}: {line}\n" if exc.label else f"{line}\n")
+    for line in exc.lines():
+        say_line(f"{exc.label}: {line}" if exc.label else line, sys.stderr)
+
+
+def _json_requested(argv: list[str]) -> bool:
+    """`--format json` (or `--format=json`) given to the command: errors go to stdout too."""
+    pairs = zip(argv, [*argv[1:], ""], strict=True)
+    return "--format=json" in argv or any(a == "--format" and b == "json" for a, b in pairs)
+
+
+def _print_json_error(exc: ArmcliError) -> None:
+    """The error as the JSON document a `--format json` caller parses from stdout.
+
+    `status` is "failed" for a negative verdict (exit 1: no plan found, error findings),
+    "error" for unusable input (exit 2); nothing was written (`output` null).
+    """
+    from armcli.io.jsondoc import dumps
+
+    status = "failed" if exc.exit_code == EXIT_FAILED else "error"
+    reason = "; ".join(one_line(line) for line in exc.lines())
+    doc = {"status": status, "reason": reason, "exit_code": exc.exit_code, "output": None}
+    sys.stdout.write(dumps(doc))
 
 
 _show_python_warning = warnings.showwarning
@@ -220,6 +241,8 @@ def main(argv: list[str] | None = None) -> None:
         if debug:
             raise
         _print_error(exc)
+        if _json_requested(args) and not exc.reported:
+            _print_json_error(exc)
         raise SystemExit(exc.exit_code) from None
     except Exception as exc:  # a bug: say so in one line unless --debug
         if debug:

@@ -49,6 +49,9 @@ class ArmcliError(Exception):
     exit_code: int = EXIT_UNUSABLE
     #: What the CLI writes before each line; None when the lines carry their own label.
     label: str | None = "error"
+    #: The command wrote its result document before raising (check's report): with
+    #: `--format json` the CLI adds no error document of its own to stdout.
+    reported: bool = False
 
     def lines(self) -> list[str]:
         """The one-line-per-problem rendering the CLI prints."""
@@ -279,13 +282,14 @@ class StaleBuildError(ArmcliError):
 
 
 class FindingsError(ArmcliError):
-    """`check` found problems of error severity.
+    """`check` found problems of error severity (raised after its report is written).
 
     `unusable` are files it could not read (inside a directory, next to usable ones),
     printed one line each before the total.
     """
 
     exit_code = EXIT_FAILED
+    reported = True
 
     def __init__(self, message: str, unusable: Sequence[ArmcliError] = ()) -> None:
         self.unusable = list(unusable)

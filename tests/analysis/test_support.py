@@ -56,3 +56,21 @@ def test_degenerate_contacts_give_no_polygon() -> None:
 )
 def test_direction_names(deg: float, name: str) -> None:
     assert direction_name(math.radians(deg)) == name
+
+
+def test_margins_at_once_equal_shapely_distances() -> None:
+    """`margins` (the zero-moment point series' vectorised margin) against shapely's geometry:
+    inside, the distance to the boundary; outside, minus the distance to the polygon."""
+    shapely = pytest.importorskip("shapely")
+    rng = np.random.default_rng(3)
+    poly = support_polygon([(x, y, 0.0) for x, y in rng.uniform(-1, 1, size=(9, 2))])
+    assert poly is not None
+    ref = shapely.geometry.Polygon(poly.vertices)
+    points = rng.uniform(-2, 2, size=(500, 2))
+    got = poly.margins(points)
+    for p, m in zip(points, got, strict=True):
+        pt = shapely.geometry.Point(p)
+        want = ref.exterior.distance(pt) if ref.contains(pt) else -ref.distance(pt)
+        assert m == pytest.approx(want, abs=TOL)
+        assert m == pytest.approx(poly.margin(p), abs=TOL)  # the one-point margin
+    assert poly.margins(np.array([[np.nan, 0.0]]))[0] == -math.inf

@@ -523,3 +523,28 @@ def test_inertia_exceeds_geometry_names_the_shape_it_measured(drop: str | None, 
     assert f"inside that {role} shape can have" in f.message
     # A visual-only shape may be only a picture (Go1's rotors): a warning, not an error.
     assert f.severity == ("warning" if drop == "collision" else "error")
+
+
+def test_a_massless_moving_link_blocks_the_dynamics_but_not_the_balance() -> None:
+    """PR2's construct: a sensor frame on a joint, without mass. It moves no centre of mass
+    and no contact, so the balance is analysed (the dynamics are not: M is singular)."""
+    text = (
+        (ALL_FIXTURES / "tipover" / "box_rod.urdf")
+        .read_text()
+        .replace(
+            "</robot>",
+            '<link name="sensor"/><joint name="pan" type="revolute"><parent link="body"/>'
+            '<child link="sensor"/><axis xyz="0 0 1"/>'
+            '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>',
+        )
+    )
+    feet = ("foot_fl", "foot_fr", "foot_rl", "foot_rr")
+    opts = CheckOptions(tipover=TipoverOptions(contact_links=feet))
+    res = check_urdf(parse_urdf(text.encode(), "box_sensor.urdf"), opts)
+    assert [f.rule for f in res.findings if f.severity == "error"] == ["mass-nonpositive"]
+    assert res.summary is not None and res.summary.balance is not None
+    assert "dynamics checks skipped: fix the number and inertia errors first" in res.summary.notes
+    # the box's closed form (tests/analysis/test_balance.py): 4 kg + 4 x 0.25 kg feet and the
+    # 1 kg ball 0.55 m above the box top at q = 0: the massless sensor changes none of it
+    zero = next(p for p in res.summary.balance.poses if p.name == "zero")
+    assert zero.com[0] == pytest.approx(0.0, abs=1e-12)

@@ -130,6 +130,8 @@ def test_everyday_output_fits_80_columns(
         ["tree", DEFAULT_SPEC],
         ["ros-package", DEFAULT_SPEC, "-o", "ros", "--samples", "20"],
         ["import", urdf, "-o", "imported.yaml"],
+        ["export", "mjcf", DEFAULT_SPEC, "--whole-robot", "-o", "mjcf/robot.xml"],  # was 81-130
+        ["plan", DEFAULT_SPEC, "--to", "1.5708,0"],  # its note on the snapped limit
     ]
     for args in runs:
         code, out, err = run_main(args, capsys)
@@ -156,3 +158,24 @@ def test_names_get_a_did_you_mean(tmp_path: Path, capsys: pytest.CaptureFixture[
     )
     code, _, err = run_main(["check", spec], capsys)
     assert code == 2 and "unknown arm joint; did you mean 'arm_base_forearm_joint'?" in err
+
+
+def test_errors_wrap_at_a_terminal_and_continuations_keep_their_indent(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An error line (up to 237 columns before) fits COLUMNS, its path whole; check's
+    indented stability lines wrap under their own indent (they lost it before)."""
+    monkeypatch.setenv("COLUMNS", "60")
+    path = "/nonexistent/" + "d" * 70 + "/trajectory.yaml"
+    code, _, err = run_main(["simulate", DEFAULT_SPEC, "--trajectory", path], capsys)
+    assert code == 2
+    lines = err.splitlines()
+    assert lines[0].startswith("error: ") and path in lines[0]  # a path is never cut
+    assert all(len(line) <= 60 for line in lines[1:]) and all(
+        line.startswith("  ") for line in lines[1:]
+    )
+    code, out, _ = run_main(["check", DEFAULT_SPEC], capsys)
+    lines = out.splitlines()
+    k = next(i for i, line in enumerate(lines) if line.startswith("  armcli simulate (damping"))
+    assert lines[k + 1].startswith("    ")  # its continuation, under its own indent
+    assert not any(line.endswith(" ") for line in lines)

@@ -58,5 +58,7 @@ def test_plot_in_missing_directory_exits_2_and_creates_nothing(tmp_path: Path) -
     plot = tmp_path / "nonexistent" / "dir" / "x.png"
     proc = _simulate("--output", str(tmp_path / "s.csv"), "--plot", str(plot))
     assert proc.returncode == 2, proc.stderr
-    assert "does not exist" in proc.stderr.splitlines()[0]
+    # one error, wrapped at the width the child sees (readline exports COLUMNS=80 under pytest)
+    assert proc.stderr.startswith("error: ") and proc.stderr.count("error:") == 1
+    assert "does not exist" in " ".join(proc.stderr.split())
     assert list(tmp_path.iterdir()) == []  # before: nonexistent/dir was created

@@ -10,6 +10,8 @@ import pytest
 from tests.helpers import DEFAULT_SPEC, FIXTURES, run_main
 
 BOX = FIXTURES / "plan" / "box_in_the_way.yaml"
+POST = FIXTURES / "plan" / "post_cuts_off.yaml"  # tests/plan/test_diagnose.py's band
+SHELF = FIXTURES / "plan" / "shelf_at_reach.yaml"
 
 
 def plan(args: list[str | Path], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
@@ -77,7 +79,7 @@ def test_failure_as_json(capsys: pytest.CaptureFixture[str]) -> None:
     ("args", "words"),
     [
         (["--to", "nowhere"], "--to: unknown pose 'nowhere'"),
-        (["--to", "0.1,0.2,0.3"], "--to: give 2 value(s)"),
+        (["--to", "0.1,0.2,0.3"], "--to: expected 2 value(s)"),
         (["--to", "reach", "--to-xyz", "1,2,3"], "--to: give exactly one goal"),
         (["--to-xyz", "1,2"], "--to-xyz: expected x,y,z in metres"),
         (["--to", "reach", "--joints", "wheel"], "--joints: unknown joint 'wheel'"),
@@ -111,3 +113,64 @@ def test_plan_for_a_urdf(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> 
     code, out, err = run_main(args, capsys)
     assert code == 0, err
     assert "joints: shoulder, elbow" in out and out_file.is_file()
+
+
+def test_pi_values_and_a_limit_typed_as_printed(capsys: pytest.CaptureFixture[str]) -> None:
+    """The spec's `pi/2` works in --to; 1.5708 (pi/2 as printed) is the stop, with a note."""
+    code, out, err = plan(["--to", "pi/2,pi/4"], capsys)
+    assert code == 0, err
+    code, out, err = plan(["--to", "1.5708,0", "--format", "json"], capsys)
+    assert code == 0, err
+    (note,) = json.loads(out)["notes"]
+    assert "arm_base_forearm_joint = 1.5708 is taken as its upper limit" in note
+
+
+def test_a_goal_point_inside_an_object_names_what_collides(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    code, _, err = plan(["--to-xyz", "0.662,0,0.532", "--scene", SHELF], capsys)
+    assert code == 1
+    assert "only in collision: hand_link and shelf" in err
+
+
+def test_a_cut_off_goal_is_not_a_timeout(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = plan(["--to", "reach", "--scene", POST, "--timeout", "0.2"], capsys)
+    assert code == 1
+    assert "the goal is cut off from the start" in err and "will not help" in err
+
+
+def test_the_summary_says_what_was_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, out, err = plan(["--to", "reach"], capsys)
+    assert code == 0, err
+    assert out.splitlines()[-1].startswith("not written: no -o FILE given")
+    out_file = tmp_path / "t.yaml"
+    out_file.write_text("old")
+    code, out, err = plan(["--to", "reach", "-o", out_file], capsys)
+    assert code == 0, err
+    assert out.splitlines()[-1] == f"replaced {out_file}"  # never silently
+
+
+def test_rpy_in_degrees_is_warned_about(capsys: pytest.CaptureFixture[str]) -> None:
+    _, _, err = plan(["--to-xyz", "0.6,0,0.5", "--to-rpy", "0,90,0", "--timeout", "0.2"], capsys)
+    assert "warning: roll, pitch, yaw 0,90,0 look like degrees" in err
+    assert "1.571" in err
+
+
+@pytest.mark.parametrize(
+    ("command", "args"),
+    [
+        ("plan", [DEFAULT_SPEC, "--to", "0.1,0.2,0.3"]),
+        ("plan", [DEFAULT_SPEC, "--to-xyz", "1,2"]),
+        ("check", [DEFAULT_SPEC, "--ignore", "no-such-rule"]),
+    ],
+)
+def test_bad_input_as_json_on_stdout(
+    command: str, args: list[str | Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, out, err = run_main([command, *args, "--format", "json"], capsys)
+    assert code == 2 and err.startswith("error: ")
+    doc = json.loads(out)
+    assert doc["status"] == "error" and doc["exit_code"] == 2
+    assert doc["reason"] == err.strip().removeprefix("error: ")

@@ -255,3 +255,9 @@ def test_a_wheel_joint_is_not_an_arm_joint(capsys: pytest.CaptureFixture[str]) -
     message = SEED.replace("arm_base_forearm_joint", "base_left_wheel_joint")
     code, _, err = run(["--message", message], capsys)
     assert code == 2 and "is a wheel joint of the mobile base, not an arm joint" in err
+
+
+def test_nothing_to_simulate_names_every_way_in(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run_main(["simulate", "specs/my_robot.yaml"], capsys)
+    assert code == 2
+    assert "--trajectory" in err and "--message" in err and "--cmd-vel" in err

@@ -127,3 +127,19 @@ def test_unbounded_console_writes_no_padding() -> None:
     terminal.console(buf, terminal.UNBOUNDED).print(t)
     assert all(len(line) < 20 for line in buf.getvalue().splitlines())
     assert re.search(r"^a +1$", buf.getvalue(), re.M)
+
+
+def test_fit_line_keeps_indent_words_and_no_workflow_command_at_a_line_start(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from armcli.io.terminal import fit_line
+
+    monkeypatch.setenv("COLUMNS", "30")
+    text = "    an indented line long enough to wrap twice over here"
+    lines = fit_line(text).splitlines()
+    assert lines[0].startswith("    an") and all(ln.startswith("      ") for ln in lines[1:])
+    assert " ".join(fit_line(text).split()) == " ".join(text.split())  # every word, whole
+    long = "error: /a/path/longer/than/thirty/columns.yaml: not found"
+    assert fit_line(long).splitlines()[0] == "error: /a/path/longer/than/thirty/columns.yaml:"
+    sneaky = "wrote a file called x ::add-mask::secret into out"
+    assert not any(ln.lstrip().startswith("::") for ln in fit_line(sneaky).splitlines())

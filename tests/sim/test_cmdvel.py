@@ -72,3 +72,20 @@ def test_many_bad_commands_are_one_line_per_kind() -> None:
     assert lines[0] == f"{first} (and 24999 more)"
     assert lines[1].startswith("<cmd_vel>:3 commands[1].time_from_start: times must increase")
     assert lines[1].endswith("(and 12499 more)")
+
+
+@pytest.mark.parametrize(
+    ("text", "words"),
+    [
+        # the valid names once, not "expected one of (valid: ...)"
+        ("commands:\n  - {linear: {w: 1}, time_from_start: 0}\n", "unknown key; valid: x, y, z"),
+        ("commands:\n  - {lineer: {x: 1}}\n",
+         "unknown key; did you mean 'linear'? valid: angular, linear, time_from_start"),
+        # a list at the top: the key the file needs, with an example
+        ("- {linear: {x: 0.2}}\n", "must be a YAML mapping with a `commands:` list"),
+    ],
+)  # fmt: skip
+def test_error_wording_says_it_once(text: str, words: str) -> None:
+    with pytest.raises(SpecError) as info:
+        loads_cmd_vel(text, source="drive.yaml")
+    assert any(words in line for line in info.value.lines()), info.value.lines()

@@ -140,8 +140,26 @@ def test_cli_render_q_and_errors(root: Path, tmp_path: Path) -> None:
     assert both.stderr.strip() == "error: --pose: give --pose or --q, not both"
     count = run_cli(["render", "--q", "0.1", "-o", str(tmp_path / "c.png")], root)
     assert count.returncode == 2
-    assert "expected 2 values, for: arm_base_forearm_joint, forearm_hand_joint" in count.stderr
+    assert "expected 2 value(s), one for each of arm_base_forearm_joint, forearm_hand_joint" in (
+        count.stderr
+    )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.png"]
+
+
+def test_cli_render_takes_a_limit_as_printed_and_says_it_replaced(
+    root: Path, tmp_path: Path
+) -> None:
+    """1.5708 is the course's stop pi/2 as printed (3.7e-6 above it): the stop, with a note;
+    rendering over an existing PNG says `replaced`."""
+    out = tmp_path / "r.png"
+    out.write_bytes(b"old")
+    res = run_cli(["render", "--q", "1.5708,0", "-o", str(out)], root)
+    assert res.returncode == 0, res.stderr
+    assert "note: arm_base_forearm_joint = 1.5708 is taken as its upper limit" in res.stderr
+    x, _, z = tip(math.pi / 2, 0.0)
+    assert res.stdout.strip() == (
+        f"replaced {out} (1200x600 px) at --q 1.5708,0; tool at ({x:.3f}, 0.000, {z:.3f}) m"
+    )
 
 
 def test_mesh_geometry_is_drawn_and_a_missing_mesh_is_an_error(tmp_path: Path) -> None:

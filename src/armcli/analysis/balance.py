@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 from armcli.analysis.boxsearch import minimize_box
 from armcli.analysis.stance import Stance
 from armcli.robot import sampling
-from armcli.robot.load import link_frame
+from armcli.robot.frames import link_frame
 from armcli.robot.sampling import BALANCE_DRAWS
 
 SEEDS_DESCENDED = 3  # local searches per edge and measure, from the best seeds

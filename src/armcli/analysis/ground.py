@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from armcli.robot.frames import link_frame
 from armcli.robot.inertia import rpy_matrix
 from armcli.spec.joint_types import ROTARY_TYPES
 from armcli.urdf.doc import Shape, Urdf, Vec3
@@ -130,8 +131,9 @@ def link_poses(model: Any, names: Collection[str]) -> dict[str, NDArray[np.float
     pin.framesForwardKinematics(model, data, pin.neutral(model))
     out = {}
     for name in names:
-        if model.existFrame(name, pin.BODY):
-            out[name] = np.asarray(data.oMf[model.getFrameId(name, pin.BODY)].homogeneous)
+        frame = link_frame(model, name)
+        if frame is not None:
+            out[name] = np.asarray(data.oMf[frame].homogeneous)
     return out
 
 

@@ -22,7 +22,7 @@ from armcli.analysis.support import SupportPolygon, support_polygon
 from armcli.errors import InputError
 from armcli.io.names import did_you_mean
 from armcli.robot import sampling
-from armcli.robot.load import link_frame
+from armcli.robot.frames import link_frame
 from armcli.robot.model import Joint, Robot
 from armcli.urdf.doc import Urdf, Vec3
 
@@ -159,12 +159,12 @@ def stance_of(
 
 def _free_joints(robot: Robot, contacts: Collection[str]) -> tuple[Joint, ...]:
     """The 1-DoF joints that carry no contact link (those would move the polygon)."""
-    import pinocchio as pin
-
     model = robot.model
     carrying: set[int] = set()
     for link in contacts:
-        jid = model.frames[model.getFrameId(link, pin.BODY)].parentJoint
+        frame = link_frame(model, link)
+        assert frame is not None  # a contact link is a link of the model (analysis.ground)
+        jid = model.frames[frame].parentJoint
         while jid > 0:
             carrying.add(jid)
             jid = model.parents[jid]

@@ -88,6 +88,20 @@ class SupportPolygon:
         p = np.asarray(xy, dtype=float)[:2]
         return -min(_segment_distance(p, e) for e in self.edges)
 
+    def margins(self, points: ArrayLike) -> NDArray[np.float64]:
+        """`margin` of each (m, 2) point at once; -inf for a point that is not finite."""
+        p = np.asarray(points, dtype=float).reshape(-1, 2)
+        d = self.offsets[None, :] - p @ self.normals.T  # (m, k)
+        a = np.array([e.a for e in self.edges], dtype=float)  # (k, 2)
+        ab = np.array([e.b for e in self.edges], dtype=float) - a
+        with np.errstate(invalid="ignore", divide="ignore"):
+            u = np.clip(np.einsum("mkj,kj->mk", p[:, None, :] - a[None], ab)
+                        / np.sum(ab * ab, axis=1), 0.0, 1.0)  # fmt: skip
+        gap = np.linalg.norm(p[:, None, :] - (a[None] + u[..., None] * ab[None]), axis=2)
+        out = np.where(np.all(d >= 0.0, axis=1), np.min(d, axis=1), -np.min(gap, axis=1))
+        out[~np.all(np.isfinite(p), axis=1)] = -math.inf
+        return np.asarray(out, dtype=float)
+
     def nearest_edge(self, xy: ArrayLike) -> int:
         """Index of the edge the point is nearest to inside (outside: the one it is beyond most)."""
         return int(np.argmin(self.edge_distances(xy)))

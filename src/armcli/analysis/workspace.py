@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from armcli.analysis.boxsearch import minimize_box
 from armcli.robot import sampling
-from armcli.robot.load import link_frame
+from armcli.robot.frames import link_frame
 from armcli.robot.model import Joint, Robot
 from armcli.robot.sampling import REACH_DRAWS, SAMPLE_SEED
 from armcli.robot.tool import ToolPoint

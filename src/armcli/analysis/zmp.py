@@ -115,10 +115,10 @@ def accelerations(
         hit = np.asarray(impact, dtype=bool)
         usable &= ~np.where(nxt, hit, np.concatenate([[False], hit[:-1]]))
     rows = np.nonzero(usable)[0]
-    a = np.empty((len(rows), v.shape[1]))
-    for i, r in enumerate(rows):
-        a[i] = (v[r + 1] - v[r]) / dt if nxt[r] else (v[r] - v[r - 1]) / dt
-    return rows, a
+    fwd = nxt[rows]
+    later = np.where(fwd, rows + 1, rows)  # forward where the next step was kept, else back
+    earlier = np.where(fwd, rows, rows - 1)
+    return rows, (v[later] - v[earlier]) / dt
 
 
 def impacts(stop: NDArray[Any], v: NDArray[Any]) -> NDArray[np.bool_]:
@@ -151,26 +151,29 @@ def zmp_series(
     rows, a = accelerations(np.asarray(step), np.asarray(v), dt, impact)
     skipped = 0 if impact is None else int(np.sum(np.asarray(impact, dtype=bool)))
     cols = _columns(stance.robot, joint_names)
-    q_full = stance.robot.neutral()
+    to_q = stance.robot.joint_map(joint_names)  # others neutral, mimic followers following
+    iv = [j.idx_v for j in cols]
     mass = float(sum(inertia.mass for inertia in model.inertias))
     z0 = stance.ground.height
-    zmp = np.empty((len(rows), 3, 2))
-    margin = np.empty((len(rows), 3))
-    shift = np.empty(len(rows))
+    w, c = np.empty((len(rows), 6)), np.empty((len(rows), 3))
+    vk, ak = np.zeros(model.nv), np.zeros(model.nv)
+    for i, r in enumerate(rows):  # Pinocchio per state; the rest at once below
+        qk = to_q.q(np.asarray(q[r], dtype=float))
+        vk[iv], ak[iv] = v[r], a[i]
+        w[i] = pin.rnea(model, data, qk, vk, ak)[:6]
+        c[i] = pin.centerOfMass(model, data, qk, False)
+    dw = mass * np.column_stack([np.ones(len(rows)), np.zeros((len(rows), 3)), c[:, 2], -c[:, 1]])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        shift = np.where(w[:, 2] > 0, mass * (c[:, 2] - z0) / w[:, 2], math.inf)
+    cases = np.stack([w + sign * base_accel * dw for sign in (0.0, 1.0, -1.0)], axis=1)
+    zmp = zero_moment_points(cases, z0)  # (K, 3, 2)
+    margin = stance.polygon.margins(zmp.reshape(-1, 2)).reshape(len(rows), 3)
     bodies: dict[int, tuple[NDArray[np.float64], NDArray[np.float64]]] = {}
-    for i, r in enumerate(rows):
-        qk, vk, ak = _state(stance.robot, cols, q_full, q[r], v[r], a[i])
-        w = np.asarray(pin.rnea(model, data, qk, vk, ak)[:6], dtype=float)
-        c = np.asarray(pin.centerOfMass(model, data, qk, False), dtype=float)
-        dw = mass * np.array([1.0, 0.0, 0.0, 0.0, c[2], -c[1]])  # d wrench / d a_b
-        shift[i] = mass * (c[2] - z0) / w[2] if w[2] > 0 else math.inf
-        for j, sign in enumerate((0.0, 1.0, -1.0)):
-            p = zero_moment_point(w + sign * base_accel * dw, z0)
-            zmp[i, j] = p
-            margin[i, j] = stance.polygon.margin(p) if np.all(np.isfinite(p)) else -math.inf
-        if np.min(margin[i]) < 0:
-            pin.ccrba(model, data, qk, np.zeros(model.nv))
-            bodies[i] = (c, np.array(data.Ig.inertia, dtype=float))
+    outside = np.nonzero(np.min(margin, axis=1) < 0)[0] if len(rows) else np.zeros(0, int)
+    for i in (int(k) for k in outside):  # the tipping bound's inputs (sim.tipping)
+        qk = to_q.q(np.asarray(q[rows[i]], dtype=float))
+        pin.ccrba(model, data, qk, np.zeros(model.nv))
+        bodies[i] = (c[i].copy(), np.array(data.Ig.inertia, dtype=float))
     return ZmpSeries(np.asarray(t)[rows], np.asarray(step)[rows], zmp, margin,
                      float(base_accel), float(threshold), skipped, shift, bodies)  # fmt: skip
 
@@ -211,6 +214,17 @@ def zero_moment_point(wrench: NDArray[Any], ground: float = 0.0) -> NDArray[np.f
     return np.array([-ny / f[2], nx / f[2]])
 
 
+def zero_moment_points(wrenches: NDArray[Any], ground: float = 0.0) -> NDArray[np.float64]:
+    """`zero_moment_point` of every wrench in (..., 6) at once: (..., 2), NaN where f_z <= 0."""
+    f, n = wrenches[..., :3], wrenches[..., 3:6]
+    nx = n[..., 0] + ground * f[..., 1]
+    ny = n[..., 1] - ground * f[..., 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        p = np.stack([-ny / f[..., 2], nx / f[..., 2]], axis=-1)
+    p[f[..., 2] <= 0.0] = math.nan
+    return np.asarray(p, dtype=float)
+
+
 def _columns(robot: Robot, names: Sequence[str]) -> list[Joint]:
     """Each simulated joint in the whole robot."""
     known = set(robot.names)
@@ -218,15 +232,3 @@ def _columns(robot: Robot, names: Sequence[str]) -> list[Joint]:
     if missing:
         raise ValueError(f"joint {missing[0]!r} is not in the whole robot")
     return [robot.joint(n) for n in names]
-
-
-def _state(
-    robot: Robot, cols: list[Joint], q0: NDArray[Any], q: NDArray[Any],
-    v: NDArray[Any], a: NDArray[Any],
-) -> tuple[NDArray[Any], NDArray[Any], NDArray[Any]]:  # fmt: skip
-    qk = robot.q(q, joints=cols, base=q0)
-    vk = np.zeros(robot.model.nv)
-    ak = np.zeros(robot.model.nv)
-    iv = [j.idx_v for j in cols]
-    vk[iv], ak[iv] = v, a
-    return qk, vk, ak

@@ -17,9 +17,9 @@ from typing import TYPE_CHECKING, Any, Literal
 
 from armcli.analysis.rate import RateVerdict
 from armcli.analysis.verdict import StabilityReport
-from armcli.check.findings import Collector, JointRow
+from armcli.check.findings import Collector, Finding, JointRow
 from armcli.check.options import CheckOptions
-from armcli.check.rules import RULES
+from armcli.check.rules import ERROR, RULES
 from armcli.robot.model import Robot
 from armcli.spec.joint_types import position_bounds
 from armcli.urdf.doc import Urdf
@@ -44,6 +44,20 @@ BLOCKS_MODEL = frozenset(r.id for r in RULES.values() if r.blocks == MODEL)
 BLOCKS_BALANCE = BLOCKS_MODEL | {r.id for r in RULES.values() if r.blocks == BALANCE}
 BLOCKS_DYNAMICS = BLOCKS_BALANCE | {r.id for r in RULES.values() if r.blocks == DYNAMICS}
 MODEL_SKIPPED = "model checks skipped: fix the structure errors first"
+
+
+def blocks_balance(f: Finding) -> bool:
+    """Whether an error stops the static balance: masses, centres of mass, joint ranges.
+
+    A moving body without mass (`mass-nonpositive` of mass 0, check/bodies.py) blocks only
+    the dynamics: it moves neither the centre of mass nor the support polygon (PR2's
+    massless sensor frames). A negative mass does move the centre of mass.
+    """
+    if f.severity != ERROR or f.rule not in BLOCKS_BALANCE:
+        return False
+    return not (f.rule == "mass-nonpositive" and f.values.get("mass") == 0.0)
+
+
 DYNAMICS_SKIPPED = "dynamics checks skipped: fix the number and inertia errors first"
 
 

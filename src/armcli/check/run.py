@@ -28,7 +28,6 @@ from armcli.check import dynamics as dyn
 from armcli.check import zmp as zmp_rules
 from armcli.check.context import (
     BALANCE,
-    BLOCKS_BALANCE,
     BLOCKS_DYNAMICS,
     BLOCKS_MODEL,
     DYNAMICS,
@@ -38,6 +37,7 @@ from armcli.check.context import (
     URDF,
     Context,
     Stage,
+    blocks_balance,
     joint_rows,
     poses,
 )
@@ -155,7 +155,7 @@ def _ready(ctx: Context, needs: Stage) -> bool:
     if needs == MODEL:
         return ctx.robot is not None
     if needs == BALANCE:  # masses and centres of mass: an inertia tensor error moves neither
-        return ctx.robot is not None and not ctx.out.has_errors(BLOCKS_BALANCE)
+        return ctx.robot is not None and not any(blocks_balance(f) for f in ctx.out.findings)
     return ctx.stage == DYNAMICS
 
 

@@ -18,7 +18,7 @@ from armcli.check.context import Context, poses
 from armcli.check.findings import JointRow
 from armcli.check.options import CheckOptions
 from armcli.check.structure import finite
-from armcli.robot.load import link_frame
+from armcli.robot.frames import link_frame
 from armcli.robot.tool import tool_point
 from armcli.spec.joint_types import total_dof
 from armcli.urdf.doc import Urdf

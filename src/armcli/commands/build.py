@@ -10,7 +10,7 @@ import typer
 
 from armcli.commands.flags import flag_errors
 from armcli.commands.robot_input import robot_options
-from armcli.io.oneline import one_line
+from armcli.io.terminal import say_line
 
 if TYPE_CHECKING:
     from armcli.urdf.source import RobotInput
@@ -36,12 +36,12 @@ def build_cmd(
     spec = robot.file()
     if check:
         check_fresh(spec, out)
-        sys.stdout.write(one_line(f"{out}: up to date with {spec}") + "\n")
+        say_line(f"{out}: up to date with {spec}")
         return
     result = build(spec, out, force=force)
-    sys.stdout.write(one_line(f"built {len(result.files)} files from {spec} into {out}/") + "\n")
+    say_line(f"built {len(result.files)} files from {spec} into {out}/")
     for f in result.files:
-        sys.stdout.write(one_line(f"  {f}") + "\n")
+        say_line(f"  {f}")
     _report_check_errors(spec, result.spec)
 
 
@@ -56,7 +56,7 @@ def _report_check_errors(spec: Path, model: Any) -> None:
 
     for f in spec_document_errors(spec, spec_urdfs(model), model):
         where = str(f.spec) if f.spec is not None else f.file
-        sys.stderr.write(one_line(f"warning: {where}: {f.message} (check: {f.rule})") + "\n")
+        say_line(f"warning: {where}: {f.message} (check: {f.rule})", sys.stderr)
 
 
 def register(app: typer.Typer) -> None:

@@ -124,7 +124,9 @@ def check_cmd(
     code = run.exit_code(findings)
     _print(run, findings, fmt, code)
     if code == EXIT_UNUSABLE:
-        raise UnusableInputsError([u.error for u in run.unusable])
+        unusable = UnusableInputsError([u.error for u in run.unusable])
+        unusable.reported = True  # in the report just printed
+        raise unusable
     if code == EXIT_FAILED:
         n_err = counts(findings)["error"]
         raise FindingsError(
@@ -147,7 +149,7 @@ def _print(run: CheckRun, findings: list[Any], fmt: str, code: int) -> None:
     elif run.results:  # nothing usable: the stderr lines say it all
         console = terminal.console()
         for item in report.to_rich(run.results, findings, [u for u, _ in unusable]):
-            console.print(item, crop=False)
+            console.print(terminal.fitted(item), crop=False)
 
 
 def register(app: typer.Typer) -> None:

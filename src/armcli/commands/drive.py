@@ -14,7 +14,7 @@ from typing import Any
 
 from armcli.errors import ModelRefusedError
 from armcli.io import terminal
-from armcli.io.oneline import one_line
+from armcli.io.outdir import existing, wrote
 from armcli.io.together import write_files_together
 from armcli.sim.options import SimOptions
 
@@ -45,11 +45,12 @@ def run_drive(
         ) from None
     err = terminal.console(sys.stderr)
     for w in driven.warnings:
-        err.print(one_line(f"warning: {w}"), markup=False, highlight=False)
+        terminal.line(err, f"warning: {w}")
+    before = existing(output, plot)
     write_files_together(driven.files(output, plot))  # never a new CSV beside an old plot
     job, res, res_run, verdict = driven.job, driven.arm, driven.run, driven.verdict
     for note in verdict.notes():
-        err.print(one_line(f"warning: {note}"), markup=False, highlight=False)
+        terminal.line(err, f"warning: {note}")
     out = terminal.console()
     metrics = simreport.joint_metrics(res, job.arm.trajectory.duration)
     ee = simjob.tool_position(job.arm, res.q[-1])
@@ -58,15 +59,11 @@ def run_drive(
     o = res_run.odometry
     L = job.model.layout
     end = res_run.sensors[-1, L.base_pos]
-    out.print(
-        f"base: odometry ({o.x[-1]:.3f}, {o.y[-1]:.3f}) m, yaw {o.yaw[-1]:.3f} rad; "
-        f"ground truth ({end[0]:.3f}, {end[1]:.3f}) m",
-        markup=False,
-        highlight=False,
-    )
-    out.print(verdict.line(), style="red" if verdict.tips else None, markup=False, highlight=False)
+    terminal.line(out, f"base: odometry ({o.x[-1]:.3f}, {o.y[-1]:.3f}) m, yaw {o.yaw[-1]:.3f} "
+                       f"rad; ground truth ({end[0]:.3f}, {end[1]:.3f}) m")  # fmt: skip
+    terminal.line(out, verdict.line(), "red" if verdict.tips else None)
     for path in (output, plot):
         if path is not None:
-            out.print(f"wrote {path}", markup=False, highlight=False)
+            terminal.line(out, wrote(path, path in before))
     if verdict.tips:
         raise verdict.error()

@@ -10,8 +10,8 @@ import typer
 
 from armcli.commands.robot_input import robot_options, write_notes
 from armcli.io.files import write_file_atomic
-from armcli.io.oneline import one_line
-from armcli.io.outdir import check_output_file
+from armcli.io.outdir import check_output_file, existing, wrote
+from armcli.io.terminal import say_line
 from armcli.io.workflow import no_workflow_commands
 
 if TYPE_CHECKING:
@@ -34,6 +34,7 @@ def expand_cmd(
     path = robot.file()
     if out is not None:
         check_output_file(out, "--out", [path])  # before any work; never over the input
+    before = existing(out)
     xml, used = expand_xacro(path, trust_xacro=robot.trust, inputs=robot.xacro)
     xml = no_workflow_commands(xml)  # no line of it a CI log reads as a command (issue 42)
     write_notes(used.notes())
@@ -42,7 +43,7 @@ def expand_cmd(
         sys.stdout.flush()
         return
     write_file_atomic(out, xml)
-    sys.stderr.write(one_line(f"wrote {out}") + "\n")
+    say_line(wrote(out, out in before), sys.stderr)
 
 
 def register(app: typer.Typer) -> None:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -11,7 +10,8 @@ import typer
 from armcli.commands.options import choice
 from armcli.commands.robot_input import robot_options, write_notes
 from armcli.defaults import MJCF_BASES
-from armcli.io.outdir import check_output_file
+from armcli.io.outdir import check_output_file, existing
+from armcli.io.terminal import say, say_line
 
 if TYPE_CHECKING:
     from armcli.urdf.source import RobotInput
@@ -49,7 +49,9 @@ def mjcf_cmd(
     """
     from armcli.compiler.expand import spec_label  # on use: `--help` stays light
     from armcli.export.mjcf_files import export_mjcf
+    from armcli.export.mjcf_scene import SCENE
 
+    before = existing(out, out.parent / SCENE)
     path = robot.file()
     check_output_file(out, "--out", [path], parents=True)  # before any work; never over it
     res = export_mjcf(
@@ -64,26 +66,27 @@ def mjcf_cmd(
     )
     write_notes(res.notes)
     exp = res.export
-    w = sys.stdout.write
-    w(f"{wrote_line(out, len(res.export.meshes))} from {res.robot}\n")
-    w(
-        f"{len(exp.joints)} joints, {len(exp.actuators)} actuators, "
-        f"keyframes: {', '.join(exp.keyframes)}\n"
-    )
-    w(res.report)
-    w(f"{res.verdict.text}\n")
+    say_line(f"{wrote_line(out, len(res.export.meshes), bool(before))} from {res.robot}")
+    say(f"{len(exp.joints)} joints, {len(exp.actuators)} actuators, "
+        f"keyframes: {', '.join(exp.keyframes)}")  # fmt: skip
+    say(res.report)
+    say(res.verdict.text)
 
 
-def wrote_line(out: Path, meshes: int) -> str:
-    """Which files the export wrote, by name: the model, its scene, and the mesh count."""
+def wrote_line(out: Path, meshes: int, replaced: bool = False) -> str:
+    """Which files the export wrote, by name: the model, its scene, and the mesh count.
+
+    `replaced`: the model or the scene was there before (io.outdir.wrote's rule).
+    """
     from armcli.export.mjcf_meshes import MESH_DIR
     from armcli.export.mjcf_scene import SCENE
 
     scene = out.parent / SCENE
+    verb = "replaced" if replaced else "wrote"
     if not meshes:
-        return f"wrote {out} and {scene}"
+        return f"{verb} {out} and {scene}"
     noun = "mesh" if meshes == 1 else "meshes"
-    return f"wrote {out}, {scene} and {meshes} {noun} in {out.parent / MESH_DIR}/"
+    return f"{verb} {out}, {scene} and {meshes} {noun} in {out.parent / MESH_DIR}/"
 
 
 def register(app: typer.Typer) -> None:

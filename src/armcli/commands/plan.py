@@ -14,8 +14,8 @@ from armcli.commands.options import choice, option, seed_option
 from armcli.commands.robot_input import robot_options
 from armcli.commands.values import Names, Numbers, names, numbers, point
 from armcli.defaults import MAX_PLAN_TIMEOUT_S, PLANNERS
-from armcli.errors import PlanningError
-from armcli.io.terminal import say
+from armcli.io.outdir import existing, wrote
+from armcli.io.terminal import say, say_line
 
 if TYPE_CHECKING:
     from armcli.plan.api import PlanResult
@@ -99,13 +99,10 @@ def plan_cmd(
     what = request.describe()
     opts = PlanOptions(planner=planner, timeout=timeout, seed=seed,
                        comment=f"armcli plan {what}, {planner}, seed {seed}")  # fmt: skip
-    try:
-        result = plan_request(robot_file, replace(request, options=opts), robot.packages)
-    except PlanningError as exc:
-        if fmt == "json":
-            _json({"status": "failed", "output": None, "reason": exc.reason})
-            raise typer.Exit(1) from None
-        raise
+    for line in request.warnings():
+        say_line(f"warning: {line}", sys.stderr)
+    result = plan_request(robot_file, replace(request, options=opts), robot.packages)
+    before = existing(output)
     if output is not None:
         from armcli.io.files import write_file_atomic
 
@@ -116,7 +113,8 @@ def plan_cmd(
     if fmt == "json":
         _json(_summary(result, output, planner, seed, done))
     else:
-        _print(result, output, what, planner, seed, done)
+        _print(result, wrote(output, output in before) if output else None, what, planner,
+               seed, done)  # fmt: skip
     if done is not None and done.broken:
         raise typer.Exit(1)
 
@@ -148,6 +146,7 @@ def _summary(
         "planner": planner,
         "seed": seed,
         "output": str(output) if output is not None else None,
+        "notes": list(r.notes),
     }
     if done is not None:
         doc["execute"] = {
@@ -168,8 +167,9 @@ def _json(doc: dict[str, Any]) -> None:
 
 
 def _print(
-    r: PlanResult, output: Path | None, what: str, planner: str, seed: int, done: Execution | None
+    r: PlanResult, written: str | None, what: str, planner: str, seed: int, done: Execution | None
 ) -> None:
+    """The summary; `written`: io.outdir.wrote's line, None when there was no -o."""
     lines = [
         f"planned {what} ({planner}, seed {seed})",
         f"  joints: {', '.join(r.joints)}",
@@ -186,8 +186,8 @@ def _print(
         if done.tip_margin is not None:
             lines.append(f"    tip-over margin {done.tip_margin * 1e3:.1f} mm")
         lines += [f"    broken: {p}" for p in done.problems]
-    if output is not None:
-        lines.append(f"wrote {output}")
+    lines += [f"  note: {n}" for n in r.notes]
+    lines.append(written or "not written: no -o FILE given (the trajectory is only checked)")
     say("\n".join(lines))  # one line each in a log; wrapped at a terminal
 
 

@@ -13,9 +13,8 @@ from armcli.commands.flags import flag_errors
 from armcli.commands.robot_input import robot_options, write_notes
 from armcli.commands.values import REACH_POINT_HELP, Numbers, point, size
 from armcli.errors import InputError
-from armcli.io.oneline import one_line
-from armcli.io.outdir import check_output_file
-from armcli.io.terminal import say
+from armcli.io.outdir import check_output_file, existing, wrote
+from armcli.io.terminal import say, say_line
 
 if TYPE_CHECKING:
     from armcli.urdf.source import RobotInput
@@ -57,10 +56,11 @@ def render_cmd(
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
     from armcli.analysis.workspace import describe, verdict  # on use: `--help` stays light
-    from armcli.view.png import MESH_HINT, load_urdf, render_png
+    from armcli.view.png import MESH_HINT, load_urdf, render_png, snapped
     from armcli.view.scene import load_robot, pose_q
 
     check_output_file(out, "--out", robot.files())  # before any work; never over the robot
+    before = existing(out)
     src = load_robot(robot)
     write_notes(src.notes)
     values = pose_q(src, pose, q)
@@ -68,6 +68,9 @@ def render_cmd(
     skipped: dict[str, str] = {}
     said: dict[str, str] = {}  # what trimesh said about a mesh it drew (a missing texture)
     urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search, skipped, said)
+    values, notes = snapped(urdf, values)
+    for note in notes:
+        say_line(f"note: {note}", sys.stderr)
     field = "--pose" if pose else "--q"
     lines: list[str] = []
     if reach or reach_point:
@@ -90,15 +93,14 @@ def render_cmd(
     )
     for uri, why in skipped.items():  # drawn without them: a picture of the rest beats none
         hint = f" ({MESH_HINT})" if why == "not found" else ""
-        sys.stderr.write(
-            one_line(f"warning: {src.source}: mesh {uri!r} {why}, not drawn{hint}") + "\n"
-        )
+        say_line(f"warning: {src.source}: mesh {uri!r} {why}, not drawn{hint}", sys.stderr)
     for uri, what in said.items():
-        sys.stderr.write(
-            one_line(f"warning: {src.source}: mesh {uri!r}: {what}; drawn without it") + "\n"
-        )
+        say_line(f"warning: {src.source}: mesh {uri!r}: {what}; drawn without it", sys.stderr)
     drawn = _drawn(src.poses, pose, q)
-    say(f"wrote {res.path} ({res.width}x{res.height} px) at {drawn};{tip}")
+    say_line(
+        f"{wrote(res.path, Path(res.path) in before)} ({res.width}x{res.height} px) at "
+        f"{drawn};{tip}"
+    )
     for line in lines:
         say(line)
 

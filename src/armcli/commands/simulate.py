@@ -15,8 +15,7 @@ from armcli.commands.robot_input import robot_options, write_notes
 from armcli.commands.values import Names, Numbers, names, numbers
 from armcli.errors import InputError, ModelRefusedError, UnstableLoopError
 from armcli.io import terminal
-from armcli.io.oneline import one_line
-from armcli.io.outdir import check_output_file, check_png_file
+from armcli.io.outdir import check_output_file, check_png_file, existing, wrote
 from armcli.io.together import write_files_together
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 
@@ -116,6 +115,10 @@ def simulate_cmd(
     unknown = unknown_rules(ignore)
     if unknown:
         raise InputError(f"unknown rule(s) {', '.join(unknown)}", field="--ignore")
+    if trajectory is None and message is None and cmd_vel is None:
+        raise InputError("nothing to simulate: give the arm a trajectory (--trajectory FILE or "
+                         "--message YAML), or drive the robot's base (--cmd-vel FILE)",
+                         field="--trajectory")  # fmt: skip
     read = [*robot.paths] or ([robot.file()] if urdf is None else [])  # the spec
     read += [p for p in (urdf, trajectory, cmd_vel, world) if p is not None]
     if output is not None:
@@ -232,7 +235,8 @@ def _report(run: ArmRun, output: Path | None, plot: Path | None, asked: bool) ->
     job, res, balance = run.job, run.result, run.balance
     write_notes([*run.notes, *(run.balance_notes if asked else ())])
     for w in run.warnings:
-        err.print(one_line(f"warning: {_flagged(w)}"), markup=False, highlight=False)
+        terminal.line(err, f"warning: {_flagged(w)}")
+    before = existing(output, plot)
     write_files_together(run.files(output, plot))  # never a new CSV beside an old plot
     metrics = simreport.joint_metrics(res, job.trajectory.duration)
     ee = simjob.tool_position(job, res.q[-1])
@@ -240,12 +244,12 @@ def _report(run: ArmRun, output: Path | None, plot: Path | None, asked: bool) ->
     out.print(simreport.summary_table(metrics, ee, job.tool_label, res), crop=False)
     if balance is not None:
         for lift in balance.lifts:  # too short to tip the robot: a wheel unloads, a warning
-            err.print(one_line(f"warning: {lift.line()}"), markup=False, highlight=False)
+            terminal.line(err, f"warning: {lift.line()}")
         line = tipping.summary_line(balance)
-        out.print(line, style="red" if balance.tips else None, markup=False, highlight=False)
+        terminal.line(out, line, "red" if balance.tips else None)
     for path in (output, plot):
         if path is not None:
-            out.print(one_line(f"wrote {path}"), markup=False, highlight=False)
+            terminal.line(out, wrote(path, path in before))
     if balance is not None and balance.tips:
         raise tipping.tip_error(balance)
 

@@ -13,8 +13,8 @@ from armcli.commands.options import choice
 from armcli.commands.robot_input import robot_options, write_notes
 from armcli.io import terminal
 from armcli.io.files import write_file_atomic
-from armcli.io.oneline import one_line
-from armcli.io.outdir import check_output_file
+from armcli.io.outdir import check_output_file, existing, wrote
+from armcli.io.terminal import say_line
 
 if TYPE_CHECKING:
     from armcli.urdf.source import RobotInput
@@ -36,6 +36,7 @@ def tree_cmd(
 
     if out is not None:
         check_output_file(out, "--out", robot.files())  # never over the robot file
+    before = existing(out)
     src = load_robot(robot)
     write_notes(src.notes)
     tree = parse_tree(src.xml, src.source)
@@ -52,7 +53,7 @@ def tree_cmd(
         sys.stdout.write(text)
     else:
         write_file_atomic(out, text.encode("utf-8"))
-        sys.stdout.write(one_line(f"wrote {out}") + "\n")
+        say_line(wrote(out, out in before))
 
 
 def register(app: typer.Typer) -> None:

@@ -15,7 +15,6 @@ from armcli.commands.values import Names, Numbers, names, numbers
 from armcli.defaults import PD_LOOPS, ROBUST_MODES
 from armcli.errors import InputError
 from armcli.io import terminal
-from armcli.io.oneline import one_line
 from armcli.io.outdir import check_output_file, check_png_file
 
 if TYPE_CHECKING:  # the tuner is imported when the command runs: `--help` stays light
@@ -157,6 +156,7 @@ def _run(
     from rich.console import Console
     from rich.progress import Progress
 
+    from armcli.io.outdir import existing, wrote
     from armcli.io.together import write_files_together
     from armcli.tune import gains as gain_vector
     from armcli.tune import report, session
@@ -186,10 +186,11 @@ def _run(
     if write:
         best = gain_vector.by_joint(outcome.result.best, job.problem.joints)
         files[spec_path] = edited_spec(spec_path, best)
+    before = existing(*files)
     write_files_together(files)
     for path in (output, plot, spec_path if write else None):
         if path is not None:
-            out.print(one_line(f"wrote {path}"), markup=False, highlight=False)
+            terminal.line(out, wrote(path, path in before))
 
 
 def _summary(out: Any, outcome: session.Outcome) -> None:
@@ -202,10 +203,10 @@ def _summary(out: Any, outcome: session.Outcome) -> None:
             a, b = session.mean_rms(row), session.mean_rms(tuned)
             parts.append(f"{row.label} {a:.4g} -> tuned {b:.4g} rad ({100 * (b - a) / a:+.1f} %)")
     if parts:
-        out.print("mean RMS error: " + "; ".join(parts), markup=False, highlight=False)
+        terminal.line(out, "mean RMS error: " + "; ".join(parts))
     if tuned.robust_cost is not None:
         costs = ", ".join(f"{r.label} {r.robust_cost:.4g}" for r in outcome.rows)
-        out.print(f"robust cost over the perturbed models: {costs}", markup=False, highlight=False)
+        terminal.line(out, f"robust cost over the perturbed models: {costs}")
 
 
 def register(app: typer.Typer) -> None:

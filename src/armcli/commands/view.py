@@ -13,6 +13,7 @@ from armcli.commands.robot_input import robot_options, write_notes
 from armcli.commands.values import Names, names
 from armcli.errors import InputError
 from armcli.io.oneline import one_line
+from armcli.io.terminal import say_line
 
 if TYPE_CHECKING:
     from armcli.urdf.source import RobotInput
@@ -141,7 +142,7 @@ def _session(
     except InputError as exc:
         if any(given is not None for given in planning):  # asked for planning: refuse
             raise
-        sys.stderr.write(f"note: no planning panel: {exc}\n")
+        say_line(f"note: no planning panel: {exc}", sys.stderr)
         return None
     return session
 

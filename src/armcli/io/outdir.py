@@ -142,6 +142,21 @@ def check_output_file(
         )
 
 
+def wrote(path: str | Path, existed: bool) -> str:
+    """`wrote PATH`, or `replaced PATH` when a file was there before the command ran.
+
+    The rule for every single output file (render's robot.png, export's robot.xml, -o,
+    --plot): an existing file is replaced, as the user named it (or took the default), but
+    never without a word. `existed`: `os.path.exists` before the write.
+    """
+    return f"{'replaced' if existed else 'wrote'} {path}"
+
+
+def existing(*paths: str | Path | None) -> set[Path]:
+    """Which of the (output) paths exist now: asked before writing, for `wrote`."""
+    return {Path(p) for p in paths if p is not None and os.path.exists(p)}
+
+
 def check_png_file(path: str | Path, field: str, inputs: Sequence[str | Path] = ()) -> None:
     """Refuse a plot path that does not end in .png (the plots are PNG; x.jpg would lie)."""
     p = Path(path)

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from typing import IO, Any
 
 from armcli.io.oneline import one_line
+from armcli.io.wrap import CONTINUATION, Paragraphs, spans
 
 UNBOUNDED = 1_000_000  # [columns] "no limit": a file or pipe gets each line whole
 NAME_MIN = 12  # [columns] a wrapped text column keeps at least this many
@@ -319,25 +320,41 @@ def _rstrip(line: list[Any]) -> list[Any]:
     return line
 
 
+def line(out: Any, text: str, style: str | None = None) -> None:
+    """Print one line of text on the rich console `out` (`console()`): escaped, fitted."""
+    from rich.text import Text
+
+    out.print(Paragraphs(Text(one_line(text), style=style or "")), crop=False)
+
+
+def fitted(item: Any) -> Any:
+    """A renderable as the terminal writer lays it out: text through `Paragraphs`."""
+    from rich.text import Text
+
+    return Paragraphs(item) if isinstance(item, str | Text) else item
+
+
 def fit_line(text: str, stream: IO[str] | None = None) -> str:
     """One plain line for `stream`, wrapped between words at a terminal (or `COLUMNS`).
 
-    Continuation lines are indented two spaces; a word longer than the width (a path) is
-    never cut, so it stays whole on a line of its own. Into a file or pipe the line is
-    whole. Error lines are not for this: they stay one line (`file:line field: problem`).
+    Continuation lines are indented CONTINUATION more than the line itself; a word longer
+    than the width (a path) is never cut, so it stays whole on a line of its own. Into a
+    file or pipe the line is whole, so grep sees every `file:line field: problem` whole.
     """
-    import textwrap
-
     width = layout_width(stream)
     if width is None or len(text) <= width:
         return text
-    return textwrap.fill(
-        text,
-        width,
-        subsequent_indent="  ",
-        break_long_words=False,
-        break_on_hyphens=False,
-    )
+    indent = len(text) - len(text.lstrip(" "))
+    cont = " " * (indent + CONTINUATION)
+    parts = spans(text[indent:], width - indent, width - len(cont))
+    lines = [text[indent:][a:b] for a, b in parts]
+    return "\n".join([text[:indent] + lines[0], *(cont + line for line in lines[1:])])
+
+
+def say_line(text: str, stream: IO[str] | None = None) -> None:
+    """Write one line (its newlines escaped, as any in a file name) to `stream`, fitted."""
+    stream = sys.stdout if stream is None else stream
+    stream.write(fit_line(one_line(text), stream) + "\n")
 
 
 def say(text: str, stream: IO[str] | None = None) -> None:

@@ -63,6 +63,7 @@ class PlanResult:
     path_time_s: float  # planning + shortcutting (the geometric path alone)
     certify_time_s: float
     margin: float  # the limit scale TOPP-RA used
+    notes: tuple[str, ...] = ()  # what the request's reading decided (plan.request)
 
     @property
     def duration_s(self) -> float:

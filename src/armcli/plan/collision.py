@@ -18,7 +18,7 @@ import numpy as np
 
 from armcli.io.scene import Scene, Shape
 from armcli.plan.robot import PlanRobot
-from armcli.robot.load import link_frame
+from armcli.robot.frames import frame_id
 
 GROUND_ID = "ground"  # the name the ground plane has in collision reports
 PADDING = 0.005  # [m] clearance the planner keeps (CollisionChecker.pad)
@@ -215,5 +215,4 @@ def _key(a: str, b: str) -> tuple[str, str]:
 
 def _frame(model: Any, name: str) -> int:
     """The frame an object's `frame_id` names: the link first (a joint may share its name)."""
-    found = link_frame(model, name)
-    return found if found is not None else int(model.getFrameId(name))
+    return frame_id(model, name)

@@ -17,6 +17,7 @@ from armcli.io.scene import Scene, load_scene
 from armcli.plan.api import PlanningContext, planning_context, values
 from armcli.plan.robot import default_joints, load_plan_robot
 from armcli.plan.srdf import Srdf, allowed_pairs, read_srdf
+from armcli.robot.jointvalues import parse_joint_values, snap_to_limits
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import RobotFile, lookup_for
 
@@ -77,20 +78,34 @@ def _group_joints(
     return chosen
 
 
-def configuration(ctx: PlanningContext, text: str, field: str) -> np.ndarray:
-    """A named pose or comma-separated joint values [rad or m] in the planned joints' order."""
+def configuration(
+    ctx: PlanningContext, text: str, field: str, notes: list[str] | None = None
+) -> np.ndarray:
+    """A named pose or joint values in the planned joints' order (robot.jointvalues' rule).
+
+    `q1,q2` or `joint=q,...` [rad or m], numbers or expressions of pi (`pi/2`); a joint a
+    named form leaves out stays at rest. A value within jointvalues.SNAP beyond a limit is
+    that limit; `notes` gets a line saying so.
+    """
     text = text.strip()
     robot = ctx.robot
     if text in robot.poses:
         return robot.pose(text)
-    parts = [p.strip() for p in text.split(",")]
     try:
-        numbers = [float(p) for p in parts]
-    except ValueError:
+        given = parse_joint_values(text, robot.joints, field)
+    except InputError as exc:
         valid = ", ".join(sorted(robot.poses)) or "none"
+        if "," in text or "=" in text or len(robot.joints) == 1:
+            raise InputError(f"{exc.message}; or a named pose: {valid}", field=field) from None
         raise InputError(
             f"unknown pose {text!r}; valid poses: {valid}, or {len(robot.joints)} "
-            f"comma-separated values for {', '.join(robot.joints)}",
+            f"comma-separated values for {', '.join(robot.joints)} (numbers or pi/2-style)",
             field=field,
         ) from None
-    return values(ctx, numbers, field)
+    full = {j: given.get(j, robot.rest_of(j)) for j in robot.joints}
+    limits = {j: (float(lo), float(hi)) for j, lo, hi in zip(robot.joints, robot.lower,
+                                                            robot.upper, strict=True)}  # fmt: skip
+    snapped, moved = snap_to_limits(full, limits)
+    if notes is not None:
+        notes.extend(f"{field}: {line}" for line in moved)
+    return values(ctx, [snapped[j] for j in robot.joints], field)

@@ -9,12 +9,16 @@ maps them to flags.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import math
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+import numpy as np
+
 from armcli.defaults import MAX_PLAN_TIMEOUT_S
-from armcli.errors import InputError
-from armcli.plan.api import PlanOptions, PlanResult, plan_motion, solve_goal
+from armcli.errors import InputError, PlanningError
+from armcli.plan.api import PlanningContext, PlanOptions, PlanResult, plan_motion, solve_goal
+from armcli.plan.diagnose import connectivity, reached_in_collision
 from armcli.plan.inputs import configuration, load_context
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import RobotFile
@@ -47,6 +51,16 @@ class PlanRequest:
             raise InputError(f"must be in (0, {MAX_PLAN_TIMEOUT_S:g}] s, got {timeout:g}",
                              field="timeout")  # fmt: skip
 
+    def warnings(self) -> list[str]:
+        """What looks wrong in the request but is not refused: `to_rpy` given in degrees."""
+        rpy = self.to_rpy
+        if rpy is None or not any(abs(a) > 2 * math.pi for a in rpy):
+            return []
+        rad = ",".join(f"{math.radians(a):.4g}" for a in rpy)
+        given = ",".join(f"{a:g}" for a in rpy)
+        return [f"roll, pitch, yaw {given} look like degrees (an angle beyond 2 pi): they are "
+                f"radians; {given} degrees are {rad} rad"]  # fmt: skip
+
     def describe(self) -> str:
         """`from home to reach`, `from home to xyz 0.2,0,0.15`: the request in words."""
         goal = self.goal
@@ -67,11 +81,41 @@ def plan_request(
     ctx = loaded.context
     if request.start is None and HOME not in ctx.robot.poses:
         raise InputError(f"this robot has no `{HOME}` pose: give `start`", field="start")
-    x_start = configuration(ctx, request.start or HOME, "start")
+    notes: list[str] = []
+    x_start = configuration(ctx, request.start or HOME, "start", notes)
     if request.goal is not None:
-        x_goal = configuration(ctx, request.goal, "goal")
+        x_goal = configuration(ctx, request.goal, "goal", notes)
     else:
         assert request.to_xyz is not None  # __post_init__: exactly one goal
-        x_goal = solve_goal(ctx, request.to_xyz, request.to_rpy, start=x_start,
-                            seed=request.options.seed)  # fmt: skip
-    return plan_motion(ctx, x_start, x_goal, request.options)
+        x_goal = _ik_goal(ctx, request, x_start)
+    try:
+        result = plan_motion(ctx, x_start, x_goal, request.options)
+    except PlanningError as exc:
+        if exc.kind != "no-path":
+            raise
+        pr, opts = ctx.robot, request.options
+        found = connectivity(ctx.checker, pr.lower, pr.upper, x_start, x_goal,
+                             step=opts.step, seed=opts.seed)  # fmt: skip
+        raise PlanningError("no-path", found.explain(opts.timeout)) from None
+    return replace(result, notes=(*result.notes, *notes))
+
+
+def _ik_goal(ctx: PlanningContext, request: PlanRequest, x_start: np.ndarray) -> np.ndarray:
+    """The IK goal; a point the tool reaches only in collision names what collides."""
+    assert request.to_xyz is not None
+    try:
+        return solve_goal(ctx, request.to_xyz, request.to_rpy, start=x_start,
+                          seed=request.options.seed)  # fmt: skip
+    except PlanningError as exc:
+        if exc.kind != "ik":
+            raise
+        pair = reached_in_collision(ctx, request.to_xyz, request.to_rpy, x_start,
+                                    request.options.seed)  # fmt: skip
+        if pair is None:
+            raise
+        raise PlanningError(
+            "goal-collision",
+            f"the tool point reaches {','.join(f'{v:g}' for v in request.to_xyz)} only in "
+            f"collision: {pair[0]} and {pair[1]} (every IK solution found collides)",
+            pair=pair,
+        ) from None

@@ -20,7 +20,8 @@ import numpy as np
 
 from armcli.defaults import DEFAULT_JOINT_ACCELERATION
 from armcli.errors import InputError
-from armcli.robot.load import checked_model, link_frame
+from armcli.robot.frames import link_frame
+from armcli.robot.load import checked_model
 from armcli.robot.mimic import Mimic, follow, mimics
 from armcli.robot.model import JointMap, Robot
 from armcli.robot.tool import tool_point

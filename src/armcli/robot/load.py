@@ -144,16 +144,3 @@ def checked_model(urdf: Urdf, *, gate: Callable[[Urdf], None] | None = None) -> 
     if said:
         raise InputError(f"the URDF parser reported: {said[0]}", file=urdf.source)
     return loaded
-
-
-def link_frame(model: Any, name: str) -> int | None:
-    """The Pinocchio frame id of the link `name`, None if there is no such link.
-
-    URDF names links and joints separately (ANYmal C has a link and a joint both called
-    LF_HFE), so a lookup by name alone is ambiguous: a link is the BODY frame.
-    """
-    import pinocchio as pin
-
-    if not model.existFrame(name, pin.BODY):
-        return None
-    return int(model.getFrameId(name, pin.BODY))

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from armcli.errors import InputError
+from armcli.robot.frames import reduced_model
 from armcli.robot.load import collision_model, load_model
 from armcli.robot.mimic import Mimic, follow, mimics
 from armcli.robot.tool import ToolPoint, tool_point
@@ -297,7 +298,7 @@ class Robot:
         lock = [self.model.getJointId(nm) for nm in names if nm not in joints]
         if not lock:
             return self
-        model = pin.buildReducedModel(self.model, lock, pin.neutral(self.model))
+        model = reduced_model(self.model, lock, pin.neutral(self.model))  # names may clash
         return Robot(model, mimics=self.mimics, tool=self.tool, source=self.source, xml=self.xml,
                      urdf=self.urdf, parser_messages=self.parser_messages)  # fmt: skip
 

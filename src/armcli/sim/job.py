@@ -15,7 +15,8 @@ import numpy as np
 
 from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_URDF
 from armcli.errors import InputError
-from armcli.robot.load import checked_model, link_frame
+from armcli.robot.frames import link_frame
+from armcli.robot.load import checked_model
 from armcli.robot.mimic import Mimic, mimics
 from armcli.robot.tool import tool_point
 from armcli.sim.options import SimOptions

@@ -123,14 +123,14 @@ class _Collector:
         for key in data:
             if key not in allowed:
                 close = difflib.get_close_matches(str(key), sorted(allowed), n=1, cutoff=CUTOFF)
-                hint = f"did you mean {close[0]!r}?" if close else "expected one of"
+                hint = f"did you mean {close[0]!r}? " if close else ""
                 meant.update(close)
-                self.once((*path, key), f"unknown key; {hint} {_listed(allowed)}".rstrip())
+                self.once((*path, key), f"unknown key; {hint}{_listed(allowed)}")
         return meant
 
 
 def _listed(allowed: set[str]) -> str:
-    return f"(valid: {', '.join(sorted(allowed))})"
+    return f"valid: {', '.join(sorted(allowed))}"
 
 
 def parse_trajectory(

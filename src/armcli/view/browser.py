@@ -126,7 +126,9 @@ class Viewer:
             # the base's pose in the world (states' base.*, MCAP's world -> odom -> base)
             moving = replay is not None and replay.base is not None
             self._base = self.server.scene.add_frame("/base", show_axes=False) if moving else None
-            root = "/base" if moving else ""
+            # everything drawn in the robot's root frame hangs from it too: the frames, the
+            # tool dot, the planning panel's goal ghost, handle and trail (view.panel)
+            self.root = root = "/base" if moving else ""
             self._robot = ViserUrdf(self.server, self._urdf, root_node_name=f"{root}/robot")
             self._ghost = None
             if replay is not None and replay.reference:
@@ -260,13 +262,18 @@ class Viewer:
         self.server.initial_camera.position = tuple(centre + size * np.array([0.55, -0.75, 0.45]))
         self._frames = {
             link: scene.add_frame(
-                f"/frames/{link}", axes_length=FRAME_AXES, axes_radius=0.003, visible=False
+                f"{self.root}/frames/{link}",
+                axes_length=FRAME_AXES,
+                axes_radius=0.003,
+                visible=False,
             )
             for link in self._urdf.link_map
         }
         self._tool_marker = None
         if self._tool is not None:
-            self._tool_marker = scene.add_icosphere("/tool", radius=0.012, color=(20, 20, 20))
+            self._tool_marker = scene.add_icosphere(
+                f"{self.root}/tool", radius=0.012, color=(20, 20, 20)
+            )
 
     def _build_gui(self, name: str) -> None:
         gui = self.server.gui

@@ -61,13 +61,14 @@ class PlanningPanel:
         self._trail: list[Any] = []
         self._replayer: threading.Thread | None = None
         self._stop = threading.Event()
-        self._goal_ghost = self._ghost("/plan/goal", GOAL_RGBA)
+        self._node = f"{viewer.root}/plan"  # under the base during a drive's replay
+        self._goal_ghost = self._ghost(f"{self._node}/goal", GOAL_RGBA)
         self._path: Any = None
         self._build_gui()
         self._build_handle()
         self._frame_camera()
         for k, ob in enumerate(session.obstacles()):
-            viewer.server.scene.add_mesh_simple(f"/plan/scene/{k}", ob.vertices, ob.faces,
+            viewer.server.scene.add_mesh_simple(f"{self._node}/scene/{k}", ob.vertices, ob.faces,
                                                 color=OBSTACLE_RGB, opacity=0.6)  # fmt: skip
         self._show_goal()
 
@@ -208,7 +209,7 @@ class PlanningPanel:
     def _build_handle(self) -> None:
         few = len(self.session.joints) < 6  # position goals only: no rotation rings
         self._handle: Any = self.viewer.server.scene.add_transform_controls(
-            "/plan/target", scale=HANDLE_SCALE, disable_rotations=few, depth_test=False
+            f"{self._node}/target", scale=HANDLE_SCALE, disable_rotations=few, depth_test=False
         )
 
         def on_drag(_event: Any) -> None:
@@ -306,12 +307,12 @@ class PlanningPanel:
     def _draw_trail(self) -> None:
         trail = self.session.trail()
         while len(self._trail) < len(trail.poses):
-            self._trail.append(self._ghost(f"/plan/trail/{len(self._trail)}", TRAIL_RGBA))
+            self._trail.append(self._ghost(f"{self._node}/trail/{len(self._trail)}", TRAIL_RGBA))
         for ghost, x in zip(self._trail, trail.poses, strict=False):
             ghost.update_cfg(self._cfg(x))
             ghost.show_visual = True
         self._path = self.viewer.server.scene.add_spline_catmull_rom(
-            "/plan/path", trail.tool_path, color=PATH_RGB, thickness=PATH_THICKNESS
+            f"{self._node}/path", trail.tool_path, color=PATH_RGB, thickness=PATH_THICKNESS
         )
 
     def _hide_trail(self) -> None:

@@ -28,6 +28,7 @@ from armcli.plan.api import PlanningContext, PlanOptions, PlanResult, plan_motio
 from armcli.plan.execute import Execution, execute
 from armcli.plan.ik import solve_ik, tool_pose
 from armcli.plan.inputs import load_context
+from armcli.robot.frames import frame_id
 from armcli.sim.options import SimOptions
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import RobotFile
@@ -289,7 +290,7 @@ class PlanningSession:
         for obj in self.scene.objects:
             T = np.eye(4)
             if obj.frame:
-                T = np.asarray(self._data.oMf[robot.model.getFrameId(obj.frame)].homogeneous)
+                T = np.asarray(self._data.oMf[frame_id(robot.model, obj.frame)].homogeneous)
             for shape in obj.shapes:
                 v, f = _triangles(shape)
                 M = T @ shape.T_frame_shape

@@ -21,6 +21,7 @@ import numpy as np
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
 from armcli.io.mesh_confine import bounded_mesh_file, check_total
+from armcli.robot.jointvalues import snap_to_limits
 from armcli.robot.tool import ToolPoint
 from armcli.spec.joint_types import position_bounds
 from armcli.urdf.meshes import MeshSearch, confined, resolve
@@ -170,6 +171,12 @@ def joint_limits(urdf: Any) -> dict[str, tuple[float, float] | None]:
     for name, joint in zip(urdf.actuated_joint_names, urdf.actuated_joints, strict=True):
         out[name] = position_bounds(joint.type, joint.limit)
     return out
+
+
+def snapped(urdf: Any, q: Mapping[str, float]) -> tuple[dict[str, float], list[str]]:
+    """`q` with values a hair beyond a limit set onto it (robot.jointvalues.SNAP), and notes."""
+    limits = {name: lim for name, lim in joint_limits(urdf).items() if lim is not None}
+    return snap_to_limits(q, limits)
 
 
 def full_configuration(

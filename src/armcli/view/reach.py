@@ -30,7 +30,7 @@ from armcli.analysis.workspace import (
 )
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
-from armcli.robot.load import link_frame
+from armcli.robot.frames import link_frame
 from armcli.robot.model import Robot
 from armcli.robot.tool import ToolPoint
 from armcli.view.png import DEFAULT_SIZE, DPI, RenderResult, full_configuration, render_figure

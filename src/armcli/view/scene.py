@@ -12,8 +12,8 @@ from pathlib import Path
 
 from armcli.errors import InputError
 from armcli.io.names import did_you_mean
+from armcli.robot.jointvalues import parse_joint_values
 from armcli.robot.tool import ToolPoint, tool_point
-from armcli.spec.expr import eval_expr
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import RobotFile, RobotInput, lookup_for, urdf_text
 from armcli.urdf.tree import tree_from_urdf
@@ -76,23 +76,11 @@ def load_robot(given: RobotInput | Path) -> RobotSource:
 
 
 def parse_q(text: str, robot: RobotSource) -> dict[str, float]:
-    """`0.3,pi/4` (in robot.joints order) or `joint=0.3,other=pi/4` -> {joint: value}."""
-    items = [s.strip() for s in text.split(",") if s.strip()]
-    out: dict[str, float] = {}
-    try:
-        if items and all("=" in s for s in items):
-            for s in items:
-                name, value = s.split("=", 1)
-                out[name.strip()] = float(eval_expr(value.strip()))
-            return out
-        if len(items) != len(robot.joints):
-            order = ", ".join(robot.joints) or "(none)"
-            raise InputError(f"expected {len(robot.joints)} values, for: {order}", field="q")
-        return {j: float(eval_expr(s)) for j, s in zip(robot.joints, items, strict=True)}
-    except InputError as exc:
-        raise InputError(exc.message, field="q") from None
-    except (ValueError, ArithmeticError) as exc:
-        raise InputError(f"{text!r}: {exc}", field="q") from None
+    """`0.3,pi/4` (in robot.joints order) or `joint=0.3,other=pi/4` -> {joint: value}.
+
+    The one rule for joint values (robot.jointvalues), as `plan --to` reads them.
+    """
+    return parse_joint_values(text, robot.joints, "q")
 
 
 def pose_q(robot: RobotSource, pose: str | None, q: str | None) -> dict[str, float]:
