@@ -190,6 +190,36 @@ def analyse(
     )
 
 
+class MarginAt:
+    """The static tip-over margin [m] as a function of some joints' values: built once per robot.
+
+    The signed distance of the centre of mass (payload included) to the support polygon's
+    boundary, as `analyse` reports it per pose, with `joints` at the values given and the
+    other searched joints at zero (clamped into range): what a base placement must keep
+    positive at every pose it judges.
+    """
+
+    def __init__(self, stance: Stance, joints: Sequence[str]) -> None:
+        """`joints`: the names the values of each call are given for, in order."""
+        self.ev = _Mass(stance)
+        self.m = stance.payload.mass if stance.payload is not None else 0.0
+        self.base = np.array(_values(stance, {}), dtype=float)
+        names = [j.name for j in stance.joints]
+        self.slots = [(k, names.index(n)) for k, n in enumerate(joints) if n in names]
+        box = stance.box
+        self.lower = np.array([lo for lo, _ in box])
+        self.upper = np.array([hi for _, hi in box])
+        self.polygon = stance.polygon
+
+    def __call__(self, values: ArrayLike) -> float:
+        """The margin [m] with the joints at `values` [rad or m]."""
+        x, given = self.base.copy(), np.asarray(values, dtype=float)
+        for k, i in self.slots:
+            x[i] = given[k]
+        c = self.ev.com(np.clip(x, self.lower, self.upper), self.m)
+        return self.polygon.margin(c)
+
+
 def _point_label(stance: Stance) -> str:
     p = stance.payload
     return "" if p is None else p.label.split(" at ", 1)[1]

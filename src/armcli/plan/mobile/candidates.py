@@ -1,0 +1,119 @@
+"""The base poses placement tries, cheapest driving first.
+
+An arm configuration q puts the tool at p(q) in the base frame. Standing the base so that
+p(q) lands on the target leaves one freedom, the yaw: the base at (T_xy - R(yaw) p_xy(q),
+yaw) for any yaw, the whole robot turned about the vertical through the target. So the
+candidates are (configuration, yaw) pairs: configurations whose tool height matches the
+target's, yaws every YAW_STEP. For a planar-reach arm the configurations come in closed
+form (`PlanarArm.at_height`: the tool exactly at the target's height, both branches);
+for another arm from a seeded sample of its joint box, nearest in height first, each then
+corrected at its base pose by inverse kinematics (`Judge.nearest`).
+
+Every candidate's driving cost (`plan.mobile.driving`) is computed at once; they are
+handed out in cost order, a chunk at a time (a partial sort: most placements stop early).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from armcli.plan.mobile.driving import driving_cost
+from armcli.plan.mobile.judge import Judge
+from armcli.robot import sampling
+
+# (planar arm: values of the first joint over its range, [rad] between candidate yaws): a
+# coarse pass first; the fine one only when the coarse finds no pose (a sliver of free floor)
+PASSES = ((46, math.radians(3.0)), (361, math.radians(0.5)))
+CHUNK = 256  # candidates sorted at a time
+ARC_SAMPLES = 181  # planar arm above or below its reach: samples per boundary arc
+ARM_DRAWS = 2048  # other arms: seeded configurations sampled
+ARM_KEPT = 48  # ... of which the nearest in height are candidates
+HEIGHT_FIRST = 1e3  # [m of driving per m of height miss]: the nearer height always wins
+
+
+@dataclass(frozen=True)
+class Family:
+    """Arm configurations (K, n), their tool points (K, 3) [m, base frame], height misses [m]."""
+
+    q: np.ndarray
+    p: np.ndarray
+    miss: np.ndarray  # [m] |tool z - target z| (0 for exact configurations)
+    exact: bool  # the configurations reach the target's height exactly (closed form)
+
+
+def planar_family(judge: Judge, samples: int) -> Family:
+    """Closed form: configurations at the target's height, else the nearest heights."""
+    arm = judge.mobile.planar
+    assert arm is not None
+    w = float(judge.target[2] - arm.shoulder[2])
+    q, _ = arm.at_height(w, samples)
+    if len(q):
+        return Family(q, arm.points(q), np.zeros(len(q)), True)
+    boundary = []  # above or below the reach: along the boundary arcs, nearest heights
+    for start, k, span in arm.arcs():
+        for t in np.linspace(0.0, span, ARC_SAMPLES):
+            x = start.copy()
+            x[k] += t
+            boundary.append(x)
+    q = np.array(boundary)
+    p = arm.points(q)
+    return Family(q, p, np.abs(p[:, 2] - judge.target[2]), True)
+
+
+def sampled_family(judge: Judge, seed: int) -> Family:
+    """Other arms: seeded configurations of the joint box, the nearest in height first."""
+    import pinocchio as pin
+
+    robot = judge.arm_robot
+    box = list(zip(robot.lower.tolist(), robot.upper.tolist(), strict=True))
+    rows = np.array(sampling.search_starts(box, ARM_DRAWS, seed=seed), dtype=float)
+    data = robot.model.createData()
+    p = np.empty((len(rows), 3))
+    for i, x in enumerate(rows):
+        pin.forwardKinematics(robot.model, data, robot.q(x))
+        p[i] = pin.updateFramePlacement(robot.model, data, robot.tool_frame).act(robot.tool_offset)
+    miss = np.abs(p[:, 2] - judge.target[2])
+    keep = np.argsort(miss, kind="stable")[:ARM_KEPT]
+    return Family(rows[keep], p[keep], miss[keep], False)
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One base pose to judge, with the configuration it was made for and its cost."""
+
+    base: tuple[float, float, float]
+    q: np.ndarray
+    miss: float  # [m] the configuration's height miss (exact: the tool error)
+    cost: float  # [m] wheel travel from the start
+
+
+def ordered(
+    family: Family, target: np.ndarray, start: ArrayLike, turn_radius: float, step: float
+) -> Iterator[Candidate]:
+    """Every (configuration, yaw every `step`) of the family as a base pose, cheapest first."""
+    yaw = np.arange(-math.pi, math.pi, step)
+    c, s = np.cos(yaw)[None, :], np.sin(yaw)[None, :]
+    px, py = family.p[:, 0:1], family.p[:, 1:2]
+    bx = target[0] - (c * px - s * py)
+    by = target[1] - (s * px + c * py)
+    yaws = np.broadcast_to(yaw[None, :], bx.shape)
+    drive = driving_cost(start, bx, by, yaws, turn_radius).ravel()
+    left = drive + HEIGHT_FIRST * np.repeat(family.miss, len(yaw))  # nearer heights first
+    n_yaw = len(yaw)
+    while True:
+        k = min(CHUNK, int(np.count_nonzero(np.isfinite(left))))
+        if k == 0:
+            return
+        idx = np.argpartition(left, k - 1)[:k] if k < len(left) else np.arange(len(left))
+        idx = idx[np.argsort(left[idx], kind="stable")]
+        idx = idx[np.isfinite(left[idx])]
+        left[idx] = np.inf
+        for flat in idx:
+            i, j = divmod(int(flat), n_yaw)
+            yield Candidate((float(bx.flat[flat]), float(by.flat[flat]), float(yaw[j])),
+                            family.q[i], float(family.miss[i]), float(drive[flat]))  # fmt: skip

@@ -1,0 +1,179 @@
+"""`armcli place`: where the base must stand for the tool to reach a point, least driving first.
+
+`place` judges candidate base poses (`plan.mobile.candidates`) in the order of the
+driving they cost from the start, and returns the first that serves the target
+(`plan.mobile.judge`: reachable within the tolerance, collision-free, stable), with the
+region around it (`plan.mobile.region`). A target nothing can serve raises
+PlacementError with the reason: above or below the tool's reach (the highest or lowest
+point it reaches), inside an object, or the object that blocks every pose.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections import Counter
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from armcli.errors import InputError, PlanningError
+from armcli.plan.mobile.candidates import (
+    PASSES,
+    Candidate,
+    Family,
+    ordered,
+    planar_family,
+    sampled_family,
+)
+from armcli.plan.mobile.driving import DEFAULT_TURN_RADIUS
+from armcli.plan.mobile.judge import Judge, Verdict
+from armcli.plan.mobile.objects import containing
+from armcli.plan.mobile.region import Region, region
+from armcli.plan.mobile.virtual import FLOOR, MobileRobot
+
+TOLERANCE = 0.01  # [m] the tool within this of the target counts as reaching it
+MAX_CHECKS = 20_000  # collision checks before a placement gives up (a sliver of free floor)
+
+
+class PlacementError(PlanningError):
+    """No base pose serves the target; `reason` says why in one line."""
+
+    def __init__(self, message: str, *, blocking: str | None = None) -> None:
+        super().__init__("place", message)
+        self.blocking = blocking
+
+
+@dataclass(frozen=True)
+class Placement:
+    """The chosen base pose, the arm there, and the region around it."""
+
+    verdict: Verdict  # base (x, y, yaw), q, tool error, tip margin
+    joints: tuple[str, ...]  # the arm's, in q's order
+    region: Region
+    cost: float  # [m] wheel travel from the start, rotate-drive-rotate
+    method: str  # "closed form" (planar-reach arm) or "sampled"
+    checks: int  # collision checks made
+    time_s: float  # [s] the placement's own time (the robot loaded before)
+
+
+def turn_radius(mobile: MobileRobot) -> float:
+    """[m] half the wheel separation (what a turn in place costs per radian of yaw)."""
+    spec = mobile.robot_file.spec
+    dd = spec.mobile_base.diff_drive if spec is not None and spec.mobile_base else None
+    return 0.5 * float(dd.wheel_separation) if dd is not None else DEFAULT_TURN_RADIUS
+
+
+def _values(name: str, given: Sequence[float], count: int) -> np.ndarray:
+    v = np.asarray(list(given), dtype=float)
+    if v.shape != (count,) or not np.all(np.isfinite(v)):
+        raise InputError(f"give {count} finite numbers", field=name)
+    return v
+
+
+def place(
+    mobile: MobileRobot,
+    target: Sequence[float],
+    start: Sequence[float] = (0.0, 0.0, 0.0),
+    *,
+    tolerance: float = TOLERANCE,
+    seed: int = 0,
+) -> Placement:
+    """The base pose of least driving from which the tool reaches `target`.
+
+    `target` (x, y, z) [m] and `start` (x, y, yaw) [m, m, rad] in the world frame.
+    PlacementError with the reason when no pose serves.
+    """
+    t0 = time.perf_counter()
+    goal, begin = _values("target", target, 3), _values("start", start, 3)
+    if not (math.isfinite(tolerance) and tolerance > 0):
+        raise InputError(f"must be a positive number of metres, got {tolerance!r}",
+                         field="tolerance")  # fmt: skip
+    inside = containing(mobile.scene, goal)
+    if inside is not None:
+        raise PlacementError(f"the target is inside {inside}: no pose of the tool can reach it",
+                             blocking=inside)  # fmt: skip
+    judge = Judge(mobile, goal, tolerance)
+    best, tally = None, Counter[str]()
+    for samples, step in PASSES:
+        if mobile.planar is not None:
+            family = planar_family(judge, samples)
+        else:
+            family = sampled_family(judge, seed)
+        _refuse_out_of_reach(mobile, judge, family)
+        best, tally = _search(judge, family, begin, turn_radius(mobile), step)
+        if best is not None or mobile.planar is None:
+            break
+    if best is None:
+        raise _blocked(mobile, tally)
+    verdict, cost = best
+    around = region(judge, verdict)
+    return Placement(verdict, mobile.arm, around, cost,
+                     "closed form" if mobile.planar is not None else "sampled", judge.checks,
+                     time.perf_counter() - t0)  # fmt: skip
+
+
+def _refuse_out_of_reach(mobile: MobileRobot, judge: Judge, family: Family) -> None:
+    """Above or below the tool's reach: the highest (lowest) point it reaches."""
+    if len(family.miss) and float(np.min(family.miss)) <= judge.tolerance:
+        return
+    z = family.p[:, 2]
+    high = float(judge.target[2]) > float(np.max(z))
+    if mobile.planar is not None:
+        lo, hi = mobile.planar.height_range()
+        top, bottom = mobile.planar.shoulder[2] + hi, mobile.planar.shoulder[2] + lo
+    else:
+        top, bottom = float(np.max(z)), float(np.min(z))
+    if high:
+        raise PlacementError(f"the target z = {judge.target[2]:.3f} m is above the tool's reach: "
+                             f"the highest point it reaches is z = {top:.3f} m")  # fmt: skip
+    raise PlacementError(f"the target z = {judge.target[2]:.3f} m is below the tool's reach: "
+                         f"the lowest point it reaches is z = {bottom:.3f} m")  # fmt: skip
+
+
+def _search(
+    judge: Judge, family: Family, start: np.ndarray, radius: float, step: float
+) -> tuple[tuple[Verdict, float] | None, Counter[str]]:
+    """The first serving candidate in cost order, and why the others did not serve."""
+    tally: Counter[str] = Counter()
+    for c in ordered(family, judge.target, start, radius, step):
+        if c.miss > judge.tolerance or judge.checks >= MAX_CHECKS:
+            break
+        v = _judge(judge, c, family.exact)
+        if v.ok:
+            return (v, c.cost), tally
+        tally[_blocker(judge.mobile, v)] += 1
+    return None, tally
+
+
+def _judge(judge: Judge, c: Candidate, exact: bool) -> Verdict:
+    if exact:
+        return judge.judge(c.base, c.q, c.miss)
+    return judge.at(c.base, c.q)  # corrected by inverse kinematics at that base pose
+
+
+def _blocker(mobile: MobileRobot, v: Verdict) -> str:
+    """What kept a pose from serving: an object's id, `self`, `tip` or `reach`."""
+    if v.why != "collision" or v.blocked is None:
+        return v.why
+    objects = {o.id for o in mobile.scene.objects} | {FLOOR}
+    hit = [name for name in v.blocked if name in objects]
+    return hit[0] if hit else "self"
+
+
+def _blocked(mobile: MobileRobot, tally: Counter[str]) -> PlacementError:
+    total = sum(tally.values())
+    if not total:
+        return PlacementError("no base pose brings the tool within reach of the target")
+    what, count = tally.most_common(1)[0]
+    share = f"{count} of the {total} poses tried"
+    if what == "tip":
+        return PlacementError(f"the robot would tip over at every pose that reaches ({share})")
+    if what == "self":
+        return PlacementError(f"the arm collides with the robot at every pose that reaches "
+                              f"({share})")  # fmt: skip
+    if what == "reach":
+        return PlacementError(f"the tool cannot come within reach of the target ({share})")
+    return PlacementError(f"{what} blocks every base pose that reaches the target ({share} "
+                          f"collide with it)", blocking=what)  # fmt: skip

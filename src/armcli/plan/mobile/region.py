@@ -1,0 +1,107 @@
+"""Around a placed pose: how far the base may stand off it and the target stay reachable.
+
+Per axis (x, y, yaw, the others held at the pose), the interval of poses that still serve
+the target: poses one STEP apart outward (no coarser than one cell of the test's reference
+grid, 1 cm and 1 degree) judged in order until one does not serve, then REFINE poses
+between the last that served and it. The arm's reach is computed for a whole row of poses
+at once (`Judge.reach`); collisions and the tip-over margin pose by pose, inside out.
+
+A navigation stack parks within a radius and a heading band of its goal, both at once
+(Nav2's goal checker: `xy_goal_tolerance`, `yaw_goal_tolerance`), so those two start at
+half of what the intervals allow and are halved until every pose on the band's edge
+(eight directions, at both ends of the heading band, and the heading band alone) serves.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from armcli.plan.mobile.judge import Judge, Verdict
+
+STEPS = (0.01, 0.01, math.radians(1.0))  # [m, m, rad] between two poses judged per axis
+SPANS = (1.0, 1.0, math.pi)  # [m, m, rad] an interval is not searched beyond this
+REFINE = 8  # poses judged between the last serving one and the first that does not
+HALVINGS = 8  # rounds of halving the Nav2 tolerances before giving up (0, 0)
+DIRECTIONS = 8  # around the xy tolerance circle
+
+
+@dataclass(frozen=True)
+class Region:
+    """The intervals per axis and the Nav2 goal tolerances, about the placed pose."""
+
+    x: tuple[float, float]  # [m]
+    y: tuple[float, float]  # [m]
+    yaw: tuple[float, float]  # [rad]
+    xy_tolerance: float  # [m] any pose this near ...
+    yaw_tolerance: float  # [rad] ... and turned this little still serves
+
+
+def _first_failing(judge: Judge, best: Verdict, poses: np.ndarray) -> int:
+    """Index of the first of `poses` that does not serve (len(poses) if all do).
+
+    A planar arm's reach comes for all poses at once; another arm's inverse kinematics
+    runs pose by pose, each seeded with the previous pose's configuration.
+    """
+    chunk = len(poses) if judge.mobile.planar is not None else 1
+    seed = best.q
+    for start in range(0, len(poses), chunk):
+        rows = poses[start : start + chunk]
+        q, errors = judge.reach(rows, seed)
+        for i, pose in enumerate(rows):
+            v = judge.best(pose, q[i], errors[i])
+            if not v.ok:
+                return start + i
+            seed = v.q
+    return len(poses)
+
+
+def extent(judge: Judge, best: Verdict, axis: int, sign: float) -> float:
+    """How far [m or rad] the pose may move along `axis` in direction `sign` and serve."""
+    unit = np.zeros(3)
+    unit[axis] = sign
+    base = np.asarray(best.base, dtype=float)
+    ts = STEPS[axis] * np.arange(1, math.ceil(SPANS[axis] / STEPS[axis]) + 1)
+    i = _first_failing(judge, best, base + ts[:, None] * unit)
+    if i == len(ts):
+        return float(ts[-1])
+    good = float(ts[i - 1]) if i > 0 else 0.0
+    between = np.linspace(good, float(ts[i]), REFINE + 2)[1:-1]
+    k = _first_failing(judge, best, base + between[:, None] * unit)
+    return float(between[k - 1]) if k > 0 else good
+
+
+def _band(best: Verdict, r: float, theta: float) -> np.ndarray:
+    """The poses on the edge of the tolerance band around the placed pose."""
+    x, y, yaw = best.base
+    poses = [(x, y, yaw - theta), (x, y, yaw + theta)]
+    for k in range(DIRECTIONS):
+        a = 2.0 * math.pi * k / DIRECTIONS
+        for dyaw in (-theta, theta):
+            poses.append((x + r * math.cos(a), y + r * math.sin(a), yaw + dyaw))
+    return np.array(poses)
+
+
+def region(judge: Judge, best: Verdict) -> Region:
+    """The region around the placed pose `best` (see the module docstring)."""
+    lo = [extent(judge, best, k, -1.0) for k in range(3)]
+    hi = [extent(judge, best, k, 1.0) for k in range(3)]
+    # both at once use up what each alone may: start from half of each
+    r, theta = 0.5 * min(lo[0], hi[0], lo[1], hi[1]), 0.5 * min(lo[2], hi[2])
+    for _ in range(HALVINGS):
+        band = _band(best, r, theta)
+        if _first_failing(judge, best, band) == len(band):
+            break
+        r, theta = 0.5 * r, 0.5 * theta
+    else:
+        r, theta = 0.0, 0.0
+    b = np.asarray(best.base, dtype=float)
+    return Region(
+        x=(float(b[0] - lo[0]), float(b[0] + hi[0])),
+        y=(float(b[1] - lo[1]), float(b[1] + hi[1])),
+        yaw=(float(b[2] - lo[2]), float(b[2] + hi[2])),
+        xy_tolerance=r,
+        yaw_tolerance=theta,
+    )
