@@ -116,9 +116,12 @@ class _Mass:
 
     def parts(self, x: ArrayLike) -> tuple[NDArray[Any], NDArray[Any]]:
         """(unloaded centre of mass, payload point) [m] at joint values x."""
+        return self.parts_at(self.q(x))
+
+    def parts_at(self, q: NDArray[np.float64]) -> tuple[NDArray[Any], NDArray[Any]]:
+        """(unloaded centre of mass, payload point) [m] at the configuration q."""
         import pinocchio as pin
 
-        q = self.q(x)
         c0 = np.array(pin.centerOfMass(self.model, self.data, q))
         if self.frame is None:
             return c0, c0
@@ -203,21 +206,28 @@ class MarginAt:
         """`joints`: the names the values of each call are given for, in order."""
         self.ev = _Mass(stance)
         self.m = stance.payload.mass if stance.payload is not None else 0.0
-        self.base = np.array(_values(stance, {}), dtype=float)
-        names = [j.name for j in stance.joints]
-        self.slots = [(k, names.index(n)) for k, n in enumerate(joints) if n in names]
-        box = stance.box
-        self.lower = np.array([lo for lo, _ in box])
-        self.upper = np.array([hi for _, hi in box])
+        searched = {j.name: (j, lo, hi) for j, (lo, hi) in zip(stance.joints, stance.box,
+                                                               strict=True)}  # fmt: skip
+        self.template = stance.q(_values(stance, {}))
+        # (value index, q index, lower, upper) per given joint the search moves; a continuous
+        # one is stored as (cos, sin): through Stance.q, the one place that writes it
+        self.slots = [(k, *searched[n][1:], searched[n][0]) for k, n in enumerate(joints)
+                      if n in searched]  # fmt: skip
+        self.fast = all(not j.continuous for *_, j in self.slots)
         self.polygon = stance.polygon
 
     def __call__(self, values: ArrayLike) -> float:
         """The margin [m] with the joints at `values` [rad or m]."""
-        x, given = self.base.copy(), np.asarray(values, dtype=float)
-        for k, i in self.slots:
-            x[i] = given[k]
-        c = self.ev.com(np.clip(x, self.lower, self.upper), self.m)
-        return self.polygon.margin(c)
+        given = np.asarray(values, dtype=float)
+        if self.fast:  # the per-pose path of a placement: no joint table walk
+            q = self.template.copy()
+            for k, lo, hi, j in self.slots:
+                q[j.idx_q] = min(max(float(given[k]), lo), hi)
+        else:
+            named = {j.name: min(max(float(given[k]), lo), hi) for k, lo, hi, j in self.slots}
+            q = self.ev.s.q(_values(self.ev.s, named))
+        c0, p = self.ev.parts_at(q)
+        return self.polygon.margin((self.ev.M * c0 + self.m * p) / (self.ev.M + self.m))
 
 
 def _point_label(stance: Stance) -> str:

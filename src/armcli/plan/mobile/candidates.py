@@ -33,7 +33,8 @@ CHUNK = 256  # candidates sorted at a time
 ARC_SAMPLES = 181  # planar arm above or below its reach: samples per boundary arc
 ARM_DRAWS = 2048  # other arms: seeded configurations sampled
 ARM_KEPT = 48  # ... of which the nearest in height are candidates
-HEIGHT_FIRST = 1e3  # [m of driving per m of height miss]: the nearer height always wins
+HEIGHT_FIRST = 1e3  # [m of driving per m of tool miss]: the nearer approach always wins
+OFF_PLANE = (-0.95, -0.5, 0.5, 0.95)  # shares of the tolerance a planar arm's base stands off
 
 
 @dataclass(frozen=True)
@@ -44,6 +45,14 @@ class Family:
     p: np.ndarray
     miss: np.ndarray  # [m] |tool z - target z| (0 for exact configurations)
     exact: bool  # the configurations reach the target's height exactly (closed form)
+    lateral: np.ndarray | None = None  # base-frame direction the tool cannot move (planar arm)
+
+    @property
+    def lateral_xy(self) -> tuple[float, float]:
+        """The lateral direction's x and y (0, 0 without one)."""
+        if self.lateral is None:
+            return 0.0, 0.0
+        return float(self.lateral[0]), float(self.lateral[1])
 
 
 def planar_family(judge: Judge, samples: int) -> Family:
@@ -53,7 +62,7 @@ def planar_family(judge: Judge, samples: int) -> Family:
     w = float(judge.target[2] - arm.shoulder[2])
     q, _ = arm.at_height(w, samples)
     if len(q):
-        return Family(q, arm.points(q), np.zeros(len(q)), True)
+        return Family(q, arm.points(q), np.zeros(len(q)), True, arm.axis)
     boundary = []  # above or below the reach: along the boundary arcs, nearest heights
     for start, k, span in arm.arcs():
         for t in np.linspace(0.0, span, ARC_SAMPLES):
@@ -62,7 +71,7 @@ def planar_family(judge: Judge, samples: int) -> Family:
             boundary.append(x)
     q = np.array(boundary)
     p = arm.points(q)
-    return Family(q, p, np.abs(p[:, 2] - judge.target[2]), True)
+    return Family(q, p, np.abs(p[:, 2] - judge.target[2]), True, arm.axis)
 
 
 def sampled_family(judge: Judge, seed: int) -> Family:
@@ -93,18 +102,32 @@ class Candidate:
 
 
 def ordered(
-    family: Family, target: np.ndarray, start: ArrayLike, turn_radius: float, step: float
+    family: Family,
+    target: np.ndarray,
+    start: ArrayLike,
+    turn_radius: float,
+    step: float,
+    tolerance: float,
 ) -> Iterator[Candidate]:
-    """Every (configuration, yaw every `step`) of the family as a base pose, cheapest first."""
+    """Every (configuration, yaw every `step`) of the family as a base pose, cheapest first.
+
+    With a planar family, each pose also stood off sideways by OFF_PLANE shares of the
+    tolerance (the tool then misses by that much): tried after every pose on the plane.
+    """
     yaw = np.arange(-math.pi, math.pi, step)
-    c, s = np.cos(yaw)[None, :], np.sin(yaw)[None, :]
-    px, py = family.p[:, 0:1], family.p[:, 1:2]
-    bx = target[0] - (c * px - s * py)
+    c, s = np.cos(yaw)[None, None, :], np.sin(yaw)[None, None, :]
+    offsets = np.array([0.0])
+    if family.lateral is not None:
+        offsets = np.array([0.0, *(f * tolerance for f in OFF_PLANE)])
+    px = family.p[None, :, 0:1] + offsets[:, None, None] * family.lateral_xy[0]
+    py = family.p[None, :, 1:2] + offsets[:, None, None] * family.lateral_xy[1]
+    bx = target[0] - (c * px - s * py)  # (offsets, configurations, yaws)
     by = target[1] - (s * px + c * py)
-    yaws = np.broadcast_to(yaw[None, :], bx.shape)
+    yaws = np.broadcast_to(yaw, bx.shape)
     drive = driving_cost(start, bx, by, yaws, turn_radius).ravel()
-    left = drive + HEIGHT_FIRST * np.repeat(family.miss, len(yaw))  # nearer heights first
-    n_yaw = len(yaw)
+    miss = np.sqrt(family.miss[None, :] ** 2 + offsets[:, None] ** 2)  # (offsets, configurations)
+    left = drive + HEIGHT_FIRST * np.repeat(miss.ravel(), len(yaw))  # nearer first
+    n_yaw, n_q = len(yaw), len(family.q)
     while True:
         k = min(CHUNK, int(np.count_nonzero(np.isfinite(left))))
         if k == 0:
@@ -114,6 +137,7 @@ def ordered(
         idx = idx[np.isfinite(left[idx])]
         left[idx] = np.inf
         for flat in idx:
-            i, j = divmod(int(flat), n_yaw)
+            dq, j = divmod(int(flat), n_yaw)
+            d, i = divmod(dq, n_q)
             yield Candidate((float(bx.flat[flat]), float(by.flat[flat]), float(yaw[j])),
-                            family.q[i], float(family.miss[i]), float(drive[flat]))  # fmt: skip
+                            family.q[i], float(miss[d, i]), float(drive[flat]))  # fmt: skip

@@ -1,7 +1,7 @@
 """The scene's objects seen from the floor: their outlines from above, what holds a point.
 
-Placement names the object a target is inside (no base pose can serve it: the tool
-would be in the object) without trying every pose, and the plot draws each object's
+Placement names the object a target is inside, deeper than its tolerance (no base pose
+can serve it: the tool would be in the object) without trying every pose, and the plot draws each object's
 outline from above. Objects fixed to a robot link move with it and are left out; so is a
 mesh for `containing` (inside a mesh is not a primitive test).
 """
@@ -24,21 +24,26 @@ def _local(shape: Shape, point: np.ndarray) -> np.ndarray:
     return np.asarray(T[:3, :3].T @ (np.asarray(point, dtype=float) - T[:3, 3]))
 
 
-def holds(shape: Shape, point: np.ndarray) -> bool:
-    """Whether a primitive contains a point [m] of its frame (its boundary included)."""
+def depth(shape: Shape, point: np.ndarray) -> float:
+    """How deep [m] a point of the shape's frame lies inside a primitive (<= 0: not inside).
+
+    The distance to the nearest face: a tool point this deep is inside the object however
+    the tool comes within that distance of it. 0 for a mesh (no primitive test).
+    """
     p = _local(shape, point)
     d = shape.dimensions
     if shape.kind == "box":
-        return bool(np.all(np.abs(p) <= np.asarray(d) / 2))
+        return float(np.min(np.asarray(d) / 2 - np.abs(p)))
     if shape.kind == "sphere":
-        return float(np.linalg.norm(p)) <= d[0]
+        return d[0] - float(np.linalg.norm(p))
     if shape.kind in ("cylinder", "cone"):  # SolidPrimitive: [height, radius], axis z, centred
         h, r = d
-        if abs(p[2]) > h / 2:
-            return False
-        radius = r if shape.kind == "cylinder" else r * (h / 2 - p[2]) / h
-        return math.hypot(p[0], p[1]) <= radius
-    return False
+        rho = math.hypot(p[0], p[1])
+        if shape.kind == "cylinder":
+            return min(r - rho, h / 2 - abs(p[2]))
+        side = (r * (h / 2 - p[2]) / h - rho) * h / math.hypot(h, r)  # to the slanted surface
+        return min(side, p[2] + h / 2)
+    return 0.0
 
 
 def world_objects(scene: Scene) -> Iterator[SceneObject]:
@@ -46,10 +51,10 @@ def world_objects(scene: Scene) -> Iterator[SceneObject]:
     return (o for o in scene.objects if not o.frame)
 
 
-def containing(scene: Scene, point: np.ndarray) -> str | None:
-    """The id of a world object whose primitive contains `point` [m], or None."""
+def containing(scene: Scene, point: np.ndarray, deeper: float = 0.0) -> str | None:
+    """The id of a world object whose primitive holds `point` [m] deeper than `deeper`."""
     for obj in world_objects(scene):
-        if any(holds(s, point) for s in obj.shapes):
+        if any(depth(s, point) > deeper for s in obj.shapes):
             return obj.id
     return None
 

@@ -90,7 +90,7 @@ def place(
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise InputError(f"must be a positive number of metres, got {tolerance!r}",
                          field="tolerance")  # fmt: skip
-    inside = containing(mobile.scene, goal)
+    inside = containing(mobile.scene, goal, tolerance)
     if inside is not None:
         raise PlacementError(f"the target is inside {inside}: no pose of the tool can reach it",
                              blocking=inside)  # fmt: skip
@@ -137,7 +137,7 @@ def _search(
 ) -> tuple[tuple[Verdict, float] | None, Counter[str]]:
     """The first serving candidate in cost order, and why the others did not serve."""
     tally: Counter[str] = Counter()
-    for c in ordered(family, judge.target, start, radius, step):
+    for c in ordered(family, judge.target, start, radius, step, judge.tolerance):
         if c.miss > judge.tolerance or judge.checks >= MAX_CHECKS:
             break
         v = _judge(judge, c, family.exact)

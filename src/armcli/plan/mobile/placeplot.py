@@ -57,7 +57,7 @@ def _serving(judge: Judge, start: Sequence[float], radius: float) -> np.ndarray:
         planar_family(judge, samples) if mobile.planar is not None else sampled_family(judge, 0)
     )
     out = []
-    for k, c in enumerate(ordered(family, judge.target, start, radius, step)):
+    for k, c in enumerate(ordered(family, judge.target, start, radius, step, judge.tolerance)):
         if k >= MAX_SHADED:
             break
         if c.miss <= judge.tolerance and judge.judge(c.base, c.q, c.miss).ok:

@@ -39,38 +39,64 @@ class Region:
     yaw_tolerance: float  # [rad] ... and turned this little still serves
 
 
-def _first_failing(judge: Judge, best: Verdict, poses: np.ndarray) -> int:
-    """Index of the first of `poses` that does not serve (len(poses) if all do).
+def _first_failing(judge: Judge, best: Verdict, rows: list[np.ndarray]) -> list[int]:
+    """Per row of poses: the index of the first pose that does not serve (its length if none).
 
-    A planar arm's reach comes for all poses at once; another arm's inverse kinematics
-    runs pose by pose, each seeded with the previous pose's configuration.
+    A planar arm's reach comes for every row at once; another arm's inverse kinematics
+    runs pose by pose, each seeded with the previous pose's configuration. Poses are
+    judged inside out and a row stops at its first failure.
     """
-    chunk = len(poses) if judge.mobile.planar is not None else 1
-    seed = best.q
-    for start in range(0, len(poses), chunk):
-        rows = poses[start : start + chunk]
-        q, errors = judge.reach(rows, seed)
-        for i, pose in enumerate(rows):
-            v = judge.best(pose, q[i], errors[i])
+    planar = judge.mobile.planar is not None
+    if planar and rows:
+        q, errors = judge.reach(np.concatenate(rows), best.q)
+    out, at = [], 0
+    for poses in rows:
+        seed, first = best.q, len(poses)
+        for i, pose in enumerate(poses):
+            if planar:
+                qi, ei = q[at + i], errors[at + i]
+            else:
+                qs, es = judge.reach(pose[None, :], seed)
+                qi, ei = qs[0], es[0]
+            v = judge.best(pose, qi, ei)
             if not v.ok:
-                return start + i
+                first = i
+                break
             seed = v.q
-    return len(poses)
+        out.append(first)
+        at += len(poses)
+    return out
 
 
-def extent(judge: Judge, best: Verdict, axis: int, sign: float) -> float:
-    """How far [m or rad] the pose may move along `axis` in direction `sign` and serve."""
-    unit = np.zeros(3)
-    unit[axis] = sign
+def _extents(judge: Judge, best: Verdict) -> list[float]:
+    """How far [m or rad] the pose may move along each axis and direction and serve.
+
+    In the order (x-, y-, yaw-, x+, y+, yaw+): a row of poses one STEP apart per axis and
+    direction, then REFINE poses between the last that served and the first that did not.
+    """
     base = np.asarray(best.base, dtype=float)
-    ts = STEPS[axis] * np.arange(1, math.ceil(SPANS[axis] / STEPS[axis]) + 1)
-    i = _first_failing(judge, best, base + ts[:, None] * unit)
-    if i == len(ts):
-        return float(ts[-1])
-    good = float(ts[i - 1]) if i > 0 else 0.0
-    between = np.linspace(good, float(ts[i]), REFINE + 2)[1:-1]
-    k = _first_failing(judge, best, base + between[:, None] * unit)
-    return float(between[k - 1]) if k > 0 else good
+    moves = [(k, sign) for sign in (-1.0, 1.0) for k in range(3)]
+    steps = [STEPS[k] * np.arange(1, math.ceil(SPANS[k] / STEPS[k]) + 1) for k, _ in moves]
+
+    def row(k: int, sign: float, ts: np.ndarray) -> np.ndarray:
+        unit = np.zeros(3)
+        unit[k] = sign
+        return base + ts[:, None] * unit
+
+    firsts = _first_failing(
+        judge, best, [row(k, s, ts) for (k, s), ts in zip(moves, steps, strict=True)]
+    )
+    goods, betweens = [], []
+    for ts, i in zip(steps, firsts, strict=True):
+        good = float(ts[i - 1]) if i > 0 else 0.0
+        goods.append(good)
+        bad = float(ts[i]) if i < len(ts) else good
+        betweens.append(np.linspace(good, bad, REFINE + 2)[1:-1] if i < len(ts) else ts[:0])
+    fine = _first_failing(
+        judge, best, [row(k, s, b) for (k, s), b in zip(moves, betweens, strict=True)]
+    )
+    return [float(b[k - 1]) if k > 0 else g for b, k, g in zip(betweens, fine, goods,
+                                                               strict=True)]  # fmt: skip
 
 
 def _band(best: Verdict, r: float, theta: float) -> np.ndarray:
@@ -86,13 +112,13 @@ def _band(best: Verdict, r: float, theta: float) -> np.ndarray:
 
 def region(judge: Judge, best: Verdict) -> Region:
     """The region around the placed pose `best` (see the module docstring)."""
-    lo = [extent(judge, best, k, -1.0) for k in range(3)]
-    hi = [extent(judge, best, k, 1.0) for k in range(3)]
+    found = _extents(judge, best)
+    lo, hi = found[:3], found[3:]
     # both at once use up what each alone may: start from half of each
     r, theta = 0.5 * min(lo[0], hi[0], lo[1], hi[1]), 0.5 * min(lo[2], hi[2])
     for _ in range(HALVINGS):
         band = _band(best, r, theta)
-        if _first_failing(judge, best, band) == len(band):
+        if _first_failing(judge, best, [band])[0] == len(band):
             break
         r, theta = 0.5 * r, 0.5 * theta
     else:
