@@ -173,7 +173,7 @@ def _along(a: np.ndarray, b: np.ndarray, shrink: float) -> np.ndarray:
     length = np.linalg.norm(d, axis=1, keepdims=True)
     u = d / length
     a2, b2 = a + shrink * u, b - shrink * u
-    k = int(math.ceil(float(np.max(length)) / SAMPLE)) + 1
+    k = math.ceil(float(np.max(length)) / SAMPLE) + 1
     t = np.linspace(0.0, 1.0, k)[None, :, None]
     return np.asarray(a2[:, None, :] + t * (b2 - a2)[:, None, :])
 

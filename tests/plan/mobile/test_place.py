@@ -10,6 +10,7 @@ matches the grid's feasible cells along each axis through the pose to within one
 from __future__ import annotations
 
 import math
+
 import numpy as np
 import pytest
 
@@ -191,10 +192,10 @@ def test_a_target_inside_an_object_names_it() -> None:
 
 
 def test_verdicts_are_mostly_decided(room: tuple[str, MobileRobot, Reference]) -> None:
-    """Around a placed pose the reference decides most cells (AMBIGUOUS everywhere tests nothing)."""
+    """Around a placed pose the reference decides most cells (all AMBIGUOUS would test nothing)."""
     _, mobile, ref = room
     target = np.array([0.3, 0.2, 0.5])
-    pose = np.array(place(mobile, target).verdict.base)
+    pose: np.ndarray = np.array(list(place(mobile, target).verdict.base))
     rng = np.random.default_rng(0)
     poses = pose + rng.uniform(-1, 1, (2000, 3)) * np.array([0.03, 0.03, math.radians(3)])
     verdicts = ref.classify(poses, target)

@@ -1,9 +1,9 @@
 """The scene's objects seen from the floor: their outlines from above, what holds a point.
 
 Placement names the object a target is inside, deeper than its tolerance (no base pose
-can serve it: the tool would be in the object) without trying every pose, and the plot draws each object's
-outline from above. Objects fixed to a robot link move with it and are left out; so is a
-mesh for `containing` (inside a mesh is not a primitive test).
+can serve it: the tool would be in the object) without trying every pose, and the plot
+draws each object's outline from above. Objects fixed to a robot link move with it and
+are left out; so is a mesh for `containing` (inside a mesh is not a primitive test).
 """
 
 from __future__ import annotations
@@ -40,9 +40,9 @@ def depth(shape: Shape, point: np.ndarray) -> float:
         h, r = d
         rho = math.hypot(p[0], p[1])
         if shape.kind == "cylinder":
-            return min(r - rho, h / 2 - abs(p[2]))
-        side = (r * (h / 2 - p[2]) / h - rho) * h / math.hypot(h, r)  # to the slanted surface
-        return min(side, p[2] + h / 2)
+            return min(r - rho, h / 2 - abs(float(p[2])))
+        side = (r * (h / 2 - float(p[2])) / h - rho) * h / math.hypot(h, r)  # the slanted side
+        return min(side, float(p[2]) + h / 2)
     return 0.0
 
 

@@ -13,10 +13,10 @@ from __future__ import annotations
 import math
 import time
 from collections import Counter
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from armcli.errors import InputError, PlanningError
 from armcli.plan.mobile.candidates import (
@@ -65,8 +65,8 @@ def turn_radius(mobile: MobileRobot) -> float:
     return 0.5 * float(dd.wheel_separation) if dd is not None else DEFAULT_TURN_RADIUS
 
 
-def _values(name: str, given: Sequence[float], count: int) -> np.ndarray:
-    v = np.asarray(list(given), dtype=float)
+def _values(name: str, given: ArrayLike, count: int) -> np.ndarray:
+    v = np.asarray(given, dtype=float).reshape(-1)
     if v.shape != (count,) or not np.all(np.isfinite(v)):
         raise InputError(f"give {count} finite numbers", field=name)
     return v
@@ -74,8 +74,8 @@ def _values(name: str, given: Sequence[float], count: int) -> np.ndarray:
 
 def place(
     mobile: MobileRobot,
-    target: Sequence[float],
-    start: Sequence[float] = (0.0, 0.0, 0.0),
+    target: ArrayLike,
+    start: ArrayLike = (0.0, 0.0, 0.0),
     *,
     tolerance: float = TOLERANCE,
     seed: int = 0,
