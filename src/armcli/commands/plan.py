@@ -33,6 +33,11 @@ SCENE_HELP = "Obstacles: YAML shaped like moveit_msgs/PlanningScene world.collis
 SRDF_HELP = "SRDF of a --urdf: its disable_collisions, group_state and group entries."
 GROUP_HELP = "Plan the joints of this planning group of --srdf (MoveIt's), e.g. arm."
 EXECUTE_HELP = "Simulate the plan right away; exit 1 if it breaks a limit or tips over."
+BASE_HELP = (
+    "Also drive the base (a differential drive): where to park for --to-xyz, the path there, "
+    "then the arm; -o is then a directory for arm.yaml, cmd_vel.yaml and path.yaml."
+)
+BASE_START_HELP = "With --base: where the base stands, x,y,yaw [m, m, rad] (default: 0,0,0)."
 FLAGS = {
     "start": "--from",
     "goal": "--to",
@@ -46,6 +51,8 @@ FLAGS = {
     "group": "--group",
     "srdf": "--srdf",
     "timeout": "--timeout",
+    "base": "--base",
+    "base_start": "--base-start",
 }
 
 
@@ -84,12 +91,26 @@ def plan_cmd(
     output: Path = option(None, "--output", "-o", help="JointTrajectory YAML to write."),
     fmt: str = choice("text", FORMATS, "--format", help="Output format (default: text)."),
     execute: bool = option(False, "--execute", help=EXECUTE_HELP),
+    base: bool = option(False, "--base", help=BASE_HELP),
+    base_start: Numbers = option(
+        None,
+        "--base-start",
+        parser=numbers("--base-start", 3, "x,y,yaw [m, m, rad]"),
+        metavar="X,Y,YAW",
+        help=BASE_START_HELP,
+    ),
 ) -> None:
     """Plan a collision-free motion, time it within the limits, certify it, write it."""
     from armcli.io.outdir import check_output_file
     from armcli.plan.api import PlanOptions
     from armcli.plan.request import PlanRequest, plan_request
 
+    if base or base_start is not None:
+        from armcli.commands.plan_base import plan_base
+
+        plan_base(robot, urdf, scene, start, to_xyz, base_start, planner, timeout, seed, output,
+                  fmt, execute)  # fmt: skip
+        return
     request = PlanRequest(start, goal, to_xyz, to_rpy, srdf, scene, joints or None, group)
     if output is not None:
         check_output_file(output, "--output")
@@ -100,10 +121,13 @@ def plan_cmd(
     try:
         result = plan_request(robot_file, replace(request, options=opts), robot.packages)
     except PlanningError as exc:
+        if exc.kind == "ik" and robot_file.spec is not None and robot_file.spec.mobile_base:
+            why = f"{exc.reason}: out of the arm's reach from where the base stands"
+            exc = PlanningError("ik", f"{why}; --base plans where to park and the drive there")
         if fmt == "json":
             _json({"status": "failed", "output": None, "reason": exc.reason})
             raise typer.Exit(1) from None
-        raise
+        raise exc from None
     if output is not None:
         from armcli.io.files import write_file_atomic
 

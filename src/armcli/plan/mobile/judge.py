@@ -13,8 +13,8 @@ construction: both solvers stay inside them.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 
 from armcli.analysis.balance import MarginAt
 from armcli.plan.ik import solve_ik
-from armcli.plan.mobile.virtual import BASE_JOINTS, MobileRobot
+from armcli.plan.mobile.virtual import MobileRobot
 from armcli.plan.robot import PlanRobot
 
 IK_ATTEMPTS = 4  # restarts of the inverse kinematics at a base pose (general arms)
@@ -38,7 +38,7 @@ class Verdict:
     error: float  # [m] tool point to target
     margin: float | None  # [m] tip-over margin; None: no support polygon to judge
     blocked: tuple[str, str] | None  # the colliding pair, if any
-    why: str  # "" when the pose serves; else "reach", "tip" or "collision"
+    why: str  # "" when the pose serves; else "reach", "tip", "park" or "collision"
 
     @property
     def ok(self) -> bool:
@@ -56,8 +56,16 @@ def world_to_base(bases: np.ndarray, point: np.ndarray) -> np.ndarray:
 class Judge:
     """Judges base poses for one target [m] (world) and tolerance [m]."""
 
-    def __init__(self, mobile: MobileRobot, target: ArrayLike, tolerance: float) -> None:
+    def __init__(
+        self,
+        mobile: MobileRobot,
+        target: ArrayLike,
+        tolerance: float,
+        park: Callable[[tuple[float, float, float]], bool] | None = None,
+    ) -> None:
+        """`park(base)`: a further condition on the pose (the base can drive there)."""
         self.mobile = mobile
+        self.park = park
         self.target = np.asarray(target, dtype=float)
         self.tolerance = tolerance
         self._margins: dict[tuple[float, ...], float | None] = {}
@@ -66,11 +74,7 @@ class Judge:
     @cached_property
     def arm_robot(self) -> PlanRobot:
         """The planning robot with the base held at the origin: the arm's joints planned."""
-        r, n = self.mobile.robot, len(BASE_JOINTS)
-        rest = {**r.rest, **dict.fromkeys(BASE_JOINTS, 0.0)}
-        return replace(r, joints=r.joints[n:], lower=r.lower[n:], upper=r.upper[n:],
-                       velocity=r.velocity[n:], acceleration=r.acceleration[n:],
-                       effort=r.effort[n:], rest=rest)  # fmt: skip
+        return self.mobile.arm_robot()
 
     def margin(self, q: np.ndarray) -> float | None:
         """The tip-over margin [m] with the arm at q (cached: the base pose does not change it)."""
@@ -122,6 +126,8 @@ class Judge:
         margin = self.margin(q)
         if margin is not None and margin <= 0.0:
             return Verdict(b, q, error, margin, None, "tip")
+        if self.park is not None and not self.park(b):
+            return Verdict(b, q, error, margin, None, "park")
         self.checks += 1
         pair = self.mobile.checker.first_collision(self.mobile.x(b, q))
         return Verdict(b, q, error, margin, pair, "collision" if pair is not None else "")

@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 import time
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -79,11 +80,15 @@ def place(
     *,
     tolerance: float = TOLERANCE,
     seed: int = 0,
+    park: Callable[[tuple[float, float, float]], bool] | None = None,
+    accept: Callable[[Verdict], bool] | None = None,
 ) -> Placement:
     """The base pose of least driving from which the tool reaches `target`.
 
     `target` (x, y, z) [m] and `start` (x, y, yaw) [m, m, rad] in the world frame.
-    PlacementError with the reason when no pose serves.
+    PlacementError with the reason when no pose serves. `park(base)`: a further condition
+    on every pose judged (the region's too); `accept(verdict)`: one on the chosen pose only
+    (a pose it refuses is passed over for the next).
     """
     t0 = time.perf_counter()
     goal, begin = _values("target", target, 3), _values("start", start, 3)
@@ -94,7 +99,7 @@ def place(
     if inside is not None:
         raise PlacementError(f"the target is inside {inside}: no pose of the tool can reach it",
                              blocking=inside)  # fmt: skip
-    judge = Judge(mobile, goal, tolerance)
+    judge = Judge(mobile, goal, tolerance, park)
     best, tally = None, Counter[str]()
     for samples, step in PASSES:
         if mobile.planar is not None:
@@ -102,7 +107,7 @@ def place(
         else:
             family = sampled_family(judge, seed)
         _refuse_out_of_reach(mobile, judge, family)
-        best, tally = _search(judge, family, begin, turn_radius(mobile), step)
+        best, tally = _search(judge, family, begin, turn_radius(mobile), step, accept)
         if best is not None or mobile.planar is None:
             break
     if best is None:
@@ -133,17 +138,22 @@ def _refuse_out_of_reach(mobile: MobileRobot, judge: Judge, family: Family) -> N
 
 
 def _search(
-    judge: Judge, family: Family, start: np.ndarray, radius: float, step: float
+    judge: Judge,
+    family: Family,
+    start: np.ndarray,
+    radius: float,
+    step: float,
+    accept: Callable[[Verdict], bool] | None,
 ) -> tuple[tuple[Verdict, float] | None, Counter[str]]:
-    """The first serving candidate in cost order, and why the others did not serve."""
+    """The first serving (and accepted) candidate in cost order, and why others were not."""
     tally: Counter[str] = Counter()
     for c in ordered(family, judge.target, start, radius, step, judge.tolerance):
         if c.miss > judge.tolerance or judge.checks >= MAX_CHECKS:
             break
         v = _judge(judge, c, family.exact)
-        if v.ok:
+        if v.ok and (accept is None or accept(v)):
             return (v, c.cost), tally
-        tally[_blocker(judge.mobile, v)] += 1
+        tally[_blocker(judge.mobile, v) if not v.ok else "path"] += 1
     return None, tally
 
 
@@ -175,5 +185,11 @@ def _blocked(mobile: MobileRobot, tally: Counter[str]) -> PlacementError:
                               f"({share})")  # fmt: skip
     if what == "reach":
         return PlacementError(f"the tool cannot come within reach of the target ({share})")
+    if what == "park":
+        return PlacementError(f"the base cannot stand at any pose that reaches the target with "
+                              f"the arm in its travel configuration ({share})")  # fmt: skip
+    if what == "path":
+        return PlacementError(f"no path for the base leads to a pose that reaches the target "
+                              f"({share})")  # fmt: skip
     return PlacementError(f"{what} blocks every base pose that reaches the target ({share} "
                           f"collide with it)", blocking=what)  # fmt: skip

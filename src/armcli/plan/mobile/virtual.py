@@ -52,10 +52,21 @@ class MobileRobot:
     no_stance: str  # why, when `stance` is None
     planar: PlanarArm | None  # the closed form, when the arm's reach is planar
     robot_file: RobotFile
+    world: Scene  # the scene's objects and the floor: what the checker was built with
+    disabled: tuple[tuple[str, str], ...]  # link pairs never checked (the collision matrix)
 
     def x(self, base: ArrayLike, q: ArrayLike) -> np.ndarray:
         """Planned values: the base pose (x, y, yaw) and the arm's joints."""
         return np.concatenate([np.asarray(base, dtype=float), np.asarray(q, dtype=float)])
+
+    def arm_robot(self, base: ArrayLike = (0.0, 0.0, 0.0)) -> PlanRobot:
+        """The planning robot with the base held at `base` (x, y, yaw): the arm's joints planned."""
+        r, n = self.robot, len(BASE_JOINTS)
+        b = np.asarray(base, dtype=float)
+        rest = {**r.rest, **{j: float(v) for j, v in zip(BASE_JOINTS, b, strict=True)}}
+        return replace(r, joints=r.joints[n:], lower=r.lower[n:], upper=r.upper[n:],
+                       velocity=r.velocity[n:], acceleration=r.acceleration[n:],
+                       effort=r.effort[n:], rest=rest)  # fmt: skip
 
     @property
     def base_links(self) -> tuple[str, ...]:
@@ -143,7 +154,8 @@ def load_mobile(
     links = [lk.name for lk in urdf.links]
     objects = load_scene(scene, links) if scene is not None else Scene()
     world = Scene((*objects.objects, floor_object()), objects.source)
-    checker = CollisionChecker(robot, world, allowed_pairs(robot_file, None, search))
+    disabled = allowed_pairs(robot_file, None, search)
+    checker = CollisionChecker(robot, world, disabled)
     candidates = set(spec.mobile_base.links) if spec is not None and spec.mobile_base else None
     standing = stance_of(urdf, candidates=candidates)
     stance = None if isinstance(standing, NoStance) else standing
@@ -152,4 +164,4 @@ def load_mobile(
                         robot.lower[n:], robot.upper[n:])  # fmt: skip
     return MobileRobot(robot, arm, checker, objects, stance,
                        standing.reason if isinstance(standing, NoStance) else "", planar,
-                       robot_file)  # fmt: skip
+                       robot_file, world, tuple(disabled))  # fmt: skip

@@ -1,0 +1,103 @@
+"""The robot's differential drive as a base plan needs it: the plugin's numbers, the limits.
+
+A spec states it (`mobile_base.diff_drive`, `sim.diffdrive.DriveParams.of`); a URDF
+carries it as a Gazebo plugin: gazebo_ros_diff_drive (`wheel_separation`,
+`wheel_diameter`, `max_wheel_torque`, `max_wheel_acceleration`, `update_rate`,
+`left_joint`, `right_joint`) or gz-sim's DiffDrive (`wheel_separation`, `wheel_radius`,
+`max_linear_acceleration`). The rim speed limit is the wheel joints' velocity limit when
+the URDF gives one, else DEFAULT_SPEED; the rim acceleration is the plugin's limit, else
+TORQUE_SHARE of what max_wheel_torque gives the whole robot.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+from armcli.errors import InputError
+from armcli.plan.mobile.basetime import DEFAULT_SPEED, TORQUE_SHARE, DriveLimits
+from armcli.plan.mobile.virtual import MobileRobot
+from armcli.sim.diffdrive import DriveParams
+from armcli.urdf.doc import Urdf
+
+NEEDS_DRIVE = (
+    "needs a differential drive (mobile_base.diff_drive in a spec, or a Gazebo diff-drive "
+    "plugin in the URDF)"
+)
+PLUGINS = ("diff_drive", "diffdrive", "diff-drive")  # in a plugin's filename, any case
+DEFAULT_RATE = 50.0  # [Hz] a plugin's update rate when it states none
+DEFAULT_TORQUE = 20.0  # [N·m] gazebo_ros_diff_drive's max_wheel_torque default
+
+
+def _number(params: Mapping[str, str], *tags: str) -> float | None:
+    for tag in tags:
+        text = params.get(tag)
+        if text is None:
+            continue
+        try:
+            value = float(text)
+        except ValueError:
+            continue
+        if math.isfinite(value):
+            return value
+    return None
+
+
+def _plugin(urdf: Urdf) -> DriveParams | None:
+    """The first diff-drive plugin of the URDF as DriveParams, None without one."""
+    for plugin in urdf.plugins:
+        name = (plugin.filename or "").lower() + (plugin.name or "").lower()
+        if not any(p in name for p in PLUGINS):
+            continue
+        p = plugin.params
+        separation = _number(p, "wheel_separation")
+        diameter = _number(p, "wheel_diameter")
+        radius = _number(p, "wheel_radius")
+        left, right = p.get("left_joint"), p.get("right_joint")
+        if separation is None or (diameter is None and radius is None) or not left or not right:
+            continue
+        return DriveParams(
+            left, right, separation, radius if radius is not None else 0.5 * float(diameter or 0),
+            _number(p, "max_wheel_torque") or DEFAULT_TORQUE,
+            _number(p, "max_wheel_acceleration", "max_linear_acceleration") or 0.0,
+            _number(p, "update_rate") or DEFAULT_RATE,
+            p.get("odometry_frame", "odom"), p.get("robot_base_frame", "base_footprint"),
+        )  # fmt: skip
+    return None
+
+
+def drive_params(mobile: MobileRobot) -> DriveParams:
+    """The robot's diff drive; InputError (field `base`) when it has none."""
+    spec = mobile.robot_file.spec
+    if spec is not None and spec.mobile_base is not None and spec.mobile_base.diff_drive:
+        return DriveParams.of(spec)
+    found = _plugin(mobile.robot_file.robot)
+    if found is None:
+        raise InputError(NEEDS_DRIVE, field="base")
+    return found
+
+
+def drive_limits(mobile: MobileRobot, params: DriveParams) -> DriveLimits:
+    """Rim speed and acceleration limits, half the track and the command period."""
+    notes = []
+    joints = {j.name: j for j in mobile.robot_file.robot.joints}
+    speeds = []
+    for name in (params.left_joint, params.right_joint):
+        lim = joints[name].limit if name in joints else None
+        if lim is not None and lim.velocity and math.isfinite(lim.velocity) and lim.velocity > 0:
+            speeds.append(lim.velocity * params.radius)
+    speed = min(speeds) if speeds else DEFAULT_SPEED
+    if not speeds:
+        notes.append(f"the wheel joints give no velocity limit: the base drives at most "
+                     f"{DEFAULT_SPEED:g} m/s")  # fmt: skip
+    accel = params.max_accel
+    if accel <= 0:
+        mass = mobile.stance.mass if mobile.stance is not None else 0.0
+        if mass <= 0:
+            raise InputError("the robot has no mass to size the drive's acceleration by",
+                             field="base")  # fmt: skip
+        accel = TORQUE_SHARE * 2 * params.max_torque / (params.radius * mass)
+        notes.append(f"max_wheel_acceleration is 0 (no limit): the base accelerates at "
+                     f"{accel:.3g} m/s² ({TORQUE_SHARE:g} of what the wheel torque "
+                     "gives)")  # fmt: skip
+    return DriveLimits(speed, accel, 0.5 * params.separation, params.period, tuple(notes))

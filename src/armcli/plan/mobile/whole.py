@@ -1,0 +1,174 @@
+"""One plan for a robot on a differential drive: where to park, how to drive there, the arm.
+
+`plan_whole` (what `armcli plan --base` calls): the arm stays in its travel configuration
+(the start pose, `home` by default) while the base drives; placement (`plan.mobile.place`)
+chooses the pose of least driving that serves the target and that the base can reach with
+the arm stowed, the base path is planned on the floor plan (`plan.mobile.basepath`),
+timed within the wheels' limits (`plan.mobile.basetime`) and certified by the 3-D checker
+turn by turn and leg by leg; then the arm's motion from the travel configuration to the
+reaching one is planned, timed and certified by the planner `plan` uses, with the base at
+its goal. The arm's trajectory holds still until the base has arrived.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from armcli.errors import PlanningError
+from armcli.plan.api import (
+    PlanningContext,
+    PlanOptions,
+    PlanResult,
+    plan_motion,
+    planning_context,
+)
+from armcli.plan.collision import CollisionChecker
+from armcli.plan.inputs import configuration
+from armcli.plan.mobile.basepath import BasePath, FloorPlan, plan_base_path
+from armcli.plan.mobile.basetime import BaseTiming, time_path
+from armcli.plan.mobile.footprint import obstacles, robot_outline
+from armcli.plan.mobile.judge import Verdict
+from armcli.plan.mobile.place import TOLERANCE, Placement, place
+from armcli.plan.mobile.virtual import MobileRobot
+from armcli.plan.mobile.wheels import drive_limits, drive_params
+from armcli.plan.timing import Timed
+from armcli.sim.diffdrive import DriveParams
+
+HOME = "home"
+CERTIFY_STEP = 0.01  # [m or rad] the 3-D check along the base path
+MAX_PATHS = 6  # placements whose base path is tried before giving up
+NEAR_FAILED = (0.15, math.radians(30.0))  # [m, rad] a pose this near one without a path is skipped
+
+
+@dataclass(frozen=True)
+class BaseGoal:
+    """What `plan --base` is asked: the tool's target, the base's start, the arm's start."""
+
+    target: tuple[float, float, float]  # [m] world
+    start: tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m, m, rad] the base's pose
+    arm_start: str | None = None  # a named pose or values; None: `home` (else the rest)
+    tolerance: float = TOLERANCE
+
+
+@dataclass(frozen=True)
+class WholePlan:
+    """The placement, the base's path and its timing, and the arm's certified motion."""
+
+    mobile: MobileRobot
+    drive: DriveParams
+    placement: Placement
+    path: BasePath
+    timing: BaseTiming
+    travel: np.ndarray  # the arm during the drive [rad or m]
+    arm: PlanResult  # at the base's goal, from `travel` to the placement's configuration
+    base_planning_time_s: float  # placement, path and timing (not the certification)
+    base_certify_time_s: float
+
+    @property
+    def arm_timed(self) -> Timed:
+        """The arm's trajectory on the whole plan's clock: held until the base has arrived."""
+        t0 = self.timing.duration
+        a = self.arm.timed
+        n = a.positions.shape[1]
+        return Timed(
+            np.concatenate([[0.0], a.times + t0]),
+            np.vstack([self.travel, a.positions]),
+            np.vstack([np.zeros(n), a.velocities]),
+            np.vstack([np.zeros(n), a.accelerations]),
+        )
+
+
+def _travel(mobile: MobileRobot, arm_start: str | None) -> np.ndarray:
+    """The arm's configuration while the base drives: the start pose, `home` by default."""
+    ctx = PlanningContext(mobile.arm_robot(), mobile.checker)  # names and values only
+    if arm_start is None:
+        robot = ctx.robot
+        if HOME in robot.poses:
+            return robot.pose(HOME)
+        return np.array([robot.rest_of(j) for j in robot.joints])
+    return configuration(ctx, arm_start, "start")
+
+
+class _Paths:
+    """The placement's `accept`: a pose is taken when a base path to it is found (cached)."""
+
+    def __init__(self, plan: FloorPlan, start: tuple[float, float, float], half: float,
+                 seed: int) -> None:  # fmt: skip
+        self.plan, self.start, self.half, self.seed = plan, start, half, seed
+        self.found: dict[tuple[float, float, float], BasePath] = {}
+        self.failed: list[tuple[float, float, float]] = []
+
+    def __call__(self, v: Verdict) -> bool:
+        near_xy, near_yaw = NEAR_FAILED
+        for f in self.failed:
+            if (
+                math.dist(f[:2], v.base[:2]) < near_xy
+                and abs(math.remainder(f[2] - v.base[2], 2 * math.pi)) < near_yaw
+            ):
+                return False  # fmt: skip
+        if len(self.failed) >= MAX_PATHS:
+            raise PlanningError("base-path", f"no base path reaches any of the {MAX_PATHS} best "
+                                "poses that serve the target")  # fmt: skip
+        try:
+            self.found[v.base] = plan_base_path(self.plan, self.start, v.base, self.half,
+                                                self.seed)  # fmt: skip
+        except PlanningError:
+            self.failed.append(v.base)
+            return False
+        return True
+
+
+def _certify(mobile: MobileRobot, timing: BaseTiming, travel: np.ndarray) -> None:
+    """Every turn and leg checked by the 3-D collision checker, CERTIFY_STEP apart."""
+    checker: CollisionChecker = mobile.checker
+    for m in timing.motions:
+        ends = m.pose_at(np.array([0.0, m.duration]))
+        a, b = mobile.x(ends[0], travel), mobile.x(ends[1], travel)
+        if not checker.motion_free(a, b, CERTIFY_STEP) or checker.first_collision(b) is not None:
+            where = ", ".join(f"{v:.3f}" for v in ends[0])
+            raise PlanningError("certify", f"the base path collides in its 3-D check ({m.kind} "
+                                f"from {where}): the floor plan missed an object")  # fmt: skip
+
+
+def plan_whole(mobile: MobileRobot, goal: BaseGoal, options: PlanOptions) -> WholePlan:
+    """Place, drive, reach (see the module docstring); PlanningError when any step fails."""
+    drive = drive_params(mobile)
+    limits = drive_limits(mobile, drive)
+    travel = _travel(mobile, goal.arm_start)
+    outline, top = robot_outline(mobile, travel)
+    floor = FloorPlan(outline, obstacles(mobile, top))
+    t0 = time.perf_counter()
+    paths = _Paths(floor, goal.start, limits.half_track, options.seed)
+    placement = place(mobile, goal.target, goal.start, tolerance=goal.tolerance,
+                      seed=options.seed, park=floor.free, accept=paths)  # fmt: skip
+    path = paths.found[placement.verdict.base]
+    timing = time_path(path, limits)
+    t1 = time.perf_counter()
+    _certify(mobile, timing, travel)
+    t2 = time.perf_counter()
+    ctx = planning_context(mobile.arm_robot(placement.verdict.base), mobile.world,
+                           mobile.disabled)  # fmt: skip
+    arm = plan_motion(ctx, travel, placement.verdict.q, options)
+    return WholePlan(mobile, drive, placement, path, timing, travel, arm, t1 - t0, t2 - t1)
+
+
+def files(plan: WholePlan, out_dir: Path, comment: str) -> dict[Path, bytes]:
+    """arm.yaml, cmd_vel.yaml and path.yaml of the plan, by path under `out_dir`."""
+    from armcli.plan.mobile.basefiles import cmd_vel_yaml, path_yaml
+    from armcli.plan.output import trajectory_yaml
+
+    root = plan.mobile.robot_file.robot
+    children = {j.child for j in root.joints}
+    frame = next((lk.name for lk in root.links if lk.name not in children), "")
+    return {
+        out_dir / "arm.yaml": trajectory_yaml(
+            plan.mobile.arm, plan.arm_timed, frame_id=frame, comment=comment
+        ),
+        out_dir / "cmd_vel.yaml": cmd_vel_yaml(plan.timing, comment),
+        out_dir / "path.yaml": path_yaml(plan.timing, comment),
+    }
