@@ -118,18 +118,18 @@ def _check(mobile: MobileRobot, ref: Reference, target: np.ndarray, start: np.nd
     try:
         p = place(mobile, target, start, tolerance=TOLERANCE)
     except PlacementError as exc:
-        if (
-            target[2] > SHOULDER[2] + L1 + L2 + TOLERANCE + REACH_BAND
-        ):  # above the closed form's top
-            return "" if "above the tool's reach" in exc.reason else f"reason: {exc.reason}"
+        top = SHOULDER[2] + L1 + L2  # the closed form's highest tool point: the arm upright
+        reasons = []
+        if target[2] > top + TOLERANCE + REACH_BAND:
+            reasons.append("above the tool's reach")
         if _deeply_inside(ref, target):
-            return "" if "inside" in exc.reason else f"reason: {exc.reason}"
+            reasons.append("inside")
+        if reasons:  # either reason is right when both hold
+            return "" if any(r in exc.reason for r in reasons) else f"reason: {exc.reason}"
         found = _grid_reaches(ref, target)
-        return (
-            ""
-            if found is None
-            else f"not placed ({exc.reason}) but the grid reaches it from {found}"
-        )
+        if found is None:
+            return ""
+        return f"not placed ({exc.reason}) but the grid reaches it from {found}"
     pose = np.array(p.verdict.base)
     if ref.classify(pose[None, :], target)[0] == INFEASIBLE:
         return f"placed at {pose}, infeasible for the reference"

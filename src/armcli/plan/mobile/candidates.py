@@ -28,12 +28,13 @@ from armcli.robot import sampling
 
 # (planar arm: values of the first joint over its range, [rad] between candidate yaws): a
 # coarse pass first; the fine one only when the coarse finds no pose (a sliver of free floor)
-PASSES = ((46, math.radians(3.0)), (361, math.radians(0.5)))
+PASSES = ((46, math.radians(3.0)), (181, math.radians(0.5)))
 CHUNK = 256  # candidates sorted at a time
 ARC_SAMPLES = 181  # planar arm above or below its reach: samples per boundary arc
 ARM_DRAWS = 2048  # other arms: seeded configurations sampled
 ARM_KEPT = 48  # ... of which the nearest in height are candidates
 HEIGHT_FIRST = 1e3  # [m of driving per m of tool miss]: the nearer approach always wins
+TIER = 1e3  # [m of driving]: a planar family's tiers never mix
 OFF_PLANE = (-0.95, -0.5, 0.5, 0.95)  # shares of the tolerance a planar arm's base stands off
 
 
@@ -43,9 +44,9 @@ class Family:
 
     q: np.ndarray
     p: np.ndarray
-    miss: np.ndarray  # [m] |tool z - target z| (0 for exact configurations)
-    exact: bool  # the configurations reach the target's height exactly (closed form)
+    miss: np.ndarray  # [m] |tool z - target z| (0 at the target's height)
     lateral: np.ndarray | None = None  # base-frame direction the tool cannot move (planar arm)
+    nearest: np.ndarray | None = None  # (K,) bool: the configuration is the pose's nearest
 
     @property
     def lateral_xy(self) -> tuple[float, float]:
@@ -56,22 +57,33 @@ class Family:
 
 
 def planar_family(judge: Judge, samples: int) -> Family:
-    """Closed form: configurations at the target's height, else the nearest heights."""
+    """Closed form: configurations at the target's height, and on the reach's boundary.
+
+    At the target's exact height, each configuration is the nearest approach from its
+    poses. A target the tool only comes near (above the top of the reach, or one whose
+    exact approaches all collide) is nearest to the reach's boundary from a pose that puts
+    it beyond the reach: the boundary's configurations within the tolerance in height
+    stand for those poses (judged afresh there, `Candidate.nearest` False).
+    """
     arm = judge.mobile.planar
     assert arm is not None
     w = float(judge.target[2] - arm.shoulder[2])
     q, _ = arm.at_height(w, samples)
-    if len(q):
-        return Family(q, arm.points(q), np.zeros(len(q)), True, arm.axis)
-    boundary = []  # above or below the reach: along the boundary arcs, nearest heights
+    boundary = []
     for start, k, span in arm.arcs():
         for t in np.linspace(0.0, span, ARC_SAMPLES):
             x = start.copy()
             x[k] += t
             boundary.append(x)
-    q = np.array(boundary)
-    p = arm.points(q)
-    return Family(q, p, np.abs(p[:, 2] - judge.target[2]), True, arm.axis)
+    qb = np.array(boundary)
+    miss_b = np.abs(arm.points(qb)[:, 2] - judge.target[2])
+    keep = miss_b <= judge.tolerance
+    qa = np.concatenate([q, qb[keep]])
+    miss = np.concatenate([np.zeros(len(q)), miss_b[keep]])
+    nearest = np.concatenate([np.ones(len(q), dtype=bool), np.zeros(int(keep.sum()), bool)])
+    if not len(qa):  # out of reach in height: the boundary tells how far
+        qa, miss, nearest = qb, miss_b, np.zeros(len(qb), dtype=bool)
+    return Family(qa, arm.points(qa), miss, arm.axis, nearest)
 
 
 def sampled_family(judge: Judge, seed: int) -> Family:
@@ -88,7 +100,7 @@ def sampled_family(judge: Judge, seed: int) -> Family:
         p[i] = pin.updateFramePlacement(robot.model, data, robot.tool_frame).act(robot.tool_offset)
     miss = np.abs(p[:, 2] - judge.target[2])
     keep = np.argsort(miss, kind="stable")[:ARM_KEPT]
-    return Family(rows[keep], p[keep], miss[keep], False)
+    return Family(rows[keep], p[keep], miss[keep])
 
 
 @dataclass(frozen=True)
@@ -97,8 +109,9 @@ class Candidate:
 
     base: tuple[float, float, float]
     q: np.ndarray
-    miss: float  # [m] the configuration's height miss (exact: the tool error)
+    miss: float  # [m] how far the configuration's tool is from the target at this pose
     cost: float  # [m] wheel travel from the start
+    nearest: bool  # q is the nearest approach at this pose (a planar arm at the exact height)
 
 
 def ordered(
@@ -108,11 +121,13 @@ def ordered(
     turn_radius: float,
     step: float,
     tolerance: float,
-) -> Iterator[Candidate]:
-    """Every (configuration, yaw every `step`) of the family as a base pose, cheapest first.
+) -> Iterator[list[Candidate]]:
+    """Every (configuration, yaw every `step`) of the family as a base pose, in chunks.
 
-    With a planar family, each pose also stood off sideways by OFF_PLANE shares of the
-    tolerance (the tool then misses by that much): tried after every pose on the plane.
+    A planar family's poses come in tiers, each cheapest driving first: at the target's
+    height on the plane, then stood off sideways by OFF_PLANE shares of the tolerance (the
+    tool misses by that much), then the reach boundary's near misses. Poses whose miss is
+    beyond the tolerance are left out. Another arm's come nearest in height first.
     """
     yaw = np.arange(-math.pi, math.pi, step)
     c, s = np.cos(yaw)[None, None, :], np.sin(yaw)[None, None, :]
@@ -126,7 +141,14 @@ def ordered(
     yaws = np.broadcast_to(yaw, bx.shape)
     drive = driving_cost(start, bx, by, yaws, turn_radius).ravel()
     miss = np.sqrt(family.miss[None, :] ** 2 + offsets[:, None] ** 2)  # (offsets, configurations)
-    left = drive + HEIGHT_FIRST * np.repeat(miss.ravel(), len(yaw))  # nearer first
+    near = np.ones(len(family.q), bool) if family.nearest is None else family.nearest
+    if family.nearest is not None:
+        tier = np.where(near[None, :], (offsets[:, None] != 0).astype(float), 2.0)
+        key = TIER * tier
+    else:
+        key = HEIGHT_FIRST * miss
+    key = np.where(miss <= tolerance, key, np.inf)
+    left = drive + np.repeat(key.ravel(), len(yaw))
     n_yaw, n_q = len(yaw), len(family.q)
     while True:
         k = min(CHUNK, int(np.count_nonzero(np.isfinite(left))))
@@ -136,8 +158,11 @@ def ordered(
         idx = idx[np.argsort(left[idx], kind="stable")]
         idx = idx[np.isfinite(left[idx])]
         left[idx] = np.inf
+        chunk = []
         for flat in idx:
             dq, j = divmod(int(flat), n_yaw)
             d, i = divmod(dq, n_q)
-            yield Candidate((float(bx.flat[flat]), float(by.flat[flat]), float(yaw[j])),
-                            family.q[i], float(miss[d, i]), float(drive[flat]))  # fmt: skip
+            chunk.append(Candidate((float(bx.flat[flat]), float(by.flat[flat]), float(yaw[j])),
+                                   family.q[i], float(miss[d, i]), float(drive[flat]),
+                                   family.nearest is not None and bool(near[i])))  # fmt: skip
+        yield chunk

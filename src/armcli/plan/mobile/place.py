@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import time
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -102,12 +102,14 @@ def place(
     judge = Judge(mobile, goal, tolerance, park)
     best, tally = None, Counter[str]()
     for samples, step in PASSES:
+        judge.checks = 0  # each pass has its budget (MAX_CHECKS)
         if mobile.planar is not None:
             family = planar_family(judge, samples)
         else:
             family = sampled_family(judge, seed)
         _refuse_out_of_reach(mobile, judge, family)
-        best, tally = _search(judge, family, begin, turn_radius(mobile), step, accept)
+        best, more = _search(judge, family, begin, turn_radius(mobile), step, accept)
+        tally += more
         if best is not None or mobile.planar is None:
             break
     if best is None:
@@ -123,7 +125,7 @@ def _refuse_out_of_reach(mobile: MobileRobot, judge: Judge, family: Family) -> N
     """Above or below the tool's reach: the highest (lowest) point it reaches."""
     if len(family.miss) and float(np.min(family.miss)) <= judge.tolerance:
         return
-    z = family.p[:, 2]
+    z = family.p[:, 2]  # the boundary's configurations span the reach's heights
     high = float(judge.target[2]) > float(np.max(z))
     if mobile.planar is not None:
         lo, hi = mobile.planar.height_range()
@@ -145,22 +147,38 @@ def _search(
     step: float,
     accept: Callable[[Verdict], bool] | None,
 ) -> tuple[tuple[Verdict, float] | None, Counter[str]]:
-    """The first serving (and accepted) candidate in cost order, and why others were not."""
+    """The first serving (and accepted) candidate in order, and why others were not."""
     tally: Counter[str] = Counter()
-    for c in ordered(family, judge.target, start, radius, step, judge.tolerance):
-        if c.miss > judge.tolerance or judge.checks >= MAX_CHECKS:
-            break
-        v = _judge(judge, c, family.exact)
-        if v.ok and (accept is None or accept(v)):
-            return (v, c.cost), tally
-        tally[_blocker(judge.mobile, v) if not v.ok else "path"] += 1
+    for chunk in ordered(family, judge.target, start, radius, step, judge.tolerance):
+        for c, v in zip(chunk, _verdicts(judge, chunk), strict=False):
+            if judge.checks >= MAX_CHECKS:
+                return None, tally
+            if v.ok and (accept is None or accept(v)):
+                return (v, c.cost), tally
+            tally[_blocker(judge.mobile, v) if not v.ok else "path"] += 1
     return None, tally
 
 
-def _judge(judge: Judge, c: Candidate, exact: bool) -> Verdict:
-    if exact:
-        return judge.judge(c.base, c.q, c.miss)
-    return judge.at(c.base, c.q)  # corrected by inverse kinematics at that base pose
+def _verdicts(judge: Judge, chunk: list[Candidate]) -> Iterator[Verdict]:
+    """Each candidate's verdict with the arm at its nearest approach from that pose.
+
+    A planar arm's configuration at the target's exact height is that approach already
+    (stood off sideways, it misses by the stand-off); a planar arm's other candidates get
+    theirs in one batch (`Judge.reach`), another arm's one by one (inverse kinematics).
+    """
+    later = [c for c in chunk if not c.nearest]
+    batch = judge.mobile.planar is not None and bool(later)
+    found = {id(c): k for k, c in enumerate(later)}
+    if batch:
+        q, errors = judge.reach(np.array([c.base for c in later]), later[0].q)
+    for c in chunk:
+        if c.nearest:
+            yield judge.judge(c.base, c.q, c.miss)
+        elif batch:
+            k = found[id(c)]
+            yield judge.best(c.base, q[k], errors[k])
+        else:
+            yield judge.at(c.base, c.q)
 
 
 def _blocker(mobile: MobileRobot, v: Verdict) -> str:

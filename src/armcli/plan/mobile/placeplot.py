@@ -56,12 +56,14 @@ def _serving(judge: Judge, start: Sequence[float], radius: float) -> np.ndarray:
     family = (
         planar_family(judge, samples) if mobile.planar is not None else sampled_family(judge, 0)
     )
-    out = []
-    for k, c in enumerate(ordered(family, judge.target, start, radius, step, judge.tolerance)):
-        if k >= MAX_SHADED:
+    out, seen = [], 0
+    for chunk in ordered(family, judge.target, start, radius, step, judge.tolerance):
+        for c in chunk:
+            seen += 1
+            if c.nearest and judge.judge(c.base, c.q, c.miss).ok:
+                out.append(c.base[:2])
+        if seen >= MAX_SHADED:
             break
-        if c.miss <= judge.tolerance and judge.judge(c.base, c.q, c.miss).ok:
-            out.append(c.base[:2])
     return np.array(out).reshape(-1, 2)
 
 
