@@ -135,26 +135,45 @@ def _certify(mobile: MobileRobot, timing: BaseTiming, travel: np.ndarray) -> Non
                                 f"from {where}): the floor plan missed an object")  # fmt: skip
 
 
-def plan_whole(mobile: MobileRobot, goal: BaseGoal, options: PlanOptions) -> WholePlan:
-    """Place, drive, reach (see the module docstring); PlanningError when any step fails."""
-    drive = drive_params(mobile)
-    limits = drive_limits(mobile, drive)
+@dataclass(frozen=True)
+class Drive:
+    """Where the base parks, its path there and its timing, certified."""
+
+    params: DriveParams
+    placement: Placement
+    path: BasePath
+    timing: BaseTiming
+    travel: np.ndarray
+    planning_time_s: float  # placement, path and timing
+    certify_time_s: float
+
+
+def plan_drive(mobile: MobileRobot, goal: BaseGoal, seed: int = 0) -> Drive:
+    """Where to park and the certified, timed path there (see the module docstring)."""
+    params = drive_params(mobile)
+    limits = drive_limits(mobile, params)
     travel = _travel(mobile, goal.arm_start)
     outline, top = robot_outline(mobile, travel)
     floor = FloorPlan(outline, obstacles(mobile, top))
     t0 = time.perf_counter()
-    paths = _Paths(floor, goal.start, limits.half_track, options.seed)
-    placement = place(mobile, goal.target, goal.start, tolerance=goal.tolerance,
-                      seed=options.seed, park=floor.free, accept=paths)  # fmt: skip
+    paths = _Paths(floor, goal.start, limits.half_track, seed)
+    placement = place(mobile, goal.target, goal.start, tolerance=goal.tolerance, seed=seed,
+                      park=floor.free, accept=paths)  # fmt: skip
     path = paths.found[placement.verdict.base]
     timing = time_path(path, limits)
     t1 = time.perf_counter()
     _certify(mobile, timing, travel)
-    t2 = time.perf_counter()
-    ctx = planning_context(mobile.arm_robot(placement.verdict.base), mobile.world,
+    return Drive(params, placement, path, timing, travel, t1 - t0, time.perf_counter() - t1)
+
+
+def plan_whole(mobile: MobileRobot, goal: BaseGoal, options: PlanOptions) -> WholePlan:
+    """Place, drive, reach (see the module docstring); PlanningError when any step fails."""
+    d = plan_drive(mobile, goal, options.seed)
+    ctx = planning_context(mobile.arm_robot(d.placement.verdict.base), mobile.world,
                            mobile.disabled)  # fmt: skip
-    arm = plan_motion(ctx, travel, placement.verdict.q, options)
-    return WholePlan(mobile, drive, placement, path, timing, travel, arm, t1 - t0, t2 - t1)
+    arm = plan_motion(ctx, d.travel, d.placement.verdict.q, options)
+    return WholePlan(mobile, d.params, d.placement, d.path, d.timing, d.travel, arm,
+                     d.planning_time_s, d.certify_time_s)  # fmt: skip
 
 
 def files(plan: WholePlan, out_dir: Path, comment: str) -> dict[Path, bytes]:
