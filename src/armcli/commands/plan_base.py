@@ -37,10 +37,10 @@ def plan_base(
 ) -> None:
     """Plan the base and the arm (plan.mobile.whole), write -o DIR's files, print."""
     from armcli.io.outdir import check_output_file
+    from armcli.io.scene import require_file
     from armcli.plan.api import PlanOptions
     from armcli.plan.mobile.virtual import load_mobile
     from armcli.plan.mobile.whole import BaseGoal, files, plan_whole
-    from armcli.plan.scene import require_file
 
     if to_xyz is None:
         raise InputError("--base plans for a point: give --to-xyz X,Y,Z", field="--to-xyz")

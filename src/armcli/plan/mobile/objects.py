@@ -14,7 +14,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from armcli.analysis.support import convex_hull
-from armcli.plan.scene import Scene, SceneObject, Shape
+from armcli.io.scene import Scene, SceneObject, Shape
 
 CIRCLE_POINTS = 32  # a round outline's polygon
 

@@ -14,10 +14,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from armcli.io.scene import require_file
 from armcli.plan.mobile.nav2 import nav2_goal
 from armcli.plan.mobile.place import TOLERANCE, Placement, place
 from armcli.plan.mobile.virtual import MobileRobot, load_mobile
-from armcli.plan.scene import require_file
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import RobotFile
 

@@ -21,10 +21,10 @@ from numpy.typing import ArrayLike
 
 from armcli.analysis.stance import NoStance, Stance, stance_of
 from armcli.errors import InputError
+from armcli.io.scene import Scene, SceneObject, Shape, load_scene
 from armcli.plan.collision import CollisionChecker
 from armcli.plan.mobile.planar import PlanarArm, planar_arm
 from armcli.plan.robot import MOVABLE, PlanRobot, load_plan_robot
-from armcli.plan.scene import Scene, SceneObject, Shape, load_scene
 from armcli.plan.srdf import allowed_pairs
 from armcli.robot.tool import tool_point
 from armcli.urdf.doc import Joint, Urdf
