@@ -37,6 +37,7 @@ BASE_HELP = (
     "Also drive the base (a differential drive): where to park for --to-xyz, the path there, "
     "then the arm; -o is then a directory for arm.yaml, cmd_vel.yaml and path.yaml."
 )
+TOLERANCE_HELP = "With --base --execute: the tool farther from the target [m] fails the run"
 BASE_START_HELP = "With --base: where the base stands, x,y,yaw [m, m, rad] (default: 0,0,0)."
 FLAGS = {
     "start": "--from",
@@ -92,6 +93,7 @@ def plan_cmd(
     fmt: str = choice("text", FORMATS, "--format", help="Output format (default: text)."),
     execute: bool = option(False, "--execute", help=EXECUTE_HELP),
     base: bool = option(False, "--base", help=BASE_HELP),
+    tolerance: float = option(0.02, "--tolerance", help=TOLERANCE_HELP),
     base_start: Numbers = option(
         None,
         "--base-start",
@@ -109,7 +111,7 @@ def plan_cmd(
         from armcli.commands.plan_base import plan_base
 
         plan_base(robot, urdf, scene, start, to_xyz, base_start, planner, timeout, seed, output,
-                  fmt, execute)  # fmt: skip
+                  fmt, execute, tolerance)  # fmt: skip
         return
     request = PlanRequest(start, goal, to_xyz, to_rpy, srdf, scene, joints or None, group)
     if output is not None:

@@ -14,11 +14,13 @@ from armcli.errors import InputError, PlanningError
 from armcli.io.terminal import say
 
 if TYPE_CHECKING:
+    from armcli.plan.mobile.execute import Executed
     from armcli.plan.mobile.whole import WholePlan
     from armcli.urdf.source import RobotInput
 
 FLAGS = {"base": "--base", "start": "--from", "target": "--to-xyz", "tolerance": "--tolerance"}
 FILES = ("arm.yaml", "cmd_vel.yaml", "path.yaml")
+RUN_FILES = ("run.csv", "run.mcap")
 
 
 def plan_base(
@@ -34,6 +36,7 @@ def plan_base(
     output: Path | None,
     fmt: str,
     execute: bool,
+    tolerance: float = 0.02,
 ) -> None:
     """Plan the base and the arm (plan.mobile.whole), write -o DIR's files, print."""
     from armcli.io.outdir import check_output_file
@@ -44,8 +47,11 @@ def plan_base(
 
     if to_xyz is None:
         raise InputError("--base plans for a point: give --to-xyz X,Y,Z", field="--to-xyz")
+    if execute and output is None:
+        raise InputError("--execute with --base writes run.csv and run.mcap: give -o DIR",
+                         field="--execute")  # fmt: skip
     if output is not None:
-        for name in FILES:
+        for name in FILES + (RUN_FILES if execute else ()):
             check_output_file(output / name, "--output", parents=True)
     if scene is not None:
         require_file(scene)
@@ -70,12 +76,63 @@ def plan_base(
         from armcli.io.together import write_files_together
 
         write_files_together(written, parents=True)
-    if execute:
-        raise InputError("--execute with --base is not available yet", field="--execute")
+    done = _execute(whole, output, written, tolerance) if execute and output else None
     if fmt == "json":
-        _json(document(whole, output, planner, seed))
+        doc = document(whole, output, planner, seed)
+        if done is not None:
+            doc["execute"] = executed(done)
+        _json(doc)
     else:
-        say("\n".join([*lines(whole, what, planner, seed), *(f"wrote {p}" for p in written)]))
+        text = [*lines(whole, what, planner, seed), *(f"wrote {p}" for p in written)]
+        if done is not None and output is not None:
+            text += executed_lines(done, output)
+        say("\n".join(text))
+    if done is not None and done.failed:
+        raise typer.Exit(1)
+
+
+def _execute(whole: WholePlan, out: Path, written: dict[Path, bytes], tolerance: float
+             ) -> Executed:  # fmt: skip
+    from armcli.io.together import write_files_together
+    from armcli.plan.mobile.execute import execute_whole, run_files
+
+    done = execute_whole(whole, out / "cmd_vel.yaml", written[out / "arm.yaml"], tolerance)
+    write_files_together(run_files(whole, done, out), parents=True)
+    return done
+
+
+def executed(done: Executed) -> dict[str, Any]:
+    """The execution's JSON fields."""
+    return {
+        "failed": done.failed,
+        "problems": list(done.problems),
+        "tool_error_m": done.tool_error,
+        "base_error_m": done.base_error[0],
+        "base_yaw_error_rad": done.base_error[1],
+        "arrived_s": done.arrived,
+        "peak_effort": {n: p for n, (p, _) in done.peak_effort.items()},
+        "effort_limit": {n: e for n, (_, e) in done.peak_effort.items()},
+        "tips": done.verdict.tips,
+        "real_time_factor": float(done.run.t[-1] / max(done.run.wall_time, 1e-9)),
+    }
+
+
+def executed_lines(done: Executed, out: Path) -> list[str]:
+    """The execution's text summary."""
+    run = done.run
+    efforts = ", ".join(f"{n} {p:.3g} of {e:g}" for n, (p, e) in done.peak_effort.items())
+    return [
+        f"executed on the MuJoCo drive ({run.t[-1]:.2f} s in {run.wall_time:.2f} s): "
+        f"tool {done.tool_error * 1e3:.1f} mm from the target (ground truth)",
+        f"  base: {done.base_error[0] * 1e3:.1f} mm and "
+        f"{math.degrees(done.base_error[1]):.2f}° off its goal; arrived at "
+        + (f"{done.arrived:.2f} s" if done.arrived is not None else "never"),
+        f"  peak efforts: {efforts}",
+        f"  {done.verdict.line()}",
+        *(f"  failed: {p}" for p in done.problems),
+        f"wrote {out / 'run.csv'}",
+        f"wrote {out / 'run.mcap'}",
+    ]
 
 
 def document(w: WholePlan, output: Path | None, planner: str, seed: int) -> dict[str, Any]:

@@ -26,8 +26,13 @@ ODOM, CMD_VEL = "/odom", "/cmd_vel"
 COVARIANCE = {0: 1e-5, 7: 1e-5, 14: 1e12, 21: 1e12, 28: 1e12, 35: 1e-3}
 
 
-def mcap_bytes(run: DriveRun, cols: dict[str, np.ndarray], rate: float) -> bytes:
-    """The run as rosbag2 MCAP bytes (sim.rosbag's topics plus the drive's)."""
+def mcap_bytes(
+    run: DriveRun,
+    cols: dict[str, np.ndarray],
+    rate: float,
+    more: Sequence[rosbag.Channel] = (),
+) -> bytes:
+    """The run as rosbag2 MCAP bytes (sim.rosbag's topics plus the drive's, plus `more`)."""
     job = run.job
     wheels = [job.params.left_joint, job.params.right_joint]
     chans = rosbag.channels(cols, [*job.arm.arm.joint_names, *wheels], job.robot)
@@ -50,7 +55,7 @@ def mcap_bytes(run: DriveRun, cols: dict[str, np.ndarray], rate: float) -> bytes
     k = sample_steps(run.steps, job.dt, rate)
     chans.append(rosbag.Channel(ODOM, ODOMETRY, rosbag.qos(10, False), _odometry(run, k, stamps)))
     chans.append(rosbag.Channel(CMD_VEL, TWIST, rosbag.qos(10, False), _cmd_vel(run)))
-    return rosbag.mcap_bytes(chans)
+    return rosbag.mcap_bytes([*chans, *more])
 
 
 def _tf(parent: str, child: str, ns: int, xyz: Any, quat: Sequence[float]) -> Any:

@@ -68,6 +68,7 @@ class WholePlan:
     arm: PlanResult  # at the base's goal, from `travel` to the placement's configuration
     base_planning_time_s: float  # placement, path and timing (not the certification)
     base_certify_time_s: float
+    goal: BaseGoal
 
     @property
     def arm_timed(self) -> Timed:
@@ -146,6 +147,7 @@ class Drive:
     travel: np.ndarray
     planning_time_s: float  # placement, path and timing
     certify_time_s: float
+    goal: BaseGoal
 
 
 def plan_drive(mobile: MobileRobot, goal: BaseGoal, seed: int = 0) -> Drive:
@@ -163,7 +165,7 @@ def plan_drive(mobile: MobileRobot, goal: BaseGoal, seed: int = 0) -> Drive:
     timing = time_path(path, limits)
     t1 = time.perf_counter()
     _certify(mobile, timing, travel)
-    return Drive(params, placement, path, timing, travel, t1 - t0, time.perf_counter() - t1)
+    return Drive(params, placement, path, timing, travel, t1 - t0, time.perf_counter() - t1, goal)
 
 
 def plan_whole(mobile: MobileRobot, goal: BaseGoal, options: PlanOptions) -> WholePlan:
@@ -173,7 +175,7 @@ def plan_whole(mobile: MobileRobot, goal: BaseGoal, options: PlanOptions) -> Who
                            mobile.disabled)  # fmt: skip
     arm = plan_motion(ctx, d.travel, d.placement.verdict.q, options)
     return WholePlan(mobile, d.params, d.placement, d.path, d.timing, d.travel, arm,
-                     d.planning_time_s, d.certify_time_s)  # fmt: skip
+                     d.planning_time_s, d.certify_time_s, goal)  # fmt: skip
 
 
 def files(plan: WholePlan, out_dir: Path, comment: str) -> dict[Path, bytes]:
