@@ -29,6 +29,9 @@ from tests.plan.mobile.reference import INFEASIBLE, Reference, read_objects
 from tests.plan.mobile.test_place import CLUTTERED
 
 REACHED = 1e-3  # [m] the integrated commands end this near the placed pose (the issue's bound)
+# specs/my_robot.yaml: the wheel joints at (-0.15, +-0.225) in base_link, whose origin is
+# above base_footprint's: /cmd_vel moves the wheels' midpoint, 0.15 m behind base_footprint.
+AXLE = np.array([-0.15, 0.0])
 YAW_REACHED = 1e-3  # [rad]
 SAMPLES_PER_COMMAND = 3  # poses checked per held command (<= 2 mm apart at 0.3 m/s, 50 Hz)
 # Targets around the cluttered room's objects (its file): on the table, beside the crate,
@@ -42,6 +45,13 @@ STARTS = [(0.0, 0.0, 0.0), (-0.5, -0.5, 1.0), (0.6, 0.6, -2.0)]
 @pytest.fixture(scope="module")
 def cluttered() -> MobileRobot:
     return load_mobile(read_robot(DEFAULT_SPEC), scene=CLUTTERED)
+
+
+def shifted(pose: np.ndarray, offset: np.ndarray) -> np.ndarray:
+    """Poses (..., 3) of the point `offset` (base frame) of bases at `pose`."""
+    c, s = np.cos(pose[..., 2]), np.sin(pose[..., 2])
+    return np.stack([pose[..., 0] + c * offset[0] - s * offset[1],
+                     pose[..., 1] + s * offset[0] + c * offset[1], pose[..., 2]], axis=-1)  # fmt: skip
 
 
 def integrate(commands: list[dict], start: tuple[float, float, float]) -> tuple[
@@ -90,8 +100,10 @@ def test_the_base_path_reaches_the_pose_and_touches_nothing(
     for target in TARGETS:
         w = _drive(cluttered, target, start)
         commands = yaml.safe_load(cmd_vel_yaml(w.timing))["commands"]
-        end, along = integrate(commands, start)
-        goal = np.array(w.placement.verdict.base)
+        x0, y0, th0 = shifted(np.array(start, dtype=float), AXLE)  # the commands' point
+        end, along = integrate(commands, (x0, y0, th0))
+        along = shifted(along, -AXLE)  # the base's poses, for the collision check
+        goal = shifted(np.array(w.placement.verdict.base), AXLE)
         assert np.hypot(*(end[:2] - goal[:2])) <= REACHED, target
         assert abs(math.remainder(end[2] - goal[2], 2 * math.pi)) <= YAW_REACHED, target
         travel = np.repeat(w.travel[None, :], len(along), axis=0)

@@ -1,8 +1,10 @@
 """The base plan's files: /cmd_vel commands as `simulate --cmd-vel` reads them, a nav_msgs/Path.
 
 Deterministic text: floats in Python's shortest round-trip repr, times as {sec, nanosec}
-(as ROS writes them), no timestamps of the run. The path's poses are the planned poses
-every PATH_PERIOD and at the end of every turn and leg, in the scene's world frame.
+(as ROS writes them), no timestamps of the run. The commands are the twist of the wheels'
+midpoint, as the plugin reads /cmd_vel; the path's poses are the base frame's (the robot's
+`robot_base_frame`), every PATH_PERIOD and at the end of every turn and leg, in the scene's
+world frame.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import numpy as np
 
 from armcli.plan.mobile.basetime import BaseTiming
 from armcli.plan.mobile.nav2 import FRAME
+from armcli.plan.mobile.wheels import to_base
 
 PATH_PERIOD = 0.1  # [s] between two poses of the nav_msgs/Path
 
@@ -47,10 +50,13 @@ def path_times(timing: BaseTiming) -> np.ndarray:
     return np.unique(np.round(np.concatenate([grid, [0.0], ends]), 9))
 
 
-def path_yaml(timing: BaseTiming, comment: str = "") -> bytes:
-    """nav_msgs/Path of the planned poses (see the module docstring)."""
+def path_yaml(timing: BaseTiming, axle: np.ndarray, comment: str = "") -> bytes:
+    """nav_msgs/Path of the base frame's planned poses (see the module docstring).
+
+    The timing is the wheels' midpoint's, `axle` (x, y) [m] in the base frame.
+    """
     t = path_times(timing)
-    poses = timing.pose_at(t)
+    poses = to_base(timing.pose_at(t), axle)
     frame = json.dumps(FRAME)
     lines = [f"# {c}" for c in comment.splitlines() if c]
     lines += [f"header: {{frame_id: {frame}}}", "poses:"]

@@ -30,6 +30,13 @@ TURN_EPS = 1e-9  # [rad] a smaller turn is none
 TURN_STEP = math.radians(5.0)  # [rad] a turn is checked every this much, objects grown to match
 MARGIN = 2.0  # [outline radii] the roadmap's area beyond the objects, start and goal
 APPROACH = (0.25, 0.5, 0.8, 1.2)  # [m] roadmap points ahead of and behind the start and goal
+# A turn in place scrubs: MuJoCo's drive turns 1.3-3 % short of its encoders and its wheels'
+# midpoint slides (plan.mobile.pursuit). The search weighs a radian of turn as TURN_WEIGHT
+# of driving (more than the wheels' travel, half the track) and the straight path is taken
+# only if its turn at the goal is at most MAX_FINAL_TURN: the base arrives heading the
+# goal's way, and what the follower corrects there is along its heading.
+TURN_WEIGHT = 1.0  # [m per rad]
+MAX_FINAL_TURN = math.radians(20.0)
 
 
 @dataclass(frozen=True)
@@ -142,6 +149,11 @@ def _connects(plan: FloorPlan, path: list[tuple[float, float]], start_yaw: float
     return tuple(legs)
 
 
+def _final_turn(legs: tuple[Leg, ...], goal_yaw: float) -> float:
+    """[rad] the turn at the goal after the last leg."""
+    return abs(float(wrap(np.asarray(goal_yaw - legs[-1].yaw)))) if legs else 0.0
+
+
 def _halton(n: int, base: int, skip: int) -> np.ndarray:
     out = np.empty(n)
     for i in range(n):
@@ -226,12 +238,14 @@ def _shortcut(plan: FloorPlan, pts: list[tuple[float, float]], start_yaw: float,
               goal_yaw: float) -> tuple[Leg, ...]:  # fmt: skip
     """Greedy straight shortcuts: from each corner, the farthest later one reachable straight.
 
-    The turns where the shortened path meets the rest are checked at the end; should one
-    fail, the path found is kept as it is (it was checked leg by leg).
+    The last leg is kept (it arrives heading the goal's way). The turns where the shortened
+    path meets the rest are checked at the end; should one fail, the path found is kept as
+    it is (it was checked leg by leg).
     """
     out, i, yaw = [pts[0]], 0, start_yaw
     while i < len(pts) - 1:
-        for j in range(len(pts) - 1, i, -1):
+        last = len(pts) - 1 if i >= len(pts) - 2 else len(pts) - 2  # the last leg is kept
+        for j in range(last, i, -1):
             legs = _connects(plan, [pts[i], pts[j]], yaw, None)
             if legs is not None:
                 out.append(pts[j])
@@ -261,10 +275,13 @@ def plan_base_path(
         raise PlanningError("base-goal", "the robot at the goal pose overlaps an object")
     a, b = (start[0], start[1]), (goal[0], goal[1])
     direct = _connects(plan, [a, b], start[2], goal[2])
-    if direct is not None:
+    weight = max(half_track, TURN_WEIGHT)
+    if direct is not None and _final_turn(direct, goal[2]) <= MAX_FINAL_TURN:
         return BasePath(start, goal, direct)
     nodes = _roadmap(plan, start, goal, seed)
-    found = _search(plan, nodes, start[2], goal[2], half_track)
+    found = _search(plan, nodes, start[2], goal[2], weight)
+    if found is None and direct is not None:
+        return BasePath(start, goal, direct)
     if found is None:
         raise PlanningError(
             "base-path",

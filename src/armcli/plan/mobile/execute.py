@@ -20,6 +20,7 @@ import numpy as np
 from armcli.errors import InputError
 from armcli.io.scene import Scene, SceneObject
 from armcli.plan.mobile.pursuit import Pursuit, legs_in_odom
+from armcli.plan.mobile.wheels import to_base
 from armcli.plan.mobile.whole import WholePlan
 from armcli.sim import drive, driveout
 from armcli.sim.drive import DriveRun
@@ -31,6 +32,7 @@ TOLERANCE = 0.02  # [m] the tool farther than this from the target on the ground
 SLACK = 1.5  # the base may take this many times its planned time (plus SLACK_S) to arrive
 SLACK_S = 2.0  # [s]
 SETTLE_S = 1.0  # [s] simulated after the arm's last point
+LOCALIZE = 10.0  # [Hz] the localiser's rate, plan.mobile.pursuit
 STOP_SLACK = 0.005  # [rad or m] MuJoCo's soft joint limits: beyond by more is a broken limit
 
 
@@ -46,6 +48,7 @@ class Executed:
     arrived: float | None  # [s] when the follower had the base at its goal (odometry)
     peak_effort: dict[str, tuple[float, float]]  # joint -> (peak, limit) [N·m or N]
     problems: tuple[str, ...]  # a tip, a broken limit, a miss beyond the tolerance
+    odometry: tuple[float, float, float]  # the follower's encoder odometry at the end
 
     @property
     def failed(self) -> bool:
@@ -69,23 +72,32 @@ def start_frame(scene: Scene, start: tuple[float, float, float]) -> Scene:
     return Scene(tuple(objects), scene.source)
 
 
-def execute_whole(plan: WholePlan, cmd_vel: Path, arm_yaml: bytes,
-                  tolerance: float = TOLERANCE) -> Executed:  # fmt: skip
-    """Run the plan (its written cmd_vel.yaml and arm.yaml) on the drive and judge it."""
+def execute_whole(
+    plan: WholePlan,
+    cmd_vel: Path,
+    arm_yaml: bytes,
+    tolerance: float = TOLERANCE,
+    localize: float = LOCALIZE,
+) -> Executed:
+    """Run the plan (its written cmd_vel.yaml and arm.yaml) on the drive and judge it.
+
+    `localize` [Hz]: the localiser's rate (`plan.mobile.pursuit`); 0: encoders alone.
+    """
     mobile = plan.mobile
     spec = mobile.robot_file.spec
     if spec is None:
         raise InputError("--execute drives a spec's robot (its mobile_base.diff_drive)",
                          field="execute")  # fmt: skip
-    start = plan.path.start
+    start = plan.goal.start
     duration = SLACK * plan.timing.duration + SLACK_S + plan.arm.duration_s + SETTLE_S
     opts = SimOptions(message=arm_yaml.decode("utf-8"), gravity_comp=True, duration=duration)
     job = drive.prepare(spec, opts, cmd_vel, world=start_frame(mobile.scene, start))
-    pilot = Pursuit(legs_in_odom(plan.timing, start), plan.timing.motions,
+    pilot = Pursuit(legs_in_odom(plan.timing, plan.path.start), plan.timing.motions,
                     radius=job.params.radius, separation=job.params.separation, dt=job.dt,
                     period=job.params.period, speed=plan.timing.limits.speed,
                     accel=plan.timing.limits.accel, wheel_dof=job.model.wheel_dof,
-                    arrival_step=steps_of(plan.timing.duration, job.dt))  # fmt: skip
+                    arrival_step=steps_of(plan.timing.duration, job.dt), axle=plan.axle,
+                    localize=localize)  # fmt: skip
     run = drive.run(job, pilot=pilot)
     arm = driveout.arm_result(run, driveout.plot_steps_of(run.steps, job.dt, job.arm.rate))
     verdict = driveout.tip_verdict(run)
@@ -109,7 +121,7 @@ def _truth(plan: WholePlan, run: DriveRun) -> tuple[np.ndarray, np.ndarray]:
 
 def _judge(plan: WholePlan, run: DriveRun, arm: SimResult, verdict: TipVerdict,
            pilot: Pursuit, tolerance: float) -> Executed:  # fmt: skip
-    start = plan.path.start
+    start = plan.goal.start
     c, s = math.cos(start[2]), math.sin(start[2])
 
     def local(x: float, y: float) -> np.ndarray:
@@ -145,7 +157,8 @@ def _judge(plan: WholePlan, run: DriveRun, arm: SimResult, verdict: TipVerdict,
     if arrived is None:
         problems.append("the base did not arrive at its goal in the time given")
     peak = {n: (float(pk), float(e)) for n, pk, e in zip(names, peaks, effort, strict=True)}
-    return Executed(run, arm, verdict, tool_err, base_err, arrived, peak, tuple(problems))
+    odom = (float(pilot.pose[0]), float(pilot.pose[1]), float(pilot.pose[2]))
+    return Executed(run, arm, verdict, tool_err, base_err, arrived, peak, tuple(problems), odom)
 
 
 def run_files(plan: WholePlan, done: Executed, out_dir: Path) -> dict[Path, bytes]:
@@ -167,11 +180,11 @@ def plan_message(plan: WholePlan) -> dict[str, object]:
     from armcli.plan.mobile.basefiles import path_times
     from armcli.sim import rosbag
 
-    start = plan.path.start
+    start = plan.goal.start
     c, s = math.cos(start[2]), math.sin(start[2])
     t = path_times(plan.timing)
     poses = []
-    for tk, (x, y, yaw) in zip(t, plan.timing.pose_at(t), strict=True):
+    for tk, (x, y, yaw) in zip(t, to_base(plan.timing.pose_at(t), plan.axle), strict=True):
         dx, dy = x - start[0], y - start[1]
         rel = yaw - start[2]
         ns = round(float(tk) * 1e9)

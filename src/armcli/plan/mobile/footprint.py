@@ -37,8 +37,13 @@ def outline(points: np.ndarray, name: str = "") -> Outline:
     return Outline(hull, centre, float(np.max(np.linalg.norm(hull - centre, axis=1))), name)
 
 
-def robot_outline(mobile: MobileRobot, q: np.ndarray) -> tuple[Outline, float]:
-    """The robot's outline in its base frame with the arm at q, and its top [m]."""
+def robot_outline(
+    mobile: MobileRobot, q: np.ndarray, origin: np.ndarray | None = None
+) -> tuple[Outline, float]:
+    """The robot's outline with the arm at q, and its top [m].
+
+    In the base frame, or about `origin` (x, y in the base frame: the point it turns about).
+    """
     import pinocchio as pin
 
     robot = mobile.robot
@@ -54,7 +59,8 @@ def robot_outline(mobile: MobileRobot, q: np.ndarray) -> tuple[Outline, float]:
         M = gdata.oMg[k]
         corners.append(box @ np.asarray(M.rotation).T + np.asarray(M.translation))
     pts = np.concatenate(corners)
-    return outline(pts[:, :2], "robot"), float(pts[:, 2].max())
+    shift = np.zeros(2) if origin is None else np.asarray(origin, dtype=float)
+    return outline(pts[:, :2] - shift, "robot"), float(pts[:, 2].max())
 
 
 def obstacles(mobile: MobileRobot, top: float) -> list[Outline]:

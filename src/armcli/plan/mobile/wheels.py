@@ -12,7 +12,9 @@ TORQUE_SHARE of what max_wheel_torque gives the whole robot.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+
+import numpy as np
 
 from armcli.errors import InputError
 from armcli.plan.mobile.basetime import DEFAULT_SPEED, TORQUE_SHARE, DriveLimits
@@ -101,3 +103,40 @@ def drive_limits(mobile: MobileRobot, params: DriveParams) -> DriveLimits:
                      f"{accel:.3g} m/s² ({TORQUE_SHARE:g} of what the wheel torque "
                      "gives)")  # fmt: skip
     return DriveLimits(speed, accel, 0.5 * params.separation, params.period, tuple(notes))
+
+
+def axle_offset(mobile: MobileRobot, params: DriveParams) -> np.ndarray:
+    """(x, y) [m] of the wheels' midpoint in the base frame: the point a diff drive turns about.
+
+    /cmd_vel's twist is this point's, and the plugin's odometry integrates it; a turn in
+    place swings the base frame around it when the two differ (the course robot's wheels
+    are 0.15 m behind base_footprint).
+    """
+    import pinocchio as pin
+
+    model = mobile.robot.model
+    missing = [j for j in (params.left_joint, params.right_joint) if not model.existJointName(j)]
+    if missing:
+        raise InputError(f"the diff drive's joint {missing[0]!r} is not a joint of the robot",
+                         field="base")  # fmt: skip
+    data = model.createData()
+    arm = mobile.arm_robot()
+    rest = [arm.rest_of(j) for j in arm.joints]
+    pin.forwardKinematics(model, data, mobile.robot.q(mobile.x((0.0, 0.0, 0.0), rest)))
+    ends = [np.asarray(data.oMi[model.getJointId(j)].translation)[:2]
+            for j in (params.left_joint, params.right_joint)]  # fmt: skip
+    return np.asarray(0.5 * (ends[0] + ends[1]), dtype=float)
+
+
+def to_axle(pose: Sequence[float], c: np.ndarray) -> tuple[float, float, float]:
+    """The wheels' midpoint pose of a base pose (x, y, yaw)."""
+    co, si = math.cos(pose[2]), math.sin(pose[2])
+    return (float(pose[0] + co * c[0] - si * c[1]), float(pose[1] + si * c[0] + co * c[1]),
+            float(pose[2]))  # fmt: skip
+
+
+def to_base(poses: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Base poses (N, 3) of the wheels' midpoint poses (N, 3)."""
+    co, si = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+    return np.stack([poses[:, 0] - co * c[0] + si * c[1], poses[:, 1] - si * c[0] - co * c[1],
+                     poses[:, 2]], axis=1)  # fmt: skip

@@ -12,6 +12,7 @@ its goal. The arm's trajectory holds still until the base has arrived.
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 from dataclasses import dataclass
@@ -35,11 +36,12 @@ from armcli.plan.mobile.footprint import obstacles, robot_outline
 from armcli.plan.mobile.judge import Verdict
 from armcli.plan.mobile.place import TOLERANCE, Placement, place
 from armcli.plan.mobile.virtual import MobileRobot
-from armcli.plan.mobile.wheels import drive_limits, drive_params
+from armcli.plan.mobile.wheels import axle_offset, drive_limits, drive_params, to_axle, to_base
 from armcli.plan.timing import Timed
 from armcli.sim.diffdrive import DriveParams
 
 HOME = "home"
+RAMP_IN = 0.01  # [s] the arm's trajectory enters its first acceleration over this
 CERTIFY_STEP = 0.01  # [m or rad] the 3-D check along the base path
 MAX_PATHS = 6  # placements whose base path is tried before giving up
 NEAR_FAILED = (0.15, math.radians(30.0))  # [m, rad] a pose this near one without a path is skipped
@@ -69,18 +71,28 @@ class WholePlan:
     base_planning_time_s: float  # placement, path and timing (not the certification)
     base_certify_time_s: float
     goal: BaseGoal
+    axle: np.ndarray  # (x, y) [m] the wheels' midpoint in the base frame: the path's point
+    floor: FloorPlan
 
     @property
     def arm_timed(self) -> Timed:
-        """The arm's trajectory on the whole plan's clock: held until the base has arrived."""
+        """The arm's trajectory on the whole plan's clock: held until the base has arrived.
+
+        Two held points (at 0 and RAMP_IN before the arm's first): the interpolation between
+        the second and the arm's first (which starts at TOPP-RA's first acceleration) is
+        then RAMP_IN long, not the whole drive (a quintic over seconds to a non-zero
+        acceleration swings far).
+        """
         t0 = self.timing.duration
         a = self.arm.timed
         n = a.positions.shape[1]
+        hold = [0.0, max(t0 - RAMP_IN, 0.0)] if t0 > RAMP_IN else [0.0]
+        k = len(hold)
         return Timed(
-            np.concatenate([[0.0], a.times + t0]),
-            np.vstack([self.travel, a.positions]),
-            np.vstack([np.zeros(n), a.velocities]),
-            np.vstack([np.zeros(n), a.accelerations]),
+            np.concatenate([hold, a.times + t0]),
+            np.vstack([np.repeat(self.travel[None, :], k, axis=0), a.positions]),
+            np.vstack([np.zeros((k, n)), a.velocities]),
+            np.vstack([np.zeros((k, n)), a.accelerations]),
         )
 
 
@@ -99,8 +111,9 @@ class _Paths:
     """The placement's `accept`: a pose is taken when a base path to it is found (cached)."""
 
     def __init__(self, plan: FloorPlan, start: tuple[float, float, float], half: float,
-                 seed: int) -> None:  # fmt: skip
-        self.plan, self.start, self.half, self.seed = plan, start, half, seed
+                 seed: int, axle: np.ndarray) -> None:  # fmt: skip
+        self.plan, self.half, self.seed, self.axle = plan, half, seed, axle
+        self.start = to_axle(start, axle)
         self.found: dict[tuple[float, float, float], BasePath] = {}
         self.failed: list[tuple[float, float, float]] = []
 
@@ -116,22 +129,29 @@ class _Paths:
             raise PlanningError("base-path", f"no base path reaches any of the {MAX_PATHS} best "
                                 "poses that serve the target")  # fmt: skip
         try:
-            self.found[v.base] = plan_base_path(self.plan, self.start, v.base, self.half,
-                                                self.seed)  # fmt: skip
+            self.found[v.base] = plan_base_path(self.plan, self.start, to_axle(v.base, self.axle),
+                                                self.half, self.seed)  # fmt: skip
         except PlanningError:
             self.failed.append(v.base)
             return False
         return True
 
 
-def _certify(mobile: MobileRobot, timing: BaseTiming, travel: np.ndarray) -> None:
-    """Every turn and leg checked by the 3-D collision checker, CERTIFY_STEP apart."""
+def _certify(mobile: MobileRobot, timing: BaseTiming, travel: np.ndarray, axle: np.ndarray) -> None:
+    """Every turn and leg checked by the 3-D collision checker, CERTIFY_STEP apart.
+
+    The plan is the wheels' midpoint's; the robot checked is the base frame's pose, which
+    swings around that point in a turn (sampled finely, each short chord checked).
+    """
     checker: CollisionChecker = mobile.checker
     for m in timing.motions:
-        ends = m.pose_at(np.array([0.0, m.duration]))
-        a, b = mobile.x(ends[0], travel), mobile.x(ends[1], travel)
-        if not checker.motion_free(a, b, CERTIFY_STEP) or checker.first_collision(b) is not None:
-            where = ", ".join(f"{v:.3f}" for v in ends[0])
+        scale = timing.limits.half_track if m.kind == "turn" else 1.0
+        n = max(1, math.ceil(abs(m.amount) * max(scale, 0.5) / CERTIFY_STEP))
+        t = np.linspace(0.0, m.duration, n + 1)
+        poses = to_base(m.pose_at(t), axle)
+        xs = [mobile.x(p, travel) for p in poses]
+        if any(not checker.motion_free(a, b, CERTIFY_STEP) for a, b in itertools.pairwise(xs)):
+            where = ", ".join(f"{v:.3f}" for v in poses[0])
             raise PlanningError("certify", f"the base path collides in its 3-D check ({m.kind} "
                                 f"from {where}): the floor plan missed an object")  # fmt: skip
 
@@ -148,6 +168,8 @@ class Drive:
     planning_time_s: float  # placement, path and timing
     certify_time_s: float
     goal: BaseGoal
+    axle: np.ndarray  # (x, y) [m] the wheels' midpoint in the base frame: the path's point
+    floor: FloorPlan  # what the path was planned on (the wheels' midpoint's frame)
 
 
 def plan_drive(mobile: MobileRobot, goal: BaseGoal, seed: int = 0) -> Drive:
@@ -155,17 +177,19 @@ def plan_drive(mobile: MobileRobot, goal: BaseGoal, seed: int = 0) -> Drive:
     params = drive_params(mobile)
     limits = drive_limits(mobile, params)
     travel = _travel(mobile, goal.arm_start)
-    outline, top = robot_outline(mobile, travel)
+    axle = axle_offset(mobile, params)
+    outline, top = robot_outline(mobile, travel, axle)
     floor = FloorPlan(outline, obstacles(mobile, top))
     t0 = time.perf_counter()
-    paths = _Paths(floor, goal.start, limits.half_track, seed)
+    paths = _Paths(floor, goal.start, limits.half_track, seed, axle)
     placement = place(mobile, goal.target, goal.start, tolerance=goal.tolerance, seed=seed,
-                      park=floor.free, accept=paths)  # fmt: skip
+                      park=lambda pose: floor.free(to_axle(pose, axle)), accept=paths)  # fmt: skip
     path = paths.found[placement.verdict.base]
     timing = time_path(path, limits)
     t1 = time.perf_counter()
-    _certify(mobile, timing, travel)
-    return Drive(params, placement, path, timing, travel, t1 - t0, time.perf_counter() - t1, goal)
+    _certify(mobile, timing, travel, axle)
+    return Drive(params, placement, path, timing, travel, t1 - t0, time.perf_counter() - t1, goal,
+                 axle, floor)  # fmt: skip
 
 
 def plan_whole(mobile: MobileRobot, goal: BaseGoal, options: PlanOptions) -> WholePlan:
@@ -175,7 +199,7 @@ def plan_whole(mobile: MobileRobot, goal: BaseGoal, options: PlanOptions) -> Who
                            mobile.disabled)  # fmt: skip
     arm = plan_motion(ctx, d.travel, d.placement.verdict.q, options)
     return WholePlan(mobile, d.params, d.placement, d.path, d.timing, d.travel, arm,
-                     d.planning_time_s, d.certify_time_s, goal)  # fmt: skip
+                     d.planning_time_s, d.certify_time_s, goal, d.axle, d.floor)  # fmt: skip
 
 
 def files(plan: WholePlan, out_dir: Path, comment: str) -> dict[Path, bytes]:
@@ -191,5 +215,5 @@ def files(plan: WholePlan, out_dir: Path, comment: str) -> dict[Path, bytes]:
             plan.mobile.arm, plan.arm_timed, frame_id=frame, comment=comment
         ),
         out_dir / "cmd_vel.yaml": cmd_vel_yaml(plan.timing, comment),
-        out_dir / "path.yaml": path_yaml(plan.timing, comment),
+        out_dir / "path.yaml": path_yaml(plan.timing, plan.axle, comment),
     }
