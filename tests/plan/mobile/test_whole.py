@@ -50,8 +50,9 @@ def cluttered() -> MobileRobot:
 def shifted(pose: np.ndarray, offset: np.ndarray) -> np.ndarray:
     """Poses (..., 3) of the point `offset` (base frame) of bases at `pose`."""
     c, s = np.cos(pose[..., 2]), np.sin(pose[..., 2])
-    return np.stack([pose[..., 0] + c * offset[0] - s * offset[1],
-                     pose[..., 1] + s * offset[0] + c * offset[1], pose[..., 2]], axis=-1)  # fmt: skip
+    x = pose[..., 0] + c * offset[0] - s * offset[1]
+    y = pose[..., 1] + s * offset[0] + c * offset[1]
+    return np.stack([x, y, pose[..., 2]], axis=-1)
 
 
 def integrate(commands: list[dict], start: tuple[float, float, float]) -> tuple[
