@@ -33,14 +33,6 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 sys.path.insert(0, str(ROOT))
 
-from armcli.errors import PlanningError  # noqa: E402
-from armcli.plan.api import PlanOptions  # noqa: E402
-from armcli.plan.mobile.driving import driving_cost  # noqa: E402
-from armcli.plan.mobile.execute import execute_whole  # noqa: E402
-from armcli.plan.mobile.place import place  # noqa: E402
-from armcli.plan.mobile.virtual import MobileRobot, load_mobile  # noqa: E402
-from armcli.plan.mobile.whole import BaseGoal, files, plan_drive, plan_whole  # noqa: E402
-from armcli.urdf.source import read_robot  # noqa: E402
 from tests.plan.mobile.reference import (  # noqa: E402
     FEASIBLE,
     L1,
@@ -50,6 +42,15 @@ from tests.plan.mobile.reference import (  # noqa: E402
     Reference,
     read_objects,
 )
+
+from armcli.errors import PlanningError  # noqa: E402
+from armcli.plan.api import PlanOptions  # noqa: E402
+from armcli.plan.mobile.driving import driving_cost  # noqa: E402
+from armcli.plan.mobile.execute import execute_whole  # noqa: E402
+from armcli.plan.mobile.place import place  # noqa: E402
+from armcli.plan.mobile.virtual import load_mobile  # noqa: E402
+from armcli.plan.mobile.whole import BaseGoal, files, plan_drive, plan_whole  # noqa: E402
+from armcli.urdf.source import read_robot  # noqa: E402
 
 SPEC = ROOT / "specs" / "my_robot.yaml"
 SCENES = {"empty": None, "office": ROOT / "bench/scenes/office.yaml",
