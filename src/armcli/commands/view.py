@@ -11,11 +11,12 @@ import typer
 from armcli.commands.flags import flag_errors
 from armcli.commands.robot_input import robot_options, write_notes
 from armcli.commands.values import Names, names
-from armcli.errors import InputError
+from armcli.errors import ArmcliError, InputError
 from armcli.io.oneline import one_line
 
 if TYPE_CHECKING:
     from armcli.urdf.source import RobotInput
+    from armcli.view.baseplan import BaseSession
     from armcli.view.planning import PlanningSession
     from armcli.view.scene import RobotSource
 
@@ -81,6 +82,7 @@ def view_cmd(
         run = load(replay, names)
     chosen = list(joints) if joints else None
     session = _session(src, (scene, srdf, chosen, group), save_dir, robot)  # before serving
+    base = _base_session(src, scene) if session is not None else None
     viewer = Viewer(
         src.xml,
         name=src.name,
@@ -92,12 +94,18 @@ def view_cmd(
         replay=run,
         host=host,
         port=port,
+        mobile=base is not None,
     )
-    panel = None
+    panel = base_panel = None
     try:  # entered before the URL is printed, so an early Ctrl-C still stops cleanly
         if session is not None:
             panel = PlanningPanel(viewer, session, src.xml, source=src.source,
                                   mesh_dir=src.mesh_dir, search=src.search)  # fmt: skip
+        if base is not None:
+            from armcli.view.basepanel import BasePanel
+
+            base_panel = BasePanel(viewer, base, src.xml, source=src.source,
+                                   mesh_dir=src.mesh_dir, search=src.search)  # fmt: skip
         if pose:
             viewer.apply_pose(pose)
         sys.stdout.write(
@@ -110,6 +118,8 @@ def view_cmd(
     finally:
         if panel is not None:
             panel.close()
+        if base_panel is not None:
+            base_panel.close()
         viewer.close()
 
 
@@ -138,6 +148,18 @@ def _session(
         sys.stderr.write(f"note: no planning panel: {exc}\n")
         return None
     return session
+
+
+def _base_session(src: RobotSource, scene: Path | None) -> BaseSession | None:
+    """The mobile base's session when the robot has a diff drive (else none, a note)."""
+    from armcli.view.baseplan import load_base_session
+
+    assert src.file is not None
+    try:
+        return load_base_session(src.file, scene, src.search)
+    except ArmcliError as exc:
+        sys.stderr.write(f"note: no mobile base panel: {exc}\n")
+        return None
 
 
 def register(app: typer.Typer) -> None:

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from armcli.errors import InputError
 from armcli.io.names import did_you_mean
@@ -95,7 +96,9 @@ class Viewer:
         replay: Replay | None = None,
         host: str = "127.0.0.1",
         port: int = 8080,
+        mobile: bool = False,
     ) -> None:
+        """`mobile`: the robot hangs from a frame `set_base` moves (a planning panel's drive)."""
         import viser
         from viser.extras import ViserUrdf
 
@@ -120,7 +123,7 @@ class Viewer:
         try:
             # a drive's replay moves the whole robot: its URDF hangs from a frame placed at
             # the base's pose in the world (states' base.*, MCAP's world -> odom -> base)
-            moving = replay is not None and replay.base is not None
+            moving = mobile or (replay is not None and replay.base is not None)
             self._base = self.server.scene.add_frame("/base", show_axes=False) if moving else None
             root = "/base" if moving else ""
             self._robot = ViserUrdf(self.server, self._urdf, root_node_name=f"{root}/robot")
@@ -149,6 +152,25 @@ class Viewer:
     def url(self) -> str:
         """Address of the viewer page."""
         return f"http://{self.host}:{self.port}"
+
+    def set_base(self, position: ArrayLike, wxyz: ArrayLike) -> None:
+        """Put the robot's root at `position` [m] turned by `wxyz` (a `mobile` viewer only)."""
+        if self._base is None:
+            raise ValueError("this viewer's robot has a fixed root (Viewer(mobile=True))")
+        with self._lock:
+            self._base.position = np.asarray(position, dtype=float)
+            self._base.wxyz = np.asarray(wxyz, dtype=float)
+
+    def base_position(self) -> np.ndarray | None:
+        """Where the robot's root is [m] (a `mobile` viewer or a drive's replay), else None."""
+        if self._base is None:
+            return None
+        with self._lock:
+            return np.asarray(self._base.position, dtype=float).copy()
+
+    def in_range(self, q: Mapping[str, float]) -> dict[str, float]:
+        """The viewer's joints of `q`, bounded ones clipped, continuous ones wrapped to ±pi."""
+        return {j: self._in_range(j, v) for j, v in q.items() if j in self._limits}
 
     @property
     def joint_names(self) -> tuple[str, ...]:

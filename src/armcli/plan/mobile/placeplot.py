@@ -49,7 +49,7 @@ def robot_outlines(mobile: MobileRobot, base: Sequence[float], q: np.ndarray
     return out
 
 
-def _serving(judge: Judge, start: Sequence[float], radius: float) -> np.ndarray:
+def serving(judge: Judge, start: Sequence[float], radius: float) -> np.ndarray:
     """Base positions (N, 2) that serve the target, among the coarse candidates."""
     mobile = judge.mobile
     samples, step = PASSES[0]
@@ -97,7 +97,7 @@ def place_png(
     shapes = robot_outlines(mobile, v.base, v.q)
     base_links = set(mobile.base_links)
     _objects(ax, mobile, _base_top(mobile, v.base, v.q, base_links))
-    ok = _serving(judge, start, turn_radius(mobile))
+    ok = serving(judge, start, turn_radius(mobile))
     ax.scatter(ok[:, 0], ok[:, 1], s=4, color="C2", alpha=0.35, lw=0,
                label="base positions that reach the target")  # fmt: skip
     for link, hull in shapes:
