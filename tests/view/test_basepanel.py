@@ -10,6 +10,7 @@ server plans and executes, and the replay moves the whole robot's root to the pa
 from __future__ import annotations
 
 import math
+
 import numpy as np
 import pytest
 
@@ -38,7 +39,7 @@ def session() -> BaseSession:
 def test_plan_draws_the_path_the_region_and_the_ghosts(session: BaseSession) -> None:
     drawing = session.plan_to(TARGET)
     assert drawing is not None, session.reason
-    x, y, yaw = drawing.parked
+    x, y, _ = drawing.parked
     assert np.allclose(drawing.path[-1, :2], (x, y), atol=1e-9)
     assert np.allclose(drawing.path[0, :2], (0.0, 0.0), atol=1e-9)
     assert np.min(np.hypot(drawing.region[:, 0] - x, drawing.region[:, 1] - y)) < REGION_TOL
