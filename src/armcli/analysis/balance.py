@@ -218,6 +218,10 @@ class MarginAt:
 
     def __call__(self, values: ArrayLike) -> float:
         """The margin [m] with the joints at `values` [rad or m]."""
+        return self.polygon.margin(self.com(values))
+
+    def com(self, values: ArrayLike) -> NDArray[np.float64]:
+        """The centre of mass [m] (payload included) with the joints at `values`."""
         given = np.asarray(values, dtype=float)
         if self.fast:  # the per-pose path of a placement: no joint table walk
             q = self.template.copy()
@@ -227,7 +231,12 @@ class MarginAt:
             named = {j.name: min(max(float(given[k]), lo), hi) for k, lo, hi, j in self.slots}
             q = self.ev.s.q(_values(self.ev.s, named))
         c0, p = self.ev.parts_at(q)
-        return self.polygon.margin((self.ev.M * c0 + self.m * p) / (self.ev.M + self.m))
+        out: NDArray[np.float64] = (self.ev.M * c0 + self.m * p) / (self.ev.M + self.m)
+        return out
+
+    def height(self, values: ArrayLike) -> float:
+        """[m] the centre of mass above the ground with the joints at `values`."""
+        return self.ev.s.height(self.com(values))
 
 
 def _point_label(stance: Stance) -> str:

@@ -71,15 +71,17 @@ def prepare(
     *,
     gate: Callable[[Urdf], None] | None = None,
     world: Path | Scene | None = None,
+    params: DriveParams | None = None,
 ) -> DriveJob:
     """Validate the inputs and build the model; InputError names what is wrong.
 
     Without a trajectory the arm holds its start pose. `gate` sees the whole robot's URDF
     first and may refuse it (the command passes check.gate.refuse_check_errors). `world`:
     a scene file (or its Scene) whose objects the robot drives among (sim.world); one the
-    robot stands in at the start is refused.
+    robot stands in at the start is refused. `params`: the diff drive when the spec's
+    `mobile_base.diff_drive` does not state it (a URDF's plugin kept verbatim by import).
     """
-    params = DriveParams.of(spec)
+    params = params if params is not None else DriveParams.of(spec)
     cmd = load_cmd_vel(cmd_vel)
     rate = opts.rate if opts.rate is not None else params.update_rate
     if opts.trajectory is None and opts.message is None:

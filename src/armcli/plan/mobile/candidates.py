@@ -35,6 +35,7 @@ ARM_DRAWS = 2048  # other arms: seeded configurations sampled
 ARM_KEPT = 48  # ... of which the nearest in height are candidates
 HEIGHT_FIRST = 1e3  # [m of driving per m of tool miss]: the nearer approach always wins
 TIER = 1e3  # [m of driving]: a planar family's tiers never mix
+FAR = 900.0  # [m] a base pose beyond any scene: what fails there fails everywhere
 OFF_PLANE = (-0.95, -0.5, 0.5, 0.95)  # shares of the tolerance a planar arm's base stands off
 
 
@@ -47,6 +48,7 @@ class Family:
     miss: np.ndarray  # [m] |tool z - target z| (0 at the target's height)
     lateral: np.ndarray | None = None  # base-frame direction the tool cannot move (planar arm)
     nearest: np.ndarray | None = None  # (K,) bool: the configuration is the pose's nearest
+    heights: tuple[float, float] = (-np.inf, np.inf)  # [m] the lowest and highest tool point
 
     @property
     def lateral_xy(self) -> tuple[float, float]:
@@ -83,11 +85,18 @@ def planar_family(judge: Judge, samples: int) -> Family:
     nearest = np.concatenate([np.ones(len(q), dtype=bool), np.zeros(int(keep.sum()), bool)])
     if not len(qa):  # out of reach in height: the boundary tells how far
         qa, miss, nearest = qb, miss_b, np.zeros(len(qb), dtype=bool)
-    return Family(qa, arm.points(qa), miss, arm.axis, nearest)
+    lo, hi = arm.height_range()
+    top = (float(arm.shoulder[2] + lo), float(arm.shoulder[2] + hi))
+    return Family(qa, arm.points(qa), miss, arm.axis, nearest, top)
 
 
 def sampled_family(judge: Judge, seed: int) -> Family:
-    """Other arms: seeded configurations of the joint box, the nearest in height first."""
+    """Other arms: seeded configurations of the joint box, the nearest in height first.
+
+    Only configurations that could stand anywhere (`standing`: no self-collision, not in the
+    floor, stable) are kept, ARM_KEPT of them: a low target's nearest heights are often the
+    arm folded into its own base.
+    """
     import pinocchio as pin
 
     robot = judge.arm_robot
@@ -99,8 +108,44 @@ def sampled_family(judge: Judge, seed: int) -> Family:
         pin.forwardKinematics(robot.model, data, robot.q(x))
         p[i] = pin.updateFramePlacement(robot.model, data, robot.tool_frame).act(robot.tool_offset)
     miss = np.abs(p[:, 2] - judge.target[2])
-    keep = np.argsort(miss, kind="stable")[:ARM_KEPT]
-    return Family(rows[keep], p[keep], miss[keep])
+    spread = (float(p[:, 2].min()), float(p[:, 2].max()))  # the samples': about the reach's
+    order = np.argsort(miss, kind="stable")
+    kept: list[np.ndarray] = []
+    for start in range(0, len(order), ARM_KEPT):
+        k = order[start : start + ARM_KEPT]
+        kept.append(k[_stands(judge, rows[k])])
+        if sum(len(x) for x in kept) >= ARM_KEPT:
+            break
+    keep = np.concatenate(kept)[:ARM_KEPT]
+    return Family(rows[keep], p[keep], miss[keep], heights=spread)
+
+
+def standing(judge: Judge, family: Family) -> Family:
+    """The family without configurations that fail wherever the base stands.
+
+    Self-collision, the arm in the floor and the tip-over margin do not depend on the base's
+    pose: each configuration is checked once, with the base far from every scene object
+    (FAR, on the same endless floor), instead of once per yaw. (Another arm's
+    configurations only seed its inverse kinematics: there this is a filter of seeds.)
+    """
+    judged = np.ones(len(family.q), dtype=bool) if family.nearest is None else family.nearest
+    ok = np.ones(len(family.q), dtype=bool)  # another pose's nearest approach: judged there
+    ok[judged] = _stands(judge, family.q[judged])
+    keep = np.nonzero(ok)[0]
+    nearest = None if family.nearest is None else family.nearest[keep]
+    return Family(family.q[keep], family.p[keep], family.miss[keep], family.lateral, nearest,
+                  family.heights)  # fmt: skip
+
+
+def _stands(judge: Judge, qs: np.ndarray) -> np.ndarray:
+    """(K,) bool: each configuration is stable and collision-free with the base at FAR."""
+    out = np.zeros(len(qs), dtype=bool)
+    for i, q in enumerate(qs):
+        margin = judge.margin(q)
+        if margin is not None and margin <= 0.0:
+            continue
+        out[i] = judge.mobile.checker.first_collision(judge.mobile.x((FAR, FAR, 0.0), q)) is None
+    return out
 
 
 @dataclass(frozen=True)
@@ -142,12 +187,11 @@ def ordered(
     drive = driving_cost(start, bx, by, yaws, turn_radius).ravel()
     miss = np.sqrt(family.miss[None, :] ** 2 + offsets[:, None] ** 2)  # (offsets, configurations)
     near = np.ones(len(family.q), bool) if family.nearest is None else family.nearest
-    if family.nearest is not None:
+    if family.nearest is not None:  # the miss is the tool's: beyond the tolerance, no pose
         tier = np.where(near[None, :], (offsets[:, None] != 0).astype(float), 2.0)
-        key = TIER * tier
-    else:
+        key = np.where(miss <= tolerance, TIER * tier, np.inf)
+    else:  # a seed's height miss: the inverse kinematics at the pose corrects it
         key = HEIGHT_FIRST * miss
-    key = np.where(miss <= tolerance, key, np.inf)
     left = drive + np.repeat(key.ravel(), len(yaw))
     n_yaw, n_q = len(yaw), len(family.q)
     while True:

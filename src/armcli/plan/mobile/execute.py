@@ -91,7 +91,8 @@ def execute_whole(
     start = plan.goal.start
     duration = SLACK * plan.timing.duration + SLACK_S + plan.arm.duration_s + SETTLE_S
     opts = SimOptions(message=arm_yaml.decode("utf-8"), gravity_comp=True, duration=duration)
-    job = drive.prepare(spec, opts, cmd_vel, world=start_frame(mobile.scene, start))
+    job = drive.prepare(spec, opts, cmd_vel, world=start_frame(mobile.scene, start),
+                        params=plan.drive)  # fmt: skip
     pilot = Pursuit(legs_in_odom(plan.timing, plan.path.start), plan.timing.motions,
                     radius=job.params.radius, separation=job.params.separation, dt=job.dt,
                     period=job.params.period, speed=plan.timing.limits.speed,
@@ -113,7 +114,8 @@ def _truth(plan: WholePlan, run: DriveRun) -> tuple[np.ndarray, np.ndarray]:
     R = np.asarray(pin.Quaternion(w, x, y, z).toRotationMatrix())
     robot = plan.mobile.arm_robot()
     data = robot.model.createData()
-    pin.forwardKinematics(robot.model, data, robot.q(s[L.arm_pos]))
+    ran = dict(zip(run.job.arm.arm.joint_names, s[L.arm_pos].tolist(), strict=True))
+    pin.forwardKinematics(robot.model, data, robot.q([ran[j] for j in robot.joints]))
     tool_b = pin.updateFramePlacement(robot.model, data, robot.tool_frame).act(robot.tool_offset)
     yaw = math.atan2(R[1, 0], R[0, 0])
     return np.array([p[0], p[1], yaw]), R @ np.asarray(tool_b) + p

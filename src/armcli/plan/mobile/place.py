@@ -27,6 +27,7 @@ from armcli.plan.mobile.candidates import (
     ordered,
     planar_family,
     sampled_family,
+    standing,
 )
 from armcli.plan.mobile.driving import DEFAULT_TURN_RADIUS
 from armcli.plan.mobile.judge import Judge, Verdict
@@ -108,6 +109,7 @@ def place(
         else:
             family = sampled_family(judge, seed)
         _refuse_out_of_reach(mobile, judge, family)
+        family = standing(judge, family)
         best, more = _search(judge, family, begin, turn_radius(mobile), step, accept)
         tally += more
         if best is not None or mobile.planar is None:
@@ -122,21 +124,24 @@ def place(
 
 
 def _refuse_out_of_reach(mobile: MobileRobot, judge: Judge, family: Family) -> None:
-    """Above or below the tool's reach: the highest (lowest) point it reaches."""
-    if len(family.miss) and float(np.min(family.miss)) <= judge.tolerance:
-        return
-    z = family.p[:, 2]  # the boundary's configurations span the reach's heights
-    high = float(judge.target[2]) > float(np.max(z))
+    """Above or below the tool's reach: the highest (lowest) point it reaches.
+
+    A planar arm's reach is exact (its boundary's configurations are in the family); another
+    arm's is its samples' (a target within the tolerance of their heights is tried).
+    """
+    bottom, top = family.heights
+    z = float(judge.target[2])
     if mobile.planar is not None:
-        lo, hi = mobile.planar.height_range()
-        top, bottom = mobile.planar.shoulder[2] + hi, mobile.planar.shoulder[2] + lo
-    else:
-        top, bottom = float(np.max(z)), float(np.min(z))
-    if high:
-        raise PlacementError(f"the target z = {judge.target[2]:.3f} m is above the tool's reach: "
-                             f"the highest point it reaches is z = {top:.3f} m")  # fmt: skip
-    raise PlacementError(f"the target z = {judge.target[2]:.3f} m is below the tool's reach: "
-                         f"the lowest point it reaches is z = {bottom:.3f} m")  # fmt: skip
+        if len(family.miss) and float(np.min(family.miss)) <= judge.tolerance:
+            return
+    elif bottom - judge.tolerance <= z <= top + judge.tolerance:
+        return
+    about = "" if mobile.planar is not None else "about "
+    if z > top:
+        raise PlacementError(f"the target z = {z:.3f} m is above the tool's reach: the highest "
+                             f"point it reaches is {about}z = {top:.3f} m")  # fmt: skip
+    raise PlacementError(f"the target z = {z:.3f} m is below the tool's reach: the lowest "
+                         f"point it reaches is {about}z = {bottom:.3f} m")  # fmt: skip
 
 
 def _search(

@@ -18,13 +18,20 @@ from typing import Any
 import numpy as np
 
 from armcli.analysis.support import convex_hull
-from armcli.plan.mobile.candidates import PASSES, ordered, planar_family, sampled_family
+from armcli.plan.mobile.candidates import (
+    PASSES,
+    ordered,
+    planar_family,
+    sampled_family,
+    standing,
+)
 from armcli.plan.mobile.judge import Judge
 from armcli.plan.mobile.objects import outline, world_objects
 from armcli.plan.mobile.place import Placement, turn_radius
 from armcli.plan.mobile.virtual import MobileRobot
 
 MAX_SHADED = 6000  # candidate poses judged for the shading
+SAMPLED_EVERY = 15  # of another arm's candidates, one in this many is judged for the shading
 
 
 def robot_outlines(mobile: MobileRobot, base: Sequence[float], q: np.ndarray
@@ -50,17 +57,26 @@ def robot_outlines(mobile: MobileRobot, base: Sequence[float], q: np.ndarray
 
 
 def serving(judge: Judge, start: Sequence[float], radius: float) -> np.ndarray:
-    """Base positions (N, 2) that serve the target, among the coarse candidates."""
+    """Base positions (N, 2) that serve the target, among the coarse candidates.
+
+    A planar arm's candidates at the target's height are judged as they are; another
+    arm's (inverse kinematics at each pose) every SAMPLED_EVERY-th, to bound the time.
+    """
     mobile = judge.mobile
     samples, step = PASSES[0]
-    family = (
-        planar_family(judge, samples) if mobile.planar is not None else sampled_family(judge, 0)
-    )
+    planar = mobile.planar is not None
+    family = standing(judge, planar_family(judge, samples) if planar else sampled_family(judge, 0))
     out, seen = [], 0
     for chunk in ordered(family, judge.target, start, radius, step, judge.tolerance):
         for c in chunk:
             seen += 1
-            if c.nearest and judge.judge(c.base, c.q, c.miss).ok:
+            if c.nearest:
+                ok = judge.judge(c.base, c.q, c.miss).ok
+            elif not planar and seen % SAMPLED_EVERY == 0:
+                ok = judge.at(c.base, c.q).ok
+            else:
+                continue
+            if ok:
                 out.append(c.base[:2])
         if seen >= MAX_SHADED:
             break
@@ -105,7 +121,9 @@ def place_png(
         ax.add_patch(Polygon(hull, closed=True, facecolor="C0" if is_base else "C1",
                              alpha=0.45 if is_base else 0.6, edgecolor="C0"))  # fmt: skip
     x, y, yaw = v.base
-    ax.arrow(x, y, 0.25 * math.cos(yaw), 0.25 * math.sin(yaw), width=0.01, color="C0")
+    size = max(max(np.ptp(np.array(h), axis=0)) for _, h in shapes)  # the robot's extent
+    ax.arrow(x, y, 0.4 * size * math.cos(yaw), 0.4 * size * math.sin(yaw), width=0.02 * size,
+             color="C0")  # fmt: skip
     ax.add_patch(Circle((x, y), max(placement.region.xy_tolerance, 1e-4), fill=False,
                         color="C3", lw=1.0, label="Nav2 xy_goal_tolerance"))  # fmt: skip
     ax.plot([start[0]], [start[1]], "ko", ms=5, label="start")

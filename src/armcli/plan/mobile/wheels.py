@@ -29,6 +29,8 @@ NEEDS_DRIVE = (
 PLUGINS = ("diff_drive", "diffdrive", "diff-drive")  # in a plugin's filename, any case
 DEFAULT_RATE = 50.0  # [Hz] a plugin's update rate when it states none
 DEFAULT_TORQUE = 20.0  # [N·m] gazebo_ros_diff_drive's max_wheel_torque default
+GRAVITY = 9.81  # [m/s²]
+TIP_SHARE = 0.5  # of the acceleration that would tip the robot: the most the base plans
 
 
 def _number(params: Mapping[str, str], *tags: str) -> float | None:
@@ -79,8 +81,15 @@ def drive_params(mobile: MobileRobot) -> DriveParams:
     return found
 
 
-def drive_limits(mobile: MobileRobot, params: DriveParams) -> DriveLimits:
-    """Rim speed and acceleration limits, half the track and the command period."""
+def drive_limits(
+    mobile: MobileRobot, params: DriveParams, travel: np.ndarray | None = None
+) -> DriveLimits:
+    """Rim speed and acceleration limits, half the track and the command period.
+
+    With the arm's travel configuration, the acceleration also stays under TIP_SHARE of
+    the one that would tip the robot: braking or speeding up by a moves the zero-moment
+    point a·h/g (h the centre of mass's height) toward an edge, so a <= g·margin/h.
+    """
     notes = []
     joints = {j.name: j for j in mobile.robot_file.robot.joints}
     speeds = []
@@ -102,6 +111,18 @@ def drive_limits(mobile: MobileRobot, params: DriveParams) -> DriveLimits:
         notes.append(f"max_wheel_acceleration is 0 (no limit): the base accelerates at "
                      f"{accel:.3g} m/s² ({TORQUE_SHARE:g} of what the wheel torque "
                      "gives)")  # fmt: skip
+    if travel is not None and mobile.stance is not None:
+        from armcli.analysis.balance import MarginAt
+
+        balance = MarginAt(mobile.stance, mobile.arm)
+        tip = GRAVITY * max(balance(travel), 0.0) / max(balance.height(travel), 1e-6)
+        if TIP_SHARE * tip < accel:
+            accel = TIP_SHARE * tip
+            notes.append(f"the base accelerates at most {accel:.3g} m/s²: {TIP_SHARE:g} of what "
+                         "would tip it with the arm stowed")  # fmt: skip
+    if accel <= 0:
+        raise InputError("the robot would tip over at any acceleration with its arm stowed",
+                         field="base")  # fmt: skip
     return DriveLimits(speed, accel, 0.5 * params.separation, params.period, tuple(notes))
 
 

@@ -175,8 +175,8 @@ class Drive:
 def plan_drive(mobile: MobileRobot, goal: BaseGoal, seed: int = 0) -> Drive:
     """Where to park and the certified, timed path there (see the module docstring)."""
     params = drive_params(mobile)
-    limits = drive_limits(mobile, params)
     travel = _travel(mobile, goal.arm_start)
+    limits = drive_limits(mobile, params, travel)
     axle = axle_offset(mobile, params)
     outline, top = robot_outline(mobile, travel, axle)
     floor = FloorPlan(outline, obstacles(mobile, top))
