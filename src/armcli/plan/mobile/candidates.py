@@ -108,7 +108,7 @@ def sampled_family(judge: Judge, seed: int) -> Family:
         pin.forwardKinematics(robot.model, data, robot.q(x))
         p[i] = pin.updateFramePlacement(robot.model, data, robot.tool_frame).act(robot.tool_offset)
     miss = np.abs(p[:, 2] - judge.target[2])
-    spread = (float(p[:, 2].min()), float(p[:, 2].max()))  # the samples': about the reach's
+    spread = _heights(judge)
     order = np.argsort(miss, kind="stable")
     kept: list[np.ndarray] = []
     for start in range(0, len(order), ARM_KEPT):
@@ -118,6 +118,26 @@ def sampled_family(judge: Judge, seed: int) -> Family:
             break
     keep = np.concatenate(kept)[:ARM_KEPT]
     return Family(rows[keep], p[keep], miss[keep], heights=spread)
+
+
+def _heights(judge: Judge) -> tuple[float, float]:
+    """[m] the lowest and highest tool point: the workspace analysis' refined envelope.
+
+    (analysis.workspace on the robot's own model, fixed root: samples, then a local search
+    from the best.)
+    """
+    from armcli.analysis.workspace import Chain, envelope, sample
+    from armcli.robot.model import Robot
+    from armcli.robot.tool import tool_point
+
+    robot_file = judge.mobile.robot_file
+    plain = Robot.from_urdf(robot_file.robot, spec=robot_file.spec)
+    tool = tool_point(robot_file.robot, robot_file.spec)
+    if tool is None:  # pragma: no cover - the mobile robot has a tool point
+        return -np.inf, np.inf
+    chain = Chain(plain, tool, dict(judge.arm_robot.rest))
+    ws = envelope(chain, sample(chain))
+    return ws.min_height, ws.max_height
 
 
 def standing(judge: Judge, family: Family) -> Family:

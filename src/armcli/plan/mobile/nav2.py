@@ -3,8 +3,10 @@
 Nav2's NavigateToPose takes a geometry_msgs/PoseStamped; its controller stops once the
 robot is within `xy_goal_tolerance` [m] and `yaw_goal_tolerance` [rad] of it (the goal
 checker's parameters). The document holds the PoseStamped under `pose` (the frame is the
-scene's world frame: Nav2's `map`) and the two tolerances beside it. Floats are written
-with Python's shortest round-trip repr: the same placement gives the same bytes.
+scene's world frame: Nav2's `map`; the pose is the region's goal, inside the region where
+the placed pose is on its edge: plan.mobile.region) and the two tolerances beside it.
+Floats are written with Python's shortest round-trip repr: the same placement gives the
+same bytes.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ def _f(x: float) -> str:
 
 def nav2_goal(placement: Placement, target: Sequence[float], start: Sequence[float]) -> bytes:
     """The Nav2 goal YAML of a placement (see the module docstring)."""
-    x, y, yaw = placement.verdict.base
+    x, y, yaw = placement.region.goal
     reach = ",".join(f"{v:g}" for v in target)
     origin = ",".join(f"{v:g}" for v in start)
     lines = [

@@ -7,9 +7,11 @@ between the last that served and it. The arm's reach is computed for a whole row
 at once (`Judge.reach`); collisions and the tip-over margin pose by pose, inside out.
 
 A navigation stack parks within a radius and a heading band of its goal, both at once
-(Nav2's goal checker: `xy_goal_tolerance`, `yaw_goal_tolerance`), so those two start at
-half of what the intervals allow and are halved until every pose on the band's edge
-(eight directions, at both ends of the heading band, and the heading band alone) serves.
+(Nav2's goal checker: `xy_goal_tolerance`, `yaw_goal_tolerance`). The Nav2 goal is moved
+from the placed pose (on the region's edge: a constraint stops the least driving there)
+toward the intervals' middle, and the two tolerances start at half the room the intervals
+leave it and are halved until every pose on the band's edge (eight directions, at both
+ends of the heading band, and the heading band alone) serves.
 """
 
 from __future__ import annotations
@@ -35,8 +37,9 @@ class Region:
     x: tuple[float, float]  # [m]
     y: tuple[float, float]  # [m]
     yaw: tuple[float, float]  # [rad]
-    xy_tolerance: float  # [m] any pose this near ...
-    yaw_tolerance: float  # [rad] ... and turned this little still serves
+    xy_tolerance: float  # [m] any pose this near the goal ...
+    yaw_tolerance: float  # [rad] ... and turned this little from it still serves
+    goal: tuple[float, float, float]  # the Nav2 goal: toward the intervals' middle
 
 
 def _first_failing(judge: Judge, best: Verdict, rows: list[np.ndarray]) -> list[int]:
@@ -110,24 +113,47 @@ def _band(best: Verdict, r: float, theta: float) -> np.ndarray:
     return np.array(poses)
 
 
+def _tolerances(judge: Judge, at: Verdict, r: float, theta: float) -> tuple[float, float]:
+    """The largest (r, theta) halvings of the given ones whose band around `at` serves."""
+    for _ in range(HALVINGS):
+        band = _band(at, r, theta)
+        if _first_failing(judge, at, [band])[0] == len(band):
+            return r, theta
+        r, theta = 0.5 * r, 0.5 * theta
+    return 0.0, 0.0
+
+
+def _goal(judge: Judge, best: Verdict, lo: list[float], hi: list[float]) -> Verdict:
+    """The Nav2 goal: toward the intervals' middle, where there is room on every side.
+
+    The least-driving pose lies where a constraint stops it (on the region's edge): Nav2
+    could park no nearer than that. The goal moves toward the middle of the intervals (all
+    the way, half, a quarter) to the first such pose that still serves.
+    """
+    b = np.asarray(best.base, dtype=float)
+    middle = b + 0.5 * (np.array(hi) - np.array(lo))
+    for share in (1.0, 0.5, 0.25):
+        pose = b + share * (middle - b)
+        v = judge.at(pose, best.q)
+        if v.ok:
+            return v
+    return best
+
+
 def region(judge: Judge, best: Verdict) -> Region:
     """The region around the placed pose `best` (see the module docstring)."""
     found = _extents(judge, best)
     lo, hi = found[:3], found[3:]
+    goal = _goal(judge, best, lo, hi)
+    g, b = np.asarray(goal.base, dtype=float), np.asarray(best.base, dtype=float)
+    room = [min(g[k] - (b[k] - lo[k]), (b[k] + hi[k]) - g[k]) for k in range(3)]
     # both at once use up what each alone may: start from half of each
-    r, theta = 0.5 * min(lo[0], hi[0], lo[1], hi[1]), 0.5 * min(lo[2], hi[2])
-    for _ in range(HALVINGS):
-        band = _band(best, r, theta)
-        if _first_failing(judge, best, [band])[0] == len(band):
-            break
-        r, theta = 0.5 * r, 0.5 * theta
-    else:
-        r, theta = 0.0, 0.0
-    b = np.asarray(best.base, dtype=float)
+    r, theta = _tolerances(judge, goal, 0.5 * min(room[0], room[1]), 0.5 * room[2])
     return Region(
         x=(float(b[0] - lo[0]), float(b[0] + hi[0])),
         y=(float(b[1] - lo[1]), float(b[1] + hi[1])),
         yaw=(float(b[2] - lo[2]), float(b[2] + hi[2])),
         xy_tolerance=r,
         yaw_tolerance=theta,
+        goal=(float(g[0]), float(g[1]), float(g[2])),
     )

@@ -3,7 +3,8 @@
 A spec states it (`mobile_base.diff_drive`, `sim.diffdrive.DriveParams.of`); a URDF
 carries it as a Gazebo plugin: gazebo_ros_diff_drive (`wheel_separation`,
 `wheel_diameter`, `max_wheel_torque`, `max_wheel_acceleration`, `update_rate`,
-`left_joint`, `right_joint`) or gz-sim's DiffDrive (`wheel_separation`, `wheel_radius`,
+`left_joint`, `right_joint`; ROS 1's camelCase names too: `wheelSeparation`, `leftJoint`,
+`wheelTorque`, ...) or gz-sim's DiffDrive (`wheel_separation`, `wheel_radius`,
 `max_linear_acceleration`). The rim speed limit is the wheel joints' velocity limit when
 the URDF gives one, else DEFAULT_SPEED; the rim acceleration is the plugin's limit, else
 TORQUE_SHARE of what max_wheel_torque gives the whole robot.
@@ -54,18 +55,21 @@ def _plugin(urdf: Urdf) -> DriveParams | None:
         if not any(p in name for p in PLUGINS):
             continue
         p = plugin.params
-        separation = _number(p, "wheel_separation")
-        diameter = _number(p, "wheel_diameter")
+        separation = _number(p, "wheel_separation", "wheelSeparation")
+        diameter = _number(p, "wheel_diameter", "wheelDiameter")
         radius = _number(p, "wheel_radius")
-        left, right = p.get("left_joint"), p.get("right_joint")
+        left = p.get("left_joint") or p.get("leftJoint")
+        right = p.get("right_joint") or p.get("rightJoint")
         if separation is None or (diameter is None and radius is None) or not left or not right:
             continue
         return DriveParams(
             left, right, separation, radius if radius is not None else 0.5 * float(diameter or 0),
-            _number(p, "max_wheel_torque") or DEFAULT_TORQUE,
-            _number(p, "max_wheel_acceleration", "max_linear_acceleration") or 0.0,
-            _number(p, "update_rate") or DEFAULT_RATE,
-            p.get("odometry_frame", "odom"), p.get("robot_base_frame", "base_footprint"),
+            _number(p, "max_wheel_torque", "wheelTorque") or DEFAULT_TORQUE,
+            _number(p, "max_wheel_acceleration", "max_linear_acceleration",
+                    "wheelAcceleration") or 0.0,
+            _number(p, "update_rate", "updateRate") or DEFAULT_RATE,
+            p.get("odometry_frame") or p.get("odometryFrame") or "odom",
+            p.get("robot_base_frame") or p.get("robotBaseFrame") or "base_footprint",
         )  # fmt: skip
     return None
 
