@@ -155,18 +155,13 @@ class Viewer:
 
     def set_base(self, position: ArrayLike, wxyz: ArrayLike) -> None:
         """Put the robot's root at `position` [m] turned by `wxyz` (a `mobile` viewer only)."""
-        if self._base is None:
-            raise ValueError("this viewer's robot has a fixed root (Viewer(mobile=True))")
+        assert self._base is not None, "a fixed root: Viewer(mobile=True) moves"
         with self._lock:
-            self._base.position = np.asarray(position, dtype=float)
-            self._base.wxyz = np.asarray(wxyz, dtype=float)
+            self._base.position, self._base.wxyz = np.asarray(position), np.asarray(wxyz)
 
     def base_position(self) -> np.ndarray | None:
         """Where the robot's root is [m] (a `mobile` viewer or a drive's replay), else None."""
-        if self._base is None:
-            return None
-        with self._lock:
-            return np.asarray(self._base.position, dtype=float).copy()
+        return None if self._base is None else np.array(self._base.position, dtype=float)
 
     def in_range(self, q: Mapping[str, float]) -> dict[str, float]:
         """The viewer's joints of `q`, bounded ones clipped, continuous ones wrapped to ±pi."""

@@ -59,18 +59,24 @@ class Family:
 
 
 def planar_family(judge: Judge, samples: int) -> Family:
-    """Closed form: configurations at the target's height, and on the reach's boundary.
+    """Closed form: configurations at the target's height, each its poses' nearest approach."""
+    arm = judge.mobile.planar
+    assert arm is not None
+    q, _ = arm.at_height(float(judge.target[2] - arm.shoulder[2]), samples)
+    return Family(q, arm.points(q), np.zeros(len(q)), arm.axis, np.ones(len(q), dtype=bool),
+                  _planar_heights(judge))  # fmt: skip
 
-    At the target's exact height, each configuration is the nearest approach from its
-    poses. A target the tool only comes near (above the top of the reach, or one whose
-    exact approaches all collide) is nearest to the reach's boundary from a pose that puts
-    it beyond the reach: the boundary's configurations within the tolerance in height
-    stand for those poses (judged afresh there, `Candidate.nearest` False).
+
+def boundary_family(judge: Judge) -> Family:
+    """The reach boundary's configurations within the tolerance of the target's height.
+
+    A target the tool only comes near (above the top of the reach, or one whose exact
+    approaches all collide) is nearest to the reach's boundary from a pose that puts it
+    beyond the reach: these configurations stand for those poses (judged afresh there,
+    `Candidate.nearest` False). Tried only when the target's height finds no pose.
     """
     arm = judge.mobile.planar
     assert arm is not None
-    w = float(judge.target[2] - arm.shoulder[2])
-    q, _ = arm.at_height(w, samples)
     boundary = []
     for start, k, span in arm.arcs():
         for t in np.linspace(0.0, span, ARC_SAMPLES):
@@ -78,16 +84,18 @@ def planar_family(judge: Judge, samples: int) -> Family:
             x[k] += t
             boundary.append(x)
     qb = np.array(boundary)
-    miss_b = np.abs(arm.points(qb)[:, 2] - judge.target[2])
-    keep = miss_b <= judge.tolerance
-    qa = np.concatenate([q, qb[keep]])
-    miss = np.concatenate([np.zeros(len(q)), miss_b[keep]])
-    nearest = np.concatenate([np.ones(len(q), dtype=bool), np.zeros(int(keep.sum()), bool)])
-    if not len(qa):  # out of reach in height: the boundary tells how far
-        qa, miss, nearest = qb, miss_b, np.zeros(len(qb), dtype=bool)
+    miss = np.abs(arm.points(qb)[:, 2] - judge.target[2])
+    keep = miss <= judge.tolerance
+    q = qb[keep]
+    return Family(q, arm.points(q), miss[keep], arm.axis, np.zeros(len(q), dtype=bool),
+                  _planar_heights(judge))  # fmt: skip
+
+
+def _planar_heights(judge: Judge) -> tuple[float, float]:
+    arm = judge.mobile.planar
+    assert arm is not None
     lo, hi = arm.height_range()
-    top = (float(arm.shoulder[2] + lo), float(arm.shoulder[2] + hi))
-    return Family(qa, arm.points(qa), miss, arm.axis, nearest, top)
+    return float(arm.shoulder[2] + lo), float(arm.shoulder[2] + hi)
 
 
 def sampled_family(judge: Judge, seed: int) -> Family:

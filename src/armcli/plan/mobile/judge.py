@@ -6,7 +6,7 @@ branches, `plan.mobile.planar`), else by the planner's inverse kinematics
 (`plan.ik.solve_ik`) in the base frame. The pose serves when that nearest approach is
 within the tolerance, the robot there is collision-free (the scene's objects and the floor
 against every link, base and arm: `plan.collision`) and statically stable (a positive
-tip-over margin at that configuration: `analysis.balance.margin_at`). Joint limits hold by
+tip-over margin at that configuration: `analysis.balance.MarginAt`). Joint limits hold by
 construction: both solvers stay inside them.
 """
 

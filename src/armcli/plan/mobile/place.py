@@ -24,6 +24,7 @@ from armcli.plan.mobile.candidates import (
     PASSES,
     Candidate,
     Family,
+    boundary_family,
     ordered,
     planar_family,
     sampled_family,
@@ -104,14 +105,13 @@ def place(
     best, tally = None, Counter[str]()
     for samples, step in PASSES:
         judge.checks = 0  # each pass has its budget (MAX_CHECKS)
-        if mobile.planar is not None:
-            family = planar_family(judge, samples)
-        else:
-            family = sampled_family(judge, seed)
-        _refuse_out_of_reach(mobile, judge, family)
-        family = standing(judge, family)
-        best, more = _search(judge, family, begin, turn_radius(mobile), step, accept)
-        tally += more
+        for family in _families(judge, samples, seed):
+            _refuse_out_of_reach(mobile, judge, family)
+            family = standing(judge, family)
+            best, more = _search(judge, family, begin, turn_radius(mobile), step, accept)
+            tally += more
+            if best is not None:
+                break
         if best is not None or mobile.planar is None:
             break
     if best is None:
@@ -123,18 +123,24 @@ def place(
                      time.perf_counter() - t0)  # fmt: skip
 
 
+def _families(judge: Judge, samples: int, seed: int) -> Iterator[Family]:
+    """A planar arm's exact heights, then its reach boundary's near misses; another arm's."""
+    if judge.mobile.planar is None:
+        yield sampled_family(judge, seed)
+        return
+    yield planar_family(judge, samples)
+    yield boundary_family(judge)
+
+
 def _refuse_out_of_reach(mobile: MobileRobot, judge: Judge, family: Family) -> None:
     """Above or below the tool's reach: the highest (lowest) point it reaches.
 
-    A planar arm's reach is exact (its boundary's configurations are in the family); another
-    arm's is its samples' (a target within the tolerance of their heights is tried).
+    A planar arm's reach is exact (`PlanarArm.height_range`); another arm's is the
+    workspace analysis' envelope.
     """
     bottom, top = family.heights
     z = float(judge.target[2])
-    if mobile.planar is not None:
-        if len(family.miss) and float(np.min(family.miss)) <= judge.tolerance:
-            return
-    elif bottom - judge.tolerance <= z <= top + judge.tolerance:
+    if bottom - judge.tolerance <= z <= top + judge.tolerance:
         return
     about = "" if mobile.planar is not None else "about "
     if z > top:
