@@ -107,11 +107,23 @@ class Outlines:
         self.n = np.stack([e[:, 1], -e[:, 0]], axis=1)  # outward (counter-clockwise)
         self.c = np.einsum("ij,ij->i", self.v, self.n)
         self.e = e
+        self.lo = np.array([o.points.min(axis=0) for o in shapes]).reshape(-1, 2)
+        self.hi = np.array([o.points.max(axis=0) for o in shapes]).reshape(-1, 2)
 
     def meets(self, poly: np.ndarray) -> bool:
-        """Whether a convex polygon (counter-clockwise) overlaps any outline."""
+        """Whether a convex polygon (counter-clockwise) overlaps any outline.
+
+        Outlines whose bounding box misses the polygon's are passed over first (most poses
+        are far from most objects); the separating-axis test runs on the rest at once.
+        """
         if not self.shapes:
             return False
+        lo, hi = poly.min(axis=0), poly.max(axis=0)
+        near = np.nonzero(np.all((self.lo < hi) & (self.hi > lo), axis=1))[0]
+        if len(near) == 0:
+            return False
+        if len(near) < len(self.shapes):
+            return Outlines([self.shapes[k] for k in near]).meets(poly)
         own = np.roll(poly, -1, axis=0) - poly
         n = np.stack([own[:, 1], -own[:, 0]], axis=1)
         c = np.einsum("ij,ij->i", poly, n)
