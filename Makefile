@@ -93,6 +93,7 @@ bench: install-dev native-check
 	$(BIN)/python bench/bench_check_packages.py
 	$(BIN)/python bench/bench_build_expand.py
 	$(BIN)/python bench/bench_drive.py
+	$(BIN)/python bench/bench_sensors.py
 
 fuzz: install-dev
 	HYPOTHESIS_PROFILE=fuzz $(BIN)/python -m pytest -q tests -k fuzz

@@ -184,8 +184,11 @@ RICH = FIXTURES / "spec" / "rich_arm.yaml"
 FINGER_GAIN = "    left_finger_joint: {kp: 200, kd: 5}\n"
 RICH_TARGET = {"shoulder_lift_joint": 0.5, "elbow_joint": -0.8, "left_finger_joint": 0.02}
 # What `check` finds in rich_arm, by design of the fixture: a 4 kg root link (KDL ignores
-# it) and Kp = 400 with Kd = 20 too stiff for an explicit loop at 1 ms; nothing else.
-RICH_FINDINGS = {("root-inertia", "warning"), ("pd-explicit-unstable", "warning")}
+# it), Kp = 400 with Kd = 20 too stiff for an explicit loop at 1 ms, and lidars 0.1 m off
+# the axis of base_link's collision cylinder (r 0.08): the rays heading back start, range_min
+# out, inside it: the lidar sees the base (check/sensors.py); nothing else.
+RICH_FINDINGS = {("root-inertia", "warning"), ("pd-explicit-unstable", "warning"),
+                 ("sensor-sees-robot", "warning")}  # fmt: skip
 
 
 def _run(argv: list[str]) -> None:

@@ -15,9 +15,8 @@ import numpy as np
 import pytest
 
 from armcli.plan.mobile.judge import world_to_base
-from armcli.view.basepanel import BasePanel
+from armcli.view.basepanel import BasePanel, MobileViewer
 from armcli.view.baseplan import BaseSession, load_base_session
-from armcli.view.browser import Viewer
 from armcli.view.scene import load_robot
 from tests.helpers import DEFAULT_SPEC, FIXTURES
 
@@ -59,7 +58,7 @@ def test_a_robot_without_a_drive_gets_no_base_session() -> None:
 
 def test_the_panel_plans_executes_and_replays_the_whole_robot(session: BaseSession) -> None:
     src = load_robot(DEFAULT_SPEC)
-    viewer = Viewer(src.xml, name=src.name, poses=src.poses, tool=src.tool, port=0, mobile=True)
+    viewer = MobileViewer(src.xml, name=src.name, poses=src.poses, tool=src.tool, port=0)
     panel = BasePanel(viewer, session, src.xml, source=src.source)
     try:
         panel.move_target(TARGET)
@@ -70,7 +69,6 @@ def test_the_panel_plans_executes_and_replays_the_whole_robot(session: BaseSessi
         assert session.plan is not None
         x, y, _ = session.plan.placement.verdict.base
         root = viewer.base_position()  # where the replay left the robot
-        assert root is not None
         assert math.hypot(root[0] - x, root[1] - y) < PARKED_TOL
     finally:
         panel.close()

@@ -75,15 +75,24 @@ def view_cmd(
     pose_q(src, pose, None)  # validate before starting the server
     if not 0 <= port <= 65535:
         raise InputError(f"{port} is not a port number", field="--port")
-    run = None
+    run, sensors = None, None
     if replay is not None:
         names = list(joint_limits(load_urdf(src.xml, src.source, src.mesh_dir, src.search)))
         load = rosbag.load_replay if rosbag.is_mcap(replay) else load_replay
         run = load(replay, names)
+        if rosbag.is_mcap(replay):
+            from armcli.sim.sensors.replay import load_sensor_replay
+
+            sensors = load_sensor_replay(replay)
     chosen = list(joints) if joints else None
     session = _session(src, (scene, srdf, chosen, group), save_dir, robot)  # before serving
     base = _base_session(src, scene) if session is not None else None
-    viewer = Viewer(
+    kind = Viewer
+    if base is not None:
+        from armcli.view.basepanel import MobileViewer
+
+        kind = MobileViewer
+    viewer = kind(
         src.xml,
         name=src.name,
         source=src.source,
@@ -92,18 +101,20 @@ def view_cmd(
         poses=src.poses,
         tool=src.tool,
         replay=run,
+        sensors=sensors,
         host=host,
         port=port,
-        mobile=base is not None,
     )
+    write_notes(viewer.sensor_notes)
     panel = base_panel = None
     try:  # entered before the URL is printed, so an early Ctrl-C still stops cleanly
         if session is not None:
             panel = PlanningPanel(viewer, session, src.xml, source=src.source,
                                   mesh_dir=src.mesh_dir, search=src.search)  # fmt: skip
         if base is not None:
-            from armcli.view.basepanel import BasePanel
+            from armcli.view.basepanel import BasePanel, MobileViewer
 
+            assert isinstance(viewer, MobileViewer)
             base_panel = BasePanel(viewer, base, src.xml, source=src.source,
                                    mesh_dir=src.mesh_dir, search=src.search)  # fmt: skip
         if pose:

@@ -13,20 +13,18 @@ from __future__ import annotations
 import math
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from armcli.errors import ArmcliError
 from armcli.urdf.meshes import MeshSearch
 from armcli.view.baseplan import BaseSession
-from armcli.view.browser import FRAME_RATE, moving_parts
+from armcli.view.browser import FRAME_RATE, Viewer, moving_parts
 from armcli.view.png import load_urdf
-
-if TYPE_CHECKING:
-    from armcli.view.browser import Viewer
 
 GHOST_RGBA = (0.2, 0.55, 0.95, 0.3)  # translucent blue arms at the parked pose
 PATH_RGB = (30, 110, 220)  # the base's path on the floor
@@ -50,10 +48,31 @@ def _yaw_wxyz(yaw: float) -> tuple[float, float, float, float]:
     return math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)
 
 
+class MobileViewer(Viewer):
+    """The viewer whose robot hangs from a frame the mobile base's replay moves."""
+
+    MOBILE = True
+
+    def set_base(self, position: ArrayLike, wxyz: ArrayLike) -> None:
+        """Put the robot's root at `position` [m] turned by `wxyz` (unit quaternion)."""
+        assert self._base is not None  # MOBILE: Viewer made the frame
+        with self._lock:
+            self._base.position, self._base.wxyz = np.asarray(position), np.asarray(wxyz)
+
+    def base_position(self) -> np.ndarray:
+        """Where the robot's root is [m]."""
+        assert self._base is not None
+        return np.array(self._base.position, dtype=float)
+
+    def in_range(self, q: Mapping[str, float]) -> dict[str, float]:
+        """The viewer's joints of `q`, bounded ones clipped, continuous ones wrapped to ±pi."""
+        return {j: self._in_range(j, v) for j, v in q.items() if j in self._limits}
+
+
 class BasePanel:
     """Adds the Mobile base folder, the room target, the drawings and the replay."""
 
-    def __init__(self, viewer: Viewer, session: BaseSession, urdf_xml: str, *,
+    def __init__(self, viewer: MobileViewer, session: BaseSession, urdf_xml: str, *,
                  source: str = "<urdf>", mesh_dir: str | Path | None = None,
                  search: MeshSearch | None = None) -> None:  # fmt: skip
         self.viewer, self.session = viewer, session

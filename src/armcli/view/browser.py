@@ -20,11 +20,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
 
 from armcli.errors import InputError
 from armcli.io.names import did_you_mean
 from armcli.robot.tool import ToolPoint
+from armcli.sim.sensors.replay import SensorReplay
 from armcli.sim.states import Replay
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_root
@@ -37,6 +37,7 @@ from armcli.view.png import (
     neutral,
     tool_position,
 )
+from armcli.view.sensors import SensorLayer
 
 GHOST_RGBA = (0.35, 0.65, 1.0, 0.35)  # translucent blue for the reference pose
 FRAME_RATE = 30.0  # [Hz] replay updates sent to the browser
@@ -83,6 +84,8 @@ def moving_parts(urdf_xml: str, joints: Collection[str], source: str = "<urdf>")
 class Viewer:
     """A running viser server showing one robot; thread-safe setters for the tests and the GUI."""
 
+    MOBILE = False  # the robot hangs from a frame that moves (view.basepanel.MobileViewer)
+
     def __init__(
         self,
         urdf_xml: str,
@@ -94,11 +97,10 @@ class Viewer:
         poses: Mapping[str, Mapping[str, float]] | None = None,
         tool: ToolPoint | None = None,
         replay: Replay | None = None,
+        sensors: SensorReplay | None = None,
         host: str = "127.0.0.1",
         port: int = 8080,
-        mobile: bool = False,
     ) -> None:
-        """`mobile`: the robot hangs from a frame `set_base` moves (a planning panel's drive)."""
         import viser
         from viser.extras import ViserUrdf
 
@@ -123,7 +125,7 @@ class Viewer:
         try:
             # a drive's replay moves the whole robot: its URDF hangs from a frame placed at
             # the base's pose in the world (states' base.*, MCAP's world -> odom -> base)
-            moving = mobile or (replay is not None and replay.base is not None)
+            moving = self.MOBILE or (replay is not None and replay.base is not None)
             self._base = self.server.scene.add_frame("/base", show_axes=False) if moving else None
             root = "/base" if moving else ""
             self._robot = ViserUrdf(self.server, self._urdf, root_node_name=f"{root}/robot")
@@ -136,7 +138,9 @@ class Viewer:
                     root_node_name=f"{root}/ghost",
                     mesh_color_override=GHOST_RGBA,
                 )
-            self._build_scene()
+            self._build_scene()  # then the sensors: a world's camera replaces the robot's
+            self._sensors = SensorLayer(self.server, self._urdf, sensors, f"{root}/robot") if (
+                sensors is not None and replay is not None) else None  # fmt: skip
             self._build_gui(name)
             self._apply()
         except BaseException:
@@ -152,20 +156,6 @@ class Viewer:
     def url(self) -> str:
         """Address of the viewer page."""
         return f"http://{self.host}:{self.port}"
-
-    def set_base(self, position: ArrayLike, wxyz: ArrayLike) -> None:
-        """Put the robot's root at `position` [m] turned by `wxyz` (a `mobile` viewer only)."""
-        assert self._base is not None, "a fixed root: Viewer(mobile=True) moves"
-        with self._lock:
-            self._base.position, self._base.wxyz = np.asarray(position), np.asarray(wxyz)
-
-    def base_position(self) -> np.ndarray | None:
-        """Where the robot's root is [m] (a `mobile` viewer or a drive's replay), else None."""
-        return None if self._base is None else np.array(self._base.position, dtype=float)
-
-    def in_range(self, q: Mapping[str, float]) -> dict[str, float]:
-        """The viewer's joints of `q`, bounded ones clipped, continuous ones wrapped to ±pi."""
-        return {j: self._in_range(j, v) for j, v in q.items() if j in self._limits}
 
     @property
     def joint_names(self) -> tuple[str, ...]:
@@ -208,6 +198,11 @@ class Viewer:
     def show_frames(self, visible: bool) -> None:
         """Show or hide the link frames, through the GUI checkbox so the page stays in sync."""
         self._frames_box.value = bool(visible)
+
+    @property
+    def sensor_notes(self) -> tuple[str, ...]:
+        """What the replay's sensors could not draw."""
+        return self._sensors.notes if self._sensors is not None else ()
 
     def seek(self, t: float) -> None:
         """Show the replay at time t [s] from the start of the record."""
@@ -335,6 +330,8 @@ class Viewer:
         if pose is not None and self._base is not None:
             self._base.position, self._base.wxyz = tuple(pose[0]), tuple(pose[1])
         self.set_configuration({j: self._in_range(j, v) for j, v in q.items()})
+        if self._sensors is not None:
+            self._sensors.show(t0)
         if self._ghost is not None:
             ref = self._replay.reference_at(t0)
             visible = ref is not None and bool(self._ghost_box.value)
