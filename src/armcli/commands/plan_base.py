@@ -57,7 +57,7 @@ def plan_base(
         require_file(scene)
     robot_file = robot.read(urdf)
     origin = tuple(base_start) if base_start is not None else (0.0, 0.0, 0.0)
-    what = f"from {start or 'home'} to xyz {','.join(f'{v:g}' for v in to_xyz)}"
+    what = f"from {start or 'the start pose'} to xyz {','.join(f'{v:g}' for v in to_xyz)}"
     opts = PlanOptions(planner=planner, timeout=timeout, seed=seed,
                        comment=f"armcli plan --base {what}, {planner}, seed {seed}")  # fmt: skip
     try:
