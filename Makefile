@@ -87,6 +87,7 @@ bench: install-dev native-check
 	$(BIN)/python bench/bench_tune.py
 	$(BIN)/python bench/bench_check_dof.py
 	$(BIN)/python bench/bench_plan.py
+	$(BIN)/python bench/bench_place.py
 	$(BIN)/python bench/bench_first_hour.py
 	$(BIN)/python bench/bench_check_corpus.py
 	$(BIN)/python bench/bench_check_packages.py

@@ -52,6 +52,10 @@ COMMANDS: dict[str, tuple[str, str]] = {
         "armcli.commands.plan",
         "Plan a collision-free motion, time it within the limits, certify it, write it.",
     ),
+    "place": (
+        "armcli.commands.place",
+        "Find where the base must stand for the tool to reach a point: least driving first.",
+    ),
     "tune": (
         "armcli.commands.tune",
         "Tune PD gains: model-based start, then a seeded search over simulated rollouts.",

@@ -116,9 +116,12 @@ class _Mass:
 
     def parts(self, x: ArrayLike) -> tuple[NDArray[Any], NDArray[Any]]:
         """(unloaded centre of mass, payload point) [m] at joint values x."""
+        return self.parts_at(self.q(x))
+
+    def parts_at(self, q: NDArray[np.float64]) -> tuple[NDArray[Any], NDArray[Any]]:
+        """(unloaded centre of mass, payload point) [m] at the configuration q."""
         import pinocchio as pin
 
-        q = self.q(x)
         c0 = np.array(pin.centerOfMass(self.model, self.data, q))
         if self.frame is None:
             return c0, c0
@@ -188,6 +191,52 @@ def analyse(
         payload_max=min(known) if len(known) == len(best) else None,
         contact_tol=None if stance.ground.declared else stance.ground.tol,
     )
+
+
+class MarginAt:
+    """The static tip-over margin [m] as a function of some joints' values: built once per robot.
+
+    The signed distance of the centre of mass (payload included) to the support polygon's
+    boundary, as `analyse` reports it per pose, with `joints` at the values given and the
+    other searched joints at zero (clamped into range): what a base placement must keep
+    positive at every pose it judges.
+    """
+
+    def __init__(self, stance: Stance, joints: Sequence[str]) -> None:
+        """`joints`: the names the values of each call are given for, in order."""
+        self.ev = _Mass(stance)
+        self.m = stance.payload.mass if stance.payload is not None else 0.0
+        searched = {j.name: (j, lo, hi) for j, (lo, hi) in zip(stance.joints, stance.box,
+                                                               strict=True)}  # fmt: skip
+        self.template = stance.q(_values(stance, {}))
+        # (value index, q index, lower, upper) per given joint the search moves; a continuous
+        # one is stored as (cos, sin): through Stance.q, the one place that writes it
+        self.slots = [(k, *searched[n][1:], searched[n][0]) for k, n in enumerate(joints)
+                      if n in searched]  # fmt: skip
+        self.fast = all(not j.continuous for *_, j in self.slots)
+        self.polygon = stance.polygon
+
+    def __call__(self, values: ArrayLike) -> float:
+        """The margin [m] with the joints at `values` [rad or m]."""
+        return self.polygon.margin(self.com(values))
+
+    def com(self, values: ArrayLike) -> NDArray[np.float64]:
+        """The centre of mass [m] (payload included) with the joints at `values`."""
+        given = np.asarray(values, dtype=float)
+        if self.fast:  # the per-pose path of a placement: no joint table walk
+            q = self.template.copy()
+            for k, lo, hi, j in self.slots:
+                q[j.idx_q] = min(max(float(given[k]), lo), hi)
+        else:
+            named = {j.name: min(max(float(given[k]), lo), hi) for k, lo, hi, j in self.slots}
+            q = self.ev.s.q(_values(self.ev.s, named))
+        c0, p = self.ev.parts_at(q)
+        out: NDArray[np.float64] = (self.ev.M * c0 + self.m * p) / (self.ev.M + self.m)
+        return out
+
+    def height(self, values: ArrayLike) -> float:
+        """[m] the centre of mass above the ground with the joints at `values`."""
+        return self.ev.s.height(self.com(values))
 
 
 def _point_label(stance: Stance) -> str:

@@ -14,6 +14,7 @@ from armcli.commands.options import choice, option, seed_option
 from armcli.commands.robot_input import robot_options
 from armcli.commands.values import Names, Numbers, names, numbers, point
 from armcli.defaults import MAX_PLAN_TIMEOUT_S, PLANNERS
+from armcli.errors import PlanningError
 from armcli.io.outdir import existing, wrote
 from armcli.io.terminal import say, say_line
 
@@ -34,6 +35,12 @@ SRDF_HELP = "SRDF of a --urdf: its disable_collisions, group_state and group ent
 GROUP_HELP = "Plan the joints of this planning group of --srdf (MoveIt's), e.g. arm."
 TIMEOUT_HELP = f"Planning time limit [s], at most {MAX_PLAN_TIMEOUT_S:g}"
 EXECUTE_HELP = "Simulate the plan right away; exit 1 if it breaks a limit or tips over."
+BASE_HELP = (
+    "Also drive the base (a differential drive): where to park for --to-xyz, the path there, "
+    "then the arm; -o is then a directory for arm.yaml, cmd_vel.yaml and path.yaml."
+)
+TOLERANCE_HELP = "With --base --execute: the tool farther from the target [m] fails the run"
+BASE_START_HELP = "With --base: where the base stands, x,y,yaw [m, m, rad] (default: 0,0,0)."
 FLAGS = {
     "start": "--from",
     "goal": "--to",
@@ -47,6 +54,8 @@ FLAGS = {
     "group": "--group",
     "srdf": "--srdf",
     "timeout": "--timeout",
+    "base": "--base",
+    "base_start": "--base-start",
 }
 
 
@@ -85,12 +94,27 @@ def plan_cmd(
     output: Path = option(None, "--output", "-o", help="JointTrajectory YAML to write."),
     fmt: str = choice("text", FORMATS, "--format", help="Output format (default: text)."),
     execute: bool = option(False, "--execute", help=EXECUTE_HELP),
+    base: bool = option(False, "--base", help=BASE_HELP),
+    tolerance: float = option(0.02, "--tolerance", help=TOLERANCE_HELP),
+    base_start: Numbers = option(
+        None,
+        "--base-start",
+        parser=numbers("--base-start", 3, "x,y,yaw [m, m, rad]"),
+        metavar="X,Y,YAW",
+        help=BASE_START_HELP,
+    ),
 ) -> None:
     """Plan a collision-free motion, time it within the limits, certify it, write it."""
     from armcli.io.outdir import check_output_file
     from armcli.plan.api import PlanOptions
     from armcli.plan.request import PlanRequest, plan_request
 
+    if base or base_start is not None:
+        from armcli.commands.plan_base import plan_base
+
+        plan_base(robot, urdf, scene, start, to_xyz, base_start, planner, timeout, seed, output,
+                  fmt, execute, tolerance)  # fmt: skip
+        return
     request = PlanRequest(start, goal, to_xyz, to_rpy, srdf, scene, joints or None, group)
     if output is not None:  # never over a file it reads (issue 42; hard links too)
         inputs = [p for p in (urdf or robot.file(), srdf, scene) if p is not None]
@@ -101,7 +125,15 @@ def plan_cmd(
                        comment=f"armcli plan {what}, {planner}, seed {seed}")  # fmt: skip
     for line in request.warnings():
         say_line(f"warning: {line}", sys.stderr)
-    result = plan_request(robot_file, replace(request, options=opts), robot.packages)
+    try:
+        result = plan_request(robot_file, replace(request, options=opts), robot.packages)
+    except PlanningError as exc:
+        if exc.kind == "ik" and robot_file.spec is not None and robot_file.spec.mobile_base:
+            why = f"{exc.reason}: out of the arm's reach from where the base stands"
+            raise PlanningError(
+                "ik", f"{why}; --base plans where to park and the drive there"
+            ) from None
+        raise
     before = existing(output)
     if output is not None:
         from armcli.io.files import write_file_atomic

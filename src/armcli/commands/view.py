@@ -11,12 +11,13 @@ import typer
 from armcli.commands.flags import flag_errors
 from armcli.commands.robot_input import robot_options, write_notes
 from armcli.commands.values import Names, names
-from armcli.errors import InputError
+from armcli.errors import ArmcliError, InputError
 from armcli.io.oneline import one_line
 from armcli.io.terminal import say_line
 
 if TYPE_CHECKING:
     from armcli.urdf.source import RobotInput
+    from armcli.view.baseplan import BaseSession
     from armcli.view.planning import PlanningSession
     from armcli.view.scene import RobotSource
 
@@ -86,7 +87,13 @@ def view_cmd(
             sensors = load_sensor_replay(replay)
     chosen = list(joints) if joints else None
     session = _session(src, (scene, srdf, chosen, group), save_dir, robot)  # before serving
-    viewer = Viewer(
+    base = _base_session(src, scene) if session is not None else None
+    kind = Viewer
+    if base is not None:
+        from armcli.view.basepanel import MobileViewer
+
+        kind = MobileViewer
+    viewer = kind(
         src.xml,
         name=src.name,
         source=src.source,
@@ -100,11 +107,17 @@ def view_cmd(
         port=port,
     )
     write_notes(viewer.sensor_notes)
-    panel = None
+    panel = base_panel = None
     try:  # entered before the URL is printed, so an early Ctrl-C still stops cleanly
         if session is not None:
             panel = PlanningPanel(viewer, session, src.xml, source=src.source,
                                   mesh_dir=src.mesh_dir, search=src.search)  # fmt: skip
+        if base is not None:
+            from armcli.view.basepanel import BasePanel, MobileViewer
+
+            assert isinstance(viewer, MobileViewer)
+            base_panel = BasePanel(viewer, base, src.xml, source=src.source,
+                                   mesh_dir=src.mesh_dir, search=src.search)  # fmt: skip
         if pose:
             viewer.apply_pose(pose)
         sys.stdout.write(
@@ -117,6 +130,8 @@ def view_cmd(
     finally:
         if panel is not None:
             panel.close()
+        if base_panel is not None:
+            base_panel.close()
         viewer.close()
 
 
@@ -145,6 +160,18 @@ def _session(
         say_line(f"note: no planning panel: {exc}", sys.stderr)
         return None
     return session
+
+
+def _base_session(src: RobotSource, scene: Path | None) -> BaseSession | None:
+    """The mobile base's session when the robot has a diff drive (else none, a note)."""
+    from armcli.view.baseplan import load_base_session
+
+    assert src.file is not None
+    try:
+        return load_base_session(src.file, scene, src.search)
+    except ArmcliError as exc:
+        sys.stderr.write(f"note: no mobile base panel: {exc}\n")
+        return None
 
 
 def register(app: typer.Typer) -> None:

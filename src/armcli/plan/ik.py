@@ -33,6 +33,8 @@ class IkResult:
     distance: float  # [m] tool point to target at the best attempt
     angle: float  # [rad] orientation error there (0 for a position goal)
     attempts: int
+    closest: np.ndarray | None = None  # the best attempt's values (a miss within a caller's
+    # looser tolerance still serves it: base placement)
 
 
 def tool_pose(robot: PlanRobot, data: object, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -129,6 +131,7 @@ def solve_ik(
     solver = _Solver(robot, np.asarray(xyz, dtype=float), rotation)
     rng = np.random.default_rng(seed)
     best = (np.inf, np.inf)
+    closest = None
     start = seed_x if seed_x is not None else 0.5 * (robot.lower + robot.upper)
     for k in range(attempts):
         x0 = start if k == 0 else rng.uniform(robot.lower, robot.upper)
@@ -136,5 +139,5 @@ def solve_ik(
         if dist < POSITION_TOL and ang < ROTATION_TOL and (free is None or free(x)):
             return IkResult(x, dist, ang, k + 1)
         if (dist, ang) < best:
-            best = (dist, ang)
-    return IkResult(None, best[0], best[1], attempts)
+            best, closest = (dist, ang), x
+    return IkResult(None, best[0], best[1], attempts, closest)

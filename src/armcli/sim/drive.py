@@ -19,7 +19,7 @@ import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -76,6 +76,7 @@ def prepare(
     gate: Callable[[Urdf], None] | None = None,
     world: Path | Scene | None = None,
     sensors: bool = True,
+    params: DriveParams | None = None,
 ) -> DriveJob:
     """Validate the inputs and build the model; InputError names what is wrong.
 
@@ -83,8 +84,10 @@ def prepare(
     first and may refuse it (the command passes check.gate.refuse_check_errors). `world`:
     a scene file (or its Scene) whose objects the robot drives among (sim.world); one the
     robot stands in at the start is refused. `sensors`: simulate the spec's sensors.
+    `params`: the diff drive when the spec's `mobile_base.diff_drive` does not state it (a
+    URDF's plugin kept verbatim by import).
     """
-    params = DriveParams.of(spec)
+    params = params if params is not None else DriveParams.of(spec)
     cmd = load_cmd_vel(cmd_vel)
     rate = opts.rate if opts.rate is not None else params.update_rate
     if opts.trajectory is None and opts.message is None:
@@ -181,8 +184,29 @@ def update_steps(steps: int, dt: float, period: float) -> np.ndarray:
     return np.array(out, dtype=np.int64)
 
 
-def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> DriveRun:
-    """Step the model for the job's duration from rest on the floor."""
+class Pilot(Protocol):
+    """Closes the loop a drive otherwise runs open: the commands, and when the arm moves.
+
+    A path follower (plan.mobile.pursuit) gives /cmd_vel at every plugin update from the
+    state as it is, instead of the job's file, and may hold the arm's reference until the
+    base has arrived.
+    """
+
+    def command(self, t: float, data: Any) -> tuple[float, float]:
+        """(linear.x [m/s], angular.z [rad/s]) at the plugin update at time t [s]."""
+        ...
+
+    def arm_step(self, k: int, data: Any) -> int:
+        """Before step k: which step's arm reference to use (<= k: the arm waits)."""
+        ...
+
+
+def run(
+    job: DriveJob,
+    progress: Callable[[int, int], None] | None = None,
+    pilot: Pilot | None = None,
+) -> DriveRun:
+    """Step the model for the job's duration from rest on the floor (`pilot`: closed loop)."""
     import mujoco
 
     m, dm, arm = job.model.model, job.model, job.arm
@@ -210,19 +234,23 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
     arm_act = slice(int(act[0]), int(act[-1]) + 1) if _contiguous(act) else act
     arm_qpos = dm.arm_qpos
     ctrl, u, command = d.ctrl, 0, np.zeros(2)
+    used = np.arange(steps + 1)  # the arm reference's step at each step (a pilot may hold it)
     rig = make_rig(job.sensors, m, steps, job.dt)
     due, sample = rig.due.tolist(), rig.sample
     start = time.perf_counter()
     for k in range(steps):
         if is_update[k]:
-            command = controller.update(lin[u], ang[u], d.qvel[wheel_dof], elapsed[u])
+            twist = (lin[u], ang[u]) if pilot is None else pilot.command(float(now[u]), d)
+            command = controller.update(twist[0], twist[1], d.qvel[wheel_dof], elapsed[u])
             u += 1
         wheel_cmd[k] = command
         spin(d, rotor, command)  # the plugin's motor speed (its "vel")
+        j = k if pilot is None else pilot.arm_step(k, d)
+        used[k] = j
         if gravity is None:
-            ctrl[arm_act] = ctrl_arm[k]
+            ctrl[arm_act] = ctrl_arm[j]
         else:
-            ctrl[arm_act] = ctrl_arm[k] + gravity(d.qpos[arm_qpos])[cols] * inv_kp
+            ctrl[arm_act] = ctrl_arm[j] + gravity(d.qpos[arm_qpos])[cols] * inv_kp
         mujoco.mj_step(m, d)
         rec[k] = d.sensordata
         rec[k, wheel_force] = -d.qfrc_constraint[rotor]  # sim.wheelmotor.clutch_torque
@@ -235,6 +263,9 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
     rec[steps, wheel_force] = clutch_torque(d, rotor)
     if due[steps]:
         sample(steps, m, d)
+    if pilot is not None and steps:
+        used[steps] = min(used[steps - 1] + 1, steps)
+        q_ref, v_ref = q_ref[used], v_ref[used]
     wall = time.perf_counter() - start
     _refuse_reset(d, rec, job.dt)
     wl = rec[:-1, dm.layout.wheel_vel]

@@ -31,8 +31,13 @@ MARKER_ARRAY, WORLD_TOPIC = "visualization_msgs/msg/MarkerArray", "/world"
 COVARIANCE = {0: 1e-5, 7: 1e-5, 14: 1e12, 21: 1e12, 28: 1e12, 35: 1e-3}
 
 
-def mcap_bytes(run: DriveRun, cols: dict[str, np.ndarray], rate: float) -> bytes:
-    """The run as rosbag2 MCAP bytes (sim.rosbag's topics plus the drive's)."""
+def mcap_bytes(
+    run: DriveRun,
+    cols: dict[str, np.ndarray],
+    rate: float,
+    more: Sequence[rosbag.Channel] = (),
+) -> bytes:
+    """The run as rosbag2 MCAP bytes (sim.rosbag's topics plus the drive's, plus `more`)."""
     job = run.job
     wheels = [job.params.left_joint, job.params.right_joint]
     chans = rosbag.channels(cols, [*job.arm.arm.joint_names, *wheels], job.robot)
@@ -61,7 +66,7 @@ def mcap_bytes(run: DriveRun, cols: dict[str, np.ndarray], rate: float) -> bytes
         world = marker_array(job.model.model, data, job.model.world)
         chans.append(rosbag.Channel(WORLD_TOPIC, MARKER_ARRAY, rosbag.qos(1, True),
                                     [(stamps[0], world)]))  # fmt: skip
-    return rosbag.mcap_bytes(chans)
+    return rosbag.mcap_bytes([*chans, *more])
 
 
 def _tf(parent: str, child: str, ns: int, xyz: Any, quat: Sequence[float]) -> Any:

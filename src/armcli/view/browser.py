@@ -84,6 +84,8 @@ def moving_parts(urdf_xml: str, joints: Collection[str], source: str = "<urdf>")
 class Viewer:
     """A running viser server showing one robot; thread-safe setters for the tests and the GUI."""
 
+    MOBILE = False  # the robot hangs from a frame that moves (view.basepanel.MobileViewer)
+
     def __init__(
         self,
         urdf_xml: str,
@@ -124,7 +126,7 @@ class Viewer:
         try:
             # a drive's replay moves the whole robot: its URDF hangs from a frame placed at
             # the base's pose in the world (states' base.*, MCAP's world -> odom -> base)
-            moving = replay is not None and replay.base is not None
+            moving = self.MOBILE or (replay is not None and replay.base is not None)
             self._base = self.server.scene.add_frame("/base", show_axes=False) if moving else None
             # everything drawn in the robot's root frame hangs from it too: the frames, the
             # tool dot, the planning panel's goal ghost, handle and trail (view.panel)
