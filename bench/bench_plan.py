@@ -141,7 +141,10 @@ class Roboplan:
 
         self.rrt.setRngSeed(seed)
         t0 = time.perf_counter()
-        path = self.rrt.plan(JointConfiguration(ARM, a), JointConfiguration(ARM, b))
+        try:
+            path = self.rrt.plan(JointConfiguration(ARM, a), JointConfiguration(ARM, b))
+        except RuntimeError:  # roboplan 0.7.0 raises on its time limit
+            path = None
         if path is None or not path.positions:
             return time.perf_counter() - t0, None
         path = self.short.shortcut(path)

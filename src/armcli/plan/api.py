@@ -146,7 +146,7 @@ def plan_motion(
     t_path = time.perf_counter() - t0
     t_plan, t_cert, last = 0.0, 0.0, None
     for margin in MARGINS if len(path) == 2 else MARGINS_CORNERS:
-        timed = parameterise(robot, path, margin)
+        timed = parameterise(robot, path, margin, ctx.checker.native)
         t_plan = time.perf_counter() - t0
         doc = trajectory_yaml(robot.joints, timed, frame_id=frame, comment=options.comment)
         t1 = time.perf_counter()

@@ -22,6 +22,12 @@ from armcli.plan.collision import CollisionChecker
 
 SHORTCUT_TRIES = 20  # random shortcut attempts after the greedy pass
 SHORTCUT_PATIENCE = 5  # stop after this many failed attempts in a row (as roboplan does)
+RANGE = 1.5  # [rad] the compiled RRT-Connect's longest extension (Euclidean in x)
+GOAL_BIAS = 0.05  # probability of growing toward the other tree's root
+THREADS = 1
+ATTEMPT_NODES = 20000
+COMPILED_SHORTCUT_TRIES = 20
+COMPILED_SHORTCUT_PATIENCE = 5
 _OMPL_NAMES = {
     "rrtconnect": "RRTConnect",
     "rrt": "RRT",
@@ -148,9 +154,31 @@ def plan_path(
 
     if ok(start, goal):
         return np.array([start, goal])
+    if checker.native is not None and planner == "rrtconnect":
+        return _compiled_path(checker, start, goal, timeout=timeout, seed=seed, step=step)
     raw: Any = _ompl_path(checker, lower, upper, start, goal, planner=planner,
                           timeout=timeout, seed=seed, step=step)  # fmt: skip
     if raw is None:
         raise PlanningError("no-path", f"no collision-free path found within {timeout:g} s")
     raw[0], raw[-1] = start, goal
     return shortcut(raw, ok, seed)
+
+
+def _compiled_path(
+    checker: CollisionChecker, start: np.ndarray, goal: np.ndarray, *, timeout: float,
+    seed: int, step: float,
+) -> np.ndarray:  # fmt: skip
+    """RRT-Connect and shortcutting in the compiled planner (plan/_native/rrt.cpp)."""
+    native = checker.native
+    assert native is not None
+    raw, _stats = native.plan(
+        np.ascontiguousarray(start, dtype=float), np.ascontiguousarray(goal, dtype=float),
+        range=RANGE, goal_bias=GOAL_BIAS, step=step, timeout=timeout, seed=seed,
+        threads=THREADS, attempt_nodes=ATTEMPT_NODES,
+    )  # fmt: skip
+    if raw is None:
+        raise PlanningError("no-path", f"no collision-free path found within {timeout:g} s")
+    raw[0], raw[-1] = start, goal
+    path: np.ndarray = native.shortcut(raw, step, seed, COMPILED_SHORTCUT_TRIES,
+                                       COMPILED_SHORTCUT_PATIENCE)  # fmt: skip
+    return path

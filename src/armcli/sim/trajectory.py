@@ -18,6 +18,7 @@ of 0 would ask for an instantaneous jump.
 
 from __future__ import annotations
 
+import contextlib
 import difflib
 import math
 from collections.abc import Mapping, Sequence
@@ -29,8 +30,9 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import Problem, SpecError
-from armcli.io.yaml import FlowKeys, YamlDoc, dotted, load_yaml, loads_yaml
+from armcli.io.yaml import MAX_YAML_BYTES, FlowKeys, YamlDoc, dotted, loads_yaml, read_text
 from armcli.sim.brace import BraceNotes
+from armcli.sim.jointtext import canonical_doc
 
 DEFAULT_SEGMENT_S = 1.0  # [s] time given to a point without time_from_start
 MIN_SEGMENT_S = 1e-6  # [s] shorter segments make the interpolated reference overflow
@@ -69,8 +71,8 @@ def load_trajectory(
     others: Mapping[str, str] = MappingProxyType({}),
 ) -> Trajectory:
     """Read and validate a trajectory file; `limits` maps each valid joint to (lower, upper)."""
-    doc = load_yaml(path, flow_sets=True)
-    return parse_trajectory(doc, limits, clamp=clamp, others=others)
+    text = read_text(path, what="YAML file")
+    return loads_trajectory(text, limits, source=str(path), clamp=clamp, others=others)
 
 
 def loads_trajectory(
@@ -80,9 +82,18 @@ def loads_trajectory(
     source: str = "<message>",
     clamp: bool = False,
     others: Mapping[str, str] = MappingProxyType({}),
+    max_bytes: int | None = MAX_YAML_BYTES,
 ) -> Trajectory:
-    """Validate a trajectory given as text, e.g. the `ros2 topic pub` payload."""
-    doc = loads_yaml(text, source, flow_sets=True)
+    """Validate a trajectory given as text, e.g. the `ros2 topic pub` payload.
+
+    Plan's own layout is read by sim.jointtext (same data, fast; problems are reported from
+    the YAML reader, which knows lines). `max_bytes`: None for armcli's own output.
+    """
+    fast = canonical_doc(text, source)
+    with contextlib.suppress(SpecError):  # reported below, from the YAML reader
+        if fast is not None:
+            return parse_trajectory(fast, limits, clamp=clamp, others=others)
+    doc = loads_yaml(text, source, flow_sets=True, max_bytes=max_bytes)
     return parse_trajectory(doc, limits, clamp=clamp, others=others)
 
 
