@@ -35,10 +35,10 @@ sys.path.insert(0, str(ROOT / "src"))
 
 from armcli.errors import PlanningError  # noqa: E402
 from armcli.io.packages import PackageLookup  # noqa: E402
+from armcli.io.scene import Scene  # noqa: E402
 from armcli.plan.api import PlanningContext, PlanOptions, plan_motion  # noqa: E402
 from armcli.plan.ik import solve_ik, tool_pose  # noqa: E402
 from armcli.plan.inputs import Loaded, load_context  # noqa: E402
-from armcli.plan.scene import Scene  # noqa: E402
 from armcli.urdf.source import read_robot  # noqa: E402
 
 SPEC = ROOT / "specs" / "my_robot.yaml"

@@ -198,3 +198,35 @@ def test_replay_moves_the_base_from_either_file(drive_files: dict[str, Path]) ->
             assert abs(wheel) > 2 * math.pi  # more than a turn
             shown = v.configuration()["base_left_wheel_joint"]
             assert shown == pytest.approx((wheel + math.pi) % (2 * math.pi) - math.pi, abs=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("text", "where"),
+    [
+        ("collision_objects:\n  - id: wall\n    primitives: [{type: box, dimensions: [1, 1]}]\n"
+         "    primitive_poses: [{}]\n", ":3 collision_objects[0].primitives[0].dimensions"),
+        ("collision_objects:\n  - id: wall\n    header: {frame_id: nowhere}\n"
+         "    primitives: [{type: sphere, dimensions: [0.1]}]\n    primitive_poses: [{}]\n",
+         ":3 collision_objects[0].header.frame_id"),
+    ],
+)  # fmt: skip
+def test_bad_world_is_exit_2_naming_file_and_field(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], text: str, where: str
+) -> None:
+    world = tmp_path / "world.yaml"
+    world.write_text(text)
+    out = tmp_path / "run.mcap"
+    args = ["simulate", DEFAULT_SPEC, "--cmd-vel", DRIVE, "--world", world, "-o", out]
+    code, _, err = run_main(args, capsys)
+    assert code == 2
+    assert f"{world}{where}" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_a_world_without_a_drive_is_exit_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    world = tmp_path / "world.yaml"
+    world.write_text("collision_objects: []\n")
+    code, _, err = run_main(["simulate", DEFAULT_SPEC, "-t", PICK, "--world", world], capsys)
+    assert code == 2 and "--world" in err

@@ -27,6 +27,7 @@ def run_drive(
     output: Path | None,
     plot: Path | None,
     progress: Callable[[int, int], None] | None = None,
+    world: Path | None = None,
 ) -> None:
     """Drive, write and report; raises TipOverError when the robot tips over."""
     from armcli.check.gate import refuse_check_errors
@@ -35,7 +36,7 @@ def run_drive(
     from armcli.sim.driving import drive_robot
 
     try:
-        driven = drive_robot(spec, opts, cmd_vel, progress=progress,
+        driven = drive_robot(spec, opts, cmd_vel, progress=progress, world=world,
                              gate=lambda u: refuse_check_errors(u, ignore=ignore))  # fmt: skip
     except ModelRefusedError as exc:
         flags = " ".join(f"--ignore {r}" for r in exc.rules())
@@ -47,8 +48,8 @@ def run_drive(
         err.print(one_line(f"warning: {w}"), markup=False, highlight=False)
     write_files_together(driven.files(output, plot))  # never a new CSV beside an old plot
     job, res, res_run, verdict = driven.job, driven.arm, driven.run, driven.verdict
-    for lift in verdict.lifts:
-        err.print(one_line(f"warning: {lift.line()}"), markup=False, highlight=False)
+    for note in verdict.notes():
+        err.print(one_line(f"warning: {note}"), markup=False, highlight=False)
     out = terminal.console()
     metrics = simreport.joint_metrics(res, job.arm.trajectory.duration)
     ee = simjob.tool_position(job.arm, res.q[-1])

@@ -38,6 +38,10 @@ CMD_VEL_HELP = (
     "Drive the whole robot on its wheels in MuJoCo: /cmd_vel commands YAML (`commands:` "
     "Twist + time_from_start); --trajectory then optional."
 )
+WORLD_HELP = (
+    "With --cmd-vel: obstacles in the world (odom at the start), a PlanningScene YAML as "
+    "plan --scene reads."
+)
 PROGRESS_AFTER_S = 1.0  # show a progress bar when the run is projected to take longer
 # The library's names for what these flags set (errors name them; commands.flags maps back).
 FLAGS = {
@@ -46,6 +50,7 @@ FLAGS = {
     "joints": "--joints",
     "output": "--output",
     "cmd_vel": "--cmd-vel",
+    "world": "--world",
 }
 
 
@@ -101,6 +106,7 @@ def simulate_cmd(
         None, "--contact-links", parser=names, metavar="LINK,...", help=CONTACT_LINKS_HELP
     ),
     cmd_vel: Path = option(None, "--cmd-vel", help=CMD_VEL_HELP),
+    world: Path = option(None, "--world", help=WORLD_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
     from armcli.check.rules import unknown_rules
@@ -142,8 +148,11 @@ def simulate_cmd(
     )
     tip_opts = TipOptions(base_accel, payload, payload_link, contact_links)
     if cmd_vel is not None:
-        _drive(spec_obj, opts, cmd_vel, tuple(ignore), output, plot, tip_opts != TipOptions())
+        _drive(spec_obj, opts, cmd_vel, world, tuple(ignore), output, plot,
+               tip_opts != TipOptions())  # fmt: skip
         return
+    if world is not None:
+        raise InputError("a world is for a drive: give --cmd-vel too", field="--world")
     asked = tip_opts != TipOptions()  # an arm on a fixed base is news only when asked about
     with _LazyProgress(terminal.console(sys.stderr)) as progress:
         run = _simulate(spec_obj, spec_path, opts, tip_opts, robot, tuple(ignore), progress,
@@ -192,8 +201,8 @@ def _sources(spec_path: Path | None, opts: SimOptions) -> dict[str, Any]:
 
 
 def _drive(
-    spec: Any, opts: SimOptions, cmd_vel: Path, ignore: tuple[str, ...], output: Path | None,
-    plot: Path | None, tip_asked: bool,
+    spec: Any, opts: SimOptions, cmd_vel: Path, world: Path | None, ignore: tuple[str, ...],
+    output: Path | None, plot: Path | None, tip_asked: bool,
 ) -> None:  # fmt: skip
     """The whole robot on its wheels (commands.drive); the base-at-rest options do not apply."""
     from armcli.commands.drive import run_drive
@@ -205,7 +214,7 @@ def _drive(
             field="--cmd-vel",
         )
     with _LazyProgress(terminal.console(sys.stderr)) as progress:
-        run_drive(spec, opts, cmd_vel, ignore, output, plot, progress)
+        run_drive(spec, opts, cmd_vel, ignore, output, plot, progress, world)
 
 
 def _report(run: ArmRun, output: Path | None, plot: Path | None, asked: bool) -> None:

@@ -1,5 +1,5 @@
 """Motion planning without ROS: collision-free paths (OMPL), timing (TOPP-RA), certification.
 
 The API is `plan.api` (planning_context, plan_motion, solve_goal); the robot comes from
-`plan.robot.load_plan_robot`, the obstacles from `plan.scene.load_scene`.
+`plan.robot.load_plan_robot`, the obstacles from `io.scene.load_scene`.
 """

@@ -21,13 +21,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from armcli.errors import InputError, PlanningError
+from armcli.io.scene import Scene
 from armcli.plan.certify import certify
 from armcli.plan.collision import PADDING, CollisionChecker
 from armcli.plan.geometric import plan_path
 from armcli.plan.ik import IkResult, solve_ik
 from armcli.plan.output import read_back, trajectory_yaml
 from armcli.plan.robot import PlanRobot
-from armcli.plan.scene import Scene
 from armcli.plan.timing import Timed, parameterise
 
 # TOPP-RA limit scales tried until the certification passes: the output spline overshoots

@@ -18,9 +18,9 @@ from typing import Any
 
 import numpy as np
 
+from armcli.io.scene import Scene, Shape
 from armcli.plan.native import compiled_scene, load
 from armcli.plan.robot import PlanRobot
-from armcli.plan.scene import Scene, Shape
 from armcli.robot.load import link_frame
 
 GROUND_ID = "ground"  # the name the ground plane has in collision reports

@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 
 from armcli.errors import InputError
+from armcli.io.scene import Scene, load_scene
 from armcli.plan.api import PlanningContext, planning_context, values
 from armcli.plan.robot import default_joints, load_plan_robot
-from armcli.plan.scene import Scene, load_scene
 from armcli.plan.srdf import Srdf, allowed_pairs, read_srdf
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import RobotFile, lookup_for

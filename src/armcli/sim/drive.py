@@ -25,6 +25,7 @@ import numpy as np
 
 from armcli.analysis.stance import NoStance, Stance, stance_of
 from armcli.errors import InputError, SimulationError
+from armcli.io.scene import Scene
 from armcli.sim import job as simjob
 from armcli.sim.cmdvel import CmdVel, load_cmd_vel
 from armcli.sim.diffdrive import DiffDriveController, DriveParams, Odometry, encoder_odometry
@@ -33,6 +34,8 @@ from armcli.sim.job import SimJob
 from armcli.sim.options import SimOptions
 from armcli.sim.simulate import steps_of
 from armcli.sim.tipping import robot_urdf
+from armcli.sim.wheelmotor import clutch_torque, spin
+from armcli.sim.world import load_world, refuse_overlaps
 from armcli.urdf.doc import Urdf
 
 if TYPE_CHECKING:
@@ -67,11 +70,14 @@ def prepare(
     cmd_vel: Path,
     *,
     gate: Callable[[Urdf], None] | None = None,
+    world: Path | Scene | None = None,
 ) -> DriveJob:
     """Validate the inputs and build the model; InputError names what is wrong.
 
     Without a trajectory the arm holds its start pose. `gate` sees the whole robot's URDF
-    first and may refuse it (the command passes check.gate.refuse_check_errors).
+    first and may refuse it (the command passes check.gate.refuse_check_errors). `world`:
+    a scene file (or its Scene) whose objects the robot drives among (sim.world); one the
+    robot stands in at the start is refused.
     """
     params = DriveParams.of(spec)
     cmd = load_cmd_vel(cmd_vel)
@@ -101,10 +107,25 @@ def prepare(
     kp = np.broadcast_to(np.asarray(job.config.kp, dtype=float), (n,))
     kd = np.broadcast_to(np.asarray(job.config.kd, dtype=float), (n,))
     gains = (kp, kd, np.asarray(job.arm.effort, dtype=float))
+    if isinstance(world, Path):
+        world = load_world(world, [lk.name for lk in robot.links])
     model = build_drive_model(
-        robot, spec, stance, params, job.arm.joint_names, gains, job.config.dt
+        robot, spec, stance, params, job.arm.joint_names, gains, job.config.dt, world=world
     )
+    if world is not None:
+        refuse_overlaps(model.model, start_data(model, job.q0), model.world, world.source)
     return DriveJob(job, cmd, params, model, stance, robot, float(duration))
+
+
+def start_data(dm: DriveModel, q0: np.ndarray) -> Any:
+    """MuJoCo's data at the start: the robot at rest on the floor at the origin, arm at q0."""
+    import mujoco
+
+    d = mujoco.MjData(dm.model)
+    d.qpos[2] = dm.base_z
+    d.qpos[dm.arm_qpos] = q0
+    mujoco.mj_forward(dm.model, d)
+    return d
 
 
 def _hold_message(spec: RobotSpec, opts: SimOptions) -> str:
@@ -156,9 +177,7 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
     import mujoco
 
     m, dm, arm = job.model.model, job.model, job.arm
-    d = mujoco.MjData(m)
-    d.qpos[2] = dm.base_z
-    d.qpos[dm.arm_qpos] = arm.q0
+    d = start_data(dm, arm.q0)
     steps = steps_of(job.duration, job.dt)
     t = np.arange(steps + 1) * job.dt
     q_ref, v_ref = arm.reference.sample(t)
@@ -167,37 +186,40 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
     gravity = _gravity(arm) if arm.config.gravity_comp else None
     inv_kp = np.divide(1.0, kp, out=np.zeros_like(kp), where=kp > 0)  # Kp 0: no g through ctrl
     updates = update_steps(steps, job.dt, job.params.period)
-    lin, ang = job.cmd.at((updates + 1) * job.dt)
+    now = (updates + 1) * job.dt  # Gazebo's sim time at each update
+    lin, ang = job.cmd.at(now)
+    elapsed = np.diff(now, prepend=0.0)  # the plugin's seconds_since_last_update
     is_update = np.zeros(steps + 1, dtype=bool)
     is_update[updates] = True
     rec = np.empty((steps + 1, dm.layout.size))
     wheel_cmd = np.zeros((steps + 1, 2))
     controller = DiffDriveController(job.params)
-    wheel_act, wheel_dof = dm.wheel_act, dm.wheel_dof
+    wheel_dof, rotor, wheel_force = dm.wheel_dof, dm.wheel_rotor, dm.layout.wheel_force
     cols = np.nonzero(dm.arm_act >= 0)[0]  # a mimic joint follows its leader: no actuator
     ctrl_arm, inv_kp = ctrl_arm[:, cols], inv_kp[cols]
     act = dm.arm_act[cols]
     arm_act = slice(int(act[0]), int(act[-1]) + 1) if _contiguous(act) else act
     arm_qpos = dm.arm_qpos
     ctrl, u, command = d.ctrl, 0, np.zeros(2)
-    mujoco.mj_forward(m, d)
     start = time.perf_counter()
     for k in range(steps):
         if is_update[k]:
-            command = controller.update(lin[u], ang[u], d.qvel[wheel_dof], job.params.period)
-            ctrl[wheel_act] = command
+            command = controller.update(lin[u], ang[u], d.qvel[wheel_dof], elapsed[u])
             u += 1
         wheel_cmd[k] = command
+        spin(d, rotor, command)  # the plugin's motor speed (its "vel")
         if gravity is None:
             ctrl[arm_act] = ctrl_arm[k]
         else:
             ctrl[arm_act] = ctrl_arm[k] + gravity(d.qpos[arm_qpos])[cols] * inv_kp
         mujoco.mj_step(m, d)
         rec[k] = d.sensordata
+        rec[k, wheel_force] = -d.qfrc_constraint[rotor]  # sim.wheelmotor.clutch_torque
         if progress is not None and k % PROGRESS_STEPS == 0 and k:
             progress(k, steps)
     mujoco.mj_forward(m, d)
     rec[steps], wheel_cmd[steps] = d.sensordata, command
+    rec[steps, wheel_force] = clutch_torque(d, rotor)
     wall = time.perf_counter() - start
     _refuse_reset(d, rec, job.dt)
     wl = rec[:-1, dm.layout.wheel_vel]

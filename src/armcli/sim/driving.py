@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from armcli.errors import InputError
+from armcli.io.scene import Scene
 from armcli.sim import drive, driveout
 from armcli.sim.drive import DriveJob, DriveRun
 from armcli.sim.liftoff import TipVerdict
@@ -62,15 +63,19 @@ def drive_robot(
     *,
     gate: Callable[[Urdf], None] | None = None,
     progress: Callable[[int, int], None] | None = None,
+    world: Path | Scene | None = None,
 ) -> Driven:
-    """Drive the spec's whole robot by the /cmd_vel commands in `cmd_vel` (sim.drive)."""
+    """Drive the spec's whole robot by the /cmd_vel commands in `cmd_vel` (sim.drive).
+
+    `world`: a scene file (or Scene) of obstacles in the world frame (sim.world).
+    """
     if spec is None or opts.urdf is not None:
         raise InputError(
             "drives a spec's robot (its mobile_base.diff_drive); give a spec instead of "
             "`SimOptions.urdf`",
             field="cmd_vel",
         )
-    job = drive.prepare(spec, opts, cmd_vel, gate=gate)
+    job = drive.prepare(spec, opts, cmd_vel, gate=gate, world=world)
     warnings = (*job.arm.trajectory.warnings, *job.cmd.warnings, *job.model.notes)
     run = drive.run(job, progress)
     arm = driveout.arm_result(run, driveout.plot_steps_of(run.steps, job.dt, job.arm.rate))

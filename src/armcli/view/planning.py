@@ -21,11 +21,11 @@ import numpy as np
 from armcli.errors import InputError, OutputRefusedError, PlanningError
 from armcli.io.files import write_file_atomic
 from armcli.io.outdir import check_output_file, relative_inside
+from armcli.io.scene import Scene, Shape
 from armcli.plan.api import PlanningContext, PlanOptions, PlanResult, plan_motion, values
 from armcli.plan.execute import Execution, execute
 from armcli.plan.ik import solve_ik, tool_pose
 from armcli.plan.inputs import load_context
-from armcli.plan.scene import Scene, Shape
 from armcli.sim.options import SimOptions
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import RobotFile

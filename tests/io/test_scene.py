@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from armcli.errors import SpecError
-from armcli.plan.scene import load_scene
+from armcli.io.scene import load_scene
 
 LINKS = ["base_link", "hand_link"]
 

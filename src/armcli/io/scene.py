@@ -1,5 +1,8 @@
 """Planning-scene YAML shaped like moveit_msgs/PlanningScene's `world.collision_objects`.
 
+One reader for the obstacles `plan --scene` plans around and the world `simulate --cmd-vel
+--world` drives in (sim.world), so it sits below both.
+
 A file holds `world: {collision_objects: [...]}` (a PlanningScene message) or the list
 under a top-level `collision_objects`. Each object has an `id`, `header.frame_id` (a robot
 link, or `world` / empty for the robot's root frame), an optional object `pose`, and
