@@ -29,10 +29,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
 from armcli.io.packages import PackageLookup  # noqa: E402
+from armcli.io.scene import Scene  # noqa: E402
 from armcli.plan.api import PlanningContext  # noqa: E402
 from armcli.plan.ik import tool_pose  # noqa: E402
 from armcli.plan.inputs import Loaded, load_context  # noqa: E402
-from armcli.io.scene import Scene  # noqa: E402
 from armcli.urdf.source import read_robot  # noqa: E402
 
 SCENES = ROOT / "bench" / "scenes"

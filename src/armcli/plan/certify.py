@@ -89,9 +89,7 @@ def _limit(s: Samples, values: np.ndarray, limit: np.ndarray, kind: str, joints:
     return Violation(kind, float(s.t[k]), joints[j], float(values[k, j]), float(limit[j]))
 
 
-def kinematic_violation(
-    robot: PlanRobot, s: Samples, compiled: Any = None
-) -> Violation | None:
+def kinematic_violation(robot: PlanRobot, s: Samples, compiled: Any = None) -> Violation | None:
     """The worst position, velocity, acceleration or effort excess, or None.
 
     `compiled`: the compiled planner's scene (plan.native), which computes the torques.

@@ -24,6 +24,9 @@ from armcli.plan.robot import PlanRobot
 from armcli.robot.load import link_frame
 
 GROUND_ID = "ground"  # the name the ground plane has in collision reports
+# Every collision query asks for contacts: coal 3.0.3's boolean-only query (Pinocchio's
+# default) can miss a penetration, e.g. a cylinder 7.9 mm into a box (found by the reach
+# helper's brute-force reference); with contacts its GJK runs to the end.
 PADDING = 0.005  # [m] clearance the planner keeps (CollisionChecker.pad)
 
 
@@ -120,10 +123,9 @@ class CollisionChecker:
         self.moving = [self.bodies[i].moves_with != self.bodies[j].moves_with
                        for i, j in self.pairs]  # fmt: skip
         mod = load() if native else None
+        names = [b.name for b in self.bodies]
         self.native = (
-            compiled_scene(mod, robot, gmodel, self.pairs, self.moving, [b.name for b in self.bodies])
-            if mod
-            else None
+            compiled_scene(mod, robot, gmodel, self.pairs, self.moving, names) if mod else None
         )
         if self.native is None:
             self._python_checks()
@@ -138,6 +140,9 @@ class CollisionChecker:
             if not moves:
                 self.gdata.deactivateCollisionPair(k)  # their relative pose never changes
                 self.gdata_moving.deactivateCollisionPair(k)
+        for gdata in (self.gdata_all, self.gdata, self.gdata_moving):
+            for req in gdata.collisionRequests:  # exact: see the note at GROUND_ID
+                req.enable_contact = True
         self._broadphase()
 
     def _pairs(self, gmodel: Any, disabled: set[tuple[str, str]]) -> list[tuple[int, int]]:

@@ -16,6 +16,7 @@ best effort: a read-only or missing cache directory only means computing every t
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -41,7 +42,7 @@ def cache_dir() -> Path:
     return Path(base) / "acm"
 
 
-def matrix_key(text: str, poses: Mapping[str, Mapping[str, float]] | None, samples: int,
+def matrix_key(text: str | bytes, poses: Mapping[str, Mapping[str, float]] | None, samples: int,
                seed: int) -> str:  # fmt: skip
     """SHA-256 over everything the matrix depends on (see the module docstring)."""
     import pinocchio
@@ -50,8 +51,9 @@ def matrix_key(text: str, poses: Mapping[str, Mapping[str, float]] | None, sampl
     h = hashlib.sha256(f"armcli-acm {FORMAT} {samples} {seed} {pinocchio.__version__}\n".encode())
     for module in (collision_matrix, sampling):
         h.update(Path(module.__file__ or "").read_bytes())
-    h.update(text.encode("utf-8", "surrogatepass"))
-    root = etree.fromstring(text.encode("utf-8", "surrogatepass"))
+    data = text if isinstance(text, bytes) else text.encode("utf-8", "surrogatepass")
+    h.update(data)
+    root = etree.fromstring(data)
     for mesh in root.iterfind(".//collision//mesh"):
         name = mesh.get("filename") or ""
         h.update(name.encode())
@@ -88,8 +90,6 @@ def cached_pairs(key: str, links: Collection[str], compute: Callable[[], Pairs])
         return found
     pairs = compute()
     doc = {"format": FORMAT, "key": key, "disabled": [list(p) for p in pairs]}
-    try:
+    with contextlib.suppress(OSError):  # no cache: computed again next time
         write_file_atomic(path, json.dumps(doc, indent=0) + "\n")
-    except OSError:
-        pass  # no cache: computed again next time
     return pairs

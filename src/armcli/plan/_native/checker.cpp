@@ -20,7 +20,7 @@ namespace armcli_plan {
 namespace {
 
 constexpr double UNBOUNDED = 1e10;     // [m] a local box this large is a half-space's
-constexpr double CHEAP_GAP = 0.02;     // [m] a box gap this wide is distance bound enough
+constexpr double CHEAP_GAP = 0.08;     // [m] a box gap this wide is distance bound enough
 constexpr double DISTANCE_TOL = 1e-6;  // [m] coal's distance may be this much too large
 constexpr double HULL_SLACK = 1e-6;    // [m] a hull must clear the margin by this much
 constexpr double OBB_SLACK = 1e-9;     // [m] and an oriented box by this much
@@ -185,7 +185,9 @@ Work::Work(const Scene& s_) : s(s_), data(s_.model) {
   hull_collide.resize(np);
   collide.reserve(np);
   distance.reserve(np);
-  request.assign(np, coal::CollisionRequest(coal::NO_REQUEST, 1));
+  // CONTACT: coal 3.0.3's boolean-only query can miss a penetration (a cylinder 7.9 mm into
+  // a box: collide 0, distance -0.0079); with contacts its GJK runs to the end and is exact.
+  request.assign(np, coal::CollisionRequest(coal::CONTACT, 1));
   for (size_t p = 0; p < np; ++p) {
     const auto& a = s.geom.geometryObjects[s.pairs[p].a].geometry;
     const auto& b = s.geom.geometryObjects[s.pairs[p].b].geometry;
@@ -196,6 +198,7 @@ Work::Work(const Scene& s_) : s(s_), data(s_.model) {
       hull_collide[p] = std::make_unique<coal::ComputeCollision>(ha ? ha.get() : a.get(),
                                                                  hb ? hb.get() : b.get());
     request[p].enable_cached_gjk_guess = true;  // as Pinocchio's GeometryData sets it
+    request[p].enable_contact = true;
   }
   x_tmp = s.lower;
   // every placement once: the geometries no planned joint moves keep it
