@@ -90,6 +90,7 @@ bench: install-dev native-check
 	$(BIN)/python bench/bench_plan.py
 	$(BIN)/python bench/bench_first_hour.py
 	$(BIN)/python bench/bench_check_corpus.py
+	$(BIN)/python bench/bench_check_packages.py
 	$(BIN)/python bench/bench_build_expand.py
 	$(BIN)/python bench/bench_drive.py
 

@@ -103,6 +103,16 @@ def test_ros_package(built: tuple[Path, RobotSpec, Path], tmp_path: Path) -> Non
     assert info.value.code in (0, None)
     srdf = tmp_path / f"{spec.name}_moveit_config" / "config" / f"{spec.name}.srdf"
     assert srdf.is_file()
+    assert _package_findings(tmp_path) == []
+
+
+def _package_findings(root: Path) -> list[str]:
+    """The package rules' findings (and unreadable files) of `check DIR` on ros-package's output."""
+    from armcli.check.ros_packages.run import check_packages
+
+    found = [f for r in check_packages(root, CheckOptions()).results for f in r.findings]
+    return [f"{f.rule}: {f.message}" for f in found
+            if f.rule.startswith("ros-") or f.rule == "input-unusable"]  # fmt: skip
 
 
 def test_ros_package_jazzy(built: tuple[Path, RobotSpec, Path], tmp_path: Path) -> None:
@@ -118,6 +128,7 @@ def test_ros_package_jazzy(built: tuple[Path, RobotSpec, Path], tmp_path: Path) 
     assert (
         tmp_path / f"{spec.name}_description" / "urdf" / "standalone_arm_gz.urdf.xacro"
     ).is_file()
+    assert _package_findings(tmp_path) == []
 
 
 def test_export_mjcf_loads_in_mujoco(built: tuple[Path, RobotSpec, Path], tmp_path: Path) -> None:
