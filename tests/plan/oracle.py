@@ -154,6 +154,11 @@ class Oracle:
         self.gdata = pin.GeometryData(self.geom)
         for req in self.gdata.collisionRequests:
             req.enable_contact = True
+        # Pinocchio's own broadphase (coal's dynamic AABB tree): the same verdicts as every
+        # pair, without coal refitting a box around a primitive for each mesh query
+        self.manager = pin.BroadPhaseManager_DynamicAABBTreeCollisionManager(
+            self.model, self.geom, self.gdata
+        )
         self.acceleration = acceleration
         del coal
 
@@ -201,7 +206,9 @@ class Oracle:
             tau = pin.rnea(m, self.data, qf, vf, af)[iv]
             if np.any(np.abs(tau) > emax * (1 + RELATIVE_TOL)):
                 note("effort", k, str(tau))
-            if pin.computeCollisions(m, self.data, self.geom, self.gdata, qf, True):
+            pin.updateGeometryPlacements(m, self.data, self.geom, self.gdata, qf)
+            self.manager.update(False)
+            if pin.computeCollisions(self.manager, True):
                 pair = next(cp for cp, r in zip(self.geom.collisionPairs,
                                                 self.gdata.collisionResults, strict=True)
                             if r.isCollision())  # fmt: skip
