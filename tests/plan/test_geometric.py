@@ -54,8 +54,8 @@ def test_a_seed_gives_one_path_at_any_thread_count(panda_bin: Loaded) -> None:
     panda_bin.context.checker.pad(PADDING, (a, b))
     # small attempts, so that several run (and later ones may finish first on threads)
     runs = [native.plan(a, b, seed=7, threads=t, attempt_nodes=40, **OPTIONS) for t in (1, 2, 2)]
-    paths = [p for p, _ in runs]
-    assert all(p is not None for p in paths)
+    paths = [p for p, _ in runs if p is not None]
+    assert len(paths) == 3
     assert all(np.array_equal(paths[0], p) for p in paths[1:])
     assert len({s["attempt"] for _, s in runs}) == 1
     other, _ = native.plan(a, b, seed=8, threads=1, attempt_nodes=40, **OPTIONS)

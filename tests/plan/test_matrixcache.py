@@ -24,8 +24,8 @@ def computed(monkeypatch: pytest.MonkeyPatch) -> list[int]:
     calls: list[int] = []
     real = matrixcache.cached_pairs
 
-    def counting(key, links, compute):  # type: ignore[no-untyped-def]
-        def wrapped():  # type: ignore[no-untyped-def]
+    def counting(key, links, compute):
+        def wrapped():
             calls.append(1)
             return compute()
 

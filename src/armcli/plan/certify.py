@@ -131,10 +131,10 @@ def collision_violation(checker: CollisionChecker, s: Samples) -> Violation | No
     them free with distance bounds instead of collision queries.
     """
     if checker.native is not None:
-        k, pair, _queries, _bounds = checker.native.sweep(np.ascontiguousarray(s.q, dtype=float))
+        k, index, _queries, _bounds = checker.native.sweep(np.ascontiguousarray(s.q, dtype=float))
         if k < 0:
             return None
-        a, b = checker.pair_names(pair)
+        a, b = checker.pair_names(index)
         return Violation("collision", float(s.t[k]), f"{a} and {b}")
     for k, (t, q) in enumerate(zip(s.t, s.q, strict=True)):
         pair = checker.first_collision(q, every_pair=k == 0)

@@ -163,27 +163,42 @@ class CollisionChecker:
         return pairs
 
     def pad(self, padding: float, ends: Iterable[np.ndarray]) -> None:
-        """Plan `padding` [m] clear of everything, except pairs closer than that at `ends`.
+        """Plan `padding` [m] clear of everything; a pair closer than that at an end, half as
+        clear as it is there.
 
         The planner's check only: a path then keeps a clearance that the trajectory's small
         deviations between its points (timing) cannot eat; certification checks with none.
+        A pair left with no clearance at all (as before) could be planned to touch, and the
+        timed motion's deviation then made contact (found on the Panda's link2 and link5).
         """
+        margins = np.full(len(self.pairs), float(padding))
+        gdata = self.pin.GeometryData(self.gmodel)
+        for x in ends:
+            close = self._within(x, float(padding))
+            q = self.robot.q(x)
+            self.pin.updateGeometryPlacements(self.model, self.data, self.gmodel, gdata, q)
+            for k in close:
+                d = self.pin.computeDistance(self.gmodel, gdata, k).min_distance
+                margins[k] = min(margins[k], max(0.5 * d, 0.0))
         if self.native is not None:
-            margins = np.full(len(self.pairs), float(padding))
-            for x in ends:
-                margins[self.native.colliding(_x(x), float(padding))] = 0.0
             self.native.set_margins(margins)
             return
-        for req in self.gdata.collisionRequests:
-            req.security_margin = padding
-        for x in ends:
-            q = self.robot.q(x)
-            self.pin.computeCollisions(self.model, self.data, self.gmodel, self.gdata, q, False)
-            for req, res in zip(self.gdata.collisionRequests, self.gdata.collisionResults,
-                                strict=True):  # fmt: skip
-                if res.isCollision():
-                    req.security_margin = 0.0
+        for req, margin in zip(self.gdata.collisionRequests, margins, strict=True):
+            req.security_margin = float(margin)
         self._broadphase()
+
+    def _within(self, x: np.ndarray, margin: float) -> list[int]:
+        """The moving pairs closer than `margin` [m] at `x`."""
+        if self.native is not None:
+            return list(self.native.colliding(_x(x), margin))
+        gdata = self.pin.GeometryData(self.gmodel)
+        for k, (req, moves) in enumerate(zip(gdata.collisionRequests, self.moving, strict=True)):
+            req.security_margin, req.enable_contact = margin, True
+            if not moves:
+                gdata.deactivateCollisionPair(k)
+        q = self.robot.q(x)
+        self.pin.computeCollisions(self.model, self.data, self.gmodel, gdata, q, False)
+        return [k for k, res in enumerate(gdata.collisionResults) if res.isCollision()]
 
     def _broadphase(self) -> None:
         """Coal's dynamic AABB tree over the planner's pairs, as roboplan uses.

@@ -264,10 +264,11 @@ def _vector(
     if len(raw) != m:
         c.add(path, f"has {len(raw)} value(s) but joint_names has {m}")
         return None
-    out = []
+    if all(type(x) is float and math.isfinite(x) for x in raw):  # as _finite finds, fast
+        return list(raw)
+    out: list[float] = []
     for i, x in enumerate(raw):
-        value = _finite(x)
-        if value is None:
+        if (value := _finite(x)) is None:
             c.add((*path, i), f"must be a finite number, got {_short(x)}")
             return None
         out.append(value)
@@ -278,11 +279,10 @@ def _finite(x: Any) -> float | None:
     """`x` as a finite float, or None (bools, strings, NaN/inf, ints beyond float range)."""
     if isinstance(x, bool) or not isinstance(x, int | float):
         return None
-    try:
+    with contextlib.suppress(OverflowError):  # an int beyond the float range
         value = float(x)
-    except OverflowError:
-        return None
-    return value if math.isfinite(value) else None
+        return value if math.isfinite(value) else None
+    return None
 
 
 def _short(x: Any) -> str:

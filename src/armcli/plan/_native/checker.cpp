@@ -23,6 +23,7 @@ constexpr double UNBOUNDED = 1e10;     // [m] a local box this large is a half-s
 constexpr double CHEAP_GAP = 0.08;     // [m] a box gap this wide is distance bound enough
 constexpr double DISTANCE_TOL = 1e-6;  // [m] coal's distance may be this much too large
 constexpr double HULL_SLACK = 1e-6;    // [m] a hull must clear the margin by this much
+constexpr double HULL_DISTANCE_TOL = 1e-5;  // [m] GJK's distance between hulls may be this high
 constexpr double OBB_SLACK = 1e-9;     // [m] and an oriented box by this much
 
 template <typename T>
@@ -183,6 +184,7 @@ Work::Work(const Scene& s_) : s(s_), data(s_.model) {
   body_stamp.assign(s.body_geoms.size(), 0);
   world_obb.resize(ng);
   hull_collide.resize(np);
+  hull_distance.resize(np);
   collide.reserve(np);
   distance.reserve(np);
   // CONTACT: coal 3.0.3's boolean-only query can miss a penetration (a cylinder 7.9 mm into
@@ -194,9 +196,11 @@ Work::Work(const Scene& s_) : s(s_), data(s_.model) {
     collide.emplace_back(a.get(), b.get());
     distance.emplace_back(a.get(), b.get());
     const auto &ha = s.hull[s.pairs[p].a], &hb = s.hull[s.pairs[p].b];
-    if (ha || hb)
-      hull_collide[p] = std::make_unique<coal::ComputeCollision>(ha ? ha.get() : a.get(),
-                                                                 hb ? hb.get() : b.get());
+    if (ha || hb) {
+      const coal::CollisionGeometry *ga = ha ? ha.get() : a.get(), *gb = hb ? hb.get() : b.get();
+      hull_collide[p] = std::make_unique<coal::ComputeCollision>(ga, gb);
+      hull_distance[p] = std::make_unique<coal::ComputeDistance>(ga, gb);
+    }
     request[p].enable_cached_gjk_guess = true;  // as Pinocchio's GeometryData sets it
     request[p].enable_contact = true;
   }
@@ -344,6 +348,12 @@ double Work::pair_distance(int p) {
     coal::DistanceRequest r(false);
     coal::DistanceResult res;
     ++queries;
+    if (hull_distance[p]) {  // the hulls' distance: a lower bound of the meshes', and cheap
+      (*hull_distance[p])(tf[P.a], tf[P.b], r, res);
+      if (res.min_distance - HULL_DISTANCE_TOL > 0.0) return res.min_distance - HULL_DISTANCE_TOL;
+      res = coal::DistanceResult();
+      ++queries;
+    }
     distance[p](tf[P.a], tf[P.b], r, res);
     return res.min_distance - DISTANCE_TOL;
   } catch (const std::exception&) {  // a pair coal cannot measure (e.g. a mesh and a plane)

@@ -121,6 +121,7 @@ class Work {
   std::vector<Obb> world_obb;
   std::vector<coal::ComputeCollision> collide;
   std::vector<std::unique_ptr<coal::ComputeCollision>> hull_collide;  // null: no hull
+  std::vector<std::unique_ptr<coal::ComputeDistance>> hull_distance;
   std::vector<coal::ComputeDistance> distance;
   std::vector<coal::CollisionRequest> request;
   Vec q, x_tmp;
