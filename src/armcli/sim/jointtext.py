@@ -19,6 +19,9 @@ from typing import Any
 
 from armcli.io.yaml import YamlDoc
 
+# [bytes] a file in plan's layout may be this large (a 60 s plan of 7 joints is ~2.6 MB);
+# anything else still goes through the YAML reader's 1 MB cap
+MAX_PLAN_BYTES = 64_000_000
 _NAME = r'"[A-Za-z0-9_./-]*"'
 _FLOAT = r"-?(?:[0-9]+\.[0-9]+(?:e[-+][0-9]+)?|[0-9]+e[-+][0-9]+)"
 _INT = r"(?:0|[1-9][0-9]*)"

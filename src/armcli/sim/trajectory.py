@@ -32,7 +32,7 @@ import numpy as np
 from armcli.errors import Problem, SpecError
 from armcli.io.yaml import MAX_YAML_BYTES, FlowKeys, YamlDoc, dotted, loads_yaml, read_text
 from armcli.sim.brace import BraceNotes
-from armcli.sim.jointtext import canonical_doc
+from armcli.sim.jointtext import MAX_PLAN_BYTES, canonical_doc
 
 DEFAULT_SEGMENT_S = 1.0  # [s] time given to a point without time_from_start
 MIN_SEGMENT_S = 1e-6  # [s] shorter segments make the interpolated reference overflow
@@ -71,7 +71,7 @@ def load_trajectory(
     others: Mapping[str, str] = MappingProxyType({}),
 ) -> Trajectory:
     """Read and validate a trajectory file; `limits` maps each valid joint to (lower, upper)."""
-    text = read_text(path, what="YAML file")
+    text = read_text(path, max_bytes=MAX_PLAN_BYTES, what="YAML file")  # YAML: 1 MB still
     return loads_trajectory(text, limits, source=str(path), clamp=clamp, others=others)
 
 
