@@ -163,8 +163,7 @@ class CollisionChecker:
         return pairs
 
     def pad(self, padding: float, ends: Iterable[np.ndarray]) -> None:
-        """Plan `padding` [m] clear of everything; a pair closer than that at an end, half as
-        clear as it is there.
+        """Plan `padding` [m] clear; a pair closer than that at an end, half its clearance there.
 
         The planner's check only: a path then keeps a clearance that the trajectory's small
         deviations between its points (timing) cannot eat; certification checks with none.
