@@ -13,7 +13,7 @@ SPEC ?= specs/my_robot.yaml
 # (the compile), a heartbeat every 30 s (scripts/install.sh).
 STAMP := $(VENV)/.installed-stamp
 DEV_STAMP := $(VENV)/.dev-stamp
-$(STAMP): pyproject.toml CMakeLists.txt src/armcli/sim/_native/rollout.cpp
+$(STAMP): pyproject.toml CMakeLists.txt src/armcli/sim/_native/rollout.cpp $(wildcard src/armcli/plan/_native/*)
 	@bash scripts/install.sh runtime $(PY) $(VENV)
 	touch $(STAMP)
 
@@ -70,15 +70,16 @@ test: install-dev sysdeps lint native-check
 # install stamp, which a C++ edit outdates: that would recreate the whole venv.
 native:
 	@test -x $(BIN)/python || $(MAKE) install-dev
-	@echo "native: recompiling the engine (armcli.sim._rollout)"
+	@echo "native: recompiling the engine and the planner (armcli.sim._rollout, armcli.plan._planner)"
 	$(BIN)/python -m pip install -q --no-build-isolation --no-deps -e .
 	$(BIN)/python -m armcli.sim.native
+	$(BIN)/python -m armcli.plan.native
 
 # The compiled engine must be there wherever a C++ compiler exists: a failed build fails
 # `make test` instead of skipping its tests.
 native-check: install-dev
 	@if command -v c++ >/dev/null 2>&1 || command -v g++ >/dev/null 2>&1; then \
-	  $(BIN)/python -m armcli.sim.native; \
+	  $(BIN)/python -m armcli.sim.native && $(BIN)/python -m armcli.plan.native; \
 	else echo "no C++ compiler: armcli installs without its simulator; simulator tests skip"; fi
 
 bench: install-dev native-check

@@ -200,7 +200,12 @@ def test_simulate_drives_the_whole_robot(installed: Installed) -> None:
 
 
 def test_plan_then_simulate(installed: Installed) -> None:
-    # the README's Plan & Execute loop, from the wheel: OMPL and TOPP-RA are runtime deps
+    # the README's Plan & Execute loop, from the wheel: the compiled planner (libtoppra of
+    # cmeel-toppra, a runtime dependency), or OMPL and toppra without a compiler
+    with zipfile.ZipFile(installed.wheel) as zf:
+        planner = [n for n in zf.namelist() if n.startswith("armcli/plan/_planner")]
+    version = installed.run("--version").stdout.splitlines()
+    assert version[2].startswith("planner: compiled" if planner else "planner: Python")
     r = installed.run("plan", "--from", "home", "--to", "reach", "-o", "planned.yaml")
     assert r.returncode == 0, r.stderr
     doc = yaml.safe_load((installed.project / "planned.yaml").read_text())

@@ -1,4 +1,4 @@
-"""`armcli --version`: armcli's version, the simulator engine, pin and xacro; no heavy imports."""
+"""`armcli --version`: armcli's version, simulator engine, planner, pin, xacro; no heavy imports."""
 
 from __future__ import annotations
 
@@ -26,8 +26,9 @@ def test_version_lines() -> None:
     lines = version_lines()
     assert lines[0] == f"armcli {armcli.__version__} ({Path(armcli.__file__).parent})"
     assert lines[1].startswith(("simulator engine: compiled (", "simulator engine: unavailable ("))
-    assert lines[2:4] == [f"pin {metadata.version('pin')}", f"xacro {metadata.version('xacro')}"]
-    assert lines[4].startswith(("camera rendering: EGL (", "camera rendering: OSMesa (",
+    assert lines[2].startswith(("planner: compiled (", "planner: Python: OMPL and toppra ("))
+    assert lines[3:5] == [f"pin {metadata.version('pin')}", f"xacro {metadata.version('xacro')}"]
+    assert lines[5].startswith(("camera rendering: EGL (", "camera rendering: OSMesa (",
                                 "camera rendering: none ("))  # fmt: skip
 
 
@@ -35,6 +36,14 @@ def test_engine_when_the_compiled_simulator_is_missing(monkeypatch: pytest.Monke
     monkeypatch.setattr(native, "load", lambda: None)
     monkeypatch.setattr(native, "why_missing", lambda: "not built")
     assert version_lines()[1] == "simulator engine: unavailable (not built)"
+
+
+def test_planner_when_the_compiled_planner_is_missing(monkeypatch: pytest.MonkeyPatch) -> None:
+    from armcli.plan import native as plan_native
+
+    monkeypatch.setattr(plan_native, "load", lambda: None)
+    monkeypatch.setattr(plan_native, "why_missing", lambda: "ARMCLI_NO_NATIVE is set")
+    assert version_lines()[2] == "planner: Python: OMPL and toppra (ARMCLI_NO_NATIVE is set)"
 
 
 def test_version_option_is_fast() -> None:

@@ -119,27 +119,3 @@ def test_bisection_order_checks_every_step_once() -> None:
         order = bisection_order(n)
         assert sorted(order) == list(range(1, n + 1))  # each intermediate point exactly once
         assert order[0] == n
-
-
-def test_broadphase_check_agrees_with_every_pair(panda: Loaded) -> None:
-    # the planner's check (coal's AABB tree, padded) against Pinocchio's pair-by-pair one
-    # with the same padding: the same verdict on random Panda configurations
-    import pinocchio as pin
-
-    from armcli.plan.collision import PADDING
-
-    ck, robot = panda.context.checker, panda.context.robot
-    ck.pad(PADDING, ())
-    data, gdata = robot.model.createData(), pin.GeometryData(ck.gmodel)
-    for k, active in enumerate(ck.gdata.activeCollisionPairs):
-        if not active:
-            gdata.deactivateCollisionPair(k)
-    for req in gdata.collisionRequests:
-        req.security_margin = PADDING
-    rng = np.random.default_rng(2)
-    for _ in range(300):
-        x = rng.uniform(robot.lower, robot.upper)
-        q = robot.q(x)
-        assert ck.free(x) == (
-            not pin.computeCollisions(robot.model, data, ck.gmodel, gdata, q, True)
-        )

@@ -22,7 +22,7 @@ def test_a_urdf_with_package_meshes_and_no_srdf_loads() -> None:
     robot = loaded.context.robot
     assert "joint1" in robot.joints
     x = np.zeros(len(robot.joints))
-    assert loaded.context.checker.free(robot.q(x))
+    assert loaded.context.checker.free(x)
 
 
 VISUAL_ELSEWHERE = """<robot name="two">
@@ -50,4 +50,4 @@ def test_a_visual_mesh_of_an_absent_package_does_not_stop_planning(tmp_path: Pat
     loaded = load_context(read_robot(path), search=PackageLookup())
     robot = loaded.context.robot
     assert robot.joints == ("j1",)
-    assert loaded.context.checker.free(robot.q(np.zeros(1)))
+    assert loaded.context.checker.free(np.zeros(1))

@@ -1,4 +1,4 @@
-"""What `armcli --version` reports: armcli, the simulator engine, pin and xacro, rendering.
+"""What `armcli --version` reports: armcli, its engines, pin and xacro, camera rendering.
 
 A bug report needs to say which installation ran (the path), whether `simulate` uses the
 compiled simulator (or why it has none), the versions of the two libraries that shape
@@ -15,6 +15,7 @@ from importlib import metadata
 from pathlib import Path
 
 import armcli
+from armcli.plan import native as plan_native
 from armcli.sim import native
 
 LIBRARIES = ("pin", "xacro")  # distributions whose versions change armcli's results
@@ -40,6 +41,14 @@ def engine() -> str:
     return f"compiled ({where})"
 
 
+def planner() -> str:
+    """Whether `plan` runs the compiled planner (plan.native), or why it plans in Python."""
+    lib = plan_native.load()
+    if lib is None:
+        return f"Python: OMPL and toppra ({plan_native.why_missing()})"
+    return f"compiled ({getattr(lib, '__file__', '')})"
+
+
 def rendering() -> str:
     """The OpenGL backend camera sensors render with (sim.sensors.gl), or why none."""
     from armcli.sim.sensors import gl  # mujoco and OpenGL: loaded only here
@@ -51,6 +60,7 @@ def version_lines() -> list[str]:
     """The lines `armcli --version` prints, armcli's own version first."""
     lines = [f"armcli {armcli.__version__} ({Path(armcli.__file__).parent})"]
     lines.append(f"simulator engine: {engine()}")
+    lines.append(f"planner: {planner()}")
     lines += [f"{name} {_dist_version(name)}" for name in LIBRARIES]
     lines.append(f"camera rendering: {rendering()}")
     lines.append(f"Python {platform.python_version()} ({sys.executable})")

@@ -233,15 +233,21 @@ dotted = _dotted
 
 
 def loads_yaml(
-    text: str, source: str = "<string>", *, flow_sets: bool = False, merge_duplicates: bool = False
+    text: str,
+    source: str = "<string>",
+    *,
+    flow_sets: bool = False,
+    merge_duplicates: bool = False,
+    max_bytes: int | None = MAX_YAML_BYTES,
 ) -> YamlDoc:
     """Parse one YAML document from text under armcli's safety rules.
 
     `merge_duplicates`: a repeated key is merged as ROS 2 reads parameter files (rcl's
     parser: `/**:` twice in one file is one node's parameters) instead of refused.
+    `max_bytes`: the size cap for files users give; None for armcli's own output read back.
     """
-    if len(text.encode("utf-8", "surrogatepass")) > MAX_YAML_BYTES:
-        raise InputError(f"file larger than {MAX_YAML_BYTES} bytes", file=source)
+    if max_bytes is not None and len(text.encode("utf-8", "surrogatepass")) > max_bytes:
+        raise InputError(f"file larger than {max_bytes} bytes", file=source)
     if "\x00" in text:
         raise InputError("binary data (NUL byte) in a YAML file", file=source)
     text = _ECHO_END.sub("\n", text)  # one message saved from `ros2 topic echo`

@@ -11,6 +11,7 @@ returned; `plan` refuses to write a trajectory that has one.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -88,8 +89,11 @@ def _limit(s: Samples, values: np.ndarray, limit: np.ndarray, kind: str, joints:
     return Violation(kind, float(s.t[k]), joints[j], float(values[k, j]), float(limit[j]))
 
 
-def kinematic_violation(robot: PlanRobot, s: Samples) -> Violation | None:
-    """The worst position, velocity, acceleration or effort excess, or None."""
+def kinematic_violation(robot: PlanRobot, s: Samples, compiled: Any = None) -> Violation | None:
+    """The worst position, velocity, acceleration or effort excess, or None.
+
+    `compiled`: the compiled planner's scene (plan.native), which computes the torques.
+    """
     names = robot.joints
     below = robot.lower - POSITION_SLACK - s.q
     above = s.q - robot.upper - POSITION_SLACK
@@ -104,18 +108,34 @@ def kinematic_violation(robot: PlanRobot, s: Samples) -> Violation | None:
         if found is not None:
             return found
     if np.any(np.isfinite(robot.effort)):
-        tau_of = inverse_dynamics(robot)
-        tau = np.array([tau_of(q, v, a) for q, v, a in zip(s.q, s.v, s.a, strict=True)])
-        return _limit(s, tau, robot.effort, "effort", names)
+        return _limit(s, _torques(robot, s, compiled), robot.effort, "effort", names)
     return None
+
+
+def _torques(robot: PlanRobot, s: Samples, compiled: Any) -> np.ndarray:
+    """Joint torques (T, n) of the sampled motion: RNEA, compiled where it can be."""
+    if compiled is not None:
+        arrays = (np.ascontiguousarray(a, dtype=float) for a in (s.q, s.v, s.a))
+        tau: np.ndarray = compiled.inverse_dynamics(*arrays, robot.v_indices())
+        return tau
+    tau_of = inverse_dynamics(robot)
+    return np.array([tau_of(q, v, a) for q, v, a in zip(s.q, s.v, s.a, strict=True)])
 
 
 def collision_violation(checker: CollisionChecker, s: Samples) -> Violation | None:
     """The first sample in collision, or None.
 
     Every enabled pair at the first sample; after it, the pairs a planned joint moves (the
-    others keep their relative pose along the whole motion).
+    others keep their relative pose along the whole motion). The compiled sweep
+    (plan/_native/certify.cpp) gives the same verdict at every sample and proves most of
+    them free with distance bounds instead of collision queries.
     """
+    if checker.native is not None:
+        k, index, _queries, _bounds = checker.native.sweep(np.ascontiguousarray(s.q, dtype=float))
+        if k < 0:
+            return None
+        a, b = checker.pair_names(index)
+        return Violation("collision", float(s.t[k]), f"{a} and {b}")
     for k, (t, q) in enumerate(zip(s.t, s.q, strict=True)):
         pair = checker.first_collision(q, every_pair=k == 0)
         if pair is not None:
@@ -126,4 +146,4 @@ def collision_violation(checker: CollisionChecker, s: Samples) -> Violation | No
 def certify(robot: PlanRobot, checker: CollisionChecker, timed: Timed) -> Violation | None:
     """The first violation of the trajectory as simulate will run it, or None."""
     s = sample(robot, timed)
-    return kinematic_violation(robot, s) or collision_violation(checker, s)
+    return kinematic_violation(robot, s, checker.native) or collision_violation(checker, s)

@@ -5,6 +5,8 @@ Self-collision pairs are filtered by the allowed-collision matrix (`disabled`: t
 planned joint changes (two links on the same rigid body, a scene object and an unmoved
 link) are checked once at the start and goal (`first_collision(..., every_pair=True)`)
 and left out of the planner's per-state check, where only moving pairs can change.
+The checks run in the compiled planner (plan.native) where it is installed: the same
+geometry, pairs, margins and coal queries, without a Python call per state.
 """
 
 from __future__ import annotations
@@ -17,10 +19,14 @@ from typing import Any
 import numpy as np
 
 from armcli.io.scene import Scene, Shape
+from armcli.plan.native import compiled_scene, load
 from armcli.plan.robot import PlanRobot
 from armcli.robot.frames import frame_id
 
 GROUND_ID = "ground"  # the name the ground plane has in collision reports
+# Every collision query asks for contacts: coal 3.0.3's boolean-only query (Pinocchio's
+# default) can miss a penetration, e.g. a cylinder 7.9 mm into a box (found by the reach
+# helper's brute-force reference); with contacts its GJK runs to the end.
 PADDING = 0.005  # [m] clearance the planner keeps (CollisionChecker.pad)
 
 
@@ -68,9 +74,20 @@ def _moving_joints(robot: PlanRobot) -> dict[int, frozenset[str]]:
 
 
 class CollisionChecker:
-    """The robot's collision model plus obstacles, with the pairs to check."""
+    """The robot's collision model plus obstacles, with the pairs to check.
 
-    def __init__(self, robot: PlanRobot, scene: Scene, disabled: Iterable[tuple[str, str]]):
+    The checks run in the compiled planner (plan.native) when it is installed, else through
+    Pinocchio's Python bindings (`native=False` forces that path; tests compare the two).
+    """
+
+    def __init__(
+        self,
+        robot: PlanRobot,
+        scene: Scene,
+        disabled: Iterable[tuple[str, str]],
+        *,
+        native: bool = True,
+    ) -> None:
         import pinocchio as pin
 
         self.pin = pin
@@ -103,13 +120,30 @@ class CollisionChecker:
             self.bodies.append(Body(GROUND_ID, frozenset(), False))
         self.pairs = self._pairs(gmodel, {_key(a, b) for a, b in disabled})
         self.gmodel = gmodel
-        self.gdata_all = pin.GeometryData(gmodel)
-        self.gdata = pin.GeometryData(gmodel)  # moving pairs, padded: the planner's
-        self.gdata_moving = pin.GeometryData(gmodel)  # moving pairs, exact
-        for k, (i, j) in enumerate(self.pairs):
-            if self.bodies[i].moves_with == self.bodies[j].moves_with:
+        # a pair whose two bodies move with the same joints keeps its relative pose
+        self.moving = [self.bodies[i].moves_with != self.bodies[j].moves_with
+                       for i, j in self.pairs]  # fmt: skip
+        mod = load() if native else None
+        names = [b.name for b in self.bodies]
+        self.native = (
+            compiled_scene(mod, robot, gmodel, self.pairs, self.moving, names) if mod else None
+        )
+        if self.native is None:
+            self._python_checks()
+
+    def _python_checks(self) -> None:
+        """Pinocchio's GeometryData per use: every pair, the planner's (padded), moving exact."""
+        pin = self.pin
+        self.gdata_all = pin.GeometryData(self.gmodel)
+        self.gdata = pin.GeometryData(self.gmodel)  # moving pairs, padded: the planner's
+        self.gdata_moving = pin.GeometryData(self.gmodel)  # moving pairs, exact
+        for k, moves in enumerate(self.moving):
+            if not moves:
                 self.gdata.deactivateCollisionPair(k)  # their relative pose never changes
                 self.gdata_moving.deactivateCollisionPair(k)
+        for gdata in (self.gdata_all, self.gdata, self.gdata_moving):
+            for req in gdata.collisionRequests:  # exact: see the note at GROUND_ID
+                req.enable_contact = True
         self._broadphase()
 
     def _pairs(self, gmodel: Any, disabled: set[tuple[str, str]]) -> list[tuple[int, int]]:
@@ -130,21 +164,41 @@ class CollisionChecker:
         return pairs
 
     def pad(self, padding: float, ends: Iterable[np.ndarray]) -> None:
-        """Plan `padding` [m] clear of everything, except pairs closer than that at `ends`.
+        """Plan `padding` [m] clear; a pair closer than that at an end, half its clearance there.
 
         The planner's check only: a path then keeps a clearance that the trajectory's small
         deviations between its points (timing) cannot eat; certification checks with none.
+        A pair left with no clearance at all (as before) could be planned to touch, and the
+        timed motion's deviation then made contact (found on the Panda's link2 and link5).
         """
-        for req in self.gdata.collisionRequests:
-            req.security_margin = padding
+        margins = np.full(len(self.pairs), float(padding))
+        gdata = self.pin.GeometryData(self.gmodel)
         for x in ends:
+            close = self._within(x, float(padding))
             q = self.robot.q(x)
-            self.pin.computeCollisions(self.model, self.data, self.gmodel, self.gdata, q, False)
-            for req, res in zip(self.gdata.collisionRequests, self.gdata.collisionResults,
-                                strict=True):  # fmt: skip
-                if res.isCollision():
-                    req.security_margin = 0.0
+            self.pin.updateGeometryPlacements(self.model, self.data, self.gmodel, gdata, q)
+            for k in close:
+                d = self.pin.computeDistance(self.gmodel, gdata, k).min_distance
+                margins[k] = min(margins[k], max(0.5 * d, 0.0))
+        if self.native is not None:
+            self.native.set_margins(margins)
+            return
+        for req, margin in zip(self.gdata.collisionRequests, margins, strict=True):
+            req.security_margin = float(margin)
         self._broadphase()
+
+    def _within(self, x: np.ndarray, margin: float) -> list[int]:
+        """The moving pairs closer than `margin` [m] at `x`."""
+        if self.native is not None:
+            return list(self.native.colliding(_x(x), margin))
+        gdata = self.pin.GeometryData(self.gmodel)
+        for k, (req, moves) in enumerate(zip(gdata.collisionRequests, self.moving, strict=True)):
+            req.security_margin, req.enable_contact = margin, True
+            if not moves:
+                gdata.deactivateCollisionPair(k)
+        q = self.robot.q(x)
+        self.pin.computeCollisions(self.model, self.data, self.gmodel, gdata, q, False)
+        return [k for k, res in enumerate(gdata.collisionResults) if res.isCollision()]
 
     def _broadphase(self) -> None:
         """Coal's dynamic AABB tree over the planner's pairs, as roboplan uses.
@@ -161,18 +215,27 @@ class CollisionChecker:
 
         Exact geometry (no padding); `every_pair` also checks the pairs no planned joint moves.
         """
+        if self.native is not None:
+            k = self.native.first_collision(_x(x), every_pair)
+            return None if k < 0 else self.pair_names(k)
         gdata = self.gdata_all if every_pair else self.gdata_moving
         q = self.robot.q(x)
         if not self.pin.computeCollisions(self.model, self.data, self.gmodel, gdata, q, True):
             return None
         for k, res in enumerate(gdata.collisionResults):
             if res.isCollision():
-                i, j = self.pairs[k]
-                return self.bodies[i].name, self.bodies[j].name
+                return self.pair_names(k)
         return None  # pragma: no cover - computeCollisions said there was one
+
+    def pair_names(self, k: int) -> tuple[str, str]:
+        """The two bodies of pair `k` (links, scene objects, the ground)."""
+        i, j = self.pairs[k]
+        return self.bodies[i].name, self.bodies[j].name
 
     def free(self, x: np.ndarray) -> bool:
         """Whether `x` is collision-free (moving pairs only, padded: the planner's check)."""
+        if self.native is not None:
+            return bool(self.native.free(_x(x)))
         pin = self.pin
         pin.updateGeometryPlacements(
             self.model, self.data, self.gmodel, self.gdata, self.robot.q(x)
@@ -186,8 +249,15 @@ class CollisionChecker:
         The end first, then midpoints by bisection (as OMPL's discrete motion validator and
         roboplan do): a blocked segment is usually refused after a few checks.
         """
+        if self.native is not None:
+            return bool(self.native.motion_free(_x(xa), _x(xb), float(step)))
         n = max(1, math.ceil(float(np.max(np.abs(xb - xa))) / step))
         return all(self.free(xa + (xb - xa) * (k / n)) for k in bisection_order(n))
+
+
+def _x(x: Any) -> np.ndarray:
+    """Joint values as the extension takes them: contiguous float64."""
+    return np.ascontiguousarray(x, dtype=np.float64)
 
 
 def bisection_order(n: int) -> list[int]:

@@ -1,11 +1,21 @@
-"""A collision-free joint-space path: OMPL (RRT-Connect by default), then shortcutting.
+"""A collision-free joint-space path: RRT-Connect (or another OMPL planner), then shortcutting.
 
-A straight segment that is free is taken as it is (no sampling needed). Otherwise OMPL
-plans in the box of the planned joints' limits with the checker as its state validity
-callback, its motion checks at `step` [rad or m]. OMPL's random numbers are seeded, so a
-seed gives the same path whenever the planner finishes before the timeout. Shortcutting is
-armcli's own, seeded with numpy: first the greedy pass (from each waypoint, the farthest one
-reachable in a straight line), then random shortcuts between points on the path.
+A straight segment that is free is taken as it is (no sampling needed). Otherwise, with the
+compiled planner installed (plan.native) and the default planner, RRT-Connect runs in C++
+(plan/_native/rrt.cpp): two trees from start and goal, extensions of at most RANGE toward
+uniform samples (toward the other tree's root with probability GOAL_BIAS), edges checked at
+`step` [rad or m] in bisection order. An attempt that grows ATTEMPT_NODES nodes without
+meeting gives way to a fresh one with the next seed, until the timeout. Attempts can run on
+THREADS threads at once; the path is always the lowest-numbered successful attempt's, so a
+seed gives the same path whatever the thread count (one by default: with two, the second
+thread's attempt is mostly wasted work, since the first's result must be waited for). The
+other planners (`--planner`), and every planner without the extension, are OMPL's with the
+checker as a Python validity callback. Every random number is seeded, so a seed gives the
+same path whenever the planner finishes before the timeout.
+
+Shortcutting: the greedy pass (from each waypoint, the farthest one reachable in a straight
+line), then seeded random shortcuts between points on the path, then the greedy pass again;
+compiled with the planner (more tries: they are cheap there), or in Python with numpy.
 """
 
 from __future__ import annotations
@@ -22,6 +32,15 @@ from armcli.plan.collision import CollisionChecker
 
 SHORTCUT_TRIES = 20  # random shortcut attempts after the greedy pass
 SHORTCUT_PATIENCE = 5  # stop after this many failed attempts in a row (as roboplan does)
+# The compiled RRT-Connect, tuned on bench/plan_peers.py's slot scene (30 queries, CPU time
+# to solve, median): range 0.5: 0.38 s, 0.7: 0.31, 0.8: 0.21, 1.0: 0.15, 1.5: 0.25, 3.0: 0.63
+# (21/30 solved within 1 s); goal bias 0.15 or bridge sampling did not help there.
+RANGE = 1.0  # [rad] longest extension (Euclidean in the planned joints' values)
+GOAL_BIAS = 0.05  # probability of growing toward the other tree's root
+ATTEMPT_NODES = 20_000  # nodes of both trees before an attempt gives way to the next seed
+THREADS = 1  # attempts run at once
+COMPILED_SHORTCUT_TRIES = 100  # random shortcut attempts (roboplan's max_iters)
+COMPILED_SHORTCUT_PATIENCE = 20  # stop after this many misses in a row (its convergence)
 _OMPL_NAMES = {
     "rrtconnect": "RRTConnect",
     "rrt": "RRT",
@@ -148,9 +167,31 @@ def plan_path(
 
     if ok(start, goal):
         return np.array([start, goal])
+    if checker.native is not None and planner == "rrtconnect":
+        return _compiled_path(checker, start, goal, timeout=timeout, seed=seed, step=step)
     raw: Any = _ompl_path(checker, lower, upper, start, goal, planner=planner,
                           timeout=timeout, seed=seed, step=step)  # fmt: skip
     if raw is None:
         raise PlanningError("no-path", f"no collision-free path found within {timeout:g} s")
     raw[0], raw[-1] = start, goal
     return shortcut(raw, ok, seed)
+
+
+def _compiled_path(
+    checker: CollisionChecker, start: np.ndarray, goal: np.ndarray, *, timeout: float,
+    seed: int, step: float,
+) -> np.ndarray:  # fmt: skip
+    """RRT-Connect and shortcutting in the compiled planner (plan/_native/rrt.cpp)."""
+    native = checker.native
+    assert native is not None
+    raw, _stats = native.plan(
+        np.ascontiguousarray(start, dtype=float), np.ascontiguousarray(goal, dtype=float),
+        range=RANGE, goal_bias=GOAL_BIAS, step=step, timeout=timeout, seed=seed,
+        threads=THREADS, attempt_nodes=ATTEMPT_NODES,
+    )  # fmt: skip
+    if raw is None:
+        raise PlanningError("no-path", f"no collision-free path found within {timeout:g} s")
+    raw[0], raw[-1] = start, goal
+    path: np.ndarray = native.shortcut(raw, step, seed, COMPILED_SHORTCUT_TRIES,
+                                       COMPILED_SHORTCUT_PATIENCE)  # fmt: skip
+    return path

@@ -8,6 +8,7 @@ pair `plan` checks is a pair MoveIt checks.
 from __future__ import annotations
 
 from armcli.defaults import COLLISION_SAMPLES
+from armcli.plan.matrixcache import cached_pairs, matrix_key
 from armcli.ros.collision_matrix import DEFAULT_SEED, compute_collision_matrix
 from armcli.urdf.meshes import MeshSearch, confined_mesh_xml
 from armcli.urdf.source import RobotFile
@@ -22,7 +23,8 @@ def allowed_pairs(
     """Link pairs never checked against each other: the SRDF's, else ros-package's matrix.
 
     `search`: the package lookup the collision meshes are resolved with (the same the
-    planner's own geometry uses), so a `package://` mesh loads here too.
+    planner's own geometry uses), so a `package://` mesh loads here too. The matrix is
+    computed once per robot and kept in the user's cache (plan.matrixcache).
     """
     if srdf is not None:
         return srdf.disabled
@@ -33,11 +35,12 @@ def allowed_pairs(
         if search is None
         else confined_mesh_xml(urdf.text, urdf.source, search, collision_only=True)
     )
-    matrix = compute_collision_matrix(
-        text,
-        samples=COLLISION_SAMPLES,
-        seed=DEFAULT_SEED,
-        source=robot.robot.source,
-        poses=poses,
-    )
-    return tuple((d.link1, d.link2) for d in matrix.disabled)
+
+    def compute() -> tuple[tuple[str, str], ...]:
+        matrix = compute_collision_matrix(
+            text, samples=COLLISION_SAMPLES, seed=DEFAULT_SEED, source=urdf.source, poses=poses
+        )
+        return tuple((d.link1, d.link2) for d in matrix.disabled)
+
+    key = matrix_key(text, poses, COLLISION_SAMPLES, DEFAULT_SEED)
+    return cached_pairs(key, [lk.name for lk in urdf.links], compute)

@@ -132,6 +132,26 @@ def _spline(times: np.ndarray, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     return np.asarray(spline(times, 1)), np.asarray(spline(times, 2))
 
 
+def _compiled(robot: PlanRobot, waypoints: np.ndarray, margin: float, compiled: Any) -> Timed:
+    """`parameterise` in the compiled planner (plan/_native/timing.cpp)."""
+    effort = np.zeros(0)
+    if np.any(np.isfinite(robot.effort)):
+        effort = np.where(np.isfinite(robot.effort), robot.effort, UNLIMITED) * (0.5 + 0.5 * margin)
+    out = compiled.time_polyline(
+        np.ascontiguousarray(waypoints, dtype=float),
+        np.minimum(robot.velocity, UNLIMITED) * margin,
+        np.asarray(robot.acceleration, dtype=float) * margin,
+        effort,
+        robot.v_indices(),
+        GRID_PER_SEGMENT,
+        OUTPUT_RATE_HZ,
+    )
+    if isinstance(out, int):
+        raise PlanningError("timing", f"TOPP-RA found no motion within the limits along "
+                            f"segment {out + 1} of the path")  # fmt: skip
+    return Timed(*out)
+
+
 def _constraints(robot: PlanRobot, margin: float) -> list[Any]:
     import toppra.constraint as constraint
 
@@ -149,8 +169,16 @@ def _constraints(robot: PlanRobot, margin: float) -> list[Any]:
     return cons
 
 
-def parameterise(robot: PlanRobot, waypoints: np.ndarray, margin: float) -> Timed:
-    """Time-optimal motion along the polyline, limits scaled by `margin`; rest at each waypoint."""
+def parameterise(
+    robot: PlanRobot, waypoints: np.ndarray, margin: float, compiled: Any = None
+) -> Timed:
+    """Time-optimal motion along the polyline, limits scaled by `margin`; rest at each waypoint.
+
+    `compiled`: the compiled planner's scene (plan.native), whose TOPP-RA is the toppra C++
+    library's; without it, TOPP-RA's Python package (the same algorithm and LP solver).
+    """
+    if compiled is not None:
+        return _compiled(robot, waypoints, margin, compiled)
     import toppra.algorithm as algo
 
     logging.getLogger("toppra").setLevel(logging.ERROR)  # library code never prints

@@ -129,15 +129,45 @@ def build_reference(traj: Trajectory, joint_names: Sequence[str], q_start: np.nd
         first_v = zeros if vel is not None else None
         first_a = zeros if acc is not None else None
         segs.append(_coeffs(knots[1], q_start, pos, vel, acc, 0, first_v, first_a))
-    for k in range(P - 1):
-        v0 = vel[k] if vel is not None else None
-        a0 = acc[k] if acc is not None else None
-        segs.append(
-            _coeffs(traj.times[k + 1] - traj.times[k], pos[k], pos, vel, acc, k + 1, v0, a0)
-        )
-    coeffs = np.array(segs) if segs else np.zeros((0, 6, n))
+    rest = _segments(np.diff(traj.times), pos, vel, acc)
+    coeffs = np.concatenate([np.array(segs).reshape(-1, 6, n), rest])
     # With a single point at t = 0 the reference is that point from the start.
     return Reference(knots=np.array(knots), coeffs=coeffs, final=pos[-1].copy())
+
+
+def _segments(
+    h: np.ndarray, pos: np.ndarray, vel: np.ndarray | None, acc: np.ndarray | None
+) -> np.ndarray:
+    """`segment_coeffs` of every segment between points at once, (S, 6, n): the same numbers.
+
+    The same operations in the same order, element by element; the powers of h are taken
+    one by one as `segment_coeffs` takes them (a numpy scalar's power is not always the
+    array power's last bit).
+    """
+    S, n = len(h), pos.shape[1]
+    c = np.zeros((S, 6, n))
+    if S == 0:
+        return c
+    p0, dp = pos[:-1], pos[1:] - pos[:-1]
+    hc = h[:, None]
+    c[:, 0] = p0
+    if vel is None:
+        c[:, 1] = dp / hc
+        return c
+    v0, v1 = vel[:-1], vel[1:]
+    c[:, 1] = v0
+    h2, h3 = (np.array([x**k for x in h])[:, None] for k in (2, 3))
+    if acc is None:
+        c[:, 2] = (3.0 * dp - (2.0 * v0 + v1) * hc) / h2
+        c[:, 3] = (-2.0 * dp + (v0 + v1) * hc) / h3
+        return c
+    a0, a1 = acc[:-1], acc[1:]
+    h4, h5 = (np.array([x**k for x in h])[:, None] for k in (4, 5))
+    c[:, 2] = 0.5 * a0
+    c[:, 3] = (20.0 * dp - (8.0 * v1 + 12.0 * v0) * hc - (3.0 * a0 - a1) * h2) / (2.0 * h3)
+    c[:, 4] = (-30.0 * dp + (14.0 * v1 + 16.0 * v0) * hc + (3.0 * a0 - 2.0 * a1) * h2) / (2.0 * h4)
+    c[:, 5] = (12.0 * dp - 6.0 * (v1 + v0) * hc - (a0 - a1) * h2) / (2.0 * h5)
+    return c
 
 
 def _coeffs(

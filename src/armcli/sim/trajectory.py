@@ -18,6 +18,7 @@ of 0 would ask for an instantaneous jump.
 
 from __future__ import annotations
 
+import contextlib
 import difflib
 import math
 from collections.abc import Mapping, Sequence
@@ -29,8 +30,16 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import Problem, SpecError, one_per_kind
-from armcli.io.yaml import FlowKeys, YamlDoc, dotted, load_yaml, loads_yaml
+from armcli.io.yaml import (
+    MAX_YAML_BYTES,
+    FlowKeys,
+    YamlDoc,
+    dotted,
+    loads_yaml,
+    read_text,
+)
 from armcli.sim.brace import BraceNotes
+from armcli.sim.jointtext import MAX_PLAN_BYTES, canonical_doc
 
 DEFAULT_SEGMENT_S = 1.0  # [s] time given to a point without time_from_start
 MIN_SEGMENT_S = 1e-6  # [s] shorter segments make the interpolated reference overflow
@@ -69,8 +78,8 @@ def load_trajectory(
     others: Mapping[str, str] = MappingProxyType({}),
 ) -> Trajectory:
     """Read and validate a trajectory file; `limits` maps each valid joint to (lower, upper)."""
-    doc = load_yaml(path, flow_sets=True)
-    return parse_trajectory(doc, limits, clamp=clamp, others=others)
+    text = read_text(path, max_bytes=MAX_PLAN_BYTES, what="YAML file")  # YAML: 1 MB still
+    return loads_trajectory(text, limits, source=str(path), clamp=clamp, others=others)
 
 
 def loads_trajectory(
@@ -80,9 +89,18 @@ def loads_trajectory(
     source: str = "<message>",
     clamp: bool = False,
     others: Mapping[str, str] = MappingProxyType({}),
+    max_bytes: int | None = MAX_YAML_BYTES,
 ) -> Trajectory:
-    """Validate a trajectory given as text, e.g. the `ros2 topic pub` payload."""
-    doc = loads_yaml(text, source, flow_sets=True)
+    """Validate a trajectory given as text, e.g. the `ros2 topic pub` payload.
+
+    Plan's own layout is read by sim.jointtext (same data, fast; problems are reported from
+    the YAML reader, which knows lines). `max_bytes`: None for armcli's own output.
+    """
+    fast = canonical_doc(text, source)
+    with contextlib.suppress(SpecError):  # reported below, from the YAML reader
+        if fast is not None:
+            return parse_trajectory(fast, limits, clamp=clamp, others=others)
+    doc = loads_yaml(text, source, flow_sets=True, max_bytes=max_bytes)
     return parse_trajectory(doc, limits, clamp=clamp, others=others)
 
 
@@ -251,10 +269,11 @@ def _vector(
     if len(raw) != m:
         c.add(path, f"has {len(raw)} value(s) but joint_names has {m}")
         return None
-    out = []
+    if all(type(x) is float and math.isfinite(x) for x in raw):  # as _finite finds, fast
+        return list(raw)
+    out: list[float] = []
     for i, x in enumerate(raw):
-        value = _finite(x)
-        if value is None:
+        if (value := _finite(x)) is None:
             c.add((*path, i), f"must be a finite number, got {_short(x)}")
             return None
         out.append(value)
@@ -265,11 +284,10 @@ def _finite(x: Any) -> float | None:
     """`x` as a finite float, or None (bools, strings, NaN/inf, ints beyond float range)."""
     if isinstance(x, bool) or not isinstance(x, int | float):
         return None
-    try:
+    with contextlib.suppress(OverflowError):  # an int beyond the float range
         value = float(x)
-    except OverflowError:
-        return None
-    return value if math.isfinite(value) else None
+        return value if math.isfinite(value) else None
+    return None
 
 
 def _short(x: Any) -> str:
