@@ -167,14 +167,11 @@ def test_placement_agrees_with_the_grid(room: tuple[str, MobileRobot, Reference]
     _agree(room, 60, seed=1)
 
 
-# coal 3.0.3 (Pinocchio's collision requests, enable_contact=False) calls a cylinder 8-25 mm
-# inside a box free: 4 of these 1000 cluttered placements (checked with coal.distance < 0);
-# /work/wt/BOARD.md 20:20, plan.collision. Strict: it fails once the checker is exact.
-COAL_MISSES = pytest.mark.xfail(strict=True, reason="plan.collision misses cylinder-box contacts")
-
-
+# Both rooms: coal 3.0.3 called a cylinder 8-25 mm inside a box free while Pinocchio's
+# collision requests had enable_contact=False (4 of the 1000 cluttered placements); plan.collision
+# now asks for contacts, so the checker agrees with the grid's exact reference here too.
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["empty", pytest.param("cluttered", marks=COAL_MISSES)])
+@pytest.mark.parametrize("name", ["empty", "cluttered"])
 def test_placement_agrees_with_the_grid_on_1000_targets(name: str) -> None:
     scene = ROOMS[name]
     mobile = load_mobile(read_robot(DEFAULT_SPEC), scene=scene)
