@@ -54,7 +54,7 @@ def test_search_starts_order() -> None:
 
 
 def test_followers_follow_their_leaders() -> None:
-    robot = Robot.from_urdf(parse_urdf(URDF, "t.urdf"))
+    robot = Robot.load(parse_urdf(URDF, "t.urdf"))
     pairs = sampling.configurations(robot)
     # yaw continuous [-pi, pi], pitch [-1, 2], slide [0, 0.3]: 3 leaders, 125-point grid
     assert len(pairs) == sampling.GRID_POINTS**3
@@ -89,8 +89,7 @@ def test_check_and_tune_draw_identical_samples(monkeypatch: pytest.MonkeyPatch) 
     same configurations: both ask `sampling.joint_space`, with the same box."""
     from armcli.check.options import CheckOptions
     from armcli.check.run import check_urdf
-    from armcli.robot.load import load_model
-    from armcli.sim.simulate import arm_from_model
+    from armcli.sim.simulate import simulated
     from armcli.tune.model_gains import start_gains
 
     seen: list[tuple[list[tuple[float, ...]], np.ndarray]] = []
@@ -104,7 +103,7 @@ def test_check_and_tune_draw_identical_samples(monkeypatch: pytest.MonkeyPatch) 
     monkeypatch.setattr(sampling, "joint_space", recording)
     doc = parse_urdf(chain_urdf(5), "chain.urdf")  # 5 joints: draws, not the grid
     check_urdf(doc, CheckOptions())
-    arm = arm_from_model(load_model("chain.urdf", xml=doc.text.decode()).model)
+    arm = simulated(Robot.load(doc))
     start_gains(arm, dt=1e-3, loop="implicit", zeta=1.0, wn_target=10.0, steps=np.ones(5))
     assert len(seen) == 2  # one sample for check, one for tune
     (box_check, rows_check), (box_tune, rows_tune) = seen

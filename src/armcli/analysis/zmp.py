@@ -33,7 +33,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from armcli.analysis.stance import Stance
 from armcli.analysis.support import SupportPolygon
-from armcli.robot.model import Joint, Robot
+from armcli.robot.joints import Joint
+from armcli.robot.model import Robot
 from armcli.urdf.doc import Urdf
 
 MAX_SAMPLES = 20_000  # states whose zero-moment point is computed, at most (pairs of steps)
@@ -146,13 +147,13 @@ def zmp_series(
     """
     import pinocchio as pin
 
-    model = stance.loaded()
-    data = model.createData()
+    loaded = stance.loaded()
+    model, data = loaded.model, loaded.data
     rows, a = accelerations(np.asarray(step), np.asarray(v), dt, impact)
     skipped = 0 if impact is None else int(np.sum(np.asarray(impact, dtype=bool)))
     cols = _columns(stance.robot, joint_names)
     q_full = stance.robot.neutral()
-    mass = float(sum(inertia.mass for inertia in model.inertias))
+    mass = loaded.mass
     z0 = stance.ground.height
     zmp = np.empty((len(rows), 3, 2))
     margin = np.empty((len(rows), 3))

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from armcli.analysis.workspace import REACH_TOL, Chain, envelope, reach_point, sample
 from armcli.check.context import Context
-from armcli.robot.load import link_frame
+from armcli.robot.frames import link_frame
 from armcli.robot.tool import tool_point
 
 

@@ -21,7 +21,8 @@ from collections.abc import Iterator, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from armcli.robot.model import Joint, Robot
+from armcli.robot.joints import Joint
+from armcli.robot.model import Robot
 
 GRID_POINTS = 5  # per joint, while the grid has at most MAX_GRID points
 MAX_GRID = 125

@@ -30,7 +30,7 @@ def mcap_bytes(run: DriveRun, cols: dict[str, np.ndarray], rate: float) -> bytes
     """The run as rosbag2 MCAP bytes (sim.rosbag's topics plus the drive's)."""
     job = run.job
     wheels = [job.params.left_joint, job.params.right_joint]
-    chans = rosbag.channels(cols, [*job.arm.arm.joint_names, *wheels], job.robot)
+    chans = rosbag.channels(cols, [*job.arm.robot.names, *wheels], job.robot)
     stamps = [round(float(t) * 1e9) for t in cols[TIME]]
     extra = _base_transforms(job.params.odom_frame, job.params.base_frame, cols, stamps)
     chans = [

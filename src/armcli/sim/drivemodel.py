@@ -35,6 +35,7 @@ from armcli.analysis.stance import Stance
 from armcli.errors import InputError
 from armcli.export.mjcf import FREE_JOINT, build_mjcf
 from armcli.io.scene import Scene
+from armcli.robot.model import Robot
 from armcli.sim.diffdrive import DriveParams
 from armcli.sim.world import WorldGeom, add_scene
 from armcli.urdf.doc import Urdf
@@ -219,17 +220,17 @@ def _axial_inertia(stance: Stance, joint: str) -> float:
     if not model.existJointName(joint):
         return 0.0
     jid = model.getJointId(joint)
-    axis = _axis(model, jid)
+    axis = _axis(stance.robot, jid)
     inertia = np.asarray(model.inertias[jid].inertia, dtype=float)
     return float(axis @ inertia @ axis)
 
 
-def _axis(model: Any, jid: int) -> np.ndarray:
+def _axis(robot: Robot, jid: int) -> np.ndarray:
+    """The joint's axis in its own frame: its column of the LOCAL joint Jacobian, unit."""
     import pinocchio as pin
 
-    data = model.createData()
-    q = pin.neutral(model)
-    pin.computeJointJacobians(model, data, q)
+    model, data = robot.model, robot.data
+    pin.computeJointJacobians(model, data, robot.neutral())
     J = pin.getJointJacobian(model, data, jid, pin.ReferenceFrame.LOCAL)
     col = np.asarray(J[3:, model.joints[jid].idx_v], dtype=float)
     return col / max(float(np.linalg.norm(col)), 1e-12)

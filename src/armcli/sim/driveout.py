@@ -25,7 +25,7 @@ STOP_TOL = 1e-9  # [rad or m] a joint beyond its range by more is on its (soft) 
 def arm_result(run: DriveRun, keep: np.ndarray) -> SimResult:
     """The arm's motion at the steps `keep`, with statistics over every step."""
     job, L, s = run.job, run.job.model.layout, run.sensors
-    arm = job.arm.arm
+    arm = job.arm.robot
     q, v, tau = s[:, L.arm_pos], s[:, L.arm_vel], s[:, L.arm_force]
     e = q - run.q_ref
     out = np.abs(e) > SETTLE_TOL
@@ -46,7 +46,7 @@ def arm_result(run: DriveRun, keep: np.ndarray) -> SimResult:
     )
     k = distinct(keep)
     return SimResult(
-        arm.joint_names,
+        arm.names,
         run.steps,
         job.dt,
         job.arm.config.integrator,
@@ -71,7 +71,7 @@ def tip_verdict(run: DriveRun) -> TipVerdict:
     z = s[:, L.contact_pos][:, 2::3]
     force = s[:, L.touch]
     contacts = {link: (force[:, i], z[:, i]) for i, link in enumerate(job.model.contacts)}
-    start = dict(zip(job.arm.arm.joint_names, job.arm.q0, strict=True))
+    start = dict(zip(job.arm.robot.names, job.arm.q0, strict=True))
     return verdict(job.stance, start, run.t, s[:, L.base_quat], contacts)
 
 

@@ -17,7 +17,7 @@ def plot_png(run: DriveRun, res: SimResult, verdict_: TipVerdict) -> bytes:
     from armcli.sim.plot import tracking_png
 
     title = f"armcli simulate --cmd-vel (MuJoCo, dt = {res.dt:g} s)"
-    return tracking_png(res, run.job.arm.arm.effort, _drive_rows(run, verdict_), 2, title)
+    return tracking_png(res, run.job.arm.robot.effort, _drive_rows(run, verdict_), 2, title)
 
 
 def _drive_rows(run: DriveRun, verdict_: TipVerdict) -> Callable[[Sequence[Any]], None]:

@@ -89,10 +89,7 @@ class TipVerdict:
 
 def static_tipping_angle(stance: Stance, values: Mapping[str, float]) -> tuple[float, str]:
     """[rad] The least rotation about a support edge that puts the centre of mass over it."""
-    import pinocchio as pin
-
-    model = stance.loaded()
-    com = np.asarray(pin.centerOfMass(model, model.createData(), stance.q(values)), dtype=float)
+    com = stance.loaded().center_of_mass(stance.q(values))
     h = max(stance.height(com), 1e-9)
     d = stance.polygon.edge_distances(com[:2])
     angles = np.arctan2(d, h)

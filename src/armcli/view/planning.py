@@ -93,7 +93,6 @@ class PlanningSession:
         self.save_dir = Path(save_dir)
         self._options = options or PlanOptions()
         robot = context.robot
-        self._data = robot.model.createData()
         home = robot.pose("home") if "home" in robot.poses else self.neutral()
         self.start, self.goal = home.copy(), home.copy()
         self.result: PlanResult | None = None
@@ -131,7 +130,7 @@ class PlanningSession:
 
     def tool(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Tool point [m] and tool link rotation in the root frame at planned values `x`."""
-        return tool_pose(self.context.robot, self._data, np.asarray(x, dtype=float))
+        return tool_pose(self.context.robot, np.asarray(x, dtype=float))
 
     # -- start and goal ----------------------------------------------------------------
     def set_start(self, x: Sequence[float] | np.ndarray) -> None:
@@ -236,15 +235,13 @@ class PlanningSession:
 
     def obstacles(self) -> list[ObstacleMesh]:
         """The scene's shapes as meshes in the root frame (link-fixed ones at the start pose)."""
-        import pinocchio as pin
-
         robot = self.context.robot
-        pin.framesForwardKinematics(robot.model, self._data, robot.q(self.start))
+        q = robot.q(self.start)
         out = []
         for obj in self.scene.objects:
             T = np.eye(4)
             if obj.frame:
-                T = np.asarray(self._data.oMf[robot.model.getFrameId(obj.frame)].homogeneous)
+                T = robot.robot.frame_pose(obj.frame, q)
             for shape in obj.shapes:
                 v, f = _triangles(shape)
                 M = T @ shape.T_frame_shape
