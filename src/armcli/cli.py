@@ -11,14 +11,15 @@ from __future__ import annotations
 
 import importlib
 import sys
-from typing import Any
+import warnings
+from typing import Any, TextIO
 
 import click
 import typer
 import typer.core
 import typer.main
 
-from armcli.errors import EXIT_FAILED, ArmcliError
+from armcli.errors import EXIT_FAILED, ArmcliError, ArmcliWarning
 from armcli.io.oneline import one_line
 
 UNSANDBOXED_FLAG = "--trust-xacro-unsandboxed"  # what `--trust-xacro=unsandboxed` becomes
@@ -158,6 +159,24 @@ def _print_error(exc: ArmcliError) -> None:
         sys.stderr.write(f"{exc.label}: {line}\n" if exc.label else f"{line}\n")
 
 
+_show_python_warning = warnings.showwarning
+
+
+def _show_warning(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: TextIO | None = None,
+    line: str | None = None,
+) -> None:
+    """Our own warnings as `warning: ...` lines (escaped), other warnings as Python shows them."""
+    if issubclass(category, ArmcliWarning):
+        sys.stderr.write(f"warning: {one_line(str(message))}\n")
+    else:
+        _show_python_warning(message, category, filename, lineno, file, line)
+
+
 def _debug_requested(argv: list[str]) -> bool:
     """`--debug` is a root option: it can only appear before the command name."""
     for arg in argv:
@@ -182,6 +201,7 @@ def main(argv: list[str] | None = None) -> None:
     # `--trust-xacro=unsandboxed` is the documented spelling; a bool flag cannot take a value
     args = [UNSANDBOXED_FLAG if a == "--trust-xacro=unsandboxed" else a for a in args]
     debug = _debug_requested(args)
+    warnings.showwarning = _show_warning
     status = None
     if sys.stderr.isatty():  # at a terminal: one line if the command stays silent
         from armcli.commands.status import start_status  # a command module: loaded on use

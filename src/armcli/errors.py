@@ -350,3 +350,11 @@ class PlanningError(ArmcliError):
         self.pair = pair
         self.reason = message
         super().__init__(message)
+
+
+class ArmcliWarning(UserWarning):
+    """Something the user should know that does not stop the command (a line `warning: ...`).
+
+    Library code warns with `warnings.warn(text, ArmcliWarning)`; the CLI prints each as one
+    escaped line on stderr (cli.main), so a library never prints.
+    """

@@ -103,6 +103,10 @@ def _mujoco_model(spec: RobotSpec, urdf: Urdf, tmp: Path, gravity: tuple[float, 
     m.opt.gravity[:] = gravity
     m.opt.timestep = MUJOCO_DT
     m.geom_solref[:, 0] = CONTACT_TIME
+    # The model's contacts do not slide; the scene's floor has friction 0, so each geom's
+    # own coefficient counts, and the caster's 0.1 would slide in the swing: every contact
+    # grips here (MuJoCo's default 1), as the model assumes.
+    m.geom_friction[:, 0] = 1.0
     return mujoco, m
 
 

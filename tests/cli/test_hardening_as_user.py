@@ -5,60 +5,15 @@ user could not read root's files anyway, so each secret is readable by both)."""
 
 from __future__ import annotations
 
-import os
-import shutil
-import subprocess
-import sys
-import tempfile
-from collections.abc import Callable, Iterator
 from pathlib import Path
-
-import pytest
 
 from tests.compiler.test_acceptance import SPEC as RICH_SPEC
 from tests.compiler.test_acceptance import write_meshes
-from tests.helpers import ROOT, SPECS
+from tests.helpers import SPECS
 from tests.meshes import prism_triangles, write_stl
-from tests.urdf.ordinary_user import ordinary_user
+from tests.urdf.ordinary_user import Run
 
-CLI_TIMEOUT_S = 120.0
 SECRET = "s3cret-token"
-Run = Callable[..., subprocess.CompletedProcess[str]]
-
-
-@pytest.fixture(params=["invoker", "ordinary-user"])
-def run(request: pytest.FixtureRequest) -> Iterator[tuple[Path, Run]]:
-    """(a work directory every user can read, a function running the CLI there)."""
-    work = Path(tempfile.mkdtemp(prefix="armcli-harden-"))  # pytest's tmp_path is root's
-    work.chmod(0o755)
-    prefix: tuple[str, ...] = ()
-    user = None
-    if request.param == "ordinary-user":
-        user = ordinary_user()
-        if isinstance(user, str):
-            pytest.skip(f"cannot run as an ordinary user here: {user}")
-        prefix = user.prefix
-
-    def cli(
-        *args: str | Path, env: dict[str, str] | None = None
-    ) -> subprocess.CompletedProcess[str]:
-        if user is not None:
-            user.own(work)
-        base = {"PATH": os.environ["PATH"], "HOME": str(work), "LANG": "C.UTF-8"}
-        return subprocess.run(
-            [*prefix, sys.executable, "-m", "armcli.cli", *map(str, args)],
-            capture_output=True,
-            text=True,
-            timeout=CLI_TIMEOUT_S,
-            check=False,
-            cwd=work,
-            env={**base, "PYTHONPATH": str(ROOT / "src"), **(env or {})},
-        )
-
-    try:
-        yield work, cli
-    finally:
-        shutil.rmtree(work, ignore_errors=True)
 
 
 def _secret(work: Path) -> Path:

@@ -24,7 +24,7 @@ from armcli.sim.simulate import SimConfig, simulate, simulated
 from armcli.sim.trajectory import loads_trajectory
 from armcli.spec.load import load_spec
 from armcli.urdf.source import read_robot
-from tests.helpers import COURSE_GAINS, ROOT, course_gains_spec, load_robot
+from tests.helpers import COURSE_GAINS, DEFAULT_SPEC, ROOT, course_gains_spec, load_robot
 
 mujoco = pytest.importorskip("mujoco")
 pin = pytest.importorskip("pinocchio")
@@ -121,16 +121,23 @@ def test_mass_matrix_and_bias_equal_pinocchio(tmp_path: Path, whole: bool) -> No
 
 
 def _loop(
-    tmp_path: Path, friction: bool, trajectory: str = TRAJECTORY, limits: bool = False
+    tmp_path: Path,
+    friction: bool,
+    trajectory: str = TRAJECTORY,
+    limits: bool = False,
+    course: bool = True,
 ) -> tuple[Any, np.ndarray]:
     """The same reference through armcli simulate and through the exported actuators.
 
     `limits`: run both at the spec's own time step with MuJoCo's joint limits on (as
     exported); otherwise at LOOP_DT with the limits off, where the two steps are equal.
-    The gains are the course's (Kp 50, Kd 5), fixed here whatever the example spec holds.
+    The gains are the course's (Kp 50, Kd 5), fixed here whatever the example spec holds,
+    or (`course` False) the example spec's own.
     """
     (tmp_path / "spec").mkdir()
     spec_path = course_gains_spec(tmp_path / "spec")
+    if not course:
+        spec_path.write_text(DEFAULT_SPEC.read_text())
     _, m, _ = _export(spec_path, tmp_path)
     spec = load_spec(spec_path)
     arm = simulated(load_robot(_urdf_file(spec_path, tmp_path)))
@@ -195,6 +202,33 @@ def test_closed_loop_agrees_on_a_trajectory_that_reaches_the_limits(
     assert np.max(np.abs(res.q - q_mj)) < LIMIT_AGREE
 
 
+# The example spec's gains (Kp 50, Kd 1.5: less damped than the course's, so its overshoot
+# hits the stops harder), friction on and off: a motion that comes back to the home pose
+# on the lower stops and hits them (armcli simulate vs the export 4.4e-3 rad with MuJoCo's
+# critically damped limit, 1.6e-3 overdamped), and one that goes to the upper stops and
+# rests there (1.0-1.4e-3 rad).
+STOP_TRAJECTORIES = {
+    "slams-into-the-stops": (
+        " - {positions: [0.6, 0.4], time_from_start: 1.0}\n"
+        " - {positions: [0.9, 1.2], time_from_start: 2.0}\n"
+        " - {positions: [0.0, 0.0], time_from_start: 3.5}\n"
+    ),
+    "rests-on-the-stops": " - {positions: [1.5707963267948966, 1.5707963267948966], "
+    "time_from_start: 1.0}\n",
+}
+
+
+@pytest.mark.parametrize("friction", [False, True], ids=["frictionless", "friction"])
+@pytest.mark.parametrize("motion", sorted(STOP_TRAJECTORIES))
+def test_the_export_follows_simulate_at_the_stops(
+    tmp_path: Path, motion: str, friction: bool
+) -> None:
+    head = "joint_names: [arm_base_forearm_joint, forearm_hand_joint]\npoints:\n"
+    res, q_mj = _loop(tmp_path, friction, head + STOP_TRAJECTORIES[motion], True, course=False)
+    assert res.stop_active.any()  # the arm does reach its stops
+    assert np.max(np.abs(res.q - q_mj)) < LIMIT_AGREE
+
+
 def _control_bounds(m: Any) -> tuple[np.ndarray, np.ndarray]:
     """ctrlrange where the actuator has one (motors), else its joint's range (positions)."""
     lo, hi = m.actuator_ctrlrange[:, 0].copy(), m.actuator_ctrlrange[:, 1].copy()
@@ -246,7 +280,8 @@ def test_actuators_keyframes_and_timestep_come_from_the_spec(tmp_path: Path) -> 
             dyn.friction,
         )
         assert tuple(j.range) == (lim.lower, lim.upper)
-        assert tuple(j.solref) == (2 * spec.control.dt, 1.0)  # stiffest stable limit
+        # the stiffest stable limit, overdamped (no rebound: armcli's stop is inelastic)
+        assert tuple(j.solref) == (2 * spec.control.dt, 2.0)
     assert res.export.keyframes == ("home", *[p for p in spec.poses if p != "home"])
     for pose in spec.poses:
         key = m.key(pose)

@@ -86,7 +86,7 @@ def test_stale_staging_files_of_killed_runs_are_removed(tmp_path: Path) -> None:
     out = tmp_path / "mj" / "robot.xml"
     out.parent.mkdir()
     dead = 2**22 + 12345  # above Linux's default pid_max: no such process
-    stale = out.parent / f".robot.xml{together.TAG}{dead}-x1.tmp"
+    stale = out.parent / f"{together.TAG}{dead}-{'5' * 16}-0.tmp"  # as io.journal names them
     stale.write_bytes(b"half a model")
     export_mjcf(_robot(tmp_path), out)
     assert not stale.exists()

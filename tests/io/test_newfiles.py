@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 from pathlib import Path
 
@@ -95,6 +96,16 @@ def test_a_killed_runs_stage_is_removed(tmp_path: Path) -> None:
     (stale / "armcli.yaml").write_bytes(b"half")
     create_files(tmp_path, {"armcli.yaml": b"a"})
     assert sorted(p.name for p in tmp_path.iterdir()) == ["armcli.yaml"]
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="needs root to give a directory to another user")
+def test_another_users_stage_is_left_alone(tmp_path: Path) -> None:
+    """Issue 42: only this user's stages are armcli's to remove (another's was rmtree'd)."""
+    theirs = tmp_path / f".armcli-new-{_dead_pid()}-abc"
+    theirs.mkdir()
+    os.chown(theirs, 65534, 65534)
+    create_files(tmp_path, {"armcli.yaml": b"a"})
+    assert theirs.is_dir()
 
 
 def _dead_pid() -> int:

@@ -196,6 +196,18 @@ def test_stale_stage_entries_of_any_type_removed(tmp_path: Path) -> None:
     assert (keep / "precious").read_text() == "x"  # a link is removed, never followed
 
 
+@pytest.mark.skipif(os.geteuid() != 0, reason="needs root to give a directory to another user")
+def test_another_users_stage_entries_are_left_alone(tmp_path: Path) -> None:
+    """Issue 42: a stale-looking stage of another user is theirs, never removed (was rmtree'd)."""
+    out = tmp_path / "o"
+    theirs = tmp_path / f".o.armcli-stage-{999_999_990}-dir"
+    (theirs / "notes").mkdir(parents=True)
+    for p in (theirs, theirs / "notes"):
+        os.chown(p, 65534, 65534)
+    write_tree_atomic(out, {"a.txt": b"1"})
+    assert (theirs / "notes").is_dir()
+
+
 def test_out_of_space_error_has_no_none(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     def full(*args: object) -> Path:
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))

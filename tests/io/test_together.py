@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from armcli.errors import OutputRefusedError
+from armcli.errors import ArmcliWarning, OutputRefusedError
 from armcli.io.files import write_file_atomic
 from armcli.io.together import TAG, finish_interrupted, write_files_together
 from tests.helpers import ROOT
@@ -100,8 +100,11 @@ def test_killed_between_renames_is_completed_by_the_next_write(tmp_path: Path) -
     )
     assert proc.returncode == -signal.SIGKILL, proc.stderr
     assert (a.read_bytes(), b.read_bytes()) == (b"new-a", b"old-b")  # the microsecond window
-    write_files_together({b.parent / "unrelated.txt": b"x"})  # any later write in either dir
+    with pytest.warns(ArmcliWarning, match="completed .*tracking.png"):  # said on stderr
+        write_files_together({b.parent / "unrelated.txt": b"x"})  # the next write into b's dir
     assert (a.read_bytes(), b.read_bytes()) == (b"new-a", b"new-b")
+    assert len(_leftovers(a.parent)) == 1  # a's journal: each directory completes its own files
+    write_files_together({a.parent / "unrelated.txt": b"x"})  # nothing left to do: no warning
     assert _leftovers(a.parent, b.parent) == []
 
 

@@ -24,7 +24,7 @@ def test_the_spec_gives_the_plugins_parameters() -> None:
     p = DriveParams.of(load_spec(DEFAULT_SPEC))
     assert (p.left_joint, p.right_joint) == ("base_left_wheel_joint", "base_right_wheel_joint")
     assert (p.separation, p.radius, p.update_rate) == (0.45, 0.1, 50.0)
-    assert (p.max_torque, p.max_accel) == (20.0, 1.0)  # the plugin's defaults in the spec model
+    assert (p.max_torque, p.max_accel) == (20.0, 1.0)  # the spec model's defaults
 
 
 def test_a_spec_without_the_plugin_is_refused() -> None:
@@ -45,8 +45,11 @@ def test_rim_speeds_ramp_at_the_acceleration_limit() -> None:
     # the instructed speed accumulates from its own value (the plugin's), measured 0.01 m/s
     cmd = c.update(0.2, 0.0, np.array([0.1, 0.1]), period)
     assert cmd == pytest.approx([0.04 / R, 0.04 / R], abs=EXACT)
-    # either wheel within 0.01 m/s of its target: both are commanded their targets
-    cmd = c.update(0.2, 0.0, np.array([0.195 / R, 0.0]), period)
+    # one wheel within 0.01 m/s of its target: both go on ramping (ROS 2; ROS 1 jumped)
+    cmd = c.update(0.2, 0.0, np.array([0.195 / R, 0.1 / R]), period)
+    assert cmd == pytest.approx([(0.04 + 0.005) / R, (0.04 + 0.02) / R], abs=EXACT)
+    # both within 0.01 m/s: both are commanded their targets
+    cmd = c.update(0.2, 0.0, np.array([0.195 / R, 0.192 / R]), period)
     assert cmd == pytest.approx([2.0, 2.0], abs=EXACT)
 
 

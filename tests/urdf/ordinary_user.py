@@ -16,12 +16,15 @@ import shutil
 import stat
 import subprocess
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 from tests.helpers import ROOT
 
 USER = "armcli-jailtest"
+# (*args, env=None, code=None) -> the finished process: `armcli ARGS`, or `python -c CODE ARGS`
+Run = Callable[..., subprocess.CompletedProcess[str]]
 _SETUP_TIMEOUT_S = 60
 
 

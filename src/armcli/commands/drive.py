@@ -48,8 +48,8 @@ def run_drive(
         err.print(one_line(f"warning: {w}"), markup=False, highlight=False)
     write_files_together(driven.files(output, plot))  # never a new CSV beside an old plot
     job, res, res_run, verdict = driven.job, driven.arm, driven.run, driven.verdict
-    for lift in verdict.lifts:
-        err.print(one_line(f"warning: {lift.line()}"), markup=False, highlight=False)
+    for note in verdict.notes():
+        err.print(one_line(f"warning: {note}"), markup=False, highlight=False)
     out = terminal.console()
     metrics = simreport.joint_metrics(res, job.arm.trajectory.duration)
     ee = simjob.tool_position(job.arm, res.q[-1])

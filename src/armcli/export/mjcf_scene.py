@@ -2,6 +2,13 @@
 
 The model file stays free of world dressing so that it can be included into
 other scenes; this file is what a user opens in `python -m mujoco.viewer`.
+
+The floor has friction 0 (FLOOR_FRICTION): MuJoCo gives a contact the larger friction of
+its two geoms, Gazebo's ODE the smaller (and Gazebo's ground plane has mu 100), so only a
+frictionless floor lets each robot geom's own coefficient count, as in Gazebo: a caster
+of mu 0.1 on MuJoCo's default floor of 1 would grip like a wheel. The drive
+(`simulate --cmd-vel`, sim.drivemodel) stands on the same floor, so the exported scene
+drives as it does.
 """
 
 from __future__ import annotations
@@ -11,6 +18,7 @@ from lxml import etree
 from armcli.compiler.xmlfmt import to_bytes
 
 SCENE = "scene.xml"
+FLOOR_FRICTION = (0.0, 0.0, 0.0)  # sliding, torsional, rolling: see the module docstring
 
 
 def scene_xml(model_file: str, model_name: str, header: str | None = None) -> bytes:
@@ -59,6 +67,12 @@ def scene_xml(model_file: str, model_name: str, header: str | None = None) -> by
     world = etree.SubElement(root, "worldbody")
     etree.SubElement(world, "light", pos="0 0 1.5", dir="0 0 -1", directional="true")
     etree.SubElement(
-        world, "geom", name="floor", size="0 0 0.05", type="plane", material="groundplane"
+        world,
+        "geom",
+        name="floor",
+        size="0 0 0.05",
+        type="plane",
+        material="groundplane",
+        friction=" ".join(f"{f:g}" for f in FLOOR_FRICTION),
     )
     return to_bytes(root, header_comment=header)

@@ -89,7 +89,8 @@ def _populate(stage: Path, root: Path, files: Mapping[str, bytes]) -> None:
         target.parent.mkdir(parents=True, exist_ok=True)
         if target.exists() or target.is_symlink():
             target.unlink()  # a hard link to the old file: never write through it
-        os.replace(stage_file(target, data, "."), target)  # target unlinked: a new file's mode
+        tmp = stage_file(target, data, f".{os.urandom(8).hex()}.tmp")  # a private stage dir
+        os.replace(tmp, target)  # target unlinked above: a new file's mode
     for path, mode in modes:  # innermost first: read-only directories receive files first
         os.chmod(path, mode)
     keep = stat.S_IMODE(os.stat(root).st_mode) if root.is_dir() else 0o777 & ~umask()

@@ -19,7 +19,14 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from armcli.errors import BuildError, ExistingFileError, OutputRefusedError
-from armcli.io.outdir import no_links_below, pid_alive, relative_inside, remove_entry, umask
+from armcli.io.outdir import (
+    mine,
+    no_links_below,
+    pid_alive,
+    relative_inside,
+    remove_entry,
+    umask,
+)
 
 _STAGE_PREFIX = ".armcli-new-"  # + PID + "-": a killed run's stage is removed by the next
 
@@ -39,11 +46,13 @@ def _stage(parent: Path, files: Mapping[str, bytes]) -> Path:
 
 
 def _clean_stale(parent: Path) -> None:
-    """Remove the stages of killed runs (their PID is not alive)."""
+    """Remove this user's stages of killed runs (their PID is not alive)."""
     with contextlib.suppress(OSError):
         for entry in os.scandir(parent):
             pid = entry.name[len(_STAGE_PREFIX) :].split("-", 1)[0]
-            if entry.name.startswith(_STAGE_PREFIX) and pid.isdigit() and not pid_alive(int(pid)):
+            if not entry.name.startswith(_STAGE_PREFIX) or not pid.isdigit() or not mine(entry):
+                continue
+            if not pid_alive(int(pid)):
                 remove_entry(Path(entry.path))
 
 

@@ -153,16 +153,27 @@ def check_png_file(path: str | Path, field: str) -> None:
 
 
 def clean_stale_stages(parent: Path, name: str) -> None:
-    """Remove staging entries of any type left by killed armcli processes."""
+    """Remove staging entries of any type left by killed armcli processes of this user."""
     prefix = f".{name}{STAGE_TAG}"
     with contextlib.suppress(FileNotFoundError, NotADirectoryError):
         for entry in list(os.scandir(parent)):
-            if not entry.name.startswith(prefix):
+            if not entry.name.startswith(prefix) or not mine(entry):
                 continue
             pid = entry.name[len(prefix) :].split("-", 1)[0]
             if pid.isdigit() and pid_alive(int(pid)):
                 continue
             remove_entry(Path(entry.path))
+
+
+def mine(entry: os.DirEntry[str]) -> bool:
+    """Whether this user owns `entry` (not followed): only then may armcli remove it as stale.
+
+    Another user's entry in a shared directory is never armcli's to delete (issue 42).
+    """
+    try:
+        return entry.stat(follow_symlinks=False).st_uid == os.geteuid()
+    except OSError:
+        return False
 
 
 def pid_alive(pid: int) -> bool:

@@ -10,12 +10,13 @@ is written into every target directory, the targets are renamed in one after
 another with SIGINT, SIGTERM, SIGHUP and SIGQUIT blocked, and the journals are
 removed.
 
-A kill before the journal exists leaves every target untouched (the staged files
-are removed by the next write into that directory); a SIGKILL in the
-microseconds between two renames leaves a journal, and the next write into any of
-its directories (`finish_interrupted`) completes the renames, so the set ends all
-new. Only a reader looking in that window, before the next armcli write, can see
-a mix.
+A kill before the journals exist leaves every target untouched (the staged files
+are removed by the next write into that directory); a SIGKILL in the microseconds
+between two renames leaves journals, and the next write into each of their directories
+completes that directory's renames (`io.journal`: a journal is replayed only when it is
+provably armcli's own and names nothing outside its directory; anything else is left
+alone and reported as a warning). Only a reader looking in that window, before the next
+armcli write there, can see a mix.
 
 Targets are written through a symlink to the file it names (the link stays), and
 an existing target keeps its permission bits. The parent directories must exist
@@ -25,24 +26,18 @@ unless `parents=True`.
 from __future__ import annotations
 
 import contextlib
-import json
 import os
 import signal
-import tempfile
+import warnings
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 
-from armcli.errors import BuildError, OutputRefusedError
-from armcli.io.outdir import pid_alive, umask
+from armcli.errors import ArmcliWarning, BuildError, OutputRefusedError
+from armcli.io.journal import TAG, SetId, recover, write_journal
+from armcli.io.outdir import umask
 
-TAG = ".armcli-set-"  # staged files `.NAME.armcli-set-PID-X.tmp`, journals `.armcli-set-PID-X.json`
+__all__ = ["TAG", "finish_interrupted", "stage_file", "target_path", "write_files_together"]
 _BLOCKED = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGQUIT}
-
-
-def _owner_pid(name: str, prefix: str) -> int | None:
-    """The PID in a staged or journal name after `prefix`, or None when it does not parse."""
-    head = name[len(prefix) :].split("-", 1)[0]
-    return int(head) if head.isdigit() else None
 
 
 def target_path(path: str | Path) -> Path:
@@ -51,14 +46,19 @@ def target_path(path: str | Path) -> Path:
     return Path(os.path.realpath(p)) if p.is_symlink() else p
 
 
-def stage_file(target: Path, data: bytes, token: str) -> Path:
-    """`data` in a flushed hidden temp file beside `target`, with the mode `target` will have."""
-    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}{token}", suffix=".tmp")
+def stage_file(target: Path, data: bytes, name: str) -> Path:
+    """`data` in a new flushed file `name` beside `target`, with the mode `target` will have.
+
+    Created with O_EXCL and O_NOFOLLOW: it is a file this process made, never an existing one.
+    """
+    tmp = target.parent / name
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC
+    fd = os.open(tmp, flags, 0o600)
     try:
         try:
             mode = os.stat(target).st_mode & 0o7777  # keep an existing file's permission bits
         except FileNotFoundError:
-            mode = 0o666 & ~umask()  # mkstemp makes 0600; a new output is an ordinary file
+            mode = 0o666 & ~umask()  # a new output is an ordinary file
         os.fchmod(fd, mode)
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
@@ -68,7 +68,7 @@ def stage_file(target: Path, data: bytes, token: str) -> Path:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
-    return Path(tmp)
+    return tmp
 
 
 def _fsync_dir(directory: Path) -> None:
@@ -94,23 +94,10 @@ def _signals_held() -> Iterator[None]:
         signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
-def _write_journal(directory: Path, name: str, pairs: list[tuple[str, str]]) -> Path:
-    journal = directory / name
-    tmp = directory / f"{name}.part"
-    with open(tmp, "w", encoding="utf-8") as fh:
-        json.dump(pairs, fh)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, journal)
-    _fsync_dir(directory)
-    return journal
-
-
-def _commit(pairs: list[tuple[str, str]], journals: list[Path]) -> None:
+def _commit(pairs: list[tuple[Path, Path]], journals: list[Path]) -> None:
     for staged, target in pairs:
-        if os.path.lexists(staged):
-            os.replace(staged, target)
-    for d in {Path(t).parent for _, t in pairs}:
+        os.replace(staged, target)
+    for d in {t.parent for _, t in pairs}:
         _fsync_dir(d)
     for j in journals:
         with contextlib.suppress(FileNotFoundError):
@@ -118,35 +105,12 @@ def _commit(pairs: list[tuple[str, str]], journals: list[Path]) -> None:
 
 
 def finish_interrupted(directory: Path) -> None:
-    """Complete the sets a killed armcli left half-renamed; remove its orphan staged files."""
-    try:
-        names = os.listdir(directory)
-    except OSError:
-        return
-    pending: set[str] = set()
-    for name in sorted(names):
-        pid = _owner_pid(name, TAG)
-        if not name.endswith(".json") or pid is None or pid_alive(pid):
-            continue
-        try:
-            pairs = [(str(s), str(t)) for s, t in json.loads((directory / name).read_text())]
-        except (OSError, ValueError, TypeError):
-            pairs = []
-        others = [Path(t).parent / name for _, t in pairs]
-        _commit(pairs, [directory / name, *others])  # every staged file was complete
-        pending |= {Path(s).name for s, _ in pairs}
-    for name in names:
-        pid = _staged_pid(name)
-        if pid is not None and name not in pending and not pid_alive(pid):
-            with contextlib.suppress(OSError):
-                os.unlink(directory / name)
+    """Complete this user's sets killed armcli runs left in `directory`; warn about the rest.
 
-
-def _staged_pid(name: str) -> int | None:
-    """The PID of a staged file `.TARGET.armcli-set-PID-X.tmp` or journal part, else None."""
-    if not name.startswith(".") or TAG not in name or not name.endswith((".tmp", ".part")):
-        return None
-    return _owner_pid(name[name.index(TAG) :], TAG)
+    Each report is one ArmcliWarning line (the CLI prints it as `warning: ...`).
+    """
+    for line in recover(directory):
+        warnings.warn(line, ArmcliWarning, stacklevel=3)
 
 
 def write_files_together(files: Mapping[Path, bytes], *, parents: bool = False) -> list[Path]:
@@ -166,26 +130,30 @@ def write_files_together(files: Mapping[Path, bytes], *, parents: bool = False) 
             t.parent.mkdir(parents=True, exist_ok=True)
         if t.is_dir():
             raise BuildError(f"{g}: is a directory, cannot write a file there")
+    targets = [Path(os.path.realpath(t.parent)) / t.name for t in targets]  # one name per dir
+    if len(set(targets)) != len(targets):
+        raise OutputRefusedError("the same file is named twice", file=given[0])
     directories = sorted({t.parent for t in targets})
     for d in directories:
         finish_interrupted(d)
-    token = f"{TAG}{os.getpid()}-"
+    set_id = SetId.new()
     staged: list[Path] = []
     try:
-        for t, data in zip(targets, files.values(), strict=True):
-            staged.append(stage_file(t, data, token))
+        for i, (t, data) in enumerate(zip(targets, files.values(), strict=True)):
+            staged.append(stage_file(t, data, set_id.staged(i)))
     except OSError as exc:
         for s in staged:
             with contextlib.suppress(OSError):
                 os.unlink(s)
         raise BuildError(f"{exc.filename or given[0]}: cannot write: {_why(exc)}") from None
-    pairs = [(str(s), str(t)) for s, t in zip(staged, targets, strict=True)]
+    pairs = list(zip(staged, targets, strict=True))
     try:
         with _signals_held():
             journals = []
             if len(pairs) > 1:
-                name = f"{token}{os.urandom(4).hex()}.json"
-                journals = [_write_journal(d, name, pairs) for d in directories]
+                for d in directories:
+                    mine = [(i, t.name) for i, t in enumerate(targets) if t.parent == d]
+                    journals.append(write_journal(d, set_id, mine))
             _commit(pairs, journals)
     except OSError as exc:  # journals left behind: the next write completes the set
         raise BuildError(f"{exc.filename or given[0]}: cannot write: {_why(exc)}") from None

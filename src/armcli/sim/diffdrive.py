@@ -2,15 +2,16 @@
 
 Controller (`OnUpdate`, every 1/update_rate): the desired rim speeds are
 `linear.x -+ angular.z * wheel_separation / 2` (left, right). When
-max_wheel_acceleration is 0, or either wheel's rim speed is within 0.01 m/s of its
-target, both joints are commanded their targets directly; otherwise each wheel's
+max_wheel_acceleration is 0 (no limit, the plugin's default), or both wheels' rim speeds
+are within 0.01 m/s of their targets, both joints are commanded their targets directly
+(the ROS 2 branch since gazebo_ros_pkgs PR #1009; ROS 1's plugin takes either wheel,
+which lets the other jump to its target mid-ramp); otherwise each wheel's
 instructed rim speed moves by `desired - current`, clipped to
 ±max_wheel_acceleration * (time since the last update). The joint motor holds the
 commanded speed with at most max_wheel_torque (ODE's `vel`/`fmax`; here a MuJoCo
-velocity actuator, sim.drivemodel). The plugin's quirks are kept: the instructed
-speed accumulates from its previous value rather than from the measured speed, the
-"reached" test is an or over the two wheels, and the comparison is >= on the left
-and > on the right.
+clutch, sim.wheelmotor). The plugin's quirks are kept: the instructed
+speed accumulates from its previous value rather than from the measured speed, and
+the comparison is >= on the left and > on the right.
 
 Odometry (`UpdateOdometryEncoder`, every simulation step, from the joint velocities
 at the start of the step): with s_l, s_r the rim distances of the step,
@@ -103,7 +104,7 @@ class DiffDriveController:
         left, right = self.desired(linear_x, angular_z)
         cur_l, cur_r = float(wheel_speed[0]) * r, float(wheel_speed[1]) * r
         a = self.p.max_accel * elapsed
-        if self.p.max_accel == 0 or abs(left - cur_l) < REACHED or abs(right - cur_r) < REACHED:
+        if self.p.max_accel == 0 or (abs(left - cur_l) < REACHED and abs(right - cur_r) < REACHED):
             self.command = np.array([left / r, right / r])
             return self.command
         if left >= cur_l:

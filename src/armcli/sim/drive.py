@@ -34,6 +34,7 @@ from armcli.sim.job import SimJob
 from armcli.sim.options import SimOptions
 from armcli.sim.simulate import steps_of
 from armcli.sim.tipping import robot_urdf
+from armcli.sim.wheelmotor import clutch_torque, spin
 from armcli.sim.world import load_world, refuse_overlaps
 from armcli.urdf.doc import Urdf
 
@@ -185,13 +186,15 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
     gravity = _gravity(arm) if arm.config.gravity_comp else None
     inv_kp = np.divide(1.0, kp, out=np.zeros_like(kp), where=kp > 0)  # Kp 0: no g through ctrl
     updates = update_steps(steps, job.dt, job.params.period)
-    lin, ang = job.cmd.at((updates + 1) * job.dt)
+    now = (updates + 1) * job.dt  # Gazebo's sim time at each update
+    lin, ang = job.cmd.at(now)
+    elapsed = np.diff(now, prepend=0.0)  # the plugin's seconds_since_last_update
     is_update = np.zeros(steps + 1, dtype=bool)
     is_update[updates] = True
     rec = np.empty((steps + 1, dm.layout.size))
     wheel_cmd = np.zeros((steps + 1, 2))
     controller = DiffDriveController(job.params)
-    wheel_act, wheel_dof = dm.wheel_act, dm.wheel_dof
+    wheel_dof, rotor, wheel_force = dm.wheel_dof, dm.wheel_rotor, dm.layout.wheel_force
     cols = np.nonzero(dm.arm_act >= 0)[0]  # a mimic joint follows its leader: no actuator
     ctrl_arm, inv_kp = ctrl_arm[:, cols], inv_kp[cols]
     act = dm.arm_act[cols]
@@ -201,20 +204,22 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
     start = time.perf_counter()
     for k in range(steps):
         if is_update[k]:
-            command = controller.update(lin[u], ang[u], d.qvel[wheel_dof], job.params.period)
-            ctrl[wheel_act] = command
+            command = controller.update(lin[u], ang[u], d.qvel[wheel_dof], elapsed[u])
             u += 1
         wheel_cmd[k] = command
+        spin(d, rotor, command)  # the plugin's motor speed (its "vel")
         if gravity is None:
             ctrl[arm_act] = ctrl_arm[k]
         else:
             ctrl[arm_act] = ctrl_arm[k] + gravity(d.qpos[arm_qpos])[cols] * inv_kp
         mujoco.mj_step(m, d)
         rec[k] = d.sensordata
+        rec[k, wheel_force] = -d.qfrc_constraint[rotor]  # sim.wheelmotor.clutch_torque
         if progress is not None and k % PROGRESS_STEPS == 0 and k:
             progress(k, steps)
     mujoco.mj_forward(m, d)
     rec[steps], wheel_cmd[steps] = d.sensordata, command
+    rec[steps, wheel_force] = clutch_torque(d, rotor)
     wall = time.perf_counter() - start
     _refuse_reset(d, rec, job.dt)
     wl = rec[:-1, dm.layout.wheel_vel]

@@ -5,19 +5,19 @@ collision geoms, the arm's `position` actuators (Kp, Kd, effort limit) and Gazeb
 `mu1` as sliding friction. Added here through MuJoCo's model editor (MjSpec):
 
 - contacts of time constant CONTACT_TIME;
-- a ground plane at z = 0, the robot's lowest contact point on it (analysis.stance), with sliding
-  friction 0 so that each contact takes the robot geom's own coefficient (MuJoCo
-  combines two geoms by the larger one; Gazebo's ODE by the smaller, and its ground
-  plane's mu is 100, so in both the robot's coefficient counts). A collision without
+- a ground plane at z = 0, the robot's lowest contact point on it (analysis.stance), with
+  the exported scene's floor friction (export.mjcf_scene.FLOOR_FRICTION: 0, so that each
+  contact takes the robot geom's own coefficient; MuJoCo combines two geoms by the larger
+  one, Gazebo's ODE by the smaller, and its ground plane's mu is 100, so in both the
+  robot's coefficient counts). A collision without
   Gazebo `mu1` keeps MuJoCo's default 1, which is Gazebo's default `mu` too. MuJoCo's
   friction is isotropic: a link whose `mu2` differs from `mu1` is noted, `mu1` is used;
-- one `velocity` actuator per drive wheel: the plugin's joint motor (ODE `vel` with
-  `fmax` = max_wheel_torque). ODE solves it as a constraint; its MuJoCo stand-in has
-  the gain kv = I / (SERVO_STEPS dt), I the wheel's inertia plus half the robot's mass
-  at the rim, so it reaches a commanded speed in about one step (MuJoCo's
-  `implicitfast` integrates kv implicitly: stable for any kv);
+- the plugin's motor on each drive wheel (sim.wheelmotor): a rotor the run spins at the
+  commanded speed and a clutch, a friction-loss constraint of max_wheel_torque holding
+  the wheel at the rotor's speed, as ODE's `vel`/`fmax` motor;
 - sensors, so one copy of `sensordata` per step records the run: the arm and wheel
-  joints' position, velocity and actuator force, the root body's pose, and per
+  joints' position, velocity and actuator force (a wheel's slot is filled by the run
+  with its clutch torque, which no sensor reads), the root body's pose, and per
   ground-contact link its normal force (a `touch` site enclosing the link's geoms)
   and its height;
 - the world's objects of a scene file (sim.world), static bodies with contact.
@@ -34,17 +34,17 @@ import numpy as np
 from armcli.analysis.stance import Stance
 from armcli.errors import InputError
 from armcli.export.mjcf import FREE_JOINT, build_mjcf
+from armcli.export.mjcf_scene import FLOOR_FRICTION
 from armcli.io.scene import Scene
-from armcli.robot.model import Robot
 from armcli.sim.diffdrive import DriveParams
+from armcli.sim.wheelmotor import add_wheel_motors, rotor_dofs
 from armcli.sim.world import WorldGeom, add_scene
 from armcli.urdf.doc import Urdf
 
-SERVO_STEPS = 1.0  # wheel motor time constant in time steps (see the module docstring)
-# [s] MuJoCo's contact time constant (solref, critically damped): its default. Measured on
-# the course robot (tests/sim/test_drive.py): softer contacts (50 ms) stop the wheels'
-# chatter but let the robot coast 2.5 % past its wheels' travel after a stop; a wheel motor
-# slower than one step (SERVO_STEPS 5) lags a turn's load by 4 %.
+# [s] MuJoCo's contact time constant (solref, critically damped): its default, as the
+# exported scene has it. Measured on the course robot (tests/sim/test_drive.py): softer
+# contacts (50 ms) stop the wheels' chatter but let the robot coast 2.5 % past its wheels'
+# travel after a stop.
 CONTACT_TIME = 0.02
 TOUCH_MARGIN = 0.02  # [m] a touch site is the link's bounding sphere plus this
 
@@ -76,7 +76,7 @@ class DriveModel:
     arm_act: np.ndarray  # (n,) int: the arm's position actuators; -1: a mimic joint follows
     wheel_qpos: np.ndarray  # (2,) int, left then right
     wheel_dof: np.ndarray  # (2,) int
-    wheel_act: np.ndarray  # (2,) int
+    wheel_rotor: np.ndarray  # (2,) int: the motors' rotor dofs (sim.wheelmotor.spin)
     contacts: tuple[str, ...]  # ground-contact links
     layout: Layout
     base_z: float  # [m] the root body's height with the lowest contact on the floor
@@ -116,13 +116,14 @@ def build_drive_model(
         name="floor",
         type=mujoco.mjtGeom.mjGEOM_PLANE,
         size=[0.0, 0.0, 0.05],
-        friction=[0.0, 0.0, 0.0],
+        friction=list(FLOOR_FRICTION),
     )
     root = _root_body(ms)
-    wheel_inertia = _wheel_motors(ms, params, stance, dt)
+    wheels = (params.left_joint, params.right_joint)
+    motor_notes = add_wheel_motors(ms, wheels, params.max_torque, dt)
     driven = _arm_actuators(ms, arm_joints, gains)
     _sensors(ms, root, arm_joints, params, stance.ground.links)
-    notes = [*_mu2_notes(urdf), *wheel_inertia]
+    notes = [*_mu2_notes(urdf), *motor_notes]
     geoms = add_scene(ms, world) if world is not None else ()
     model = ms.compile()
     model.geom_solref[:] = (CONTACT_TIME, 1.0)
@@ -138,10 +139,7 @@ def build_drive_model(
             [model.jnt_dofadr[model.joint(j).id] for j in (params.left_joint, params.right_joint)],
             dtype=int,
         ),
-        wheel_act=np.array(
-            [model.actuator(f"{j}_motor").id for j in (params.left_joint, params.right_joint)],
-            dtype=int,
-        ),
+        wheel_rotor=rotor_dofs(model, wheels),
         contacts=stance.ground.links,
         layout=_layout(len(arm_joints), len(stance.ground.links)),
         base_z=-stance.ground.height,
@@ -189,51 +187,6 @@ def _root_body(ms: Any) -> Any:
         if any(j.name == FREE_JOINT for j in body.joints):
             return body
     raise InputError("the exported model has no free root body")  # export(base="free") has one
-
-
-def _wheel_motors(ms: Any, params: DriveParams, stance: Stance, dt: float) -> list[str]:
-    """The plugin's joint motors; any actuator the export gave a wheel is switched off."""
-    import mujoco
-
-    notes = []
-    mass = stance.mass
-    for joint in (params.left_joint, params.right_joint):
-        for act in ms.actuators:
-            if act.target == joint:
-                act.gainprm[0] = 0.0
-                act.biasprm[:3] = 0.0
-                notes.append(f"the export's actuator on {joint} is replaced by the plugin's motor")
-        i_wheel = _axial_inertia(stance, joint)
-        inertia = i_wheel + 0.5 * mass * params.radius**2
-        act = ms.add_actuator(
-            name=f"{joint}_motor", target=joint, trntype=mujoco.mjtTrn.mjTRN_JOINT
-        )
-        act.set_to_velocity(kv=inertia / (SERVO_STEPS * dt))
-        act.forcelimited = 1
-        act.forcerange = [-params.max_torque, params.max_torque]
-    return notes
-
-
-def _axial_inertia(stance: Stance, joint: str) -> float:
-    """[kg·m²] the wheel body's inertia about its joint axis (Pinocchio's model)."""
-    model = stance.model
-    if not model.existJointName(joint):
-        return 0.0
-    jid = model.getJointId(joint)
-    axis = _axis(stance.robot, jid)
-    inertia = np.asarray(model.inertias[jid].inertia, dtype=float)
-    return float(axis @ inertia @ axis)
-
-
-def _axis(robot: Robot, jid: int) -> np.ndarray:
-    """The joint's axis in its own frame: its column of the LOCAL joint Jacobian, unit."""
-    import pinocchio as pin
-
-    model, data = robot.model, robot.data
-    pin.computeJointJacobians(model, data, robot.neutral())
-    J = pin.getJointJacobian(model, data, jid, pin.ReferenceFrame.LOCAL)
-    col = np.asarray(J[3:, model.joints[jid].idx_v], dtype=float)
-    return col / max(float(np.linalg.norm(col)), 1e-12)
 
 
 def _sensors(

@@ -1,10 +1,17 @@
 """Did the robot tip over in the contact simulation, and which wheel left the ground when?
 
-A robot tips when its base rolls or pitches past its static tipping angle: the
-rotation about the nearest support edge that brings its centre of mass over that edge,
-atan(d / h) with d the centre of mass's distance inside the edge and h its height
-(at the run's start pose), or past TIP_CAP_DEG, whichever is less. Short of that it
-rocks back.
+Each edge of the support polygon is a tipping axis with its own static tipping angle:
+the rotation about that edge that brings the centre of mass over it, atan(d / h) with d
+the centre of mass's distance inside the edge and h its height (at the run's start pose;
+at least MIN_BOUND_DEG). The base's tilt toward an edge is the rotation about that edge's
+axis that gravity, seen from the base, shows (`edge_tilts`); a robot that tips backward
+is measured against its rear edge's angle, not against the least angle of all edges.
+
+Past an edge's angle the robot may still rock back onto its contacts: the arm swinging
+in, the wheels' reaction easing after a launch. So a run tips over only when it ends
+past an edge's angle, or tilted more than TIP_CAP_DEG (resting on something other than
+its contacts); it tipped when that last excursion began. Excursions it came back from
+are reported (`Rock`), as are lift-offs.
 
 A contact link (a wheel, the caster) has lifted off while it carries no normal force
 and stands more than LIFT_CLEARANCE above where it started: MuJoCo's soft contacts
@@ -23,7 +30,7 @@ import numpy as np
 from armcli.analysis.stance import Stance
 from armcli.errors import TipOverError
 
-TIP_CAP_DEG = 15.0  # [deg] a base tilted further has tipped whatever its geometry
+TIP_CAP_DEG = 15.0  # [deg] a base that ends the run tilted further has fallen
 MIN_BOUND_DEG = 1.0  # [deg] below this the soft contacts' own rocking would count as tipping
 LIFT_CLEARANCE = 1e-3  # [m] see the module docstring
 
@@ -46,55 +53,109 @@ class Lift:
 
 
 @dataclass(frozen=True)
-class TipVerdict:
-    """The run's tilt against its bound, and its lift-offs."""
+class Rock:
+    """An excursion past an edge's tipping angle that came back onto the contacts."""
 
-    static_angle: float  # [rad] at the start pose (negative: not statically stable)
     direction: str  # toward which edge
-    bound: float  # [rad] min(static angle, TIP_CAP_DEG), at least MIN_BOUND_DEG
-    max_tilt: float  # [rad]
+    angle: float  # [rad] that edge's tipping angle
+    start: float  # [s]
+    duration: float  # [s]
+    peak: float  # [rad] the largest tilt toward the edge
+
+    def line(self) -> str:
+        """The warning's text."""
+        return (
+            f"the base rocked past its {self.direction} tipping angle "
+            f"({math.degrees(self.angle):.1f} deg) at t = {self.start:.3f} s for "
+            f"{self.duration:.3f} s (up to {math.degrees(self.peak):.1f} deg) and came back "
+            "onto its contacts"
+        )
+
+
+@dataclass(frozen=True)
+class TipVerdict:
+    """The run's tilt toward each support edge against that edge's angle, and its lift-offs."""
+
+    angles: tuple[float, ...]  # [rad] per edge: static tipping angle, at least MIN_BOUND_DEG
+    directions: tuple[str, ...]  # per edge
+    max_tilt: float  # [rad] the base's largest tilt, in any direction
     max_tilt_time: float  # [s]
-    tip_time: float | None  # [s] first state past the bound; None: it did not tip
+    worst: int  # the edge tilted toward most, relative to its angle
+    worst_tilt: float  # [rad] the largest tilt toward that edge
+    tip_time: float | None  # [s] when the excursion it did not come back from began
+    rocks: tuple[Rock, ...]
     lifts: tuple[Lift, ...]
 
     @property
     def tips(self) -> bool:
-        """Whether the base tilted past its bound."""
+        """Whether the run ended past an edge's tipping angle (or past TIP_CAP_DEG)."""
         return self.tip_time is not None
+
+    @property
+    def static_angle(self) -> float:
+        """[rad] the least tipping angle over the edges (negative: not statically stable)."""
+        return min(self.angles)
+
+    @property
+    def direction(self) -> str:
+        """Toward which edge the base tilted most, relative to that edge's angle."""
+        return self.directions[self.worst]
 
     def line(self) -> str:
         """The summary's line."""
         head = (
             f"base tilt: max {math.degrees(self.max_tilt):.2f} deg at t = "
-            f"{self.max_tilt_time:.3f} s; tips past {math.degrees(self.bound):.1f} deg "
-            f"(static tipping angle {math.degrees(self.static_angle):.1f} deg toward "
-            f"{self.direction}, cap {TIP_CAP_DEG:g} deg)"
+            f"{self.max_tilt_time:.3f} s; toward {self.direction} up to "
+            f"{math.degrees(self.worst_tilt):.1f} deg of its "
+            f"{math.degrees(self.angles[self.worst]):.1f} deg tipping angle"
         )
         if self.tips:
-            return f"TIPS OVER at t = {self.tip_time:.3f} s: {head}"
+            return f"TIPS OVER at t = {self.tip_time:.3f} s: {head}, and did not come back"
         return f"{head}: stays upright; {len(self.lifts)} lift-off(s)"
+
+    def notes(self) -> list[str]:
+        """Warnings: each lift-off and each excursion past a tipping angle, in time order."""
+        events = [(r.start, r.line()) for r in self.rocks]
+        events += [(lift.start, lift.line()) for lift in self.lifts]
+        return [text for _, text in sorted(events)]
 
     def error(self) -> TipOverError:
         """What a run that tipped ends with (after its files are written)."""
         t = float(self.tip_time if self.tip_time is not None else math.nan)
         return TipOverError(
-            f"the robot tips over: its base tilted past {math.degrees(self.bound):.1f} deg "
-            f"at t = {t:.3f} s (static tipping angle {math.degrees(self.static_angle):.1f} deg "
-            f"toward {self.direction})",
+            f"the robot tips over: its base tilted toward {self.direction} past that edge's "
+            f"tipping angle ({math.degrees(self.angles[self.worst]):.1f} deg) at t = "
+            f"{t:.3f} s and did not come back",
             time=t,
             margin=math.nan,
             case="contact simulation",
         )
 
 
-def static_tipping_angle(stance: Stance, values: Mapping[str, float]) -> tuple[float, str]:
-    """[rad] The least rotation about a support edge that puts the centre of mass over it."""
+def tipping_angles(stance: Stance, values: Mapping[str, float]) -> np.ndarray:
+    """[rad] per support edge: the rotation about it that puts the centre of mass over it."""
     com = stance.loaded().center_of_mass(stance.q(values))
     h = max(stance.height(com), 1e-9)
-    d = stance.polygon.edge_distances(com[:2])
-    angles = np.arctan2(d, h)
+    return np.asarray(np.arctan2(stance.polygon.edge_distances(com[:2]), h), dtype=float)
+
+
+def static_tipping_angle(stance: Stance, values: Mapping[str, float]) -> tuple[float, str]:
+    """[rad] The least rotation about a support edge that puts the centre of mass over it."""
+    angles = tipping_angles(stance, values)
     i = int(np.argmin(angles))
     return float(angles[i]), stance.polygon.edges[i].direction
+
+
+def edge_tilts(quat: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """[rad] (N, k): per (w, x, y, z) row, the base's tilt toward each outward `normals` row.
+
+    The world's up axis seen in the base frame is u (the third row of R); the base has
+    rotated by atan2(-u · n, u_z) about the edge whose outward normal is n (root x-y).
+    """
+    w, x, y, z = (quat / np.linalg.norm(quat, axis=1, keepdims=True)).T
+    ux, uy, uz = 2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)
+    lean = -(np.outer(ux, normals[:, 0]) + np.outer(uy, normals[:, 1]))
+    return np.asarray(np.arctan2(lean, uz[:, None]), dtype=float)
 
 
 def tilt(quat: np.ndarray) -> np.ndarray:
@@ -126,6 +187,13 @@ def lifts(link: str, t: np.ndarray, force: np.ndarray, height: np.ndarray) -> li
     ]
 
 
+def intervals(mask: np.ndarray) -> list[tuple[int, int]]:
+    """(first, past-the-last) index of each run of True in `mask`."""
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    starts, ends = np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]
+    return [(int(a), int(b)) for a, b in zip(starts, ends, strict=True)]
+
+
 def verdict(
     stance: Stance,
     start: Mapping[str, float],
@@ -134,18 +202,32 @@ def verdict(
     contacts: Mapping[str, tuple[np.ndarray, np.ndarray]],
 ) -> TipVerdict:
     """The verdict of a run: base orientation per state, and per contact link (force, height)."""
-    static, direction = static_tipping_angle(stance, start)
-    bound = max(min(static, math.radians(TIP_CAP_DEG)), math.radians(MIN_BOUND_DEG))
+    angles = np.maximum(tipping_angles(stance, start), math.radians(MIN_BOUND_DEG))
+    toward = edge_tilts(quat, stance.polygon.normals)
+    past = toward > angles
     angle = tilt(quat)
-    k = int(np.argmax(angle))
-    past = np.nonzero(angle > bound)[0]
+    down = past.any(axis=1) | (angle > math.radians(TIP_CAP_DEG))
+    last = intervals(down)[-1] if down[-1] else None
+    rocks = [
+        Rock(stance.polygon.edges[i].direction, float(angles[i]), float(t[a]),
+             float(t[min(b, len(t) - 1)] - t[a]), float(np.max(toward[a:b, i])))
+        for i in range(len(angles)) for a, b in intervals(past[:, i])
+        if last is None or a < last[0]
+    ]  # fmt: skip
+    ratio = toward / angles
+    worst = int(np.argmax(ratio)) % ratio.shape[1]
+    if last is not None:
+        worst = int(np.argmax(toward[-1] - angles))
     found = [lift for link, (f, h) in contacts.items() for lift in lifts(link, t, f, h)]
+    m = int(np.argmax(angle))
     return TipVerdict(
-        static_angle=static,
-        direction=direction,
-        bound=bound,
-        max_tilt=float(angle[k]),
-        max_tilt_time=float(t[k]),
-        tip_time=float(t[past[0]]) if past.size else None,
+        angles=tuple(float(a) for a in angles),
+        directions=tuple(e.direction for e in stance.polygon.edges),
+        max_tilt=float(angle[m]),
+        max_tilt_time=float(t[m]),
+        worst=int(worst),
+        worst_tilt=float(np.max(toward[:, worst])),
+        tip_time=float(t[last[0]]) if last is not None else None,
+        rocks=tuple(sorted(rocks, key=lambda r: (r.start, r.direction))),
         lifts=tuple(sorted(found, key=lambda lift: (lift.start, lift.link))),
     )

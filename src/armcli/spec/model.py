@@ -114,8 +114,10 @@ class DiffDrive(_Model):
     wheel_separation: Positive = Field(description="distance between the wheels [m]")
     wheel_diameter: Positive = Field(description="wheel diameter [m]")
     max_wheel_torque: Positive = Field(20.0, description="largest wheel torque [N·m]")
-    max_wheel_acceleration: Positive = Field(
-        1.0, description="largest wheel rim acceleration [m/s²] (as gazebo_ros_diff_drive uses it)"
+    max_wheel_acceleration: NonNeg = Field(
+        1.0,
+        description="largest wheel rim acceleration [m/s²] (as gazebo_ros_diff_drive uses it); "
+        "0: no limit, the plugin's own default",
     )
     publish_odom: bool = Field(True, description="publish the odometry topic")
     publish_odom_tf: bool = Field(True, description="publish the odom -> base transform")
