@@ -40,18 +40,12 @@ class Kinematics:
         raise NotImplementedError
 
     def frame(self, name: str) -> int:
-        """The Pinocchio frame id of the link `name`, else of another frame so called.
+        """The Pinocchio frame id of the link `name`, else of the one frame so called.
 
         A link wins over a joint of the same name (`frames.frame_id`). InputError listing
         the links when there is no such frame.
         """
-        found = frame_id(self.model, name)
-        if found is None:
-            import pinocchio as pin
-
-            links = sorted(str(f.name) for f in self.model.frames if f.type == pin.BODY)
-            raise InputError(f"unknown link {name!r}; links: {', '.join(links)}", field="link")
-        return found
+        return frame_id(self.model, name, field="link")
 
     @property
     def tool_frame(self) -> int:

@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from armcli.errors import InputError
+from armcli.robot.frames import reduced_model
 from armcli.robot.joints import Joint, JointMap, joint_table, put
 from armcli.robot.kinematics import Kinematics
 from armcli.robot.load import checked_model, collision_model, load_model
@@ -229,7 +230,7 @@ class Robot(Kinematics):
         lock = [self.model.getJointId(nm) for nm in names if nm not in joints]
         if not lock:
             return self
-        return self._like(pin.buildReducedModel(self.model, lock, pin.neutral(self.model)))
+        return self._like(reduced_model(self.model, lock, pin.neutral(self.model)))
 
     def with_limits(self, **arrays: ArrayLike) -> Robot:
         """A copy with some limit arrays replaced (names of `LIMITS`, one value per joint).
