@@ -16,9 +16,8 @@ import numpy as np
 import pytest
 from lxml import etree
 
-from armcli.export.mjcf import quat
 from armcli.export.mjcf_files import export_mjcf
-from armcli.robot.frames import rpy_matrix
+from armcli.robot.frames import rpy_matrix, rpy_quaternion
 from armcli.sim.reference import build_reference
 from armcli.sim.simulate import SimConfig, simulate, simulated
 from armcli.sim.trajectory import loads_trajectory
@@ -297,7 +296,8 @@ def test_quaternion_matches_the_urdf_rotation() -> None:
     for _ in range(20):
         rpy = tuple(float(x) for x in rng.uniform(-math.pi, math.pi, 3))
         mat = np.zeros(9)
-        mujoco.mju_quat2Mat(mat, np.array(quat(rpy)))  # type: ignore[arg-type]
+        x, y, z, w = rpy_quaternion(rpy)  # MuJoCo reads (w, x, y, z), as the export writes it
+        mujoco.mju_quat2Mat(mat, np.array([w, x, y, z]))
         assert np.allclose(mat.reshape(3, 3), rpy_matrix(rpy), atol=1e-15)
 
 

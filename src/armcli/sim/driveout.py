@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from armcli.robot.frames import quaternion_rpy
 from armcli.sim.drive import DriveRun
-from armcli.sim.liftoff import TipVerdict, roll_pitch_yaw, verdict
+from armcli.sim.liftoff import TipVerdict, verdict
 from armcli.sim.rollout import Stats
 from armcli.sim.simulate import SETTLE_TOL, SimResult
 from armcli.sim.states import column, distinct, sample_states, sample_steps
@@ -80,7 +81,7 @@ def columns(run: DriveRun, res: SimResult, rate: float) -> dict[str, np.ndarray]
     job, L, s = run.job, run.job.model.layout, run.sensors
     cols = sample_states(res, rate)
     k = sample_steps(run.steps, job.dt, rate)
-    roll, pitch, yaw = roll_pitch_yaw(s[:, L.base_quat])
+    roll, pitch, yaw = quaternion_rpy(s[:, L.base_quat])
     pos = s[:, L.base_pos]
     base = {
         "x": pos[:, 0],
