@@ -24,11 +24,12 @@ def test_few_joints_get_the_full_grid() -> None:
     assert np.allclose(rows, np.array(list(itertools.product(*axis))), rtol=0, atol=1e-15)
 
 
-def test_many_joints_get_zero_corners_and_seeded_draws() -> None:
+def test_many_joints_get_rest_corners_and_seeded_draws() -> None:
     box = [(0.5, 1.0), (-1.0, 1.0), (-2.0, 0.0), (-1.0, 1.0)]
     rows = sampling.joint_space(box)
     assert rows.shape == (1 + 2**4 + sampling.RANDOM_SAMPLES, 4)
-    assert rows[0].tolist() == [0.5, 0.0, 0.0, 0.0]  # 0 clamped into each range
+    # the rest pose: 0 where the range holds it, else the middle, (0.5 + 1.0) / 2
+    assert rows[0].tolist() == [0.75, 0.0, 0.0, 0.0]
     assert {tuple(r) for r in rows[1:17]} == set(itertools.product(*box))
     # the draws: the standard library's generator, seeded, one row after the other
     rng = random.Random(sampling.SAMPLE_SEED)

@@ -177,8 +177,8 @@ def _point_label(stance: Stance) -> str:
 
 
 def _values(stance: Stance, values: dict[str, float]) -> list[float]:
-    """The searched joints' values of a pose (0 clamped into range where it gives none)."""
-    return [float(np.clip(values.get(j.name, 0.0), lo, hi))
+    """The searched joints' values of a pose, clamped into range; a joint it leaves out rests."""
+    return [float(np.clip(values.get(j.name, j.rest), lo, hi))
             for j, (lo, hi) in zip(stance.joints, stance.box, strict=True)]  # fmt: skip
 
 

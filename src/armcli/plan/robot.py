@@ -146,12 +146,7 @@ class PlanRobot:
             valid = ", ".join(sorted(self.poses)) or "none"
             raise InputError(f"unknown pose {name!r}; valid: {valid}", field="pose")
         given = self.poses[name]
-        return np.array([given.get(j, self.rest_of(j)) for j in self.joints], dtype=float)
-
-    def rest_of(self, joint: str) -> float:
-        """A planned joint's default value: 0 clipped into its range."""
-        i = self.joints.index(joint)
-        return float(np.clip(0.0, self.lower[i], self.upper[i]))
+        return np.array([given.get(j, self.robot.rest(j)) for j in self.joints], dtype=float)
 
 
 def default_joints(urdf: Urdf, spec: RobotSpec | None) -> tuple[str, ...]:

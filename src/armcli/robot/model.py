@@ -83,6 +83,7 @@ class Robot(Kinematics):
         self._by_name = {j.name: j for j in self.joints}
         self._local = threading.local()
         self._neutral: NDArray[np.float64] | None = None
+        self._rest: NDArray[np.float64] | None = None
 
     @classmethod
     def load(
@@ -161,13 +162,22 @@ class Robot(Kinematics):
             self._neutral = np.asarray(pin.neutral(self.model), dtype=float)
         return self._neutral.copy()
 
+    def rest_q(self) -> NDArray[np.float64]:
+        """The rest configuration: every 1-DoF joint at `rest`, the free-flyer at identity."""
+        if self._rest is None:
+            q = self.neutral()
+            for j in self.joints:
+                put(q, j, j.rest)
+            self._rest = q
+        return self._rest.copy()
+
     def follow(self, values: Mapping[str, float]) -> dict[str, float]:
         """`values` with every mimic follower of a given leader set from it."""
         return follow(self.mimics, values)
 
     def q(
         self,
-        values: Mapping[str, float] | ArrayLike = (),
+        values: Mapping[str, float] | ArrayLike | None = None,
         *,
         joints: Sequence[Joint] | None = None,
         base: ArrayLike | None = None,
@@ -176,10 +186,13 @@ class Robot(Kinematics):
 
         `values` is a mapping by joint name (names that are not 1-DoF joints of the model
         are ignored) or a sequence aligned with `joints` (default: every joint, tree
-        order). `base` defaults to the neutral configuration. Mimic followers are not
-        moved here: `follow` the values first.
+        order); None sets none. `base` defaults to the rest configuration (`rest_q`: an
+        unset joint rests).
+        Mimic followers are not moved here: `follow` the values first.
         """
-        q = self.neutral() if base is None else np.array(base, dtype=float)
+        q = self.rest_q() if base is None else np.array(base, dtype=float)
+        if values is None:
+            return q
         if isinstance(values, Mapping):
             pairs: Iterable[tuple[Joint, Any]] = (
                 (self._by_name[n], x) for n, x in values.items() if n in self._by_name
@@ -194,10 +207,10 @@ class Robot(Kinematics):
     def joint_map(self, joints: Sequence[str], rest: Mapping[str, float] | None = None) -> JointMap:
         """`x` (values of `joints`, in order) -> q, vectorised: for a caller building q per state.
 
-        A planner's validity check calls it per state. Other joints at `rest` (else
-        neutral), followers following their leaders: the same q as `q(follow(...))`.
+        A planner's validity check calls it per state. Other joints at `rest` (else at
+        their own rest), followers following their leaders: the same q as `q(follow(...))`.
         """
-        rest = dict(rest or {})
+        rest = {**{j.name: j.rest for j in self.joints}, **(rest or {})}
         chosen = [self.joint(n) for n in joints]
         template = self.q(self.follow({**rest, **{j.name: 0.0 for j in chosen}}))
 
@@ -214,12 +227,10 @@ class Robot(Kinematics):
         return JointMap(template, (lq, lx), (cq, cq + 1, cx), followers, tuple(joints), rest)
 
     def reduced(self, joints: Sequence[str]) -> Robot:
-        """The robot with only `joints` movable; the others locked at their neutral value.
+        """The robot with only `joints` movable; the others locked where they rest (`rest`).
 
         InputError (field `joints`) for an unknown joint or one listed twice.
         """
-        import pinocchio as pin
-
         names = list(self.model.names)[1:]
         for name in joints:
             if name not in names:
@@ -230,7 +241,7 @@ class Robot(Kinematics):
         lock = [self.model.getJointId(nm) for nm in names if nm not in joints]
         if not lock:
             return self
-        return self._like(reduced_model(self.model, lock, pin.neutral(self.model)))
+        return self._like(reduced_model(self.model, lock, self.rest_q()))
 
     def with_limits(self, **arrays: ArrayLike) -> Robot:
         """A copy with some limit arrays replaced (names of `LIMITS`, one value per joint).

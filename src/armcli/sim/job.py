@@ -197,12 +197,13 @@ def _report_frame(robot: Robot, spec: RobotSpec | None) -> tuple[str, np.ndarray
 
 
 def start_state(robot: Robot, spec: RobotSpec | None) -> np.ndarray:
-    """The spec's `home` pose if it has one, else zero clamped into the joint limits."""
-    q = np.zeros(len(robot.names))
-    if spec is not None and "home" in spec.poses:
-        home = spec.pose("home")
-        q = np.array([home.get(j, 0.0) for j in robot.names], dtype=float)
-    return np.clip(q, robot.lower, robot.upper)
+    """The spec's `home` pose (clamped into the joint limits); a joint it leaves out rests.
+
+    Without a `home` pose every joint rests (`Robot.rest`: 0, else the middle of its range).
+    """
+    home = spec.pose("home") if spec is not None and "home" in spec.poses else {}
+    q = np.array([home.get(j, robot.rest(j)) for j in robot.names], dtype=float)
+    return np.asarray(np.clip(q, robot.lower, robot.upper), dtype=float)
 
 
 def _duration_and_rate(

@@ -34,9 +34,11 @@ from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
 from armcli.io.userfile import open_regular
 from armcli.robot.frames import axis_quaternion, quaternion_product, rotate, rpy_quaternion
+from armcli.robot.joints import rest
 from armcli.sim.mcap_guard import check_chunks
 from armcli.sim.simulate import SimResult
 from armcli.sim.states import MAX_REPLAY_ROWS, TIME, Replay, column, sample_states
+from armcli.spec.joint_types import position_bounds
 from armcli.urdf.doc import Joint, Urdf
 
 MCAP_SUFFIX = ".mcap"
@@ -184,6 +186,8 @@ def channels(cols: Mapping[str, np.ndarray], names: Sequence[str], urdf: Urdf) -
     state, ref, tf = [], [], []
     tracked = [n for n in names if column(n, "reference") in cols]  # a wheel has no reference
     moving = [j for j in urdf.joints if j.type != "fixed" and j.movable]
+    bounds = {j.name: position_bounds(j.type, j.limit) for j in moving}
+    resting = {n: rest(*b) if b is not None else 0.0 for n, b in bounds.items()}  # not simulated
     for k, ns in enumerate(stamps):
         values = {n: float(cols[column(n, "position")][k]) for n in names}
         state.append((ns, _joint_state(
@@ -192,7 +196,7 @@ def channels(cols: Mapping[str, np.ndarray], names: Sequence[str], urdf: Urdf) -
         )))  # fmt: skip
         ref.append((ns, _joint_state(ns, tracked, position=[cols[column(n, "reference")][k]
                                                             for n in tracked])))  # fmt: skip
-        tf.append((ns, {"transforms": [_transform(j, values.get(j.name, 0.0), ns)
+        tf.append((ns, {"transforms": [_transform(j, values.get(j.name, resting[j.name]), ns)
                                        for j in moving]}))  # fmt: skip
     fixed = [j for j in urdf.joints if j.type == "fixed"]
     start = stamps[0]

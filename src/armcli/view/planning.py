@@ -111,9 +111,9 @@ class PlanningSession:
         return tuple(self.context.robot.poses)
 
     def neutral(self) -> np.ndarray:
-        """Each planned joint at 0, clipped into its range."""
+        """Each planned joint where it rests (`Robot.rest`: 0, else the middle of its range)."""
         robot = self.context.robot
-        return np.clip(np.zeros(len(robot.joints)), robot.lower, robot.upper)
+        return np.array([robot.robot.rest(j) for j in robot.joints])
 
     def as_dict(self, x: np.ndarray) -> dict[str, float]:
         """Planned joint values by name."""
