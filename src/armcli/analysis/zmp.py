@@ -152,7 +152,7 @@ def zmp_series(
     rows, a = accelerations(np.asarray(step), np.asarray(v), dt, impact)
     skipped = 0 if impact is None else int(np.sum(np.asarray(impact, dtype=bool)))
     cols = _columns(stance.robot, joint_names)
-    q_full = stance.robot.neutral()
+    q_full = stance.robot.rest_q()  # joints not simulated: where they rest, as simulate locks them
     mass = loaded.mass
     z0 = stance.ground.height
     zmp = np.empty((len(rows), 3, 2))
