@@ -89,8 +89,10 @@ bench: install-dev native-check
 	$(BIN)/python bench/bench_plan.py
 	$(BIN)/python bench/bench_first_hour.py
 	$(BIN)/python bench/bench_check_corpus.py
+	$(BIN)/python bench/bench_check_packages.py
 	$(BIN)/python bench/bench_build_expand.py
 	$(BIN)/python bench/bench_drive.py
+	$(BIN)/python bench/bench_sensors.py
 
 fuzz: install-dev
 	HYPOTHESIS_PROFILE=fuzz $(BIN)/python -m pytest -q tests -k fuzz

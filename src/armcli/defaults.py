@@ -27,6 +27,7 @@ DEFAULT_STATE_RATE_HZ = 10.0  # [Hz] joint-state output without a joint_state_pu
 
 # Choices and defaults of command options whose `--help` must not import their library.
 ROS_TARGETS = ("humble-classic", "jazzy")  # the course's ROS 2 Humble + Gazebo classic; Jazzy + gz
+ROS_DISTROS = ("humble", "jazzy", "kilted", "lyrical")  # `check DIR --distro` (ROS packages)
 COLLISION_SAMPLES = 10_000  # the MoveIt Setup Assistant's default "sampling density"
 MJCF_BASES = ("fixed", "free")  # `export mjcf --base`: root welded to the world, or free
 PdLoop = Literal["implicit", "explicit"]  # armcli's simulator, or an explicit torque loop

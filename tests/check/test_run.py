@@ -198,6 +198,15 @@ def both(*edits: Callable[[Any], None]) -> Callable[[Any], None]:
     return edit
 
 
+_RAYS = ("<ray><scan><horizontal><samples>36</samples><min_angle>-3.1</min_angle>"
+         "<max_angle>3.1</max_angle></horizontal></scan><range><min>{min}</min><max>8</max>"
+         "</range></ray>")  # fmt: skip
+
+
+def _sensor(link: str, kind: str, body: str) -> str:
+    return f'<gazebo reference="{link}"><sensor name="s" type="{kind}">{body}</sensor></gazebo>'
+
+
 CASES: dict[str, tuple[Callable[[Any], None], RobotSpec | CheckOptions | None, set[str]]] = {
     "duplicate-name": (append('<link name="hand_link"/>'), None, {"duplicate-name"}),
     "unknown-link": (set_attr(J2, "parent", "link", "no_such_link"), None, {"unknown-link"}),
@@ -323,7 +332,20 @@ CASES: dict[str, tuple[Callable[[Any], None], RobotSpec | CheckOptions | None, s
         tipover(SAFE_SPEC, trajectory=SWING, base_accel=8.0),
         {"zmp-outside-support"},
     ),
-}
+    # sensors (more cases: tests/check/test_sensors.py)
+    "sensor-link": (append(_sensor("nowhere", "imu", "<update_rate>10</update_rate>")), None,
+                    {"sensor-link"}),
+    "sensor-rate": (append(_sensor("base_link", "imu", "<update_rate>5000</update_rate>")),
+                    None, {"sensor-rate"}),
+    "sensor-fov": (append(_sensor("base_link", "camera",
+                                  "<camera><horizontal_fov>0</horizontal_fov></camera>")),
+                   None, {"sensor-fov"}),
+    "sensor-range": (append(_sensor("base_link", "ray", _RAYS.format(min=9))), None,
+                     {"sensor-range"}),
+    # a lidar in the middle of the base's box, its rays starting 5 cm out: still inside
+    "sensor-sees-robot": (append(_sensor("base_link", "ray", _RAYS.format(min=0.05))), None,
+                          {"sensor-sees-robot"}),
+}  # fmt: skip
 
 
 def run(edit: Callable[[Any], None], spec: RobotSpec | CheckOptions | None) -> Any:
@@ -337,8 +359,10 @@ def run(edit: Callable[[Any], None], spec: RobotSpec | CheckOptions | None) -> A
 def test_every_rule_has_a_case() -> None:
     # parser-message (non-error urdfdom output) has no known trigger with urdfdom 4:
     # everything it prints starts with "Error"; it stays for other parser versions.
-    # input-unusable is about files that do not parse at all: test_check_inputs.py.
-    assert set(RULES) - set(CASES) == {"input-unusable"}
+    # input-unusable is about files that do not parse at all: test_check_inputs.py; the
+    # ROS package rules read directories of packages: tests/check/ros_packages/.
+    ros = {r for r in RULES if r.startswith("ros-")}
+    assert set(RULES) - set(CASES) == {"input-unusable", *ros}
 
 
 @pytest.mark.parametrize("rule", sorted(r for r in CASES if r != "parser-message"))

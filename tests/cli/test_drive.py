@@ -223,10 +223,12 @@ def test_bad_world_is_exit_2_naming_file_and_field(
     assert not out.exists()
 
 
-def test_a_world_without_a_drive_is_exit_2(
+def test_a_world_in_an_arm_run_is_read_too(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
+    # what an arm's sensors see (sim.sensors.armsense): read, and refused as in a drive
     world = tmp_path / "world.yaml"
-    world.write_text("collision_objects: []\n")
+    world.write_text("collision_objects:\n  - id: wall\n    primitives: [{type: box}]\n"
+                     "    primitive_poses: [{}]\n")  # fmt: skip
     code, _, err = run_main(["simulate", DEFAULT_SPEC, "-t", PICK, "--world", world], capsys)
-    assert code == 2 and "--world" in err
+    assert code == 2 and f"{world}:3 collision_objects[0].primitives[0].dimensions" in err

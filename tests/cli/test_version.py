@@ -27,6 +27,8 @@ def test_version_lines() -> None:
     assert lines[0] == f"armcli {armcli.__version__} ({Path(armcli.__file__).parent})"
     assert lines[1].startswith(("simulator engine: compiled (", "simulator engine: unavailable ("))
     assert lines[2:4] == [f"pin {metadata.version('pin')}", f"xacro {metadata.version('xacro')}"]
+    assert lines[4].startswith(("camera rendering: EGL (", "camera rendering: OSMesa (",
+                                "camera rendering: none ("))  # fmt: skip
 
 
 def test_engine_when_the_compiled_simulator_is_missing(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -30,10 +30,12 @@ from armcli.check.run import check_urdf
 from armcli.compiler.xacro_writer import WORLD_JOINT
 from armcli.errors import InputError
 from armcli.ros import jazzy
+from armcli.ros.holding import integral_terms
 from armcli.ros.packages import RosPackages, ros_packages
 from armcli.spec.load import load_spec, loads_spec
 from armcli.spec.model import RobotSpec
 from armcli.urdf.read import parse_urdf
+from armcli.urdf.source import spec_urdfs
 from tests.helpers import ROOT, run_cli
 
 GOLDEN = ROOT / "tests" / "ros" / "golden"
@@ -235,9 +237,15 @@ def test_controllers_carry_the_spec_gains_rate_and_tolerances(
     arm = doc["arm_controller"]["ros__parameters"]
     assert arm["command_interfaces"] == ["effort"]
     assert arm["joints"] == spec.movable_arm_joints()
+    # The spec's PD sags 0.028 rad at `reach` (> MoveIt's 0.01): the generator adds the
+    # integral term of ros/holding.py (tests/ros/test_holding.py), clamped at the effort limit
+    holding = integral_terms(spec, spec_urdfs(spec)[f"{spec.name}.urdf"])
+    assert set(holding) == set(spec.control.gains)
     for j, g in spec.control.gains.items():
-        # JTC effort law: ff_velocity_scale * v_ref + p e + d e' + i ∫e == the spec's PD(+I)
-        want = {"p": g.kp, "d": g.kd, "i": g.ki, "i_clamp": 0.0, "ff_velocity_scale": 0.0}
+        # JTC effort law: ff_velocity_scale * v_ref + p e + d e' + i ∫e == the spec's PD + I
+        extra = holding[j]
+        want = {"p": g.kp, "d": g.kd, "i": extra.i, "i_clamp": 100.0, "ff_velocity_scale": 0.0}
+        assert extra.i > 0
         assert arm["gains"][j] == want
         assert arm["constraints"][j] == {
             "trajectory": spec.control.tolerances.trajectory,

@@ -37,9 +37,12 @@ def test_template_files_are_the_examples(template: str) -> None:
     assert trajectories, "a template without trajectories"
     for f in trajectories:
         assert files[f"trajectories/{f.name}"] == f.read_bytes()
+    extras = sorted((EXAMPLES / t.extras).iterdir()) if t.extras else []
+    for f in extras:  # beside the spec: a world, a Foxglove layout
+        assert files[f.name] == f.read_bytes()
     assert set(files) == {"armcli.yaml", "README.md"} | {
         f"trajectories/{f.name}" for f in trajectories
-    }
+    } | {f.name for f in extras}
 
 
 @pytest.mark.parametrize("template", sorted(TEMPLATES))
@@ -120,7 +123,7 @@ def test_init_into_a_file_is_refused(tmp_path: Path, capsys: pytest.CaptureFixtu
 
 def test_unknown_template(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert _main(["init", str(tmp_path), "--template", "ur5"]) == 2  # a usage error
-    assert "'ur5' is not one of 'course', 'tabletop'" in capsys.readouterr().err
-    with pytest.raises(InputError, match="unknown template 'ur5'; known: course, tabletop"):
+    assert "'ur5' is not one of 'course', 'rover', 'tabletop'" in capsys.readouterr().err
+    with pytest.raises(InputError, match="unknown template 'ur5'; known: course, rover, tabletop"):
         init_project(tmp_path, "ur5")  # the library call says the same
     assert list(tmp_path.iterdir()) == []

@@ -15,6 +15,8 @@ from typing import TYPE_CHECKING
 
 from armcli.check.findings import Finding
 from armcli.check.options import CheckOptions
+from armcli.check.ros_packages.run import check_packages
+from armcli.check.ros_packages.workspace import has_packages
 from armcli.check.rules import ERROR, RULES
 from armcli.check.run import CheckResult, check_document, check_urdf
 from armcli.check.spec_locate import key_lines, locate
@@ -101,6 +103,11 @@ def run_check(
     unusable: list[Unusable] = []
     notes: list[tuple[str, str]] = []
     for path in paths:
+        if path.is_dir() and has_packages(path):  # ROS packages: their robots and the rules
+            pc = check_packages(path, base, distro=base.ros_distro, trust=trust_xacro)
+            results.extend(pc.results)
+            notes += [(str(path), n) for n in pc.notes]
+            continue
         try:
             docs, bad = _documents(path, trust_xacro, inputs)
         except InputError as exc:

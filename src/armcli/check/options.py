@@ -35,6 +35,7 @@ class CheckOptions:
     package_dirs: Mapping[str, Path] = field(default_factory=dict)
     search_paths: tuple[Path, ...] = ()
     tipover: TipoverOptions = field(default_factory=TipoverOptions)
+    ros_distro: str | None = None  # `--distro` for ROS packages (default: from their plugins)
 
     def mesh_search(self) -> MeshSearch:
         """The mesh-resolver view of these options (shared with view and render)."""

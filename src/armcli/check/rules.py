@@ -11,10 +11,6 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    pass
 
 ERROR = "error"
 WARNING = "warning"
@@ -40,6 +36,18 @@ class Rule:
     blocks: str | None = None
 
 
+_SENSOR_RULES = [  # check/sensors.py; in _RULES before the ROS packages'
+    Rule("sensor-link", ERROR, "a sensor's <gazebo reference> is not a link of the robot",
+         "name one of the robot's links (Gazebo drops the sensor)"),
+    Rule("sensor-rate", ERROR, "a sensor updates faster than the physics steps",
+         "lower the sensor's rate to at most 1 / dt, or lower dt"),
+    Rule("sensor-fov", ERROR, "empty field of view (equal scan angles, camera fov not in (0, pi))",
+         "give min_angle < max_angle for several rays, a horizontal_fov in (0, pi)"),
+    Rule("sensor-range", ERROR, "range_min >= range_max or near >= far: the range is empty",
+         "give range_min < range_max (near < far)"),
+    Rule("sensor-sees-robot", WARNING, "a lidar's rays start in the robot's collision shapes",
+         "move the lidar clear of them (it sees itself) or raise range_min past them"),
+]  # fmt: skip
 _RULES = [
     # structure
     Rule(
@@ -313,11 +321,74 @@ _RULES = [
         "a --reach-point the tool point cannot reach within the joint limits",
         "move the point or the arm's mount (the message says how close the arm gets)",
     ),
+    *_SENSOR_RULES,
+    # ROS packages (check DIR over package.xml directories: check/ros_packages/)
+    Rule(
+        "ros-joint-states-twice",
+        ERROR,
+        "more than one publisher of /joint_states in one launch (joint_state_publisher[_gui] "
+        "beside a joint_state_broadcaster spawner or Gazebo's joint-state plugin)",
+        "remove the extra publisher (the message says which one stays)",
+    ),
+    Rule(
+        "ros-control-node-with-sim",
+        ERROR,
+        "ros2_control_node launched for a robot whose <ros2_control> hardware is a simulator's "
+        "system (gz_ros2_control, gazebo_ros2_control), which runs its own controller manager",
+        "remove the ros2_control_node; spawn the controllers on the simulator's controller manager",
+    ),
+    Rule(
+        "ros-wheel-geometry",
+        ERROR,
+        "diff-drive wheel separation or radius (plugin or controller YAML) more than 1 % from "
+        "the URDF's wheels, or a diff_drive_controller parameter the distro no longer has",
+        "write the URDF's value (in the message)",
+    ),
+    Rule(
+        "ros-unknown-joint",
+        ERROR,
+        "a controller, <ros2_control> block or MoveIt YAML names a joint the URDF lacks",
+        "use the URDF's joint name (the message suggests the closest)",
+    ),
+    Rule(
+        "ros-srdf-unknown",
+        ERROR,
+        "an SRDF group, chain, end effector, group state, passive joint or collision entry "
+        "names a joint, link or group the robot lacks",
+        "use the URDF's name (the message suggests the closest)",
+    ),
+    Rule(
+        "ros-classic-plugin",
+        ERROR,
+        "a Gazebo plugin the launch's simulator does not load (Gazebo classic's in Gazebo "
+        "Harmonic or the reverse, or another distro's name)",
+        "use the plugin of the simulator the launch starts",
+    ),
+    Rule(
+        "ros-sim-time",
+        WARNING,
+        "a node of a launch that starts Gazebo without use_sim_time: true",
+        "give the node use_sim_time: true (or SetParameter use_sim_time for the launch)",
+    ),
+    Rule(
+        "ros-start-sag",
+        WARNING,
+        "at a named pose the arm, held by its controller's gains, settles farther from the "
+        "command than MoveIt's allowed_start_tolerance or the goal tolerance: Execute fails",
+        "raise p (the message gives the value that holds) or add an integral term",
+    ),
+    Rule(
+        "ros-missing-depend",
+        WARNING,
+        "a launch file uses a package its package.xml does not depend on",
+        "add the <exec_depend> to package.xml",
+    ),
     # inputs
     Rule(
         "input-unusable",
         ERROR,
-        "file could not be read as a URDF (not XML, not URDF, refused, too large)",
+        "file could not be read (a URDF, launch file, YAML or package.xml: malformed, refused, "
+        "too large)",
         "fix or remove the file",
     ),
 ]

@@ -18,6 +18,7 @@ from armcli.check import (
     joints,
     meshes,
     reach,
+    sensors,
     structure,
     summary,
     tipover,
@@ -90,6 +91,7 @@ FAMILIES: tuple[Family, ...] = (
     Family("tipover", BALANCE, tipover.check),
     Family("zmp", DYNAMICS, zmp_rules.check),
     Family("reach", MODEL, reach.check),
+    Family("sensors", MODEL, sensors.check),
 )
 
 

@@ -47,6 +47,7 @@ _CHILD_KEYS: dict[str, tuple[str, ...]] = {
     "calibration": ("calibration",),
 }
 _PD_RULE_PREFIX = "pd-"
+_SENSOR_RULE_PREFIX = "sensor-"  # check/sensors.py: about the spec's sensor named
 # check/tipover.py and check/zmp.py: about a pose or the base's drive, not a URDF element
 _BALANCE_RULES = frozenset({"com-outside-support", "support-margin", "zmp-outside-support",
                             "zmp-margin"})  # fmt: skip
@@ -134,10 +135,24 @@ def _pd_path(f: Finding, doc: YamlDoc) -> Path_ | None:
     return next((p for p in paths if p in doc.lines), None)
 
 
+def _sensor_path(f: Finding, doc: YamlDoc) -> Path_ | None:
+    """Sensor findings are about the spec's sensor named, the number they name in it."""
+    base = ("sensors", str(f.values.get("sensor")))
+    for part in ("lidar", "camera", None):
+        path = (*base, part) if part else base
+        if path in doc.lines:
+            refined = _refine(path, f, doc)
+            if refined != path or part is None:
+                return refined
+    return None
+
+
 def spec_path(f: Finding, root: Any, doc: YamlDoc) -> Path_ | None:
     """The spec field a finding in the URDF `root` (lxml tree of the generated text) is about."""
     if f.rule.startswith(_PD_RULE_PREFIX):
         return _pd_path(f, doc)
+    if f.rule.startswith(_SENSOR_RULE_PREFIX) and "sensor" in f.values:
+        return _sensor_path(f, doc)
     if f.rule in _BALANCE_RULES:
         return _balance_path(f, doc)
     el = _element_at(root, f.line) if f.line else None

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import sys
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -12,6 +13,7 @@ import typer
 from armcli.commands.options import choice
 from armcli.commands.robot_input import robot_options, write_notes
 from armcli.commands.values import REACH_POINT_HELP, Names, Numbers, names, point
+from armcli.defaults import ROS_DISTROS
 from armcli.errors import (
     EXIT_FAILED,
     EXIT_UNUSABLE,
@@ -31,6 +33,10 @@ FORMATS = ("table", "json", "github", "sarif")
 PAYLOAD_LINK_HELP = "Link carrying --payload at its origin (default: the tool point)."
 CONTACT_LINKS_HELP = "Comma-separated links touching the ground (default: from the geometry)."
 TRAJECTORY_HELP = "Simulate this JointTrajectory and report the zero-moment point (needs gains)."
+DISTRO_HELP = (
+    "ROS 2 distro of a directory of ROS packages: humble, jazzy, kilted or lyrical "
+    "(default: from the Gazebo plugins and packages found)."
+)
 BASE_ACCEL_HELP = (
     "Base acceleration and braking [m/s²] with --trajectory "
     "(default: the diff-drive plugin's max_wheel_acceleration)."
@@ -88,6 +94,7 @@ def check_cmd(
     reach_point: list[Numbers] = typer.Option(
         [], "--reach-point", parser=point("--reach-point"), metavar="X,Y,Z", help=REACH_POINT_HELP
     ),
+    distro: str = choice(None, ROS_DISTROS, "--distro", help=DISTRO_HELP),
 ) -> None:
     """Check robot descriptions for physical sanity; exit 1 on error findings."""
     from armcli.check import report
@@ -103,11 +110,11 @@ def check_cmd(
     tip = tipover_options(
         payload, payload_link, contact_links, min_margin, trajectory, base_accel, reach_point
     )
-    base = CheckOptions(package_dirs=robot.packages.package_dirs, tipover=tip)
+    base = CheckOptions(package_dirs=robot.packages.package_dirs, tipover=tip, ros_distro=distro)
     if spec is not None:  # the spec layers (pydantic, ~0.4 s to import) only for a spec
         from armcli.spec.load import load_spec
 
-        base = CheckOptions(spec=load_spec(spec), package_dirs=base.package_dirs, tipover=tip)
+        base = replace(base, spec=load_spec(spec))
     run = run_check(robot.files(), base, trust_xacro=robot.trust, inputs=robot.xacro)
     for file, note in run.notes:
         write_notes([note], file.removesuffix(EXPANDED_TAG))

@@ -28,7 +28,8 @@ def init_cmd(
         "--template",
         click_type=click.Choice(tuple(TEMPLATES)),
         show_default=False,
-        help="course (default: a 2-axis arm on a mobile base) or tabletop (a 3-axis arm).",
+        help="course (default: a 2-axis arm on a mobile base), rover (the course robot with "
+        "lidar, depth camera, IMU and a world) or tabletop (a 3-axis arm).",
     ),
     source: Path | None = typer.Option(
         None,

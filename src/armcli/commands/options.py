@@ -16,10 +16,12 @@ import typer
 from armcli.errors import InputError
 
 
-def choice(default: str, choices: Sequence[str], *names: str, help: str) -> Any:
-    """A string option restricted to `choices`; the default is stated in `help`."""
+def choice(default: str | None, choices: Sequence[str], *names: str, help: str) -> Any:
+    """A string option restricted to `choices`; the default is stated in `help` (None: unset)."""
 
-    def check(value: str) -> str:
+    def check(value: str | None) -> str | None:
+        if value is None and default is None:
+            return None
         if value not in choices:
             raise InputError(
                 f"unknown value {value!r}; valid: {', '.join(choices)}", field=names[0]

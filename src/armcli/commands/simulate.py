@@ -39,8 +39,8 @@ CMD_VEL_HELP = (
     "Twist + time_from_start); --trajectory then optional."
 )
 WORLD_HELP = (
-    "With --cmd-vel: obstacles in the world (odom at the start), a PlanningScene YAML as "
-    "plan --scene reads."
+    "Objects in the world (a PlanningScene YAML as plan --scene reads): obstacles of a "
+    "--cmd-vel drive; in an arm run, what its sensors see."
 )
 PROGRESS_AFTER_S = 1.0  # show a progress bar when the run is projected to take longer
 # The library's names for what these flags set (errors name them; commands.flags maps back).
@@ -151,18 +151,17 @@ def simulate_cmd(
         _drive(spec_obj, opts, cmd_vel, world, tuple(ignore), output, plot,
                tip_opts != TipOptions())  # fmt: skip
         return
-    if world is not None:
-        raise InputError("a world is for a drive: give --cmd-vel too", field="--world")
     asked = tip_opts != TipOptions()  # an arm on a fixed base is news only when asked about
     with _LazyProgress(terminal.console(sys.stderr)) as progress:
         run = _simulate(spec_obj, spec_path, opts, tip_opts, robot, tuple(ignore), progress,
-                        plot is not None)  # fmt: skip
+                        plot is not None, world)  # fmt: skip
     _report(run, output, plot, asked)
 
 
 def _simulate(
     spec: Any, spec_path: Path | None, opts: SimOptions, tip_opts: TipOptions,
     robot: RobotInput, ignore: tuple[str, ...], progress: _LazyProgress, plot: bool,
+    world: Path | None,
 ) -> ArmRun:  # fmt: skip
     """The run, with library refusals told in the command's terms (options, spec fields).
 
@@ -177,7 +176,7 @@ def _simulate(
             gate=lambda doc: refuse_check_errors(doc, ignore=ignore),
             balance_gate=lambda doc: refuse_check_errors(doc, ignore=ignore,
                                                          only=bears_on_balance),
-            progress=progress, plot=plot,
+            progress=progress, plot=plot, world=world,
         )  # fmt: skip
     except ModelRefusedError as exc:
         flags = " ".join(f"--ignore {r}" for r in exc.rules())

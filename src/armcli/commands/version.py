@@ -1,9 +1,10 @@
-"""What `armcli --version` reports: armcli, the simulator engine, pin and xacro.
+"""What `armcli --version` reports: armcli, the simulator engine, pin and xacro, rendering.
 
 A bug report needs to say which installation ran (the path), whether `simulate` uses the
-compiled simulator (or why it has none), and the versions of the two libraries that shape
-every output (Pinocchio for dynamics and checks, xacro for expansion). Versions come
-from the installed metadata so that no heavy library is imported.
+compiled simulator (or why it has none), the versions of the two libraries that shape
+every output (Pinocchio for dynamics and checks, xacro for expansion), and whether a
+camera sensor can render (the OpenGL backend MuJoCo found: EGL, OSMesa or none, tried
+the way the camera tries it). Versions come from the installed metadata.
 """
 
 from __future__ import annotations
@@ -39,10 +40,18 @@ def engine() -> str:
     return f"compiled ({where})"
 
 
+def rendering() -> str:
+    """The OpenGL backend camera sensors render with (sim.sensors.gl), or why none."""
+    from armcli.sim.sensors import gl  # mujoco and OpenGL: loaded only here
+
+    return gl.describe()
+
+
 def version_lines() -> list[str]:
     """The lines `armcli --version` prints, armcli's own version first."""
     lines = [f"armcli {armcli.__version__} ({Path(armcli.__file__).parent})"]
     lines.append(f"simulator engine: {engine()}")
     lines += [f"{name} {_dist_version(name)}" for name in LIBRARIES]
+    lines.append(f"camera rendering: {rendering()}")
     lines.append(f"Python {platform.python_version()} ({sys.executable})")
     return lines

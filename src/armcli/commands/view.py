@@ -74,11 +74,15 @@ def view_cmd(
     pose_q(src, pose, None)  # validate before starting the server
     if not 0 <= port <= 65535:
         raise InputError(f"{port} is not a port number", field="--port")
-    run = None
+    run, sensors = None, None
     if replay is not None:
         names = list(joint_limits(load_urdf(src.xml, src.source, src.mesh_dir, src.search)))
         load = rosbag.load_replay if rosbag.is_mcap(replay) else load_replay
         run = load(replay, names)
+        if rosbag.is_mcap(replay):
+            from armcli.sim.sensors.replay import load_sensor_replay
+
+            sensors = load_sensor_replay(replay)
     chosen = list(joints) if joints else None
     session = _session(src, (scene, srdf, chosen, group), save_dir, robot)  # before serving
     viewer = Viewer(
@@ -90,9 +94,11 @@ def view_cmd(
         poses=src.poses,
         tool=src.tool,
         replay=run,
+        sensors=sensors,
         host=host,
         port=port,
     )
+    write_notes(viewer.sensor_notes)
     panel = None
     try:  # entered before the URL is printed, so an early Ctrl-C still stops cleanly
         if session is not None:

@@ -35,6 +35,7 @@ class YamlDoc:
     data: Any
     lines: dict[Path_, int] = field(default_factory=dict)
     source: str = "<string>"
+    merge_duplicates: bool = False  # ROS's parameter parser merges a repeated key's mappings
 
     def line_of(self, path: Path_) -> int | None:
         """Line of `path`, or of its closest ancestor that has one."""
@@ -195,6 +196,10 @@ def _build(
                     line=key_node.start_mark.line + 1,
                 )
             key = str(key) if not isinstance(key, str) else key
+            if key in out and doc.merge_duplicates:
+                later = _build(value_node, loader, (*path, key), doc, flow_sets)
+                out[key] = _merged(out[key], later)
+                continue
             if key in out:
                 raise InputError(
                     f"duplicate key {key!r}",
@@ -207,6 +212,16 @@ def _build(
     raise InputError("unsupported YAML node", file=doc.source)  # pragma: no cover
 
 
+def _merged(first: Any, later: Any) -> Any:
+    """A repeated key as rcl's parameter parser reads it: mappings merged, else the later."""
+    if isinstance(first, dict) and isinstance(later, dict):
+        out = dict(first)
+        for k, v in later.items():
+            out[k] = _merged(out[k], v) if k in out else v
+        return out
+    return later
+
+
 def _dotted(path: Path_) -> str:
     out = ""
     for part in path:
@@ -217,8 +232,14 @@ def _dotted(path: Path_) -> str:
 dotted = _dotted
 
 
-def loads_yaml(text: str, source: str = "<string>", *, flow_sets: bool = False) -> YamlDoc:
-    """Parse one YAML document from text under armcli's safety rules."""
+def loads_yaml(
+    text: str, source: str = "<string>", *, flow_sets: bool = False, merge_duplicates: bool = False
+) -> YamlDoc:
+    """Parse one YAML document from text under armcli's safety rules.
+
+    `merge_duplicates`: a repeated key is merged as ROS 2 reads parameter files (rcl's
+    parser: `/**:` twice in one file is one node's parameters) instead of refused.
+    """
     if len(text.encode("utf-8", "surrogatepass")) > MAX_YAML_BYTES:
         raise InputError(f"file larger than {MAX_YAML_BYTES} bytes", file=source)
     if "\x00" in text:
@@ -226,7 +247,7 @@ def loads_yaml(text: str, source: str = "<string>", *, flow_sets: bool = False) 
     text = _ECHO_END.sub("\n", text)  # one message saved from `ros2 topic echo`
     _scan_events(text, source)
     loader = _Loader(text)
-    doc = YamlDoc(data=None, source=source)
+    doc = YamlDoc(data=None, source=source, merge_duplicates=merge_duplicates)
     try:
         node = loader.get_single_node()
         if node is not None:

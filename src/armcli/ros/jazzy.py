@@ -14,8 +14,10 @@ files); `ros_package` puts it into packages. The course xacro parts
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
+import yaml
 from lxml import etree
 
 from armcli.compiler.ros2_control import joint_block
@@ -33,6 +35,7 @@ from armcli.compiler.xmlfmt import XACRO_NS, fmt, to_bytes
 from armcli.errors import InputError
 from armcli.ros import interfaces
 from armcli.ros import moveit as mc
+from armcli.ros.holding import START_TOLERANCE, Integral
 from armcli.ros.interfaces import GAIN_INTERFACES, JAZZY
 from armcli.ros.launch import render
 from armcli.ros.srdf import chain_joints
@@ -65,7 +68,7 @@ MOVEIT_DEPENDS = ["launch", "launch_ros"]  # gz_move_group.launch.py imports the
 EXECUTION = {
     "allowed_execution_duration_scaling": 1.2,
     "allowed_goal_duration_margin": 0.5,
-    "allowed_start_tolerance": 0.01,
+    "allowed_start_tolerance": START_TOLERANCE,
 }
 
 
@@ -225,6 +228,12 @@ def bridge(spec: RobotSpec) -> list[dict[str, Any]]:
     return out
 
 
+def bridge_yaml(spec: RobotSpec, note: str) -> bytes:
+    """ros_gz_bridge's config file: a YAML list of topic entries (`bridge`)."""
+    body = yaml.dump(bridge(spec), Dumper=mc.Dumper, sort_keys=False, default_flow_style=False)
+    return ("".join(f"# {line}\n" for line in note.splitlines()) + body).encode("utf-8")
+
+
 def description_xacros(spec: RobotSpec, bringup_pkg: str, header: str) -> dict[str, bytes]:
     """urdf/ name -> bytes of the Jazzy top-level xacro files."""
     out = {STANDALONE: top_xacro(spec, bringup_pkg, whole=False, header=header)}
@@ -233,13 +242,19 @@ def description_xacros(spec: RobotSpec, bringup_pkg: str, header: str) -> dict[s
     return out
 
 
-def controllers(spec: RobotSpec, source: str | None = None) -> dict[str, Any]:
+def controllers(
+    spec: RobotSpec,
+    source: str | None = None,
+    holding: Mapping[str, Integral] | None = None,
+) -> dict[str, Any]:
     """controller_manager + joint_state_broadcaster + an effort JointTrajectoryController.
 
     JTC's effort law is `ff_velocity_scale * v_ref + PID(q_ref - q, v_ref - v)`; with
     ff_velocity_scale 0 and PID gains p = Kp, d = Kd, i = Ki this is the spec's
     `Kp (q_ref - q) + Kd (v_ref - v) [+ Ki integral]`, the loop `simulate` runs.
-    i_clamp bounds the integral torque by the effort limit (0 when Ki is 0).
+    `holding` (ros/holding.py) adds the integral term that keeps the arm at its named
+    poses when the spec's PD alone sags more than MoveIt's start tolerance. i_clamp bounds
+    the integral torque by the effort limit (0 without an integral term).
     """
     gains = required_gains(spec, source)
     chain = chain_joints(spec)
@@ -256,11 +271,12 @@ def controllers(spec: RobotSpec, source: str | None = None) -> dict[str, Any]:
     for name, g in gains.items():
         lim = joints[name].limit
         clamp = float(lim.effort) if (lim is not None and g.ki > 0) else 0.0
+        extra = (holding or {}).get(name)
         pid[name] = {
             "p": float(g.kp),
             "d": float(g.kd),
-            "i": float(g.ki),
-            "i_clamp": clamp,
+            "i": float(extra.i if extra is not None else g.ki),
+            "i_clamp": float(extra.i_clamp) if extra is not None else clamp,
             "ff_velocity_scale": 0.0,
         }
     arm: dict[str, Any] = {

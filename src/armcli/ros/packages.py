@@ -16,7 +16,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
 from lxml import etree
 
 from armcli.compiler.meshfiles import MeshNames, package_of, spec_mesh_names
@@ -35,6 +34,7 @@ from armcli.ros.collision_matrix import (
     compute_collision_matrix,
 )
 from armcli.ros.copying import mesh_files
+from armcli.ros.holding import Integral, integral_terms
 from armcli.ros.jazzy_readme import readme as jazzy_readme
 from armcli.ros.launch import render
 from armcli.ros.ros2_control import moveit_urdf_xacro, ros2_control_xacro
@@ -324,7 +324,7 @@ def ros_packages(
     )
     note = GENERATED.format(spec=label)
     if target == "jazzy":
-        files = jazzy_files(spec, n, label, info, source)
+        files = jazzy_files(spec, n, label, info, source, integral_terms(spec, urdf_xml))
     else:
         files = {**description_files(spec, n, label, info), **bringup_files(n, note, info)}
     files.update(moveit_files(spec, n, urdf_xml, matrix, note, info, target))
@@ -332,9 +332,14 @@ def ros_packages(
 
 
 def jazzy_files(
-    spec: RobotSpec, n: Names, label: str, info: PackageInfo, source: str | None
+    spec: RobotSpec,
+    n: Names,
+    label: str,
+    info: PackageInfo,
+    source: str | None,
+    holding: Mapping[str, Integral] | None = None,
 ) -> dict[str, bytes]:
-    """Description (course xacro + Jazzy top levels) and the Gazebo Harmonic bringup."""
+    """Description (course xacro + Jazzy top levels), Gazebo Harmonic bringup (`holding`)."""
     note = GENERATED.format(spec=label)
     tops = jazzy.description_xacros(spec, n.bringup, note)
     whole = jazzy.TOP.format(name=n.robot)
@@ -351,9 +356,9 @@ def jazzy_files(
     }
     files = {
         f"config/{jazzy.controllers_file(n.robot)}": mc.dump_yaml(
-            jazzy.controllers(spec, source), note
+            jazzy.controllers(spec, source, holding), note
         ),
-        f"config/{jazzy.bridge_file(n.robot)}": _bridge_yaml(jazzy.bridge(spec), note),
+        f"config/{jazzy.bridge_file(n.robot)}": jazzy.bridge_yaml(spec, note),
         f"launch/{launch}": jazzy.bringup_launch(values, note),
         "README.md": jazzy_readme(spec, n.bringup, launch, n.moveit, note),
     }
@@ -362,12 +367,6 @@ def jazzy_files(
         **description_files(spec, n, label, info, tops),
         **_package(n.bringup, about, [n.description, *jazzy.BRINGUP_DEPENDS], files, info),
     }
-
-
-def _bridge_yaml(entries: list[dict[str, Any]], note: str) -> bytes:
-    """ros_gz_bridge's config file: a YAML list of topic entries."""
-    body = yaml.dump(entries, Dumper=mc.Dumper, sort_keys=False, default_flow_style=False)
-    return ("".join(f"# {line}\n" for line in note.splitlines()) + body).encode("utf-8")
 
 
 def write_ros_packages(

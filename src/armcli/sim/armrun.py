@@ -17,11 +17,16 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from armcli.errors import InputError
+from armcli.io.scene import Scene
 from armcli.sim import job as simjob
 from armcli.sim import precheck, tipping
 from armcli.sim.job import SimJob
 from armcli.sim.options import SimOptions
+from armcli.sim.sensors.armsense import arm_readings, arm_sensors, sensor_steps
+from armcli.sim.sensors.messages import channels as sensor_channels
+from armcli.sim.sensors.reading import Reading
 from armcli.sim.simulate import SimResult
+from armcli.sim.world import load_world
 from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import MeshSearch
 
@@ -30,6 +35,7 @@ if TYPE_CHECKING:
     from armcli.analysis.zmp import ZmpSeries
     from armcli.sim.tipping import Tipping, ZmpReport
     from armcli.spec.model import RobotSpec
+    from armcli.spec.sensors import Sensor
 
 Gate = Callable[[Urdf], None]  # refuses a model (ModelRefusedError): check's error rules
 Progress = Callable[[int, int], None]
@@ -47,6 +53,7 @@ class ArmRun:
     notes: tuple[str, ...] = ()  # `note: ...` lines: what the job's set-up decided
     balance_notes: tuple[str, ...] = ()  # why there is no zero-moment point (fixed base)
     warnings: tuple[str, ...] = ()  # what the trajectory asks that the arm cannot do
+    readings: tuple[Reading, ...] = ()  # the sensors on the arm (sim.sensors.armsense)
 
     def files(self, output: Path | None, plot: Path | None) -> dict[Path, bytes]:
         """The states file (.csv, .json, .mcap) and the tracking plot, as bytes by path."""
@@ -55,7 +62,8 @@ class ArmRun:
         files: dict[Path, bytes] = {}
         res, job = self.result, self.job
         if output is not None and rosbag.is_mcap(output):
-            files[output] = rosbag.run_mcap_bytes(res, job.rate, job.urdf)
+            files[output] = rosbag.run_mcap_bytes(res, job.rate, job.urdf,
+                                                  sensor_channels(self.readings))  # fmt: skip
         elif output is not None:
             cols = states.sample_states(res, job.rate)
             if self.series is not None:
@@ -76,11 +84,14 @@ def run_balanced(
     *,
     plot: bool = False,
     every_step: bool = False,
+    also: Callable[[int], np.ndarray] | None = None,
 ) -> ArmRun:
-    """Run `job`, keeping the steps `tip` needs (and every step with `every_step`)."""
+    """Run `job`, keeping the steps `tip`, `also` (the sensors) and `every_step` need."""
 
     def keep(steps: int) -> np.ndarray:
         out = np.arange(steps + 1) if every_step else np.zeros(0, dtype=np.int64)
+        if also is not None:
+            out = np.union1d(out, also(steps))
         return out if tip is None else np.union1d(out, tip.steps(job, steps))
 
     res = simjob.run(job, progress, plot=plot, extra=keep)
@@ -120,6 +131,7 @@ def simulate_arm(
     balance_gate: Gate | None = None,
     progress: Progress | None = None,
     plot: bool = False,
+    world: Path | Scene | None = None,
 ) -> ArmRun:
     """Prepare and run `opts` (the spec's arm, or `opts.urdf`) with its zero-moment point.
 
@@ -127,6 +139,8 @@ def simulate_arm(
     `balance_gate` refuses the whole robot when only its balance is at stake (the base's
     links are not simulated). InputError (`SimOptions.trajectory`/`message`) for a
     reference faster than a velocity limit; the effort limits gravity exceeds are warnings.
+    The spec's sensors on the arm's links are sampled from the run (sim.sensors.armsense),
+    among `world`'s objects (seen, not touched).
     """
     job = simjob.prepare(spec, opts, gate=gate)
     whole = tipping.robot_urdf(spec, job)  # parsed once: the gate and the balance read it
@@ -140,8 +154,26 @@ def simulate_arm(
     tip = tipping.prepare(spec, job, balance or tipping.TipOptions(), search or MeshSearch(),
                           notes, whole)  # fmt: skip
     warnings = (*precheck.holding_problems(job), *job.trajectory.warnings)
-    run = run_balanced(job, tip, progress, plot=plot)
-    return replace(run, notes=job.notes, balance_notes=tuple(notes), warnings=warnings)
+    sensors, scene = _arm_sensing(spec, opts, job, world)
+    also = (lambda steps: sensor_steps(sensors, steps, job.config.dt)) if sensors else None
+    run = run_balanced(job, tip, progress, plot=plot, also=also)
+    readings: tuple[Reading, ...] = ()
+    if sensors and job.urdf is not None:
+        readings, sensor_notes = arm_readings(job.urdf, run.result, sensors, scene)
+        warnings = (*warnings, *sensor_notes)
+    return replace(run, notes=job.notes, balance_notes=tuple(notes), warnings=warnings,
+                   readings=readings)  # fmt: skip
+
+
+def _arm_sensing(
+    spec: RobotSpec | None, opts: SimOptions, job: SimJob, world: Path | Scene | None
+) -> tuple[dict[str, Sensor], Scene | None]:
+    """The spec's sensors the simulated arm carries, and the world they see (read here)."""
+    if spec is None or opts.urdf is not None or job.urdf is None:
+        return {}, None
+    if isinstance(world, Path):
+        world = load_world(world, [lk.name for lk in job.urdf.links])
+    return arm_sensors(spec.sensors, job.urdf), world
 
 
 def _refuse_too_fast(job: SimJob, opts: SimOptions) -> None:

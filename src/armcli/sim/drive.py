@@ -16,8 +16,8 @@ are computed from them after the run (sim.liftoff), the outputs by sim.driveout.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
-from dataclasses import dataclass, replace
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -32,6 +32,8 @@ from armcli.sim.diffdrive import DiffDriveController, DriveParams, Odometry, enc
 from armcli.sim.drivemodel import DriveModel, build_drive_model
 from armcli.sim.job import SimJob
 from armcli.sim.options import SimOptions
+from armcli.sim.sensors.reading import Reading
+from armcli.sim.sensors.rig import make_rig
 from armcli.sim.simulate import steps_of
 from armcli.sim.tipping import robot_urdf
 from armcli.sim.wheelmotor import clutch_torque, spin
@@ -40,6 +42,7 @@ from armcli.urdf.doc import Urdf
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
+    from armcli.spec.sensors import Sensor
 
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last command or trajectory point by default
 MAX_DRIVE_STEPS = 600_000  # every step's sensors are kept: ~150 MB for the course robot
@@ -57,6 +60,7 @@ class DriveJob:
     stance: Stance  # the whole robot on its contacts (static tipping angle)
     robot: Urdf  # the whole robot's URDF (MCAP /robot_description, replay)
     duration: float  # [s]
+    sensors: Mapping[str, Sensor] = field(default_factory=dict)  # simulated (sim.sensors)
 
     @property
     def dt(self) -> float:
@@ -71,13 +75,14 @@ def prepare(
     *,
     gate: Callable[[Urdf], None] | None = None,
     world: Path | Scene | None = None,
+    sensors: bool = True,
 ) -> DriveJob:
     """Validate the inputs and build the model; InputError names what is wrong.
 
     Without a trajectory the arm holds its start pose. `gate` sees the whole robot's URDF
     first and may refuse it (the command passes check.gate.refuse_check_errors). `world`:
     a scene file (or its Scene) whose objects the robot drives among (sim.world); one the
-    robot stands in at the start is refused.
+    robot stands in at the start is refused. `sensors`: simulate the spec's sensors.
     """
     params = DriveParams.of(spec)
     cmd = load_cmd_vel(cmd_vel)
@@ -114,7 +119,8 @@ def prepare(
     )
     if world is not None:
         refuse_overlaps(model.model, start_data(model, job.q0), model.world, world.source)
-    return DriveJob(job, cmd, params, model, stance, robot, float(duration))
+    kept = dict(spec.sensors) if sensors else {}
+    return DriveJob(job, cmd, params, model, stance, robot, float(duration), kept)
 
 
 def start_data(dm: DriveModel, q0: np.ndarray) -> Any:
@@ -150,6 +156,8 @@ class DriveRun:
     wheel_command: np.ndarray  # (N + 1, 2) [rad/s] the joint speeds the plugin set
     odometry: Odometry
     wall_time: float  # [s] spent stepping
+    readings: tuple[Reading, ...] = ()  # the sensors' (sim.sensors)
+    notes: tuple[str, ...] = ()  # what the sensors could not do
 
     @property
     def steps(self) -> int:
@@ -191,7 +199,7 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
     elapsed = np.diff(now, prepend=0.0)  # the plugin's seconds_since_last_update
     is_update = np.zeros(steps + 1, dtype=bool)
     is_update[updates] = True
-    rec = np.empty((steps + 1, dm.layout.size))
+    rec = np.empty((steps + 1, m.nsensordata))  # the Layout's, then the sensors' (IMU)
     wheel_cmd = np.zeros((steps + 1, 2))
     controller = DiffDriveController(job.params)
     wheel_dof, rotor, wheel_force = dm.wheel_dof, dm.wheel_rotor, dm.layout.wheel_force
@@ -201,6 +209,8 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
     arm_act = slice(int(act[0]), int(act[-1]) + 1) if _contiguous(act) else act
     arm_qpos = dm.arm_qpos
     ctrl, u, command = d.ctrl, 0, np.zeros(2)
+    rig = make_rig(job.sensors, m, steps, job.dt)
+    due, sample = rig.due.tolist(), rig.sample
     start = time.perf_counter()
     for k in range(steps):
         if is_update[k]:
@@ -215,16 +225,21 @@ def run(job: DriveJob, progress: Callable[[int, int], None] | None = None) -> Dr
         mujoco.mj_step(m, d)
         rec[k] = d.sensordata
         rec[k, wheel_force] = -d.qfrc_constraint[rotor]  # sim.wheelmotor.clutch_torque
+        if due[k]:
+            sample(k, m, d)
         if progress is not None and k % PROGRESS_STEPS == 0 and k:
             progress(k, steps)
     mujoco.mj_forward(m, d)
     rec[steps], wheel_cmd[steps] = d.sensordata, command
     rec[steps, wheel_force] = clutch_torque(d, rotor)
+    if due[steps]:
+        sample(steps, m, d)
     wall = time.perf_counter() - start
     _refuse_reset(d, rec, job.dt)
     wl = rec[:-1, dm.layout.wheel_vel]
     odom = encoder_odometry(wl[:, 0], wl[:, 1], job.dt, job.params.radius, job.params.separation)
-    return DriveRun(job, t, rec, q_ref, v_ref, wheel_cmd, odom, wall)
+    return DriveRun(job, t, rec, q_ref, v_ref, wheel_cmd, odom, wall,
+                    rig.readings(job.dt, rec), rig.notes)  # fmt: skip
 
 
 def _refuse_reset(d: Any, rec: np.ndarray, dt: float) -> None:

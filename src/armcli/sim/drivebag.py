@@ -3,7 +3,9 @@
 /joint_states with the wheels, /odom (nav_msgs/msg/Odometry: the plugin's encoder
 odometry at each output time, its covariance), /cmd_vel (geometry_msgs/msg/Twist at each
 command's time) and in /tf `odom -> base` plus `world -> odom`: the drift a perfect
-localiser would remove, so that `world -> base` is the ground truth (as map -> odom in ROS).
+localiser would remove, so that `world -> base` is the ground truth (as map -> odom in ROS);
+then the sensors' topics (sim.sensors.messages) and, latched, the world's objects on
+`/world` (visualization_msgs/msg/MarkerArray, sim.world).
 """
 
 from __future__ import annotations
@@ -15,13 +17,16 @@ import numpy as np
 
 from armcli.robot.frames import matrix_quaternion, pose_matrix, yaw_quaternion
 from armcli.sim import rosbag
-from armcli.sim.drive import DriveRun
+from armcli.sim.drive import DriveRun, start_data
+from armcli.sim.sensors.messages import channels as sensor_channels
 from armcli.sim.states import TIME, sample_steps
+from armcli.sim.world import marker_array
 
 WORLD = rosbag.WORLD
 ODOMETRY = "nav_msgs/msg/Odometry"
 TWIST = "geometry_msgs/msg/Twist"
 ODOM, CMD_VEL = "/odom", "/cmd_vel"
+MARKER_ARRAY, WORLD_TOPIC = "visualization_msgs/msg/MarkerArray", "/world"
 # the plugin's covariance (x, y, yaw), its defaults; 1e12 for the unobserved z, roll, pitch
 COVARIANCE = {0: 1e-5, 7: 1e-5, 14: 1e12, 21: 1e12, 28: 1e12, 35: 1e-3}
 
@@ -50,6 +55,12 @@ def mcap_bytes(run: DriveRun, cols: dict[str, np.ndarray], rate: float) -> bytes
     k = sample_steps(run.steps, job.dt, rate)
     chans.append(rosbag.Channel(ODOM, ODOMETRY, rosbag.qos(10, False), _odometry(run, k, stamps)))
     chans.append(rosbag.Channel(CMD_VEL, TWIST, rosbag.qos(10, False), _cmd_vel(run)))
+    chans += sensor_channels(run.readings)
+    if job.model.world:
+        data = start_data(job.model, job.arm.q0)
+        world = marker_array(job.model.model, data, job.model.world)
+        chans.append(rosbag.Channel(WORLD_TOPIC, MARKER_ARRAY, rosbag.qos(1, True),
+                                    [(stamps[0], world)]))  # fmt: skip
     return rosbag.mcap_bytes(chans)
 
 

@@ -20,6 +20,8 @@ collision geoms, the arm's `position` actuators (Kp, Kd, effort limit) and Gazeb
   with its clutch torque, which no sensor reads), the root body's pose, and per
   ground-contact link its normal force (a `touch` site enclosing the link's geoms)
   and its height;
+- the spec's sensors (sim.sensors.model): a site each, an IMU's MuJoCo sensors after
+  the drive's, a camera's MuJoCo camera;
 - the world's objects of a scene file (sim.world), static bodies with contact.
 """
 
@@ -37,6 +39,7 @@ from armcli.export.mjcf import FREE_JOINT, build_mjcf
 from armcli.export.mjcf_scene import FLOOR_FRICTION
 from armcli.io.scene import Scene
 from armcli.sim.diffdrive import DriveParams
+from armcli.sim.sensors.model import add_sensors
 from armcli.sim.wheelmotor import add_wheel_motors, rotor_dofs
 from armcli.sim.world import WorldGeom, add_scene
 from armcli.urdf.doc import Urdf
@@ -123,6 +126,7 @@ def build_drive_model(
     motor_notes = add_wheel_motors(ms, wheels, params.max_torque, dt)
     driven = _arm_actuators(ms, arm_joints, gains)
     _sensors(ms, root, arm_joints, params, stance.ground.links)
+    add_sensors(ms, getattr(spec, "sensors", {}))  # after the drive's: its Layout holds
     notes = [*_mu2_notes(urdf), *motor_notes]
     geoms = add_scene(ms, world) if world is not None else ()
     model = ms.compile()

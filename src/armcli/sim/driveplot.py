@@ -1,4 +1,7 @@
-"""A drive run's plot: the tracking plot with the path seen from above and the wheel loads."""
+"""A drive run's plot: the tracking plot with the path seen from above and the wheel loads.
+
+With a world or a lidar, a last row shows one scan over the world (sim.sensors.plot).
+"""
 
 from __future__ import annotations
 
@@ -17,7 +20,14 @@ def plot_png(run: DriveRun, res: SimResult, verdict_: TipVerdict) -> bytes:
     from armcli.sim.plot import tracking_png
 
     title = f"armcli simulate --cmd-vel (MuJoCo, dt = {res.dt:g} s)"
-    return tracking_png(res, run.job.arm.robot.effort, _drive_rows(run, verdict_), 2, title)
+    rows = 4 if _has_scene(run) else 2  # the scan seen from above takes two rows
+    return tracking_png(res, run.job.arm.robot.effort, _drive_rows(run, verdict_), rows, title)
+
+
+def _has_scene(run: DriveRun) -> bool:
+    from armcli.sim.sensors.plot import pick_scan
+
+    return bool(run.job.model.world) or pick_scan(run.readings) is not None
 
 
 def _drive_rows(run: DriveRun, verdict_: TipVerdict) -> Callable[[Sequence[Any]], None]:
@@ -26,16 +36,18 @@ def _drive_rows(run: DriveRun, verdict_: TipVerdict) -> Callable[[Sequence[Any]]
     window = max(1, round(LOAD_WINDOW_S / job.dt))
 
     def wide(row: Sequence[Any]) -> Any:
-        """One axes across the figure in place of a row's per-joint axes."""
-        spec = row[0].get_subplotspec()
-        grid, fig = spec.get_gridspec(), row[0].figure
+        """One axes across the figure in place of the per-joint axes of the rows given."""
+        first, last = row[0].get_subplotspec(), row[-1].get_subplotspec()
+        grid, fig = first.get_gridspec(), row[0].figure
         for a in row:
             a.remove()
-        return fig.add_subplot(grid[spec.rowspan.start, :])
+        return fig.add_subplot(grid[first.rowspan.start : last.rowspan.stop, :])
 
     def draw(axes: Sequence[Any]) -> None:
-        half = len(axes) // 2
-        ax, load = wide(axes[:half]), wide(axes[half:])
+        n = len(axes) // (4 if _has_scene(run) else 2)
+        ax, load = wide(axes[:n]), wide(axes[n : 2 * n])
+        if len(axes) > 2 * n:
+            _scan_row(wide(axes[2 * n :]), run)
         pos = s[::step, L.base_pos]
         ax.plot(pos[:, 0], pos[:, 1], color="C0", lw=1.5, label=f"truth ({job.params.base_frame})")
         ax.plot(run.odometry.x[::step], run.odometry.y[::step], "--", color="C1", lw=1.2,
@@ -62,3 +74,13 @@ def _drive_rows(run: DriveRun, verdict_: TipVerdict) -> Callable[[Sequence[Any]]
         load.grid(True, alpha=0.3)
 
     return draw
+
+
+def _scan_row(ax: Any, run: DriveRun) -> None:
+    from armcli.sim.drive import start_data
+    from armcli.sim.sensors.plot import draw_scan
+
+    job = run.job
+    data = start_data(job.model, job.arm.q0)
+    path = run.sensors[:, job.model.layout.base_pos][:, :2]
+    draw_scan(ax, job.model.model, data, job.model.world, path, run.readings)

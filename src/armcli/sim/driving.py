@@ -64,10 +64,12 @@ def drive_robot(
     gate: Callable[[Urdf], None] | None = None,
     progress: Callable[[int, int], None] | None = None,
     world: Path | Scene | None = None,
+    sensors: bool = True,
 ) -> Driven:
     """Drive the spec's whole robot by the /cmd_vel commands in `cmd_vel` (sim.drive).
 
-    `world`: a scene file (or Scene) of obstacles in the world frame (sim.world).
+    `world`: a scene file (or Scene) of obstacles in the world frame (sim.world);
+    `sensors`: simulate the spec's sensors (sim.sensors).
     """
     if spec is None or opts.urdf is not None:
         raise InputError(
@@ -75,8 +77,9 @@ def drive_robot(
             "`SimOptions.urdf`",
             field="cmd_vel",
         )
-    job = drive.prepare(spec, opts, cmd_vel, gate=gate, world=world)
+    job = drive.prepare(spec, opts, cmd_vel, gate=gate, world=world, sensors=sensors)
     warnings = (*job.arm.trajectory.warnings, *job.cmd.warnings, *job.model.notes)
     run = drive.run(job, progress)
+    warnings = (*warnings, *run.notes)
     arm = driveout.arm_result(run, driveout.plot_steps_of(run.steps, job.dt, job.arm.rate))
     return Driven(job, run, arm, driveout.tip_verdict(run), warnings)

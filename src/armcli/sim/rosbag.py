@@ -172,12 +172,15 @@ def _joint_state(ns: int, names: Sequence[str], **arrays: Sequence[float]) -> di
 
 @dataclass(frozen=True)
 class Channel:
-    """One topic: its type, QoS and the (log time [ns], message) pairs written on it."""
+    """One topic: its type, QoS and the (log time [ns], message) pairs written on it.
+
+    A message is a dict (serialised by mcap_ros2) or its CDR bytes already (sim.sensors.cdr).
+    """
 
     topic: str
     datatype: str
     qos: str
-    messages: list[tuple[int, dict[str, Any]]]
+    messages: list[tuple[int, Any]]  # (log time [ns], a dict or CDR bytes)
 
 
 def channels(cols: Mapping[str, np.ndarray], names: Sequence[str], urdf: Urdf) -> list[Channel]:
@@ -240,24 +243,26 @@ def mcap_bytes(chans: Sequence[Channel]) -> bytes:
             )
         )
     for ns, rank, k, msg in sorted(_messages(chans), key=lambda m: m[:3]):
-        data = encoders[chans[rank].datatype](msg)
+        data = msg if isinstance(msg, bytes) else encoders[chans[rank].datatype](msg)
         writer.add_message(ids[rank], log_time=ns, data=data, publish_time=ns, sequence=k)
     writer.finish()  # type: ignore[no-untyped-call]
     return buf.getvalue()
 
 
-def _messages(chans: Sequence[Channel]) -> Iterator[tuple[int, int, int, dict[str, Any]]]:
+def _messages(chans: Sequence[Channel]) -> Iterator[tuple[int, int, int, Any]]:
     for rank, ch in enumerate(chans):
         for k, (ns, msg) in enumerate(ch.messages):
             yield ns, rank, k, msg
 
 
-def run_mcap_bytes(res: SimResult, rate: float, urdf: Urdf | None) -> bytes:
-    """The run sampled at `rate` [Hz] as the bytes of a rosbag2 MCAP file."""
+def run_mcap_bytes(
+    res: SimResult, rate: float, urdf: Urdf | None, extra: Sequence[Channel] = ()
+) -> bytes:
+    """The run sampled at `rate` [Hz] (and `extra` topics) as the bytes of an MCAP file."""
     if urdf is None:
         raise ValueError("an MCAP file needs the simulated robot description")
     cols = sample_states(res, rate)
-    return mcap_bytes(channels(cols, res.joint_names, urdf))
+    return mcap_bytes([*channels(cols, res.joint_names, urdf), *extra])
 
 
 def write_mcap(path: Path, res: SimResult, rate: float, urdf: Urdf | None) -> None:

@@ -169,3 +169,58 @@ def refuse_overlaps(model: Any, data: Any, geoms: Sequence[WorldGeom], source: s
             "(the world's frame is odom at the start: the robot's root at the origin)",
             file=source,
         )
+
+
+# -- the world as visualization_msgs/MarkerArray (the MCAP's /world) ---------------------------
+
+MARKERS = {
+    "box": 1,
+    "sphere": 2,
+    "cylinder": 3,
+    "mesh": 11,
+}  # CUBE, SPHERE, CYLINDER, TRIANGLE_LIST
+
+
+def marker_array(model: Any, data: Any, geoms: Sequence[WorldGeom]) -> dict[str, Any]:
+    """The world's objects as a MarkerArray message: in `world`, or on their link.
+
+    Each geom's pose is MuJoCo's (a mesh in its own frame, which MuJoCo may have moved to
+    the mesh's centre), so Foxglove and RViz draw exactly what the sensors see.
+    """
+    import mujoco
+
+    out = []
+    for i, g in enumerate(geoms):
+        gid = model.geom(g.name).id
+        kind = mujoco.mjtGeom(model.geom_type[gid]).name[len("mjGEOM_") :].lower()
+        if g.frame:  # on a link: its pose in the link's body, the marker follows the link
+            pos, quat = model.geom_pos[gid], model.geom_quat[gid]
+        else:
+            pos, quat = data.geom_xpos[gid], np.zeros(4)
+            mujoco.mju_mat2Quat(quat, data.geom_xmat[gid])
+        size = model.geom_size[gid]
+        d = 2 * size
+        scale = {"box": d, "sphere": [d[0]] * 3, "cylinder": [d[0], d[0], d[1]]}.get(kind, [1] * 3)
+        r, gr, b, a = (float(c) for c in model.geom_rgba[gid])
+        marker = {
+            "header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": g.frame or "world"},
+            "ns": g.object_id, "id": i, "type": MARKERS.get(kind, 11), "action": 0,
+            "pose": {"position": dict(zip("xyz", map(float, pos), strict=True)),
+                     "orientation": dict(zip("wxyz", map(float, quat), strict=True))},
+            "scale": dict(zip("xyz", map(float, scale), strict=True)),
+            "color": {"r": r, "g": gr, "b": b, "a": a},
+            "frame_locked": bool(g.frame),
+            "points": _triangles(model, gid) if kind == "mesh" else [],
+        }  # fmt: skip
+        out.append(marker)
+    return {"markers": out}
+
+
+def _triangles(model: Any, gid: int) -> list[dict[str, float]]:
+    """A mesh geom's triangles as a TRIANGLE_LIST's points, in the geom's frame."""
+    mesh = int(model.geom_dataid[gid])
+    v0, nv = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
+    f0, nf = int(model.mesh_faceadr[mesh]), int(model.mesh_facenum[mesh])
+    verts = model.mesh_vert[v0 : v0 + nv]
+    corners = verts[model.mesh_face[f0 : f0 + nf].reshape(-1)]
+    return [{"x": float(x), "y": float(y), "z": float(z)} for x, y, z in corners]

@@ -29,6 +29,8 @@ class ExampleTemplate:
     trajectories: str  # directory under examples/ with this robot's trajectories
     pose: str  # a named pose of the spec, for the README's render command
     about: str  # one sentence for the README
+    extras: str | None = None  # directory under examples/ whose files go beside the spec
+    more: str = ""  # more README lines (commands the template is for)
 
 
 TEMPLATES = {
@@ -37,6 +39,20 @@ TEMPLATES = {
         trajectories="trajectories",
         pose="reach",
         about="the ROS 2 for Beginners course robot: a 2-axis arm on a differential-drive base.",
+    ),
+    "rover": ExampleTemplate(
+        spec="rover.yaml",
+        trajectories="trajectories/rover",
+        pose="reach",
+        about="the course robot with a 2-D lidar, a depth camera and an IMU, and a world of "
+        "boxes to drive it through (world.yaml; Foxglove: foxglove_layout.json).",
+        extras="rover",
+        more=(
+            "\nDrive it among the boxes with its sensors on, then replay the run (scans and "
+            "point clouds drawn)\nor open run.mcap in Foxglove with foxglove_layout.json:\n\n"
+            "```bash\narmcli simulate --cmd-vel trajectories/drive.yaml --world world.yaml "
+            "-o run.mcap --plot drive.png\narmcli view --replay run.mcap\n```\n"
+        ),
     ),
     "tabletop": ExampleTemplate(
         spec="tabletop_arm.yaml",
@@ -66,6 +82,9 @@ def template_files(name: str) -> dict[str, bytes]:
     )
     for f in trajectories:
         files[(TRAJECTORY_DIR / f.name).as_posix()] = f.read_bytes()
+    if t.extras is not None:
+        for f in sorted(examples.joinpath(t.extras).iterdir(), key=lambda f: f.name):
+            files[f.name] = f.read_bytes()
     readme = Template(resources.files("armcli").joinpath("data", "init_readme.md.tmpl").read_text())
     files[README] = readme.substitute(
         name=Path(t.spec).stem,
@@ -75,6 +94,7 @@ def template_files(name: str) -> dict[str, bytes]:
         pose=t.pose,
         pick=(TRAJECTORY_DIR / "pick.yaml").as_posix(),
         trajectories=", ".join(_listed(f.name, f.read_text("utf-8")) for f in trajectories),
+        more=t.more,
     ).encode("utf-8")
     return files
 

@@ -3,7 +3,8 @@
 One description per sensor (where, how often, what it sees, how noisy, which topic),
 compiled for Gazebo classic (gazebo_ros sensor plugins, in `build`'s URDF) and for
 Gazebo Harmonic (gz-sim sensors and the ros_gz_bridge configuration of the
-`--target jazzy` bringup).
+`--target jazzy` bringup), and simulated by `simulate` (sim.sensors) from the same
+fields: one source for the tags and the data.
 """
 
 from __future__ import annotations

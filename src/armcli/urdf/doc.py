@@ -154,6 +154,34 @@ class Gazebo:
 
 
 @dataclass(frozen=True)
+class GazeboSensor:
+    """A <sensor> in a top-level <gazebo> (classic or Harmonic), its numbers as written.
+
+    A number that is missing or not a number is None; `rays` and `vertical` are a scan's
+    (samples, min angle, max angle), `range` a lidar's (min, max) and `clip` a camera's
+    (near, far) [m]; `pose` is the sensor's in its link (x y z roll pitch yaw).
+    """
+
+    name: str
+    type: str  # Gazebo's: ray, gpu_ray, lidar, gpu_lidar, camera, depth, depth_camera, imu, ...
+    link: str | None  # the <gazebo reference>
+    line: int | None
+    pose: tuple[float, ...] | None = None
+    update_rate: float | None = None
+    frame: str | None = None  # the plugin's frame_name, or Harmonic's gz_frame_id
+    rays: tuple[float | None, float | None, float | None] | None = None
+    vertical: tuple[float | None, float | None, float | None] | None = None
+    range: tuple[float | None, float | None] | None = None
+    horizontal_fov: float | None = None
+    clip: tuple[float | None, float | None] | None = None
+
+    @property
+    def is_lidar(self) -> bool:
+        """Whether it casts rays (Gazebo's ray, gpu_ray, lidar, gpu_lidar)."""
+        return self.type in ("ray", "gpu_ray", "lidar", "gpu_lidar")
+
+
+@dataclass(frozen=True)
 class Ros2Control:
     """A top-level <ros2_control>: its hardware plugin and the joints' command interfaces."""
 
@@ -192,6 +220,7 @@ class Urdf:
     ros2_control: tuple[Ros2Control, ...] = ()
     transmissions: tuple[Transmission, ...] = ()
     plugins: tuple[Plugin, ...] = ()  # every <plugin>, in document order
+    sensors: tuple[GazeboSensor, ...] = ()  # every <gazebo><sensor>, in document order
 
     def link(self, name: str) -> Link | None:
         """The link called `name`, or None."""

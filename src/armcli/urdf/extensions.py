@@ -1,15 +1,15 @@
 """The simulator extensions of a URDF, read once into urdf/doc.py's types.
 
-`<gazebo>`, `<ros2_control>`, `<transmission>` and every `<plugin>`: what check (the
-servo loop, passive joints), the MJCF export (friction, the tags it cannot carry) and
-the drive model (mu2) read, so none of them parses the XML again.
+`<gazebo>`, `<ros2_control>`, `<transmission>`, every `<plugin>` and every sensor: what
+check (the servo loop, passive joints, the sensors' rules), the MJCF export (friction, the
+tags it cannot carry) and the drive model (mu2) read, so none of them parses the XML again.
 """
 
 from __future__ import annotations
 
 from lxml import etree
 
-from armcli.urdf.doc import Gazebo, Plugin, Ros2Control, Transmission
+from armcli.urdf.doc import Gazebo, GazeboSensor, Plugin, Ros2Control, Transmission
 
 
 def _ln(el: etree._Element) -> int | None:
@@ -64,3 +64,50 @@ def plugins(root: etree._Element) -> tuple[Plugin, ...]:
         Plugin(el.get("filename"), el.get("name"), _first_texts(el), _ln(el))
         for el in root.iter("plugin")
     )
+
+
+def _number(el: etree._Element, path: str) -> float | None:
+    text = el.findtext(path)
+    try:
+        return float(text) if text is not None else None
+    except ValueError:
+        return None
+
+
+def _scan(el: etree._Element, axis: str) -> tuple[float | None, float | None, float | None] | None:
+    """(samples, min angle, max angle) of a ray sensor's horizontal or vertical scan."""
+    for scan in ("ray/scan", "lidar/scan"):
+        node = el.find(f"{scan}/{axis}")
+        if node is not None:
+            return _number(node, "samples"), _number(node, "min_angle"), _number(node, "max_angle")
+    return None
+
+
+def _pair(
+    el: etree._Element, path: str, a: str, b: str
+) -> tuple[float | None, float | None] | None:
+    node = el.find(path)
+    return (_number(node, a), _number(node, b)) if node is not None else None
+
+
+def _sensor(gz: etree._Element, el: etree._Element) -> GazeboSensor:
+    pose_text = (el.findtext("pose") or "").split()
+    try:
+        pose = tuple(float(x) for x in pose_text) if len(pose_text) == 6 else None
+    except ValueError:
+        pose = None
+    frame = el.findtext("gz_frame_id") or el.findtext("plugin/frame_name")
+    rng = _pair(el, "ray/range", "min", "max") or _pair(el, "lidar/range", "min", "max")
+    return GazeboSensor(
+        name=el.get("name", ""), type=el.get("type", ""), link=gz.get("reference"),
+        line=_ln(el), pose=pose, update_rate=_number(el, "update_rate"),
+        frame=frame.strip() if frame else None, rays=_scan(el, "horizontal"),
+        vertical=_scan(el, "vertical"), range=rng,
+        horizontal_fov=_number(el, "camera/horizontal_fov"),
+        clip=_pair(el, "camera/clip", "near", "far"),
+    )  # fmt: skip
+
+
+def sensors(root: etree._Element) -> tuple[GazeboSensor, ...]:
+    """The <sensor> elements of the top-level <gazebo> blocks."""
+    return tuple(_sensor(gz, el) for gz in root.findall("gazebo") for el in gz.findall("sensor"))

@@ -377,6 +377,7 @@ def parse_urdf(data: bytes, source: str) -> Urdf:
         tuple(num.problems),
         _ln(root),
         gazebo=ext.gazebo(root),
+        sensors=ext.sensors(root),
         ros2_control=ext.ros2_control(root),
         transmissions=ext.transmissions(root),
         plugins=ext.plugins(root),

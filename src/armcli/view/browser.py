@@ -25,6 +25,7 @@ from armcli.errors import InputError
 from armcli.io.names import did_you_mean
 from armcli.robot.frames import matrix_quaternion
 from armcli.robot.tool import ToolPoint
+from armcli.sim.sensors.replay import SensorReplay
 from armcli.sim.states import Replay
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_root
@@ -37,6 +38,7 @@ from armcli.view.png import (
     neutral,
     tool_position,
 )
+from armcli.view.sensors import SensorLayer
 
 GHOST_RGBA = (0.35, 0.65, 1.0, 0.35)  # translucent blue for the reference pose
 FRAME_RATE = 30.0  # [Hz] replay updates sent to the browser
@@ -94,6 +96,7 @@ class Viewer:
         poses: Mapping[str, Mapping[str, float]] | None = None,
         tool: ToolPoint | None = None,
         replay: Replay | None = None,
+        sensors: SensorReplay | None = None,
         host: str = "127.0.0.1",
         port: int = 8080,
     ) -> None:
@@ -134,7 +137,9 @@ class Viewer:
                     root_node_name=f"{root}/ghost",
                     mesh_color_override=GHOST_RGBA,
                 )
-            self._build_scene()
+            self._build_scene()  # then the sensors: a world's camera replaces the robot's
+            self._sensors = SensorLayer(self.server, self._urdf, sensors, f"{root}/robot") if (
+                sensors is not None and replay is not None) else None  # fmt: skip
             self._build_gui(name)
             self._apply()
         except BaseException:
@@ -192,6 +197,11 @@ class Viewer:
     def show_frames(self, visible: bool) -> None:
         """Show or hide the link frames, through the GUI checkbox so the page stays in sync."""
         self._frames_box.value = bool(visible)
+
+    @property
+    def sensor_notes(self) -> tuple[str, ...]:
+        """What the replay's sensors could not draw."""
+        return self._sensors.notes if self._sensors is not None else ()
 
     def seek(self, t: float) -> None:
         """Show the replay at time t [s] from the start of the record."""
@@ -319,6 +329,8 @@ class Viewer:
         if pose is not None and self._base is not None:
             self._base.position, self._base.wxyz = tuple(pose[0]), tuple(pose[1])
         self.set_configuration({j: self._in_range(j, v) for j, v in q.items()})
+        if self._sensors is not None:
+            self._sensors.show(t0)
         if self._ghost is not None:
             ref = self._replay.reference_at(t0)
             visible = ref is not None and bool(self._ghost_box.value)
