@@ -35,6 +35,7 @@ from armcli.defaults import STANDALONE_ARM_URDF  # noqa: E402
 from armcli.robot import sampling  # noqa: E402
 from armcli.robot.model import Robot  # noqa: E402
 from armcli.spec.load import load_spec  # noqa: E402
+from armcli.urdf.read import parse_urdf  # noqa: E402
 
 DOFS = (30, 60, 120, 128)
 KP, KD, DAMPING, DT = 5.0, 0.05, 0.01, 1e-3
@@ -70,19 +71,19 @@ def analysis_seconds(spec_path: Path, with_reference: bool) -> tuple[float, floa
     """The stability analysis on check's samples: new, and the old eigenvalue computation."""
     spec = load_spec(spec_path)
     xml = expand_urdfs(spec)[STANDALONE_ARM_URDF].decode()
-    robot = Robot.from_xml(xml, STANDALONE_ARM_URDF)
+    robot = Robot.load(parse_urdf(xml.encode(), STANDALONE_ARM_URDF), strict=False)
     model, ranges = robot.model, robot.joints
     samples = sampling.configurations(robot)
     n = model.nv
     t0 = time.perf_counter()
-    lin = pdloop.linearise(model, [q for _, q in samples])
+    lin = pdloop.linearise(robot, [q for _, q in samples])
     pd = pdloop.PD.of(range(n), [KP] * n, [KD] * n, [DAMPING] * n)
     verdicts.analyse(lin, [[p[r.name] for r in ranges] for p, _ in samples], pd, DT)
     new = time.perf_counter() - t0
     if not with_reference:
         return new, None
     t0 = time.perf_counter()
-    lin = pdloop.linearise(model, [q for _, q in samples], gravity=False)  # M only, as before
+    lin = pdloop.linearise(robot, [q for _, q in samples], gravity=False)  # M only, as before
     Ms, Gs = list(lin.M), list(lin.G)
     kp, d = np.full(n, KP), np.full(n, KD + DAMPING)
     for scheme in ("explicit", "implicit"):

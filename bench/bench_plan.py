@@ -99,11 +99,10 @@ def course() -> None:
 def ik(count: int) -> None:
     ctx = panda_context(None).context
     r = ctx.robot
-    data = r.model.createData()
     rng = np.random.default_rng(SEED)
     times, ok = [], 0
     for k in range(count):
-        p, R = tool_pose(r, data, rng.uniform(r.lower, r.upper))
+        p, R = tool_pose(r, rng.uniform(r.lower, r.upper))
         t0 = time.perf_counter()
         res = solve_ik(r, p, R, seed=k)
         times.append(time.perf_counter() - t0)

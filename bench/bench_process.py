@@ -76,7 +76,7 @@ traj, urdf = Path(sys.argv[1]), Path(sys.argv[2])
 duration, dt = float(sys.argv[3]), float(sys.argv[4])
 opts = SimOptions(trajectory=traj, urdf=urdf, kp=(50.0,), kd=(5.0,), dt=dt, duration=duration)
 job = simjob.prepare(None, opts)
-simulate(job.arm, job.reference, job.q0, job.duration, job.config)
+simulate(job.robot, job.reference, job.q0, job.duration, job.config)
 """
 
 

@@ -14,7 +14,6 @@ import math
 import statistics
 import sys
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -22,19 +21,20 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
-from armcli.robot.load import load_model  # noqa: E402
+from armcli.robot.model import Robot  # noqa: E402
 from armcli.sim import native  # noqa: E402
 from armcli.sim import rollout as ro  # noqa: E402
 from armcli.sim.reference import build_reference  # noqa: E402
 from armcli.sim.simulate import (  # noqa: E402
     Run,
     SimConfig,
-    arm_from_model,
     plant_of,
     simulate,
     simulate_batch,
+    simulated,
 )
 from armcli.sim.trajectory import loads_trajectory  # noqa: E402
+from armcli.urdf.read import read_urdf  # noqa: E402
 
 DT = 1e-3  # [s] the spec's control.dt
 KP, KD = 50.0, 5.0
@@ -50,11 +50,11 @@ TRAJ = (
 
 
 def setup(urdf: Path, friction: bool):
-    arm = arm_from_model(load_model(urdf).model)
+    arm = simulated(Robot.load(read_urdf(urdf)))
     if not friction:
-        arm = replace(arm, friction=np.zeros(2))
-    tr = loads_trajectory(TRAJ, dict.fromkeys(arm.joint_names, (0.0, math.pi / 2)))
-    return arm, build_reference(tr, arm.joint_names, Q0)
+        arm = arm.with_limits(friction=np.zeros(2))
+    tr = loads_trajectory(TRAJ, dict.fromkeys(arm.names, (0.0, math.pi / 2)))
+    return arm, build_reference(tr, arm.names, Q0)
 
 
 def mujoco_model(urdf: Path, friction: bool):

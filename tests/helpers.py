@@ -15,10 +15,13 @@ import subprocess
 import sys
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import pytest
 from hypothesis import strategies as st
+
+if TYPE_CHECKING:
+    from armcli.robot.model import Robot
 
 ROOT = Path(__file__).resolve().parents[1]  # the repository checkout
 SPECS = ROOT / "specs"
@@ -37,6 +40,14 @@ def gains_text(text: str, gains: dict[str, tuple[float, float]]) -> str:
         text, n = re.subn(rf"(\n    {joint}: )\{{kp: [^}}\n]*\}}", line, text)
         assert n == 1, joint
     return text
+
+
+def load_robot(path: Path, *, floating: bool = False, strict: bool = True) -> Robot:
+    """The robot of a URDF file as armcli loads it: the strict reader, then `Robot.load`."""
+    from armcli.robot.model import Robot
+    from armcli.urdf.read import read_urdf
+
+    return Robot.load(read_urdf(path), floating=floating, strict=strict)
 
 
 def course_gains_spec(directory: Path, name: str = "my_robot.yaml") -> Path:

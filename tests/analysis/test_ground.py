@@ -8,7 +8,7 @@ import pytest
 
 from armcli.analysis.ground import Ground, find_ground, has_wheels, mesh_loader
 from armcli.compiler.expand import expand_urdfs
-from armcli.robot.load import load_model
+from armcli.robot.model import Robot
 from armcli.spec.load import load_spec
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.read import parse_urdf
@@ -32,15 +32,15 @@ WHEEL = """<link name="{n}"><collision><origin rpy="1.5707963 0 0"/><geometry>{g
 
 def ground_of(xml: str, tmp: Path | None = None) -> Ground | None:
     urdf = parse_urdf(xml.encode(), str((tmp or Path("/nonexistent")) / "r.urdf"))
-    model = load_model(urdf.source, xml=xml, floating=True).model
+    robot = Robot.load(urdf, floating=True, strict=False)
     missing: list[str] = []
-    return find_ground(urdf, model, mesh=mesh_loader(urdf, MeshSearch(), missing))
+    return find_ground(urdf, robot, mesh=mesh_loader(urdf, MeshSearch(), missing))
 
 
 def test_course_robot_touches_on_its_wheels_and_caster() -> None:
     spec = load_spec(DEFAULT_SPEC)
     urdf = parse_urdf(expand_urdfs(spec)["my_robot.urdf"], "my_robot.urdf")
-    g = find_ground(urdf, load_model("x", xml=urdf.text.decode(), floating=True).model)
+    g = find_ground(urdf, Robot.load(urdf, floating=True, strict=False))
     assert g is not None and has_wheels(g)
     assert g.height == pytest.approx(0.0, abs=TOL)
     got = {c.link: (c.rolling, c.points) for c in g.contacts}

@@ -4,7 +4,6 @@ of a planar two-link arm, and brute-force iteration of the integrator itself."""
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 import pinocchio as pin
@@ -14,10 +13,11 @@ from armcli.analysis import pdloop
 from armcli.analysis import stability as stab
 from armcli.analysis import verdict as verdicts
 from armcli.errors import UnstableLoopError
+from armcli.robot.model import Robot
 from armcli.sim.job import load_arm
-from armcli.sim.simulate import Arm, SimConfig, check_stability
+from armcli.sim.simulate import SimConfig, check_stability
 from armcli.spec.load import load_spec
-from tests.helpers import DEFAULT_SPEC
+from tests.helpers import DEFAULT_SPEC, load_robot
 
 # The course arm (specs/my_robot.yaml): two solid cylinders r = 0.02 m, l = 0.3 m,
 # m = 0.3 kg, hinged at one end, both joints about y; gains Kp = 50, Kd = 5, joint
@@ -118,10 +118,7 @@ def test_suggested_bounds_are_the_stability_edge() -> None:
 def test_pinocchio_crba_matches_the_textbook_matrix(root) -> None:
     import pinocchio as pin
 
-    from armcli.robot.load import load_model
-    from armcli.robot.model import Robot
-
-    robot = Robot(load_model(root / "urdf" / "standalone_arm.urdf").model)
+    robot = load_robot(root / "urdf" / "standalone_arm.urdf")
     model, data = robot.model, robot.data
     for q2 in (0.0, 0.7, math.pi / 2):
         q = robot.q({"arm_base_forearm_joint": 0.3, "forearm_hand_joint": q2})
@@ -134,7 +131,7 @@ def test_pinocchio_crba_matches_the_textbook_matrix(root) -> None:
 
 
 @pytest.fixture(scope="module")
-def seed_arm() -> Arm:
+def seed_arm() -> Robot:
     return load_arm(load_spec(DEFAULT_SPEC), None, None)
 
 
@@ -152,10 +149,10 @@ def _sweep() -> list[tuple[float, float, float, float]]:
 
 @pytest.mark.parametrize(("kp", "kd", "damping", "dt"), _sweep())
 def test_check_verdict_equals_simulate_acceptance(
-    seed_arm: Arm, kp: float, kd: float, damping: float, dt: float
+    seed_arm: Robot, kp: float, kd: float, damping: float, dt: float
 ) -> None:
     """`check`'s implicit-loop verdict and `simulate`'s refusal come from one bound."""
-    arm = replace(seed_arm, damping=np.full(2, damping))
+    arm = seed_arm.with_limits(damping=np.full(2, damping))
     configs = np.array([[a, b] for a in (0.0, 0.8, 1.57) for b in (0.0, 0.8, 1.57)])
     data = arm.model.createData()
     Ms = []

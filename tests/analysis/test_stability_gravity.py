@@ -23,13 +23,12 @@ from armcli.analysis import pdloop
 from armcli.analysis import stability as stab
 from armcli.check.options import CheckOptions
 from armcli.check.run import check_urdf
-from armcli.robot.load import load_model
 from armcli.sim.reference import build_reference
-from armcli.sim.simulate import SimConfig, arm_from_model, simulate
+from armcli.sim.simulate import SimConfig, simulate, simulated
 from armcli.sim.trajectory import loads_trajectory
 from armcli.spec.load import load_spec
 from armcli.urdf.read import read_urdf
-from tests.helpers import FIXTURES
+from tests.helpers import FIXTURES, load_robot
 
 PENDULUM = FIXTURES / "stability" / "pendulum_1cm.urdf"
 # The fixture's numbers (see its header): bob mass, centre-of-mass depth, inertia about the
@@ -44,7 +43,7 @@ SWING_RTOL = 0.02  # the linear invariant against the nonlinear pendulum at ~0.1
 
 @pytest.fixture(scope="module")
 def model():
-    return load_model(PENDULUM).model
+    return load_robot(PENDULUM)
 
 
 def _lin(model, thetas):
@@ -82,13 +81,13 @@ def test_without_gravity_the_bound_ignores_it(model) -> None:
 
 def _swing(model, dt: float, seconds: float) -> np.ndarray:
     """The real simulator (semi-implicit Euler, both engines' step) from 0.05 rad, Kp 0.001."""
-    arm = arm_from_model(model)
+    arm = simulated(model)
     traj = loads_trajectory(
         "joint_names: [swing_joint]\npoints: [{positions: [0.0], time_from_start: 0.01}]",
         {"swing_joint": (-3.0, 3.0)},
     )
     q0 = np.array([SWING_START])
-    ref = build_reference(traj, arm.joint_names, q0)
+    ref = build_reference(traj, arm.names, q0)
     cfg = SimConfig(kp=np.array([0.001]), kd=np.zeros(1), dt=dt, integrator="euler")
     return simulate(arm, ref, q0, seconds, cfg).q[:, 0]
 

@@ -23,9 +23,8 @@ from armcli.check.options import CheckOptions
 from armcli.check.run import check_urdf
 from armcli.errors import UnstableLoopError
 from armcli.robot import sampling
-from armcli.robot.load import load_model
 from armcli.robot.model import Robot
-from armcli.sim.simulate import SimConfig, arm_from_model, check_stability
+from armcli.sim.simulate import SimConfig, check_stability, simulated
 from armcli.spec.load import load_spec
 from armcli.spec.model import Gains, RobotSpec
 from armcli.urdf.doc import Urdf
@@ -61,11 +60,9 @@ def _check(urdf: Urdf, kp: list[float], kd: list[float], dt: float, gc: bool) ->
 def _simulate_accepts(urdf: Urdf, kp: list[float], kd: list[float], dt: float,
                       gc: bool) -> UnstableLoopError | None:  # fmt: skip
     """`simulate`'s refusal on check's own operating points (None: accepted)."""
-    model = load_model(urdf.source, xml=urdf.text.decode()).model
-    arm = arm_from_model(model)
-    configs = np.array(
-        [[p[j] for j in arm.joint_names] for p, _ in sampling.configurations(Robot(model))]
-    )
+    robot = Robot.load(urdf, strict=False)
+    arm = simulated(robot)
+    configs = np.array([[p[j] for j in arm.names] for p, _ in sampling.configurations(robot)])
     cfg = SimConfig(np.array(kp, dtype=float), np.array(kd, dtype=float), dt, gravity_comp=gc)
     try:
         check_stability(arm, cfg, configs)

@@ -17,6 +17,7 @@ from armcli.compiler.expand import expand_urdfs
 from armcli.robot.model import Robot
 from armcli.robot.tool import ToolPoint
 from armcli.spec.load import load_spec
+from armcli.urdf.read import parse_urdf
 from tests.helpers import DEFAULT_SPEC, ROOT
 
 EXACT = 1e-9  # [m] local search converged onto an extreme
@@ -28,7 +29,7 @@ SHOULDER = np.array([0.15, 0.0, 0.32])  # mount (0.15, 0, 0.2) above base_link a
 def model() -> Robot:
     spec = load_spec(DEFAULT_SPEC)
     text = expand_urdfs(spec)["my_robot.urdf"].decode()
-    return Robot.from_xml(text, "my_robot.urdf")
+    return Robot.load(parse_urdf(text.encode(), "my_robot.urdf"), strict=False)
 
 
 def tool_at(q1: float, q2: float) -> np.ndarray:

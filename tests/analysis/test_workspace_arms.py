@@ -20,10 +20,8 @@ import numpy as np
 import pytest
 
 from armcli.analysis.workspace import REACH_TOL, Chain, envelope, reach_point, sample
-from armcli.robot.load import load_model
-from armcli.robot.model import Robot
 from armcli.robot.tool import ToolPoint
-from tests.helpers import FIXTURES
+from tests.helpers import FIXTURES, load_robot
 
 BRUTE = 20_000  # brute-force draws per arm (about 0.1 s of forward kinematics)
 SEED = 12345  # not the search's own seed: a different cloud
@@ -56,7 +54,7 @@ def arm(request: pytest.FixtureRequest) -> tuple[Chain, np.ndarray, np.ndarray]:
     path, link, n = ARMS[request.param]
     if path is None:
         pytest.skip("example-robot-data is not installed (pip install -e '.[dev]')")
-    chain = Chain(Robot(load_model(path).model), ToolPoint(link))
+    chain = Chain(load_robot(path, strict=False), ToolPoint(link))
     assert len(chain.joints) == n
     rng = np.random.default_rng(SEED)
     x = rng.uniform(chain.lower, chain.upper, size=(BRUTE, n))

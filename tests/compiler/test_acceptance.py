@@ -123,7 +123,9 @@ def test_simulate_drives_the_mimic_finger_through_its_leader(built: Path) -> Non
 
     msg = "{joint_names: [left_finger_joint], points: [{positions: [0.02], time_from_start: 0.5}]}"
     job = _finger_job(built, msg)
-    assert tuple(job.arm.joint_names) == FINGERS
+    assert job.robot.names == FINGERS
+    # the coupling survives into the simulated robot (issue 38: it was dropped there)
+    assert [(m.follower, m.leader) for m in job.robot.mimics] == [tuple(reversed(FINGERS))]
     q_ref, v_ref = job.reference.sample(np.array([0.0, 0.25, 0.5, 1.0]))
     np.testing.assert_array_equal(q_ref[:, 1], q_ref[:, 0])  # exactly: 1 * leader + 0
     np.testing.assert_array_equal(v_ref[:, 1], v_ref[:, 0])

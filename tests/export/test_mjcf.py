@@ -9,7 +9,6 @@ menagerie-style smoke test only asks MuJoCo to load and step the model.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -17,16 +16,14 @@ import numpy as np
 import pytest
 from lxml import etree
 
-from armcli.export.mjcf import quat
 from armcli.export.mjcf_files import export_mjcf
-from armcli.robot.inertia import rpy_matrix
-from armcli.robot.load import load_model
+from armcli.robot.frames import rpy_matrix, rpy_quaternion
 from armcli.sim.reference import build_reference
-from armcli.sim.simulate import SimConfig, arm_from_model, simulate
+from armcli.sim.simulate import SimConfig, simulate, simulated
 from armcli.sim.trajectory import loads_trajectory
 from armcli.spec.load import load_spec
 from armcli.urdf.source import read_robot
-from tests.helpers import COURSE_GAINS, DEFAULT_SPEC, ROOT, course_gains_spec
+from tests.helpers import COURSE_GAINS, DEFAULT_SPEC, ROOT, course_gains_spec, load_robot
 
 mujoco = pytest.importorskip("mujoco")
 pin = pytest.importorskip("pinocchio")
@@ -142,12 +139,12 @@ def _loop(
         spec_path.write_text(DEFAULT_SPEC.read_text())
     _, m, _ = _export(spec_path, tmp_path)
     spec = load_spec(spec_path)
-    arm = arm_from_model(load_model(_urdf_file(spec_path, tmp_path)).model)
-    tr = loads_trajectory(trajectory, dict.fromkeys(arm.joint_names, (0.0, math.pi / 2)))
-    ref = build_reference(tr, arm.joint_names, Q0)
-    plant = arm if friction else replace(arm, friction=np.zeros(2))
-    kp = np.array([spec.control.gains[j].kp for j in arm.joint_names])
-    kd = np.array([spec.control.gains[j].kd for j in arm.joint_names])
+    arm = simulated(load_robot(_urdf_file(spec_path, tmp_path)))
+    tr = loads_trajectory(trajectory, dict.fromkeys(arm.names, (0.0, math.pi / 2)))
+    ref = build_reference(tr, arm.names, Q0)
+    plant = arm if friction else arm.with_limits(friction=np.zeros(2))
+    kp = np.array([spec.control.gains[j].kp for j in arm.names])
+    kd = np.array([spec.control.gains[j].kd for j in arm.names])
     dt = spec.control.dt if limits else LOOP_DT
     res = simulate(plant, ref, Q0, DURATION, SimConfig(kp, kd, dt=dt))
     assert not res.saturated.any()
@@ -299,7 +296,8 @@ def test_quaternion_matches_the_urdf_rotation() -> None:
     for _ in range(20):
         rpy = tuple(float(x) for x in rng.uniform(-math.pi, math.pi, 3))
         mat = np.zeros(9)
-        mujoco.mju_quat2Mat(mat, np.array(quat(rpy)))  # type: ignore[arg-type]
+        x, y, z, w = rpy_quaternion(rpy)  # MuJoCo reads (w, x, y, z), as the export writes it
+        mujoco.mju_quat2Mat(mat, np.array([w, x, y, z]))
         assert np.allclose(mat.reshape(3, 3), rpy_matrix(rpy), atol=1e-15)
 
 

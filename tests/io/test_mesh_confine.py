@@ -80,19 +80,18 @@ def test_pinocchio_gets_only_absolute_confined_paths(
     urdf.write_text(
         _with_collision_meshes(_arm(root), "package://robot_pkg/etc/passwd", "../meshes/box.stl")
     )
-    seen: list[tuple[str, list[str] | None]] = []
-    real = collision_model  # what Robot.collision_model hands the xml to
+    seen: list[str] = []
+    real = collision_model  # what Robot.collision_model hands the xml to (no search dirs)
 
-    def spy(model: Any, xml: str, package_dirs: list[str] | None = None, source: str = "") -> Any:
-        seen.append((xml, package_dirs))
-        return real(model, xml, package_dirs, source)
+    def spy(model: Any, xml: str, source: str = "") -> Any:
+        seen.append(xml)
+        return real(model, xml, source)
 
     monkeypatch.setattr(armcli.robot.model, "collision_model", spy)
     opts = CheckOptions(spec=load_spec(root / "specs" / "my_robot.yaml"))
     check_urdf(read_urdf(urdf), opts)
     assert len(seen) == 1
-    xml, dirs = seen[0]
-    assert not dirs
+    xml = seen[0]
     assert f'filename="{(pkg / "etc" / "passwd").resolve()}"' in xml
     assert f'filename="{(pkg / "meshes" / "box.stl").resolve()}"' in xml
     assert "package://" not in xml

@@ -51,14 +51,13 @@ def test_unreachable_reports_the_closest_distance(course: Loaded) -> None:
 
 def test_panda_pose_ik_matches_fk(panda: Loaded) -> None:
     robot = panda.context.robot
-    data = robot.model.createData()
     rng = np.random.default_rng(3)
     for _ in range(10):
         q = rng.uniform(robot.lower, robot.upper)
-        p, R = tool_pose(robot, data, q)
+        p, R = tool_pose(robot, q)
         res = solve_ik(robot, p, R, seed=5)
         assert res.x is not None
-        p2, R2 = tool_pose(robot, data, res.x)
+        p2, R2 = tool_pose(robot, res.x)
         assert np.linalg.norm(p2 - p) < POSITION_TOL
         angle = math.acos(max(-1.0, min(1.0, (np.trace(R2.T @ R) - 1) / 2)))
         assert angle < ROTATION_TOL

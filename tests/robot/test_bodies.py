@@ -8,7 +8,7 @@ import pinocchio as pin
 import pytest
 
 from armcli.robot import bodies
-from armcli.robot import inertia as inr
+from armcli.robot.frames import rpy_matrix
 from armcli.urdf.read import parse_urdf
 
 LUMP_TOL = 1e-12  # [kg, m, kg·m²] two engines summing the same terms in another order
@@ -72,7 +72,7 @@ def test_moved_is_pinocchios_placement_and_inverts() -> None:
     x = _random_mass(rng)
     xyz, rpy = (0.2, -0.1, 0.4), (0.3, -0.5, 1.1)
     up = bodies.moved(x, xyz, rpy)
-    M = pin.SE3(inr.rpy_matrix(rpy), np.array(xyz))  # the child frame in the parent's
+    M = pin.SE3(rpy_matrix(rpy), np.array(xyz))  # the child frame in the parent's
     ref = M.act(pin.Inertia(x.mass, x.com, x.J))
     assert np.allclose(up.com, ref.lever, atol=LUMP_TOL)
     assert np.allclose(up.J, ref.inertia, atol=LUMP_TOL)

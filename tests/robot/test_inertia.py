@@ -80,16 +80,6 @@ def test_parallel_axis_and_rotation_match_a_point_cloud() -> None:
     )
 
 
-@pytest.mark.parametrize(
-    "rpy", [(0, 0, 0), (math.pi / 2, 0, 0), (0.3, -0.7, 1.1), (-2.0, 1.2, 0.4)]
-)
-def test_rpy_is_urdf_fixed_axis_xyz(rpy: tuple[float, float, float]) -> None:
-    # URDF: rotate about fixed X by roll, then fixed Y by pitch, then fixed Z by yaw;
-    # scipy's lower-case "xyz" is exactly that extrinsic sequence.
-    ref = Rotation.from_euler("xyz", rpy).as_matrix()
-    np.testing.assert_allclose(inr.rpy_matrix(rpy), ref, atol=EXACT_RTOL)
-
-
 def test_triangle_inequality_edges() -> None:
     # Thin rod along z: moments (I, I, 0) sit exactly on the bound; a flat plate
     # in the xy plane has Izz = Ixx + Iyy exactly; both are physical.

@@ -9,7 +9,7 @@ import random
 import numpy as np
 import pytest
 
-from armcli.robot import inertia as inr
+from armcli.robot.frames import rpy_matrix
 from armcli.robot.inertia_bounds import (
     EXCEEDS_RTOL,
     excess,
@@ -117,7 +117,7 @@ def test_tolerance_covers_a_thin_tube_written_with_4_digits() -> None:
 def test_fix_values_rotate_into_the_inertial_frame() -> None:
     """A wheel whose geometry is rolled 90 deg about x while the inertial frame is not:
     the solid cylinder's axis moment (m r²/2) must land on iyy."""
-    R_geom_inertial = inr.rpy_matrix((math.pi / 2, 0.0, 0.0)).T
+    R_geom_inertial = rpy_matrix((math.pi / 2, 0.0, 0.0)).T
     fix = fix_values(solid_inertia(CYLINDER, MASS), R_geom_inertial)
     r = (CYLINDER.dims or ())[0]
     assert fix["iyy"] == pytest.approx(MASS * r * r / 2, rel=1e-3)

@@ -52,7 +52,7 @@ URDF = b"""<robot name="t">
 
 @pytest.fixture(scope="module")
 def robot() -> Robot:
-    return Robot.from_urdf(parse_urdf(URDF, "t.urdf"))
+    return Robot.load(parse_urdf(URDF, "t.urdf"))
 
 
 def test_joint_table_reads_the_urdf(robot: Robot) -> None:
@@ -152,11 +152,60 @@ def test_collision_model_resolves_meshes_inside_the_allowed_roots(tmp_path: Path
     mesh = b'<mesh filename="meshes/box.stl"/>'
     text = URDF.replace(b'<box size="0.1 0.1 0.1"/>', mesh)
     (tmp_path / "t.urdf").write_bytes(text)
-    robot = Robot.from_urdf(parse_urdf(text, str(tmp_path / "t.urdf")))
+    robot = Robot.load(parse_urdf(text, str(tmp_path / "t.urdf")))
     gm = robot.collision_model(MeshSearch())
     real = (tmp_path / "meshes" / "box.stl").resolve()
     assert [g.meshPath for g in gm.geometryObjects if g.meshPath.endswith(".stl")] == [str(real)]
-    gone = Robot.from_urdf(parse_urdf(text.replace(b"box.stl", b"gone.stl"),
+    gone = Robot.load(parse_urdf(text.replace(b"box.stl", b"gone.stl"),
                                       str(tmp_path / "t.urdf")))  # fmt: skip
     with pytest.raises(InputError, match=r"mesh 'meshes/gone\.stl' cannot be found"):
         gone.collision_model(MeshSearch())
+
+
+def test_limit_arrays_are_read_only_views_of_the_model(robot: Robot) -> None:
+    # the URDF's numbers, per joint in tree order (yaw continuous: no stops)
+    assert robot.lower.tolist() == [-math.inf, -1.0, 0.0, 0.0]
+    assert robot.upper.tolist() == [math.inf, 2.0, 0.3, 0.1]
+    assert robot.effort.tolist() == [10.0, 20.0, math.inf, 5.0]  # slide's effort="0": none
+    assert robot.velocity.tolist() == [3.0, 2.0, 1.0, 1.0]
+    assert robot.damping.tolist() == [0.5, 0.0, 0.0, 0.0]
+    assert robot.friction.tolist() == [0.2, 0.0, 0.0, 0.0]
+    with pytest.raises(ValueError, match="read-only"):
+        robot.lower[1] = 0.0
+
+
+def test_with_limits_is_a_new_robot_over_a_copied_model(robot: Robot) -> None:
+    other = robot.with_limits(effort=np.array([1.0, 0.0, -2.0, 4.0]), lower=np.full(4, -0.5))
+    assert other.effort.tolist() == [1.0, math.inf, math.inf, 4.0]  # <= 0: no limit, as read
+    assert other.lower.tolist() == [-math.inf, -0.5, -0.5, -0.5]  # yaw stays continuous
+    assert robot.effort.tolist() == [10.0, 20.0, math.inf, 5.0]  # the original unchanged
+    assert other.mimics == robot.mimics and other.tool == robot.tool  # couplings survive
+    with pytest.raises(ValueError, match="unknown limit 'stiffness'"):
+        robot.with_limits(stiffness=np.zeros(4))
+
+
+def test_scaled_masses_and_friction(robot: Robot) -> None:
+    scaled = robot.scaled([2.0, 1.0, 1.0, 0.5], [1.0, 1.0, 3.0, 1.0])
+    assert scaled.mass == pytest.approx(2.0 + 1.0 + 1.0 + 0.05, abs=EXACT)  # URDF masses
+    assert scaled.friction.tolist() == [0.2, 0.0, 0.0, 0.0]  # 3 x 0: still none
+    assert scaled.model.inertias[1].lever.tolist() == robot.model.inertias[1].lever.tolist()
+    assert robot.scaled([1.0] * 4, [2.0, 1.0, 1.0, 1.0]).friction[0] == pytest.approx(0.4)
+
+
+def test_a_point_mass_moves_the_centre_of_mass(robot: Robot) -> None:
+    q = robot.q({"yaw": 0.3, "pitch": -0.4, "slide": 0.1})
+    loaded = robot.with_point_mass("flange", (0.0, 0.0, 0.05), 2.0)
+    point = robot.point_position("flange", (0.0, 0.0, 0.05), q)
+    expected = (robot.mass * robot.center_of_mass(q) + 2.0 * point) / (robot.mass + 2.0)
+    np.testing.assert_allclose(loaded.center_of_mass(q), expected, atol=EXACT)
+    assert loaded.mass == pytest.approx(robot.mass + 2.0, abs=EXACT)
+
+
+def test_each_thread_has_its_own_data(robot: Robot) -> None:
+    import threading
+
+    seen = []
+    thread = threading.Thread(target=lambda: seen.append(robot.data))
+    thread.start()
+    thread.join()
+    assert seen[0] is not robot.data and robot.data is robot.data

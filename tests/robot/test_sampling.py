@@ -24,11 +24,12 @@ def test_few_joints_get_the_full_grid() -> None:
     assert np.allclose(rows, np.array(list(itertools.product(*axis))), rtol=0, atol=1e-15)
 
 
-def test_many_joints_get_zero_corners_and_seeded_draws() -> None:
+def test_many_joints_get_rest_corners_and_seeded_draws() -> None:
     box = [(0.5, 1.0), (-1.0, 1.0), (-2.0, 0.0), (-1.0, 1.0)]
     rows = sampling.joint_space(box)
     assert rows.shape == (1 + 2**4 + sampling.RANDOM_SAMPLES, 4)
-    assert rows[0].tolist() == [0.5, 0.0, 0.0, 0.0]  # 0 clamped into each range
+    # the rest pose: 0 where the range holds it, else the middle, (0.5 + 1.0) / 2
+    assert rows[0].tolist() == [0.75, 0.0, 0.0, 0.0]
     assert {tuple(r) for r in rows[1:17]} == set(itertools.product(*box))
     # the draws: the standard library's generator, seeded, one row after the other
     rng = random.Random(sampling.SAMPLE_SEED)
@@ -54,7 +55,7 @@ def test_search_starts_order() -> None:
 
 
 def test_followers_follow_their_leaders() -> None:
-    robot = Robot.from_urdf(parse_urdf(URDF, "t.urdf"))
+    robot = Robot.load(parse_urdf(URDF, "t.urdf"))
     pairs = sampling.configurations(robot)
     # yaw continuous [-pi, pi], pitch [-1, 2], slide [0, 0.3]: 3 leaders, 125-point grid
     assert len(pairs) == sampling.GRID_POINTS**3
@@ -89,8 +90,7 @@ def test_check_and_tune_draw_identical_samples(monkeypatch: pytest.MonkeyPatch) 
     same configurations: both ask `sampling.joint_space`, with the same box."""
     from armcli.check.options import CheckOptions
     from armcli.check.run import check_urdf
-    from armcli.robot.load import load_model
-    from armcli.sim.simulate import arm_from_model
+    from armcli.sim.simulate import simulated
     from armcli.tune.model_gains import start_gains
 
     seen: list[tuple[list[tuple[float, ...]], np.ndarray]] = []
@@ -104,7 +104,7 @@ def test_check_and_tune_draw_identical_samples(monkeypatch: pytest.MonkeyPatch) 
     monkeypatch.setattr(sampling, "joint_space", recording)
     doc = parse_urdf(chain_urdf(5), "chain.urdf")  # 5 joints: draws, not the grid
     check_urdf(doc, CheckOptions())
-    arm = arm_from_model(load_model("chain.urdf", xml=doc.text.decode()).model)
+    arm = simulated(Robot.load(doc))
     start_gains(arm, dt=1e-3, loop="implicit", zeta=1.0, wn_target=10.0, steps=np.ones(5))
     assert len(seen) == 2  # one sample for check, one for tune
     (box_check, rows_check), (box_tune, rows_tune) = seen

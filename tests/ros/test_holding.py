@@ -36,7 +36,7 @@ def _robot(spec: RobotSpec) -> tuple[bytes, Robot]:
     """The URDF the controller drives (the whole robot, else the arm) and its Robot."""
     urdfs = spec_urdfs(spec)
     xml = urdfs.get(f"{spec.name}.urdf", urdfs["standalone_arm.urdf"])
-    return xml, Robot.from_urdf(parse_urdf(xml, spec.name))
+    return xml, Robot.load(parse_urdf(xml, spec.name), strict=False)
 
 
 Gains = Mapping[str, tuple[float, float, float, float]]  # joint -> p, d, i, i_clamp

@@ -16,8 +16,9 @@ import pinocchio as pin
 import pytest
 
 from armcli.cli import main
+from armcli.robot.model import Robot
 from armcli.sim import rollout as ro
-from armcli.sim.simulate import Arm, SimConfig, arm_from_model, plant_of
+from armcli.sim.simulate import SimConfig, plant_of, simulated
 from tests.helpers import DEFAULT_SPEC
 from tests.sim.engines import run_held
 
@@ -39,11 +40,11 @@ def pendulum_urdf(joint: str, axis: str = "0 1 0", limits: str = "") -> str:
 </robot>"""
 
 
-def _arm(urdf: str) -> Arm:
-    return arm_from_model(pin.buildModelFromXML(urdf))
+def _arm(urdf: str) -> Robot:
+    return simulated(Robot(pin.buildModelFromXML(urdf)))
 
 
-def _plant(arm: Arm, integrator: str, dt: float) -> ro.Plant:
+def _plant(arm: Robot, integrator: str, dt: float) -> ro.Plant:
     cfg = SimConfig(kp=np.zeros(1), kd=np.zeros(1), dt=dt, integrator=integrator)  # type: ignore[arg-type]
     return plant_of(arm, cfg)
 

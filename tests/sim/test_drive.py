@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from armcli.sim import drive, driveout, liftoff
+from armcli.robot.frames import quaternion_rpy, tilt
+from armcli.sim import drive, driveout
 from armcli.sim import job as simjob
-from armcli.sim.liftoff import roll_pitch_yaw
 from armcli.sim.options import SimOptions
 from armcli.spec.load import load_spec
 from tests.helpers import DEFAULT_SPEC, ROOT, course_gains_spec
@@ -64,7 +64,7 @@ def _axle(run: drive.DriveRun) -> tuple[np.ndarray, np.ndarray]:
     links = ("base_left_wheel_link", "base_right_wheel_link")  # the course robot's wheels
     wheels = [job.model.contacts.index(link) for link in links]
     mid = pos[:, wheels, :2].mean(axis=1)
-    return mid - mid[0], roll_pitch_yaw(s[:, L.base_quat])[2]
+    return mid - mid[0], quaternion_rpy(s[:, L.base_quat])[2]
 
 
 @pytest.mark.parametrize(
@@ -208,4 +208,4 @@ def test_a_robot_that_rocks_back_onto_its_wheels_does_not_tip(tmp_path: Path, ca
     L = run.job.model.layout
     end = run.sensors[-20:]  # the last 20 ms: back on the ground, level
     assert np.all(end[:, L.touch] > 0.0)
-    assert np.max(liftoff.tilt(end[:, L.base_quat])) < math.radians(1.0)
+    assert np.max(tilt(end[:, L.base_quat])) < math.radians(1.0)

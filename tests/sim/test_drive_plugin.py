@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 import pytest
 
+from armcli.robot.frames import quaternion_rpy
 from armcli.sim import drive
-from armcli.sim.liftoff import roll_pitch_yaw
 from armcli.sim.options import SimOptions
 from armcli.spec.load import load_spec
 from tests.helpers import DEFAULT_SPEC
@@ -65,7 +65,7 @@ def _plugin_reference(job: drive.DriveJob, commands: Commands = ARC, model: Any 
     wheel_dof = [m.jnt_dofadr[m.joint(j).id] for j in wheels]
     rotor = [m.jnt_dofadr[m.joint(f"{j}_rotor").id] for j in wheels]  # the motors' speed
     d.qpos[2] = dm.base_z
-    for j, q in zip(job.arm.arm.joint_names, job.arm.q0, strict=True):
+    for j, q in zip(job.arm.robot.names, job.arm.q0, strict=True):
         d.qpos[m.jnt_qposadr[m.joint(j).id]] = q
     for i in dm.arm_act[dm.arm_act >= 0]:
         name = dm.model.actuator(int(i)).name
@@ -95,7 +95,7 @@ def _plugin_reference(job: drive.DriveJob, commands: Commands = ARC, model: Any 
 
 def _pose(d: Any) -> tuple[float, float, float]:
     """(x, y, yaw) of the free base."""
-    yaw = roll_pitch_yaw(d.qpos[3:7].reshape(1, 4))[2][0]
+    yaw = quaternion_rpy(d.qpos[3:7].reshape(1, 4))[2][0]
     return float(d.qpos[0]), float(d.qpos[1]), float(yaw)
 
 
@@ -115,7 +115,7 @@ def _spec_with(tmp_path: Path, old: str, new: str) -> Path:
 def _assert_follows_the_plugin(job: drive.DriveJob, run: drive.DriveRun) -> None:
     L = job.model.layout
     x, y, _ = run.sensors[-1, L.base_pos]
-    yaw = roll_pitch_yaw(run.sensors[-1:, L.base_quat])[2][0]
+    yaw = quaternion_rpy(run.sensors[-1:, L.base_quat])[2][0]
     rx, ry, ryaw = _pose(_plugin_reference(job))
     assert (x, y) == pytest.approx((rx, ry), abs=SAME_RUN_M)
     assert yaw == pytest.approx(ryaw, abs=SAME_RUN_RAD)

@@ -17,10 +17,11 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from armcli.robot.load import load_model
+from armcli.robot.model import Robot
 from armcli.sim.reference import Reference, build_reference
-from armcli.sim.simulate import Arm, SimConfig, arm_from_model, plant_of, simulate
+from armcli.sim.simulate import SimConfig, plant_of, simulate, simulated
 from armcli.sim.trajectory import loads_trajectory
+from tests.helpers import load_robot
 from tests.sim.engines import run_held
 from tests.sim.test_simulate import _arm, pendulum
 
@@ -51,13 +52,13 @@ def trajectory(times: tuple[float, ...], kind: str, first_at_zero: bool = False)
 
 
 @pytest.fixture(scope="module")
-def arm(built_dir: Path) -> Arm:
-    model = arm_from_model(load_model(built_dir / "standalone_arm.urdf").model).model
+def arm(built_dir: Path) -> Robot:
+    model = simulated(load_robot(built_dir / "standalone_arm.urdf")).model
     return _arm(model, damping=DAMPING)  # stops far away, no friction: the smooth dynamics
 
 
 def dop853(
-    arm: Arm, ref: Reference, q0: np.ndarray, t_end: float, kd: float = KD, dt: float = DT
+    arm: Robot, ref: Reference, q0: np.ndarray, t_end: float, kd: float = KD, dt: float = DT
 ) -> np.ndarray:
     """q at every step time from DOP853 on q'' = ABA(q, v, PD - D v), restarted at each
     knot on that segment's polynomial, so it never steps across a discontinuity."""
@@ -99,14 +100,14 @@ def dop853(
     ],
 )
 def test_rk4_follows_dop853_at_every_step(
-    arm: Arm, times: tuple[float, ...], kind: str, first_at_zero: bool
+    arm: Robot, times: tuple[float, ...], kind: str, first_at_zero: bool
 ) -> None:
     """Before the fix: 5.6e-6 rad (knots on the grid, the step after a velocity jump) and
     5.1e-4 rad (knots off the grid)."""
     q0, t_end = np.array([0.2, 0.2]), 2.2
     tr = loads_trajectory(trajectory(times, kind, first_at_zero),
-                          dict.fromkeys(arm.joint_names, (0.0, math.pi / 2)))  # fmt: skip
-    ref = build_reference(tr, arm.joint_names, q0)
+                          dict.fromkeys(arm.names, (0.0, math.pi / 2)))  # fmt: skip
+    ref = build_reference(tr, arm.names, q0)
     cfg = SimConfig(np.full(2, KP), np.full(2, KD), dt=DT, integrator="rk4")
     res = simulate(arm, ref, q0, t_end, cfg)
     err = np.max(np.abs(res.q - dop853(arm, ref, q0, t_end)), axis=1)
@@ -121,7 +122,7 @@ def _energy(model: pin.Model, q: np.ndarray, v: np.ndarray) -> np.ndarray:
     ])  # fmt: skip
 
 
-def _drift(arm: Arm, q0: list[float], dt: float, seconds: float) -> tuple[float, float]:
+def _drift(arm: Robot, q0: list[float], dt: float, seconds: float) -> tuple[float, float]:
     """(energy drift [J/h] fitted over the run, largest |E - E0| [J]) of a free swing."""
     n = len(q0)
     steps = round(seconds / dt)
@@ -143,7 +144,7 @@ def test_euler_is_symplectic_for_a_constant_mass_matrix() -> None:
     assert abs(drift) < 1e-3
 
 
-def test_euler_energy_drift_on_the_arm(arm: Arm) -> None:
+def test_euler_energy_drift_on_the_arm(arm: Robot) -> None:
     """Two links: M(q) varies and the Coriolis forces are taken at the step's start, so
     the scheme is not symplectic and a conservative swing's energy drifts. Measured +5.6e-2
     J/h at 1 ms over an hour (sim/simulate.py's docstring); it shrinks with dt."""
@@ -156,12 +157,12 @@ def test_euler_energy_drift_on_the_arm(arm: Arm) -> None:
 
 
 @pytest.mark.slow  # ~8 s: DOP853 at rtol 1e-12 through 3 s of quintic segments
-def test_euler_is_first_order_against_dop853(arm: Arm) -> None:
+def test_euler_is_first_order_against_dop853(arm: Robot) -> None:
     """Quintic segments (a smooth reference): Euler's error is O(dt) and halves with dt."""
     q0, t_end, kd = np.array([0.1, 0.1]), 3.0, 5.0
     tr = loads_trajectory(trajectory((1.0, 1.5, 2.0, 2.5), "quintic"),
-                          dict.fromkeys(arm.joint_names, (0.0, math.pi / 2)))  # fmt: skip
-    ref = build_reference(tr, arm.joint_names, q0)
+                          dict.fromkeys(arm.names, (0.0, math.pi / 2)))  # fmt: skip
+    ref = build_reference(tr, arm.names, q0)
     exact = dop853(arm, ref, q0, t_end, kd=kd, dt=5e-4)
     errs = {}
     for dt in (1e-3, 5e-4):
@@ -186,7 +187,7 @@ def test_rk4_resting_on_a_stop_has_no_phantom_velocity() -> None:
 
 
 def test_rk4_coupled_joint_settles_at_its_static_equilibrium(built_dir: Path) -> None:
-    model = arm_from_model(load_model(built_dir / "standalone_arm.urdf").model).model
+    model = simulated(load_robot(built_dir / "standalone_arm.urdf")).model
     arm = _arm(model, lower=0.0, upper=math.pi / 2, damping=0.2)
     kp, q2_ref = 50.0, 0.8
     cfg = SimConfig(np.array([0.0, kp]), np.array([0.0, 2.0]), dt=5e-4, integrator="rk4")
@@ -216,12 +217,12 @@ POSITIONS_ONLY = (  # linear segments: the reference velocity jumps at every kno
 
 
 def test_rk4_is_fourth_order_on_positions_only_trajectory(built_dir: Path) -> None:
-    model = arm_from_model(load_model(built_dir / "standalone_arm.urdf").model).model
+    model = simulated(load_robot(built_dir / "standalone_arm.urdf")).model
     arm = _arm(model, damping=0.1)
     kp, kd, t_end = 50.0, 1.0, 2.0
-    tr = loads_trajectory(POSITIONS_ONLY, dict.fromkeys(arm.joint_names, (0.0, math.pi / 2)))
+    tr = loads_trajectory(POSITIONS_ONLY, dict.fromkeys(arm.names, (0.0, math.pi / 2)))
     q0 = np.array([0.2, 0.2])
-    ref = build_reference(tr, arm.joint_names, q0)
+    ref = build_reference(tr, arm.names, q0)
     data = model.createData()
 
     def f(t: float, y: np.ndarray, seg: float) -> np.ndarray:

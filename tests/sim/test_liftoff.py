@@ -12,9 +12,7 @@ from armcli.sim.liftoff import (
     LIFT_CLEARANCE,
     edge_tilts,
     lifts,
-    roll_pitch_yaw,
     static_tipping_angle,
-    tilt,
     tipping_angles,
     verdict,
 )
@@ -44,17 +42,6 @@ def test_static_tipping_angle_of_the_box_on_feet() -> None:
     # nearer edges): atan(0.15 / h)
     assert angle == pytest.approx(math.atan2(0.15, 1.1 / 6.0), abs=1e-9)
     assert direction in ("left", "right")
-
-
-def test_tilt_and_angles_of_known_rotations() -> None:
-    a = 0.3
-    about_y = np.array([[math.cos(a / 2), 0.0, math.sin(a / 2), 0.0]])  # (w, x, y, z)
-    about_z = np.array([[math.cos(a / 2), 0.0, 0.0, math.sin(a / 2)]])
-    assert tilt(about_y)[0] == pytest.approx(a, abs=EXACT)
-    assert tilt(about_z)[0] == pytest.approx(0.0, abs=1e-7)  # turning is no tilt
-    roll, pitch, yaw = roll_pitch_yaw(np.vstack([about_y, about_z]))
-    assert (roll[0], pitch[0], yaw[0]) == pytest.approx((0.0, a, 0.0), abs=EXACT)
-    assert (roll[1], pitch[1], yaw[1]) == pytest.approx((0.0, 0.0, a), abs=EXACT)
 
 
 def test_a_lift_off_needs_no_force_and_clearance() -> None:

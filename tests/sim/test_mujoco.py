@@ -9,16 +9,16 @@ collide the arm's own geoms); the test trajectory stays away from the joint stop
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from armcli.robot.load import load_model
+from armcli.robot.model import Robot
 from armcli.sim.reference import build_reference
-from armcli.sim.simulate import Arm, SimConfig, arm_from_model, simulate
+from armcli.sim.simulate import SimConfig, simulate, simulated
 from armcli.sim.trajectory import loads_trajectory
+from tests.helpers import load_robot
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -66,14 +66,14 @@ def mujoco_run(m: object, q_ref: np.ndarray, v_ref: np.ndarray) -> np.ndarray:
 
 
 @pytest.fixture(scope="module")
-def arm(built_dir: Path) -> Arm:
-    return arm_from_model(load_model(built_dir / "standalone_arm.urdf").model)
+def arm(built_dir: Path) -> Robot:
+    return simulated(load_robot(built_dir / "standalone_arm.urdf"))
 
 
-def _both(arm: Arm, built_dir: Path, friction: bool) -> tuple[np.ndarray, np.ndarray]:
-    tr = loads_trajectory(MULTI, dict.fromkeys(arm.joint_names, (0.0, math.pi / 2)))
-    ref = build_reference(tr, arm.joint_names, Q0)
-    plant = arm if friction else replace(arm, friction=np.zeros(2))
+def _both(arm: Robot, built_dir: Path, friction: bool) -> tuple[np.ndarray, np.ndarray]:
+    tr = loads_trajectory(MULTI, dict.fromkeys(arm.names, (0.0, math.pi / 2)))
+    ref = build_reference(tr, arm.names, Q0)
+    plant = arm if friction else arm.with_limits(friction=np.zeros(2))
     cfg = SimConfig(np.full(2, KP), np.full(2, KD), dt=DT)
     res = simulate(plant, ref, Q0, DURATION, cfg)
     assert not res.stop_active.any() and not res.saturated.any()  # same physics on both sides
@@ -83,12 +83,12 @@ def _both(arm: Arm, built_dir: Path, friction: bool) -> tuple[np.ndarray, np.nda
     return res.q, q_mj
 
 
-def test_agrees_with_mujoco_without_friction(arm: Arm, built_dir: Path) -> None:
+def test_agrees_with_mujoco_without_friction(arm: Robot, built_dir: Path) -> None:
     q, q_mj = _both(arm, built_dir, friction=False)
     assert np.max(np.abs(q - q_mj)) < AGREE
 
 
-def test_friction_difference_with_mujoco_is_small(arm: Arm, built_dir: Path) -> None:
+def test_friction_difference_with_mujoco_is_small(arm: Robot, built_dir: Path) -> None:
     # MuJoCo solves frictionloss as a soft (regularised) constraint, armcli as a hard
     # stiction/velocity-level one, so they differ slightly where the joints stick.
     q, q_mj = _both(arm, built_dir, friction=True)

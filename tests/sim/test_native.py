@@ -4,7 +4,6 @@ and recording that change nothing, running statistics, and refusing a missing or
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from pathlib import Path
 from typing import cast
 
@@ -13,22 +12,22 @@ import pinocchio as pin
 import pytest
 
 from armcli.errors import InputError, SimulationError
-from armcli.robot.load import load_model
+from armcli.robot.model import Robot
 from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim.options import Integrator
 from armcli.sim.reference import build_reference
 from armcli.sim.simulate import (
     SETTLE_TOL,
-    Arm,
     Run,
     SimConfig,
-    arm_from_model,
     plant_of,
     simulate,
     simulate_batch,
+    simulated,
 )
 from armcli.sim.trajectory import loads_trajectory
+from tests.helpers import load_robot
 from tests.sim.engines import require_native, run_held
 from tests.sim.test_rollout import TILTED_URDF
 
@@ -43,13 +42,13 @@ TRAJ = (
 
 
 @pytest.fixture(scope="module")
-def arm(built_dir: Path) -> Arm:
-    return arm_from_model(load_model(built_dir / "standalone_arm.urdf").model)
+def arm(built_dir: Path) -> Robot:
+    return simulated(load_robot(built_dir / "standalone_arm.urdf"))
 
 
-def _reference(arm: Arm):
-    tr = loads_trajectory(TRAJ, dict.fromkeys(arm.joint_names, (0.0, math.pi / 2)))
-    return build_reference(tr, arm.joint_names, np.zeros(2))
+def _reference(arm: Robot):
+    tr = loads_trajectory(TRAJ, dict.fromkeys(arm.names, (0.0, math.pi / 2)))
+    return build_reference(tr, arm.names, np.zeros(2))
 
 
 def _erd_models() -> list[pin.Model]:
@@ -67,13 +66,13 @@ def _free_step_equals_python_aba(model: pin.Model) -> bool:
     v1 = v0 + dt a, q1 = q0 + dt v1 with a = ABA(q0, v0, 0), bit for bit. False when
     Python's ABA is not finite (massless chains: a singular mass matrix)."""
     simulable = [model.names[j] for j in range(1, model.njoints) if model.joints[j].nv == 1]
-    arm = arm_from_model(model, simulable)
+    arm = simulated(Robot(model), simulable)
     n, dt = arm.model.nv, 1e-3
-    wide = replace(arm, lower=np.full(n, -1e9), upper=np.full(n, 1e9), damping=np.zeros(n),
+    wide = arm.with_limits(lower=np.full(n, -1e9), upper=np.full(n, 1e9), damping=np.zeros(n),
                    friction=np.zeros(n), velocity=np.full(n, 1e9))  # fmt: skip
     rng = np.random.default_rng(n)
     q0, v0 = rng.uniform(-1, 1, n), rng.uniform(-1, 1, n)
-    a = pin.aba(wide.model, wide.model.createData(), wide.robot.q(q0), v0,
+    a = pin.aba(wide.model, wide.model.createData(), wide.q(q0), v0,
                 np.zeros(n), pin.Convention.WORLD)  # fmt: skip
     if not np.all(np.isfinite(a)):
         return False
@@ -95,7 +94,7 @@ def test_the_engine_receives_the_model_exactly() -> None:
     assert compared >= 40 or (not ERD.is_dir() and compared == 1)
 
 
-def test_chunking_and_recording_change_nothing(arm: Arm, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_chunking_and_recording_change_nothing(arm: Robot, monkeypatch: pytest.MonkeyPatch) -> None:
     """The run continues across chunks (friction's warm start included) and keeping a
     subset of the states keeps exactly those rows."""
     require_native()
@@ -111,10 +110,10 @@ def test_chunking_and_recording_change_nothing(arm: Arm, monkeypatch: pytest.Mon
         np.testing.assert_array_equal(getattr(part.stats, f), getattr(whole.stats, f))
 
 
-def test_running_statistics_equal_the_full_trace(arm: Arm) -> None:
+def test_running_statistics_equal_the_full_trace(arm: Robot) -> None:
     """Statistics the engine accumulates step by step, against numpy on every state."""
     require_native()
-    weak = replace(arm, effort=np.array([3.0, 1.0]))  # saturates; the stops are hit
+    weak = arm.with_limits(effort=np.array([3.0, 1.0]))  # saturates; the stops are hit
     cfg = SimConfig(np.full(2, 50.0), np.full(2, 2.0), dt=5e-4)
     res = simulate(weak, _reference(arm), np.zeros(2), 2.0, cfg)
     e = res.q - res.q_ref
@@ -132,17 +131,17 @@ def test_running_statistics_equal_the_full_trace(arm: Arm) -> None:
     assert steps_sat.any() and steps_stop.any()
 
 
-def test_batch_on_threads_equals_simulate_run_by_run(arm: Arm) -> None:
+def test_batch_on_threads_equals_simulate_run_by_run(arm: Robot) -> None:
     """The batch entry point (`armcli tune`) gives each run's `simulate` result exactly, on
     threads too, diverged runs included."""
     require_native()
     ref = _reference(arm)
-    weak = replace(arm, effort=np.array([3.0, 0.5]))
-    free = replace(arm, effort=np.full(2, np.inf), lower=np.full(2, -1e3), upper=np.full(2, 1e3))
+    weak = arm.with_limits(effort=np.array([3.0, 0.5]))
+    free = arm.with_limits(effort=np.full(2, np.inf), lower=np.full(2, -1e3), upper=np.full(2, 1e3))
     runs = [
         Run(a, ref, np.zeros(2), 1.5, SimConfig(np.full(2, kp), np.full(2, kd), 1e-3, integ))
         for a, kp, kd, integ in cast(
-            list[tuple[Arm, float, float, Integrator]],
+            list[tuple[Robot, float, float, Integrator]],
             [
                 (arm, 50, 5, "euler"),
                 (weak, 200, 2, "euler"),
@@ -155,7 +154,7 @@ def test_batch_on_threads_equals_simulate_run_by_run(arm: Arm) -> None:
     assert sum(isinstance(r, SimulationError) for r in batch) == 1
     for run, got in zip(runs, batch, strict=True):
         try:
-            want = simulate(run.arm, run.reference, run.q0, run.duration, run.cfg)
+            want = simulate(run.robot, run.reference, run.q0, run.duration, run.cfg)
         except SimulationError as exc:
             assert isinstance(got, SimulationError) and str(got) == str(exc)
             continue
@@ -165,7 +164,7 @@ def test_batch_on_threads_equals_simulate_run_by_run(arm: Arm) -> None:
 
 
 def test_missing_extension_is_an_error_saying_how_to_get_it(
-    arm: Arm, monkeypatch: pytest.MonkeyPatch
+    arm: Robot, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setenv("ARMCLI_NO_NATIVE", "1")
     monkeypatch.setattr(native, "_state", {})

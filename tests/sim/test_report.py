@@ -9,10 +9,11 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from armcli.robot.model import Robot
 from armcli.sim import rollout as ro
 from armcli.sim.reference import Reference
 from armcli.sim.report import SETTLE_TOL, joint_metrics
-from armcli.sim.simulate import Arm, SimConfig, SimResult, plant_of, simulate
+from armcli.sim.simulate import SimConfig, SimResult, plant_of, simulate
 from armcli.sim.states import sample_states, sample_steps, states_bytes
 from tests.sim.engines import hold, require_native
 
@@ -20,25 +21,31 @@ DT = 1e-3
 INERTIA = 0.25  # [kg·m²] about the joint axis
 
 
-def wheel(damping: float) -> Arm:
+def wheel(damping: float) -> Robot:
     """A joint about the vertical axis (gravity exerts no torque): inertia INERTIA."""
     model = pin.Model()
     jid = model.addJoint(0, pin.JointModelRZ(), pin.SE3.Identity(), "wheel")
     model.appendBodyToJoint(jid, pin.Inertia(1.0, np.zeros(3), np.diag([1.0, 1.0, INERTIA])),
                             pin.SE3.Identity())  # fmt: skip
     one = np.ones(1)
-    return Arm(model, ("wheel",), -1e3 * one, 1e3 * one, np.inf * one, 1e3 * one,
-               damping * one, 0.0 * one)  # fmt: skip
+    return Robot(model).with_limits(
+        lower=-1e3 * one,
+        upper=1e3 * one,
+        effort=np.inf * one,
+        velocity=1e3 * one,
+        damping=damping * one,
+        friction=0 * one,
+    )
 
 
-def _coast(arm: Arm, q0: float, v0: float, steps: int) -> SimResult:
+def _coast(arm: Robot, q0: float, v0: float, steps: int) -> SimResult:
     """No gains, the reference held at 0, from (q0, v0): the error is the position."""
     require_native()
     cfg = SimConfig(np.zeros(1), np.zeros(1), dt=DT)
     r = ro.run(plant_of(arm, cfg), hold(np.zeros(1)), np.array([q0]), np.array([v0]), steps,
                settle_tol=SETTLE_TOL)  # fmt: skip
     tr = r.trace
-    return SimResult(arm.joint_names, steps, DT, "euler", tr.step, tr.step * DT, tr.q, tr.v,
+    return SimResult(arm.names, steps, DT, "euler", tr.step, tr.step * DT, tr.q, tr.v,
                      tr.q_ref, tr.v_ref, tr.tau, tr.saturated, tr.stop, r.stats, SETTLE_TOL,
                      0.0)  # fmt: skip
 

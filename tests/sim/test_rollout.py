@@ -13,9 +13,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from armcli.robot.model import Robot
 from armcli.sim import rollout as ro
 from armcli.sim.options import Integrator
-from armcli.sim.simulate import Arm, SimConfig, arm_from_model, plant_of
+from armcli.sim.simulate import SimConfig, plant_of, simulated
 from tests.sim.engines import run_held
 
 ID_TOL = 1e-9  # [N·m] inverse dynamics vs reported torque: round-off of (v' - v) / dt
@@ -38,20 +39,14 @@ TILTED_URDF = """<robot name="tilted">
 </robot>"""
 
 
-def _arm(model: pin.Model, lower: float = -1e3, upper: float = 1e3, **kw: float) -> Arm:
+def _arm(model: pin.Model, lower: float = -1e3, upper: float = 1e3, **kw: float) -> Robot:
     n = model.nv
-    base = dict(effort=np.inf, velocity=100.0, damping=0.0, friction=0.0)
+    base = dict(lower=lower, upper=upper, effort=np.inf, velocity=100.0, damping=0.0, friction=0.0)
     base.update(kw)
-    return Arm(
-        model=model,
-        joint_names=tuple(model.names[1:]),
-        lower=np.full(n, lower),
-        upper=np.full(n, upper),
-        **{k: np.full(n, float(v)) for k, v in base.items()},
-    )
+    return Robot(model).with_limits(**{k: np.full(n, float(v)) for k, v in base.items()})
 
 
-def _plant(arm: Arm, cfg: SimConfig) -> ro.Plant:
+def _plant(arm: Robot, cfg: SimConfig) -> ro.Plant:
     return plant_of(arm, cfg, energy_max=1e9)
 
 
@@ -69,7 +64,7 @@ def pendulum(length: float = 0.5) -> pin.Model:
 
 @pytest.mark.parametrize("integrator", ["euler", "rk4"])
 def test_tilted_axes_run_into_the_prismatic_stop(integrator: Integrator) -> None:
-    arm = arm_from_model(pin.buildModelFromXML(TILTED_URDF))
+    arm = simulated(Robot(pin.buildModelFromXML(TILTED_URDF)))
     kinds = {arm.model.joints[j].shortname() for j in range(1, arm.model.njoints)}
     assert {"JointModelRevoluteUnaligned", "JointModelPrismaticUnaligned"} <= kinds
     cfg = SimConfig(np.full(3, 20.0), np.full(3, 0.5), dt=5e-4, integrator=integrator)

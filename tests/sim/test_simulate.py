@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -11,19 +10,20 @@ import pinocchio as pin
 import pytest
 
 from armcli.errors import InputError, SimulationError, UnstableLoopError
-from armcli.robot.load import load_model
+from armcli.robot.model import Robot
 from armcli.sim import rollout as ro
 from armcli.sim.options import Integrator
 from armcli.sim.reference import build_reference
 from armcli.sim.simulate import (
-    Arm,
     SimConfig,
-    arm_from_model,
+    check_limits,
     check_stability,
     plant_of,
     simulate,
+    simulated,
 )
 from armcli.sim.trajectory import loads_trajectory
+from tests.helpers import load_robot
 from tests.sim.engines import run_held
 
 G = 9.81
@@ -31,7 +31,7 @@ WIDE = 1e3  # [rad] limits far away: no stop contact
 ROUNDOFF = 1e-12
 
 
-def pendulum(mass: float = 1.0, length: float = 0.5, gravity: bool = True) -> Arm:
+def pendulum(mass: float = 1.0, length: float = 0.5, gravity: bool = True) -> Robot:
     """Point-mass-like rod pendulum about y: I_pivot = m l^2 + I_c."""
     model = pin.Model()
     jid = model.addJoint(0, pin.JointModelRY(), pin.SE3.Identity(), "hinge")
@@ -44,25 +44,19 @@ def pendulum(mass: float = 1.0, length: float = 0.5, gravity: bool = True) -> Ar
     return _arm(model)
 
 
-def _arm(model: pin.Model, lower: float = -WIDE, upper: float = WIDE, **kw: float) -> Arm:
+def _arm(model: pin.Model, lower: float = -WIDE, upper: float = WIDE, **kw: float) -> Robot:
     n = model.nv
-    base = dict(effort=np.inf, velocity=100.0, damping=0.0, friction=0.0)
+    base = dict(lower=lower, upper=upper, effort=np.inf, velocity=100.0, damping=0.0, friction=0.0)
     base.update(kw)
-    return Arm(
-        model=model,
-        joint_names=tuple(model.names[1:]),
-        lower=np.full(n, lower),
-        upper=np.full(n, upper),
-        **{k: np.full(n, float(v)) for k, v in base.items()},
-    )
+    return Robot(model).with_limits(**{k: np.full(n, float(v)) for k, v in base.items()})
 
 
 @pytest.fixture(scope="module")
-def arm(built_dir: Path) -> Arm:
-    return arm_from_model(load_model(built_dir / "standalone_arm.urdf").model)
+def arm(built_dir: Path) -> Robot:
+    return simulated(load_robot(built_dir / "standalone_arm.urdf"))
 
 
-def _plant(arm: Arm, cfg: SimConfig) -> ro.Plant:
+def _plant(arm: Robot, cfg: SimConfig) -> ro.Plant:
     return plant_of(arm, cfg)
 
 
@@ -97,7 +91,7 @@ def test_pendulum_small_amplitude_period(integrator: Integrator) -> None:
     assert period == pytest.approx(expected, rel=5e-5)
 
 
-def test_energy_conserved_without_damping(arm: Arm) -> None:
+def test_energy_conserved_without_damping(arm: Robot) -> None:
     free = _arm(arm.model)
     cfg = SimConfig(kp=np.zeros(2), kd=np.zeros(2), dt=2.5e-4, integrator="rk4")
     steps = 40_000  # 10 s
@@ -109,7 +103,7 @@ def test_energy_conserved_without_damping(arm: Arm) -> None:
     assert max(abs(e - e0) for e in energies) < 1e-7
 
 
-def test_semi_implicit_euler_energy_bounded(arm: Arm) -> None:
+def test_semi_implicit_euler_energy_bounded(arm: Robot) -> None:
     free = _arm(arm.model)
     energy_err = {}
     for dt in (1e-3, 1e-4):
@@ -127,7 +121,7 @@ def test_semi_implicit_euler_energy_bounded(arm: Arm) -> None:
     assert 5 < energy_err[1e-3] / energy_err[1e-4] < 20
 
 
-def test_pd_with_gravity_compensation_converges(arm: Arm) -> None:
+def test_pd_with_gravity_compensation_converges(arm: Robot) -> None:
     plant_arm = _arm(arm.model, lower=0.0, upper=math.pi / 2, damping=0.1)
     cfg = SimConfig(kp=np.full(2, 50.0), kd=np.full(2, 5.0), dt=1e-3, gravity_comp=True)
     r = run_held(_plant(plant_arm, cfg), [0.2, 0.2], [0.0, 0.0], 8000, [0.7, 0.9]).trace
@@ -154,7 +148,7 @@ def test_coulomb_friction_slip_acceleration() -> None:
     assert a == pytest.approx((0.2 - 0.05) / I_pivot, rel=1e-3)
 
 
-def test_hard_stop_no_pass_through_no_energy_gain(arm: Arm) -> None:
+def test_hard_stop_no_pass_through_no_energy_gain(arm: Robot) -> None:
     stops = _arm(arm.model, lower=0.0, upper=math.pi / 2)
     cfg = SimConfig(kp=np.zeros(2), kd=np.zeros(2), dt=1e-3)
     r = run_held(_plant(stops, cfg), [0.3, 0.2], [2.0, 3.0], 3000).trace
@@ -166,17 +160,17 @@ def test_hard_stop_no_pass_through_no_energy_gain(arm: Arm) -> None:
 
 
 @pytest.mark.parametrize("dt", [1e-3, 5e-3, 1e-2])
-def test_implicit_damping_stable_for_large_kd(arm: Arm, dt: float) -> None:
+def test_implicit_damping_stable_for_large_kd(arm: Robot, dt: float) -> None:
     # explicit Euler would need dt (Kd + D) lambda_max(M^-1) < 2, i.e. Kd < ~3.5 at 1 ms
     cfg = SimConfig(kp=np.full(2, 50.0), kd=np.full(2, 50.0), dt=dt, gravity_comp=True)
     check_stability(arm, cfg, np.zeros((1, 2)))
     tr = loads_trajectory("joint_names: [arm_base_forearm_joint]\npoints: [{positions: [0.8]}]",
-                          dict.fromkeys(arm.joint_names, (0.0, 2.0)))  # fmt: skip
-    res = simulate(arm, build_reference(tr, arm.joint_names, np.zeros(2)), np.zeros(2), 8.0, cfg)
+                          dict.fromkeys(arm.names, (0.0, 2.0)))  # fmt: skip
+    res = simulate(arm, build_reference(tr, arm.names, np.zeros(2)), np.zeros(2), 8.0, cfg)
     assert abs(res.q[-1, 0] - 0.8) < 0.01  # friction 0.05 / Kp 50 = 1e-3 rad band
 
 
-def test_stability_check_refuses_and_explains(arm: Arm) -> None:
+def test_stability_check_refuses_and_explains(arm: Robot) -> None:
     cfg = SimConfig(kp=np.full(2, 50.0), kd=np.full(2, 5.0), dt=1e-3, integrator="rk4")
     with pytest.raises(UnstableLoopError, match=r"stable for dt <= .*default euler integrator"):
         check_stability(arm, cfg, np.zeros((1, 2)))
@@ -187,21 +181,19 @@ def test_stability_check_refuses_and_explains(arm: Arm) -> None:
     assert "--dt" not in str(exc.value)
 
 
-def test_divergence_is_reported_not_nan(arm: Arm) -> None:
+def test_divergence_is_reported_not_nan(arm: Robot) -> None:
     unlimited = _arm(arm.model)  # no effort limit, no stops: nothing bounds the blow-up
     cfg = SimConfig(kp=np.full(2, 1e8), kd=np.zeros(2), dt=1e-3)
     tr = loads_trajectory("joint_names: [forearm_hand_joint]\npoints: [{positions: [0.5]}]",
-                          dict.fromkeys(arm.joint_names, (0.0, 2.0)))  # fmt: skip
+                          dict.fromkeys(arm.names, (0.0, 2.0)))  # fmt: skip
     with pytest.raises(SimulationError) as exc:
-        simulate(
-            unlimited, build_reference(tr, arm.joint_names, np.zeros(2)), np.zeros(2), 2.0, cfg
-        )
+        simulate(unlimited, build_reference(tr, arm.names, np.zeros(2)), np.zeros(2), 2.0, cfg)
     err = exc.value
     assert err.step is not None and err.step > 0 and err.time == pytest.approx(err.step * 1e-3)
     assert err.cause and "nan" not in str(err).lower()
 
 
-def test_reported_effort_balances_gravity_at_rest(arm: Arm) -> None:
+def test_reported_effort_balances_gravity_at_rest(arm: Robot) -> None:
     no_friction = _arm(arm.model, lower=0.0, upper=math.pi / 2, damping=0.1)
     cfg = SimConfig(kp=np.full(2, 50.0), kd=np.full(2, 5.0), dt=1e-3)  # no gravity comp
     r = run_held(_plant(no_friction, cfg), [0.7, 0.9], [0.0, 0.0], 10_000, [0.7, 0.9]).trace
@@ -220,22 +212,22 @@ def test_reported_effort_balances_gravity_at_rest(arm: Arm) -> None:
         ("damping", math.inf, "damping inf"),
         ("lower", math.nan, "lower nan"),  # would mean "no stop"
         ("upper", math.nan, "upper nan"),
-        ("effort", 0.0, "effort 0"),
+        # an effort <= 0 is no limit (inf), as the URDF reads: tests/robot/test_model.py
         ("velocity", math.nan, "velocity nan"),
     ],
 )
 def test_arm_refuses_values_that_are_not_numbers_or_out_of_order(
-    arm: Arm, field: str, value: float, message: str
+    arm: Robot, field: str, value: float, message: str
 ) -> None:
     bad = getattr(arm, field).copy()
     bad[1] = value
     with pytest.raises(InputError, match=rf"joint 'forearm_hand_joint': {message} "):
-        replace(arm, **{field: bad})
+        check_limits(arm.with_limits(**{field: bad}))
 
 
-def test_arm_refuses_limits_out_of_order(arm: Arm) -> None:
+def test_arm_refuses_limits_out_of_order(arm: Robot) -> None:
     with pytest.raises(InputError, match=r"lower limit 1 is above upper 0\.5"):
-        replace(arm, lower=np.array([0.0, 1.0]), upper=np.array([1.0, 0.5]))
+        simulated(arm.with_limits(lower=np.array([0.0, 1.0]), upper=np.array([1.0, 0.5])))
 
 
 @pytest.mark.parametrize(

@@ -25,7 +25,7 @@ from armcli.tune import job as tjob
 from armcli.tune import session
 from armcli.tune.engine import DaskEngine, LocalEngine
 from armcli.tune.objective import INFEASIBLE_COST, RMS, Weights
-from armcli.tune.problem import nominal_arm
+from armcli.tune.problem import nominal_robot
 from armcli.tune.search import SearchOptions, cost_of, nominal
 from tests.helpers import ROOT
 
@@ -67,7 +67,7 @@ def test_metrics_match_a_plain_simulate_run(job: tjob.TuneJob) -> None:
     ev = LocalEngine(1).evaluate(p, [gains], Weights())[0]
     case = p.cases[0]
     cfg = SimConfig(job.start.kp, job.start.kd, p.dt, p.integrator, p.gravity_comp)
-    res = simulate(nominal_arm(p), case.reference, case.q0, case.duration, cfg)
+    res = simulate(nominal_robot(p), case.reference, case.q0, case.duration, cfg)
     expected = [m.rms_error for m in joint_metrics(res, case.t_end)]
     assert ev.metrics[0, 0, :n, RMS].tolist() == expected
 

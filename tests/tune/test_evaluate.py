@@ -72,8 +72,8 @@ def test_stability_verdict_per_candidate_is_the_bound(job: tjob.TuneJob) -> None
     Ms, Gs = list(sm.lin.M), list(sm.lin.G)
     for scale in (1.0, 30.0, 1e3, 1e5):
         kp = job.start.kp * scale
-        pd = pdloop.PD.of(range(n), kp, job.start.kd, sm.arm.damping)
-        d = job.start.kd + sm.arm.damping
+        pd = pdloop.PD.of(range(n), kp, job.start.kd, sm.robot.damping)
+        d = job.start.kd + sm.robot.damping
         rho = ref.worst_radius(Ms, Gs, range(n), kp, d, job.problem.dt, "implicit")
         assert stab.stable(sm.lin, pd, job.problem.dt, "implicit") == (rho <= 1 + ref.RADIUS_TOL)
 
@@ -88,8 +88,8 @@ def test_a_rollout_keeps_only_the_states_its_metrics_read(job: tjob.TuneJob) -> 
     kp, kd = np.split(_batch(job)[2], 2)
     cfg = SimConfig(kp, kd, job.problem.dt, job.problem.integrator, job.problem.gravity_comp)
     for case in job.problem.cases:
-        (kept,) = evaluate.rollout_batch([evaluate.RolloutJob(sm.arm, case, cfg)])
-        whole = simulate(sm.arm, case.reference, case.q0, case.duration, cfg)
+        (kept,) = evaluate.rollout_batch([evaluate.RolloutJob(sm.robot, case, cfg)])
+        whole = simulate(sm.robot, case.reference, case.q0, case.duration, cfg)
         assert kept is not None
         assert kept.step[0] == round(case.t_end / cfg.dt) and kept.step[-1] == whole.steps
         assert kept.q.shape[0] < whole.q.shape[0] / 2

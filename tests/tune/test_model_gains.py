@@ -4,17 +4,16 @@ torque: the joint axis is vertical), so the loop is m q'' + kd q' + kp q = kp q_
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from armcli.robot.load import load_model
+from armcli.robot.model import Robot
 from armcli.sim.reference import Reference
-from armcli.sim.simulate import Arm, SimConfig, SimResult, arm_from_model, simulate
+from armcli.sim.simulate import SimConfig, SimResult, simulate, simulated
 from armcli.tune.model_gains import STABILITY_MARGIN, start_gains
 from armcli.tune.objective import overshoot
-from tests.helpers import FIXTURES
+from tests.helpers import FIXTURES, load_robot
 
 URDF = FIXTURES / "tune" / "pendulum.urdf"
 M_PENDULUM = 0.01 + 2.0 * 0.5**2  # [kg·m²] izz + m r² from the fixture
@@ -26,12 +25,12 @@ GAIN_REL_TOL = 1e-9
 
 
 @pytest.fixture(scope="module")
-def arm() -> Arm:
-    return arm_from_model(load_model(URDF).model)
+def arm() -> Robot:
+    return simulated(load_robot(URDF))
 
 
 def step_response(
-    arm: Arm, kp: float, kd: float, duration: float
+    arm: Robot, kp: float, kd: float, duration: float
 ) -> tuple[np.ndarray, np.ndarray, SimResult]:
     ref = Reference(knots=np.array([0.0]), coeffs=np.zeros((0, 6, 1)), final=np.array([STEP]))
     cfg = SimConfig(np.array([kp]), np.array([kd]), DT_FINE)
@@ -40,7 +39,7 @@ def step_response(
 
 
 @pytest.mark.parametrize("zeta, wn", [(0.5, 10.0), (0.3, 20.0)])
-def test_underdamped_step_matches_closed_form(arm: Arm, zeta: float, wn: float) -> None:
+def test_underdamped_step_matches_closed_form(arm: Robot, zeta: float, wn: float) -> None:
     start = start_gains(arm, dt=DT_FINE, loop="implicit", zeta=zeta, wn_target=wn,
                         steps=np.array([STEP]))  # fmt: skip
     row = start.rows[0]
@@ -61,7 +60,7 @@ def test_underdamped_step_matches_closed_form(arm: Arm, zeta: float, wn: float) 
     assert overshoot(res, 0.0)[0] == pytest.approx(measured_os, abs=1e-12)
 
 
-def test_critical_damping_does_not_overshoot(arm: Arm) -> None:
+def test_critical_damping_does_not_overshoot(arm: Robot) -> None:
     start = start_gains(arm, dt=DT_FINE, loop="implicit", zeta=1.0, wn_target=10.0,
                         steps=np.array([STEP]))  # fmt: skip
     _, q, _ = step_response(arm, start.kp[0], start.kd[0], duration=2.0)
@@ -81,7 +80,7 @@ def test_critical_damping_does_not_overshoot(arm: Arm) -> None:
         ("explicit", 2.0 * math.sqrt(2.0) - 2.0),
     ],
 )
-def test_stability_cap_is_the_jury_bound(arm: Arm, loop: str, x_max: float) -> None:
+def test_stability_cap_is_the_jury_bound(arm: Robot, loop: str, x_max: float) -> None:
     dt = 0.01
     start = start_gains(arm, dt=dt, loop=loop, zeta=1.0, wn_target=1e4, steps=np.array([STEP]))
     row = start.rows[0]
@@ -89,9 +88,9 @@ def test_stability_cap_is_the_jury_bound(arm: Arm, loop: str, x_max: float) -> N
     assert row.wn == pytest.approx(x_max / (STABILITY_MARGIN * dt), rel=1e-6)
 
 
-def test_effort_cap(arm: Arm) -> None:
+def test_effort_cap(arm: Robot) -> None:
     effort = 20.0  # [N·m]
-    limited = replace(arm, effort=np.array([effort]))
+    limited = arm.with_limits(effort=np.array([effort]))
     start = start_gains(limited, dt=1e-3, loop="implicit", zeta=1.0, wn_target=1e3,
                         steps=np.array([STEP]))  # fmt: skip
     # No gravity torque: kp * step = effort exactly.

@@ -18,7 +18,7 @@ from armcli.tune import session
 from armcli.tune.engine import LocalEngine
 from armcli.tune.model_gains import linearised, sample_configurations
 from armcli.tune.objective import INFEASIBLE_COST
-from armcli.tune.problem import nominal_arm
+from armcli.tune.problem import nominal_robot
 from armcli.tune.search import SearchOptions, cost_of
 from tests.helpers import ROOT
 
@@ -47,9 +47,9 @@ def test_default_cases_are_the_example_trajectories(job: tjob.TuneJob) -> None:
 
 
 def test_tuned_gains_stable_at_the_spec_dt(job: tjob.TuneJob, outcome: session.Outcome) -> None:
-    arm = nominal_arm(job.problem)
+    arm = nominal_robot(job.problem)
     qs = sample_configurations(arm)
-    n = len(arm.joint_names)
+    n = len(arm.names)
     best = outcome.result.best
     pd = pdloop.PD.of(range(n), best[:n], best[n:], arm.damping)
     rep = analyse(linearised(arm, qs, gravity=True), qs.tolist(), pd, load_spec(SPEC).control.dt)

@@ -7,11 +7,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from armcli.robot.load import load_model
-from armcli.sim.simulate import Arm, arm_from_model
+from armcli.robot.model import Robot
+from armcli.sim.simulate import simulated
 from armcli.tune.model_gains import linearised, loop_stable, sample_configurations
 from armcli.tune.spec_start import KD_MARGIN, _explicit_kd
-from tests.helpers import FIXTURES
+from tests.helpers import FIXTURES, load_robot
 
 URDF = FIXTURES / "tune" / "pendulum.urdf"
 M_PENDULUM = 0.01 + 2.0 * 0.5**2  # [kg·m²] izz + m r² from the fixture (vertical axis)
@@ -21,11 +21,11 @@ BISECT_REL_TOL = 1e-3
 
 
 @pytest.fixture(scope="module")
-def arm() -> Arm:
-    return arm_from_model(load_model(URDF).model)
+def arm() -> Robot:
+    return simulated(load_robot(URDF))
 
 
-def test_kd_lowered_to_the_explicit_bound(arm: Arm) -> None:
+def test_kd_lowered_to_the_explicit_bound(arm: Robot) -> None:
     kp = np.array([M_PENDULUM * WN**2])
     kd = np.array([2.0 * WN * M_PENDULUM])  # zeta = 1
     lin = linearised(arm, sample_configurations(arm), gravity=True)
@@ -39,6 +39,6 @@ def test_kd_lowered_to_the_explicit_bound(arm: Arm) -> None:
     assert loop_stable(arm, lin, kp, got, "implicit", DT)  # the simulator's loop too
 
 
-def test_stable_gains_are_kept(arm: Arm) -> None:
+def test_stable_gains_are_kept(arm: Robot) -> None:
     kp, kd = np.array([1.0]), np.array([0.1])
     assert _explicit_kd(arm, kp, kd, DT).tolist() == kd.tolist()

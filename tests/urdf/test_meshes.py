@@ -52,7 +52,7 @@ def _robot_route(pkg: Path, uri: str) -> list[str]:
     """The collision mesh files Pinocchio loaded for `check` and `plan` (the URDF in urdf/)."""
     source = pkg / "urdf" / "r.urdf"
     source.write_bytes(_text(uri))
-    gm = Robot.from_urdf(parse_urdf(_text(uri), str(source))).collision_model(SEARCH)
+    gm = Robot.load(parse_urdf(_text(uri), str(source))).collision_model(SEARCH)
     return [g.meshPath for g in gm.geometryObjects]
 
 

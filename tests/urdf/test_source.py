@@ -9,7 +9,7 @@ import pytest
 
 from armcli.errors import InputError, XacroRefusedError
 from armcli.io.packages import PackageLookup
-from armcli.robot.load import checked_model
+from armcli.robot.model import Robot
 from armcli.urdf.source import (
     Trust,
     allowed_roots,
@@ -67,14 +67,14 @@ def test_foreign_xacro_safe_by_suffix_or_content(tmp_path: Path, name: str) -> N
     assert {j.name for j in safe.joints} >= {"arm_base_forearm_joint", "forearm_hand_joint"}
 
 
-def test_checked_model_refuses_what_pinocchio_would_accept(root: Path) -> None:
+def test_robot_load_refuses_what_pinocchio_would_accept(root: Path) -> None:
     with pytest.raises(InputError, match=r"nan_mass\.urdf:\d+: .*mass@value: non-finite"):
-        checked_model(read_urdf_file(BAD / "urdf" / "nan_mass.urdf"))
+        Robot.load(read_urdf_file(BAD / "urdf" / "nan_mass.urdf"))
     with pytest.raises(InputError, match="not a number: '0x1p-1'"):
-        checked_model(read_urdf_file(BAD / "urdf" / "hex_number.urdf"))
+        Robot.load(read_urdf_file(BAD / "urdf" / "hex_number.urdf"))
     with pytest.raises(XacroRefusedError):
-        checked_model(read_urdf_file(BAD / "xacro" / "eval_exploit_renamed.urdf"))
-    loaded = checked_model(read_urdf_file(root / "urdf" / "standalone_arm.urdf"))
+        Robot.load(read_urdf_file(BAD / "xacro" / "eval_exploit_renamed.urdf"))
+    loaded = Robot.load(read_urdf_file(root / "urdf" / "standalone_arm.urdf"))
     assert loaded.model.nq == 2
     assert abs(sum(i.mass for i in loaded.model.inertias) - ARM_MASS_KG) < MASS_TOL
 

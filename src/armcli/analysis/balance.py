@@ -29,7 +29,6 @@ from numpy.typing import ArrayLike, NDArray
 from armcli.analysis.boxsearch import minimize_box
 from armcli.analysis.stance import Stance
 from armcli.robot import sampling
-from armcli.robot.frames import link_frame
 from armcli.robot.sampling import BALANCE_DRAWS
 
 SEEDS_DESCENDED = 3  # local searches per edge and measure, from the best seeds
@@ -97,13 +96,10 @@ class _Mass:
     def __init__(self, stance: Stance) -> None:
 
         self.s = stance
-        self.model = stance.model
-        self.data = stance.robot.data
+        self.robot = stance.robot
         self.M = stance.mass
         self.iv = [jr.idx_v for jr in stance.joints]
-        p = stance.payload
-        self.frame = link_frame(self.model, p.link) if p is not None else None
-        self.xyz = np.asarray(p.xyz if p is not None else (0.0, 0.0, 0.0), dtype=float)
+        self.payload = stance.payload  # its link is one of the robot's (stance_of checked)
         self.jacobians = 0  # com_jac calls so far (bounded by MAX_JACOBIANS)
 
     @property
@@ -120,13 +116,10 @@ class _Mass:
 
     def parts_at(self, q: NDArray[np.float64]) -> tuple[NDArray[Any], NDArray[Any]]:
         """(unloaded centre of mass, payload point) [m] at the configuration q."""
-        import pinocchio as pin
-
-        c0 = np.array(pin.centerOfMass(self.model, self.data, q))
-        if self.frame is None:
+        c0 = self.robot.center_of_mass(q)
+        if self.payload is None:
             return c0, c0
-        pin.updateFramePlacement(self.model, self.data, self.frame)
-        return c0, np.asarray(self.data.oMf[self.frame].act(self.xyz), dtype=float)
+        return c0, self.robot.point_position(self.payload.link, self.payload.xyz, q)
 
     def com(self, x: ArrayLike, m: float) -> NDArray[Any]:
         c0, p = self.parts(x)
@@ -139,26 +132,14 @@ class _Mass:
         return c, (0.0 * J if self.spent else J)
 
     def _com_jac(self, x: ArrayLike, m: float) -> tuple[NDArray[Any], NDArray[Any]]:
-        import pinocchio as pin
-
         q = self.q(x)
-        J0 = np.array(pin.jacobianCenterOfMass(self.model, self.data, q)).reshape(3, -1)
-        J0 = J0[:, self.iv]  # nv = 1 comes back 1-D
-        c0 = np.array(self.data.com[0])
-        if self.frame is None or m <= 0:
+        c0, J0 = self.robot.center_of_mass_jacobian(q)
+        J0 = J0[:, self.iv]
+        if self.payload is None or m <= 0:
             return c0, J0
-        J6 = pin.computeFrameJacobian(self.model, self.data, q, self.frame,
-                                      pin.LOCAL_WORLD_ALIGNED)  # fmt: skip
-        J = np.asarray(J6, dtype=float).reshape(6, -1)[:, self.iv]
-        T = self.data.oMf[self.frame]
-        r = np.asarray(T.rotation, dtype=float) @ self.xyz
-        p = np.asarray(T.translation, dtype=float) + r
-        Jp = J[:3] - _skew(r) @ J[3:]
+        p, Jp = self.robot.jacobian(q, self.payload.link, self.payload.xyz, self.iv)
+        Jp = Jp[:3]
         return (self.M * c0 + m * p) / (self.M + m), (self.M * J0 + m * Jp) / (self.M + m)
-
-
-def _skew(r: NDArray[Any]) -> NDArray[Any]:
-    return np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
 
 
 def analyse(
@@ -245,8 +226,8 @@ def _point_label(stance: Stance) -> str:
 
 
 def _values(stance: Stance, values: dict[str, float]) -> list[float]:
-    """The searched joints' values of a pose (0 clamped into range where it gives none)."""
-    return [float(np.clip(values.get(j.name, 0.0), lo, hi))
+    """The searched joints' values of a pose, clamped into range; a joint it leaves out rests."""
+    return [float(np.clip(values.get(j.name, j.rest), lo, hi))
             for j, (lo, hi) in zip(stance.joints, stance.box, strict=True)]  # fmt: skip
 
 
@@ -266,7 +247,9 @@ def _at(
         margins=tuple(float(v) for v in d),
         tip_angles=tuple(math.atan2(float(v), h) for v in d),
         margin=poly.margin(c),
-        payload_max=_payload_max(ev, c0, p, threshold) if payload and ev.frame else None,
+        payload_max=_payload_max(ev, c0, p, threshold)
+        if payload and ev.payload is not None
+        else None,
     )
 
 
@@ -371,7 +354,7 @@ def _payload_over_range(
     search's worst configuration for the current guess gives the next one, until the
     guess repeats. None when the robot fails unloaded.
     """
-    if ev.frame is None:
+    if ev.payload is None:
         return None
     guess, bounds = (m if m > 0 else 1.0), [math.inf]
     worst: tuple[PoseBalance, ...] = ()

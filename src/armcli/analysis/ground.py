@@ -28,8 +28,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from armcli.robot.frames import link_frame
-from armcli.robot.inertia import rpy_matrix
+from armcli.robot.frames import link_frame, pose_matrix
+from armcli.robot.model import Robot
 from armcli.spec.joint_types import ROTARY_TYPES
 from armcli.urdf.doc import Shape, Urdf, Vec3
 from armcli.urdf.mesh_points import read_vertices
@@ -84,7 +84,7 @@ def shape_points(shape: Shape, T: NDArray[np.float64], mesh: MeshVertices | None
     g = shape.geometry
     if g is None or (g.kind != "mesh" and not g.dims):
         return np.empty((0, 3))
-    Tm = T @ _pose_matrix(shape.origin.xyz, shape.origin.rpy)
+    Tm = T @ pose_matrix(shape.origin.xyz, shape.origin.rpy)
     R, c = Tm[:3, :3], Tm[:3, 3]
     if g.kind == "box" and g.dims is not None and len(g.dims) == 3:
         signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
@@ -115,26 +115,11 @@ def _cylinder_bottom(R: NDArray[Any], c: NDArray[Any], r: float, length: float) 
     return np.vstack([cap + rim for cap in caps])
 
 
-def _pose_matrix(xyz: Sequence[float], rpy: Sequence[float]) -> NDArray[np.float64]:
-    """4x4 of a URDF origin."""
-    T = np.eye(4)
-    T[:3, :3] = rpy_matrix(rpy)
-    T[:3, 3] = xyz
-    return T
-
-
-def link_poses(model: Any, names: Collection[str]) -> dict[str, NDArray[np.float64]]:
+def link_poses(robot: Robot, names: Collection[str]) -> dict[str, NDArray[np.float64]]:
     """4x4 pose [m] in the root frame of each named link at the neutral pose (Pinocchio FK)."""
-    import pinocchio as pin
-
-    data = model.createData()
-    pin.framesForwardKinematics(model, data, pin.neutral(model))
-    out = {}
-    for name in names:
-        frame = link_frame(model, name)
-        if frame is not None:
-            out[name] = np.asarray(data.oMf[frame].homogeneous)
-    return out
+    q = robot.neutral()
+    found = {name: link_frame(robot.model, name) for name in names}
+    return {name: robot.frame_pose(fid, q) for name, fid in found.items() if fid is not None}
 
 
 def _rolling_links(urdf: Urdf, poses: dict[str, NDArray[np.float64]]) -> set[str]:
@@ -170,7 +155,7 @@ def _rolling_links(urdf: Urdf, poses: dict[str, NDArray[np.float64]]) -> set[str
 
 def find_ground(
     urdf: Urdf,
-    model: Any,
+    robot: Robot,
     *,
     candidates: Collection[str] | None = None,
     declared: Sequence[str] | None = None,
@@ -190,7 +175,7 @@ def find_ground(
         pool = [lk for lk in pool if lk.name in wanted]
     elif candidates is not None:
         pool = [lk for lk in pool if lk.name in candidates]
-    poses = link_poses(model, [lk.name for lk in pool])
+    poses = link_poses(robot, [lk.name for lk in pool])
     lowest: dict[str, NDArray[Any]] = {}
     for lk in pool:
         if lk.name not in poses:

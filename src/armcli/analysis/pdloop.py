@@ -14,7 +14,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from armcli.robot.load import mass_matrix
+from armcli.robot.model import Robot
 
 Scheme = Literal["explicit", "implicit", "rk4"]
 """How the PD loop is stepped: semi-implicit Euler with damping explicit (a torque loop as
@@ -73,23 +73,15 @@ def one_blas_thread() -> Iterator[None]:
         yield
 
 
-def linearise(
-    model: Any, configurations: Sequence[Any], *, gravity: bool = True, data: Any = None
-) -> Linearised:
+def linearise(robot: Robot, configurations: Sequence[Any], *, gravity: bool = True) -> Linearised:
     """M(q) (CRBA, symmetric) and G(q) = dg/dq at each Pinocchio configuration.
 
     `gravity=False` for a loop that compensates g(q) (then G = 0).
     """
-    import pinocchio as pin
-
-    data = data if data is not None else model.createData()
+    nv = robot.model.nv
     Ms, Gs = [], []
     for q in configurations:
         q = np.asarray(q, dtype=float)
-        Ms.append(mass_matrix(model, data, q))
-        if gravity:
-            G = np.array(pin.computeGeneralizedGravityDerivatives(model, data, q), dtype=float)
-            Gs.append(0.5 * (G + G.T))
-        else:
-            Gs.append(np.zeros((model.nv, model.nv)))
+        Ms.append(robot.mass_matrix(q))
+        Gs.append(robot.gravity_stiffness(q) if gravity else np.zeros((nv, nv)))
     return Linearised(np.array(Ms, dtype=float), np.array(Gs, dtype=float))

@@ -23,7 +23,8 @@ from armcli.errors import InputError
 from armcli.io.names import did_you_mean
 from armcli.robot import sampling
 from armcli.robot.frames import link_frame
-from armcli.robot.model import Joint, Robot
+from armcli.robot.joints import Joint
+from armcli.robot.model import Robot
 from armcli.urdf.doc import Urdf, Vec3
 
 FIXED_BASE = (
@@ -83,11 +84,12 @@ class Stance:
         """Mass of the robot [kg], without the payload."""
         return self.robot.mass
 
-    def loaded(self) -> Any:
-        """The model with the payload's point mass on its link (for inverse dynamics)."""
-        if self.payload is None or self.payload.mass <= 0:
-            return self.model
-        return with_payload(self.model, self.payload)
+    def loaded(self) -> Robot:
+        """The robot with the payload's point mass on its link (for inverse dynamics)."""
+        p = self.payload
+        if p is None or p.mass <= 0:
+            return self.robot
+        return self.robot.with_point_mass(p.link, p.xyz, p.mass)
 
     def height(self, com: ArrayLike) -> float:
         """Height [m] of a point above the ground plane."""
@@ -99,18 +101,6 @@ class NoStance:
     """Why a robot has no support polygon to analyse (a note for the report)."""
 
     reason: str
-
-
-def with_payload(model: Any, payload: Payload) -> Any:
-    """A copy of `model` with the payload's point mass added to its link's body."""
-    import pinocchio as pin
-
-    out = pin.Model(model)
-    frame = out.frames[link_frame(out, payload.link)]
-    point = frame.placement.act(np.asarray(payload.xyz, dtype=float))
-    jid = frame.parentJoint
-    out.inertias[jid] = out.inertias[jid] + pin.Inertia(payload.mass, point, np.zeros((3, 3)))
-    return out
 
 
 def stance_of(
@@ -130,8 +120,7 @@ def stance_of(
     names = {lk.name for lk in urdf.links}
     if declared is None and candidates is not None and not names & set(candidates):
         return NoStance(FIXED_BASE)  # e.g. a spec's standalone arm: none of its base's links
-    robot = Robot.from_urdf(urdf, floating=True)
-    model = robot.model
+    robot = Robot.load(urdf, floating=True, strict=False)
     if declared is not None:
         unknown = [n for n in declared if n not in names]
         if unknown:
@@ -141,14 +130,14 @@ def stance_of(
                 file=urdf.source,
                 field="contact_links",
             )
-    ground = find_ground(urdf, model, candidates=candidates, declared=declared, mesh=mesh)
+    ground = find_ground(urdf, robot, candidates=candidates, declared=declared, mesh=mesh)
     if ground is None or (declared is None and candidates is None and not has_wheels(ground)):
         return NoStance(FIXED_BASE)
     polygon = support_polygon(ground.points())
     if polygon is None:
         links = ", ".join(ground.links)
         return NoStance(f"the ground contacts ({links}) span no area: no support polygon")
-    if payload is not None and link_frame(model, payload.link) is None:
+    if payload is not None and link_frame(robot.model, payload.link) is None:
         raise InputError(
             f"unknown link {payload.link!r} for the payload; "
             f"{did_you_mean(payload.link, names)}links: {', '.join(sorted(names))}",
@@ -162,9 +151,7 @@ def _free_joints(robot: Robot, contacts: Collection[str]) -> tuple[Joint, ...]:
     model = robot.model
     carrying: set[int] = set()
     for link in contacts:
-        frame = link_frame(model, link)
-        assert frame is not None  # a contact link is a link of the model (analysis.ground)
-        jid = model.frames[frame].parentJoint
+        jid = model.frames[robot.frame(link)].parentJoint
         while jid > 0:
             carrying.add(jid)
             jid = model.parents[jid]

@@ -29,8 +29,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from armcli.analysis.boxsearch import minimize_box
 from armcli.robot import sampling
-from armcli.robot.frames import link_frame
-from armcli.robot.model import Joint, Robot
+from armcli.robot.frames import joint_frame, link_frame
+from armcli.robot.joints import Joint
+from armcli.robot.model import Robot
 from armcli.robot.sampling import REACH_DRAWS, SAMPLE_SEED
 from armcli.robot.tool import ToolPoint
 
@@ -84,7 +85,6 @@ class Chain:
             raise ValueError(f"no link {tool.link!r} in the model")
         self.robot = robot
         self.model = model
-        self.data = robot.data
         self.frame = frame
         self.xyz = np.asarray(tool.xyz, dtype=float)
         self.tool = tool
@@ -109,33 +109,20 @@ class Chain:
 
     def position(self, x: ArrayLike) -> NDArray[np.float64]:
         """The tool point [m] in the root frame."""
-        import pinocchio as pin
-
-        pin.framesForwardKinematics(self.model, self.data, self.q(x))
-        return np.asarray(self.data.oMf[self.frame].act(self.xyz), dtype=float)
+        return self.robot.point_position(self.tool.link, self.xyz, self.q(x))
 
     def jacobian(self, x: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """(tool point [m], d point / dx (3, n))."""
-        import pinocchio as pin
-
-        J6 = pin.computeFrameJacobian(self.model, self.data, self.q(x), self.frame,
-                                      pin.LOCAL_WORLD_ALIGNED)  # fmt: skip
-        J = np.asarray(J6, dtype=float).reshape(6, -1)[:, self.iv]  # nv = 1 comes back 1-D
-        T = self.data.oMf[self.frame]
-        r = np.asarray(T.rotation, dtype=float) @ self.xyz
-        p = np.asarray(T.translation, dtype=float) + r
-        skew = np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
-        return p, J[:3] - skew @ J[3:]
+        p, J = self.robot.jacobian(self.q(x), self.tool.link, self.xyz, self.iv)
+        return p, J[:3]
 
     def shoulder(self) -> NDArray[np.float64]:
         """The origin [m] of the chain's first moving joint (fixed by everything above it)."""
-        import pinocchio as pin
-
         if not self.joints:
             return self.position([])
-        pin.forwardKinematics(self.model, self.data, self.q0)
-        return np.asarray(self.data.oMi[self.model.getJointId(self.joints[0].name)].translation,
-                          dtype=float).copy()  # fmt: skip
+        first = joint_frame(self.model, self.joints[0].name)
+        assert first is not None  # one of the model's joints
+        return self.robot.frame_pose(first, self.q0)[:3, 3].copy()
 
     def names(self, x: ArrayLike) -> tuple[tuple[str, float], ...]:
         """The chain's joint values by name."""

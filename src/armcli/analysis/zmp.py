@@ -33,7 +33,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from armcli.analysis.stance import Stance
 from armcli.analysis.support import SupportPolygon
-from armcli.robot.model import Joint, Robot
+from armcli.robot.joints import Joint
+from armcli.robot.model import Robot
 from armcli.urdf.doc import Urdf
 
 MAX_SAMPLES = 20_000  # states whose zero-moment point is computed, at most (pairs of steps)
@@ -146,14 +147,14 @@ def zmp_series(
     """
     import pinocchio as pin
 
-    model = stance.loaded()
-    data = model.createData()
+    loaded = stance.loaded()
+    model, data = loaded.model, loaded.data
     rows, a = accelerations(np.asarray(step), np.asarray(v), dt, impact)
     skipped = 0 if impact is None else int(np.sum(np.asarray(impact, dtype=bool)))
     cols = _columns(stance.robot, joint_names)
-    to_q = stance.robot.joint_map(joint_names)  # others neutral, mimic followers following
+    to_q = stance.robot.joint_map(joint_names)  # others at rest, as simulate locks them
     iv = [j.idx_v for j in cols]
-    mass = float(sum(inertia.mass for inertia in model.inertias))
+    mass = loaded.mass
     z0 = stance.ground.height
     w, c = np.empty((len(rows), 6)), np.empty((len(rows), 3))
     vk, ak = np.zeros(model.nv), np.zeros(model.nv)

@@ -49,7 +49,7 @@ def check(c: Context) -> None:
         return
     names, pd = controlled
     ki = np.array([spec.control.gains[n].ki for n in names])
-    lin = pdloop.linearise(robot.model, [q for _, q in c.samples], data=robot.data)
+    lin = pdloop.linearise(robot, [q for _, q in c.samples])
     v = rate_verdict(lin, Pid.of(pd, ki), spec.control.controller_update_rate)
     c.rate = v
     if v.stable:

@@ -7,7 +7,6 @@ self-collision at the spec's named poses (Pinocchio GeometryModel + coal).
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import replace
 from typing import Any
 
@@ -20,6 +19,7 @@ from armcli.check.findings import Collector, JointRow, Value
 from armcli.check.options import CheckOptions
 from armcli.check.structure import finite
 from armcli.errors import ModelLoadError
+from armcli.robot.collision import SelfCollision
 from armcli.robot.model import Robot
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
@@ -54,12 +54,9 @@ def gravity(
     Returns:
         `rows` with `gravity_max` [N·m or N] filled in (None for joints not in the model).
     """
-    import pinocchio as pin
-
-    model, data = robot.model, robot.data
-    worst = np.zeros(model.nv)
+    worst = np.zeros(robot.model.nv)
     for _, q in samples:
-        worst = np.maximum(worst, np.abs(pin.computeGeneralizedGravity(model, data, q)))
+        worst = np.maximum(worst, np.abs(robot.gravity(q)))
     by_name = {j.name: j.idx_v for j in robot.joints}
     lines = {j.name: (j.limit.line if j.limit else j.line) for j in urdf.joints}
     new_rows = []
@@ -105,7 +102,7 @@ def stability(
         return None
     names, pd = controlled
     gravity = not spec.control.gravity_compensation
-    lin = pdloop.linearise(robot.model, [q for _, q in samples], gravity=gravity, data=robot.data)
+    lin = pdloop.linearise(robot, [q for _, q in samples], gravity=gravity)
     qs = [[p[n] for n in names] for p, _ in samples]
     rep = verdicts.analyse(lin, qs, pd, spec.control.dt)
     line = next((j.line for j in urdf.joints if j.name == names[0]), None)
@@ -167,8 +164,6 @@ def self_collision(
     Adjacent (parent-child) links and overlaps below PENETRATION_TOL [m] do not count. Skipped
     with a note when a mesh cannot be found or the collision model cannot be built.
     """
-    import pinocchio as pin
-
     search = opts.mesh_search()
     if any(p is None or not p.is_file() for p in mesh_paths(urdf, search).values()):
         notes.append("self-collision skipped: some meshes cannot be found")
@@ -178,33 +173,24 @@ def self_collision(
     except ModelLoadError as exc:
         notes.append(f"self-collision skipped: {exc.message}")
         return
-    model, data = robot.model, robot.data
-    link_of = [str(model.frames[g.parentFrame].name) for g in gmodel.geometryObjects]
     adjacent = {frozenset((j.parent, j.child)) for j in urdf.joints}
-    pairs = []
-    for i, k in itertools.combinations(range(len(link_of)), 2):
-        if link_of[i] != link_of[k] and frozenset((link_of[i], link_of[k])) not in adjacent:
-            gmodel.addCollisionPair(pin.CollisionPair(i, k))
-            pairs.append((link_of[i], link_of[k]))
-    gdata = pin.GeometryData(gmodel)
-    for req, pair in zip(gdata.collisionRequests, gmodel.collisionPairs, strict=True):
+    check = SelfCollision(robot, lambda a, b: frozenset((a, b)) not in adjacent, gmodel)
+    for req, (i, k) in zip(check.gdata.collisionRequests, check.objects, strict=True):
         # coal refuses negative margins on meshes ("not handled yet for BVHModel"): there,
         # touching counts as colliding.
-        meshy = _is_mesh(gmodel, pair.first) or _is_mesh(gmodel, pair.second)
+        meshy = _is_mesh(gmodel, i) or _is_mesh(gmodel, k)
         req.security_margin = 0.0 if meshy else -PENETRATION_TOL
     named = [p for p in poses if p[0] in (opts.spec.poses if opts.spec else {})]
     for name, values in named:
-        pin.computeCollisions(model, data, gmodel, gdata, robot.q(values), False)
-        for k, (a, b) in enumerate(pairs):
-            if gdata.collisionResults[k].isCollision():
-                out.add(
-                    "self-collision",
-                    _link_line(urdf, a),
-                    f"pose {name!r}: {a!r} and {b!r} collide",
-                    pose=name,
-                    link1=a,
-                    link2=b,
-                )
+        for a, b in (check.pairs[k] for k in check.colliding(robot.q(values))):
+            out.add(
+                "self-collision",
+                _link_line(urdf, a),
+                f"pose {name!r}: {a!r} and {b!r} collide",
+                pose=name,
+                link1=a,
+                link2=b,
+            )
 
 
 def _is_mesh(gmodel: Any, index: int) -> bool:

@@ -13,6 +13,7 @@ from armcli.check.findings import Collector
 from armcli.check.structure import finite
 from armcli.robot import inertia as inr
 from armcli.robot import inertia_bounds as bounds
+from armcli.robot.frames import rpy_matrix
 from armcli.urdf.doc import Inertial, Link, Shape, Urdf
 from armcli.urdf.tree import KinematicTree
 
@@ -181,7 +182,7 @@ def _solid_fix(link: Link, ine: Inertial) -> dict[str, float]:
         return {}
     if not finite(*ine.origin.rpy, *shape.origin.rpy):
         return {}
-    R_geom_inertial = inr.rpy_matrix(shape.origin.rpy).T @ inr.rpy_matrix(ine.origin.rpy)
+    R_geom_inertial = rpy_matrix(shape.origin.rpy).T @ rpy_matrix(ine.origin.rpy)
     return bounds.fix_values(
         bounds.solid_inertia(shape.geometry, float(ine.mass or 0.0)), R_geom_inertial
     )
@@ -200,8 +201,8 @@ def _versus_geometry(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -
     if not finite(*poses):
         return  # reported by the number rules
     g, m = shape.geometry, float(ine.mass or 0.0)
-    R_link_geom = inr.rpy_matrix(shape.origin.rpy)
-    R_link_inertial = inr.rpy_matrix(ine.origin.rpy)
+    R_link_geom = rpy_matrix(shape.origin.rpy)
+    R_link_inertial = rpy_matrix(ine.origin.rpy)
     # Both tensors expressed in the geometry frame, where the formula is diagonal.
     actual = inr.rotate(inr.rotate(J, R_link_inertial), R_link_geom.T)
     expected = bounds.solid_inertia(g, m)
@@ -251,8 +252,8 @@ def _exceeds(link: Link, ine: Inertial, J: np.ndarray, out: Collector) -> bool:
     if not finite(*ine.origin.xyz, *ine.origin.rpy, *shape.origin.xyz, *shape.origin.rpy):
         return False  # reported by the number rules
     g, m = shape.geometry, float(ine.mass or 0.0)
-    R_link_geom = inr.rpy_matrix(shape.origin.rpy)
-    R_geom_inertial = R_link_geom.T @ inr.rpy_matrix(ine.origin.rpy)
+    R_link_geom = rpy_matrix(shape.origin.rpy)
+    R_geom_inertial = R_link_geom.T @ rpy_matrix(ine.origin.rpy)
     offset = R_link_geom.T @ np.subtract(ine.origin.xyz, shape.origin.xyz)
     ex = bounds.excess(inr.rotate(J, R_geom_inertial), m, offset, g)
     if not ex.axes:

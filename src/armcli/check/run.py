@@ -166,7 +166,7 @@ def _load(ctx: Context) -> None:
         ctx.stage = "refused"
         return
     try:
-        robot = Robot.from_urdf(ctx.urdf, spec=ctx.opts.spec)
+        robot = Robot.load(ctx.urdf, spec=ctx.opts.spec, strict=False)
     except ModelLoadError as exc:
         ctx.out.add("model-load", None, exc.message)
         ctx.stage = "refused"

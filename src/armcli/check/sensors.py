@@ -25,6 +25,7 @@ import numpy as np
 from armcli.check.context import Context
 from armcli.defaults import DEFAULT_DT
 from armcli.errors import ArmcliError
+from armcli.robot.frames import rpy_quaternion
 from armcli.urdf.doc import GazeboSensor
 
 MAX_SELF_RAYS = 4096  # rays of a lidar tried for sensor-sees-robot (evenly spread)
@@ -102,7 +103,7 @@ def _mujoco_model(c: Context, lidars: list[GazeboSensor]) -> tuple[Any, Any]:
     """MuJoCo's model of the URDF (export mjcf, fixed base) with a site per lidar."""
     import mujoco
 
-    from armcli.export.mjcf import build_mjcf, quat
+    from armcli.export.mjcf import build_mjcf
 
     ms = mujoco.MjSpec.from_string(build_mjcf(c.urdf).model.decode("utf-8"))
     for s in lidars:
@@ -110,7 +111,8 @@ def _mujoco_model(c: Context, lidars: list[GazeboSensor]) -> tuple[Any, Any]:
         if body is None:  # the root `world` link is MuJoCo's worldbody
             body = ms.worldbody
         x, y, z, roll, pitch, yaw = s.pose or (0.0,) * 6
-        body.add_site(name=f"lidar/{s.name}", pos=[x, y, z], quat=list(quat((roll, pitch, yaw))))
+        qx, qy, qz, qw = rpy_quaternion((roll, pitch, yaw))
+        body.add_site(name=f"lidar/{s.name}", pos=[x, y, z], quat=[qw, qx, qy, qz])  # MuJoCo's
     model = ms.compile()
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)

@@ -10,8 +10,6 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from armcli.analysis.rate import RateVerdict
 from armcli.analysis.verdict import StabilityReport
 from armcli.check.context import Context, poses
@@ -19,6 +17,7 @@ from armcli.check.findings import JointRow
 from armcli.check.options import CheckOptions
 from armcli.check.structure import finite
 from armcli.robot.frames import link_frame
+from armcli.robot.model import Robot
 from armcli.robot.tool import tool_point
 from armcli.spec.joint_types import total_dof
 from armcli.urdf.doc import Urdf
@@ -77,15 +76,11 @@ def summarise(ctx: Context) -> Summary:
     }
     if ctx.robot is None or _no_arm(ctx):
         return Summary(**base, end_effector="", poses=())
-    import pinocchio as pin
-
-    model, data = ctx.robot.model, ctx.robot.data
-    ee_label, ee_frame, ee_offset = _end_effector(urdf, ctx.opts, model)
+    robot = ctx.robot
+    ee_label, ee_frame, ee_offset = _end_effector(urdf, ctx.opts, robot)
     pose_rows = []
     for name, values in poses(ctx):
-        q = ctx.robot.q(values)
-        pin.framesForwardKinematics(model, data, q)
-        xyz = data.oMf[ee_frame].act(np.asarray(ee_offset, dtype=float))
+        xyz = robot.point_position(ee_frame, ee_offset, robot.q(values))
         pose_rows.append(PoseRow(name, tuple(values.items()), tuple(float(x) for x in xyz)))  # type: ignore[arg-type]
     return Summary(**base, end_effector=ee_label, poses=tuple(pose_rows))
 
@@ -102,11 +97,11 @@ def _total_mass(urdf: Urdf) -> float:
 
 
 def _end_effector(
-    urdf: Urdf, opts: CheckOptions, model: Any
+    urdf: Urdf, opts: CheckOptions, robot: Robot
 ) -> tuple[str, int, tuple[float, float, float]]:
     """The tool point (armcli.robot.tool) as (label, Pinocchio frame id, offset [m])."""
     tool = tool_point(urdf, opts.spec)
-    frame = link_frame(model, tool.link) if tool is not None else None
+    frame = link_frame(robot.model, tool.link) if tool is not None else None
     if tool is None or frame is None:
-        return str(model.frames[0].name), 0, (0.0, 0.0, 0.0)
+        return str(robot.model.frames[0].name), 0, (0.0, 0.0, 0.0)
     return tool.label, frame, tool.xyz

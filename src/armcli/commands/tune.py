@@ -161,12 +161,12 @@ def _run(
     from armcli.tune import gains as gain_vector
     from armcli.tune import report, session
     from armcli.tune.plot import tune_png
-    from armcli.tune.problem import nominal_arm
+    from armcli.tune.problem import nominal_robot
     from armcli.tune.write import edited_spec
 
     out = terminal.console()
     out.print(report.reasoning_table(job.start), crop=False)
-    arm_damping = nominal_arm(job.problem).damping
+    arm_damping = nominal_robot(job.problem).damping
     with Progress(console=Console(stderr=True), transient=True) as bar:
         task = bar.add_task(f"tuning on {engine.name}", total=opts.trials)
         outcome = session.run(job, engine, opts, lambda d, t: bar.update(task, completed=d))

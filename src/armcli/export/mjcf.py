@@ -27,7 +27,6 @@ coincide) and its solver then lets a robot held by its wheels on a mu-0 caster c
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,6 +40,7 @@ from armcli.export import mjcf_parts as parts
 from armcli.export.mjcf_mass import FromGeometry, Node, Plan, plan_masses, write_inertial
 from armcli.export.mjcf_meshes import mesh_assets
 from armcli.export.mjcf_report import Extras, Note, scan, text
+from armcli.robot.frames import rpy_quaternion
 from armcli.spec.joint_types import position_bounds
 from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Joint, Link, Pose, Shape, Urdf
@@ -72,31 +72,13 @@ class MjcfExport:
     keyframes: tuple[str, ...]
 
 
-def quat(rpy: tuple[float, float, float]) -> tuple[float, float, float, float]:
-    """(w, x, y, z) of URDF's fixed-axis roll-pitch-yaw: R = Rz(yaw) Ry(pitch) Rx(roll)."""
-    r, p, y = (0.5 * a for a in rpy)
-    cr, sr, cp, sp, cy, sy = (
-        math.cos(r),
-        math.sin(r),
-        math.cos(p),
-        math.sin(p),
-        math.cos(y),
-        math.sin(y),
-    )
-    return (
-        cr * cp * cy + sr * sp * sy,
-        sr * cp * cy - cr * sp * sy,
-        cr * sp * cy + sr * cp * sy,
-        cr * cp * sy - sr * sp * cy,
-    )
-
-
 def _place(attrs: dict[str, str], pose: Pose) -> dict[str, str]:
     """pos/quat attributes of a URDF origin; identity parts are left out."""
     if any(pose.xyz):
         attrs["pos"] = vec(pose.xyz)
     if any(pose.rpy):
-        attrs["quat"] = vec(quat(pose.rpy))
+        x, y, z, w = rpy_quaternion(pose.rpy)
+        attrs["quat"] = vec((w, x, y, z))  # MuJoCo's order
     return attrs
 
 

@@ -16,6 +16,7 @@ from lxml import etree
 
 from armcli.compiler.xmlfmt import fmt, vec
 from armcli.export.mjcf_report import EXTRA_TAGS, Extras, Note
+from armcli.robot.joints import rest
 from armcli.spec.control import command_interfaces
 from armcli.spec.joint_types import position_bounds
 from armcli.spec.model import RobotSpec
@@ -115,11 +116,14 @@ def actuators(
 
 
 def _poses(joints: list[Joint], spec: RobotSpec | None) -> dict[str, dict[str, float]]:
-    """`home` first (the spec's, else 0 clamped into each range), then the spec's poses."""
+    """`home` first (the spec's, else each joint at rest), then the spec's poses.
+
+    A joint a pose leaves out rests (`robot.joints.rest`: 0, else the middle of its range).
+    """
     zero = {}
     for j in joints:
         r = _range(j)
-        zero[j.name] = min(max(0.0, r[0]), r[1]) if r is not None else 0.0
+        zero[j.name] = rest(*r) if r is not None else 0.0
     out = {HOME: dict(zero)}
     if spec is not None:
         for name in spec.poses:

@@ -162,7 +162,7 @@ def plan_motion(
         c_cert += time.process_time() - c1
         if last is None:
             return PlanResult(robot.joints, path, back, doc, t_plan, t_path, t_cert, margin,
-                              c_cert)  # fmt: skip
+                              certify_cpu_s=c_cert)  # fmt: skip
         if last.kind == "collision":
             break
     assert last is not None
@@ -212,7 +212,7 @@ def solve_goal(
     elif len(robot.joints) >= 6 and x0 is not None:
         from armcli.plan.ik import tool_pose
 
-        rotation = tool_pose(robot, robot.model.createData(), x0)[1]
+        rotation = tool_pose(robot, x0)[1]
     res: IkResult = solve_ik(robot, target, rotation, seed_x=x0, seed=seed,
                              free=lambda x: ctx.checker.first_collision(x, every_pair=True)
                              is None)  # fmt: skip

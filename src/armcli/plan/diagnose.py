@@ -176,6 +176,6 @@ def reached_in_collision(
     if rpy is not None:
         rotation = np.asarray(pin.rpy.rpyToMatrix(*(float(a) for a in rpy)))
     elif len(robot.joints) >= 6:
-        rotation = tool_pose(robot, robot.model.createData(), start)[1]
+        rotation = tool_pose(robot, start)[1]
     res = solve_ik(robot, np.asarray(list(xyz), dtype=float), rotation, seed_x=start, seed=seed)
     return None if res.x is None else ctx.checker.first_collision(res.x, every_pair=True)

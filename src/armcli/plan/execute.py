@@ -59,12 +59,12 @@ def execute(
     run = run_balanced(job, tip, every_step=True)
     res = run.result
     metrics = tuple(simreport.joint_metrics(res, job.trajectory.duration))
-    arm = job.arm
+    arm = job.robot
     peak_tau = np.max(np.abs(res.tau), axis=0)
     peak_v = np.max(np.abs(res.v), axis=0)
     vlim = np.where(arm.velocity > 0, arm.velocity, np.inf)
     problems = []
-    for i, name in enumerate(arm.joint_names):
+    for i, name in enumerate(arm.names):
         if res.stats.saturated_steps[i] > 0:
             problems.append(f"{name} reaches its effort limit {arm.effort[i]:g}")
         if peak_v[i] > vlim[i] * (1 + VELOCITY_TOL):
@@ -74,7 +74,7 @@ def execute(
         margin = run.balance.min_margin
         if run.balance.tips:
             problems.append(tipping.tip_error(run.balance).args[0])
-    return Execution(metrics, peak_tau, arm.effort, peak_v, vlim, arm.joint_names, margin,
+    return Execution(metrics, peak_tau, arm.effort, peak_v, vlim, arm.names, margin,
                      tuple(problems), _states(res))  # fmt: skip
 
 

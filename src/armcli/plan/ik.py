@@ -37,13 +37,10 @@ class IkResult:
     # looser tolerance still serves it: base placement)
 
 
-def tool_pose(robot: PlanRobot, data: object, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def tool_pose(robot: PlanRobot, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Tool point [m] and tool link rotation in the root frame at planned joint values `x`."""
-    import pinocchio as pin
-
-    pin.forwardKinematics(robot.model, data, robot.q(x))
-    M = pin.updateFramePlacement(robot.model, data, robot.tool_frame)
-    return np.asarray(M.act(robot.tool_offset)), np.asarray(M.rotation)
+    q = robot.q(x)
+    return robot.robot.tool_position(q), robot.robot.frame_pose(robot.tool_frame, q)[:3, :3]
 
 
 class _Solver:
@@ -51,7 +48,7 @@ class _Solver:
         import pinocchio as pin
 
         self.pin, self.robot = pin, robot
-        self.data = robot.model.createData()
+        self.data = robot.robot.data
         self.xyz, self.rotation = xyz, rotation
         self.cols = _columns(robot)
 

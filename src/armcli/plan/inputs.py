@@ -102,7 +102,7 @@ def configuration(
             f"comma-separated values for {', '.join(robot.joints)} (numbers or pi/2-style)",
             field=field,
         ) from None
-    full = {j: given.get(j, robot.rest_of(j)) for j in robot.joints}
+    full = {j: given.get(j, robot.robot.rest(j)) for j in robot.joints}
     limits = {j: (float(lo), float(hi)) for j, lo, hi in zip(robot.joints, robot.lower,
                                                             robot.upper, strict=True)}  # fmt: skip
     snapped, moved = snap_to_limits(full, limits)

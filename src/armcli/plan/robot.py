@@ -1,10 +1,12 @@
-"""The robot a plan moves: Pinocchio model, planned joints and their limits, collision geometry.
+"""What a plan adds to the robot it moves: the planned joints, their limits, named poses.
 
-`load_plan_robot` is the one place this package loads a model (robot.load's checked
-loader; `PlanRobot.q_slow` is `robot.model.Robot.q`). The whole robot is loaded with
-a fixed root, so the arm is checked against its own mobile base. Planned joints are the
-free 1-DoF joints a plan moves; mimic followers follow their leaders; every other joint
-stays at its rest value (0, or the middle of its range when 0 is outside it).
+`load_plan_robot` loads the robot once (`Robot.load`, the strict loader) with a fixed root,
+so the arm is checked against its own mobile base, and its collision geometry. `PlanRobot`
+keeps only what is plan's over that `Robot`: which joints are planned (the free 1-DoF
+joints a plan moves; mimic followers follow their leaders), their accelerations, the named
+poses and whether the robot stands on the ground. Its limit arrays are views of the
+robot's, per planned joint; every other 1-DoF joint stays where the robot says an unset
+joint rests (`Robot.rest`).
 """
 
 from __future__ import annotations
@@ -20,14 +22,12 @@ import numpy as np
 
 from armcli.defaults import DEFAULT_JOINT_ACCELERATION
 from armcli.errors import InputError
-from armcli.robot.frames import link_frame
-from armcli.robot.load import checked_model
-from armcli.robot.mimic import Mimic, follow, mimics
-from armcli.robot.model import JointMap, Robot
-from armcli.robot.tool import tool_point
+from armcli.robot.joints import JointMap, span
+from armcli.robot.mimic import Mimic, mimics
+from armcli.robot.model import Robot
 from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import MeshSearch
-from armcli.urdf.source import RobotFile, urdf_text
+from armcli.urdf.source import RobotFile
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -37,34 +37,88 @@ MOVABLE = ("revolute", "continuous", "prismatic")
 
 @dataclass(frozen=True)
 class PlanRobot:
-    """One loaded robot for planning; arrays are per planned joint, in `joints` order.
+    """A robot and the joints a plan moves; the arrays are per planned joint, in `joints` order.
 
     `q(x)` maps planned joint values [rad or m] to Pinocchio's configuration vector.
     """
 
-    model: Any  # pinocchio.Model, fixed root
+    robot: Robot  # the whole robot, fixed root: q, limits, mimic couplings, tool, kinematics
     geometry: Any  # pinocchio.GeometryModel of the robot's collision shapes
-    urdf: Urdf
     joints: tuple[str, ...]
-    lower: np.ndarray  # [rad or m]
-    upper: np.ndarray
-    velocity: np.ndarray  # [rad/s or m/s]
-    acceleration: np.ndarray  # [rad/s² or m/s²]
-    effort: np.ndarray  # [N·m or N]; inf when none
-    tool_frame: int
-    tool_offset: np.ndarray  # [m] in the tool link's frame
-    tool_label: str
+    acceleration: np.ndarray  # [rad/s² or m/s²]: the spec's, the URDF's or the default
     poses: Mapping[str, Mapping[str, float]]  # named poses: spec poses or SRDF group states
-    mimic: tuple[Mimic, ...] = ()
-    rest: Mapping[str, float] = field(default_factory=dict)  # every other 1-DoF joint
     mobile: bool = False  # stands on the ground: the ground plane is an obstacle
     spec: RobotSpec | None = None
     acceleration_defaulted: tuple[str, ...] = ()  # joints given DEFAULT_JOINT_ACCELERATION
+    held: Mapping[str, float] = field(default_factory=dict)  # unplanned joints not at rest
+
+    @property
+    def model(self) -> Any:
+        """The robot's pinocchio.Model (fixed root)."""
+        return self.robot.model
+
+    @property
+    def urdf(self) -> Urdf:
+        """The document the robot was loaded from."""
+        assert self.robot.urdf is not None  # load_plan_robot loads from one
+        return self.robot.urdf
+
+    @property
+    def mimic(self) -> tuple[Mimic, ...]:
+        """The robot's mimic couplings, leaders first."""
+        return self.robot.mimics
 
     @cached_property
-    def robot(self) -> Robot:
-        """The model's robot handle (`Robot.q` builds the configuration)."""
-        return Robot(self.model, mimics=self.mimic)
+    def _index(self) -> list[int]:
+        """Each planned joint's position in `robot.joints`."""
+        return [self.robot.names.index(j) for j in self.joints]
+
+    @cached_property
+    def lower(self) -> np.ndarray:
+        """[rad or m] each planned joint's lower limit; -pi for a continuous joint."""
+        return np.array([span(*self._range(k))[0] for k in self._index])
+
+    @cached_property
+    def upper(self) -> np.ndarray:
+        """[rad or m] each planned joint's upper limit; pi for a continuous joint."""
+        return np.array([span(*self._range(k))[1] for k in self._index])
+
+    def _range(self, k: int) -> tuple[float, float]:
+        return float(self.robot.lower[k]), float(self.robot.upper[k])
+
+    @cached_property
+    def velocity(self) -> np.ndarray:
+        """[rad/s or m/s] each planned joint's velocity limit; inf when the URDF gives none."""
+        v = self.robot.velocity[self._index]
+        return np.where((v > 0) & np.isfinite(v), v, math.inf)
+
+    @cached_property
+    def effort(self) -> np.ndarray:
+        """[N·m or N] each planned joint's effort limit; inf when the URDF gives none."""
+        return np.array(self.robot.effort[self._index])
+
+    @property
+    def tool_frame(self) -> int:
+        """The frame id of the tool point's link."""
+        return self.robot.tool_frame
+
+    @property
+    def tool_offset(self) -> np.ndarray:
+        """[m] the tool point in its link's frame."""
+        assert self.robot.tool is not None  # load_plan_robot refuses a robot without one
+        return np.array(self.robot.tool.xyz, dtype=float)
+
+    @property
+    def tool_label(self) -> str:
+        """How reports name the tool point."""
+        assert self.robot.tool is not None
+        return self.robot.tool.label
+
+    @cached_property
+    def rest(self) -> dict[str, float]:
+        """Every 1-DoF joint not planned: at its `held` value, else its rest (`Robot.rest`)."""
+        return {j.name: float(self.held.get(j.name, j.rest)) for j in self.robot.joints
+                if j.name not in self.joints}  # fmt: skip
 
     @cached_property
     def _map(self) -> JointMap:
@@ -82,11 +136,11 @@ class PlanRobot:
         """`q` joint by joint through `Robot.q`."""
         values = dict(self.rest)
         values.update(zip(self.joints, (float(v) for v in x), strict=True))
-        return self.robot.q(follow(self.mimic, values))
+        return self.robot.q(self.robot.follow(values))
 
     def v_indices(self) -> list[int]:
         """Velocity indices of the planned joints in the model (for Jacobians and torques)."""
-        return [int(self.model.joints[self.model.getJointId(j)].idx_v) for j in self.joints]
+        return [self.robot.joint(j).idx_v for j in self.joints]
 
     def pose(self, name: str) -> np.ndarray:
         """Planned joint values of a named pose; joints it leaves out stay at rest."""
@@ -94,16 +148,7 @@ class PlanRobot:
             valid = ", ".join(sorted(self.poses)) or "none"
             raise InputError(f"unknown pose {name!r}; valid: {valid}", field="pose")
         given = self.poses[name]
-        return np.array([given.get(j, self.rest_of(j)) for j in self.joints], dtype=float)
-
-    def rest_of(self, joint: str) -> float:
-        """A planned joint's default value: 0 clipped into its range."""
-        i = self.joints.index(joint)
-        return float(np.clip(0.0, self.lower[i], self.upper[i]))
-
-
-def _rest(lo: float, hi: float) -> float:
-    return 0.0 if lo <= 0.0 <= hi else 0.5 * (lo + hi)
+        return np.array([given.get(j, self.robot.rest(j)) for j in self.joints], dtype=float)
 
 
 def default_joints(urdf: Urdf, spec: RobotSpec | None) -> tuple[str, ...]:
@@ -129,12 +174,10 @@ def load_plan_robot(
     from an SRDF, beside the spec's poses.
     """
     urdf, spec = robot.robot, robot.spec
-    model = checked_model(urdf).model
-    urdf_text(urdf)  # refuses a non-UTF-8 document before Pinocchio sees it
-    geometry = Robot(model, source=urdf.source, urdf=urdf).collision_model(search or MeshSearch())
-    followers = {m.follower for m in mimics(urdf.joints)}
+    loaded = Robot.load(urdf, spec=spec)
+    geometry = loaded.collision_model(search or MeshSearch())
+    followers = {m.follower for m in loaded.mimics}
     chosen = tuple(joints) if joints else default_joints(urdf, spec)
-    by_name = {j.name: j for j in urdf.joints}
     valid = [j.name for j in urdf.joints if j.type in MOVABLE and j.name not in followers]
     for name in chosen:
         if name not in valid:
@@ -143,60 +186,34 @@ def load_plan_robot(
         raise InputError("a joint is listed twice", field="joints")
     if not chosen:
         raise InputError("this robot has no movable joint to plan for", file=urdf.source)
-    lower, upper, vel, acc, eff, defaulted = [], [], [], [], [], []
+    acc, defaulted = _accelerations(urdf, spec, chosen)
+    _ = loaded.tool_frame  # a link, not a joint of the same name (ANYmal C); else InputError
+    poses: dict[str, Mapping[str, float]] = dict(group_states or {})
+    if spec is not None:
+        poses.update({name: spec.pose(name) for name in spec.poses})
+    return PlanRobot(loaded, geometry, chosen, acc, poses,
+                     mobile=spec is not None and spec.mobile_base is not None, spec=spec,
+                     acceleration_defaulted=defaulted)  # fmt: skip
+
+
+def _accelerations(
+    urdf: Urdf, spec: RobotSpec | None, joints: Sequence[str]
+) -> tuple[np.ndarray, tuple[str, ...]]:
+    """Each joint's acceleration limit [rad/s² or m/s²], and the joints given the default.
+
+    The spec's limit, else the URDF's, else DEFAULT_JOINT_ACCELERATION.
+    """
+    by_name = {j.name: j for j in urdf.joints}
     spec_acc = _spec_accelerations(spec)
-    for name in chosen:
-        j = by_name[name]
-        lim = j.limit
-        if j.type == "continuous" or lim is None:
-            lo, hi = -math.pi, math.pi
-        else:
-            lo, hi = float(lim.lower or 0.0), float(lim.upper or 0.0)
-        lower.append(lo)
-        upper.append(hi)
-        v = lim.velocity if lim is not None and lim.velocity else math.inf
-        vel.append(float(v))
-        e = lim.effort if lim is not None and lim.effort else math.inf
-        eff.append(float(e))
+    out, defaulted = [], []
+    for name in joints:
+        lim = by_name[name].limit
         a = spec_acc.get(name) or (lim.acceleration if lim is not None else None)
         if not a:
             a = DEFAULT_JOINT_ACCELERATION
             defaulted.append(name)
-        acc.append(float(a))
-    rest = {
-        j.name: _rest(float(j.limit.lower or 0.0), float(j.limit.upper or 0.0))
-        if j.limit is not None and j.type != "continuous"
-        else 0.0
-        for j in urdf.joints
-        if j.type in MOVABLE and j.name not in chosen
-    }
-    tool = tool_point(urdf, spec)
-    tool_frame = link_frame(model, tool.link) if tool is not None else None
-    if tool is None or tool_frame is None:  # a link, not a joint of the same name (ANYmal C)
-        raise InputError("this URDF has no link to use as the tool point", file=urdf.source)
-    poses: dict[str, Mapping[str, float]] = dict(group_states or {})
-    if spec is not None:
-        poses.update({name: spec.pose(name) for name in spec.poses})
-    return PlanRobot(
-        model=model,
-        geometry=geometry,
-        urdf=urdf,
-        joints=chosen,
-        lower=np.array(lower),
-        upper=np.array(upper),
-        velocity=np.array(vel),
-        acceleration=np.array(acc),
-        effort=np.array(eff),
-        tool_frame=tool_frame,
-        tool_offset=np.array(tool.xyz, dtype=float),
-        tool_label=tool.label,
-        poses=poses,
-        mimic=tuple(mimics(urdf.joints)),
-        rest=rest,
-        mobile=spec is not None and spec.mobile_base is not None,
-        spec=spec,
-        acceleration_defaulted=tuple(defaulted),
-    )
+        out.append(float(a))
+    return np.array(out), tuple(defaulted)
 
 
 def _spec_accelerations(spec: RobotSpec | None) -> dict[str, float]:

@@ -1,4 +1,4 @@
-"""One robot handle (`model.Robot`), its loading, the joint-space sampler and the body maths.
+"""The one robot handle (`model.Robot`), frames, collision pairs, sampler and body maths.
 
 May import `armcli.urdf` and below; Pinocchio is imported inside functions.
 """

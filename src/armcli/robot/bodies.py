@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from armcli.robot import inertia as inr
+from armcli.robot.frames import rpy_matrix
 from armcli.urdf.doc import Joint, Link, Vec3
 
 
@@ -36,7 +37,7 @@ def link_mass(link: Link) -> Mass | None:
         return None
     J = inr.tensor(*ine.inertia)
     if any(ine.origin.rpy):
-        J = inr.rotate(J, inr.rpy_matrix(ine.origin.rpy))
+        J = inr.rotate(J, rpy_matrix(ine.origin.rpy))
     return Mass(float(ine.mass), np.asarray(ine.origin.xyz, dtype=float), J)
 
 
@@ -65,7 +66,7 @@ def moved(x: Mass, xyz: Vec3, rpy: Vec3, *, inverse: bool = False) -> Mass:
 
     `xyz`, `rpy`: the child frame's placement in the parent's [m, rad], as a URDF origin.
     """
-    R, p = inr.rpy_matrix(rpy), np.asarray(xyz, dtype=float)
+    R, p = rpy_matrix(rpy), np.asarray(xyz, dtype=float)
     if inverse:
         return Mass(x.mass, R.T @ (x.com - p), inr.rotate(x.J, R.T))
     return Mass(x.mass, p + R @ x.com, inr.rotate(x.J, R))
@@ -98,7 +99,7 @@ def rigid_group(
         link, R, p = frontier.pop()
         for j in fixed:
             if j.parent == link.name:
-                Rj, pj = inr.rpy_matrix(j.origin.rpy), np.asarray(j.origin.xyz, dtype=float)
+                Rj, pj = rpy_matrix(j.origin.rpy), np.asarray(j.origin.xyz, dtype=float)
                 item = (links[str(j.child)], R @ Rj, p + R @ pj)
                 parts.append(item)
                 frontier.append(item)
@@ -122,7 +123,7 @@ def lump(links: Mapping[str, Link], joint: Joint, joints: Iterable[Joint]) -> Bo
             unknown = True
             continue
         assert ine.inertia is not None and ine.mass is not None  # _finite_inertial
-        Ri = R @ inr.rpy_matrix(ine.origin.rpy)
+        Ri = R @ rpy_matrix(ine.origin.rpy)
         com = p + R @ np.asarray(ine.origin.xyz, dtype=float)
         masses.append(
             Mass(max(float(ine.mass), 0.0), com, inr.rotate(inr.tensor(*ine.inertia), Ri))

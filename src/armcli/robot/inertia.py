@@ -9,7 +9,6 @@ inertias and the inertia-versus-geometry rule cannot drift apart.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -42,26 +41,6 @@ def sphere_inertia(m: float, r: float) -> Matrix:
 def tensor(ixx: float, ixy: float, ixz: float, iyy: float, iyz: float, izz: float) -> Matrix:
     """The symmetric tensor from URDF's six `<inertia>` attributes."""
     return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]], dtype=float)
-
-
-def rpy_matrix(rpy: Sequence[float]) -> Matrix:
-    """URDF fixed-axis roll-pitch-yaw: R = Rz(yaw) @ Ry(pitch) @ Rx(roll)."""
-    r, p, y = (float(a) for a in rpy)
-    cr, sr, cp, sp, cy, sy = (
-        math.cos(r),
-        math.sin(r),
-        math.cos(p),
-        math.sin(p),
-        math.cos(y),
-        math.sin(y),
-    )
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
 
 
 def rotate(J: Matrix, R: Matrix) -> Matrix:

@@ -1,4 +1,4 @@
-"""URDF -> Pinocchio model; the one place parser quirks are handled.
+"""URDF -> Pinocchio model (`Robot.load` calls it); the one place parser quirks are handled.
 
 Pinocchio's URDF parser prints problems to stderr (and e.g. turns mass="nan"
 into 0) instead of raising, so loading captures the C-level stderr and returns
@@ -14,10 +14,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-from numpy.typing import NDArray
-
 from armcli.errors import InputError, ModelLoadError
+from armcli.robot.frames import link_frame as link_frame  # plan/collision.py's, until it moves
 from armcli.urdf.doc import Urdf
 from armcli.urdf.source import urdf_text
 
@@ -31,7 +29,7 @@ class LoadedModel:
     parser_messages: list[str] = field(default_factory=list)
 
 
-def _capture_stderr(fn: Any) -> tuple[Any, list[str]]:
+def capture_stderr(fn: Any) -> tuple[Any, list[str]]:
     """Run fn() with the process-level stderr (fd 2) redirected to a temp file.
 
     If fn raises, the exception gets the captured lines as `parser_messages`.
@@ -78,7 +76,7 @@ def load_model(path: str | Path, *, xml: str | None = None, floating: bool = Fal
     text = xml if xml is not None else Path(path).read_text(encoding="utf-8")
     args = (pin.JointModelFreeFlyer(),) if floating else ()
     try:
-        model, messages = _capture_stderr(lambda: pin.buildModelFromXML(text, *args))
+        model, messages = capture_stderr(lambda: pin.buildModelFromXML(text, *args))
     except (RuntimeError, ValueError) as exc:
         said = parser_problems(getattr(exc, "parser_messages", []))
         detail = f" ({'; '.join(said)})" if said else ""
@@ -88,30 +86,18 @@ def load_model(path: str | Path, *, xml: str | None = None, floating: bool = Fal
     return LoadedModel(model=model, source=source, parser_messages=messages)
 
 
-def mass_matrix(model: Any, data: Any, q: Any) -> NDArray[np.float64]:
-    """The joint-space mass matrix M(q) [kg·m² or kg], symmetric.
+def collision_model(model: Any, xml: str, source: str = "<urdf>") -> Any:
+    """The URDF text's collision geometry, a Pinocchio GeometryModel over `model`.
 
-    Pinocchio's CRBA fills only the upper triangle; every user needs the whole matrix.
-    """
-    import pinocchio as pin
-
-    M = pin.crba(model, data, q)
-    return np.asarray(np.triu(M) + np.triu(M, 1).T, dtype=np.float64)
-
-
-def collision_model(
-    model: Any, xml: str, package_dirs: list[str] | None = None, source: str = "<urdf>"
-) -> Any:
-    """The URDF's collision geometry as a Pinocchio GeometryModel (meshes need package_dirs).
-
-    ModelLoadError when Pinocchio refuses it (e.g. a mesh it cannot read).
+    Meshes are read from the paths the text gives (`Robot.collision_model` resolves and
+    confines them first). ModelLoadError when Pinocchio refuses it (a mesh it cannot read).
     """
     import pinocchio as pin
 
     try:
-        gmodel, _ = _capture_stderr(
+        gmodel, _ = capture_stderr(
             lambda: pin.buildGeomFromUrdfString(
-                model, xml, pin.GeometryType.COLLISION, package_dirs=package_dirs or []
+                model, xml, pin.GeometryType.COLLISION, package_dirs=[]
             )
         )
     except (RuntimeError, ValueError) as exc:
@@ -128,7 +114,9 @@ _PROBLEM = {
 }
 
 
-def checked_model(urdf: Urdf, *, gate: Callable[[Urdf], None] | None = None) -> LoadedModel:
+def checked_model(
+    urdf: Urdf, *, gate: Callable[[Urdf], None] | None = None, floating: bool = False
+) -> LoadedModel:
     """A parsed URDF -> Pinocchio model, refusing what Pinocchio would silently accept.
 
     `gate`, when given, may refuse the document after the number checks (e.g.
@@ -139,7 +127,7 @@ def checked_model(urdf: Urdf, *, gate: Callable[[Urdf], None] | None = None) -> 
         raise InputError(f"{p.where}: {_PROBLEM[p.kind]} {p.text!r}", file=urdf.source, line=p.line)
     if gate is not None:
         gate(urdf)
-    loaded = load_model(urdf.source, xml=urdf_text(urdf))
+    loaded = load_model(urdf.source, xml=urdf_text(urdf), floating=floating)
     said = [m for m in parser_problems(loaded.parser_messages) if "error" in m.lower()]
     if said:
         raise InputError(f"the URDF parser reported: {said[0]}", file=urdf.source)

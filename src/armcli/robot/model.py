@@ -1,18 +1,21 @@
-"""One handle on a robot: Pinocchio model and data, the joint table, mimic couplings, tool.
+"""One handle on a robot: model and data, joints and limits, mimic couplings, tool, kinematics.
 
-As pink's `Configuration` and Pinocchio's `RobotWrapper`: code that computes with a
-robot asks this class for what it needs instead of building its own. `Robot.q` is the
-one place that turns joint values into a Pinocchio configuration: a continuous joint
-(revolute without limits) is stored there as the pair (cos, sin) of its angle (nq = 2,
-nv = 1). Pinocchio itself is imported inside the functions, so importing this module
-keeps `armcli --help` fast.
+As pink's `Configuration` and Pinocchio's `RobotWrapper`: code that computes with a robot
+asks this class for what it needs instead of building its own. `Robot.load` is the one
+loader. The kinematics (`frame_pose`, `tool_position`, `jacobian`, `mass_matrix`,
+`gravity`, ...) are its methods, inherited from `robot.kinematics.Kinematics`. The limit
+arrays (`lower`, `upper`, `effort`, `velocity`, `damping`, `friction`, per joint of
+`joints`) are read-only views of the model's, so a variant of the robot (other limits,
+scaled masses, a payload) is a new `Robot` over a copied model (`with_limits`, `scaled`,
+`with_point_mass`), never an edited copy of a table. Where an unset joint rests is
+`robot.joints.rest`'s rule. Pinocchio is imported inside the functions, so importing this
+module keeps `armcli --help` fast.
 """
 
 from __future__ import annotations
 
-import math
-from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
+import threading
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -20,121 +23,42 @@ from numpy.typing import ArrayLike, NDArray
 
 from armcli.errors import InputError
 from armcli.robot.frames import reduced_model
-from armcli.robot.load import collision_model, load_model
+from armcli.robot.joints import Joint, JointMap, joint_table, put
+from armcli.robot.kinematics import Kinematics
+from armcli.robot.load import checked_model, collision_model, load_model
 from armcli.robot.mimic import Mimic, follow, mimics
 from armcli.robot.tool import ToolPoint, tool_point
 from armcli.urdf.meshes import MeshSearch, confined_mesh_xml
+from armcli.urdf.source import urdf_text
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
     from armcli.urdf.doc import Urdf
 
-
-@dataclass(frozen=True)
-class Joint:
-    """One 1-DoF joint of the model: where it sits in q and v, and its URDF numbers."""
-
-    name: str
-    idx_q: int
-    idx_v: int
-    continuous: bool  # stored as (cos, sin) in q
-    lower: float  # [rad or m]; -inf for a continuous joint (no stop)
-    upper: float  # [rad or m]; inf for a continuous joint
-    effort: float  # [N·m or N]; inf when the URDF gives none (<= 0 or not finite)
-    velocity: float  # [rad/s or m/s] as the URDF gives it (<= 0 or inf: none)
-    damping: float  # [N·m·s/rad or N·s/m]
-    friction: float  # [N·m or N]
-
-    @property
-    def span(self) -> tuple[float, float]:
-        """The finite range to sample it over [rad or m] (`span` of its limits)."""
-        return span(self.lower, self.upper)
+LIMITS = ("lower", "upper", "effort", "velocity", "damping", "friction")  # the limit arrays
 
 
-def _put(q: NDArray[np.float64], joint: Joint, x: float) -> None:
-    """Set one joint in q: the angle of a continuous joint as its (cos, sin) pair."""
-    if joint.continuous:
-        q[joint.idx_q], q[joint.idx_q + 1] = math.cos(x), math.sin(x)
-    else:
-        q[joint.idx_q] = x
+def _readonly(values: Iterable[float]) -> NDArray[np.float64]:
+    out = np.array(list(values), dtype=float)
+    out.flags.writeable = False
+    return out
 
 
-@dataclass(frozen=True)
-class JointMap:
-    """Where chosen joints and their mimic followers sit in q (`Robot.joint_map`)."""
+class Robot(Kinematics):
+    """A Pinocchio model with its joints, limits, mimic couplings, tool point and kinematics.
 
-    template: NDArray[np.float64]  # q with the chosen joints at 0, the others at rest
-    lin: tuple[NDArray[np.int64], NDArray[np.int64]]  # (q, x) indices of 1-nq chosen joints
-    cont: tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]  # (cos, sin, x)
-    followers: tuple[tuple[int, bool, str, str, float, float], ...]  # as `Robot.joint_map`
-    joints: tuple[str, ...]
-    rest: Mapping[str, float]
-
-    def q(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
-        """The configuration with the chosen joints at `x` [rad or m]."""
-        q = self.template.copy()  # index arrays kept apart: the planner calls this per state
-        q[self.lin[0]] = x[self.lin[1]]
-        if len(self.cont[2]):
-            q[self.cont[0]] = np.cos(x[self.cont[2]])
-            q[self.cont[1]] = np.sin(x[self.cont[2]])
-        if self.followers:
-            values = dict(zip(self.joints, x.tolist(), strict=True))
-            for iq, continuous, name, leader, mult, offset in self.followers:  # leaders first
-                v = mult * values.get(leader, self.rest.get(leader, 0.0)) + offset
-                values[name] = v
-                if continuous:  # as `_put`, inlined: per state
-                    q[iq], q[iq + 1] = math.cos(v), math.sin(v)
-                else:
-                    q[iq] = v
-        return q
-
-
-def span(lower: float, upper: float) -> tuple[float, float]:
-    """A joint range to sample over [rad or m]: [lower, upper], else [-pi, pi].
-
-    [-pi, pi] when the range is not finite and in order (a continuous joint's is infinite).
+    `joints` are the 1-DoF joints in tree order, and the limit arrays follow that order;
+    `mimics` the URDF's couplings (leaders first; a follower is never set on its own);
+    `tool` the end-effector point, None for a model without links. `xml` and `urdf` are
+    the URDF text and document the model came from, kept for the collision geometry.
     """
-    if not (math.isfinite(lower) and math.isfinite(upper)) or lower > upper:
-        return -math.pi, math.pi
-    return lower, upper
 
-
-def joint_table(model: Any) -> tuple[Joint, ...]:
-    """The model's 1-DoF joints in tree order; multi-DoF joints (floating, planar) are left out."""
-    out = []
-    for jid in range(1, model.njoints):
-        jm = model.joints[jid]
-        if jm.nv != 1:
-            continue
-        continuous = jm.nq == 2
-        lo = -math.inf if continuous else float(model.lowerPositionLimit[jm.idx_q])
-        hi = math.inf if continuous else float(model.upperPositionLimit[jm.idx_q])
-        effort = float(model.effortLimit[jm.idx_v])
-        out.append(
-            Joint(
-                name=str(model.names[jid]),
-                idx_q=int(jm.idx_q),
-                idx_v=int(jm.idx_v),
-                continuous=continuous,
-                lower=lo,
-                upper=hi,
-                effort=effort if effort > 0 and math.isfinite(effort) else math.inf,
-                velocity=float(model.velocityLimit[jm.idx_v]),
-                damping=float(model.damping[jm.idx_v]),
-                friction=float(model.friction[jm.idx_v]),
-            )
-        )
-    return tuple(out)
-
-
-class Robot:
-    """A Pinocchio model with its joint table, mimic couplings and tool point.
-
-    `joints` are the 1-DoF joints in tree order; `mimics` the URDF's couplings (leaders
-    first; a follower is never set on its own); `tool` the end-effector point
-    (`robot.tool`), None for a model without links. `xml` and `urdf` are the URDF text
-    and document the model came from, kept for the collision geometry.
-    """
+    lower: NDArray[np.float64]  # [rad or m]; -inf: no stop (a continuous joint)
+    upper: NDArray[np.float64]  # [rad or m]; inf: no stop
+    effort: NDArray[np.float64]  # [N·m or N]; inf when the URDF gives none
+    velocity: NDArray[np.float64]  # [rad/s or m/s] as the URDF gives it (<= 0 or inf: none)
+    damping: NDArray[np.float64]  # [N·m·s/rad or N·s/m]
+    friction: NDArray[np.float64]  # [N·m or N]
 
     def __init__(
         self,
@@ -152,49 +76,54 @@ class Robot:
         self.joints = joint_table(model)
         names = {j.name for j in self.joints}
         self.mimics = tuple(m for m in mimics if m.leader in names and m.follower in names)
-        self.tool = tool
-        self.source = source
-        self.xml = xml
-        self.urdf = urdf
+        self.tool, self.source, self.xml, self.urdf = tool, source, xml, urdf
         self.parser_messages = tuple(parser_messages)
+        for name in LIMITS:
+            setattr(self, name, _readonly(getattr(j, name) for j in self.joints))
         self._by_name = {j.name: j for j in self.joints}
-        self._data: Any = None
+        self._local = threading.local()
         self._neutral: NDArray[np.float64] | None = None
+        self._rest: NDArray[np.float64] | None = None
 
     @classmethod
-    def from_xml(
+    def load(
         cls,
-        xml: str,
-        source: str = "<urdf>",
+        urdf: Urdf,
         *,
         floating: bool = False,
-        mimics: Iterable[Mimic] = (),
-        tool: ToolPoint | None = None,
-        urdf: Urdf | None = None,
+        spec: RobotSpec | None = None,
+        strict: bool = True,
+        gate: Callable[[Urdf], None] | None = None,
     ) -> Robot:
-        """Load URDF text (`floating`: the root on a free-flyer joint); ModelLoadError if bad."""
-        loaded = load_model(source, xml=xml, floating=floating)
-        return cls(loaded.model, mimics=mimics, tool=tool, source=source, xml=xml, urdf=urdf,
+        """The one loader: a parsed URDF's robot, its mimic couplings and tool point.
+
+        `floating`: the root on a free-flyer joint. `spec`: its `arm.tool` is the tool
+        point. `strict` refuses (InputError) what Pinocchio would silently accept, such
+        as mass="nan" read as 0, and a document its parser reports an error in: what
+        simulates, plans or tunes must be sound; `check` loads with strict=False and
+        reports those as findings. `gate` may refuse the document first (check's errors).
+        ModelLoadError when Pinocchio refuses the URDF.
+        """
+        if strict:
+            loaded = checked_model(urdf, gate=gate, floating=floating)
+        else:
+            loaded = load_model(urdf.source, xml=urdf_text(urdf), floating=floating)
+        return cls(loaded.model, mimics=mimics(urdf.joints), tool=tool_point(urdf, spec),
+                   source=urdf.source, xml=urdf_text(urdf), urdf=urdf,
                    parser_messages=loaded.parser_messages)  # fmt: skip
 
-    @classmethod
-    def from_urdf(
-        cls, urdf: Urdf, *, floating: bool = False, spec: RobotSpec | None = None
-    ) -> Robot:
-        """A parsed URDF's robot, with its mimic couplings and tool point (the spec's, if any)."""
-        try:
-            xml = urdf.text.decode("utf-8")
-        except UnicodeDecodeError:
-            raise InputError("URDF is not UTF-8 text", file=urdf.source) from None
-        return cls.from_xml(xml, urdf.source, floating=floating, mimics=mimics(urdf.joints),
-                            tool=tool_point(urdf, spec), urdf=urdf)  # fmt: skip
+    def _like(self, model: Any) -> Robot:
+        """This robot over another model (a reduced, scaled or loaded copy)."""
+        return Robot(model, mimics=self.mimics, tool=self.tool, source=self.source, xml=self.xml,
+                     urdf=self.urdf, parser_messages=self.parser_messages)  # fmt: skip
 
     @property
     def data(self) -> Any:
-        """The model's pinocchio.Data, created on first use and shared by this handle's users."""
-        if self._data is None:
-            self._data = self.model.createData()
-        return self._data
+        """A pinocchio.Data for the model, one per thread, shared by this handle's users."""
+        data = getattr(self._local, "data", None)
+        if data is None:
+            data = self._local.data = self.model.createData()
+        return data
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -221,6 +150,10 @@ class Robot:
                 f"unknown joint {name!r}; valid: {', '.join(self.names)}", field="joints"
             ) from None
 
+    def rest(self, joint: str) -> float:
+        """Where `joint` sits when nobody sets it [rad or m] (`robot.joints.rest`'s rule)."""
+        return self.joint(joint).rest
+
     def neutral(self) -> NDArray[np.float64]:
         """Pinocchio's neutral configuration (every joint at 0, the free-flyer at identity)."""
         if self._neutral is None:
@@ -229,13 +162,22 @@ class Robot:
             self._neutral = np.asarray(pin.neutral(self.model), dtype=float)
         return self._neutral.copy()
 
+    def rest_q(self) -> NDArray[np.float64]:
+        """The rest configuration: every 1-DoF joint at `rest`, the free-flyer at identity."""
+        if self._rest is None:
+            q = self.neutral()
+            for j in self.joints:
+                put(q, j, j.rest)
+            self._rest = q
+        return self._rest.copy()
+
     def follow(self, values: Mapping[str, float]) -> dict[str, float]:
         """`values` with every mimic follower of a given leader set from it."""
         return follow(self.mimics, values)
 
     def q(
         self,
-        values: Mapping[str, float] | ArrayLike = (),
+        values: Mapping[str, float] | ArrayLike | None = None,
         *,
         joints: Sequence[Joint] | None = None,
         base: ArrayLike | None = None,
@@ -244,10 +186,13 @@ class Robot:
 
         `values` is a mapping by joint name (names that are not 1-DoF joints of the model
         are ignored) or a sequence aligned with `joints` (default: every joint, tree
-        order). `base` defaults to the neutral configuration. Mimic followers are not
-        moved here: `follow` the values first.
+        order); None sets none. `base` defaults to the rest configuration (`rest_q`: an
+        unset joint rests).
+        Mimic followers are not moved here: `follow` the values first.
         """
-        q = self.neutral() if base is None else np.array(base, dtype=float)
+        q = self.rest_q() if base is None else np.array(base, dtype=float)
+        if values is None:
+            return q
         if isinstance(values, Mapping):
             pairs: Iterable[tuple[Joint, Any]] = (
                 (self._by_name[n], x) for n, x in values.items() if n in self._by_name
@@ -256,16 +201,16 @@ class Robot:
             chosen = self.joints if joints is None else joints
             pairs = zip(chosen, np.asarray(values, dtype=float).reshape(-1), strict=True)
         for j, x in pairs:
-            _put(q, j, float(x))
+            put(q, j, float(x))
         return q
 
     def joint_map(self, joints: Sequence[str], rest: Mapping[str, float] | None = None) -> JointMap:
         """`x` (values of `joints`, in order) -> q, vectorised: for a caller building q per state.
 
-        A planner's validity check calls it per state. Other joints at `rest` (else
-        neutral), followers following their leaders: the same q as `q(follow(...))`.
+        A planner's validity check calls it per state. Other joints at `rest` (else at
+        their own rest), followers following their leaders: the same q as `q(follow(...))`.
         """
-        rest = dict(rest or {})
+        rest = {**{j.name: j.rest for j in self.joints}, **(rest or {})}
         chosen = [self.joint(n) for n in joints]
         template = self.q(self.follow({**rest, **{j.name: 0.0 for j in chosen}}))
 
@@ -282,12 +227,10 @@ class Robot:
         return JointMap(template, (lq, lx), (cq, cq + 1, cx), followers, tuple(joints), rest)
 
     def reduced(self, joints: Sequence[str]) -> Robot:
-        """The robot with only `joints` movable; the others locked at their neutral value.
+        """The robot with only `joints` movable; the others locked where they rest (`rest`).
 
         InputError (field `joints`) for an unknown joint or one listed twice.
         """
-        import pinocchio as pin
-
         names = list(self.model.names)[1:]
         for name in joints:
             if name not in names:
@@ -298,9 +241,60 @@ class Robot:
         lock = [self.model.getJointId(nm) for nm in names if nm not in joints]
         if not lock:
             return self
-        model = reduced_model(self.model, lock, pin.neutral(self.model))  # names may clash
-        return Robot(model, mimics=self.mimics, tool=self.tool, source=self.source, xml=self.xml,
-                     urdf=self.urdf, parser_messages=self.parser_messages)  # fmt: skip
+        return self._like(reduced_model(self.model, lock, self.rest_q()))
+
+    def with_limits(self, **arrays: ArrayLike) -> Robot:
+        """A copy with some limit arrays replaced (names of `LIMITS`, one value per joint).
+
+        A continuous joint keeps its infinite range; an effort <= 0 or not finite is read
+        back as inf (no limit), as from a URDF.
+        """
+        model = self.model.copy()
+        vectors = {
+            "lower": (model.lowerPositionLimit, True),
+            "effort": (model.effortLimit, False),
+            "upper": (model.upperPositionLimit, True),
+            "damping": (model.damping, False),
+            "velocity": (model.velocityLimit, False),
+            "friction": (model.friction, False),
+        }
+        for name, values in arrays.items():
+            if name not in vectors:
+                raise ValueError(f"unknown limit {name!r}; valid: {', '.join(LIMITS)}")
+            vec, in_q = vectors[name]
+            for j, x in zip(self.joints, np.asarray(values, dtype=float), strict=True):
+                if not in_q:
+                    vec[j.idx_v] = x
+                elif not j.continuous:  # a continuous joint has no range to set
+                    vec[j.idx_q] = x
+        return self._like(model)
+
+    def scaled(self, mass: Sequence[float], friction: Sequence[float]) -> Robot:
+        """A copy with the bodies' masses and inertias and the joints' friction scaled.
+
+        `mass`: a factor per body in model order (same centre of mass); `friction`: one
+        per joint of `joints`.
+        """
+        import pinocchio as pin
+
+        model = self.model.copy()
+        for i, s in enumerate(mass, start=1):
+            Y = model.inertias[i]
+            model.inertias[i] = pin.Inertia(Y.mass * s, Y.lever.copy(), Y.inertia * s)
+        for j, s in zip(self.joints, friction, strict=True):
+            model.friction[j.idx_v] = j.friction * s
+        return self._like(model)
+
+    def with_point_mass(self, link: str, xyz: ArrayLike, mass: float) -> Robot:
+        """A copy with a point mass [kg] at `xyz` [m] in `link`'s frame added to its body."""
+        import pinocchio as pin
+
+        model = pin.Model(self.model)
+        frame = model.frames[self.frame(link)]
+        point = frame.placement.act(np.asarray(xyz, dtype=float))
+        jid = frame.parentJoint
+        model.inertias[jid] = model.inertias[jid] + pin.Inertia(mass, point, np.zeros((3, 3)))
+        return self._like(model)
 
     def collision_model(self, search: MeshSearch | None = None) -> Any:
         """The URDF's collision geometry, a pinocchio.GeometryModel, built on demand.
@@ -322,4 +316,4 @@ class Robot:
             text = self.xml
         if text is None:
             raise InputError("no URDF text to read collision geometry from", file=self.source)
-        return collision_model(self.model, text, [], self.source)
+        return collision_model(self.model, text, self.source)

@@ -4,7 +4,7 @@
 the workspace and the collision matrix all sample the joint range box the same way:
 
 - a full grid of GRID_POINTS per joint while it has at most MAX_GRID points;
-- else the zero pose (clamped into range), every corner of the box while there are at
+- else the rest pose (`robot.joints.rest`), every corner of the box while there are at
   most MAX_CORNERS (gravity torques peak there for serial arms) and seeded uniform draws.
 
 Draws use the standard library's generator (numpy.random costs 20 ms of start-up), one
@@ -21,14 +21,15 @@ from collections.abc import Iterator, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from armcli.robot.model import Joint, Robot
+from armcli.robot.joints import Joint, rest
+from armcli.robot.model import Robot
 
 GRID_POINTS = 5  # per joint, while the grid has at most MAX_GRID points
 MAX_GRID = 125
 MAX_CORNERS = 64  # every corner of the range box when there are at most this many
 RANDOM_SAMPLES = 100  # draws of `joint_space` (check's and tune's sample)
 SAMPLE_SEED = 0
-BALANCE_DRAWS = 32  # start points of the balance search (besides zero, poses, corners)
+BALANCE_DRAWS = 32  # start points of the balance search (besides rest, poses, corners)
 REACH_DRAWS = 500  # the workspace cloud `check` draws (render --reach draws more)
 
 Bounds = Sequence[tuple[float, float]]  # finite (lower, upper) per joint [rad or m]
@@ -39,9 +40,9 @@ def bounds(joints: Sequence[Joint]) -> list[tuple[float, float]]:
     return [j.span for j in joints]
 
 
-def zero(box: Bounds) -> list[float]:
-    """The zero pose, clamped into the box."""
-    return [min(max(0.0, lo), hi) for lo, hi in box]
+def rest_pose(box: Bounds) -> list[float]:
+    """Each joint where it rests (`robot.joints.rest`: 0, else the middle of its range)."""
+    return [rest(lo, hi) for lo, hi in box]
 
 
 def corners(box: Bounds) -> list[list[float]]:
@@ -72,18 +73,18 @@ def grid(box: Bounds) -> list[list[float]] | None:
 
 
 def joint_space(box: Bounds) -> NDArray[np.float64]:
-    """`check`'s and `tune`'s sample (N, n): the grid, else zero, corners and draws."""
+    """`check`'s and `tune`'s sample (N, n): the grid, else rest, corners and draws."""
     rows = grid(box)
     if rows is None:
-        rows = [zero(box), *corners(box), *draws(box, RANDOM_SAMPLES)]
+        rows = [rest_pose(box), *corners(box), *draws(box, RANDOM_SAMPLES)]
     return np.array(rows, dtype=float).reshape(len(rows), len(box))
 
 
 def search_starts(
     box: Bounds, count: int, *, named: Sequence[Sequence[float]] = (), seed: int = SAMPLE_SEED
 ) -> list[list[float]]:
-    """Start points of a search over the box: zero, `named`, corners, then `count` draws."""
-    return [zero(box), *[list(r) for r in named], *corners(box), *draws(box, count, seed)]
+    """Start points of a search over the box: rest, `named`, corners, then `count` draws."""
+    return [rest_pose(box), *[list(r) for r in named], *corners(box), *draws(box, count, seed)]
 
 
 def values(

@@ -23,6 +23,7 @@ import numpy as np
 from armcli.defaults import COLLISION_SAMPLES
 from armcli.errors import BuildError, InputError
 from armcli.robot import sampling
+from armcli.robot.collision import SelfCollision
 from armcli.robot.model import Robot
 from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_urdf
@@ -114,11 +115,13 @@ class _Sampler:
         return self.robot.q(self.robot.follow(dict(zip(names, angles, strict=True))))
 
     def _defaults(self) -> dict[str, float]:
-        return {j.name: 0.0 if lo <= 0.0 <= hi else 0.5 * (lo + hi)
-                for j, (lo, hi) in zip(self.free, self.box, strict=True)}  # fmt: skip
+        return {j.name: j.rest for j in self.free}
 
     def default(self) -> np.ndarray:
-        """MoveIt's default state: 0 where the limits allow it, else the middle of the range."""
+        """MoveIt's default state: every joint at rest (`robot.joints.rest`, MoveIt's rule).
+
+        0 where the limits allow it, else the middle of the range.
+        """
         return self._q(self._defaults().values())
 
     def named(self, values: dict[str, float]) -> np.ndarray:
@@ -134,34 +137,16 @@ class _Sampler:
 
 
 class _Checker:
-    """Pinocchio geometry model restricted to candidate link pairs."""
+    """The robot's collision geometry restricted to the candidate link pairs."""
 
     def __init__(self, robot: Robot, candidates: list[tuple[str, str]]) -> None:
-        import pinocchio as pin
-
-        self.pin = pin
-        self.model = robot.model
-        self.data = robot.data
-        gmodel = robot.collision_model()
-        link_of = [self.model.frames[g.parentFrame].name for g in gmodel.geometryObjects]
         wanted = set(candidates)
-        self.pair_links: list[tuple[str, str]] = []
-        for i, j in itertools.combinations(range(len(link_of)), 2):
-            key = _pair(link_of[i], link_of[j])
-            if link_of[i] != link_of[j] and key in wanted:
-                gmodel.addCollisionPair(pin.CollisionPair(i, j))
-                self.pair_links.append(key)
-        self.gmodel = gmodel
-        self.gdata = pin.GeometryData(gmodel)
+        self.check = SelfCollision(robot, lambda a, b: _pair(a, b) in wanted)
+        self.pair_links = [_pair(a, b) for a, b in self.check.pairs]
 
     def colliding(self, q: np.ndarray, active: Iterable[int]) -> set[tuple[str, str]]:
         """Link pairs in collision at q, testing only the collision pairs in `active`."""
-        self.pin.updateGeometryPlacements(self.model, self.data, self.gmodel, self.gdata, q)
-        hits = set()
-        for k in active:
-            if self.pin.computeCollision(self.gmodel, self.gdata, k):
-                hits.add(self.pair_links[k])
-        return hits
+        return {self.pair_links[k] for k in self.check.colliding(q, active)}
 
 
 def _classify(
@@ -205,7 +190,7 @@ def compute_collision_matrix(
     links = tuple(sorted(lk.name for lk in urdf.links if lk.collisions))
     adjacent = adjacent_pairs(urdf)
     candidates = [p for p in itertools.combinations(links, 2) if p not in adjacent]
-    robot = Robot.from_urdf(urdf)
+    robot = Robot.load(urdf, strict=False)
     checker = _Checker(robot, candidates)
     sampler = _Sampler(robot)
     all_k = range(len(checker.pair_links))

@@ -41,7 +41,7 @@ def controller_verdict(
     joints = chain_joints(spec)
     if trajectory_interface(spec, joints, JAZZY) != "effort":
         return None
-    robot = Robot.from_urdf(parse_urdf(urdf_xml, f"{spec.name}.urdf"))
+    robot = Robot.load(parse_urdf(urdf_xml, f"{spec.name}.urdf"), strict=False)
     names = [j for j in joints if j in spec.control.gains and j in robot.names]
     if not names:
         return None
@@ -54,7 +54,7 @@ def controller_verdict(
     )
     ki = [holding[j].i if j in holding else g.ki for j, g in zip(names, gains, strict=True)]
     samples = sampling.configurations(robot)
-    lin = pdloop.linearise(robot.model, [q for _, q in samples], data=robot.data)
+    lin = pdloop.linearise(robot, [q for _, q in samples])
     return rate_verdict(lin, Pid.of(pd, ki), spec.control.controller_update_rate), names, samples
 
 

@@ -19,7 +19,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from armcli.analysis.sag import Hold, settle
-from armcli.robot.load import mass_matrix
 from armcli.robot.model import Robot
 from armcli.ros.srdf import chain_joints
 from armcli.spec.model import RobotSpec
@@ -54,7 +53,7 @@ def integral_terms(
     `urdf_xml`: the robot the controller drives. Joints whose spec already has `ki` keep
     it (their clamp: the effort limit).
     """
-    robot = Robot.from_urdf(parse_urdf(urdf_xml, f"{spec.name}.urdf"))
+    robot = Robot.load(parse_urdf(urdf_xml, f"{spec.name}.urdf"), strict=False)
     joints = [j for j in chain_joints(spec) if j in spec.control.gains]
     if sag_at_poses(spec, robot) <= tolerance:
         return {}
@@ -72,10 +71,9 @@ def integral_terms(
 
 def _largest_inertia(spec: RobotSpec, robot: Robot, joints: list[str]) -> dict[str, float]:
     """Each joint's largest diagonal mass-matrix entry [kg·m²] over the named poses."""
-    data = robot.model.createData()
     out = {j: 0.0 for j in joints}
     for name in spec.poses:
-        M = mass_matrix(robot.model, data, robot.q(robot.follow(spec.pose(name))))
+        M = robot.mass_matrix(robot.q(robot.follow(spec.pose(name))))
         for j in joints:
             k = robot.joint(j).idx_v
             out[j] = max(out[j], float(M[k, k]))

@@ -15,6 +15,7 @@ import yaml
 
 from armcli.defaults import DEFAULT_JOINT_ACCELERATION
 from armcli.errors import InputError
+from armcli.robot.joints import rest
 from armcli.ros.interfaces import HUMBLE, trajectory_interface
 from armcli.ros.srdf import ARM_GROUP, chain_joints
 from armcli.spec.joint_types import position_bounds
@@ -159,12 +160,16 @@ def passive_joints(spec: RobotSpec) -> list[str]:
 
 
 def initial_positions(spec: RobotSpec) -> dict[str, Any]:
-    """Start of the mock hardware: the `home` pose if the spec has one, else the limit-clamped 0."""
+    """Start of the mock hardware: the `home` pose if the spec has one, clamped into the limits.
+
+    A joint it leaves out rests (`robot.joints.rest`: 0, else the middle of its range).
+    """
     values = spec.pose("home") if "home" in spec.poses else {}
     joints = spec.all_joints()
     out = {}
     for name in [*chain_joints(spec), *passive_joints(spec)]:
-        bounds, v = position_bounds(joints[name].type, joints[name].limit), values.get(name, 0.0)
+        bounds = position_bounds(joints[name].type, joints[name].limit)
+        v = values.get(name, rest(*bounds) if bounds is not None else 0.0)
         if bounds is not None:
             v = min(max(v, bounds[0]), bounds[1])
         out[name] = float(v)

@@ -73,7 +73,7 @@ class ArmRun:
             from armcli.sim.plot import tracking_png  # matplotlib: only for a plot
 
             row = tipping.plot_row(self.series) if self.series is not None else None
-            files[plot] = tracking_png(res, job.arm.effort, row)
+            files[plot] = tracking_png(res, job.robot.effort, row)
         return files
 
 

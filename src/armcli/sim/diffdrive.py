@@ -23,7 +23,6 @@ the encoder odometry (`odometry_source` 0), and the states file has the truth be
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -146,8 +145,3 @@ def encoder_odometry(
     v = np.concatenate([[0.0], np.hypot(dx, dy) / dt])
     w = np.concatenate([[0.0], dtheta / dt])
     return Odometry(x, y, theta, v, w)
-
-
-def yaw_quaternion(yaw: float) -> tuple[float, float, float, float]:
-    """(x, y, z, w) of a rotation by `yaw` [rad] about z (tf2's setRPY(0, 0, yaw))."""
-    return 0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0)

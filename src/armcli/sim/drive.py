@@ -112,14 +112,14 @@ def prepare(
     stance = stance_of(robot, candidates=set(spec.mobile_base.links) if spec.mobile_base else None)
     if isinstance(stance, NoStance):
         raise InputError(f"the robot cannot stand: {stance.reason}", field="mobile_base")
-    n = len(job.arm.joint_names)
+    n = len(job.robot.names)
     kp = np.broadcast_to(np.asarray(job.config.kp, dtype=float), (n,))
     kd = np.broadcast_to(np.asarray(job.config.kd, dtype=float), (n,))
-    gains = (kp, kd, np.asarray(job.arm.effort, dtype=float))
+    gains = (kp, kd, np.asarray(job.robot.effort, dtype=float))
     if isinstance(world, Path):
         world = load_world(world, [lk.name for lk in robot.links])
     model = build_drive_model(
-        robot, spec, stance, params, job.arm.joint_names, gains, job.config.dt, world=world
+        robot, spec, stance, params, job.robot.names, gains, job.config.dt, world=world
     )
     if world is not None:
         refuse_overlaps(model.model, start_data(model, job.q0), model.world, world.source)
@@ -145,7 +145,7 @@ def _hold_message(spec: RobotSpec, opts: SimOptions) -> str:
     arm = simjob.load_arm(spec, None, opts.joints)
     q0 = simjob.start_state(arm, spec)
     point = {"positions": [float(x) for x in q0], "time_from_start": 0.0}
-    return str(yaml.safe_dump({"joint_names": list(arm.joint_names), "points": [point]}))
+    return str(yaml.safe_dump({"joint_names": list(arm.names), "points": [point]}))
 
 
 @dataclass(frozen=True)
@@ -298,12 +298,5 @@ def _contiguous(ids: np.ndarray) -> bool:
 
 def _gravity(arm: SimJob) -> Callable[[np.ndarray], np.ndarray]:
     """g(q) [N·m] of the fixed-base arm, as `simulate`'s controller adds it."""
-    import pinocchio as pin
-
-    robot = arm.arm.robot
-    model, data = robot.model, robot.model.createData()
-
-    def g(q: np.ndarray) -> Any:
-        return pin.computeGeneralizedGravity(model, data, robot.q(q))
-
-    return g
+    robot = arm.robot
+    return lambda q: robot.gravity(robot.q(q))

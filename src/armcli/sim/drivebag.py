@@ -15,8 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from armcli.robot.frames import matrix_quaternion, pose_matrix, yaw_quaternion
 from armcli.sim import rosbag
-from armcli.sim.diffdrive import yaw_quaternion
 from armcli.sim.drive import DriveRun, start_data
 from armcli.sim.sensors.messages import channels as sensor_channels
 from armcli.sim.states import TIME, sample_steps
@@ -40,7 +40,7 @@ def mcap_bytes(
     """The run as rosbag2 MCAP bytes (sim.rosbag's topics plus the drive's, plus `more`)."""
     job = run.job
     wheels = [job.params.left_joint, job.params.right_joint]
-    chans = rosbag.channels(cols, [*job.arm.arm.joint_names, *wheels], job.robot)
+    chans = rosbag.channels(cols, [*job.arm.robot.names, *wheels], job.robot)
     stamps = [round(float(t) * 1e9) for t in cols[TIME]]
     extra = _base_transforms(job.params.odom_frame, job.params.base_frame, cols, stamps)
     chans = [
@@ -95,7 +95,7 @@ def _base_transforms(
         T_world_odom = T_world_base @ np.linalg.inv(T_odom_base)
         out.append(
             [
-                _tf(WORLD, odom, ns, T_world_odom[:3, 3], _quat(T_world_odom[:3, :3])),
+                _tf(WORLD, odom, ns, T_world_odom[:3, 3], matrix_quaternion(T_world_odom[:3, :3])),
                 _tf(odom, base, ns, T_odom_base[:3, 3], yaw_quaternion(float(cols["odom.yaw"][i]))),
             ]
         )
@@ -103,41 +103,7 @@ def _base_transforms(
 
 
 def _pose(x: float, y: float, z: float, roll: float, pitch: float, yaw: float) -> np.ndarray:
-    T = np.eye(4)
-    q = rosbag.quat_rpy((roll, pitch, yaw))
-    T[:3, :3] = _matrix(q)
-    T[:3, 3] = (x, y, z)
-    return T
-
-
-def _matrix(q: np.ndarray) -> np.ndarray:
-    x, y, z, w = q
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
-def _quat(R: np.ndarray) -> tuple[float, float, float, float]:
-    """(x, y, z, w) of a rotation matrix (Shepperd's method, w >= 0)."""
-    w = 0.5 * np.sqrt(max(1.0 + R[0, 0] + R[1, 1] + R[2, 2], 0.0))
-    if w > 1e-6:
-        return (
-            (R[2, 1] - R[1, 2]) / (4 * w),
-            (R[0, 2] - R[2, 0]) / (4 * w),
-            (R[1, 0] - R[0, 1]) / (4 * w),
-            w,
-        )
-    i = int(np.argmax(np.diag(R)))
-    j, k = (i + 1) % 3, (i + 2) % 3
-    v = np.zeros(3)
-    v[i] = 0.5 * np.sqrt(max(1.0 + R[i, i] - R[j, j] - R[k, k], 0.0))
-    v[j] = (R[j, i] + R[i, j]) / (4 * v[i])
-    v[k] = (R[k, i] + R[i, k]) / (4 * v[i])
-    return float(v[0]), float(v[1]), float(v[2]), float((R[k, j] - R[j, k]) / (4 * v[i]))
+    return pose_matrix((x, y, z), (roll, pitch, yaw))
 
 
 def _odometry(run: DriveRun, k: np.ndarray, stamps: list[int]) -> list[Any]:

@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from armcli.robot.frames import quaternion_rpy
 from armcli.sim.drive import DriveRun
-from armcli.sim.liftoff import TipVerdict, roll_pitch_yaw, verdict
+from armcli.sim.liftoff import TipVerdict, verdict
 from armcli.sim.rollout import Stats
 from armcli.sim.simulate import SETTLE_TOL, SimResult
 from armcli.sim.states import column, distinct, sample_states, sample_steps
@@ -25,7 +26,7 @@ STOP_TOL = 1e-9  # [rad or m] a joint beyond its range by more is on its (soft) 
 def arm_result(run: DriveRun, keep: np.ndarray) -> SimResult:
     """The arm's motion at the steps `keep`, with statistics over every step."""
     job, L, s = run.job, run.job.model.layout, run.sensors
-    arm = job.arm.arm
+    arm = job.arm.robot
     q, v, tau = s[:, L.arm_pos], s[:, L.arm_vel], s[:, L.arm_force]
     e = q - run.q_ref
     out = np.abs(e) > SETTLE_TOL
@@ -46,7 +47,7 @@ def arm_result(run: DriveRun, keep: np.ndarray) -> SimResult:
     )
     k = distinct(keep)
     return SimResult(
-        arm.joint_names,
+        arm.names,
         run.steps,
         job.dt,
         job.arm.config.integrator,
@@ -71,7 +72,7 @@ def tip_verdict(run: DriveRun) -> TipVerdict:
     z = s[:, L.contact_pos][:, 2::3]
     force = s[:, L.touch]
     contacts = {link: (force[:, i], z[:, i]) for i, link in enumerate(job.model.contacts)}
-    start = dict(zip(job.arm.arm.joint_names, job.arm.q0, strict=True))
+    start = dict(zip(job.arm.robot.names, job.arm.q0, strict=True))
     return verdict(job.stance, start, run.t, s[:, L.base_quat], contacts)
 
 
@@ -80,7 +81,7 @@ def columns(run: DriveRun, res: SimResult, rate: float) -> dict[str, np.ndarray]
     job, L, s = run.job, run.job.model.layout, run.sensors
     cols = sample_states(res, rate)
     k = sample_steps(run.steps, job.dt, rate)
-    roll, pitch, yaw = roll_pitch_yaw(s[:, L.base_quat])
+    roll, pitch, yaw = quaternion_rpy(s[:, L.base_quat])
     pos = s[:, L.base_pos]
     base = {
         "x": pos[:, 0],

@@ -21,7 +21,7 @@ def plot_png(run: DriveRun, res: SimResult, verdict_: TipVerdict) -> bytes:
 
     title = f"armcli simulate --cmd-vel (MuJoCo, dt = {res.dt:g} s)"
     rows = 4 if _has_scene(run) else 2  # the scan seen from above takes two rows
-    return tracking_png(res, run.job.arm.arm.effort, _drive_rows(run, verdict_), rows, title)
+    return tracking_png(res, run.job.arm.robot.effort, _drive_rows(run, verdict_), rows, title)
 
 
 def _has_scene(run: DriveRun) -> bool:

@@ -78,7 +78,7 @@ def _excursion(stance: Stance, series: zmps.ZmpSeries, c: int, a: int, b: int) -
     poly = stance.polygon
     edge = poly.nearest_edge(p) if np.all(np.isfinite(p)) else 0
     com, inertia = series.bodies.get(k, (np.zeros(3), np.zeros((3, 3))))
-    mass = float(sum(i.mass for i in stance.loaded().inertias))
+    mass = stance.loaded().mass
     d = float(poly.edge_distances(com[:2])[edge])
     h = stance.height(com)
     ex = poly.edges[edge]

@@ -15,21 +15,19 @@ import numpy as np
 
 from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_URDF
 from armcli.errors import InputError
-from armcli.robot.frames import link_frame
-from armcli.robot.load import checked_model
-from armcli.robot.mimic import Mimic, mimics
-from armcli.robot.tool import tool_point
+from armcli.robot.frames import pose_matrix
+from armcli.robot.mimic import Mimic
+from armcli.robot.model import Robot
 from armcli.sim.options import SimOptions
 from armcli.sim.plot import plot_steps
 from armcli.sim.reference import Reference, build_reference, coupled
 from armcli.sim.simulate import (
     MAX_STEPS,
-    Arm,
     SimConfig,
     SimResult,
-    arm_from_model,
     check_stability,
     simulate,
+    simulated,
     steps_of,
 )
 from armcli.sim.states import distinct, sample_steps
@@ -52,15 +50,13 @@ RATE_SLACK = 1e-9  # relative: --rate 1000 with dt 0.001 is exactly one sample p
 class SimJob:
     """Everything one simulation run needs, as `prepare` decided it from the user inputs."""
 
-    arm: Arm
+    robot: Robot  # the simulated joints movable, the others locked; its tool point reported
     trajectory: Trajectory
     reference: Reference
     q0: np.ndarray
     duration: float
     config: SimConfig
-    tool_frame: int  # pinocchio frame id of the end-effector link
-    tool_offset: np.ndarray  # [m] point in that frame
-    tool_label: str
+    tool_label: str  # the tool point and the frame it is reported in
     rate: float  # [Hz] joint_state_publisher rate
     T_frame_root: np.ndarray  # 4x4 pose of the arm's root link in the reporting frame
     notes: tuple[str, ...] = ()  # what reading a xacro --urdf reported (Urdf.notes)
@@ -92,28 +88,28 @@ def load_arm(
     joints: Sequence[str] | None,
     *,
     trust_xacro: Trust = False,
-) -> Arm:
+) -> Robot:
     """The simulated arm: the spec's standalone arm built in memory, or a given URDF.
 
     A given URDF goes through the same strict reader as `check` (no DOCTYPE, finite
     numbers, no foreign xacro without trust), since Pinocchio alone would simulate
     mass="nan" as 0 kg.
     """
-    return arm_from_model(
-        checked_model(arm_urdf(spec, urdf, trust_xacro=trust_xacro)).model, joints
-    )
+    return simulated(Robot.load(arm_urdf(spec, urdf, trust_xacro=trust_xacro), spec=spec), joints)
 
 
-def mimic_pairs(doc: Urdf, arm: Arm, traj: Trajectory, source: str) -> list[tuple[int, int, Mimic]]:
+def mimic_pairs(
+    couplings: Sequence[Mimic], robot: Robot, traj: Trajectory, source: str
+) -> list[tuple[int, int, Mimic]]:
     """(follower, leader) model indices of the simulated mimic joints, leaders first.
 
     A follower is commanded through its leader (multiplier * leader + offset), as
     gazebo_ros2_control and MoveIt do; naming it in the trajectory, or locking its leader
     while it moves, is refused.
     """
-    names = list(arm.joint_names)
+    names = list(robot.names)
     out = []
-    for m in mimics(doc.joints):
+    for m in couplings:  # the whole robot's, some perhaps locked in `robot`
         if m.follower not in names:
             continue  # locked
         if m.follower in traj.joint_names:
@@ -134,13 +130,13 @@ def mimic_pairs(doc: Urdf, arm: Arm, traj: Trajectory, source: str) -> list[tupl
 
 
 def _gains(
-    arm: Arm,
+    robot: Robot,
     spec: RobotSpec | None,
     override: Sequence[float] | None,
     which: str,
     leaders: dict[str, str] | None = None,
 ) -> np.ndarray:
-    n = len(arm.joint_names)
+    n = len(robot.names)
     if override:
         if len(override) not in (1, n):
             raise InputError(
@@ -155,20 +151,20 @@ def _gains(
         if follower not in gains and leader in gains:  # is driven like its leader
             gains[follower] = gains[leader]
     followers = leaders or {}  # given through their leaders, never on their own
-    missing = [j for j in arm.joint_names if j not in gains and j not in followers]
+    missing = [j for j in robot.names if j not in gains and j not in followers]
     if missing:
         raise InputError(
             f"no {which} for {', '.join(missing)} in the spec's control.gains; "
             f"give `SimOptions.{which}`",
             field=f"SimOptions.{which}",
         )
-    return np.array([getattr(gains[j], which) for j in arm.joint_names], dtype=float)
+    return np.array([getattr(gains[j], which) for j in robot.names], dtype=float)
 
 
-def _refuse_integral_gain(arm: Arm, spec: RobotSpec | None) -> None:
+def _refuse_integral_gain(robot: Robot, spec: RobotSpec | None) -> None:
     """The simulator runs PD: a spec ki would be silently dropped, so it is refused instead."""
     gains = spec.control.gains if spec is not None else {}
-    for j in arm.joint_names:
+    for j in robot.names:
         if j in gains and gains[j].ki > 0.0:
             raise InputError(
                 f"= {gains[j].ki:g}: armcli simulates PD control only (no integral term); "
@@ -177,47 +173,37 @@ def _refuse_integral_gain(arm: Arm, spec: RobotSpec | None) -> None:
             )
 
 
-def _tool(arm: Arm, doc: Urdf, spec: RobotSpec | None) -> tuple[int, np.ndarray, str]:
-    """The tool point (armcli.robot.tool) as (Pinocchio frame id, offset [m], label)."""
-    model = arm.model
-    tool = tool_point(doc, spec)
-    frame = link_frame(model, tool.link) if tool is not None else None
-    if tool is None or frame is None:
-        raise InputError("this URDF has no link to report as the end effector", file=doc.source)
-    return frame, np.array(tool.xyz, dtype=float), tool.label
+def _report_frame(robot: Robot, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
+    """How the tool point is reported ("tool in frame"), and the arm root's pose in that frame.
 
-
-def _report_frame(arm: Arm, spec: RobotSpec | None) -> tuple[str, np.ndarray]:
-    """Frame the tool point is reported in, and the arm root's pose in it.
-
-    With a spec that mounts the arm on a mobile base, that is the base's root link
+    With a spec that mounts the arm on a mobile base, the frame is the base's root link
     (base_footprint), composed from the fixed joint origins (moving joints at 0),
     so the numbers match `check` and `view`; otherwise the arm's own root link.
+    InputError (before the run) for a URDF without a link to report.
     """
-    import pinocchio as pin
-
-    model = arm.model
+    model, _ = robot.model, robot.tool_frame
+    tool = str(robot.tool.label if robot.tool is not None else "")
     root = next(f.name for f in model.frames if f.parentJoint == 0 and f.name != "universe")
-    T = pin.SE3.Identity()
+    T = np.eye(4)
     if spec is None or spec.mounted_base() is None:
-        return root, T.homogeneous
+        return f"{tool} in {root}", T
     by_child = {j.child: j for j in spec.all_joints().values()}
     link = spec.arm_root()
     while link in by_child:
         joint = by_child[link]
-        rot = pin.rpy.rpyToMatrix(*joint.origin.rpy)
-        T = pin.SE3(rot, np.array(joint.origin.xyz, dtype=float)) * T
+        T = pose_matrix(joint.origin.xyz, joint.origin.rpy) @ T
         link = joint.parent
-    return link, T.homogeneous
+    return f"{tool} in {link}", T
 
 
-def start_state(arm: Arm, spec: RobotSpec | None) -> np.ndarray:
-    """The spec's `home` pose if it has one, else zero clamped into the joint limits."""
-    q = np.zeros(len(arm.joint_names))
-    if spec is not None and "home" in spec.poses:
-        home = spec.pose("home")
-        q = np.array([home.get(j, 0.0) for j in arm.joint_names], dtype=float)
-    return np.clip(q, arm.lower, arm.upper)
+def start_state(robot: Robot, spec: RobotSpec | None) -> np.ndarray:
+    """The spec's `home` pose (clamped into the joint limits); a joint it leaves out rests.
+
+    Without a `home` pose every joint rests (`Robot.rest`: 0, else the middle of its range).
+    """
+    home = spec.pose("home") if spec is not None and "home" in spec.poses else {}
+    q = np.array([home.get(j, robot.rest(j)) for j in robot.names], dtype=float)
+    return np.asarray(np.clip(q, robot.lower, robot.upper), dtype=float)
 
 
 def _duration_and_rate(
@@ -279,10 +265,11 @@ def prepare(
     dt = dt if dt is not None else (spec.control.dt if spec is not None else DEFAULT_DT)
     dt = time_step(dt, dt_field)
     doc = arm_urdf(spec, opts.urdf, trust_xacro=opts.trust_xacro, inputs=opts.xacro)
-    arm = arm_from_model(checked_model(doc, gate=gate if opts.urdf else None).model, opts.joints)
+    whole = Robot.load(doc, spec=spec, gate=gate if opts.urdf else None)
+    robot = simulated(whole, opts.joints)
     limits = {
         n: (float(lo), float(hi))
-        for n, lo, hi in zip(arm.joint_names, arm.lower, arm.upper, strict=True)
+        for n, lo, hi in zip(robot.names, robot.lower, robot.upper, strict=True)
     }
     others = base_joints(spec)
     if trajectory is not None:
@@ -291,40 +278,34 @@ def prepare(
         traj = loads_trajectory(
             str(message), limits, source="SimOptions.message", clamp=opts.clamp, others=others
         )
-    pairs = mimic_pairs(doc, arm, traj, str(trajectory) if trajectory else "SimOptions.message")
-    q0 = start_state(arm, spec)
+    source = str(trajectory) if trajectory else "SimOptions.message"
+    pairs = mimic_pairs(whole.mimics, robot, traj, source)
+    q0 = start_state(robot, spec)
     for f, lead, m in pairs:
-        q0[f] = np.clip(m.position(q0[lead]), arm.lower[f], arm.upper[f])
-    ref = coupled(build_reference(traj, arm.joint_names, q0), pairs)
+        q0[f] = np.clip(m.position(q0[lead]), robot.lower[f], robot.upper[f])
+    ref = coupled(build_reference(traj, robot.names, q0), pairs)
     gc = (
         opts.gravity_comp
         if opts.gravity_comp is not None
         else bool(spec and spec.control.gravity_compensation)
     )
     leaders = {m.follower: m.leader for _, _, m in pairs}
-    kp = _gains(arm, spec, opts.kp, "kp", leaders)
-    kd = _gains(arm, spec, opts.kd, "kd", leaders)
+    kp = _gains(robot, spec, opts.kp, "kp", leaders)
+    kd = _gains(robot, spec, opts.kd, "kd", leaders)
     if opts.kp is None or opts.kd is None:
-        _refuse_integral_gain(arm, spec)
+        _refuse_integral_gain(robot, spec)
     cfg = SimConfig(kp, kd, dt, opts.integrator, gc)
     configs = np.vstack([q0[None, :], ref.sample(traj.times)[0]])
-    check_stability(arm, cfg, configs)
+    check_stability(robot, cfg, configs)
     total, rate = _duration_and_rate(spec, opts, traj.duration, dt)
-    fid, off, label = _tool(arm, doc, spec)
-    frame, T_frame_root = _report_frame(arm, spec)
-    label = f"{label} in {frame}"
-    return SimJob(
-        arm, traj, ref, q0, total, cfg, fid, off, label, float(rate), T_frame_root, doc.notes, doc
-    )
+    label, T_frame_root = _report_frame(robot, spec)
+    return SimJob(robot, traj, ref, q0, total, cfg, label, float(rate), T_frame_root, doc.notes,
+                  doc)  # fmt: skip
 
 
 def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
     """End-effector point in the reporting frame (see `_report_frame`) at configuration q [m]."""
-    import pinocchio as pin
-
-    data = job.arm.model.createData()
-    pin.framesForwardKinematics(job.arm.model, data, job.arm.robot.q(q))
-    p_root = np.asarray(data.oMf[job.tool_frame].act(job.tool_offset), dtype=float)
+    p_root = job.robot.tool_position(job.robot.q(q))
     out: np.ndarray = job.T_frame_root[:3, :3] @ p_root + job.T_frame_root[:3, 3]
     return out
 
@@ -349,4 +330,5 @@ def run(
     if extra is not None:
         keep = np.concatenate([keep, extra(steps)])
     keep = distinct(keep)
-    return simulate(job.arm, job.reference, job.q0, job.duration, job.config, progress, record=keep)
+    return simulate(job.robot, job.reference, job.q0, job.duration, job.config, progress,
+                    record=keep)  # fmt: skip

@@ -29,6 +29,7 @@ import numpy as np
 
 from armcli.analysis.stance import Stance
 from armcli.errors import TipOverError
+from armcli.robot.frames import tilt
 
 TIP_CAP_DEG = 15.0  # [deg] a base that ends the run tilted further has fallen
 MIN_BOUND_DEG = 1.0  # [deg] below this the soft contacts' own rocking would count as tipping
@@ -134,10 +135,7 @@ class TipVerdict:
 
 def tipping_angles(stance: Stance, values: Mapping[str, float]) -> np.ndarray:
     """[rad] per support edge: the rotation about it that puts the centre of mass over it."""
-    import pinocchio as pin
-
-    model = stance.loaded()
-    com = np.asarray(pin.centerOfMass(model, model.createData(), stance.q(values)), dtype=float)
+    com = stance.loaded().center_of_mass(stance.q(values))
     h = max(stance.height(com), 1e-9)
     return np.asarray(np.arctan2(stance.polygon.edge_distances(com[:2]), h), dtype=float)
 
@@ -159,22 +157,6 @@ def edge_tilts(quat: np.ndarray, normals: np.ndarray) -> np.ndarray:
     ux, uy, uz = 2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)
     lean = -(np.outer(ux, normals[:, 0]) + np.outer(uy, normals[:, 1]))
     return np.asarray(np.arctan2(lean, uz[:, None]), dtype=float)
-
-
-def tilt(quat: np.ndarray) -> np.ndarray:
-    """[rad] Angle between the base's z axis and the vertical, from (w, x, y, z) rows."""
-    x, y = quat[:, 1], quat[:, 2]
-    z_z = 1.0 - 2.0 * (x * x + y * y) / np.maximum(np.sum(quat * quat, axis=1), 1e-300)
-    return np.asarray(np.arccos(np.clip(z_z, -1.0, 1.0)), dtype=float)
-
-
-def roll_pitch_yaw(quat: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """[rad] URDF's roll, pitch, yaw (R = Rz Ry Rx) of (w, x, y, z) rows; yaw unwrapped."""
-    w, x, y, z = quat.T
-    roll = np.arctan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y))
-    pitch = np.arcsin(np.clip(2.0 * (w * y - z * x), -1.0, 1.0))
-    yaw = np.unwrap(np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
-    return roll, pitch, yaw
 
 
 def lifts(link: str, t: np.ndarray, force: np.ndarray, height: np.ndarray) -> list[Lift]:

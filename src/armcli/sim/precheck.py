@@ -26,7 +26,7 @@ def _point_at(job: SimJob, t: float) -> int:
 
 def speed_problems(job: SimJob) -> list[str]:
     """One line per joint whose reference outruns its velocity limit (first segment only)."""
-    ref, arm = job.reference, job.arm
+    ref, robot = job.reference, job.robot
     out: list[str] = []
     said: set[int] = set()
     for s in range(len(ref.knots) - 1):
@@ -35,8 +35,8 @@ def speed_problems(job: SimJob) -> list[str]:
             continue
         _, v = ref.sample(np.linspace(a, b, SPEED_SAMPLES, endpoint=False))
         peak = np.max(np.abs(v), axis=0)
-        for j, name in enumerate(arm.joint_names):
-            vmax = float(arm.velocity[j])
+        for j, name in enumerate(robot.names):
+            vmax = float(robot.velocity[j])
             if j in said or not (math.isfinite(vmax) and vmax > 0):
                 continue
             if peak[j] > vmax * (1 + SPEED_TOL):
@@ -53,22 +53,18 @@ def speed_problems(job: SimJob) -> list[str]:
 
 def holding_problems(job: SimJob) -> list[str]:
     """One line per joint whose effort limit cannot hold the arm against gravity at a point."""
-    import pinocchio as pin
-
-    arm = job.arm
-    robot = arm.robot
-    data = robot.data
+    robot = job.robot
     times = np.concatenate(([0.0], job.trajectory.times))
     q_ref, _ = job.reference.sample(times)
-    worst = np.zeros(len(arm.joint_names))
-    where = np.zeros(len(arm.joint_names), dtype=int)
+    worst = np.zeros(len(robot.names))
+    where = np.zeros(len(robot.names), dtype=int)
     for k, q in enumerate(q_ref):
-        g = np.abs(pin.computeGeneralizedGravity(arm.model, data, robot.q(q)))
+        g = np.abs(robot.gravity(robot.q(q)))
         better = g > worst
         worst, where = np.where(better, g, worst), np.where(better, k, where)
     out = []
-    for j, name in enumerate(arm.joint_names):
-        effort = float(arm.effort[j])
+    for j, name in enumerate(robot.names):
+        effort = float(robot.effort[j])
         if math.isfinite(effort) and worst[j] > effort * (1 + SPEED_TOL):
             at = "the start" if where[j] == 0 else f"points[{where[j] - 1}]"
             out.append(

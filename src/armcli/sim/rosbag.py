@@ -33,9 +33,12 @@ import numpy as np
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
 from armcli.io.userfile import open_regular
+from armcli.robot.frames import axis_quaternion, quaternion_product, rotate, rpy_quaternion
+from armcli.robot.joints import rest
 from armcli.sim.mcap_guard import check_chunks
 from armcli.sim.simulate import SimResult
 from armcli.sim.states import TIME, Replay, column, sample_states
+from armcli.spec.joint_types import position_bounds
 from armcli.urdf.doc import Joint, Urdf
 
 MCAP_SUFFIX = ".mcap"
@@ -128,48 +131,17 @@ def qos(depth: int, transient_local: bool) -> str:
 # -- transforms of the URDF's joints --------------------------------------------------------
 
 
-def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Hamilton product of (x, y, z, w) quaternions."""
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
-    return np.array([
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-        aw * bw - ax * bx - ay * by - az * bz,
-    ])  # fmt: skip
-
-
-def _quat_axis(axis: np.ndarray, angle: float) -> np.ndarray:
-    s = math.sin(angle / 2.0)
-    return np.array([axis[0] * s, axis[1] * s, axis[2] * s, math.cos(angle / 2.0)])
-
-
-def quat_rpy(rpy: Sequence[float]) -> np.ndarray:
-    """URDF's fixed-axis roll, pitch, yaw (R = Rz(y) Ry(p) Rx(r)) as (x, y, z, w)."""
-    r, p, y = rpy
-    qx = _quat_axis(np.array([1.0, 0.0, 0.0]), r)
-    qy = _quat_axis(np.array([0.0, 1.0, 0.0]), p)
-    qz = _quat_axis(np.array([0.0, 0.0, 1.0]), y)
-    return _quat_mul(qz, _quat_mul(qy, qx))
-
-
-def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    u, w = q[:3], q[3]
-    return np.asarray(v + 2.0 * np.cross(u, np.cross(u, v) + w * v), dtype=float)
-
-
 def joint_transform(j: Joint, value: float) -> tuple[np.ndarray, np.ndarray]:
     """(translation [m], rotation (x, y, z, w)) of the child link in the parent link at `value`."""
     xyz = np.array(j.origin.xyz, dtype=float)
-    rot = quat_rpy(j.origin.rpy)
+    rot = np.array(rpy_quaternion(j.origin.rpy))
     if j.type == "fixed" or not j.movable:
         return xyz, rot
     axis = np.array(j.axis or (1.0, 0.0, 0.0), dtype=float)
     axis = axis / np.linalg.norm(axis)
     if j.type == "prismatic":
-        return xyz + _rotate(rot, axis * value), rot
-    return xyz, _quat_mul(rot, _quat_axis(axis, value))
+        return xyz + rotate(rot, axis * value), rot
+    return xyz, quaternion_product(rot, axis_quaternion(axis, value))
 
 
 # -- messages --------------------------------------------------------------------------------
@@ -218,6 +190,8 @@ def channels(cols: Mapping[str, np.ndarray], names: Sequence[str], urdf: Urdf) -
     state, ref, tf = [], [], []
     tracked = [n for n in names if column(n, "reference") in cols]  # a wheel has no reference
     moving = [j for j in urdf.joints if j.type != "fixed" and j.movable]
+    bounds = {j.name: position_bounds(j.type, j.limit) for j in moving}
+    resting = {n: rest(*b) if b is not None else 0.0 for n, b in bounds.items()}  # not simulated
     for k, ns in enumerate(stamps):
         values = {n: float(cols[column(n, "position")][k]) for n in names}
         state.append((ns, _joint_state(
@@ -226,7 +200,7 @@ def channels(cols: Mapping[str, np.ndarray], names: Sequence[str], urdf: Urdf) -
         )))  # fmt: skip
         ref.append((ns, _joint_state(ns, tracked, position=[cols[column(n, "reference")][k]
                                                             for n in tracked])))  # fmt: skip
-        tf.append((ns, {"transforms": [_transform(j, values.get(j.name, 0.0), ns)
+        tf.append((ns, {"transforms": [_transform(j, values.get(j.name, resting[j.name]), ns)
                                        for j in moving]}))  # fmt: skip
     fixed = [j for j in urdf.joints if j.type == "fixed"]
     start = stamps[0]
@@ -361,7 +335,7 @@ def _collect_base(msg: Any, bases: dict[int, np.ndarray]) -> None:
         return
     p1, q1 = _tf_parts(first.transform)
     p2, q2 = _tf_parts(second.transform)
-    p, q = p1 + _rotate(q1, p2), _quat_mul(q1, q2)
+    p, q = p1 + rotate(q1, p2), quaternion_product(q1, q2)
     values = np.array([*p, q[3], q[0], q[1], q[2]], dtype=float)
     if np.all(np.isfinite(values)):
         stamp = first.header.stamp

@@ -27,7 +27,6 @@ import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
-from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -36,8 +35,7 @@ from armcli.analysis import pdloop
 from armcli.analysis import verdict as verdicts
 from armcli.defaults import DEFAULT_DT
 from armcli.errors import InputError, SimulationError
-from armcli.robot.load import mass_matrix
-from armcli.robot.model import Robot
+from armcli.robot.model import LIMITS, Robot
 from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim.options import INTEGRATORS, Integrator
@@ -48,42 +46,6 @@ VEL_ABORT_FACTOR = 10.0  # divergence when |v| exceeds this times the URDF veloc
 DEFAULT_VABORT = 1000.0  # [rad/s or m/s] when the URDF gives no velocity limit
 SETTLE_TOL = 0.01  # [rad or m] |q - q_ref| band for "settled"
 MAX_STEPS = 2_000_000  # the longest run `simulate` accepts: bounds its time, ~1 µs a step
-
-
-@dataclass(frozen=True)
-class Arm:
-    """A fixed-base model reduced to the simulated one-dof joints, plus its URDF limits.
-
-    Refuses, naming the joint, values that are not numbers or out of order: a NaN friction
-    would freeze the joint and a NaN limit would silently mean "no stop".
-    """
-
-    model: Any  # pinocchio.Model
-    joint_names: tuple[str, ...]
-    lower: np.ndarray  # [rad or m]; -inf: no stop (continuous joints)
-    upper: np.ndarray
-    effort: np.ndarray  # [N·m or N]; inf when the URDF gives none
-    velocity: np.ndarray  # [rad/s or m/s]; <= 0 or inf: none
-    damping: np.ndarray  # [N·m·s/rad or N·s/m]
-    friction: np.ndarray  # [N·m or N]
-
-    @cached_property
-    def robot(self) -> Robot:
-        """The model's robot handle (`Robot.q` turns the simulator's q into Pinocchio's)."""
-        return Robot(self.model)
-
-    def __post_init__(self) -> None:
-        n = len(self.joint_names)
-        for name in ("lower", "upper", "effort", "velocity", "damping", "friction"):
-            values = np.asarray(getattr(self, name), dtype=float)
-            if values.shape != (n,):
-                raise InputError(f"{name}: {values.shape[0] if values.ndim else 1} values for "
-                                 f"{n} joint(s)")  # fmt: skip
-            for joint, x in zip(self.joint_names, values, strict=True):
-                _check_joint_value(joint, name, float(x))
-        for joint, lo, hi in zip(self.joint_names, self.lower, self.upper, strict=True):
-            if lo > hi:
-                raise InputError(f"joint {joint!r}: lower limit {lo:g} is above upper {hi:g}")
 
 
 def _check_joint_value(joint: str, name: str, x: float) -> None:
@@ -145,9 +107,11 @@ class SimResult:
     wall_time: float  # [s] spent in the engine
 
 
-def arm_from_model(model: Any, joints: Sequence[str] | None = None) -> Arm:
-    """Keep `joints` (all by default) movable and lock the others at their neutral value."""
-    robot = Robot(model)
+def simulated(robot: Robot, joints: Sequence[str] | None = None) -> Robot:
+    """`robot` with `joints` (all by default) movable, the others locked; checked for the engine.
+
+    Every joint 1-DoF, its limits numbers and in order (`check_limits`).
+    """
     robot = robot.reduced(list(joints)) if joints else robot
     model = robot.model
     for jid in range(1, model.njoints):
@@ -159,34 +123,39 @@ def arm_from_model(model: Any, joints: Sequence[str] | None = None) -> Arm:
                 "to lock it)",
                 field="joints",
             )
-    table = robot.joints  # simulated in model (tree) order whatever --joints says
-    return Arm(
-        model=model,
-        joint_names=robot.names,
-        # a continuous joint's angle is unbounded: no stops (Pinocchio's limits are on cos, sin)
-        lower=np.array([j.lower for j in table]),
-        upper=np.array([j.upper for j in table]),
-        effort=np.array([j.effort for j in table]),
-        velocity=np.array([j.velocity for j in table]),
-        damping=np.array([j.damping for j in table]),
-        friction=np.array([j.friction for j in table]),
-    )
+    check_limits(robot)
+    return robot
 
 
-def plant_of(arm: Arm, cfg: SimConfig, energy_max: float = np.inf) -> ro.Plant:
-    """The rollout's plant: the arm's parameters, the gains and settings of `cfg`."""
-    vel = np.where((arm.velocity > 0) & np.isfinite(arm.velocity), arm.velocity, np.nan)
+def check_limits(robot: Robot) -> None:
+    """Refuse, naming the joint, limits that are not numbers or out of order.
+
+    A NaN friction would freeze the joint and a NaN limit would silently mean "no stop".
+    The simulated joints keep the model's (tree) order whatever `joints` says; a continuous
+    joint's angle is unbounded (lower -inf, upper inf: no stops).
+    """
+    for name in LIMITS:
+        for joint, x in zip(robot.names, getattr(robot, name), strict=True):
+            _check_joint_value(joint, name, float(x))
+    for joint, lo, hi in zip(robot.names, robot.lower, robot.upper, strict=True):
+        if lo > hi:
+            raise InputError(f"joint {joint!r}: lower limit {lo:g} is above upper {hi:g}")
+
+
+def plant_of(robot: Robot, cfg: SimConfig, energy_max: float = np.inf) -> ro.Plant:
+    """The rollout's plant: the robot's limits, the gains and settings of `cfg`."""
+    vel = np.where((robot.velocity > 0) & np.isfinite(robot.velocity), robot.velocity, np.nan)
     vabort = np.where(np.isnan(vel), DEFAULT_VABORT, VEL_ABORT_FACTOR * vel)
-    n = len(arm.joint_names)
+    n = len(robot.names)
     return ro.Plant(
-        model=arm.model,
+        model=robot.model,
         kp=np.broadcast_to(np.asarray(cfg.kp, dtype=float), (n,)),
         kd=np.broadcast_to(np.asarray(cfg.kd, dtype=float), (n,)),
-        damping=arm.damping,
-        friction=arm.friction,
-        lower=arm.lower,
-        upper=arm.upper,
-        effort=arm.effort,
+        damping=robot.damping,
+        friction=robot.friction,
+        lower=robot.lower,
+        upper=robot.upper,
+        effort=robot.effort,
         vabort=vabort,
         gravity_comp=cfg.gravity_comp,
         dt=cfg.dt,
@@ -195,7 +164,7 @@ def plant_of(arm: Arm, cfg: SimConfig, energy_max: float = np.inf) -> ro.Plant:
     )
 
 
-def check_stability(arm: Arm, cfg: SimConfig, configurations: np.ndarray) -> None:
+def check_stability(robot: Robot, cfg: SimConfig, configurations: np.ndarray) -> None:
     """Refuse gains/dt the integrator cannot handle: `check`'s verdict for this loop.
 
     The verdict and its remedy come from armcli.analysis.verdict (Euler steps damping
@@ -203,18 +172,18 @@ def check_stability(arm: Arm, cfg: SimConfig, configurations: np.ndarray) -> Non
 
     Raises UnstableLoopError, which names no option: the command says where dt came from.
     """
-    qs = [arm.robot.q(q) for q in configurations]
-    lin = pdloop.linearise(arm.model, qs, gravity=not cfg.gravity_comp)
-    pd = pdloop.PD.of(range(arm.model.nv), cfg.kp, cfg.kd, arm.damping)
+    qs = [robot.q(q) for q in configurations]
+    lin = pdloop.linearise(robot, qs, gravity=not cfg.gravity_comp)
+    pd = pdloop.PD.of(range(robot.model.nv), cfg.kp, cfg.kd, robot.damping)
     scheme: pdloop.Scheme = "rk4" if cfg.integrator == "rk4" else "implicit"
-    verdicts.refuse_unstable(lin, pd, cfg.dt, scheme, arm.joint_names, configurations.tolist())
+    verdicts.refuse_unstable(lin, pd, cfg.dt, scheme, robot.names, configurations.tolist())
 
 
 @dataclass(frozen=True)
 class Run:
-    """One closed-loop run of a batch: an arm, its reference, start and settings."""
+    """One closed-loop run of a batch: a robot, its reference, start and settings."""
 
-    arm: Arm
+    robot: Robot
     reference: Reference
     q0: np.ndarray
     duration: float  # [s]
@@ -223,7 +192,7 @@ class Run:
 
 
 def simulate(
-    arm: Arm,
+    robot: Robot,
     reference: Reference,
     q0: np.ndarray,
     duration: float,
@@ -237,7 +206,7 @@ def simulate(
     Keeps the states at the strictly increasing steps `record` (default: every step);
     `progress(steps_done, steps_total)` is called between chunks of steps.
     """
-    return _run(Run(arm, reference, q0, duration, cfg, record), None, progress)
+    return _run(Run(robot, reference, q0, duration, cfg, record), None, progress)
 
 
 def simulate_batch(runs: Sequence[Run], threads: int = 1) -> list[SimResult | SimulationError]:
@@ -249,12 +218,12 @@ def simulate_batch(runs: Sequence[Run], threads: int = 1) -> list[SimResult | Si
     mod = native.require()
     compiled: dict[int, Any] = {}
     for r in runs:
-        if id(r.arm.model) not in compiled:
-            compiled[id(r.arm.model)] = native.compiled_model(mod, r.arm.model)
+        if id(r.robot.model) not in compiled:
+            compiled[id(r.robot.model)] = native.compiled_model(mod, r.robot.model)
 
     def one(r: Run) -> SimResult | SimulationError:
         try:
-            return _run(r, compiled[id(r.arm.model)], None)
+            return _run(r, compiled[id(r.robot.model)], None)
         except SimulationError as exc:
             return exc
 
@@ -271,18 +240,18 @@ def steps_of(duration: float, dt: float) -> int:
 
 def _run(r: Run, compiled: Any, progress: Callable[[int, int], None] | None) -> SimResult:
     steps = steps_of(r.duration, r.cfg.dt)
-    plant = plant_of(r.arm, r.cfg)
-    plant = replace(plant, energy_max=_energy_max(r.arm, r.q0, plant.vabort))
+    plant = plant_of(r.robot, r.cfg)
+    plant = replace(plant, energy_max=_energy_max(r.robot, r.q0, plant.vabort))
     start = time.perf_counter()
     out = ro.run(plant, r.reference, np.asarray(r.q0, dtype=float), np.zeros(len(r.q0)), steps,
                  record=r.record, settle_tol=SETTLE_TOL, compiled=compiled,
                  progress=progress)  # fmt: skip
     wall = time.perf_counter() - start
     if out.failure:
-        _raise(r.arm, plant, out)
+        _raise(r.robot, plant, out)
     tr = out.trace
     return SimResult(
-        joint_names=r.arm.joint_names,
+        joint_names=r.robot.names,
         steps=steps,
         dt=r.cfg.dt,
         integrator=r.cfg.integrator,
@@ -301,14 +270,14 @@ def _run(r: Run, compiled: Any, progress: Callable[[int, int], None] | None) -> 
     )
 
 
-def _energy_max(arm: Arm, q0: np.ndarray, vabort: np.ndarray) -> float:
+def _energy_max(robot: Robot, q0: np.ndarray, vabort: np.ndarray) -> float:
     """[J] A kinetic energy no run within the velocity limits reaches: a blow-up beyond it."""
-    M = mass_matrix(arm.model, arm.model.createData(), arm.robot.q(q0))
+    M = robot.mass_matrix(robot.q(q0))
     return float(0.5 * np.max(np.linalg.eigvalsh(M)) * np.sum(vabort**2))
 
 
-def _raise(arm: Arm, plant: ro.Plant, r: ro.Rollout) -> None:
-    joint = arm.joint_names[r.fail_joint] if r.fail_joint >= 0 else None
+def _raise(robot: Robot, plant: ro.Plant, r: ro.Rollout) -> None:
+    joint = robot.names[r.fail_joint] if r.fail_joint >= 0 else None
     if r.failure == "nonfinite":
         msg, cause = (
             "the state became non-finite",

@@ -122,7 +122,7 @@ def prepare(
     if isinstance(found, NoStance):
         notes.append(f"no zero-moment point: {found.reason}")
         return None
-    missing_joints = [n for n in job.arm.joint_names if not found.model.existJointName(n)]
+    missing_joints = [n for n in job.robot.names if not found.model.existJointName(n)]
     if missing_joints:
         notes.append(f"no zero-moment point: {', '.join(missing_joints)} not in {urdf.source}")
         return None

@@ -17,7 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from armcli.sim.simulate import Arm, Run, SimConfig, SimResult, simulate_batch, steps_of
+from armcli.robot.model import Robot
+from armcli.sim.simulate import Run, SimConfig, SimResult, simulate_batch, steps_of
 from armcli.tune import gains as gain_vector
 from armcli.tune.model_gains import loop_stable
 from armcli.tune.objective import METRIC_FIELDS, Weights, run_cost, run_metrics
@@ -36,9 +37,9 @@ class CandidateEval:
 
 @dataclass(frozen=True, eq=False)
 class RolloutJob:
-    """One closed-loop run: an arm, a case and the controller settings."""
+    """One closed-loop run: a robot, a case and the controller settings."""
 
-    arm: Arm
+    robot: Robot
     case: Case
     cfg: SimConfig
 
@@ -51,7 +52,7 @@ def rollout_batch(jobs: Sequence[RolloutJob]) -> list[SimResult | None]:
     the GIL, which the threads of `--jobs` share.
     """
     runs = [
-        Run(j.arm, j.case.reference, j.case.q0, j.case.duration, j.cfg, _tail(j.case, j.cfg.dt))
+        Run(j.robot, j.case.reference, j.case.q0, j.case.duration, j.cfg, _tail(j.case, j.cfg.dt))
         for j in jobs
     ]
     return [r if isinstance(r, SimResult) else None for r in simulate_batch(runs)]
@@ -71,7 +72,7 @@ def _unstable_reason(problem: TuneProblem, kp: np.ndarray, kd: np.ndarray) -> st
     """
     margin = 1.0 if problem.variants else problem.stability_margin
     for v, sm in enumerate(scored_models(problem)):
-        if not loop_stable(sm.arm, sm.lin, kp, kd, problem.loop, margin * problem.dt):
+        if not loop_stable(sm.robot, sm.lin, kp, kd, problem.loop, margin * problem.dt):
             return f"model {v}: {problem.loop} loop unstable at {margin:g} x dt"
     return ""
 
@@ -90,7 +91,7 @@ def evaluate_candidates(
         cfgs.append(cfg)
         reasons.append(_unstable_reason(problem, kp, kd))
         if not reasons[-1]:
-            jobs += [RolloutJob(sm.arm, case, cfg) for sm in models for case in problem.cases]
+            jobs += [RolloutJob(sm.robot, case, cfg) for sm in models for case in problem.cases]
     results = iter(rollout_batch(jobs))
     out = []
     for reason in reasons:

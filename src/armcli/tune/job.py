@@ -29,7 +29,7 @@ from armcli.tune.model_gains import (
     StartGains,
     start_gains,
 )
-from armcli.tune.problem import Case, TuneProblem, draw_variants, nominal_arm
+from armcli.tune.problem import Case, TuneProblem, draw_variants, nominal_robot
 from armcli.urdf.source import spec_urdfs
 
 DEFAULT_ZETA = 1.0  # critically damped
@@ -139,11 +139,11 @@ def prepare(
     xml = spec_urdfs(spec)[ARM_URDF].decode("utf-8")
     base = TuneProblem(xml, ARM_URDF, tuple(s.joints or ()), spec.control.dt, "euler",
                        bool(spec.control.gravity_compensation), loop, 1.0, (), ())  # fmt: skip
-    arm = nominal_arm(base)
-    joints = arm.joint_names
-    limits = {n: (float(lo), float(hi)) for n, lo, hi in zip(joints, arm.lower, arm.upper,
+    robot = nominal_robot(base)
+    joints = robot.names
+    limits = {n: (float(lo), float(hi)) for n, lo, hi in zip(joints, robot.lower, robot.upper,
                                                               strict=True)}  # fmt: skip
-    q0 = start_state(arm, spec)
+    q0 = start_state(robot, spec)
     paths = list(trajectories) or default_trajectories(spec_path, joints)
     cases = [_traj_case(load_trajectory(p, limits), p.stem, joints, q0, s.settle) for p in paths]
     if not cases:
@@ -159,10 +159,10 @@ def prepare(
         if s.wn is not None
         else 2 * math.pi * spec.control.controller_update_rate / TARGET_RATIO
     )
-    start = start_gains(arm, dt=spec.control.dt, loop=s.loop, zeta=s.zeta, wn_target=wn,
+    start = start_gains(robot, dt=spec.control.dt, loop=s.loop, zeta=s.zeta, wn_target=wn,
                         steps=largest_steps(cases, len(joints)),
                         gravity=not base.gravity_comp)  # fmt: skip
-    variants = draw_variants(arm, s.robust, s.mass_scale, s.friction_scale, s.seed)
+    variants = draw_variants(robot, s.robust, s.mass_scale, s.friction_scale, s.seed)
     problem = TuneProblem(xml, ARM_URDF, joints, spec.control.dt, "euler", base.gravity_comp,
                           loop, STABILITY_MARGIN, tuple(cases), variants).with_key()  # fmt: skip
     return TuneJob(problem, start, _spec_gains(spec, joints))

@@ -34,8 +34,7 @@ from armcli.analysis import stability as stab
 from armcli.defaults import PD_LOOPS
 from armcli.errors import InputError
 from armcli.robot import sampling
-from armcli.robot.model import span
-from armcli.sim.simulate import Arm
+from armcli.robot.model import Robot
 
 TARGET_RATIO = 10.0  # wn <= 2 pi f_c / TARGET_RATIO for a loop closed at f_c [Hz]
 STABILITY_MARGIN = 2.0  # gains must be stable at this multiple of dt
@@ -78,30 +77,24 @@ class StartGains:
     dt: float  # [s]
 
 
-def sample_configurations(arm: Arm) -> np.ndarray:
+def sample_configurations(robot: Robot) -> np.ndarray:
     """The joint-space sample `check` takes too (`robot.sampling.joint_space`), (N, n)."""
-    return sampling.joint_space([span(lo, hi) for lo, hi in zip(arm.lower, arm.upper, strict=True)])
+    return sampling.joint_space(sampling.bounds(robot.joints))
 
 
-def linearised(arm: Arm, qs: np.ndarray, *, gravity: bool) -> pdloop.Linearised:
+def linearised(robot: Robot, qs: np.ndarray, *, gravity: bool) -> pdloop.Linearised:
     """M(q) and gravity's stiffness at every sample, as the stability bound needs them.
 
     `gravity=False` (gravity compensation) gives zero stiffness.
     """
-    return pdloop.linearise(arm.model, [arm.robot.q(q) for q in qs], gravity=gravity)
+    return pdloop.linearise(robot, [robot.q(q) for q in qs], gravity=gravity)
 
 
-def gravity_max(arm: Arm, qs: np.ndarray) -> np.ndarray:
+def gravity_max(robot: Robot, qs: np.ndarray) -> np.ndarray:
     """Max |g(q)| per joint over the sample [N·m or N]."""
-    import pinocchio as pin
-
-    data = arm.model.createData()
-    worst = np.zeros(len(arm.joint_names))
+    worst = np.zeros(len(robot.names))
     for q in qs:
-        worst = np.maximum(
-            worst,
-            np.abs(pin.computeGeneralizedGravity(arm.model, data, arm.robot.q(q))),
-        )
+        worst = np.maximum(worst, np.abs(robot.gravity(robot.q(q))))
     return worst
 
 
@@ -142,7 +135,7 @@ def stability_cap(
 
 
 def start_gains(
-    arm: Arm,
+    robot: Robot,
     *,
     dt: float,
     loop: str,
@@ -155,21 +148,21 @@ def start_gains(
 
     Raises InputError when the effort limit cannot even hold the arm against gravity.
     """
-    qs = sample_configurations(arm)
-    lin = linearised(arm, qs, gravity=gravity)
+    qs = sample_configurations(robot)
+    lin = linearised(robot, qs, gravity=gravity)
     Ms = list(lin.M)
     lam = lambda_max(Ms)
     g_jj = np.max(np.maximum(np.diagonal(lin.G, axis1=1, axis2=2), 0.0), axis=0)
     lam_j = np.max([np.diag(np.linalg.inv(M)) for M in Ms], axis=0)
-    g = gravity_max(arm, qs)
+    g = gravity_max(robot, qs)
     diag = np.array([np.diag(M) for M in Ms])
     rows = []
-    for j, name in enumerate(arm.joint_names):
+    for j, name in enumerate(robot.names):
         m_max = float(diag[:, j].max())
         wn_s = stability_cap(
-            loop, m_max, zeta, float(arm.damping[j]), float(lam_j[j]), dt, float(g_jj[j])
+            loop, m_max, zeta, float(robot.damping[j]), float(lam_j[j]), dt, float(g_jj[j])
         )
-        wn_e = _effort_cap(name, float(arm.effort[j]), float(g[j]), float(steps[j]), m_max)
+        wn_e = _effort_cap(name, float(robot.effort[j]), float(g[j]), float(steps[j]), m_max)
         caps: dict[Binding, float] = {"target": wn_target, "stability": wn_s, "effort": wn_e}
         binding = min(caps, key=lambda k: caps[k])
         wn = caps[binding]
@@ -182,7 +175,7 @@ def start_gains(
         )  # fmt: skip
     kp = np.array([r.kp for r in rows])
     kd = np.array([r.kd for r in rows])
-    scale = _coupled_scale(arm, lin, kp, kd, loop, dt)
+    scale = _coupled_scale(robot, lin, kp, kd, loop, dt)
     if scale < 1.0:
         kp, kd = kp * scale, kd * math.sqrt(scale)
         rows = [_scaled(r, scale) for r in rows]
@@ -205,16 +198,16 @@ def _effort_cap(name: str, effort: float, g: float, step: float, m: float) -> fl
 
 
 def loop_stable(
-    arm: Arm, lin: pdloop.Linearised, kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
+    robot: Robot, lin: pdloop.Linearised, kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
 ) -> bool:
     """The verdict of `armcli.analysis.stability` at every sample, for `loop` at dt."""
-    pd = pdloop.PD.of(range(len(kp)), kp, kd, arm.damping)
+    pd = pdloop.PD.of(range(len(kp)), kp, kd, robot.damping)
     scheme: pdloop.Scheme = "implicit" if loop == "implicit" else "explicit"
     return stab.stable(lin, pd, dt, scheme)
 
 
 def _coupled_scale(
-    arm: Arm, lin: pdloop.Linearised, kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
+    robot: Robot, lin: pdloop.Linearised, kp: np.ndarray, kd: np.ndarray, loop: str, dt: float
 ) -> float:
     """Common kp scale keeping the coupled loop stable at margin * dt (1 when it is).
 
@@ -222,11 +215,11 @@ def _coupled_scale(
     are unstable: gravity's stiffness alone is too much for the time step.
     """
     h = STABILITY_MARGIN * dt
-    if loop_stable(arm, lin, kp, kd, loop, h):
+    if loop_stable(robot, lin, kp, kd, loop, h):
         return 1.0
-    if not loop_stable(arm, lin, kp * SCALE_FLOOR, kd * math.sqrt(SCALE_FLOOR), loop, h):
+    if not loop_stable(robot, lin, kp * SCALE_FLOOR, kd * math.sqrt(SCALE_FLOOR), loop, h):
         scheme: pdloop.Scheme = "implicit" if loop == "implicit" else "explicit"
-        free = pdloop.PD.of(range(len(kp)), 0.0 * kp, 0.0 * kd, arm.damping)
+        free = pdloop.PD.of(range(len(kp)), 0.0 * kp, 0.0 * kd, robot.damping)
         edge = stab.largest_stable_dt(lin, free, scheme, dt)
         raise InputError(
             f"= {dt:g} s: gravity's stiffness alone makes the {loop} loop unstable at "
@@ -235,7 +228,7 @@ def _coupled_scale(
             field="control.dt",
         )
     return _largest(
-        lambda s: loop_stable(arm, lin, s * kp, math.sqrt(s) * kd, loop, h), SCALE_FLOOR, 1.0
+        lambda s: loop_stable(robot, lin, s * kp, math.sqrt(s) * kd, loop, h), SCALE_FLOOR, 1.0
     )
 
 

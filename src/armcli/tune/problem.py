@@ -1,8 +1,9 @@
 """What a tuning evaluates: the arm (as URDF text), the cases and the perturbed models.
 
 A `TuneProblem` is plain picklable data so that it can be shipped once to every Dask
-worker; `arms()` rebuilds the Pinocchio models on first use in each process and caches
-them under the problem's content key, so a worker pays for the URDF parse once.
+worker; `scored_models` loads the robot (`Robot.load`) on first use in each process and
+caches its variants under the problem's content key, so a worker pays for the URDF parse
+once.
 """
 
 from __future__ import annotations
@@ -17,11 +18,12 @@ import numpy as np
 
 from armcli.analysis.pdloop import Linearised
 from armcli.defaults import PdLoop
-from armcli.robot.load import load_model
+from armcli.robot.model import Robot
 from armcli.sim.options import Integrator
 from armcli.sim.reference import Reference
-from armcli.sim.simulate import Arm, arm_from_model
+from armcli.sim.simulate import simulated
 from armcli.tune.model_gains import linearised, sample_configurations
+from armcli.urdf.read import parse_urdf
 
 _CACHE: dict[str, tuple[Scored, ...]] = {}
 _LOCK = threading.Lock()
@@ -31,7 +33,7 @@ _LOCK = threading.Lock()
 class Scored:
     """One model candidates are scored on, with its inertia sample for the stability check."""
 
-    arm: Arm
+    robot: Robot
     qs: np.ndarray  # (S, n) sampled configurations
     lin: Linearised  # M(q) and gravity's stiffness at each sample
 
@@ -77,22 +79,15 @@ class TuneProblem:
         return replace(self, key=hashlib.sha256(blob).hexdigest()[:16])
 
 
-def nominal_arm(problem: TuneProblem) -> Arm:
-    """The unperturbed arm of `problem`."""
-    model = load_model(problem.urdf_name, xml=problem.urdf_xml).model
-    return arm_from_model(model, list(problem.joints))
+def nominal_robot(problem: TuneProblem) -> Robot:
+    """The unperturbed robot of `problem`: its joints movable, the others locked."""
+    urdf = parse_urdf(problem.urdf_xml.encode("utf-8"), problem.urdf_name)
+    return simulated(Robot.load(urdf), list(problem.joints))
 
 
-def perturb(arm: Arm, variant: Variant) -> Arm:
-    """`arm` with scaled masses/inertias (same centre of mass) and scaled friction."""
-    import pinocchio as pin
-
-    model = arm.model.copy()
-    for i, s in enumerate(variant.mass_scale, start=1):
-        Y = model.inertias[i]
-        model.inertias[i] = pin.Inertia(Y.mass * s, Y.lever.copy(), Y.inertia * s)
-    friction = arm.friction * np.asarray(variant.friction_scale, dtype=float)
-    return replace(arm, model=model, friction=friction)
+def perturb(robot: Robot, variant: Variant) -> Robot:
+    """`robot` with scaled masses/inertias (same centre of mass) and scaled friction."""
+    return robot.scaled(variant.mass_scale, variant.friction_scale)
 
 
 def scored_models(problem: TuneProblem) -> tuple[Scored, ...]:
@@ -103,22 +98,22 @@ def scored_models(problem: TuneProblem) -> tuple[Scored, ...]:
     key = problem.key or problem.with_key().key
     with _LOCK:
         if key not in _CACHE:
-            arm = nominal_arm(problem)
-            qs = sample_configurations(arm)
-            built = tuple(perturb(arm, v) for v in problem.variants) or (arm,)
+            robot = nominal_robot(problem)
+            qs = sample_configurations(robot)
+            built = tuple(perturb(robot, v) for v in problem.variants) or (robot,)
             gravity = not problem.gravity_comp
             _CACHE[key] = tuple(Scored(a, qs, linearised(a, qs, gravity=gravity)) for a in built)
         return _CACHE[key]
 
 
 def draw_variants(
-    arm: Arm, count: int, mass_range: tuple[float, float], friction_range: tuple[float, float],
+    robot: Robot, count: int, mass_range: tuple[float, float], friction_range: tuple[float, float],
     seed: int,
 ) -> tuple[Variant, ...]:  # fmt: skip
     """`count` perturbed models, scales uniform in the given ranges, from a seeded stream."""
     rng = np.random.default_rng(seed)
-    bodies = arm.model.njoints - 1
-    n = len(arm.joint_names)
+    bodies = robot.model.njoints - 1
+    n = len(robot.names)
     out = []
     for _ in range(count):
         ms = rng.uniform(mass_range[0], mass_range[1], size=bodies)

@@ -14,7 +14,7 @@ from armcli.sim.simulate import SimConfig, SimResult, simulate
 from armcli.tune import gains as gain_vector
 from armcli.tune.engine import Engine
 from armcli.tune.job import TuneJob
-from armcli.tune.problem import nominal_arm
+from armcli.tune.problem import nominal_robot
 from armcli.tune.report import Row
 from armcli.tune.search import SearchOptions, SearchResult, cost_of, nominal, search
 
@@ -71,7 +71,7 @@ def showcase_case(job: TuneJob, outcome: Outcome) -> int:
 def tracking_runs(job: TuneJob, outcome: Outcome, case: int) -> list[tuple[str, SimResult]]:
     """Full time series of each gain set on one trajectory (nominal model), for the plot."""
     p = job.problem
-    arm = nominal_arm(p)
+    robot = nominal_robot(p)
     c = p.cases[case]
     out = []
     for row in outcome.rows:
@@ -79,5 +79,5 @@ def tracking_runs(job: TuneJob, outcome: Outcome, case: int) -> list[tuple[str, 
             continue
         kp, kd = gain_vector.split(row.gains)
         cfg = SimConfig(kp, kd, p.dt, p.integrator, p.gravity_comp)
-        out.append((row.label, simulate(arm, c.reference, c.q0, c.duration, cfg)))
+        out.append((row.label, simulate(robot, c.reference, c.q0, c.duration, cfg)))
     return out

@@ -14,8 +14,8 @@ import numpy as np
 
 from armcli.defaults import STANDALONE_ARM_URDF
 from armcli.errors import InputError
-from armcli.robot.load import load_model
-from armcli.sim.simulate import Arm, arm_from_model
+from armcli.robot.model import Robot
+from armcli.sim.simulate import simulated
 from armcli.spec.joint_types import LIMITED_TYPES
 from armcli.spec.model import RobotSpec
 from armcli.tune.model_gains import (
@@ -26,6 +26,7 @@ from armcli.tune.model_gains import (
     sample_configurations,
     start_gains,
 )
+from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import spec_urdfs
 
 STEP_CAP = math.pi / 2  # [rad or m] the largest step the start gains are sized for
@@ -46,28 +47,27 @@ def spec_start_gains(spec: RobotSpec) -> dict[str, tuple[float, float]]:
     ]
     if not joints:
         return {}
-    xml = spec_urdfs(spec)[STANDALONE_ARM_URDF].decode("utf-8")
-    arm = arm_from_model(load_model(STANDALONE_ARM_URDF, xml=xml).model, joints)
-    steps = np.minimum(
-        np.where(np.isfinite(arm.upper - arm.lower), arm.upper - arm.lower, STEP_CAP), STEP_CAP
-    )
+    urdf = parse_urdf(spec_urdfs(spec)[STANDALONE_ARM_URDF], STANDALONE_ARM_URDF)
+    robot = simulated(Robot.load(urdf, strict=False), joints)
+    span = robot.upper - robot.lower
+    steps = np.minimum(np.where(np.isfinite(span), span, STEP_CAP), STEP_CAP)
     wn = 2 * math.pi * spec.control.controller_update_rate / TARGET_RATIO
     try:
         start = start_gains(
-            arm, dt=spec.control.dt, loop="implicit", zeta=1.0, wn_target=wn, steps=steps
+            robot, dt=spec.control.dt, loop="implicit", zeta=1.0, wn_target=wn, steps=steps
         )
     except InputError:
         return {}  # an effort limit below gravity: no start gains; tune says why
     except np.linalg.LinAlgError:
         return {}  # a massless chain (singular mass matrix): nothing to size gains on; check says
-    kd = _explicit_kd(arm, start.kp, start.kd, spec.control.dt)
+    kd = _explicit_kd(robot, start.kp, start.kd, spec.control.dt)
     return {
         name: (float(kp), float(kd_j))
-        for name, kp, kd_j in zip(arm.joint_names, start.kp, kd, strict=True)
+        for name, kp, kd_j in zip(robot.names, start.kp, kd, strict=True)
     }
 
 
-def _explicit_kd(arm: Arm, kp: np.ndarray, kd: np.ndarray, dt: float) -> np.ndarray:
+def _explicit_kd(robot: Robot, kp: np.ndarray, kd: np.ndarray, dt: float) -> np.ndarray:
     """kd, lowered until the explicit torque loop (Gazebo's) is stable at dt too.
 
     `check` judges both loops; the implicit start alone left the imported OpenManipulator-X
@@ -75,10 +75,10 @@ def _explicit_kd(arm: Arm, kp: np.ndarray, kd: np.ndarray, dt: float) -> np.ndar
     only makes that loop more stable, and the simulator's implicit loop stays stable.
     Unchanged when no Kd makes it stable (then `check` says why).
     """
-    lin = linearised(arm, sample_configurations(arm), gravity=True)
-    if loop_stable(arm, lin, kp, kd, "explicit", dt):
+    lin = linearised(robot, sample_configurations(robot), gravity=True)
+    if loop_stable(robot, lin, kp, kd, "explicit", dt):
         return kd
-    if not loop_stable(arm, lin, kp, 0.0 * kd, "explicit", dt):
+    if not loop_stable(robot, lin, kp, 0.0 * kd, "explicit", dt):
         return kd
-    s = _largest(lambda s: loop_stable(arm, lin, kp, s * kd, "explicit", dt), KD_FLOOR, 1.0)
+    s = _largest(lambda s: loop_stable(robot, lin, kp, s * kd, "explicit", dt), KD_FLOOR, 1.0)
     return kd * s * KD_MARGIN

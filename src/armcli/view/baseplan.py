@@ -101,7 +101,7 @@ class BaseSession:
             raise InputError("nothing executed yet: click Execute first", field="execute")
         run = done.run
         L, s = run.job.model.layout, run.sensors
-        names = [*run.job.arm.arm.joint_names, run.job.params.left_joint,
+        names = [*run.job.arm.robot.names, run.job.params.left_joint,
                  run.job.params.right_joint]  # fmt: skip
         cols = np.column_stack([s[:, L.arm_pos], s[:, L.wheel_pos]])
         step = max(1, len(run.t) // 2000)

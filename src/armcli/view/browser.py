@@ -23,6 +23,7 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.io.names import did_you_mean
+from armcli.robot.frames import matrix_quaternion
 from armcli.robot.tool import ToolPoint
 from armcli.sim.sensors.replay import SensorReplay
 from armcli.sim.states import Replay
@@ -376,7 +377,8 @@ class Viewer:
             for link, frame in self._frames.items():
                 T = self._urdf.get_transform(link, self._urdf.base_link)
                 frame.position = tuple(T[:3, 3])
-                frame.wxyz = tuple(_quat_wxyz(T[:3, :3]))
+                x, y, z, w = matrix_quaternion(T[:3, :3])
+                frame.wxyz = (w, x, y, z)
                 frame.visible = visible
 
     def _play_loop(self) -> None:
@@ -392,11 +394,3 @@ class Viewer:
                 t = 0.0 if self._loop.value else self._replay.duration
                 self._playing = bool(self._loop.value)
             self._time_slider.value = t
-
-
-def _quat_wxyz(R: np.ndarray) -> np.ndarray:
-    """Unit quaternion (w, x, y, z) of a rotation matrix."""
-    from scipy.spatial.transform import Rotation
-
-    x, y, z, w = Rotation.from_matrix(R).as_quat()
-    return np.array([w, x, y, z])

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from armcli.errors import ArmcliError, InputError
+from armcli.robot.frames import matrix_quaternion, quaternion_matrix
 from armcli.urdf.meshes import MeshSearch
 from armcli.view.browser import FRAME_RATE, moving_parts
 from armcli.view.planning import PlanningSession
@@ -99,7 +100,8 @@ class PlanningPanel:
         with self._lock:
             rotation = None
             if wxyz is not None and len(self.session.joints) >= 6:
-                rotation = _matrix(np.asarray(wxyz, dtype=float))
+                w, x, y, z = (float(v) for v in wxyz)
+                rotation = quaternion_matrix((x, y, z, w))
             outcome = self.session.drag_goal(xyz, rotation)
             self._set_status(outcome.text())
             if outcome.x is not None:
@@ -300,7 +302,7 @@ class PlanningPanel:
         self._buttons(busy=False)
 
     def _place_handle(self, p: np.ndarray, R: np.ndarray) -> None:
-        w, x, y, z = (float(v) for v in _quaternion(R))
+        x, y, z, w = matrix_quaternion(R)
         self._handle.position = (float(p[0]), float(p[1]), float(p[2]))
         self._handle.wxyz = (w, x, y, z)
 
@@ -351,19 +353,3 @@ def _click(action: Callable[[], object]) -> Callable[[Any], None]:
         action()
 
     return on_click
-
-
-def _quaternion(R: np.ndarray) -> np.ndarray:
-    """Unit quaternion (w, x, y, z) of a rotation matrix."""
-    from scipy.spatial.transform import Rotation
-
-    x, y, z, w = Rotation.from_matrix(R).as_quat()
-    return np.array([w, x, y, z])
-
-
-def _matrix(wxyz: np.ndarray) -> np.ndarray:
-    """Rotation matrix of a unit quaternion (w, x, y, z)."""
-    from scipy.spatial.transform import Rotation
-
-    w, x, y, z = wxyz
-    return np.asarray(Rotation.from_quat([x, y, z, w]).as_matrix())

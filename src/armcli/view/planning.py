@@ -28,7 +28,6 @@ from armcli.plan.api import PlanningContext, PlanOptions, PlanResult, plan_motio
 from armcli.plan.execute import Execution, execute
 from armcli.plan.ik import solve_ik, tool_pose
 from armcli.plan.inputs import load_context
-from armcli.robot.frames import frame_id
 from armcli.sim.options import SimOptions
 from armcli.urdf.meshes import MeshSearch
 from armcli.urdf.source import RobotFile
@@ -99,7 +98,6 @@ class PlanningSession:
         self._written: dict[str, tuple[int, ...]] = {}  # path -> _identity of what Save wrote
         self._options = options or PlanOptions()
         robot = context.robot
-        self._data = robot.model.createData()
         home = robot.pose("home") if "home" in robot.poses else self.neutral()
         self.start, self.goal = home.copy(), home.copy()
         self.result: PlanResult | None = None
@@ -118,9 +116,9 @@ class PlanningSession:
         return tuple(self.context.robot.poses)
 
     def neutral(self) -> np.ndarray:
-        """Each planned joint at 0, clipped into its range."""
+        """Each planned joint where it rests (`Robot.rest`: 0, else the middle of its range)."""
         robot = self.context.robot
-        return np.clip(np.zeros(len(robot.joints)), robot.lower, robot.upper)
+        return np.array([robot.robot.rest(j) for j in robot.joints])
 
     def as_dict(self, x: np.ndarray) -> dict[str, float]:
         """Planned joint values by name."""
@@ -137,7 +135,7 @@ class PlanningSession:
 
     def tool(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Tool point [m] and tool link rotation in the root frame at planned values `x`."""
-        return tool_pose(self.context.robot, self._data, np.asarray(x, dtype=float))
+        return tool_pose(self.context.robot, np.asarray(x, dtype=float))
 
     # -- start and goal ----------------------------------------------------------------
     def set_start(self, x: Sequence[float] | np.ndarray) -> None:
@@ -282,15 +280,13 @@ class PlanningSession:
 
     def obstacles(self) -> list[ObstacleMesh]:
         """The scene's shapes as meshes in the root frame (link-fixed ones at the start pose)."""
-        import pinocchio as pin
-
         robot = self.context.robot
-        pin.framesForwardKinematics(robot.model, self._data, robot.q(self.start))
+        q = robot.q(self.start)
         out = []
         for obj in self.scene.objects:
             T = np.eye(4)
             if obj.frame:
-                T = np.asarray(self._data.oMf[frame_id(robot.model, obj.frame)].homogeneous)
+                T = robot.robot.frame_pose(obj.frame, q)
             for shape in obj.shapes:
                 v, f = _triangles(shape)
                 M = T @ shape.T_frame_shape

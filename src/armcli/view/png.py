@@ -21,6 +21,7 @@ import numpy as np
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
 from armcli.io.mesh_confine import bounded_mesh_file, check_total
+from armcli.robot.joints import rest
 from armcli.robot.jointvalues import snap_to_limits
 from armcli.robot.tool import ToolPoint
 from armcli.spec.joint_types import position_bounds
@@ -206,8 +207,8 @@ def full_configuration(
 
 
 def neutral(limit: tuple[float, float] | None) -> float:
-    """The value a joint takes when nobody sets it: 0, or the nearest limit if 0 is outside."""
-    return 0.0 if limit is None else float(np.clip(0.0, limit[0], limit[1]))
+    """The value a joint takes when nobody sets it: its rest (`robot.joints.rest`)."""
+    return 0.0 if limit is None else rest(*limit)
 
 
 def tool_position(urdf: Any, tool: ToolPoint | None) -> np.ndarray | None:

@@ -33,6 +33,7 @@ from armcli.io.files import write_file_atomic
 from armcli.robot.frames import link_frame
 from armcli.robot.model import Robot
 from armcli.robot.tool import ToolPoint
+from armcli.urdf.read import parse_urdf
 from armcli.view.png import DEFAULT_SIZE, DPI, RenderResult, full_configuration, render_figure
 
 REACH_SAMPLES = 6000  # drawn points: a filled region at 1200x600 px, ~1 s to draw
@@ -60,7 +61,7 @@ def reach_of(
     samples: int = REACH_SAMPLES,
 ) -> tuple[Chain, NDArray[np.float64], Workspace, tuple[ReachPoint, ...]]:
     """The chain at pose `q`, its sampled tool positions (n, 3) [m], envelope and verdicts."""
-    robot = Robot.from_xml(xml, source)
+    robot = Robot.load(parse_urdf(xml.encode("utf-8"), source), strict=False)
     if link_frame(robot.model, tool.link) is None:
         raise InputError(f"no link {tool.link!r} for the tool point", file=source)
     chain = Chain(robot, tool, q)

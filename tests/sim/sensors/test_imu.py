@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from armcli.sim.liftoff import roll_pitch_yaw
+from armcli.robot.frames import quaternion_rpy
 from armcli.sim.sensors.imu import ImuSampler
 from armcli.sim.sensors.model import add_sensors
 from tests.sim.sensors.drives import course_with, reading, run
@@ -81,7 +81,7 @@ def test_turning_in_place_the_gyro_reads_the_bases_rate(tmp_path: Path) -> None:
     assert abs(np.mean(gyro[:, 2]) - 0.5) < 2 * RATE_TOL  # the base turns 1-2 % slow (slip)
     # the truth: the base's yaw recorded every step, its change over each 10 ms period
     L = result.job.model.layout
-    yaw = np.unwrap(roll_pitch_yaw(result.sensors[:, L.base_quat])[2])
+    yaw = np.unwrap(quaternion_rpy(result.sensors[:, L.base_quat])[2])
     k = r.steps[later]
     truth = (yaw[k] - yaw[k - 10]) / (10 * result.job.dt)
     assert np.max(np.abs(gyro[:, 2] - truth)) < TRUTH_RATE_TOL
@@ -97,4 +97,4 @@ def test_the_orientation_is_the_bases_ground_truth(tmp_path: Path) -> None:
     imu = r.data["imu"][:, :4]
     sign = np.sign(np.sum(imu * np.column_stack([x, y, z, w]), axis=1))  # q and -q: one turn
     assert np.max(np.abs(imu - sign[:, None] * np.column_stack([x, y, z, w]))) < QUAT_TOL
-    assert np.ptp(roll_pitch_yaw(np.column_stack([w, x, y, z]))[2]) > 0.2  # it did turn
+    assert np.ptp(quaternion_rpy(np.column_stack([w, x, y, z]))[2]) > 0.2  # it did turn

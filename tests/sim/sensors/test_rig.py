@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from armcli.errors import InputError
-from armcli.sim.liftoff import roll_pitch_yaw
+from armcli.robot.frames import quaternion_rpy
 from armcli.sim.sensors.rays import lidar_directions
 from tests.sim.sensors.drives import course_with, reading, run
 
@@ -44,7 +44,7 @@ def test_driven_into_a_wall_the_closest_range_is_the_truth(tmp_path: Path) -> No
     for j in (0, len(scan.steps) // 2, len(scan.steps) - 1):
         k = scan.steps[j]
         pos, quat = result.sensors[k, L.base_pos], result.sensors[k, L.base_quat]
-        roll, pitch, yaw = (float(a[0]) for a in roll_pitch_yaw(quat[None, :]))
+        roll, pitch, yaw = (float(a[0]) for a in quaternion_rpy(quat[None, :]))
         assert abs(roll) < 0.01 and abs(pitch) < 0.01  # level: the wall's distance is planar
         c, s = math.cos(yaw), math.sin(yaw)
         lidar_x = pos[0] + c * LIDAR_XYZ[0] - s * LIDAR_XYZ[1]

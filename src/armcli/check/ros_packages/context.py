@@ -149,7 +149,7 @@ class PackageContext:
             from armcli.robot.model import Robot
 
             try:
-                self._models[key] = Robot.from_urdf(urdf)
+                self._models[key] = Robot.load(urdf, strict=False)
             except (ArmcliError, ValueError, RuntimeError):
                 self._models[key] = None
         return self._models[key]

@@ -46,7 +46,7 @@ def _controller(ctx: PackageContext, cf: ControllerFile, c: Controller, urdf: Ur
     joints = [robot.joint(j) for j in names]
     pd = pdloop.PD.of([j.idx_v for j in joints], kp, kd, [j.damping for j in joints])
     samples = sampling.configurations(robot)
-    lin = pdloop.linearise(robot.model, [q for _, q in samples], data=robot.data)
+    lin = pdloop.linearise(robot, [q for _, q in samples])
     rate = cf.update_rate if cf.update_rate is not None and cf.update_rate > 0 else DEFAULT_RATE
     v = rate_verdict(lin, Pid.of(pd, ki), rate)
     if v.stable:

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from armcli.check.ros_packages.context import PackageContext
 from armcli.check.ros_packages.params import DIFF_DRIVE, Controller
-from armcli.robot.inertia import rpy_matrix
+from armcli.robot.frames import rpy_matrix
 from armcli.urdf.doc import Joint, Urdf
 
 RULE = "ros-wheel-geometry"

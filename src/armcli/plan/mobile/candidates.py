@@ -139,7 +139,7 @@ def _heights(judge: Judge) -> tuple[float, float]:
     from armcli.robot.tool import tool_point
 
     robot_file = judge.mobile.robot_file
-    plain = Robot.from_urdf(robot_file.robot, spec=robot_file.spec)
+    plain = Robot.load(robot_file.robot, spec=robot_file.spec, strict=False)
     tool = tool_point(robot_file.robot, robot_file.spec)
     if tool is None:  # pragma: no cover - the mobile robot has a tool point
         return -np.inf, np.inf

@@ -114,7 +114,7 @@ def _truth(plan: WholePlan, run: DriveRun) -> tuple[np.ndarray, np.ndarray]:
     R = np.asarray(pin.Quaternion(w, x, y, z).toRotationMatrix())
     robot = plan.mobile.arm_robot()
     data = robot.model.createData()
-    ran = dict(zip(run.job.arm.arm.joint_names, s[L.arm_pos].tolist(), strict=True))
+    ran = dict(zip(run.job.arm.robot.names, s[L.arm_pos].tolist(), strict=True))
     pin.forwardKinematics(robot.model, data, robot.q([ran[j] for j in robot.joints]))
     tool_b = pin.updateFramePlacement(robot.model, data, robot.tool_frame).act(robot.tool_offset)
     yaw = math.atan2(R[1, 0], R[0, 0])
@@ -139,7 +139,7 @@ def _judge(plan: WholePlan, run: DriveRun, arm: SimResult, verdict: TipVerdict,
     tool_err = float(np.linalg.norm(tool - target))
     job = run.job
     L, sens = job.model.layout, run.sensors
-    names, effort = job.arm.arm.joint_names, job.arm.arm.effort
+    names, effort = job.arm.robot.names, job.arm.robot.effort
     peaks = np.max(np.abs(sens[:, L.arm_force]), axis=0)
     problems = []
     if verdict.tips:
@@ -148,7 +148,7 @@ def _judge(plan: WholePlan, run: DriveRun, arm: SimResult, verdict: TipVerdict,
         if arm.stats.saturated_steps[i] > 0:
             problems.append(f"{name} reaches its effort limit {effort[i]:g}")
         q = sens[:, L.arm_pos][:, i]
-        lo, hi = job.arm.arm.lower[i], job.arm.arm.upper[i]
+        lo, hi = job.arm.robot.lower[i], job.arm.robot.upper[i]
         if np.any(q < lo - STOP_SLACK) or np.any(q > hi + STOP_SLACK):
             problems.append(f"{name} leaves its range [{lo:g}, {hi:g}] by more than "
                             f"{STOP_SLACK:g}")  # fmt: skip

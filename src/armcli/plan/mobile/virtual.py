@@ -63,10 +63,8 @@ class MobileRobot:
         """The planning robot with the base held at `base` (x, y, yaw): the arm's joints planned."""
         r, n = self.robot, len(BASE_JOINTS)
         b = np.asarray(base, dtype=float)
-        rest = {**r.rest, **{j: float(v) for j, v in zip(BASE_JOINTS, b, strict=True)}}
-        return replace(r, joints=r.joints[n:], lower=r.lower[n:], upper=r.upper[n:],
-                       velocity=r.velocity[n:], acceleration=r.acceleration[n:],
-                       effort=r.effort[n:], rest=rest)  # fmt: skip
+        held = {**r.held, **{j: float(v) for j, v in zip(BASE_JOINTS, b, strict=True)}}
+        return replace(r, joints=r.joints[n:], acceleration=r.acceleration[n:], held=held)
 
     @property
     def base_links(self) -> tuple[str, ...]:

@@ -146,7 +146,7 @@ def axle_offset(mobile: MobileRobot, params: DriveParams) -> np.ndarray:
                          field="base")  # fmt: skip
     data = model.createData()
     arm = mobile.arm_robot()
-    rest = [arm.rest_of(j) for j in arm.joints]
+    rest = [arm.robot.rest(j) for j in arm.joints]
     pin.forwardKinematics(model, data, mobile.robot.q(mobile.x((0.0, 0.0, 0.0), rest)))
     ends = [np.asarray(data.oMi[model.getJointId(j)].translation)[:2]
             for j in (params.left_joint, params.right_joint)]  # fmt: skip

@@ -103,7 +103,7 @@ def _travel(mobile: MobileRobot, arm_start: str | None) -> np.ndarray:
         robot = ctx.robot
         if HOME in robot.poses:
             return robot.pose(HOME)
-        return np.array([robot.rest_of(j) for j in robot.joints])
+        return np.array([robot.robot.rest(j) for j in robot.joints])
     return configuration(ctx, arm_start, "start")
 
 
