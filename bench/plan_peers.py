@@ -99,14 +99,13 @@ def queries(kind: Kind, ctx: PlanningContext, rb: Roboplan, count: int, seed: in
     """Seeded start/goal pairs of `kind` (see the module docstring)."""
     rng = np.random.default_rng(seed)
     r, ck = ctx.robot, ctx.checker
-    data = r.model.createData()
     ends: tuple[list[np.ndarray], list[np.ndarray]] = ([], [])
     out: list[tuple[np.ndarray, np.ndarray]] = []
     while len(out) < count:
         x = rng.uniform(r.lower, r.upper)
         if ck.first_collision(x, every_pair=True) is not None or rb.has(x):
             continue
-        p = tool_pose(r, data, x)[0]
+        p = tool_pose(r, x)[0]
         for k, test in enumerate((kind.first, kind.second)):
             if test(p) and len(ends[k]) <= len(ends[1 - k]):
                 ends[k].append(x)

@@ -99,7 +99,7 @@ def course() -> tuple[Robot, list[str], pdloop.PD, list, pdloop.Linearised]:
     pd = pdloop.PD.of([robot.joint(n).idx_v for n in names], [g.kp for g in gains],
                       [g.kd for g in gains], [robot.joint(n).damping for n in names])  # fmt: skip
     samples = sampling.configurations(robot)
-    lin = pdloop.linearise(robot.model, [q for _, q in samples], data=robot.data)
+    lin = pdloop.linearise(robot, [q for _, q in samples])
     return robot, names, pd, samples, lin
 
 
@@ -208,7 +208,7 @@ def test_single_pendulum_in_a_horizontal_plane_is_the_closed_form(kp: float, kd:
         parse_urdf(PENDULUM.format(l=length, m=m, axis=1).encode(), "p"), strict=False
     )
     samples = sampling.configurations(robot)
-    lin = pdloop.linearise(robot.model, [q for _, q in samples], data=robot.data)
+    lin = pdloop.linearise(robot, [q for _, q in samples])
     pd = pdloop.PD.of([0], [kp], [kd], [0.0])
     inertia = m * length**2 + 1e-9  # point mass on a massless rod, plus the URDF's izz
     # Jury on the held double integrator (tests/analysis/test_zoh.py): the edge of a / 2 < b < 2
@@ -223,7 +223,7 @@ def test_hanging_pendulum_edge_in_the_simulation() -> None:
     xml = PENDULUM.format(l=length, m=m, axis=0).replace('xyz="0 0 0"', 'xyz="0 1 0"')
     robot = Robot.load(parse_urdf(xml.encode(), "p"), strict=False)
     samples = sampling.configurations(robot)
-    lin = pdloop.linearise(robot.model, [q for _, q in samples], data=robot.data)
+    lin = pdloop.linearise(robot, [q for _, q in samples])
     pd = pdloop.PD.of([0], [kp], [kd], [0.0])
     v = rate.rate_verdict(lin, zoh.Pid.of(pd), 100.0)
     q_star = samples[v.worst][1]

@@ -68,7 +68,7 @@ def _hits_wall(loaded: Loaded, x: np.ndarray) -> bool:
 @pytest.fixture(scope="module")
 def reach_point() -> np.ndarray:
     ctx = load_context(read_robot(DEFAULT_SPEC)).context
-    return tool_pose(ctx.robot, ctx.robot.model.createData(), ctx.robot.pose("reach"))[0]
+    return tool_pose(ctx.robot, ctx.robot.pose("reach"))[0]
 
 
 @pytest.mark.parametrize("fmt", FORMATS)

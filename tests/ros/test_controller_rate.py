@@ -60,9 +60,7 @@ def test_the_verdict_is_on_the_written_gains() -> None:
     pd = pdloop.PD.of([robot.joint(n).idx_v for n in names], [x.kp for x in g],
                       [x.kd for x in g], [robot.joint(n).damping for n in names])  # fmt: skip
     ki = np.array([control.holding[n].i for n in names])
-    lin = pdloop.linearise(
-        robot.model, [q for _, q in sampling.configurations(robot)], data=robot.data
-    )
+    lin = pdloop.linearise(robot, [q for _, q in sampling.configurations(robot)])
     want = rate.rate_verdict(lin, zoh.Pid.of(pd, ki), spec.control.controller_update_rate)
     assert control.rate == want and want.stable
 
