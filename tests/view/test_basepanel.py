@@ -10,6 +10,7 @@ server plans and executes, and the replay moves the whole robot's root to the pa
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,6 +18,8 @@ import pytest
 from armcli.plan.mobile.judge import world_to_base
 from armcli.view.basepanel import BasePanel, MobileViewer
 from armcli.view.baseplan import BaseSession, load_base_session
+from armcli.view.panel import PlanningPanel
+from armcli.view.planning import load_session
 from armcli.view.scene import load_robot
 from tests.helpers import DEFAULT_SPEC, FIXTURES
 
@@ -56,9 +59,15 @@ def test_a_robot_without_a_drive_gets_no_base_session() -> None:
     assert load_base_session(src.file) is None
 
 
-def test_the_panel_plans_executes_and_replays_the_whole_robot(session: BaseSession) -> None:
+def test_the_panel_plans_executes_and_replays_the_whole_robot(
+    session: BaseSession, tmp_path: Path
+) -> None:
+    """As `armcli view SPEC --scene ROOM` builds it: the arm's planning panel beside."""
     src = load_robot(DEFAULT_SPEC)
+    assert src.file is not None
     viewer = MobileViewer(src.xml, name=src.name, poses=src.poses, tool=src.tool, port=0)
+    arm = PlanningPanel(viewer, load_session(src.file, scene=CORRIDOR, save_dir=tmp_path), src.xml,
+                        source=src.source)  # fmt: skip
     panel = BasePanel(viewer, session, src.xml, source=src.source)
     try:
         panel.move_target(TARGET)
@@ -70,6 +79,15 @@ def test_the_panel_plans_executes_and_replays_the_whole_robot(session: BaseSessi
         x, y, _ = session.plan.placement.verdict.base
         root = viewer.base_position()  # where the replay left the robot
         assert math.hypot(root[0] - x, root[1] - y) < PARKED_TOL
+        # the room's walls and table stayed in the world while the robot drove (drawn in
+        # the base frame, they travelled with it: the robot never came nearer the table)
+        scene = viewer.server.scene
+        walls = [scene.get_handle_by_name(f"/room/{k}") for k in range(3)]
+        assert all(h is not None and np.allclose(h.position, 0.0) for h in walls)
+        assert scene.get_handle_by_name("/base/plan/scene/0") is None
+        arm.plan()  # the arm's planning panel plans with the base at the origin: it goes back
+        assert np.allclose(viewer.base_position(), 0.0)
     finally:
+        arm.close()
         panel.close()
         viewer.close()

@@ -5,7 +5,10 @@ room (position only); **Plan** draws the base's path on the floor, the feasible 
 (the floor positions from which the target is in reach) as points, and ghosts of the arm
 along its motion at the parked pose; **Execute** runs the plan on the MuJoCo drive and
 replays the whole robot: the root moves with the run's ground truth (`Viewer.set_base`),
-the arm and the wheels with its joints. One lock, as view.panel's.
+the arm and the wheels with its joints, and leaves it parked. The scene's objects are the
+room's: they stay in the world (the planning panel draws them at /room), and either
+panel's Plan puts the robot back at the origin, where both plan from. One lock, as
+view.panel's.
 """
 
 from __future__ import annotations
@@ -58,6 +61,10 @@ class MobileViewer(Viewer):
         assert self._base is not None  # MOBILE: Viewer made the frame
         with self._lock:
             self._base.position, self._base.wxyz = np.asarray(position), np.asarray(wxyz)
+
+    def home(self) -> None:
+        """Put the robot back at the room's origin, where plans start (after a replay)."""
+        self.set_base((0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0))
 
     def base_position(self) -> np.ndarray:
         """Where the robot's root is [m]."""
@@ -112,6 +119,8 @@ class BasePanel:
             self._buttons(busy=True)
             try:
                 self._status.content = "planning the base and the arm..."
+                self.close()  # a replay still running
+                self.viewer.home()  # the plan starts at the origin
                 x, y, z = (float(v) for v in self._handle.position)
                 drawing = self.session.plan_to((x, y, z))
                 self._clear()

@@ -68,8 +68,11 @@ class PlanningPanel:
         self._build_gui()
         self._build_handle()
         self._frame_camera()
+        # a drive's replay carries the scene with the robot (it is the arm's, in the base
+        # frame); the mobile base panel's scene is the room, which stays (view.basepanel)
+        scene = "/room" if viewer.MOBILE else f"{self._node}/scene"
         for k, ob in enumerate(session.obstacles()):
-            viewer.server.scene.add_mesh_simple(f"{self._node}/scene/{k}", ob.vertices, ob.faces,
+            viewer.server.scene.add_mesh_simple(f"{scene}/{k}", ob.vertices, ob.faces,
                                                 color=OBSTACLE_RGB, opacity=0.6)  # fmt: skip
         self._show_goal()
 
@@ -131,6 +134,11 @@ class PlanningPanel:
 
     def _plan(self) -> tuple[PlanResult | None, str | None]:
         try:
+            if self.viewer.MOBILE:  # the arm is planned with its base at the room's origin
+                from armcli.view.basepanel import MobileViewer
+
+                assert isinstance(self.viewer, MobileViewer)
+                self.viewer.home()
             if self._start_box.value == CURRENT:
                 self.session.set_start(self.session.from_dict(self.viewer.configuration()))
             return self.session.plan(), self.session.reason
