@@ -171,7 +171,7 @@ def lines(w: WholePlan, what: str, planner: str, seed: int) -> list[str]:
         f"{math.degrees(v.base[2]) + 0.0:.1f}° (planned in {w.base_planning_time_s * 1e3:.1f} ms; "
         "checked in 3-D)",
         *notes,
-        f"  arm: {', '.join(r.joints)}: {r.path_length_rad:.4f} rad, {r.duration_s:.3f} s in "
+        f"  arm ({', '.join(r.joints)}): path {r.path_length_rad:.4f} rad, {r.duration_s:.3f} s in "
         f"{len(r.timed.times)} points after the base stops (planned in "
         f"{r.planning_time_s * 1e3:.1f} ms; certified at 1 kHz)",
         f"  tool error at the goal {v.error * 1e3:.2f} mm; whole motion "
