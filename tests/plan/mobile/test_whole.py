@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 import yaml
 
+from armcli.errors import PlanningError
 from armcli.plan.api import PlanOptions
 from armcli.plan.mobile.basefiles import cmd_vel_yaml
 from armcli.plan.mobile.virtual import MobileRobot, load_mobile
@@ -142,3 +143,23 @@ def test_the_wheels_stay_within_their_limits(cluttered: MobileRobot) -> None:
         np.diff(np.concatenate([[0.0], ang, [0.0]])))  # fmt: skip
     # a mean over one period of a ramp at `accel` changes by at most accel * period per period
     assert np.max(steps) <= lim.accel * lim.period + 1e-9
+
+
+def test_an_arm_failure_names_the_arm_and_the_parked_pose(
+    cluttered: MobileRobot, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`plan --base` plans twice (the base, then the arm there): the reason says which failed."""
+    import armcli.plan.mobile.whole as whole
+
+    def no_path(*_args: object) -> None:
+        raise PlanningError("no-path", "no collision-free path found within 1 s")
+
+    monkeypatch.setattr(whole, "plan_motion", no_path)
+    with pytest.raises(PlanningError) as caught:
+        _plan(cluttered, (1.35, 0.0, 0.5), (0.0, 0.0, 0.0))
+    assert caught.value.kind == "no-path"
+    parked = _drive(cluttered, (1.35, 0.0, 0.5), (0.0, 0.0, 0.0)).placement.verdict.base
+    assert str(caught.value) == (
+        f"the arm, with the base parked at ({parked[0]:.3f}, {parked[1]:.3f}) m, "
+        f"{math.degrees(parked[2]):.1f} deg: no collision-free path found within 1 s"
+    )

@@ -197,7 +197,16 @@ def plan_whole(mobile: MobileRobot, goal: BaseGoal, options: PlanOptions) -> Who
     d = plan_drive(mobile, goal, options.seed)
     ctx = planning_context(mobile.arm_robot(d.placement.verdict.base), mobile.world,
                            mobile.disabled)  # fmt: skip
-    arm = plan_motion(ctx, d.travel, d.placement.verdict.q, options)
+    try:
+        arm = plan_motion(ctx, d.travel, d.placement.verdict.q, options)
+    except PlanningError as exc:  # say which half failed: the base's plan stands
+        x, y, yaw = d.placement.verdict.base
+        raise PlanningError(
+            exc.kind,
+            f"the arm, with the base parked at ({x:.3f}, {y:.3f}) m, "
+            f"{math.degrees(yaw):.1f} deg: {exc.reason}",
+            pair=exc.pair,
+        ) from exc
     return WholePlan(mobile, d.params, d.placement, d.path, d.timing, d.travel, arm,
                      d.planning_time_s, d.certify_time_s, goal, d.axle, d.floor)  # fmt: skip
 
