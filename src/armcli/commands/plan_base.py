@@ -15,10 +15,12 @@ from armcli.io.terminal import say
 
 if TYPE_CHECKING:
     from armcli.plan.mobile.execute import Executed
+    from armcli.plan.mobile.virtual import MobileRobot
     from armcli.plan.mobile.whole import WholePlan
     from armcli.urdf.source import RobotInput
 
-FLAGS = {"base": "--base", "start": "--from", "target": "--to-xyz", "tolerance": "--tolerance"}
+FLAGS = {"base": "--base", "start": "--from", "target": "--to-xyz", "tolerance": "--tolerance",
+         "execute": "--execute"}  # fmt: skip
 FILES = ("arm.yaml", "cmd_vel.yaml", "path.yaml")
 RUN_FILES = ("run.csv", "run.mcap")
 
@@ -63,6 +65,8 @@ def plan_base(
     try:
         with flag_errors(FLAGS):
             mobile = load_mobile(robot_file, scene=scene, search=robot.packages)
+            if execute:  # refused before planning (nothing written), after "needs a drive"
+                _executable(mobile)
             goal = BaseGoal((to_xyz[0], to_xyz[1], to_xyz[2]), (origin[0], origin[1], origin[2]),
                             start)  # fmt: skip
             whole = plan_whole(mobile, goal, opts)
@@ -91,6 +95,14 @@ def plan_base(
         raise typer.Exit(1)
 
 
+def _executable(mobile: MobileRobot) -> None:
+    from armcli.plan.mobile.execute import executable
+    from armcli.plan.mobile.wheels import drive_params
+
+    drive_params(mobile)
+    executable(mobile.robot_file)
+
+
 def _execute(whole: WholePlan, out: Path, written: dict[Path, bytes], tolerance: float
              ) -> Executed:  # fmt: skip
     from armcli.io.together import write_files_together
@@ -110,11 +122,20 @@ def executed(done: Executed) -> dict[str, Any]:
         "base_error_m": done.base_error[0],
         "base_yaw_error_rad": done.base_error[1],
         "arrived_s": done.arrived,
+        "localizer_hz": done.localize,
         "peak_effort": {n: p for n, (p, _) in done.peak_effort.items()},
         "effort_limit": {n: e for n, (_, e) in done.peak_effort.items()},
         "tips": done.verdict.tips,
         "real_time_factor": float(done.run.t[-1] / max(done.run.wall_time, 1e-9)),
     }
+
+
+def _localised(done: Executed) -> list[str]:
+    """Say how the base was followed: the ground-truth fixes stand in for a localiser."""
+    if done.localize <= 0:
+        return ["  followed on the encoder odometry alone"]
+    return [f"  followed on the encoder odometry with a {done.localize:g} Hz ground-truth fix "
+            "(a stand-in for a localiser such as AMCL)"]  # fmt: skip
 
 
 def executed_lines(done: Executed, out: Path) -> list[str]:
@@ -124,6 +145,7 @@ def executed_lines(done: Executed, out: Path) -> list[str]:
     return [
         f"executed on the MuJoCo drive ({run.t[-1]:.2f} s in {run.wall_time:.2f} s): "
         f"tool {done.tool_error * 1e3:.1f} mm from the target (ground truth)",
+        *_localised(done),
         f"  base: {done.base_error[0] * 1e3:.1f} mm and "
         f"{math.degrees(done.base_error[1]):.2f}° off its goal; arrived at "
         + (f"{done.arrived:.2f} s" if done.arrived is not None else "never"),

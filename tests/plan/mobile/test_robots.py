@@ -76,3 +76,41 @@ def test_a_robot_without_a_drive_gets_one_line(tmp_path: Path) -> None:
     assert res.returncode == 2
     assert "--base: needs a differential drive" in res.stderr
     assert not (tmp_path / "x").exists()
+    res = run_cli(["plan", "--urdf", str(FIXTURES / "plan" / "two_link.urdf"), "--to-xyz",
+                   "0.2,0,0.2", "--base", "-o", str(tmp_path / "x"), "--execute"])  # fmt: skip
+    assert "--base: needs a differential drive" in res.stderr  # the first thing missing
+
+
+def test_execute_without_a_spec_is_refused_before_planning(tmp_path: Path) -> None:
+    res = run_cli(["plan", "--urdf", str(ROVER), "--to-xyz", "1.5,0.3,0.15", "--base",
+                   "-o", str(tmp_path / "x"), "--execute"])  # fmt: skip
+    assert res.returncode == 2
+    assert res.stderr.startswith("error: --execute: drives a spec's robot"), res.stderr
+    assert not (tmp_path / "x").exists()
+
+
+# LoCoBot's wx250s arm ends in a continuous joint (`gripper`): `armcli import` then finds no
+# fixed joint whose subtree holds the arm without a continuous joint, and keeps the wheels in
+# the spec's arm (no mobile_base): the drive has no base to run.
+SPINNER = """  <link name="spinner"/>
+  <joint name="gripper" type="continuous">
+    <parent link="end_effector_link"/><child link="spinner"/><axis xyz="1 0 0"/>
+    <limit effort="1" velocity="3"/>
+  </joint>
+</robot>"""
+
+
+def test_execute_without_a_mobile_base_is_refused_before_planning(tmp_path: Path) -> None:
+    urdf = tmp_path / "rover_spinner.urdf"
+    urdf.write_text(ROVER.read_text().replace("</robot>", SPINNER))
+    spec = tmp_path / "rover.yaml"
+    res = run_cli(["import", str(urdf), "-o", str(spec)])
+    assert res.returncode == 0, res.stderr
+    res = run_cli(["plan", str(spec), "--to-xyz", "1.5,0.3,0.15", "--base", "-o",
+                   str(tmp_path / "x"), "--execute"])  # fmt: skip
+    assert res.returncode == 2
+    assert " ".join(res.stderr.split()) == (
+        f"error: --execute: drives a spec's mobile_base apart from its arm: {spec} has no "
+        "mobile_base (its arm holds the wheels)"
+    )
+    assert not (tmp_path / "x").exists()

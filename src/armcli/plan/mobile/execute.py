@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -27,6 +28,10 @@ from armcli.sim.drive import DriveRun
 from armcli.sim.liftoff import TipVerdict
 from armcli.sim.options import SimOptions
 from armcli.sim.simulate import SimResult, steps_of
+from armcli.urdf.source import RobotFile
+
+if TYPE_CHECKING:
+    from armcli.spec.model import RobotSpec
 
 TOLERANCE = 0.02  # [m] the tool farther than this from the target on the ground truth: a miss
 SLACK = 1.5  # the base may take this many times its planned time (plus SLACK_S) to arrive
@@ -49,6 +54,7 @@ class Executed:
     peak_effort: dict[str, tuple[float, float]]  # joint -> (peak, limit) [N·m or N]
     problems: tuple[str, ...]  # a tip, a broken limit, a miss beyond the tolerance
     odometry: tuple[float, float, float]  # the follower's encoder odometry at the end
+    localize: float = 0.0  # [Hz] the localiser stand-in's ground-truth fixes (0: encoders only)
 
     @property
     def failed(self) -> bool:
@@ -72,6 +78,23 @@ def start_frame(scene: Scene, start: tuple[float, float, float]) -> Scene:
     return Scene(tuple(objects), scene.source)
 
 
+def executable(robot_file: RobotFile) -> RobotSpec:
+    """The spec the drive runs; InputError before any planning when there is none to run.
+
+    The drive simulates a spec's `mobile_base` apart from its `arm`: a URDF has no spec,
+    and an imported robot whose wheels stayed in its arm (no `mobile_base`) has no base.
+    """
+    spec = robot_file.spec
+    if spec is None:
+        raise InputError("drives a spec's robot: `armcli import` writes one from the URDF "
+                         "(keeping its diff-drive plugin)", field="execute")  # fmt: skip
+    if spec.mobile_base is None:
+        raise InputError(f"drives a spec's mobile_base apart from its arm: {robot_file.path} "
+                         "has no mobile_base (its arm holds the wheels)",
+                         field="execute")  # fmt: skip
+    return spec
+
+
 def execute_whole(
     plan: WholePlan,
     cmd_vel: Path,
@@ -84,10 +107,7 @@ def execute_whole(
     `localize` [Hz]: the localiser's rate (`plan.mobile.pursuit`); 0: encoders alone.
     """
     mobile = plan.mobile
-    spec = mobile.robot_file.spec
-    if spec is None:
-        raise InputError("--execute drives a spec's robot (its mobile_base.diff_drive)",
-                         field="execute")  # fmt: skip
+    spec = executable(mobile.robot_file)
     start = plan.goal.start
     duration = SLACK * plan.timing.duration + SLACK_S + plan.arm.duration_s + SETTLE_S
     opts = SimOptions(message=arm_yaml.decode("utf-8"), gravity_comp=True, duration=duration)
@@ -102,7 +122,7 @@ def execute_whole(
     run = drive.run(job, pilot=pilot)
     arm = driveout.arm_result(run, driveout.plot_steps_of(run.steps, job.dt, job.arm.rate))
     verdict = driveout.tip_verdict(run)
-    return _judge(plan, run, arm, verdict, pilot, tolerance)
+    return replace(_judge(plan, run, arm, verdict, pilot, tolerance), localize=localize)
 
 
 def _truth(plan: WholePlan, run: DriveRun) -> tuple[np.ndarray, np.ndarray]:
