@@ -107,7 +107,7 @@ def place_png(
 
     v = placement.verdict
     judge = Judge(mobile, target, tolerance)
-    fig = Figure(figsize=(7.0, 7.0))
+    fig = Figure(figsize=(7.0, 7.6))
     FigureCanvasAgg(fig)
     ax = fig.add_subplot(1, 1, 1)
     shapes = robot_outlines(mobile, v.base, v.q)
@@ -134,7 +134,9 @@ def place_png(
     ax.set_ylabel("y [m]")
     ax.set_title(f"armcli place: base at ({x:.3f}, {y:.3f}) m, yaw {math.degrees(yaw):.1f}°; "
                  f"{placement.cost:.2f} m of wheel travel", fontsize=10)  # fmt: skip
-    ax.legend(loc="upper right", fontsize=8)
+    # below the floor, not on it: a corner legend hid objects and serving poses
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2, fontsize=8)
+    fig.subplots_adjust(bottom=0.2)
     ax.grid(True, alpha=0.3)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=100)
