@@ -124,6 +124,13 @@ class Kinematics:
 
         return np.asarray(pin.computeGeneralizedGravity(self.model, self.data, _q(q)))
 
+    def inverse_dynamics(self, q: ArrayLike, v: ArrayLike, a: ArrayLike) -> Vector:
+        """tau(q, v, a) [N·m or N]: the joint torques of that motion (RNEA), a fresh array."""
+        import pinocchio as pin
+
+        tau = pin.rnea(self.model, self.data, _q(q), _q(v), _q(a))
+        return np.array(tau, dtype=float)
+
     def gravity_stiffness(self, q: ArrayLike) -> NDArray[np.float64]:
         """dg/dq [N·m/rad or N/m], symmetrised: gravity's stiffness on the joints."""
         import pinocchio as pin
