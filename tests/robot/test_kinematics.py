@@ -101,6 +101,7 @@ def test_gravity_is_the_gradient_of_the_potential_and_its_stiffness_its_slope(
         i = robot.joint(name).idx_v
         assert g[i] == pytest.approx(_derivative(robot, potential, name), abs=FD_TOL)
         slope[:, i] = _derivative(robot, robot.gravity, name)
+    np.testing.assert_allclose(robot.gravity_jacobian(q), slope, atol=1e-7)
     np.testing.assert_allclose(robot.gravity_stiffness(q), 0.5 * (slope + slope.T), atol=1e-7)
 
 

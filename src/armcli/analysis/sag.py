@@ -111,13 +111,8 @@ def _gravity(
     robot: Robot, base: Array, joints: Sequence[str], x: Array, vidx: NDArray[np.int_]
 ) -> tuple[Array, Array]:
     """G and dg/dq of the held joints at `x` (the other joints as in `base`)."""
-    import pinocchio as pin
-
     q = robot.q(robot.follow(dict(zip(joints, x.tolist(), strict=True))), base=base)
-    g = np.asarray(pin.computeGeneralizedGravity(robot.model, robot.data, q), dtype=float)
-    dg = np.asarray(
-        pin.computeGeneralizedGravityDerivatives(robot.model, robot.data, q), dtype=float
-    )
+    g, dg = robot.gravity(q), robot.gravity_jacobian(q)
     return g[vidx], dg[np.ix_(vidx, vidx)]
 
 
