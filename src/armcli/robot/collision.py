@@ -81,7 +81,7 @@ class SelfCollision:
     def __init__(
         self, robot: Robot, keep: Callable[[str, str], bool], gmodel: Any | None = None
     ) -> None:
-        """`gmodel`: the geometry to use (default: `robot.collision_model()`, meshes as given)."""
+        """`gmodel`: the geometry to use (default: `Robot.collision_model()`, meshes as given)."""
         import pinocchio as pin
 
         self.robot = robot
