@@ -115,3 +115,12 @@ def test_a_bad_option_value_names_no_environment_variable(
 
     code, _, err = run_main(["simulate", "--dt", "abc"], capsys)
     assert code == 2 and "Invalid value for '--dt': 'abc'" in err and "env var" not in err
+
+
+@pytest.mark.parametrize("name", list(COMMANDS))
+def test_no_help_states_a_default_the_option_lacks(name: str) -> None:
+    """`place --help` said "--target ... (default: Ellipsis)" for a required option."""
+    import click
+
+    helps = [p.help or "" for p in load_command(name).params if isinstance(p, click.Option)]
+    assert not [h for h in helps if "Ellipsis" in h or "(default: None)" in h]
