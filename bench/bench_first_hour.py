@@ -6,7 +6,8 @@
    seconds measured on a fresh machine when the issue was filed, OLD) and beside a peer
    where one exists: `simulate` along pick.yaml next to a bare MuJoCo script stepping the
    exported arm as long (BARE); `simulate --plot` next to `simulate` (what the plot costs);
-   `render`; a 5 s drive with `--plot` next to the bare script stepping the exported
+   `render`; `plan` from home to reach (its planning takes milliseconds: the rest is
+   start-up); a 5 s drive with `--plot` next to the bare script stepping the exported
    whole robot as long; `view` until it prints its address (its start-up).
 3. `armcli check` of every example-robot-data URDF next to `urdf_validate` on the same
    file: the median of the per-file ratios, and the sums.
@@ -37,7 +38,8 @@ ROOT = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
 ENV = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
 # [CPU s] issue 40's figures, measured on a fresh machine (wall ~ CPU there)
-OLD = {"simulate": 2.0, "simulate --plot": 4.0, "render": 3.4, "drive --plot": 2.8, "view": 3.1}
+OLD = {"simulate": 2.0, "simulate --plot": 4.0, "render": 3.4, "drive --plot": 2.8, "view": 3.1,
+       "plan": 2.0}  # fmt: skip
 BARE = """
 import sys
 import mujoco
@@ -92,6 +94,7 @@ def everyday(armcli: str, tmp: Path, reps: int) -> None:
         ("simulate", sim, [*bare, str(arm.parent / "scene.xml"), "7.0", "0.001"], "MuJoCo"),
         ("simulate --plot", [*sim, "--plot", str(tmp / "t.png")], sim, "simulate"),
         ("render", [armcli, "render", str(spec), "-o", str(tmp / "r.png")], None, ""),
+        ("plan", [armcli, "plan", str(spec), "--to", "reach", "-o", str(tmp / "p.yaml")], None, ""),
         ("drive --plot", [armcli, "simulate", str(spec), "--cmd-vel", str(drive), "--plot",
                           str(tmp / "d.png")],
          [*bare, str(whole.parent / "scene.xml"), "5.5", "0.001"], "MuJoCo"),

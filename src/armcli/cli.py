@@ -24,6 +24,7 @@ from armcli.io.oneline import one_line
 from armcli.io.terminal import say_line
 
 UNSANDBOXED_FLAG = "--trust-xacro-unsandboxed"  # what `--trust-xacro=unsandboxed` becomes
+JSON_ERRORS = object()  # the click context's `obj` when errors go to stdout as JSON too
 
 # name -> (module, one-line help for the command list). A test checks that each help
 # line is the first line of the command's own docstring.
@@ -95,6 +96,15 @@ class _LazyGroup(typer.core.TyperGroup):
             return None
         return load_command(cmd_name)
 
+    def invoke(self, ctx: click.Context) -> Any:
+        """Click's usage errors (a bad option value) also as JSON on stdout for --format json."""
+        try:
+            return super().invoke(ctx)
+        except click.ClickException as exc:  # typer prints it on stderr and exits
+            if ctx.obj is JSON_ERRORS:
+                _write_json_error(exc.format_message(), exc.exit_code)
+            raise
+
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         rows = [(name, help_line) for name, (_, help_line) in COMMANDS.items()]
         with formatter.section("Commands"):
@@ -113,6 +123,9 @@ def load_command(name: str) -> click.Command:
     module.register(holder)
     group: Any = typer.main.get_command(holder)
     command: click.Command = group.commands[name]
+    for param in command.params:  # click 8.2.1 says "(env var: 'None')" (click issue #2971)
+        if isinstance(param, click.Option) and param.envvar is None:
+            param.show_envvar = False
     return command
 
 
@@ -170,7 +183,7 @@ def _json_requested(argv: list[str]) -> bool:
     return "--format=json" in argv or any(a == "--format" and b == "json" for a, b in pairs)
 
 
-def _print_json_error(exc: ArmcliError) -> None:
+def _write_json_error(reason: str, exit_code: int) -> None:
     """The error as the JSON document a `--format json` caller parses from stdout.
 
     `status` is "failed" for a negative verdict (exit 1: no plan found, error findings),
@@ -178,9 +191,8 @@ def _print_json_error(exc: ArmcliError) -> None:
     """
     from armcli.io.jsondoc import dumps
 
-    status = "failed" if exc.exit_code == EXIT_FAILED else "error"
-    reason = "; ".join(one_line(line) for line in exc.lines())
-    doc = {"status": status, "reason": reason, "exit_code": exc.exit_code, "output": None}
+    status = "failed" if exit_code == EXIT_FAILED else "error"
+    doc = {"status": status, "reason": one_line(reason), "exit_code": exit_code, "output": None}
     sys.stdout.write(dumps(doc))
 
 
@@ -233,7 +245,7 @@ def main(argv: list[str] | None = None) -> None:
 
         status = start_status(args)
     try:
-        app(args=args, prog_name="armcli")
+        app(args=args, prog_name="armcli", obj=JSON_ERRORS if _json_requested(args) else None)
     except SystemExit as exc:  # typer turns Ctrl-C into a silent exit 130: say it once
         if exc.code == EXIT_INTERRUPTED:
             sys.stderr.write(INTERRUPTED)
@@ -246,7 +258,7 @@ def main(argv: list[str] | None = None) -> None:
             raise
         _print_error(exc)
         if _json_requested(args) and not exc.reported:
-            _print_json_error(exc)
+            _write_json_error("; ".join(exc.lines()), exc.exit_code)
         raise SystemExit(exc.exit_code) from None
     except Exception as exc:  # a bug: say so in one line unless --debug
         if debug:

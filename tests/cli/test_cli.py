@@ -83,3 +83,44 @@ def test_unknown_command_is_a_usage_error() -> None:
         check=False,
     )
     assert res.returncode == 2 and "No such command" in res.stderr
+
+
+@pytest.mark.parametrize(
+    ("args", "reason"),
+    [
+        (["plan", "--timeout", "abc", "--format", "json"], "Invalid value for '--timeout'"),
+        (["check", "--no-such-option", "--format=json"], "No such option: --no-such-option"),
+        (["no-such-command", "--format", "json"], "No such command 'no-such-command'"),
+    ],
+)
+def test_a_usage_error_is_json_on_stdout_too(
+    args: list[str], reason: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Issue 40: --format json got an empty stdout when click refused an option's value."""
+    import json
+
+    from tests.helpers import run_main
+
+    code, out, err = run_main(args, capsys)
+    assert code == 2 and reason in err
+    doc = json.loads(out)
+    assert doc["status"] == "error" and doc["exit_code"] == 2 and reason in doc["reason"]
+
+
+def test_a_bad_option_value_names_no_environment_variable(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """click 8.2.1 printed "Invalid value for '--dt' (env var: 'None')" (click issue #2971)."""
+    from tests.helpers import run_main
+
+    code, _, err = run_main(["simulate", "--dt", "abc"], capsys)
+    assert code == 2 and "Invalid value for '--dt': 'abc'" in err and "env var" not in err
+
+
+@pytest.mark.parametrize("name", list(COMMANDS))
+def test_no_help_states_a_default_the_option_lacks(name: str) -> None:
+    """`place --help` said "--target ... (default: Ellipsis)" for a required option."""
+    import click
+
+    helps = [p.help or "" for p in load_command(name).params if isinstance(p, click.Option)]
+    assert not [h for h in helps if "Ellipsis" in h or "(default: None)" in h]

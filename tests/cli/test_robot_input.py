@@ -26,7 +26,7 @@ from tests.helpers import DEFAULT_SPEC, ROOT, run_main
 
 GROUP = {"--package-dir", "--env", "--trust-xacro", "--trust-xacro-unsandboxed"}
 XACRO_COMMANDS = {"check", "tree", "view", "render", "expand", "import", "simulate", "plan",
-                  "export mjcf"}  # fmt: skip
+                  "place", "export mjcf"}  # fmt: skip
 PARSERS = ("parse_args(", "parse_env(", "parse_package_dirs(", "trust_mode(", "find_spec(")
 
 

@@ -143,3 +143,28 @@ def test_fit_line_keeps_indent_words_and_no_workflow_command_at_a_line_start(
     assert fit_line(long).splitlines()[0] == "error: /a/path/longer/than/thirty/columns.yaml:"
     sneaky = "wrote a file called x ::add-mask::secret into out"
     assert not any(ln.lstrip().startswith("::") for ln in fit_line(sneaky).splitlines())
+
+
+def test_a_unit_or_an_equals_sign_never_starts_a_line() -> None:
+    """Issue 40: `render` ended `tool at (0.450, 0.000, 0.020)` / `m`; `check`, `z` / `= 0.000`."""
+    from armcli.io.wrap import spans
+
+    for plain, width in (("tool at (0.450, 0.000, 0.020) m", 29), ("ground at z = 0.000 m", 11)):
+        lines = [plain[a:b] for a, b in spans(plain, width, width)]
+        assert " ".join(lines) == plain and all(len(ln) <= width for ln in lines), lines
+        assert not any(ln.split()[0] in ("m", "=") for ln in lines), lines
+    # a unit whose number cannot go down with it (the pair is wider than a line) goes alone
+    assert spans("ab cd 1234567 m", 13, 6) == [(0, 13), (14, 15)]
+
+
+def test_a_table_title_and_caption_wrap_under_their_indent() -> None:
+    """Issue 40: `check`'s balance table title and caption went on flush left."""
+    t = FitTable([Column("pose", number=False), Column("x\n[m]")], title="static balance " * 5,
+                 caption="support polygon " * 5)  # fmt: skip
+    t.add_row("home", "0.1500")
+    lines = _render(t, 40).splitlines()
+    head = next(i for i, ln in enumerate(lines) if ln.startswith("pose"))
+    (caption,) = (i for i, ln in enumerate(lines) if ln.startswith("support"))
+    assert lines[0].startswith("static") and head > 1 and caption < len(lines) - 1, lines
+    continued = lines[1:head] + lines[caption + 1 :]
+    assert all(ln.startswith("  ") for ln in continued), lines

@@ -182,3 +182,24 @@ def test_a_pair_close_at_an_end_keeps_half_its_clearance(panda_bin: Loaded) -> N
         assert python.free(x)
         return
     pytest.fail("no free state with a pair closer than the padding")  # pragma: no cover
+
+
+def test_link_pairs_are_the_robots_one_set_up(panda_bin: Loaded) -> None:
+    """Plan's self-collision pairs are robot.collision's (check and the matrix use it too).
+
+    The reference: SelfCollision over the robot's own geometry, keeping the pairs the
+    Panda's SRDF does not disable; every link then meets every scene object.
+    """
+    from armcli.robot.collision import SelfCollision
+
+    checker = panda_bin.context.checker
+    robot = checker.robot
+    disabled = {frozenset(p) for p in read_srdf(PANDA / "srdf" / "panda.srdf").disabled}
+    own = SelfCollision(
+        robot.robot, lambda a, b: frozenset((a, b)) not in disabled, robot.geometry.copy()
+    )
+    links = len(robot.geometry.geometryObjects)
+    assert [p for p in checker.pairs if p[1] < links] == own.objects
+    scene = {(i, j) for i in range(links) for j in range(links, len(checker.bodies))}
+    assert {p for p in checker.pairs if p[1] >= links} == scene
+    assert len(own.objects) > 10 and len(scene) > 100  # 44 link pairs; 17 shapes x 14 objects

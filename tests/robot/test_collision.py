@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
-from armcli.robot.collision import SelfCollision, add_pairs, geometry_links
+from armcli.robot.collision import SelfCollision, add_pairs, box_corners, geometry_links, placements
 from armcli.robot.model import Robot
 from armcli.urdf.read import parse_urdf
 
@@ -50,3 +51,20 @@ def test_self_collision_finds_the_overlap_where_the_hand_says(robot: Robot) -> N
     # the tip's cube is 0.25 m from the slider's (0.1 m each: apart) and 0.3 m up is clear
     never = SelfCollision(robot, lambda a, b: "base" not in (a, b))
     assert never.colliding(robot.q({"x": 0.0})) == []
+
+
+def test_placements_and_box_corners_are_where_the_urdf_puts_them(robot: Robot) -> None:
+    """At x = 0.2: the base cube at the origin, the slider's at x and 0.3 above it, the
+    tip's 0.3 further along x; none turned, so the corners are the centres +- half sizes."""
+    gmodel = robot.collision_model()
+    q = robot.q({"x": 0.2})
+    T = placements(robot, gmodel, q)
+    centres = [(0.0, 0.0, 0.0), (0.2, 0.0, 0.0), (0.2, 0.0, 0.3), (0.5, 0.0, 0.0)]
+    np.testing.assert_allclose(T[:, :3, 3], centres, atol=1e-12)
+    np.testing.assert_allclose(T[:, :3, :3], np.broadcast_to(np.eye(3), (4, 3, 3)), atol=1e-12)
+    boxes = box_corners(robot, gmodel, q)
+    assert [link for link, _ in boxes] == ["base", "slider", "slider", "tip"]
+    for (_, corners), centre, half in zip(boxes, centres, (0.1, 0.05, 0.05, 0.05), strict=True):
+        assert corners.shape == (8, 3)
+        np.testing.assert_allclose(corners.min(axis=0), np.array(centre) - half, atol=1e-12)
+        np.testing.assert_allclose(corners.max(axis=0), np.array(centre) + half, atol=1e-12)

@@ -101,7 +101,24 @@ def test_gravity_is_the_gradient_of_the_potential_and_its_stiffness_its_slope(
         i = robot.joint(name).idx_v
         assert g[i] == pytest.approx(_derivative(robot, potential, name), abs=FD_TOL)
         slope[:, i] = _derivative(robot, robot.gravity, name)
+    np.testing.assert_allclose(robot.gravity_jacobian(q), slope, atol=1e-7)
     np.testing.assert_allclose(robot.gravity_stiffness(q), 0.5 * (slope + slope.T), atol=1e-7)
+
+
+def test_inverse_dynamics_is_mass_matrix_gravity_and_the_energy_balance(robot: Robot) -> None:
+    """RNEA against CRBA: tau(q, 0, a) = M a + g; the velocity terms do no work beyond
+    the mass matrix's change: vᵀ (tau(q, v, 0) - g) = ½ vᵀ (dM/dt) v (M by central
+    differences along v)."""
+    q = robot.q(VALUES)
+    rng = np.random.default_rng(2)
+    zero = np.zeros(robot.model.nv)
+    for v, a in rng.normal(size=(4, 2, robot.model.nv)):
+        expected = robot.mass_matrix(q) @ a + robot.gravity(q)
+        np.testing.assert_allclose(robot.inverse_dynamics(q, zero, a), expected, atol=1e-12)
+        M_dot = (robot.mass_matrix(pin.integrate(robot.model, q, H * v))
+                 - robot.mass_matrix(pin.integrate(robot.model, q, -H * v))) / (2 * H)  # fmt: skip
+        work = v @ (robot.inverse_dynamics(q, v, zero) - robot.gravity(q))
+        assert work == pytest.approx(0.5 * v @ M_dot @ v, abs=FD_TOL)
 
 
 def test_center_of_mass_weighs_the_bodies(robot: Robot) -> None:

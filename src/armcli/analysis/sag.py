@@ -71,13 +71,13 @@ class Sag:
 
 
 def settle(robot: Robot, q_ref: Mapping[str, float], hold: Hold) -> Sag:
-    """The steady state of `hold` at `q_ref` (joints absent from it at 0, locked)."""
+    """The steady state of `hold` at `q_ref` (joints absent from it at rest, `Robot.rest`)."""
     joints = [robot.joint(n) for n in hold.joints]
     vidx = np.array([j.idx_v for j in joints], dtype=int)
     lower = np.array([j.lower for j in joints])
     upper = np.array([j.upper for j in joints])
     kp, i_max = np.array(hold.kp, dtype=float), np.array(hold.i_max, dtype=float)
-    ref = np.array([float(q_ref.get(n, 0.0)) for n in hold.joints])
+    ref = np.array([float(q_ref.get(n, robot.rest(n))) for n in hold.joints])
     base = robot.q(robot.follow(dict(q_ref)))
     x, converged = ref.copy(), False
     for _ in range(NEWTON_STEPS):
@@ -111,13 +111,8 @@ def _gravity(
     robot: Robot, base: Array, joints: Sequence[str], x: Array, vidx: NDArray[np.int_]
 ) -> tuple[Array, Array]:
     """G and dg/dq of the held joints at `x` (the other joints as in `base`)."""
-    import pinocchio as pin
-
     q = robot.q(robot.follow(dict(zip(joints, x.tolist(), strict=True))), base=base)
-    g = np.asarray(pin.computeGeneralizedGravity(robot.model, robot.data, q), dtype=float)
-    dg = np.asarray(
-        pin.computeGeneralizedGravityDerivatives(robot.model, robot.data, q), dtype=float
-    )
+    g, dg = robot.gravity(q), robot.gravity_jacobian(q)
     return g[vidx], dg[np.ix_(vidx, vidx)]
 
 

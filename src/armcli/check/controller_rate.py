@@ -11,6 +11,8 @@ YAML's `update_rate` and gains.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from armcli.analysis import pdloop
@@ -20,9 +22,9 @@ from armcli.check.context import Context
 from armcli.check.dynamics import spec_pd
 from armcli.check.findings import Value
 from armcli.errors import InputError
-from armcli.ros.interfaces import JAZZY, trajectory_interface
-from armcli.ros.srdf import chain_joints
-from armcli.spec.model import RobotSpec
+
+if TYPE_CHECKING:  # the spec models (pydantic) load only where a spec is read: not for a URDF
+    from armcli.spec.model import RobotSpec
 
 RULE = "ros-controller-unstable"
 RATE_FIELD = "control.controller_update_rate"
@@ -30,6 +32,9 @@ RATE_FIELD = "control.controller_update_rate"
 
 def effort_commanded(spec: RobotSpec) -> bool:
     """Whether the Jazzy target drives the arm by effort (a PID on torque, held between updates)."""
+    from armcli.ros.interfaces import JAZZY, trajectory_interface  # they read spec models
+    from armcli.ros.srdf import chain_joints
+
     try:
         return trajectory_interface(spec, chain_joints(spec), JAZZY) == "effort"
     except InputError:  # no common interface: ros-package refuses the spec, check says nothing

@@ -8,7 +8,7 @@ self-collision at the spec's named poses (Pinocchio GeometryModel + coal).
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -21,9 +21,11 @@ from armcli.check.structure import finite
 from armcli.errors import ModelLoadError
 from armcli.robot.collision import SelfCollision
 from armcli.robot.model import Robot
-from armcli.spec.model import RobotSpec
 from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import mesh_paths
+
+if TYPE_CHECKING:  # a URDF's check loads no spec models (pydantic)
+    from armcli.spec.model import RobotSpec
 
 # Shapes must overlap by more than this to count as colliding: links that merely
 # touch by construction (e.g. a link resting on the base top) are not a collision.

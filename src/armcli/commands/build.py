@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import typer
 
@@ -13,6 +13,7 @@ from armcli.commands.robot_input import robot_options
 from armcli.io.terminal import say_line
 
 if TYPE_CHECKING:
+    from armcli.spec.model import RobotSpec
     from armcli.urdf.source import RobotInput
 
 
@@ -45,7 +46,7 @@ def build_cmd(
     _report_check_errors(spec, result.spec)
 
 
-def _report_check_errors(spec: Path, model: Any) -> None:
+def _report_check_errors(spec: Path, doc: RobotSpec) -> None:
     """What `armcli check` will call an error in the built URDFs, said now (a warning each).
 
     The URDFs `check SPEC` reads (meshes resolved from the spec), not the written ones:
@@ -54,7 +55,7 @@ def _report_check_errors(spec: Path, model: Any) -> None:
     from armcli.check.inputs import spec_document_errors
     from armcli.urdf.source import spec_urdfs
 
-    for f in spec_document_errors(spec, spec_urdfs(model), model):
+    for f in spec_document_errors(spec, spec_urdfs(doc), doc):
         where = str(f.spec) if f.spec is not None else f.file
         say_line(f"warning: {where}: {f.message} (check: {f.rule})", sys.stderr)
 

@@ -48,8 +48,11 @@ def out_option(default: Path, help: str) -> Any:
 
 def option(default: Any, *names: str, help: str, **kwargs: Any) -> Any:
     """A typer option whose default, when set, is stated in the help text (not as `[default:]`)."""
-    unset = (
-        default is None or default is False or (isinstance(default, list | tuple) and not default)
+    unset = (  # `...`: a required option (typer's spelling), which has no default to state
+        default is None
+        or default is False
+        or default is ...
+        or (isinstance(default, list | tuple) and not default)
     )
     text = help if unset else f"{help} (default: {default})."
     return typer.Option(default, *names, show_default=False, help=text, **kwargs)

@@ -115,11 +115,11 @@ def simulate_cmd(
     unknown = unknown_rules(ignore)
     if unknown:
         raise InputError(f"unknown rule(s) {', '.join(unknown)}", field="--ignore")
+    read = [*robot.paths] or ([robot.file()] if urdf is None else [])  # the spec: found first
     if trajectory is None and message is None and cmd_vel is None:
         raise InputError("nothing to simulate: give the arm a trajectory (--trajectory FILE or "
                          "--message YAML), or drive the robot's base (--cmd-vel FILE)",
                          field="--trajectory")  # fmt: skip
-    read = [*robot.paths] or ([robot.file()] if urdf is None else [])  # the spec
     read += [p for p in (urdf, trajectory, cmd_vel, world) if p is not None]
     if output is not None:
         from armcli.sim import rosbag  # the MCAP writer: imported by runs that write a file

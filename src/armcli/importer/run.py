@@ -269,10 +269,14 @@ def import_urdf(
     start = gains(spec) if gains is not None else {}
     if start:
         per_joint = {j: {"kp": Num(_sig(kp)), "kd": Num(_sig(kd))} for j, (kp, kd) in start.items()}
-        data["control"] = BlockMap(gains=BlockMap(per_joint))
+        # ros2_control holds each effort for 1/update_rate: at controller_manager's default
+        # 100 Hz such gains diverge (`check`: ros-controller-unstable); 1000 Hz is Gazebo's
+        # physics rate, as the example specs use
+        data["control"] = BlockMap(controller_update_rate=1000, gains=BlockMap(per_joint))
         comments["control"] = [
             "Start gains: the model-based start of `armcli tune` (not tuned yet);",
-            "`armcli tune --write` improves them.",
+            "`armcli tune --write` improves them. The controllers update at 1000 Hz:",
+            "at 100 Hz (ros2_control's default) the arm would diverge between updates.",
         ]
         text = document(data, header, comments)
         spec = _load(text, out, source)

@@ -139,14 +139,14 @@ class FitTable:
         from rich.text import Text
 
         if self.title:  # wrapped at the console's width, not the table's
-            yield Hanging(Text(), Text(self.title, style="italic"), 0)
+            yield Paragraphs(Text(self.title, style="italic"))
         widths = self.widths(options.max_width)
         if widths is None:
             yield from self._records(options.max_width)
         else:
             yield from self._lines(widths)
         if self.caption:
-            yield Hanging(Text(), Text(self.caption, style="dim"), 0)
+            yield Paragraphs(Text(self.caption, style="dim"))
 
     def _lines(self, widths: list[int]) -> Iterator[Any]:
         from rich.text import Text
@@ -161,7 +161,7 @@ class FitTable:
         yield rule
         for kind, data in self.items:
             if kind == "group":
-                yield Hanging(Text(), _text(data, "bold", restyle=True), 0)
+                yield Paragraphs(_text(data, "bold", restyle=True))
             elif kind == "rule":
                 yield rule
             else:
@@ -191,11 +191,9 @@ class FitTable:
 
     def _records(self, width: int) -> Iterator[Any]:
         """Each row as its text cells (a heading) and wrapped `header value` pairs."""
-        from rich.text import Text
-
         for kind, data in self.items:
             if kind == "group":
-                yield Hanging(Text(), _text(data, "bold", restyle=True), 0)
+                yield Paragraphs(_text(data, "bold", restyle=True))
                 continue
             if kind == "rule":
                 continue

@@ -15,6 +15,8 @@ from typing import Any
 
 MIN_WIDTH = 12  # [columns] a paragraph is never laid out narrower than this
 CONTINUATION = 2  # [columns] a wrapped line's continuation: its own indent plus this
+# a word that never starts a line: `=` or a unit armcli prints after a number
+GLUED = re.compile(r"(=|m|mm|cm|s|ms|rad|deg|°|kg|N|N·m|Hz|px|%)[,;:.)]*$")
 
 
 @dataclass(frozen=True)
@@ -53,19 +55,21 @@ def spans(plain: str, first: int, rest: int) -> list[tuple[int, int]]:
 
     A word never breaks: one longer than a line stays where it is (moving it to a line
     of its own would not make it fit, and would leave a label such as `error:` alone),
-    and a word starting `::` never starts a line (a GitHub Actions workflow command).
+    and a word starting `::` never starts a line (a GitHub Actions workflow command). A
+    unit or `=` never starts a line either: it goes down with the word before it
+    (`(0.450, 0.000, 0.020) m`, `z = 0.000`), so nobody reads a number without its unit.
     """
     words = [(m.start(), m.end()) for m in re.finditer(r"[^ ]+", plain)]
     if not words:
         return [(0, 0)]
-    out: list[tuple[int, int]] = []
-    start, end = words[0]
+    lines = [[words[0]]]
     for a, b in words[1:]:
-        room = first if not out else rest
-        if (b - start) <= room or (b - a) > rest or plain.startswith("::", a):
-            end = b  # it fits; or it fits nowhere; or it must not start a line
-            continue
-        out.append((start, end))
-        start, end = a, b
-    out.append((start, end))
-    return out
+        line, room = lines[-1], first if len(lines) == 1 else rest
+        if (b - line[0][0]) <= room or (b - a) > rest or plain.startswith("::", a):
+            line.append((a, b))  # it fits; or it fits nowhere; or it must not start a line
+        elif (len(line) > 1 and GLUED.match(plain, a, b) and b - line[-1][0] <= rest
+              and not plain.startswith("::", line[-1][0])):  # fmt: skip
+            lines.append([line.pop(), (a, b)])  # the unit and its number, together
+        else:
+            lines.append([(a, b)])
+    return [(line[0][0], line[-1][1]) for line in lines]

@@ -21,6 +21,7 @@ import numpy as np
 from armcli.io.scene import Scene, Shape
 from armcli.plan.native import compiled_scene, load
 from armcli.plan.robot import PlanRobot
+from armcli.robot.collision import add_pairs
 from armcli.robot.frames import frame_id
 
 GROUND_ID = "ground"  # the name the ground plane has in collision reports
@@ -93,7 +94,6 @@ class CollisionChecker:
         self.pin = pin
         self.robot = robot
         self.model = robot.model
-        self.data = robot.model.createData()
         gmodel = robot.geometry.copy()
         moving = _moving_joints(robot)
         frames = self.model.frames
@@ -131,6 +131,11 @@ class CollisionChecker:
         if self.native is None:
             self._python_checks()
 
+    @property
+    def data(self) -> Any:
+        """The robot's pinocchio.Data for this thread (Robot.data, shared by its users)."""
+        return self.robot.robot.data
+
     def _python_checks(self) -> None:
         """Pinocchio's GeometryData per use: every pair, the planner's (padded), moving exact."""
         pin = self.pin
@@ -147,21 +152,24 @@ class CollisionChecker:
         self._broadphase()
 
     def _pairs(self, gmodel: Any, disabled: set[tuple[str, str]]) -> list[tuple[int, int]]:
-        pairs = []
-        robot_root = {b.name for b in self.bodies if b.is_link and not b.moves_with}
-        for i, a in enumerate(self.bodies):
-            for j in range(i + 1, len(self.bodies)):
-                b = self.bodies[j]
-                if a.name == b.name or (not a.is_link and not b.is_link):
-                    continue
-                if a.is_link and b.is_link and _key(a.name, b.name) in disabled:
-                    continue
-                ground = GROUND_ID in (a.name, b.name)
-                if ground and (a.name in robot_root or b.name in robot_root):
-                    continue  # the base stands on the ground by construction
-                gmodel.addCollisionPair(self.pin.CollisionPair(i, j))
-                pairs.append((i, j))
-        return pairs
+        """Register the pairs to check (robot.collision.add_pairs: one set-up for every checker).
+
+        Bodies of one owner never; two scene objects never; two links unless the matrix
+        disables them; the ground and a link of the robot's root never (it stands on it).
+        """
+        bodies = self.bodies
+        robot_root = {b.name for b in bodies if b.is_link and not b.moves_with}
+
+        def keep(i: int, j: int) -> bool:
+            a, b = bodies[i], bodies[j]
+            if not a.is_link and not b.is_link:
+                return False
+            if a.is_link and b.is_link and _key(a.name, b.name) in disabled:
+                return False
+            ground = GROUND_ID in (a.name, b.name)
+            return not (ground and (a.name in robot_root or b.name in robot_root))
+
+        return add_pairs(gmodel, [b.name for b in bodies], keep)
 
     def pad(self, padding: float, ends: Iterable[np.ndarray]) -> None:
         """Plan `padding` [m] clear; a pair closer than that at an end, half its clearance there.

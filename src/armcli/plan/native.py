@@ -83,7 +83,7 @@ def joint_entries(robot: PlanRobot) -> list[tuple[int, int, int, bool, float, np
 
     One per 1-DoF joint that a planned joint moves: the planned joints themselves and the
     mimic followers of one (through any chain of followers); the others keep the value
-    `robot.q` gives them.
+    `PlanRobot.q` gives them.
     """
     model, n = robot.model, len(robot.joints)
     affine: dict[str, tuple[float, np.ndarray]] = {

@@ -91,18 +91,16 @@ class SegmentPath:
 
 def inverse_dynamics(robot: PlanRobot) -> Any:
     """tau(x, xd, xdd) of the planned joints [N·m or N]: RNEA, followers moving with leaders."""
-    import pinocchio as pin
-
-    model, data = robot.model, robot.model.createData()
+    nv = robot.model.nv
     idx = robot.v_indices()
     lead = _follower_map(robot)
 
     def tau(x: np.ndarray, xd: np.ndarray, xdd: np.ndarray) -> np.ndarray:
-        v, a = np.zeros(model.nv), np.zeros(model.nv)
+        v, a = np.zeros(nv), np.zeros(nv)
         v[idx], a[idx] = xd, xdd
         for f, leader, mult in lead:
             v[f], a[f] = mult * v[leader], mult * a[leader]
-        return np.asarray(pin.rnea(model, data, robot.q(x), v, a))[idx]
+        return robot.robot.inverse_dynamics(robot.q(x), v, a)[idx]
 
     return tau
 

@@ -7,6 +7,8 @@ parent-child links, the collision matrix keeps the pairs MoveIt does not decide 
 construction, `plan` drops the pairs its SRDF disables. `add_pairs` registers them in
 object order (i < j), so a pair's index is its index in the GeometryData's requests and
 results; `SelfCollision` is the robot's own geometry with its pairs, ready to pose.
+`placements` and `box_corners` pose the objects at a configuration (the base placement's
+floor plan and plot).
 """
 
 from __future__ import annotations
@@ -15,7 +17,8 @@ import itertools
 from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
-from numpy.typing import ArrayLike
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from armcli.robot.model import Robot
 
@@ -23,6 +26,32 @@ from armcli.robot.model import Robot
 def geometry_links(model: Any, gmodel: Any) -> list[str]:
     """The link that owns each collision object, in object order."""
     return [str(model.frames[g.parentFrame].name) for g in gmodel.geometryObjects]
+
+
+def placements(robot: Robot, gmodel: Any, q: ArrayLike) -> NDArray[np.float64]:
+    """Each collision object's pose T_root_object (N, 4, 4) at configuration q [m]."""
+    import pinocchio as pin
+
+    gdata = pin.GeometryData(gmodel)
+    pin.updateGeometryPlacements(robot.model, robot.data, gmodel, gdata, np.asarray(q, dtype=float))
+    return np.array([M.homogeneous for M in gdata.oMg], dtype=float).reshape(-1, 4, 4)
+
+
+def box_corners(robot: Robot, gmodel: Any, q: ArrayLike) -> list[tuple[str, NDArray[np.float64]]]:
+    """Each collision object's link and its local bounding box's 8 corners (8, 3) at q [m].
+
+    The box is the shape's own axis-aligned one, turned with the object: a conservative
+    outline for a floor plan seen from above.
+    """
+    links = geometry_links(robot.model, gmodel)
+    out = []
+    for T, g, link in zip(placements(robot, gmodel, q), gmodel.geometryObjects, links, strict=True):
+        g.geometry.computeLocalAABB()
+        lo, hi = np.asarray(g.geometry.aabb_local.min_), np.asarray(g.geometry.aabb_local.max_)
+        box = np.array([[a, b, c] for a in (lo[0], hi[0]) for b in (lo[1], hi[1])
+                        for c in (lo[2], hi[2])])  # fmt: skip
+        out.append((link, box @ T[:3, :3].T + T[:3, 3]))
+    return out
 
 
 def add_pairs(
@@ -52,7 +81,7 @@ class SelfCollision:
     def __init__(
         self, robot: Robot, keep: Callable[[str, str], bool], gmodel: Any | None = None
     ) -> None:
-        """`gmodel`: the geometry to use (default: `robot.collision_model()`, meshes as given)."""
+        """`gmodel`: the geometry to use (default: `Robot.collision_model()`, meshes as given)."""
         import pinocchio as pin
 
         self.robot = robot

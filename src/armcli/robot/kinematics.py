@@ -124,12 +124,23 @@ class Kinematics:
 
         return np.asarray(pin.computeGeneralizedGravity(self.model, self.data, _q(q)))
 
-    def gravity_stiffness(self, q: ArrayLike) -> NDArray[np.float64]:
-        """dg/dq [N·m/rad or N/m], symmetrised: gravity's stiffness on the joints."""
+    def inverse_dynamics(self, q: ArrayLike, v: ArrayLike, a: ArrayLike) -> Vector:
+        """tau(q, v, a) [N·m or N]: the joint torques of that motion (RNEA), a fresh array."""
+        import pinocchio as pin
+
+        tau = pin.rnea(self.model, self.data, _q(q), _q(v), _q(a))
+        return np.array(tau, dtype=float)
+
+    def gravity_jacobian(self, q: ArrayLike) -> NDArray[np.float64]:
+        """dg/dq [N·m/rad or N/m] as Pinocchio's derivatives give it (nv x nv), a fresh array."""
         import pinocchio as pin
 
         G = pin.computeGeneralizedGravityDerivatives(self.model, self.data, _q(q))
-        G = np.array(G, dtype=float)
+        return np.array(G, dtype=float)
+
+    def gravity_stiffness(self, q: ArrayLike) -> NDArray[np.float64]:
+        """dg/dq [N·m/rad or N/m], symmetrised: gravity's stiffness on the joints."""
+        G = self.gravity_jacobian(q)
         return np.asarray(0.5 * (G + G.T), dtype=np.float64)
 
     def center_of_mass(self, q: ArrayLike) -> Vector:

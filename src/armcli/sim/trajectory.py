@@ -30,14 +30,7 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import Problem, SpecError, one_per_kind
-from armcli.io.yaml import (
-    MAX_YAML_BYTES,
-    FlowKeys,
-    YamlDoc,
-    dotted,
-    loads_yaml,
-    read_text,
-)
+from armcli.io.yaml import MAX_YAML_BYTES, FlowKeys, YamlDoc, dotted, loads_yaml, read_text
 from armcli.sim.brace import BraceNotes
 from armcli.sim.jointtext import MAX_PLAN_BYTES, canonical_doc
 

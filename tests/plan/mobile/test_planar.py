@@ -69,3 +69,17 @@ def test_an_arm_with_a_waist_is_not_planar() -> None:
     mobile = load_mobile(read_robot(FIXTURES / "plan" / "mobile" / "rover_arm.urdf"))
     assert mobile.planar is None
     assert mobile.arm == ("joint1", "joint2", "joint3", "joint4")
+
+
+def test_the_closed_form_keeps_its_values_when_the_robot_computes_again() -> None:
+    """`planar_arm` reads the robot's shared Data: its vectors must be copies, not views
+    that the next computation in that Data moves (the placement's plot did, and shaded
+    the wrong base positions)."""
+    mobile = load_mobile(read_robot(DEFAULT_SPEC))
+    arm = mobile.planar
+    assert arm is not None
+    before = {k: np.copy(getattr(arm, k)) for k in ("shoulder", "axis", "e_u", "l1", "l2")}
+    robot = mobile.robot
+    robot.robot.frame_pose("hand_link", robot.q(mobile.x((1.0, 2.0, 0.5), (0.7, 0.9))))
+    for k, v in before.items():
+        np.testing.assert_array_equal(getattr(arm, k), v, err_msg=k)

@@ -105,16 +105,12 @@ def sampled_family(judge: Judge, seed: int) -> Family:
     floor, stable) are kept, ARM_KEPT of them: a low target's nearest heights are often the
     arm folded into its own base.
     """
-    import pinocchio as pin
-
     robot = judge.arm_robot
     box = list(zip(robot.lower.tolist(), robot.upper.tolist(), strict=True))
     rows = np.array(sampling.search_starts(box, ARM_DRAWS, seed=seed), dtype=float)
-    data = robot.model.createData()
     p = np.empty((len(rows), 3))
     for i, x in enumerate(rows):
-        pin.forwardKinematics(robot.model, data, robot.q(x))
-        p[i] = pin.updateFramePlacement(robot.model, data, robot.tool_frame).act(robot.tool_offset)
+        p[i] = robot.robot.tool_position(robot.q(x))
     miss = np.abs(p[:, 2] - judge.target[2])
     spread = _heights(judge)
     order = np.argsort(miss, kind="stable")

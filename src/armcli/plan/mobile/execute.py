@@ -23,6 +23,7 @@ from armcli.io.scene import Scene, SceneObject
 from armcli.plan.mobile.pursuit import Pursuit, legs_in_odom
 from armcli.plan.mobile.wheels import to_base
 from armcli.plan.mobile.whole import WholePlan
+from armcli.robot.frames import quaternion_matrix
 from armcli.sim import drive, driveout
 from armcli.sim.drive import DriveRun
 from armcli.sim.liftoff import TipVerdict
@@ -127,16 +128,12 @@ def execute_whole(
 
 def _truth(plan: WholePlan, run: DriveRun) -> tuple[np.ndarray, np.ndarray]:
     """The final base pose (x, y, yaw) and tool point [m], ground truth, in the start frame."""
-    import pinocchio as pin
-
     L, s = run.job.model.layout, run.sensors[-1]
     p, (w, x, y, z) = s[L.base_pos], s[L.base_quat]
-    R = np.asarray(pin.Quaternion(w, x, y, z).toRotationMatrix())
+    R = quaternion_matrix((x, y, z, w))
     robot = plan.mobile.arm_robot()
-    data = robot.model.createData()
     ran = dict(zip(run.job.arm.robot.names, s[L.arm_pos].tolist(), strict=True))
-    pin.forwardKinematics(robot.model, data, robot.q([ran[j] for j in robot.joints]))
-    tool_b = pin.updateFramePlacement(robot.model, data, robot.tool_frame).act(robot.tool_offset)
+    tool_b = robot.robot.tool_position(robot.q([ran[j] for j in robot.joints]))
     yaw = math.atan2(R[1, 0], R[0, 0])
     return np.array([p[0], p[1], yaw]), R @ np.asarray(tool_b) + p
 

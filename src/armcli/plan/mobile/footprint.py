@@ -18,6 +18,7 @@ import numpy as np
 from armcli.analysis.support import convex_hull
 from armcli.plan.mobile.objects import _points, world_objects
 from armcli.plan.mobile.virtual import MobileRobot
+from armcli.robot.collision import box_corners
 
 
 @dataclass(frozen=True)
@@ -44,20 +45,9 @@ def robot_outline(
 
     In the base frame, or about `origin` (x, y in the base frame: the point it turns about).
     """
-    import pinocchio as pin
-
     robot = mobile.robot
-    data, gdata = robot.model.createData(), pin.GeometryData(robot.geometry)
-    pin.updateGeometryPlacements(robot.model, data, robot.geometry, gdata,
-                                 robot.q(mobile.x((0.0, 0.0, 0.0), q)))  # fmt: skip
-    corners = []
-    for k, g in enumerate(robot.geometry.geometryObjects):
-        g.geometry.computeLocalAABB()
-        lo, hi = np.asarray(g.geometry.aabb_local.min_), np.asarray(g.geometry.aabb_local.max_)
-        box = np.array([[a, b, c] for a in (lo[0], hi[0]) for b in (lo[1], hi[1])
-                        for c in (lo[2], hi[2])])  # fmt: skip
-        M = gdata.oMg[k]
-        corners.append(box @ np.asarray(M.rotation).T + np.asarray(M.translation))
+    q_robot = robot.q(mobile.x((0.0, 0.0, 0.0), q))
+    corners = [box for _, box in box_corners(robot.robot, robot.geometry, q_robot)]
     pts = np.concatenate(corners)
     shift = np.zeros(2) if origin is None else np.asarray(origin, dtype=float)
     return outline(pts[:, :2] - shift, "robot"), float(pts[:, 2].max())

@@ -29,6 +29,7 @@ from armcli.plan.mobile.judge import Judge
 from armcli.plan.mobile.objects import outline, world_objects
 from armcli.plan.mobile.place import Placement, turn_radius
 from armcli.plan.mobile.virtual import MobileRobot
+from armcli.robot.collision import box_corners, geometry_links, placements
 
 MAX_SHADED = 6000  # candidate poses judged for the shading
 SAMPLED_EVERY = 15  # of another arm's candidates, one in this many is judged for the shading
@@ -37,23 +38,10 @@ SAMPLED_EVERY = 15  # of another arm's candidates, one in this many is judged fo
 def robot_outlines(mobile: MobileRobot, base: Sequence[float], q: np.ndarray
                    ) -> list[tuple[str, list[tuple[float, float]]]]:  # fmt: skip
     """Each collision shape's outline from above (its box's hull) at the pose: (link, points)."""
-    import pinocchio as pin
-
     robot = mobile.robot
-    data, gdata = robot.model.createData(), pin.GeometryData(robot.geometry)
-    pin.updateGeometryPlacements(robot.model, data, robot.geometry, gdata,
-                                 robot.q(mobile.x(base, q)))  # fmt: skip
-    out = []
-    for k, g in enumerate(robot.geometry.geometryObjects):
-        g.geometry.computeLocalAABB()
-        lo, hi = np.asarray(g.geometry.aabb_local.min_), np.asarray(g.geometry.aabb_local.max_)
-        corners = np.array([[a, b, c] for a in (lo[0], hi[0]) for b in (lo[1], hi[1])
-                            for c in (lo[2], hi[2])])  # fmt: skip
-        M = gdata.oMg[k]
-        world = corners @ np.asarray(M.rotation).T + np.asarray(M.translation)
-        link = str(robot.model.frames[g.parentFrame].name)
-        out.append((link, convex_hull([(float(x), float(y)) for x, y in world[:, :2]])))
-    return out
+    boxes = box_corners(robot.robot, robot.geometry, robot.q(mobile.x(base, q)))
+    return [(link, convex_hull([(float(x), float(y)) for x, y in world[:, :2]]))
+            for link, world in boxes]  # fmt: skip
 
 
 def serving(judge: Judge, start: Sequence[float], radius: float) -> np.ndarray:
@@ -145,18 +133,15 @@ def place_png(
 
 def _base_top(mobile: MobileRobot, base: Sequence[float], q: np.ndarray, links: set[str]) -> float:
     """[m] the top of the base's collision shapes: objects lower than this meet the base."""
-    import pinocchio as pin
-
     robot = mobile.robot
-    data, gdata = robot.model.createData(), pin.GeometryData(robot.geometry)
-    pin.updateGeometryPlacements(robot.model, data, robot.geometry, gdata,
-                                 robot.q(mobile.x(base, q)))  # fmt: skip
+    poses = placements(robot.robot, robot.geometry, robot.q(mobile.x(base, q)))
+    owners = geometry_links(robot.model, robot.geometry)
     top = 0.0
-    for k, g in enumerate(robot.geometry.geometryObjects):
-        if str(robot.model.frames[g.parentFrame].name) not in links:
+    for T, g, link in zip(poses, robot.geometry.geometryObjects, owners, strict=True):
+        if link not in links:
             continue
         g.geometry.computeLocalAABB()
         radius = float(np.linalg.norm(np.asarray(g.geometry.aabb_local.max_)
                                       - np.asarray(g.geometry.aabb_local.min_))) / 2  # fmt: skip
-        top = max(top, float(gdata.oMg[k].translation[2]) + radius)
+        top = max(top, float(T[2, 3]) + radius)
     return top

@@ -18,10 +18,11 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
+
+from armcli.robot.model import Robot
 
 PARALLEL_TOL = 1e-6  # |a1 x a2| and |a · z| below this: parallel axes, horizontal axis
 TWO_PI = 2.0 * math.pi
@@ -227,29 +228,30 @@ class PlanarArm:
         return np.concatenate(qs), np.concatenate(us)
 
 
-def planar_arm(robot: Any, joints: Sequence[str], tool_frame: int, tool_offset: np.ndarray,
-               lower: np.ndarray, upper: np.ndarray) -> PlanarArm | None:  # fmt: skip
+def planar_arm(robot: Robot, joints: Sequence[str], lower: np.ndarray, upper: np.ndarray
+               ) -> PlanarArm | None:  # fmt: skip
     """The closed form of `joints` (the arm, root to tool) if they make a planar-reach arm.
 
-    `robot` is a pinocchio.Model whose root frame is the base; evaluated with every joint
-    at zero. None unless there are exactly two revolute joints with parallel horizontal
-    axes.
+    `robot`'s root frame is the base; evaluated with every joint at zero (the closed form's
+    reference, not the rest pose). None unless there are exactly two revolute joints with
+    parallel horizontal axes.
     """
     import pinocchio as pin
 
-    if len(joints) != 2 or not all(robot.existJointName(j) for j in joints):
+    model = robot.model
+    if len(joints) != 2 or not all(model.existJointName(j) for j in joints):
         return None
-    ids = [robot.getJointId(j) for j in joints]
-    if any(robot.joints[i].nv != 1 or robot.joints[i].nq != 1 for i in ids):
+    ids = [model.getJointId(j) for j in joints]
+    if any(model.joints[i].nv != 1 or model.joints[i].nq != 1 for i in ids):
         return None
-    data = robot.createData()
-    q = pin.neutral(robot)
-    pin.computeJointJacobians(robot, data, q)
-    pin.updateFramePlacements(robot, data)
+    q = robot.neutral()
+    P3 = robot.tool_position(q)
+    data = robot.data
+    pin.computeJointJacobians(model, data, q)
     axes = []
     for i in ids:
-        J = np.asarray(pin.getJointJacobian(robot, data, i, pin.WORLD))
-        col = J[:, robot.joints[i].idx_v]
+        J = np.asarray(pin.getJointJacobian(model, data, i, pin.WORLD))
+        col = J[:, model.joints[i].idx_v]
         if np.linalg.norm(col[3:]) < 0.5:  # a prismatic joint: no rotation
             return None
         axes.append(col[3:] / np.linalg.norm(col[3:]))
@@ -258,9 +260,9 @@ def planar_arm(robot: Any, joints: Sequence[str], tool_frame: int, tool_offset: 
         return None
     if a @ axes[1] < 0:  # antiparallel: the second joint turns the other way
         return None
-    S = np.asarray(data.oMi[ids[0]].translation, dtype=float)
-    P2 = np.asarray(data.oMi[ids[1]].translation, dtype=float)
-    P3 = np.asarray(data.oMf[tool_frame].act(np.asarray(tool_offset, dtype=float)), dtype=float)
+    # copies: `data` is the robot's, and a view into it would move with the next user's call
+    S = np.array(data.oMi[ids[0]].translation, dtype=float)
+    P2 = np.array(data.oMi[ids[1]].translation, dtype=float)
     z = np.array([0.0, 0.0, 1.0])
     e_u = np.cross(z, a)
 

@@ -158,8 +158,7 @@ def load_mobile(
     standing = stance_of(urdf, candidates=candidates)
     stance = None if isinstance(standing, NoStance) else standing
     n = len(BASE_JOINTS)
-    planar = planar_arm(robot.model, arm, robot.tool_frame, robot.tool_offset,
-                        robot.lower[n:], robot.upper[n:])  # fmt: skip
+    planar = planar_arm(robot.robot, arm, robot.lower[n:], robot.upper[n:])
     return MobileRobot(robot, arm, checker, objects, stance,
                        standing.reason if isinstance(standing, NoStance) else "", planar,
                        robot_file, world, tuple(disabled))  # fmt: skip

@@ -20,6 +20,7 @@ import numpy as np
 from armcli.errors import InputError
 from armcli.plan.mobile.basetime import DEFAULT_SPEED, TORQUE_SHARE, DriveLimits
 from armcli.plan.mobile.virtual import MobileRobot
+from armcli.robot.frames import joint_frame
 from armcli.sim.diffdrive import DriveParams
 from armcli.urdf.doc import Urdf
 
@@ -137,19 +138,18 @@ def axle_offset(mobile: MobileRobot, params: DriveParams) -> np.ndarray:
     place swings the base frame around it when the two differ (the course robot's wheels
     are 0.15 m behind base_footprint).
     """
-    import pinocchio as pin
-
-    model = mobile.robot.model
-    missing = [j for j in (params.left_joint, params.right_joint) if not model.existJointName(j)]
-    if missing:
-        raise InputError(f"the diff drive's joint {missing[0]!r} is not a joint of the robot",
-                         field="base")  # fmt: skip
-    data = model.createData()
+    robot = mobile.robot.robot
+    wheels = []
+    for joint in (params.left_joint, params.right_joint):
+        frame = joint_frame(robot.model, joint)
+        if frame is None:
+            raise InputError(f"the diff drive's joint {joint!r} is not a joint of the robot",
+                             field="base")  # fmt: skip
+        wheels.append(frame)
     arm = mobile.arm_robot()
     rest = [arm.robot.rest(j) for j in arm.joints]
-    pin.forwardKinematics(model, data, mobile.robot.q(mobile.x((0.0, 0.0, 0.0), rest)))
-    ends = [np.asarray(data.oMi[model.getJointId(j)].translation)[:2]
-            for j in (params.left_joint, params.right_joint)]  # fmt: skip
+    q = mobile.robot.q(mobile.x((0.0, 0.0, 0.0), rest))
+    ends = [robot.frame_pose(f, q)[:2, 3] for f in wheels]  # a joint's frame: its origin
     return np.asarray(0.5 * (ends[0] + ends[1]), dtype=float)
 
 
