@@ -115,6 +115,20 @@ def test_plan_for_a_urdf(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> 
     assert "joints: shoulder, elbow" in out and out_file.is_file()
 
 
+def test_execute_of_a_urdf_is_refused_before_planning(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A URDF has no gains to simulate with: refused up front, no plan file left behind."""
+    out_file = tmp_path / "t.yaml"
+    urdf = FIXTURES / "plan" / "two_link.urdf"
+    args = ["plan", "--urdf", urdf, "--from", "0,0", "--to", "1.0,-0.5", "--execute", "-o",
+            out_file]  # fmt: skip
+    code, out, err = run_main(args, capsys)
+    assert code == 2 and not out_file.exists()
+    assert err.count("error:") == 1 and "--execute" in err and "armcli import" in err, err
+    assert "SimOptions" not in err
+
+
 def test_pi_values_and_a_limit_typed_as_printed(capsys: pytest.CaptureFixture[str]) -> None:
     """The spec's `pi/2` works in --to; 1.5708 (pi/2 as printed) is the stop, with a note."""
     code, out, err = plan(["--to", "pi/2,pi/4"], capsys)

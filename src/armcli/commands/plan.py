@@ -120,6 +120,10 @@ def plan_cmd(
         inputs = [p for p in (urdf or robot.file(), srdf, scene) if p is not None]
         check_output_file(output, "--output", inputs)
     robot_file = robot.read(urdf)
+    if execute:  # refused before planning: nothing written
+        from armcli.plan.execute import check_executable
+
+        check_executable(robot_file.spec)
     what = request.describe()
     opts = PlanOptions(planner=planner, timeout=timeout, seed=seed,
                        comment=f"armcli plan {what}, {planner}, seed {seed}")  # fmt: skip

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from armcli.errors import InputError
 from armcli.sim import job as simjob
 from armcli.sim import report as simreport
 from armcli.sim import tipping
@@ -47,6 +48,19 @@ class Execution:
     def broken(self) -> bool:
         """Whether a limit was broken or the robot tipped."""
         return bool(self.problems)
+
+
+def check_executable(spec: RobotSpec | None) -> None:
+    """InputError before any planning when the plan could not be simulated: no PD gains.
+
+    The run drives each joint with the spec's `control.gains`; a URDF carries none, and
+    a failure after planning would leave the plan written and the command failed.
+    """
+    if spec is None or not spec.control.gains:
+        raise InputError("simulates with a spec's control.gains, and this robot has none: "
+                         "`armcli import` writes a spec with start gains from a URDF, or run "
+                         "the written plan with `armcli simulate --urdf FILE --kp ... --kd ... "
+                         "-t PLAN`", field="--execute")  # fmt: skip
 
 
 def execute(
