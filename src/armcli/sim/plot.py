@@ -73,10 +73,11 @@ def tracking_png(
     if extra_row is not None:
         extra_row(list(axes[3:].ravel()) if rows > 1 else axes[3])
     title = title or f"armcli simulate ({res.integrator}, dt = {res.dt:g} s)"
-    fig.suptitle(title, fontsize=12)
-    # fixed margins [in]: room for the y labels, the titles and the x labels
+    # fixed margins [in]: room for the y labels, the titles and the x labels; the figure's
+    # title a fixed distance from the top, above the first row's titles at any height
     w, h = fig.get_size_inches()
-    fig.subplots_adjust(left=0.75 / w, right=1 - 0.2 / w, bottom=0.5 / h, top=1 - 0.6 / h,
+    fig.suptitle(title, fontsize=12, y=1 - 0.1 / h, va="top")
+    fig.subplots_adjust(left=0.75 / w, right=1 - 0.2 / w, bottom=0.5 / h, top=1 - 0.8 / h,
                         hspace=0.45, wspace=0.3)  # fmt: skip
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=100, metadata={"Software": None})
