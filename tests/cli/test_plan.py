@@ -123,7 +123,7 @@ def test_execute_of_a_urdf_is_refused_before_planning(
     urdf = FIXTURES / "plan" / "two_link.urdf"
     args = ["plan", "--urdf", urdf, "--from", "0,0", "--to", "1.0,-0.5", "--execute", "-o",
             out_file]  # fmt: skip
-    code, out, err = run_main(args, capsys)
+    code, _, err = run_main(args, capsys)
     assert code == 2 and not out_file.exists()
     assert err.count("error:") == 1 and "--execute" in err and "armcli import" in err, err
     assert "SimOptions" not in err
