@@ -56,6 +56,7 @@ FLAGS = {
     "timeout": "--timeout",
     "base": "--base",
     "base_start": "--base-start",
+    "execute": "--execute",
 }
 
 

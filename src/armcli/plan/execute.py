@@ -60,7 +60,7 @@ def check_executable(spec: RobotSpec | None) -> None:
         raise InputError("simulates with a spec's control.gains, and this robot has none: "
                          "`armcli import` writes a spec with start gains from a URDF, or run "
                          "the written plan with `armcli simulate --urdf FILE --kp ... --kd ... "
-                         "-t PLAN`", field="--execute")  # fmt: skip
+                         "-t PLAN`", field="execute")  # fmt: skip
 
 
 def execute(
