@@ -26,9 +26,7 @@ def balance_items(balance: StaticBalance | None, zmp: ZmpReport | None) -> list[
     if balance is not None:
         out.append(_table(balance))
     if zmp is not None:
-        from armcli.sim.tipping import summary_line  # loaded by the --trajectory run already
-
-        out.append(Text(summary_line(zmp), style="red" if zmp.tips else ""))
+        out.append(Text(zmp.line(), style="red" if zmp.tips else ""))
     return out
 
 

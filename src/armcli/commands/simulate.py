@@ -229,7 +229,6 @@ def _report(run: ArmRun, output: Path | None, plot: Path | None, asked: bool) ->
     """
     from armcli.sim import job as simjob
     from armcli.sim import report as simreport
-    from armcli.sim import tipping
 
     err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
     job, res, balance = run.job, run.result, run.balance
@@ -243,15 +242,14 @@ def _report(run: ArmRun, output: Path | None, plot: Path | None, asked: bool) ->
     out = terminal.console()
     out.print(simreport.summary_table(metrics, ee, job.tool_label, res), crop=False)
     if balance is not None:
-        for lift in balance.lifts:  # too short to tip the robot: a wheel unloads, a warning
-            terminal.line(err, f"warning: {lift.line()}")
-        line = tipping.summary_line(balance)
-        terminal.line(out, line, "red" if balance.tips else None)
+        for note in balance.notes():  # too short to tip the robot: a wheel unloads, a warning
+            terminal.line(err, f"warning: {note}")
+        terminal.line(out, balance.line(), "red" if balance.tips else None)
     for path in (output, plot):
         if path is not None:
             terminal.line(out, wrote(path, path in before))
     if balance is not None and balance.tips:
-        raise tipping.tip_error(balance)
+        raise balance.error()
 
 
 class _LazyProgress:

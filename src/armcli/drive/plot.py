@@ -8,14 +8,14 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from armcli.analysis.liftoff import TipVerdict
+from armcli.analysis.liftoff import TiltVerdict
 from armcli.drive.job import DriveRun
 from armcli.sim.simulate import SimResult
 
 LOAD_WINDOW_S = 0.01  # [s] the wheel loads are drawn as means over this (a single step chatters)
 
 
-def plot_png(run: DriveRun, res: SimResult, verdict_: TipVerdict) -> bytes:
+def plot_png(run: DriveRun, res: SimResult, verdict_: TiltVerdict) -> bytes:
     """The tracking plot with two more rows: the path seen from above, the wheel loads."""
     from armcli.sim.plot import tracking_png
 
@@ -30,7 +30,7 @@ def _has_scene(run: DriveRun) -> bool:
     return bool(run.job.model.world) or pick_scan(run.readings) is not None
 
 
-def _drive_rows(run: DriveRun, verdict_: TipVerdict) -> Callable[[Sequence[Any]], None]:
+def _drive_rows(run: DriveRun, verdict_: TiltVerdict) -> Callable[[Sequence[Any]], None]:
     job, L, s = run.job, run.job.model.layout, run.sensors
     step = max(1, run.steps // 4000)
     window = max(1, round(LOAD_WINDOW_S / job.dt))

@@ -87,7 +87,7 @@ def execute(
     if run.balance is not None:
         margin = run.balance.min_margin
         if run.balance.tips:
-            problems.append(tipping.tip_error(run.balance).args[0])
+            problems.append(run.balance.error().args[0])
     return Execution(metrics, peak_tau, arm.effort, peak_v, vlim, arm.names, margin,
                      tuple(problems), _states(res))  # fmt: skip
 

@@ -207,6 +207,49 @@ class ZmpReport:
         """The worst moment's case, with the base's acceleration when it counts."""
         return self.case + (f" at {self.base_accel:g} m/s²" if self.case != zmps.CASES[0] else "")
 
+    def line(self) -> str:
+        """The summary's line: where the point came closest to the edge, and whether it tips."""
+        load = f", {self.payload}" if self.payload else ""
+        head = (
+            f"zero-moment point (base held on its wheels{load}; base accel "
+            f"{self.base_accel:g} m/s² from {self.accel_source}): "
+        )
+        if self.tips:
+            what = (
+                f"TIPS: {-self.min_margin * 1e3:.1f} mm outside the support polygon "
+                f"toward {self.direction}"
+            )
+        elif self.min_margin < 0:
+            what = (
+                f"{-self.min_margin * 1e3:.1f} mm outside toward {self.direction} for "
+                f"{sum(e.duration for e in self.lifts):.3f} s: a wheel lifts off, no tip"
+            )
+        else:
+            what = f"least margin {self.min_margin * 1e3:.1f} mm toward {self.direction}"
+        left = f"; {self.impacts} joint-stop impact(s) left out" if self.impacts else ""
+        holds = "any" if math.isinf(self.max_base_accel) else f"{self.max_base_accel:.3g} m/s²"
+        return (
+            f"{head}{what} at t = {self.time:.3f} s ({self.when}); arm motion alone: "
+            f"{self.arm_margin * 1e3:.1f} mm; base acceleration that holds: {holds}{left}"
+        )
+
+    def notes(self) -> list[str]:
+        """The lift-off warnings: excursions too short to tip the robot, case by case."""
+        return [e.line() for e in self.lifts]
+
+    def error(self) -> TipOverError:
+        """The error a run that tips the robot over ends with (after its files are written)."""
+        e = next(e for e in self.excursions if e.tips)
+        accel = f" at {self.base_accel:g} m/s²" if e.case != zmps.CASES[0] else ""
+        return TipOverError(
+            f"the robot tips over: its zero-moment point is up to {e.depth * 1e3:.1f} mm "
+            f"outside the support polygon toward {e.direction} from t = {e.start:.3f} s for "
+            f"{e.duration:.3f} s ({e.case}{accel}), long enough to rotate it over that edge",
+            time=e.start,
+            margin=-e.depth,
+            case=e.case,
+        )
+
 
 def report(tip: Tipping, series: zmps.ZmpSeries) -> ZmpReport:
     """The numbers of a run's zero-moment point."""
@@ -230,42 +273,6 @@ def report(tip: Tipping, series: zmps.ZmpSeries) -> ZmpReport:
         max_base_accel_margin=zmps.max_base_accel(series, poly, tip.threshold),
         impacts=series.impacts,
         excursions=excursions(tip.stance, series),
-    )
-
-
-def summary_line(r: ZmpReport) -> str:
-    """The summary's line: where the point came closest to the edge, and whether it tips."""
-    load = f", {r.payload}" if r.payload else ""
-    head = (f"zero-moment point (base held on its wheels{load}; base accel {r.base_accel:g} "
-            f"m/s² from {r.accel_source}): ")  # fmt: skip
-    if r.tips:
-        what = (
-            f"TIPS: {-r.min_margin * 1e3:.1f} mm outside the support polygon toward {r.direction}"
-        )
-    elif r.min_margin < 0:
-        what = (f"{-r.min_margin * 1e3:.1f} mm outside toward {r.direction} for "
-                f"{sum(e.duration for e in r.lifts):.3f} s: a wheel lifts off, no tip")  # fmt: skip
-    else:
-        what = f"least margin {r.min_margin * 1e3:.1f} mm toward {r.direction}"
-    left = f"; {r.impacts} joint-stop impact(s) left out" if r.impacts else ""
-    holds = "any" if math.isinf(r.max_base_accel) else f"{r.max_base_accel:.3g} m/s²"
-    return (
-        f"{head}{what} at t = {r.time:.3f} s ({r.when}); arm motion alone: "
-        f"{r.arm_margin * 1e3:.1f} mm; base acceleration that holds: {holds}{left}"
-    )
-
-
-def tip_error(r: ZmpReport) -> TipOverError:
-    """The error a run that tips the robot over ends with (after its files are written)."""
-    e = next(e for e in r.excursions if e.tips)
-    accel = f" at {r.base_accel:g} m/s²" if e.case != zmps.CASES[0] else ""
-    return TipOverError(
-        f"the robot tips over: its zero-moment point is up to {e.depth * 1e3:.1f} mm outside "
-        f"the support polygon toward {e.direction} from t = {e.start:.3f} s for "
-        f"{e.duration:.3f} s ({e.case}{accel}), long enough to rotate it over that edge",
-        time=e.start,
-        margin=-e.depth,
-        case=e.case,
     )
 
 

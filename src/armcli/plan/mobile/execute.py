@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from armcli.analysis.liftoff import TipVerdict
+from armcli.analysis.liftoff import TiltVerdict
 from armcli.drive import job as drive
 from armcli.drive import output as driveout
 from armcli.drive.job import DriveRun
@@ -49,7 +49,7 @@ class Executed:
 
     run: DriveRun
     arm: SimResult
-    verdict: TipVerdict
+    verdict: TiltVerdict
     tool_error: float  # [m] ground truth, at the end
     base_error: tuple[float, float]  # [m, rad] final pose against the plan (ground truth)
     arrived: float | None  # [s] when the follower had the base at its goal (odometry)
@@ -139,7 +139,7 @@ def _truth(plan: WholePlan, run: DriveRun) -> tuple[np.ndarray, np.ndarray]:
     return np.array([p[0], p[1], yaw]), R @ np.asarray(tool_b) + p
 
 
-def _judge(plan: WholePlan, run: DriveRun, arm: SimResult, verdict: TipVerdict,
+def _judge(plan: WholePlan, run: DriveRun, arm: SimResult, verdict: TiltVerdict,
            pilot: Pursuit, tolerance: float) -> Executed:  # fmt: skip
     start = plan.goal.start
     c, s = math.cos(start[2]), math.sin(start[2])
