@@ -13,7 +13,7 @@ from collections.abc import Callable, Iterable
 
 from armcli.check.options import CheckOptions
 from armcli.check.rules import ERROR, RULES
-from armcli.check.run import check_urdf
+from armcli.check.run import check_rules
 from armcli.errors import ModelRefusedError, RuleViolation
 from armcli.urdf.doc import Urdf
 
@@ -48,14 +48,19 @@ def refuse_check_errors(
 
     Rules in `ignore` do not refuse (as `check --ignore` silences them): the user has
     judged the finding, e.g. a true `inertia-exceeds-geometry` on an arm whose inertia is
-    right although its collision shape is smaller.
+    right although its collision shape is smaller. Only the rule families that can report
+    a refusing error run (check.run.check_rules): the gate asks only for what it refuses.
     """
     skip = NOT_SIMULATED | set(ignore)
-    result = check_urdf(urdf, options)
+
+    def refuses(rule: str) -> bool:
+        return rule not in skip and (only is None or only(rule))
+
+    found = check_rules(urdf, options, lambda r: RULES[r].severity == ERROR and refuses(r))
     errors = [
         RuleViolation(f.rule, f.file, f.line, f.message)
-        for f in result.findings
-        if f.severity == ERROR and f.rule not in skip and (only is None or only(f.rule))
+        for f in found
+        if f.severity == ERROR and refuses(f.rule)
     ]
     if errors:
         raise ModelRefusedError(urdf.source, errors)
