@@ -197,11 +197,17 @@ def verdict(
     down = past.any(axis=1) | (angle > math.radians(TIP_CAP_DEG))
     last = intervals(down)[-1] if down[-1] else None
     rocks = [
-        Rock(stance.polygon.edges[i].direction, float(angles[i]), float(t[a]),
-             float(t[min(b, len(t) - 1)] - t[a]), float(np.max(toward[a:b, i])))
-        for i in range(len(angles)) for a, b in intervals(past[:, i])
+        Rock(
+            stance.polygon.edges[i].direction,
+            float(angles[i]),
+            float(t[a]),
+            float(t[min(b, len(t) - 1)] - t[a]),
+            float(np.max(toward[a:b, i])),
+        )
+        for i in range(len(angles))
+        for a, b in intervals(past[:, i])
         if last is None or a < last[0]
-    ]  # fmt: skip
+    ]
     ratio = toward / angles
     worst = int(np.argmax(ratio)) % ratio.shape[1]
     if last is not None:

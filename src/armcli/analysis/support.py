@@ -20,8 +20,16 @@ from numpy.typing import ArrayLike, NDArray
 COLLINEAR_TOL = 1e-6  # [m²] a hull of smaller area is a line or a point: no polygon
 HULL_EPS = 1e-12  # [m²] cross products below this are collinear (rounding of the contact points)
 # The eight compass directions of the root frame (+x forward, +y left, ROS REP 103).
-_DIRECTIONS = ("front", "front-left", "left", "rear-left", "rear", "rear-right", "right",
-               "front-right")  # fmt: skip
+_DIRECTIONS = (
+    "front",
+    "front-left",
+    "left",
+    "rear-left",
+    "rear",
+    "rear-right",
+    "right",
+    "front-right",
+)
 
 
 def direction_name(angle: float) -> str:
@@ -95,8 +103,11 @@ class SupportPolygon:
         a = np.array([e.a for e in self.edges], dtype=float)  # (k, 2)
         ab = np.array([e.b for e in self.edges], dtype=float) - a
         with np.errstate(invalid="ignore", divide="ignore"):
-            u = np.clip(np.einsum("mkj,kj->mk", p[:, None, :] - a[None], ab)
-                        / np.sum(ab * ab, axis=1), 0.0, 1.0)  # fmt: skip
+            u = np.clip(
+                np.einsum("mkj,kj->mk", p[:, None, :] - a[None], ab) / np.sum(ab * ab, axis=1),
+                0.0,
+                1.0,
+            )
         gap = np.linalg.norm(p[:, None, :] - (a[None] + u[..., None] * ab[None]), axis=2)
         out = np.where(np.all(d >= 0.0, axis=1), np.min(d, axis=1), -np.min(gap, axis=1))
         out[~np.all(np.isfinite(p), axis=1)] = -math.inf
