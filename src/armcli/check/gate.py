@@ -21,9 +21,15 @@ from armcli.urdf.doc import Urdf
 # (the dynamics come from <inertial>), contact at named poses, the URDF's name, and a motor
 # too weak for gravity (the run reports the saturation).
 NOT_SIMULATED = frozenset(
-    {"mesh-missing", "self-collision", "material-undefined", "rgba-range", "robot-name",
-     "gravity-effort"}
-)  # fmt: skip
+    {
+        "mesh-missing",
+        "self-collision",
+        "material-undefined",
+        "rgba-range",
+        "robot-name",
+        "gravity-effort",
+    }
+)
 
 
 def bears_on_balance(rule: str) -> bool:
