@@ -50,8 +50,14 @@ def _drive_rows(run: DriveRun, verdict_: TiltVerdict) -> Callable[[Sequence[Any]
             _scan_row(wide(axes[2 * n :]), run)
         pos = s[::step, L.base_pos]
         ax.plot(pos[:, 0], pos[:, 1], color="C0", lw=1.5, label=f"truth ({job.params.base_frame})")
-        ax.plot(run.odometry.x[::step], run.odometry.y[::step], "--", color="C1", lw=1.2,
-                label="odometry (wheel encoders)")  # fmt: skip
+        ax.plot(
+            run.odometry.x[::step],
+            run.odometry.y[::step],
+            "--",
+            color="C1",
+            lw=1.2,
+            label="odometry (wheel encoders)",
+        )
         ax.plot(pos[0, 0], pos[0, 1], "o", color="k", ms=4, label="start")
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_xlabel("x [m]")
@@ -68,8 +74,10 @@ def _drive_rows(run: DriveRun, verdict_: TiltVerdict) -> Callable[[Sequence[Any]
             load.axvspan(lift.start, lift.start + lift.duration, color="C3", alpha=0.25)
         load.set_xlabel("time [s]")
         load.set_ylabel("normal force [N]")
-        load.set_title(f"wheel and caster loads ({LOAD_WINDOW_S * 1e3:g} ms means; shaded: "
-                       "lift-off)", fontsize=11)  # fmt: skip
+        load.set_title(
+            f"wheel and caster loads ({LOAD_WINDOW_S * 1e3:g} ms means; shaded: lift-off)",
+            fontsize=11,
+        )
         load.legend(loc="best", fontsize=8)
         load.grid(True, alpha=0.3)
 
