@@ -191,8 +191,9 @@ def _print(
     if done is not None:
         lines.append("  executed in simulation:")
         for m, tau, lim in zip(done.metrics, done.peak_effort, done.effort_limit, strict=True):
-            lines.append(f"    {m.name}: max error {m.max_error:.4f} rad, "
-                         f"peak effort {tau:.3g} of {lim:g}")  # fmt: skip
+            lines.append(
+                f"    {m.name}: max error {m.max_error:.4f} rad, peak effort {tau:.3g} of {lim:g}"
+            )
         if done.tip_margin is not None:
             lines.append(f"    tip-over margin {done.tip_margin * 1e3:.1f} mm")
         lines += [f"    broken: {p}" for p in done.problems]
