@@ -8,10 +8,10 @@ import pytest
 
 from armcli.check import run
 from armcli.check.context import URDF
-from armcli.check.gate import NOT_SIMULATED, bears_on_balance, refuse_check_errors
+from armcli.check.gate import NOT_SIMULATED, bears_on_balance, refuse_check_errors, require_known
 from armcli.check.rules import ERROR, RULES
 from armcli.check.run import check_urdf, families_for
-from armcli.errors import ModelRefusedError
+from armcli.errors import InputError, ModelRefusedError
 from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_urdf
 from tests.helpers import ROOT
@@ -117,3 +117,10 @@ def test_a_family_reports_only_the_rules_it_declares(monkeypatch: pytest.MonkeyP
     with pytest.raises(RuntimeError, match="'axis' is not among the rules"):
         check_urdf(parse_urdf(MY.encode(), "my_robot.urdf"))
     assert all(f.rules <= set(RULES) for f in run.FAMILIES[:-1])  # every id is a real rule
+
+
+def test_an_unknown_rule_to_ignore_is_refused_by_its_field() -> None:
+    with pytest.raises(InputError) as err:
+        require_known(["axis", "no-such-rule"])
+    assert err.value.field == "ignore" and "no-such-rule" in str(err.value)
+    require_known(["axis", "pd-unstable"])  # real rules pass

@@ -12,9 +12,9 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 
 from armcli.check.options import CheckOptions
-from armcli.check.rules import ERROR, RULES
+from armcli.check.rules import ERROR, RULES, unknown_rules
 from armcli.check.run import check_rules
-from armcli.errors import ModelRefusedError, RuleViolation
+from armcli.errors import InputError, ModelRefusedError, RuleViolation
 from armcli.urdf.doc import Urdf
 
 # Errors about what the simulator never reads or what a run itself shows: meshes and colours
@@ -30,6 +30,13 @@ NOT_SIMULATED = frozenset(
         "gravity-effort",
     }
 )
+
+
+def require_known(ignore: Iterable[str]) -> None:
+    """Refuse an `ignore` naming no rule: a typo would silence nothing, silently."""
+    unknown = unknown_rules(ignore)
+    if unknown:
+        raise InputError(f"unknown rule(s) {', '.join(unknown)}", field="ignore")
 
 
 def bears_on_balance(rule: str) -> bool:

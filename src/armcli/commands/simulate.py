@@ -15,7 +15,7 @@ from armcli.commands.robot_input import robot_options, write_notes
 from armcli.commands.values import Names, Numbers, names, numbers
 from armcli.errors import InputError, ModelRefusedError, UnstableLoopError
 from armcli.io import terminal
-from armcli.io.outdir import check_output_file, check_png_file, existing, wrote
+from armcli.io.outdir import existing, wrote
 from armcli.io.together import write_files_together
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 
@@ -50,6 +50,8 @@ FLAGS = {
     "output": "--output",
     "cmd_vel": "--cmd-vel",
     "world": "--world",
+    "ignore": "--ignore",
+    "plot": "--plot",
 }
 
 
@@ -108,27 +110,18 @@ def simulate_cmd(
     world: Path = option(None, "--world", help=WORLD_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
-    from armcli.check.rules import unknown_rules
-    from armcli.sim import states
+    from armcli.check.gate import require_known
+    from armcli.sim.rosbag import check_outputs  # the writers: imported by runs that write
     from armcli.sim.tipping import TipOptions
 
-    unknown = unknown_rules(ignore)
-    if unknown:
-        raise InputError(f"unknown rule(s) {', '.join(unknown)}", field="--ignore")
+    require_known(ignore)
     read = [*robot.paths] or ([robot.file()] if urdf is None else [])  # the spec: found first
     if trajectory is None and message is None and cmd_vel is None:
         raise InputError("nothing to simulate: give the arm a trajectory (--trajectory FILE or "
                          "--message YAML), or drive the robot's base (--cmd-vel FILE)",
                          field="--trajectory")  # fmt: skip
     read += [p for p in (urdf, trajectory, cmd_vel, world) if p is not None]
-    if output is not None:
-        from armcli.sim import rosbag  # the MCAP writer: imported by runs that write a file
-
-        if not rosbag.is_mcap(output):
-            states.output_format(output)
-        check_output_file(output, "--output", read)  # never over an input (issue 42)
-    if plot is not None:
-        check_png_file(plot, "--plot", read)
+    check_outputs(output, plot, read)  # never over an input (issue 42)
     spec_path, spec_obj = None, None
     if robot.path is not None or urdf is None:  # the spec layers are imported only for a spec
         from armcli.spec.load import load_spec

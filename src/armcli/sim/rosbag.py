@@ -33,11 +33,12 @@ import numpy as np
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
 from armcli.io.mcap_guard import check_chunks
+from armcli.io.outdir import check_output_file, check_png_file
 from armcli.io.userfile import open_regular
 from armcli.robot.frames import axis_quaternion, quaternion_product, rotate, rpy_quaternion
 from armcli.robot.joints import rest
 from armcli.sim.simulate import SimResult
-from armcli.sim.states import TIME, Replay, column, sample_states
+from armcli.sim.states import TIME, Replay, column, output_format, sample_states
 from armcli.spec.joint_types import position_bounds
 from armcli.urdf.doc import Joint, Urdf
 
@@ -58,6 +59,20 @@ MAX_REPLAY_TRANSFORMS = 10_000_000  # 1 h of the course drive at 50 Hz: 6 a stat
 def is_mcap(path: Path) -> bool:
     """Whether `path` names an MCAP file (by its extension)."""
     return path.suffix.lower() == MCAP_SUFFIX
+
+
+def check_outputs(output: Path | None, plot: Path | None, inputs: Sequence[Path]) -> None:
+    """Refuse a run's states file or plot before the run, naming the field.
+
+    A format it cannot write (.csv, .json, .mcap; a plot is PNG), or a path over one of the
+    `inputs` (issue 42).
+    """
+    if output is not None:
+        if not is_mcap(output):
+            output_format(output)
+        check_output_file(output, "output", inputs)
+    if plot is not None:
+        check_png_file(plot, "plot", inputs)
 
 
 # -- message definitions, as rosbag2 writes them ---------------------------------------------
