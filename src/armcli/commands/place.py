@@ -63,14 +63,8 @@ def place_cmd(
     robot_file = robot.read(urdf)
     try:
         with flag_errors(FLAGS):
-            placed = place_robot(
-                robot_file,
-                target,
-                scene=scene,
-                start=start or (0.0, 0.0, 0.0),
-                tolerance=tolerance,
-                search=robot.packages,
-            )
+            placed = place_robot(robot_file, target, scene=scene, start=start or (0.0, 0.0, 0.0),
+                                 tolerance=tolerance, search=robot.packages)  # fmt: skip
     except PlanningError as exc:
         if fmt == "json":
             _json(failed_document(exc.reason))
