@@ -8,15 +8,14 @@ from armcli.sim import job as simjob
 from armcli.sim.options import SimOptions
 from armcli.sim.plot import PLOT_POINTS
 from armcli.sim.states import sample_states
-from armcli.spec.load import load_spec
-from tests.helpers import DEFAULT_SPEC
+from tests.helpers import DEFAULT_SPEC, spec_file
 
 MSG = "{joint_names: [forearm_hand_joint], points: [{positions: [0.8], time_from_start: 1}]}"
 
 
 def _job(duration: float, rate: float) -> simjob.SimJob:
     opts = SimOptions(message=MSG, duration=duration, rate=rate)
-    return simjob.prepare(load_spec(DEFAULT_SPEC), opts)
+    return simjob.prepare(spec_file(DEFAULT_SPEC), opts)
 
 
 def test_a_run_keeps_the_output_states_and_the_last() -> None:
