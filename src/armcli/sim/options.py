@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Literal, get_args
 from armcli.errors import InputError
 
 if TYPE_CHECKING:
-    from armcli.sim.trajectory import Trajectory
+    from armcli.trajectory.message import Trajectory
 
 Integrator = Literal["euler", "rk4"]
 """euler: semi-implicit Euler, Kd and damping implicit (first order; symplectic only for a
