@@ -30,16 +30,15 @@ from armcli.drive.model import DriveModel, build_drive_model
 from armcli.drive.wheelmotor import clutch_torque, spin
 from armcli.errors import InputError, SimulationError
 from armcli.io.scene import Scene
-from armcli.robot.file import floating_of, robot_of
+from armcli.robot.file import floating_of
 from armcli.sim import job as simjob
 from armcli.sim.job import SimJob
 from armcli.sim.options import SimOptions
 from armcli.sim.sensors.reading import Reading
 from armcli.sim.sensors.rig import make_rig
-from armcli.sim.simulate import simulated, steps_of
+from armcli.sim.simulate import steps_of
 from armcli.sim.tipping import whole_robot
 from armcli.sim.world import load_world, refuse_overlaps
-from armcli.trajectory.message import Trajectory
 from armcli.urdf.doc import Urdf
 from armcli.urdf.source import RobotFile
 
@@ -50,7 +49,6 @@ if TYPE_CHECKING:
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last command or trajectory point by default
 MAX_DRIVE_STEPS = 600_000  # every step's sensors are kept: ~150 MB for the course robot
 PROGRESS_STEPS = 10_000  # steps between progress reports
-HOLD = "<the start pose>"  # the source of the trajectory a drive without one holds
 
 
 @dataclass(frozen=True)
@@ -96,10 +94,8 @@ def prepare(
     params = params if params is not None else DriveParams.of(spec)
     cmd = load_cmd_vel(cmd_vel)
     rate = opts.rate if opts.rate is not None else params.update_rate
-    if opts.trajectory is None and opts.message is None:
-        opts = replace(opts, trajectory=_hold(file, opts))
     hold = opts.duration if opts.duration is not None else 1.0  # 0 is refused, as elsewhere
-    job = simjob.prepare(file, replace(opts, rate=rate, duration=hold))
+    job = simjob.prepare(file, replace(opts, rate=rate, duration=hold), hold=True)
     robot = whole_robot(file)
     if gate is not None:
         gate(robot)
@@ -149,13 +145,6 @@ def _driven_spec(file: RobotFile) -> RobotSpec:
         raise InputError("drives a spec's robot (its mobile_base.diff_drive); give a spec "
                          "instead of a URDF", field="cmd_vel")  # fmt: skip
     return file.spec
-
-
-def _hold(file: RobotFile, opts: SimOptions) -> Trajectory:
-    """A one-point trajectory at the start pose, from time 0: the arm holds still."""
-    arm = simulated(robot_of(file, file.arm), opts.joints)
-    q0 = simjob.start_state(arm, file.spec)
-    return Trajectory(arm.names, np.zeros(1), q0[None, :].copy(), None, None, source=HOLD)
 
 
 @dataclass(frozen=True)

@@ -41,6 +41,7 @@ if TYPE_CHECKING:
 
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
 ARM_URDF = STANDALONE_ARM_URDF
+HOLD = "<the start pose>"  # the source of the trajectory a held arm tracks (`prepare(hold=)`)
 RATE_SLACK = 1e-9  # relative: --rate 1000 with dt 0.001 is exactly one sample per step
 
 
@@ -227,42 +228,30 @@ def base_joints(spec: RobotSpec | None) -> dict[str, str]:
 
 
 def prepare(
-    file: RobotFile, opts: SimOptions, *, gate: Callable[[Urdf], None] | None = None
+    file: RobotFile,
+    opts: SimOptions,
+    *,
+    gate: Callable[[Urdf], None] | None = None,
+    hold: bool = False,
 ) -> SimJob:
     """Validate every input and assemble the run; raises InputError on bad input.
 
     What runs is `file.arm` (a spec's standalone arm, or a URDF file) with the file's
     spec's settings (gains, dt, home). `gate` sees a URDF file (`--urdf`) before it is
     simulated and may refuse it (the simulate command passes check.gate.refuse_check_errors).
+    `hold`: without a trajectory the arm holds its start pose (the drive's arm).
     """
-    spec = file.spec
-    trajectory, message, dt = opts.trajectory, opts.message, opts.dt
-    if (trajectory is None) == (message is None):
-        raise InputError(
-            "give exactly one of `SimOptions.trajectory` (a file) or `SimOptions.message`",
-            field="SimOptions.trajectory",
-        )
+    spec, dt = file.spec, opts.dt
+    if not (hold and opts.trajectory is None and opts.message is None):
+        _one_trajectory(opts)
     dt_field = "SimOptions.dt" if dt is not None else "control.dt"  # else the spec's, checked
     dt = dt if dt is not None else (spec.control.dt if spec is not None else DEFAULT_DT)
     dt = time_step(dt, dt_field)
     doc = file.arm
     whole = robot_of(file, doc, gate=None if file.compiled else gate)
     robot = simulated(whole, opts.joints)
-    limits = {
-        n: (float(lo), float(hi))
-        for n, lo, hi in zip(robot.names, robot.lower, robot.upper, strict=True)
-    }
-    others = base_joints(spec)
-    if isinstance(trajectory, Trajectory):
-        traj = _within(trajectory, limits)
-    elif trajectory is not None:
-        traj = load_trajectory(trajectory, limits, clamp=opts.clamp, others=others)
-    else:
-        traj = loads_trajectory(
-            str(message), limits, source="SimOptions.message", clamp=opts.clamp, others=others
-        )
-    source = traj.source if trajectory is not None else "SimOptions.message"
-    pairs = mimic_pairs(whole.mimics, robot, traj, source)
+    traj = _trajectory(robot, spec, opts)
+    pairs = mimic_pairs(whole.mimics, robot, traj, traj.source)
     q0 = start_state(robot, spec)
     for f, lead, m in pairs:
         q0[f] = np.clip(m.position(q0[lead]), robot.lower[f], robot.upper[f])
@@ -284,6 +273,38 @@ def prepare(
     label, T_frame_root = _report_frame(robot, spec)
     return SimJob(robot, traj, ref, q0, total, cfg, label, float(rate), T_frame_root, doc.notes,
                   doc)  # fmt: skip
+
+
+def _one_trajectory(opts: SimOptions) -> None:
+    if (opts.trajectory is None) == (opts.message is None):
+        raise InputError(
+            "give exactly one of `SimOptions.trajectory` (a file) or `SimOptions.message`",
+            field="SimOptions.trajectory",
+        )
+
+
+def _trajectory(robot: Robot, spec: RobotSpec | None, opts: SimOptions) -> Trajectory:
+    """What the arm tracks: a file, a message, a `Trajectory` handed over, else its start.
+
+    The start pose held is built here as an object (the drive without a trajectory), not
+    written as YAML text and read back.
+    """
+    trajectory, message = opts.trajectory, opts.message
+    if trajectory is None and message is None:
+        q0 = start_state(robot, spec)
+        return Trajectory(robot.names, np.zeros(1), q0[None, :], None, None, source=HOLD)
+    limits = {
+        n: (float(lo), float(hi))
+        for n, lo, hi in zip(robot.names, robot.lower, robot.upper, strict=True)
+    }
+    if isinstance(trajectory, Trajectory):
+        return _within(trajectory, limits)
+    others = base_joints(spec)
+    if trajectory is not None:
+        return load_trajectory(trajectory, limits, clamp=opts.clamp, others=others)
+    return loads_trajectory(
+        str(message), limits, source="SimOptions.message", clamp=opts.clamp, others=others
+    )
 
 
 def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:
