@@ -81,12 +81,16 @@ class Tipping:
 def whole_robot(file: RobotFile) -> Urdf:
     """The robot whose balance a fixed-base run reports.
 
-    A spec's whole robot when it mounts the arm on a base, else what is simulated (`file.arm`).
+    A spec's whole robot when it mounts the arm on a base (also for a URDF file run with
+    that spec's settings, `RobotFile.with_spec`), else what is simulated (`file.arm`).
     """
     spec = file.spec
-    if file.compiled and spec is not None and spec.mounted_base() is not None:
+    if spec is None or spec.mounted_base() is None:
+        return file.arm
+    if file.compiled:
         return file.robot
-    return file.arm
+    whole = file.document(f"{spec.name}.urdf") if file.arm.source.endswith(".urdf") else None
+    return whole if whole is not None else file.arm
 
 
 def prepare(

@@ -61,8 +61,13 @@ class RobotFile:
         return cls(path, docs, spec, compiled=True)
 
     def with_spec(self, spec: RobotSpec) -> RobotFile:
-        """This URDF run with a spec's settings (`simulate SPEC --urdf FILE`), no robot built."""
-        return RobotFile(self.path, self.urdfs, spec)
+        """This URDF run with a spec's settings (`simulate SPEC --urdf FILE`), no robot built.
+
+        A spec that mounts the arm on a base adds its compiled documents after this file's:
+        the whole robot a fixed-base run's balance stands on (`sim.tipping.whole_robot`).
+        """
+        extra = RobotFile.of_spec(spec).urdfs if spec.mounted_base() is not None else ()
+        return RobotFile(self.path, self.urdfs + extra, spec)
 
     def document(self, name: str) -> Urdf | None:
         """A spec's document by file name (`my_robot.urdf`), None when it has none so named."""
