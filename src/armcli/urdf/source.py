@@ -63,10 +63,12 @@ class RobotFile:
     def with_spec(self, spec: RobotSpec) -> RobotFile:
         """This URDF run with a spec's settings (`simulate SPEC --urdf FILE`), no robot built.
 
-        A spec that mounts the arm on a base adds its compiled documents after this file's:
-        the whole robot a fixed-base run's balance stands on (`sim.tipping.whole_robot`).
+        A spec that mounts the arm on a base adds its compiled documents after a URDF file's
+        (not a xacro file's): the whole robot a fixed-base run's balance stands on
+        (`sim.tipping.whole_robot`).
         """
-        extra = RobotFile.of_spec(spec).urdfs if spec.mounted_base() is not None else ()
+        urdf = self.urdfs[0].source.endswith(".urdf")
+        extra = RobotFile.of_spec(spec).urdfs if urdf and spec.mounted_base() is not None else ()
         return RobotFile(self.path, self.urdfs + extra, spec)
 
     def document(self, name: str) -> Urdf | None:
