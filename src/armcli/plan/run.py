@@ -68,10 +68,5 @@ def plan(
         write_file_atomic(output, result.document)
     if not run:
         return Planned(result, what)
-    sim = SimOptions(
-        message=result.document.decode("utf-8"),
-        urdf=urdf,
-        trust_xacro=robot.trust,
-        xacro=robot.xacro,
-    )
-    return Planned(result, what, execute(robot_file.spec, sim, robot.packages))
+    sim = SimOptions(message=result.document.decode("utf-8"))
+    return Planned(result, what, execute(robot_file, sim, robot.packages))

@@ -27,6 +27,7 @@ from armcli.tune.engine import make_engine
 from armcli.tune.problem import nominal_robot
 from armcli.tune.search import SearchOptions, validate
 from armcli.tune.write import check_writable, edited_spec
+from armcli.urdf.source import RobotFile
 
 Started = Callable[[tjob.TuneJob, str], None]  # the job and the engine's name
 Progress = Callable[[int, int], None]  # trials done, trials in all
@@ -65,7 +66,8 @@ def tune(
     """Tune the spec's PD gains as `req` asks; nothing is written here."""
     validate(req.search)
     check_outputs(req)
-    job = tjob.prepare(load_spec(req.spec), req.spec, list(req.trajectories), req.settings)
+    file = RobotFile.of_spec(load_spec(req.spec), req.spec)  # compiled once
+    job = tjob.prepare(file, list(req.trajectories), req.settings)
     jobs = req.jobs if req.jobs is not None else (os.cpu_count() or 1)
     engine = make_engine(jobs, req.scheduler, trust_scheduler=req.trust_scheduler)
     try:
