@@ -117,9 +117,11 @@ def simulate_cmd(
     require_known(ignore)
     read = [*robot.paths] or ([robot.file()] if urdf is None else [])  # the spec: found first
     if trajectory is None and message is None and cmd_vel is None:
-        raise InputError("nothing to simulate: give the arm a trajectory (--trajectory FILE or "
-                         "--message YAML), or drive the robot's base (--cmd-vel FILE)",
-                         field="--trajectory")  # fmt: skip
+        raise InputError(
+            "nothing to simulate: give the arm a trajectory (--trajectory FILE or "
+            "--message YAML), or drive the robot's base (--cmd-vel FILE)",
+            field="--trajectory",
+        )
     read += [p for p in (urdf, trajectory, cmd_vel, world) if p is not None]
     check_outputs(output, plot, read)  # never over an input (issue 42)
     file, spec_path = _robot_file(robot, urdf)
@@ -138,13 +140,13 @@ def simulate_cmd(
     )
     tip_opts = TipOptions(base_accel, payload, payload_link, contact_links)
     if cmd_vel is not None:
-        _drive(file, opts, cmd_vel, world, tuple(ignore), output, plot,
-               tip_opts != TipOptions())  # fmt: skip
+        _drive(file, opts, cmd_vel, world, tuple(ignore), output, plot, tip_opts != TipOptions())
         return
     asked = tip_opts != TipOptions()  # an arm on a fixed base is news only when asked about
     with _LazyProgress(terminal.console(sys.stderr)) as progress:
-        run = _simulate(file, spec_path, opts, tip_opts, robot, tuple(ignore), progress,
-                        plot is not None, world)  # fmt: skip
+        run = _simulate(
+            file, spec_path, opts, tip_opts, robot, tuple(ignore), progress, plot is not None, world
+        )
     _report(run, output, plot, asked)
 
 
@@ -164,10 +166,16 @@ def _robot_file(robot: RobotInput, urdf: Path | None) -> tuple[RobotFile, Path |
 
 
 def _simulate(
-    file: RobotFile, spec_path: Path | None, opts: SimOptions, tip_opts: TipOptions,
-    robot: RobotInput, ignore: tuple[str, ...], progress: _LazyProgress, plot: bool,
+    file: RobotFile,
+    spec_path: Path | None,
+    opts: SimOptions,
+    tip_opts: TipOptions,
+    robot: RobotInput,
+    ignore: tuple[str, ...],
+    progress: _LazyProgress,
+    plot: bool,
     world: Path | None,
-) -> ArmRun:  # fmt: skip
+) -> ArmRun:
     """The run, with library refusals told in the command's terms (options, spec fields).
 
     A model `check` reports as an error is not simulated (same rule ids), unless ignored.
@@ -178,13 +186,18 @@ def _simulate(
 
     try:
         return simulate_arm(
-            file, opts, tip_opts, robot.packages,
-            gate=lambda doc: refuse_check_errors(doc, CheckOptions(robot_file=file),
-                                                 ignore=ignore),
-            balance_gate=lambda doc: refuse_check_errors(doc, CheckOptions(robot_file=file),
-                                                         ignore=ignore, only=bears_on_balance),
-            progress=progress, plot=plot, world=world,
-        )  # fmt: skip
+            file,
+            opts,
+            tip_opts,
+            robot.packages,
+            gate=lambda doc: refuse_check_errors(doc, CheckOptions(robot_file=file), ignore=ignore),
+            balance_gate=lambda doc: refuse_check_errors(
+                doc, CheckOptions(robot_file=file), ignore=ignore, only=bears_on_balance
+            ),
+            progress=progress,
+            plot=plot,
+            world=world,
+        )
     except ModelRefusedError as exc:
         flags = " ".join(f"--ignore {r}" for r in exc.rules())
         raise ModelRefusedError(
@@ -207,9 +220,15 @@ def _sources(spec_path: Path | None, opts: SimOptions) -> dict[str, Any]:
 
 
 def _drive(
-    file: RobotFile, opts: SimOptions, cmd_vel: Path, world: Path | None, ignore: tuple[str, ...],
-    output: Path | None, plot: Path | None, tip_asked: bool,
-) -> None:  # fmt: skip
+    file: RobotFile,
+    opts: SimOptions,
+    cmd_vel: Path,
+    world: Path | None,
+    ignore: tuple[str, ...],
+    output: Path | None,
+    plot: Path | None,
+    tip_asked: bool,
+) -> None:
     """The whole robot on its wheels (commands.drive); the base-at-rest options do not apply."""
     from armcli.commands.drive import run_drive
 

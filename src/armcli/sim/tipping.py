@@ -54,8 +54,9 @@ class TipOptions:
         if self.base_accel is not None and not (
             math.isfinite(self.base_accel) and self.base_accel >= 0
         ):
-            raise InputError(f"must be finite and >= 0, got {self.base_accel:g}",
-                             field="TipOptions.base_accel")  # fmt: skip
+            raise InputError(
+                f"must be finite and >= 0, got {self.base_accel:g}", field="TipOptions.base_accel"
+            )
 
 
 @dataclass(frozen=True)
@@ -73,9 +74,18 @@ class Tipping:
 
     def series(self, job: SimJob, res: SimResult) -> zmps.ZmpSeries:
         """The zero-moment point at every kept state of the run."""
-        return zmps.zmp_series(self.stance, res.joint_names, res.t, res.step, res.q, res.v,
-                               res.dt, self.base_accel, self.threshold,
-                               zmps.impacts(res.stop_active, res.v))  # fmt: skip
+        return zmps.zmp_series(
+            self.stance,
+            res.joint_names,
+            res.t,
+            res.step,
+            res.q,
+            res.v,
+            res.dt,
+            self.base_accel,
+            self.threshold,
+            zmps.impacts(res.stop_active, res.v),
+        )
 
 
 def whole_robot(file: RobotFile) -> Urdf:
@@ -113,9 +123,14 @@ def prepare(
         return None
     missing: list[str] = []
     search = lookup_for(spec, search)  # the packages the spec records too
-    found = stance_of(urdf, candidates=candidates, declared=opts.contact_links,
-                      mesh=mesh_loader(urdf, search, missing), payload=payload,
-                      floating=floating_of(file, urdf))  # fmt: skip
+    found = stance_of(
+        urdf,
+        candidates=candidates,
+        declared=opts.contact_links,
+        mesh=mesh_loader(urdf, search, missing),
+        payload=payload,
+        floating=floating_of(file, urdf),
+    )
     if isinstance(found, NoStance):
         notes.append(f"no zero-moment point: {found.reason}")
         return None
@@ -289,8 +304,14 @@ def plot_row(series: zmps.ZmpSeries) -> Any:
         k = int(np.argmin(np.min(series.margin[:, :cases], axis=1)))  # the least moment
         low = float(np.min(series.margin[k, :cases])) * 1e3
         ax.plot(series.t[k], low, "o", color="C3", ms=5, zorder=5)
-        ax.annotate(f"least {low:.1f} mm at {series.t[k]:.3f} s", (series.t[k], low),
-                    xytext=(8, -4), textcoords="offset points", fontsize=8, color="C3")  # fmt: skip
+        ax.annotate(
+            f"least {low:.1f} mm at {series.t[k]:.3f} s",
+            (series.t[k], low),
+            xytext=(8, -4),
+            textcoords="offset points",
+            fontsize=8,
+            color="C3",
+        )
         top = float(np.max(series.margin[:, :cases])) * 1e3
         span = top - min(low, 0.0)
         ax.set_ylim(min(low, 0.0) - 0.15 * span, top + 0.6 * span)  # the legend goes on top
