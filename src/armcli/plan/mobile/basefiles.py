@@ -36,10 +36,14 @@ def cmd_vel_yaml(timing: BaseTiming, comment: str = "") -> bytes:
     lines = [f"# {c}" for c in comment.splitlines() if c]
     lines.append("commands:")
     for t, v, w in zip(times, lin, ang, strict=True):
-        lines.append(f"  - {{linear: {{x: {_f(v)}}}, angular: {{z: {_f(w)}}}, "
-                     f"time_from_start: {_stamp(float(t))}}}")  # fmt: skip
-    lines.append(f"  - {{linear: {{x: 0.0}}, angular: {{z: 0.0}}, "
-                 f"time_from_start: {_stamp(timing.duration)}}}")  # fmt: skip
+        lines.append(
+            f"  - {{linear: {{x: {_f(v)}}}, angular: {{z: {_f(w)}}}, "
+            f"time_from_start: {_stamp(float(t))}}}"
+        )
+    lines.append(
+        f"  - {{linear: {{x: 0.0}}, angular: {{z: 0.0}}, "
+        f"time_from_start: {_stamp(timing.duration)}}}"
+    )
     return ("\n".join(lines) + "\n").encode("utf-8")
 
 

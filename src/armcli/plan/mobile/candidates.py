@@ -63,8 +63,14 @@ def planar_family(judge: Judge, samples: int) -> Family:
     arm = judge.mobile.planar
     assert arm is not None
     q, _ = arm.at_height(float(judge.target[2] - arm.shoulder[2]), samples)
-    return Family(q, arm.points(q), np.zeros(len(q)), arm.axis, np.ones(len(q), dtype=bool),
-                  _planar_heights(judge))  # fmt: skip
+    return Family(
+        q,
+        arm.points(q),
+        np.zeros(len(q)),
+        arm.axis,
+        np.ones(len(q), dtype=bool),
+        _planar_heights(judge),
+    )
 
 
 def boundary_family(judge: Judge) -> Family:
@@ -87,8 +93,9 @@ def boundary_family(judge: Judge) -> Family:
     miss = np.abs(arm.points(qb)[:, 2] - judge.target[2])
     keep = miss <= judge.tolerance
     q = qb[keep]
-    return Family(q, arm.points(q), miss[keep], arm.axis, np.zeros(len(q), dtype=bool),
-                  _planar_heights(judge))  # fmt: skip
+    return Family(
+        q, arm.points(q), miss[keep], arm.axis, np.zeros(len(q), dtype=bool), _planar_heights(judge)
+    )
 
 
 def _planar_heights(judge: Judge) -> tuple[float, float]:
@@ -157,8 +164,9 @@ def standing(judge: Judge, family: Family) -> Family:
     ok[judged] = _stands(judge, family.q[judged])
     keep = np.nonzero(ok)[0]
     nearest = None if family.nearest is None else family.nearest[keep]
-    return Family(family.q[keep], family.p[keep], family.miss[keep], family.lateral, nearest,
-                  family.heights)  # fmt: skip
+    return Family(
+        family.q[keep], family.p[keep], family.miss[keep], family.lateral, nearest, family.heights
+    )
 
 
 def _stands(judge: Judge, qs: np.ndarray) -> np.ndarray:
@@ -230,7 +238,13 @@ def ordered(
         for flat in idx:
             dq, j = divmod(int(flat), n_yaw)
             d, i = divmod(dq, n_q)
-            chunk.append(Candidate((float(bx.flat[flat]), float(by.flat[flat]), float(yaw[j])),
-                                   family.q[i], float(miss[d, i]), float(drive[flat]),
-                                   family.nearest is not None and bool(near[i])))  # fmt: skip
+            chunk.append(
+                Candidate(
+                    (float(bx.flat[flat]), float(by.flat[flat]), float(yaw[j])),
+                    family.q[i],
+                    float(miss[d, i]),
+                    float(drive[flat]),
+                    family.nearest is not None and bool(near[i]),
+                )
+            )
         yield chunk

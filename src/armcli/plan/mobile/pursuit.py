@@ -76,10 +76,22 @@ def legs_in_odom(timing: BaseTiming, start: tuple[float, float, float]) -> list[
 class Pursuit:
     """The pilot: odometry, the motion being followed, the commands, the arm's hold."""
 
-    def __init__(self, legs: list[Leg], motions: tuple[Motion, ...], *, radius: float,
-                 separation: float, dt: float, period: float, speed: float, accel: float,
-                 wheel_dof: np.ndarray, arrival_step: int, axle: np.ndarray,
-                 localize: float = 0.0) -> None:  # fmt: skip
+    def __init__(
+        self,
+        legs: list[Leg],
+        motions: tuple[Motion, ...],
+        *,
+        radius: float,
+        separation: float,
+        dt: float,
+        period: float,
+        speed: float,
+        accel: float,
+        wheel_dof: np.ndarray,
+        arrival_step: int,
+        axle: np.ndarray,
+        localize: float = 0.0,
+    ) -> None:
         self.legs, self.motions = legs, motions
         self.r, self.b, self.dt, self.period = radius, separation, dt, period
         self.speed, self.accel = speed, accel
@@ -101,8 +113,9 @@ class Pursuit:
         """The pose followed: the odometry, corrected by the localiser's last fix."""
         x, y, yaw = self.pose
         c, s = math.cos(self.fix[2]), math.sin(self.fix[2])
-        return np.array([self.fix[0] + c * x - s * y, self.fix[1] + s * x + c * y,
-                         self.fix[2] + yaw])  # fmt: skip
+        return np.array(
+            [self.fix[0] + c * x - s * y, self.fix[1] + s * x + c * y, self.fix[2] + yaw]
+        )
 
     def _localize(self, data: Any) -> None:
         """The ground truth's wheels' midpoint, relative to where it started: a perfect fix."""
@@ -173,8 +186,9 @@ class Pursuit:
             return False
         if abs(along) >= FINAL_TOL:
             b = here[:2] + along * heading
-            self.legs.append(Leg("drive", here[:2].copy(), b, float(here[2]),
-                                 math.copysign(1.0, along)))  # fmt: skip
+            self.legs.append(
+                Leg("drive", here[:2].copy(), b, float(here[2]), math.copysign(1.0, along))
+            )
         self.legs.append(Leg("turn", end.copy(), end.copy(), goal.yaw, 1.0))
         return True
 

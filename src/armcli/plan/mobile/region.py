@@ -98,8 +98,7 @@ def _extents(judge: Judge, best: Verdict) -> list[float]:
     fine = _first_failing(
         judge, best, [row(k, s, b) for (k, s), b in zip(moves, betweens, strict=True)]
     )
-    return [float(b[k - 1]) if k > 0 else g for b, k, g in zip(betweens, fine, goods,
-                                                               strict=True)]  # fmt: skip
+    return [float(b[k - 1]) if k > 0 else g for b, k, g in zip(betweens, fine, goods, strict=True)]
 
 
 def _band(best: Verdict, r: float, theta: float) -> np.ndarray:
