@@ -17,6 +17,7 @@ import numpy as np
 from armcli.plan.mobile.basetime import BaseTiming
 from armcli.plan.mobile.nav2 import FRAME
 from armcli.plan.mobile.wheels import to_base
+from armcli.sim.cmdvel import CmdVel
 
 PATH_PERIOD = 0.1  # [s] between two poses of the nav_msgs/Path
 
@@ -30,6 +31,12 @@ def _stamp(t: float) -> str:
     return f"{{sec: {sec}, nanosec: {nanosec}}}"
 
 
+def _read_back(t: float) -> float:
+    """[s] the time `_stamp(t)` reads back as (sim.trajectory's {sec, nanosec} rule)."""
+    sec, nanosec = divmod(round(t * 1e9), 1_000_000_000)
+    return float(sec) + nanosec * 1e-9
+
+
 def cmd_vel_yaml(timing: BaseTiming, comment: str = "") -> bytes:
     """The commands: one per plugin period (each held until the next), then a stop."""
     times, lin, ang = timing.commands()
@@ -41,6 +48,21 @@ def cmd_vel_yaml(timing: BaseTiming, comment: str = "") -> bytes:
     lines.append(f"  - {{linear: {{x: 0.0}}, angular: {{z: 0.0}}, "
                  f"time_from_start: {_stamp(timing.duration)}}}")  # fmt: skip
     return ("\n".join(lines) + "\n").encode("utf-8")
+
+
+def cmd_vel_of(timing: BaseTiming, source: str = "cmd_vel.yaml") -> CmdVel:
+    """The commands `cmd_vel_yaml` writes, as `sim.cmdvel.load_cmd_vel` reads them back.
+
+    Value for value (floats round-trip through their repr, times through {sec, nanosec}),
+    without writing and parsing the text: `plan --base --execute` runs its own plan.
+    """
+    times, lin, ang = timing.commands()
+    n = len(times)
+    linear, angular = np.zeros((n + 1, 3)), np.zeros((n + 1, 3))
+    linear[:n, 0] = [float(v) + 0.0 for v in lin]
+    angular[:n, 2] = [float(w) + 0.0 for w in ang]
+    t = [_read_back(float(x)) for x in times] + [_read_back(timing.duration)]
+    return CmdVel(np.array(t, dtype=float), linear, angular, source)
 
 
 def path_times(timing: BaseTiming) -> np.ndarray:

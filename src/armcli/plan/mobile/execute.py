@@ -25,6 +25,7 @@ from armcli.plan.mobile.wheels import to_base
 from armcli.plan.mobile.whole import WholePlan
 from armcli.robot.frames import quaternion_matrix
 from armcli.sim import drive, driveout
+from armcli.sim.cmdvel import CmdVel
 from armcli.sim.drive import DriveRun
 from armcli.sim.liftoff import TipVerdict
 from armcli.sim.options import SimOptions
@@ -98,12 +99,15 @@ def executable(robot_file: RobotFile) -> RobotSpec:
 
 def execute_whole(
     plan: WholePlan,
-    cmd_vel: Path,
+    cmd_vel: Path | CmdVel,
     arm_yaml: bytes,
     tolerance: float = TOLERANCE,
     localize: float = LOCALIZE,
 ) -> Executed:
     """Run the plan (its written cmd_vel.yaml and arm.yaml) on the drive and judge it.
+
+    `cmd_vel`: the file, or the same commands unparsed (`basefiles.cmd_vel_of`): the
+    follower steers the base, the file's commands go to the MCAP's /cmd_vel.
 
     `localize` [Hz]: the localiser's rate (`plan.mobile.pursuit`); 0: encoders alone.
     """
