@@ -122,8 +122,11 @@ class Pursuit:
         self.fix = np.array([truth[0] - (c * ox - s * oy), truth[1] - (s * ox + c * oy), dyaw])
 
     def arm_steps(self, k0: int, k1: int) -> np.ndarray:
-        """The arm's reference step at steps k0 .. k1 - 1: held at the planned arrival until
-        the base has arrived, then resumed from there."""
+        """The arm's reference step at steps k0 .. k1 - 1 (held until the base has arrived).
+
+        Held at the planned arrival until the follower has the base standing at its goal,
+        then resumed from there.
+        """
         k = np.arange(k0, k1)
         if self.arrived is None:
             return np.minimum(k, self.arrival_step)
