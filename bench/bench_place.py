@@ -156,8 +156,8 @@ def bench_execute() -> None:
     """The whole execute (drive model, run, judgement) with the compiled steps and without."""
     import mujoco  # noqa: F401  (imported once per process, not per run: start-up)
 
+    from armcli.drive import step as drivestep
     from armcli.plan.mobile.basefiles import cmd_vel_of
-    from armcli.sim import drivestep
 
     mobile = load_mobile(read_robot(SPEC), scene=SCENES["warehouse"])
     goal = BaseGoal((1.35, 0.5, 0.42), (-0.5, -1.6, 0.0))  # onto the east rack's low board
@@ -189,7 +189,7 @@ def _bare_steps(done: Executed) -> None:
     """The floor: MuJoCo's mj_step alone, as many steps on the same model, nothing else."""
     import mujoco
 
-    from armcli.sim.drive import start_data
+    from armcli.drive.job import start_data
 
     job = done.run.job
     d = start_data(job.model, job.arm.q0)

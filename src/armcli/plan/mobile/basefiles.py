@@ -14,10 +14,10 @@ import math
 
 import numpy as np
 
+from armcli.drive.cmdvel import CmdVel
 from armcli.plan.mobile.basetime import BaseTiming
 from armcli.plan.mobile.nav2 import FRAME
 from armcli.plan.mobile.wheels import to_base
-from armcli.sim.cmdvel import CmdVel
 
 PATH_PERIOD = 0.1  # [s] between two poses of the nav_msgs/Path
 
@@ -51,7 +51,7 @@ def cmd_vel_yaml(timing: BaseTiming, comment: str = "") -> bytes:
 
 
 def cmd_vel_of(timing: BaseTiming, source: str = "cmd_vel.yaml") -> CmdVel:
-    """The commands `cmd_vel_yaml` writes, as `sim.cmdvel.load_cmd_vel` reads them back.
+    """The commands `cmd_vel_yaml` writes, as `drive.cmdvel.load_cmd_vel` reads them back.
 
     Value for value (floats round-trip through their repr, times through {sec, nanosec}),
     without writing and parsing the text: `plan --base --execute` runs its own plan.

@@ -8,7 +8,7 @@ only, is turned here line by line into the data the safe YAML reader builds from
 same floats (YAML reads each of these number forms as `float(text)`), ints, strings and
 key order. Anything else (another layout, a name or number of another form) gives None
 and is read by the YAML reader. Reading a 60 s plan back this way takes milliseconds where
-the general reader takes a second; tests/sim/test_jointtext.py checks that both readers
+the general reader takes a second; tests/trajectory/test_jointtext.py checks that both readers
 give the same data.
 """
 

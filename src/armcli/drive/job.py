@@ -1,16 +1,16 @@
 """Drive the whole robot on its wheels in MuJoCo while the arm follows its trajectory.
 
 What `armcli simulate SPEC --cmd-vel drive.yaml` runs: the robot as `export mjcf` writes
-it (sim.drivemodel) standing on a floor under gravity; its base driven by
-gazebo_ros_diff_drive's controller (sim.diffdrive) from the /cmd_vel commands
-(sim.cmdvel); its arm under the PD law, gains, gravity compensation and reference of
+it (drive.model) standing on a floor under gravity; its base driven by
+gazebo_ros_diff_drive's controller (drive.diffdrive) from the /cmd_vel commands
+(drive.cmdvel); its arm under the PD law, gains, gravity compensation and reference of
 `simulate` (sim.job prepares them as for the fixed-base engine) through the export's
 position actuators: ctrl = q_ref + (Kd / Kp) v_ref (+ g(q) / Kp with gravity
 compensation, the fixed-base arm's g as the controller computes it), so the actuator
 force Kp (q_ref - q) + Kd (v_ref - v) + g is clipped at the effort limit as a whole.
 
 Every step's sensors are kept (one copy of `sensordata`); odometry, tipping and lift-off
-are computed from them after the run (sim.liftoff), the outputs by sim.driveout.
+are computed from them after the run (analysis.liftoff), the outputs by drive.output.
 """
 
 from __future__ import annotations
@@ -24,20 +24,20 @@ from typing import TYPE_CHECKING, Any, Protocol
 import numpy as np
 
 from armcli.analysis.stance import NoStance, Stance, stance_of
+from armcli.drive.cmdvel import CmdVel, load_cmd_vel
+from armcli.drive.diffdrive import DiffDriveController, DriveParams, Odometry, encoder_odometry
+from armcli.drive.model import DriveModel, build_drive_model
+from armcli.drive.step import SEEN, Steps
+from armcli.drive.wheelmotor import clutch_torque
 from armcli.errors import InputError, SimulationError
 from armcli.io.scene import Scene
 from armcli.sim import job as simjob
-from armcli.sim.cmdvel import CmdVel, load_cmd_vel
-from armcli.sim.diffdrive import DiffDriveController, DriveParams, Odometry, encoder_odometry
-from armcli.sim.drivemodel import DriveModel, build_drive_model
-from armcli.sim.drivestep import SEEN, Steps
 from armcli.sim.job import SimJob
 from armcli.sim.options import SimOptions
 from armcli.sim.sensors.reading import Reading
 from armcli.sim.sensors.rig import make_rig
 from armcli.sim.simulate import steps_of
 from armcli.sim.tipping import robot_urdf
-from armcli.sim.wheelmotor import clutch_torque
 from armcli.sim.world import load_world, refuse_overlaps
 from armcli.urdf.doc import Urdf
 
@@ -190,7 +190,7 @@ class Pilot(Protocol):
 
     A path follower (plan.mobile.pursuit) gives /cmd_vel at every plugin update from the
     state as it is, instead of the job's file, and may hold the arm's reference until the
-    base has arrived. Between two updates the drive steps without it (`sim.drivestep`) and
+    base has arrived. Between two updates the drive steps without it (`drive.step`) and
     then shows it what each step started from (`observe`).
     """
 
@@ -203,7 +203,7 @@ class Pilot(Protocol):
         ...
 
     def observe(self, k0: int, seen: np.ndarray) -> None:
-        """The states steps k0 .. k0 + len(seen) - 1 started from (`sim.drivestep.SEEN`)."""
+        """The states steps k0 .. k0 + len(seen) - 1 started from (`drive.step.SEEN`)."""
         ...
 
 

@@ -5,13 +5,13 @@ actuator controls (the reference's ctrl row, plus g(q) / Kp of the fixed-base ar
 gravity compensation), steps MuJoCo and records the sensors and the clutch torques. Only
 the plugin's update (every `update_rate` period, 20 steps on the course robot) needs Python:
 `Steps.advance` runs the steps in between in one call. The compiled loop is the same
-arithmetic in the same order as `_python_steps` here (tests/sim/test_drivestep.py compares
+arithmetic in the same order as `_python_steps` here (tests/drive/test_step.py compares
 them bit for bit); it takes mj_step's address from the libmujoco the mujoco package loaded
 (ctypes) instead of linking MuJoCo, so it cannot disagree with the installed MuJoCo's structs.
 
 Before each step k it also keeps what a path follower reads of the state (`seen[k]`: the
 free joint's qpos and the wheels' speeds), so the follower can integrate its odometry after
-the steps instead of inside them (`sim.drive.Pilot.observe`).
+the steps instead of inside them (`drive.job.Pilot.observe`).
 """
 
 from __future__ import annotations
@@ -26,12 +26,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from armcli.sim.drivemodel import DriveModel
+from armcli.drive.model import DriveModel
 
 if TYPE_CHECKING:
     from armcli.robot.model import Robot
 
-SOURCE = Path(__file__).parent / "_native" / "drivestep.cpp"
+SOURCE = Path(__file__).parents[1] / "sim" / "_native" / "drivestep.cpp"
 SEEN = 9  # seen[k]: qpos[0:7] (the free joint), then the two wheels' qvel
 _state: dict[str, Any] = {}
 
@@ -133,7 +133,7 @@ def _python_steps(s: Steps, k0: int, k1: int, rows: np.ndarray, command: np.ndar
     """The compiled loop's steps in Python (no extension): the same arithmetic, in order."""
     import mujoco
 
-    from armcli.sim.wheelmotor import spin
+    from armcli.drive.wheelmotor import spin
 
     m, d, dm, rec, seen = s.m, s.d, s.dm, s.rec, s.seen
     rotor, wheel_dof, wheel_force = dm.wheel_rotor, dm.wheel_dof, dm.layout.wheel_force
@@ -150,4 +150,4 @@ def _python_steps(s: Steps, k0: int, k1: int, rows: np.ndarray, command: np.ndar
             ctrl[act] = s.ctrl_arm[j] + g[cols] * s.inv_kp
         mujoco.mj_step(m, d)
         rec[k] = d.sensordata
-        rec[k, wheel_force] = -d.qfrc_constraint[rotor]  # sim.wheelmotor.clutch_torque
+        rec[k, wheel_force] = -d.qfrc_constraint[rotor]  # drive.wheelmotor.clutch_torque

@@ -3,7 +3,7 @@
 The YAML mirrors the ROS message (`header.frame_id`, `joint_names`, `points` with
 `positions` and optional `velocities`, `accelerations`, `effort`, `time_from_start`), so
 the payload of `ros2 topic pub /set_joint_trajectory ...` reads as ROS reads it, including
-the brace form `{0.5, 0.3}` (see armcli.sim.brace).
+the brace form `{0.5, 0.3}` (see armcli.trajectory.brace).
 
 Interpolation follows ros2_control's joint_trajectory_controller: per segment, linear
 when the points give positions only, cubic when they give velocities, quintic when they
@@ -31,8 +31,8 @@ import numpy as np
 
 from armcli.errors import Problem, SpecError, one_per_kind
 from armcli.io.yaml import MAX_YAML_BYTES, FlowKeys, YamlDoc, dotted, loads_yaml, read_text
-from armcli.sim.brace import BraceNotes
-from armcli.sim.jointtext import MAX_PLAN_BYTES, canonical_doc
+from armcli.trajectory.brace import BraceNotes
+from armcli.trajectory.jointtext import MAX_PLAN_BYTES, canonical_doc
 
 DEFAULT_SEGMENT_S = 1.0  # [s] time given to a point without time_from_start
 MIN_SEGMENT_S = 1e-6  # [s] shorter segments make the interpolated reference overflow
@@ -86,7 +86,7 @@ def loads_trajectory(
 ) -> Trajectory:
     """Validate a trajectory given as text, e.g. the `ros2 topic pub` payload.
 
-    Plan's own layout is read by sim.jointtext (same data, fast; problems are reported from
+    Plan's own layout is read by trajectory.jointtext (same data, fast; problems are reported from
     the YAML reader, which knows lines). `max_bytes`: None for armcli's own output.
     """
     fast = canonical_doc(text, source)
@@ -293,7 +293,7 @@ def _time(
 ) -> float:
     """`time_from_start` of entry `k` of the list `key` [s] (seconds or {sec, nanosec}).
 
-    Missing: DEFAULT_SEGMENT_S after the previous entry. sim.cmdvel reads its times so too.
+    Missing: DEFAULT_SEGMENT_S after the previous entry. drive.cmdvel reads its times so too.
     """
     path: tuple[str | int, ...] = (key, k, "time_from_start")
     last = previous[-1] if previous else 0.0

@@ -1,6 +1,6 @@
 """The drive's compiled steps against its Python steps: the same run, bit for bit.
 
-sim.drivestep runs the steps between two plugin updates in C++ (armcli.sim._drivestep)
+drive.step runs the steps between two plugin updates in C++ (armcli.sim._drivestep)
 or, without the extension, in Python. Both must be the same arithmetic in the same order:
 the reference is the Python loop (the one the drive ran before the compiled one existed),
 on a run that exercises every term: the base driving and turning (rotor speeds, clutch
@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from armcli.sim import drive, drivestep
+from armcli.drive import job as drive
+from armcli.drive import step as drivestep
 from armcli.sim.options import SimOptions
 from armcli.spec.load import load_spec
 from tests.helpers import DEFAULT_SPEC

@@ -1,4 +1,4 @@
-"""Plan's layout read by sim.jointtext gives the YAML reader's data, float for float."""
+"""Plan's layout read by trajectory.jointtext gives the YAML reader's data, float for float."""
 
 from __future__ import annotations
 
@@ -13,8 +13,8 @@ from armcli.errors import SpecError
 from armcli.io.yaml import loads_yaml
 from armcli.plan.output import trajectory_yaml
 from armcli.plan.timing import Timed
-from armcli.sim.jointtext import canonical_doc
-from armcli.sim.trajectory import loads_trajectory
+from armcli.trajectory.jointtext import canonical_doc
+from armcli.trajectory.message import loads_trajectory
 
 NAMES = ("joint_a", "arm/b-2", "c.3")
 finite = st.floats(allow_nan=False, allow_infinity=False)
