@@ -136,24 +136,23 @@ class Pursuit:
         """Integrate the encoder odometry over steps k0 .. k0 + len(seen) - 1, with the fixes.
 
         Step k's wheel speeds (seen[:, 7:9], the state it started from) move the pose by
-        one step, as the plugin's odometry does; cumulative sums keep the order of the
-        step-by-step additions. A fix (every `every` steps) sees the pose after its step.
+        one step, as the plugin's odometry does; a fix (every `every` steps) sees the pose
+        after its step. Plain floats: a plugin period is ~20 steps, too few for numpy.
         """
-        n = len(seen)
-        wl, wr = seen[:, 7] * self.r * self.dt, seen[:, 8] * self.r * self.dt
-        dtheta = (wr - wl) / self.b
-        yaw = np.cumsum(np.concatenate([[self.pose[2]], dtheta]))
-        heading = yaw[:-1] + dtheta / 2.0
-        ds = (wl + wr) / 2
-        x = np.cumsum(np.concatenate([[self.pose[0]], ds * np.cos(heading)]))
-        y = np.cumsum(np.concatenate([[self.pose[1]], ds * np.sin(heading)]))
-        poses = np.column_stack([x[1:], y[1:], yaw[1:]])
-        if self.every:
-            for i in np.nonzero((np.arange(k0, k0 + n) % self.every) == 0)[0].tolist():
-                self.pose = poses[i].copy()
+        r, dt, b = self.r, self.dt, self.b
+        x, y, yaw = (float(v) for v in self.pose)
+        for i, (vl, vr) in enumerate(seen[:, 7:9].tolist()):
+            wl, wr = vl * r * dt, vr * r * dt
+            dtheta = (wr - wl) / b
+            heading = yaw + dtheta / 2.0
+            x += (wl + wr) / 2 * math.cos(heading)
+            y += (wl + wr) / 2 * math.sin(heading)
+            yaw += dtheta
+            if self.every and (k0 + i) % self.every == 0:
+                self.pose = np.array([x, y, yaw])
                 self._localize(seen[i, :7])
-        self.pose = poses[-1].copy()
-        self.k = k0 + n - 1
+        self.pose = np.array([x, y, yaw])
+        self.k = k0 + len(seen) - 1
 
     def command(self, t: float, data: Any) -> tuple[float, float]:
         """The twist for the next plugin period.
