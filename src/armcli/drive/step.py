@@ -151,3 +151,14 @@ def _python_steps(s: Steps, k0: int, k1: int, rows: np.ndarray, command: np.ndar
         mujoco.mj_step(m, d)
         rec[k] = d.sensordata
         rec[k, wheel_force] = -d.qfrc_constraint[rotor]  # drive.wheelmotor.clutch_torque
+
+
+if __name__ == "__main__":  # `python -m armcli.drive.step`: are the compiled steps installed
+    import sys
+
+    if load() is None:
+        print("armcli: compiled drive steps unavailable (not built, or built from another "
+              f"{SOURCE.name}: run make native); the drive runs its Python steps",
+              file=sys.stderr)  # fmt: skip
+        raise SystemExit(1)
+    print(f"armcli: compiled drive steps {load()}")
