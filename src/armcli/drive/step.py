@@ -60,15 +60,22 @@ def _import() -> ModuleType | None:
     return _drivestep
 
 
-def mj_step_address() -> int:
-    """mj_step's address in the libmujoco the mujoco package loaded (dlopen finds the same)."""
+def mj_step_address() -> int | None:
+    """mj_step's address in the libmujoco the mujoco package loaded (dlopen finds the same).
+
+    None when the package holds no libmujoco of its own (a build against a system MuJoCo):
+    the drive then runs its Python steps.
+    """
     import mujoco
 
     if "mj_step" not in _state:
-        lib = next(iter(sorted(Path(mujoco.__file__).parent.glob("libmujoco*"))))
-        _state["lib"] = ctypes.CDLL(str(lib))  # already loaded: the same handle
-        _state["mj_step"] = ctypes.cast(_state["lib"].mj_step, ctypes.c_void_p).value
-    address: int = _state["mj_step"]
+        libs = sorted(Path(mujoco.__file__).parent.glob("libmujoco*"))
+        if not libs:
+            _state["mj_step"] = None
+        else:
+            _state["lib"] = ctypes.CDLL(str(libs[0]))  # already loaded: the same handle
+            _state["mj_step"] = ctypes.cast(_state["lib"].mj_step, ctypes.c_void_p).value
+    address: int | None = _state["mj_step"]
     return address
 
 
@@ -90,7 +97,7 @@ class Steps:
     def __post_init__(self) -> None:
         self.act = np.ascontiguousarray(self.dm.arm_act[self.cols], dtype=np.int64)
         mod = load()
-        if mod is not None:
+        if mod is not None and mj_step_address() is not None:
             self.native = _stepper(mod, self)
 
     def advance(self, k0: int, k1: int, rows: np.ndarray, command: np.ndarray) -> None:
