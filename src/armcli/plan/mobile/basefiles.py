@@ -32,7 +32,7 @@ def _stamp(t: float) -> str:
 
 
 def _read_back(t: float) -> float:
-    """[s] the time `_stamp(t)` reads back as (sim.trajectory's {sec, nanosec} rule)."""
+    """[s] the time `_stamp(t)` reads back as (trajectory.message's {sec, nanosec} rule)."""
     sec, nanosec = divmod(round(t * 1e9), 1_000_000_000)
     return float(sec) + nanosec * 1e-9
 
