@@ -18,8 +18,7 @@ import pytest
 from armcli.drive import job as drive
 from armcli.drive import step as drivestep
 from armcli.sim.options import SimOptions
-from armcli.spec.load import load_spec
-from tests.helpers import DEFAULT_SPEC
+from tests.helpers import DEFAULT_SPEC, spec_file
 
 pytest.importorskip("mujoco")
 
@@ -61,7 +60,7 @@ def _runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, pilot: bool) -> list[
     cmd = tmp_path / "drive.yaml"
     cmd.write_text(DRIVE)
     opts = SimOptions(message=MOVES, duration=2.5, gravity_comp=True)
-    job = drive.prepare(load_spec(DEFAULT_SPEC), opts, cmd)
+    job = drive.prepare(spec_file(DEFAULT_SPEC), opts, cmd)
     out = []
     for compiled in (True, False):
         if not compiled:
@@ -90,7 +89,7 @@ def test_a_pilot_observes_every_step_once_from_the_state_it_started(
 ) -> None:
     cmd = tmp_path / "drive.yaml"
     cmd.write_text(DRIVE)
-    job = drive.prepare(load_spec(DEFAULT_SPEC), SimOptions(duration=1.0), cmd)
+    job = drive.prepare(spec_file(DEFAULT_SPEC), SimOptions(duration=1.0), cmd)
     pilot = HoldingPilot(job)
     run = drive.run(job, pilot=pilot)
     assert pilot.seen_steps == list(range(run.steps))
