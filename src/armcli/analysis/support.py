@@ -90,9 +90,9 @@ class SupportPolygon:
         Inside a convex polygon the nearest boundary point is on the nearest edge line;
         outside, the distance to the nearest point of the polygon (an edge or a corner).
         """
-        d = self.edge_distances(xy)
-        if np.all(d >= 0.0):
-            return float(np.min(d))
+        nearest = float(self.edge_distances(xy).min())  # NaN (not finite): outside, below
+        if nearest >= 0.0:
+            return nearest
         p = np.asarray(xy, dtype=float)[:2]
         return -min(_segment_distance(p, e) for e in self.edges)
 

@@ -116,9 +116,11 @@ def _executable(mobile: MobileRobot) -> None:
 
 def _execute(whole: WholePlan, out: Path, written: dict[Path, bytes], tolerance: float) -> Executed:
     from armcli.io.together import write_files_together
+    from armcli.plan.mobile.basefiles import cmd_vel_of
     from armcli.plan.mobile.execute import execute_whole, run_files
 
-    done = execute_whole(whole, out / "cmd_vel.yaml", written[out / "arm.yaml"], tolerance)
+    cmd_vel = cmd_vel_of(whole.timing, str(out / "cmd_vel.yaml"))  # as written, not re-read
+    done = execute_whole(whole, cmd_vel, written[out / "arm.yaml"], tolerance)
     write_files_together(run_files(whole, done, out), parents=True)
     return done
 

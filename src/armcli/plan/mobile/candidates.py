@@ -204,13 +204,32 @@ def ordered(
     A planar family's poses come in tiers, each cheapest driving first: at the target's
     height on the plane, then stood off sideways by OFF_PLANE shares of the tolerance (the
     tool misses by that much), then the reach boundary's near misses. Poses whose miss is
-    beyond the tolerance are left out. Another arm's come nearest in height first.
+    beyond the tolerance are left out. Another arm's come nearest in height first. The
+    stand-off tier's poses are costed only once the plane's are used up (most placements
+    stop in the first chunk): a tier never mixes with the next (TIER).
     """
-    yaw = np.arange(-math.pi, math.pi, step)
-    c, s = np.cos(yaw)[None, None, :], np.sin(yaw)[None, None, :]
     offsets = np.array([0.0])
     if family.lateral is not None:
         offsets = np.array([0.0, *(f * tolerance for f in OFF_PLANE)])
+    tiers = [offsets]
+    if family.nearest is not None and bool(np.all(family.nearest)) and len(offsets) > 1:
+        tiers = [offsets[:1], offsets[1:]]  # the plane's tier 0, the stand-offs' tier 1
+    for offs in tiers:
+        yield from _chunks(family, offs, target, start, turn_radius, step, tolerance)
+
+
+def _chunks(
+    family: Family,
+    offsets: np.ndarray,
+    target: np.ndarray,
+    start: ArrayLike,
+    turn_radius: float,
+    step: float,
+    tolerance: float,
+) -> Iterator[list[Candidate]]:
+    """`ordered`'s chunks over the given sideways offsets [m] (see there)."""
+    yaw = np.arange(-math.pi, math.pi, step)
+    c, s = np.cos(yaw)[None, None, :], np.sin(yaw)[None, None, :]
     px = family.p[None, :, 0:1] + offsets[:, None, None] * family.lateral_xy[0]
     py = family.p[None, :, 1:2] + offsets[:, None, None] * family.lateral_xy[1]
     bx = target[0] - (c * px - s * py)  # (offsets, configurations, yaws)

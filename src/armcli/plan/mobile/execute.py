@@ -21,6 +21,7 @@ import numpy as np
 from armcli.analysis.liftoff import TiltVerdict
 from armcli.drive import job as drive
 from armcli.drive import output as driveout
+from armcli.drive.cmdvel import CmdVel
 from armcli.drive.job import DriveRun
 from armcli.errors import InputError
 from armcli.io.scene import Scene, SceneObject
@@ -99,12 +100,15 @@ def executable(robot_file: RobotFile) -> RobotSpec:
 
 def execute_whole(
     plan: WholePlan,
-    cmd_vel: Path,
+    cmd_vel: Path | CmdVel,
     arm_yaml: bytes,
     tolerance: float = TOLERANCE,
     localize: float = LOCALIZE,
 ) -> Executed:
     """Run the plan (its written cmd_vel.yaml and arm.yaml) on the drive and judge it.
+
+    `cmd_vel`: the file, or the same commands unparsed (`basefiles.cmd_vel_of`): the
+    follower steers the base, the file's commands go to the MCAP's /cmd_vel.
 
     `localize` [Hz]: the localiser's rate (`plan.mobile.pursuit`); 0: encoders alone.
     """
