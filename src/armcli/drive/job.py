@@ -143,8 +143,10 @@ def start_data(dm: DriveModel, q0: np.ndarray) -> Any:
 def _driven_spec(file: RobotFile) -> RobotSpec:
     """The spec whose whole robot drives; InputError for a URDF (no diff drive to run)."""
     if file.spec is None or not file.compiled:
-        raise InputError("drives a spec's robot (its mobile_base.diff_drive); give a spec "
-                         "instead of a URDF", field="cmd_vel")  # fmt: skip
+        raise InputError(
+            "drives a spec's robot (its mobile_base.diff_drive); give a spec instead of a URDF",
+            field="cmd_vel",
+        )
     return file.spec
 
 
@@ -230,9 +232,17 @@ def run(
     wheel_cmd = np.zeros((steps + 1, 2))
     controller = DiffDriveController(job.params)
     cols = np.nonzero(dm.arm_act >= 0)[0]  # a mimic joint follows its leader: no actuator
-    stepper = Steps(m, d, dm, np.ascontiguousarray(ctrl_arm[:, cols]), inv_kp[cols], cols,
-                    arm.robot if arm.config.gravity_comp else None, rec,
-                    np.empty((steps + 1, SEEN)))  # fmt: skip
+    stepper = Steps(
+        m,
+        d,
+        dm,
+        np.ascontiguousarray(ctrl_arm[:, cols]),
+        inv_kp[cols],
+        cols,
+        arm.robot if arm.config.gravity_comp else None,
+        rec,
+        np.empty((steps + 1, SEEN)),
+    )
     command = np.zeros(2)
     used = np.arange(steps + 1)  # the arm reference's step at each step (a pilot may hold it)
     rig = make_rig(job.sensors, m, steps, job.dt)
@@ -268,8 +278,9 @@ def run(
     _refuse_reset(d, rec, job.dt)
     wl = rec[:-1, dm.layout.wheel_vel]
     odom = encoder_odometry(wl[:, 0], wl[:, 1], job.dt, job.params.radius, job.params.separation)
-    return DriveRun(job, t, rec, q_ref, v_ref, wheel_cmd, odom, wall,
-                    rig.readings(job.dt, rec), rig.notes)  # fmt: skip
+    return DriveRun(
+        job, t, rec, q_ref, v_ref, wheel_cmd, odom, wall, rig.readings(job.dt, rec), rig.notes
+    )
 
 
 def _refuse_reset(d: Any, rec: np.ndarray, dt: float) -> None:
@@ -277,8 +288,9 @@ def _refuse_reset(d: Any, rec: np.ndarray, dt: float) -> None:
     import mujoco
 
     W = mujoco.mjtWarning
-    bad = [w for w in (W.mjWARN_BADQACC, W.mjWARN_BADQPOS, W.mjWARN_BADQVEL)
-           if d.warning[w].number > 0]  # fmt: skip
+    bad = [
+        w for w in (W.mjWARN_BADQACC, W.mjWARN_BADQPOS, W.mjWARN_BADQVEL) if d.warning[w].number > 0
+    ]
     if bad:
         rows = np.nonzero(~np.all(np.isfinite(rec), axis=1))[0]
         step = int(rows[0]) if rows.size else None

@@ -125,15 +125,29 @@ def _stepper(mod: ModuleType, s: Steps) -> Any:
     else:
         model, rest, idx_q, cont = None, np.zeros(0), np.zeros(0, i64), np.zeros(0, np.uint8)
     return mod.stepper(
-        step=mj_step_address(), m=s.m._address, d=d._address, qpos=d.qpos, qvel=d.qvel,
-        ctrl=d.ctrl, sensordata=d.sensordata, qfrc_constraint=d.qfrc_constraint,
-        rotor=np.asarray(dm.wheel_rotor, dtype=i64), wheel_dof=np.asarray(dm.wheel_dof, dtype=i64),
+        step=mj_step_address(),
+        m=s.m._address,
+        d=d._address,
+        qpos=d.qpos,
+        qvel=d.qvel,
+        ctrl=d.ctrl,
+        sensordata=d.sensordata,
+        qfrc_constraint=d.qfrc_constraint,
+        rotor=np.asarray(dm.wheel_rotor, dtype=i64),
+        wheel_dof=np.asarray(dm.wheel_dof, dtype=i64),
         wheel_force=np.arange(s.rec.shape[1], dtype=i64)[dm.layout.wheel_force],
-        arm_qpos=np.asarray(dm.arm_qpos, dtype=i64), act=s.act,
-        cols=np.asarray(s.cols, dtype=i64), inv_kp=np.ascontiguousarray(s.inv_kp, dtype=float),
-        ctrl_arm=s.ctrl_arm, rec=s.rec, seen=s.seen, gravity_model=model, rest_q=rest,
-        idx_q=idx_q, continuous=cont,
-    )  # fmt: skip
+        arm_qpos=np.asarray(dm.arm_qpos, dtype=i64),
+        act=s.act,
+        cols=np.asarray(s.cols, dtype=i64),
+        inv_kp=np.ascontiguousarray(s.inv_kp, dtype=float),
+        ctrl_arm=s.ctrl_arm,
+        rec=s.rec,
+        seen=s.seen,
+        gravity_model=model,
+        rest_q=rest,
+        idx_q=idx_q,
+        continuous=cont,
+    )
 
 
 def _python_steps(s: Steps, k0: int, k1: int, rows: np.ndarray, command: np.ndarray) -> None:
@@ -164,8 +178,10 @@ if __name__ == "__main__":  # `python -m armcli.drive.step`: are the compiled st
     import sys
 
     if load() is None:
-        print("armcli: compiled drive steps unavailable (not built, or built from another "
-              f"{SOURCE.name}: run make native); the drive runs its Python steps",
-              file=sys.stderr)  # fmt: skip
+        print(
+            "armcli: compiled drive steps unavailable (not built, or built from another "
+            f"{SOURCE.name}: run make native); the drive runs its Python steps",
+            file=sys.stderr,
+        )
         raise SystemExit(1)
     print(f"armcli: compiled drive steps {load()}")
