@@ -110,20 +110,9 @@ def simulate_cmd(
     world: Path = option(None, "--world", help=WORLD_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
-    from armcli.check.gate import require_known
-    from armcli.sim.rosbag import check_outputs  # the writers: imported by runs that write
     from armcli.sim.tipping import TipOptions
 
-    require_known(ignore)
-    read = [*robot.paths] or ([robot.file()] if urdf is None else [])  # the spec: found first
-    if trajectory is None and message is None and cmd_vel is None:
-        raise InputError(
-            "nothing to simulate: give the arm a trajectory (--trajectory FILE or "
-            "--message YAML), or drive the robot's base (--cmd-vel FILE)",
-            field="--trajectory",
-        )
-    read += [p for p in (urdf, trajectory, cmd_vel, world) if p is not None]
-    check_outputs(output, plot, read)  # never over an input (issue 42)
+    _check_request(robot, ignore, urdf, (trajectory, message, cmd_vel, world), (output, plot))
     file, spec_path = _robot_file(robot, urdf)
     opts = SimOptions(
         trajectory=trajectory,
@@ -139,15 +128,42 @@ def simulate_cmd(
         rate=rate,
     )
     tip_opts = TipOptions(base_accel, payload, payload_link, contact_links)
-    if cmd_vel is not None:
-        _drive(file, opts, cmd_vel, world, tuple(ignore), output, plot, tip_opts != TipOptions())
-        return
     asked = tip_opts != TipOptions()  # an arm on a fixed base is news only when asked about
+    if cmd_vel is not None:
+        return _drive(file, opts, cmd_vel, world, tuple(ignore), output, plot, asked)
     with _LazyProgress(terminal.console(sys.stderr)) as progress:
         run = _simulate(
             file, spec_path, opts, tip_opts, robot, tuple(ignore), progress, plot is not None, world
         )
     _report(run, output, plot, asked)
+
+
+def _check_request(
+    robot: RobotInput,
+    ignore: list[str],
+    urdf: Path | None,
+    inputs: tuple[Path | None, str | None, Path | None, Path | None],
+    outputs: tuple[Path | None, Path | None],
+) -> None:
+    """Refuse what no run can use, before any model is read.
+
+    Unknown --ignore rules, nothing to simulate, an output over an input (issue 42); the
+    spec is found first, so a directory without one says so before anything else.
+    """
+    from armcli.check.gate import require_known
+    from armcli.sim.rosbag import check_outputs  # the writers: imported by runs that write
+
+    require_known(ignore)
+    read = [*robot.paths] or ([robot.file()] if urdf is None else [])
+    trajectory, message, cmd_vel, world = inputs
+    if trajectory is None and message is None and cmd_vel is None:
+        raise InputError(
+            "nothing to simulate: give the arm a trajectory (--trajectory FILE or "
+            "--message YAML), or drive the robot's base (--cmd-vel FILE)",
+            field="--trajectory",
+        )
+    read += [p for p in (urdf, trajectory, cmd_vel, world) if p is not None]
+    check_outputs(*outputs, read)
 
 
 def _robot_file(robot: RobotInput, urdf: Path | None) -> tuple[RobotFile, Path | None]:

@@ -11,15 +11,10 @@ import typer
 from armcli.commands.flags import flag_errors
 from armcli.commands.robot_input import robot_options, write_notes
 from armcli.commands.values import Names, names
-from armcli.errors import ArmcliError, InputError
 from armcli.io.oneline import one_line
-from armcli.io.terminal import say_line
 
 if TYPE_CHECKING:
     from armcli.urdf.source import RobotInput
-    from armcli.view.baseplan import BaseSession
-    from armcli.view.planning import PlanningSession
-    from armcli.view.scene import RobotSource
 
 SCENE_HELP = "Obstacles for the planning panel: YAML like moveit_msgs/PlanningScene."
 SRDF_HELP = "SRDF of a URDF: its named poses (group_state) and disabled collision pairs."
@@ -37,6 +32,7 @@ SAVE_HELP = "Directory the planning panel's Save writes into (default: the curre
         "joints": "--joints",
         "group": "--group",
         "srdf": "--srdf",
+        "save_dir": "--save-dir",
     }
 )
 @robot_options()
@@ -64,125 +60,20 @@ def view_cmd(
     save_dir: Path = typer.Option(Path("."), "--save-dir", show_default=False, help=SAVE_HELP),
 ) -> None:
     """Open a browser 3-D viewer: joint sliders, named poses, replay, motion planning."""
-    from armcli.sim import rosbag  # on use: `--help` stays light
-    from armcli.sim.states import load_replay
-    from armcli.view.browser import Viewer
-    from armcli.view.panel import PlanningPanel
-    from armcli.view.png import joint_limits, load_urdf
-    from armcli.view.scene import load_robot, pose_q
+    from armcli.view.launch import ViewRequest, open_viewer  # on use: `--help` stays light
 
-    src = load_robot(robot)
-    write_notes(src.notes)
-    pose_q(src, pose, None)  # validate before starting the server
-    if not 0 <= port <= 65535:
-        raise InputError(f"{port} is not a port number", field="--port")
-    run, sensors = None, None
-    if replay is not None:
-        names = list(joint_limits(load_urdf(src.xml, src.source, src.mesh_dir, src.search)))
-        load = rosbag.load_replay if rosbag.is_mcap(replay) else load_replay
-        run = load(replay, names)
-        if rosbag.is_mcap(replay):
-            from armcli.sim.sensors.replay import load_sensor_replay
-
-            sensors = load_sensor_replay(replay)
-    chosen = list(joints) if joints else None
-    session = _session(src, (scene, srdf, chosen, group), save_dir, robot)  # before serving
-    base = _base_session(src, scene) if session is not None else None
-    kind = Viewer
-    if base is not None:
-        from armcli.view.basepanel import MobileViewer
-
-        kind = MobileViewer
-    viewer = kind(
-        src.xml,
-        name=src.name,
-        source=src.source,
-        mesh_dir=src.mesh_dir,
-        search=src.search,
-        poses=src.poses,
-        tool=src.tool,
-        replay=run,
-        sensors=sensors,
-        host=host,
-        port=port,
-    )
-    write_notes(viewer.sensor_notes)
-    panel = base_panel = None
+    chosen = tuple(joints) if joints else None
+    request = ViewRequest(replay, pose, host, port, scene, srdf, chosen, group, save_dir)
+    app = open_viewer(robot, request, write_notes)
     try:  # entered before the URL is printed, so an early Ctrl-C still stops cleanly
-        if session is not None:
-            panel = PlanningPanel(
-                viewer,
-                session,
-                src.xml,
-                source=src.source,
-                mesh_dir=src.mesh_dir,
-                search=src.search,
-            )
-        if base is not None:
-            from armcli.view.basepanel import BasePanel, MobileViewer
-
-            assert isinstance(viewer, MobileViewer)
-            base_panel = BasePanel(
-                viewer, base, src.xml, source=src.source, mesh_dir=src.mesh_dir, search=src.search
-            )
-        if pose:
-            viewer.apply_pose(pose)
-        sys.stdout.write(
-            one_line(f"armcli view: {src.name} at {viewer.url}  (Ctrl-C to stop)") + "\n"
-        )
+        line = f"armcli view: {app.name} at {app.viewer.url}  (Ctrl-C to stop)"
+        sys.stdout.write(one_line(line) + "\n")  # whole, never fitted: the URL carries a token
         sys.stdout.flush()
-        viewer.serve_forever()
+        app.serve()
     except KeyboardInterrupt:
         sys.stdout.write("viewer stopped\n")
     finally:
-        if panel is not None:
-            panel.close()
-        if base_panel is not None:
-            base_panel.close()
-        viewer.close()
-
-
-def _session(
-    src: RobotSource,
-    planning: tuple[Path | None, Path | None, list[str] | None, str | None],
-    save_dir: Path,
-    robot: RobotInput,
-) -> PlanningSession | None:
-    """The planning panel's session; a robot that cannot be planned for gets none (a note)."""
-    from armcli.view.planning import load_session
-
-    scene, srdf, joints, group = planning
-    if not save_dir.is_dir():
-        raise InputError(f"{save_dir} is not a directory", field="--save-dir")
-    assert src.file is not None
-    try:
-        session = load_session(
-            src.file,
-            srdf=srdf,
-            scene=scene,
-            joints=joints,
-            group=group,
-            search=src.search,
-            save_dir=save_dir,
-        )
-    except InputError as exc:
-        if any(given is not None for given in planning):  # asked for planning: refuse
-            raise
-        say_line(f"note: no planning panel: {exc}", sys.stderr)
-        return None
-    return session
-
-
-def _base_session(src: RobotSource, scene: Path | None) -> BaseSession | None:
-    """The mobile base's session when the robot has a diff drive (else none, a note)."""
-    from armcli.view.baseplan import load_base_session
-
-    assert src.file is not None
-    try:
-        return load_base_session(src.file, scene, src.search)
-    except ArmcliError as exc:
-        sys.stderr.write(f"note: no mobile base panel: {exc}\n")
-        return None
+        app.close()
 
 
 def register(app: typer.Typer) -> None:
