@@ -4,7 +4,7 @@ The rover (specs/rover.yaml: the course robot) drives its example drive among th
 of specs/rover/world.yaml for DURATION s at dt = 1 ms, arm holding still, three ways in
 turn (A B C A B C ...): without sensors, with the 360-ray 2-D lidar at 10 Hz alone, with
 the 160 x 120 depth camera at 10 Hz alone. CPU seconds (time.process_time) of the run
-(`sim.drive.run`: stepping, the sensors, their readings; the model is prepared once per
+(`drive.job.run`: stepping, the sensors, their readings; the model is prepared once per
 variant, untimed), the ratio to the bare drive taken round by round. Then the whole
 command (`armcli simulate ... -o run.mcap`, a fresh process: CPU from wait4) the same way,
 so the MCAP's sensor messages are counted too.
@@ -36,7 +36,7 @@ import yaml
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
-from armcli.sim import drive  # noqa: E402
+from armcli.drive import job as drive  # noqa: E402
 from armcli.sim.options import SimOptions  # noqa: E402
 from armcli.sim.sensors import raycast, scanners  # noqa: E402
 from armcli.spec.load import load_spec  # noqa: E402
@@ -166,7 +166,7 @@ def main() -> None:
         jobs = {k: drive.prepare(load_spec(p), SimOptions(duration=duration), DRIVE, world=WORLD)
                 for k, p in specs.items()}  # fmt: skip
         report(
-            "the run (sim.drive.run)",
+            "the run (drive.job.run)",
             rounds({k: (lambda j=j: loop_cpu(j)) for k, j in jobs.items()}, n),
         )
         out = tmp / "run.mcap"

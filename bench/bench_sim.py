@@ -24,7 +24,6 @@ sys.path.insert(0, str(ROOT / "src"))
 from armcli.robot.model import Robot  # noqa: E402
 from armcli.sim import native  # noqa: E402
 from armcli.sim import rollout as ro  # noqa: E402
-from armcli.sim.reference import build_reference  # noqa: E402
 from armcli.sim.simulate import (  # noqa: E402
     Run,
     SimConfig,
@@ -33,7 +32,8 @@ from armcli.sim.simulate import (  # noqa: E402
     simulate_batch,
     simulated,
 )
-from armcli.sim.trajectory import loads_trajectory  # noqa: E402
+from armcli.trajectory.message import loads_trajectory  # noqa: E402
+from armcli.trajectory.reference import build_reference  # noqa: E402
 from armcli.urdf.read import read_urdf  # noqa: E402
 
 DT = 1e-3  # [s] the spec's control.dt

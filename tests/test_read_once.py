@@ -63,7 +63,7 @@ NOT_CONSUMERS = {
 
 
 def test_extensions_are_read_once() -> None:
-    """check/interface.py, check/joints.py, export/mjcf_report.py and sim/drivemodel.py each
+    """check/interface.py, check/joints.py, export/mjcf_report.py and drive/model.py each
     parsed `<ros2_control>`, `<transmission>`, `<gazebo>` or `<mimic>` again with lxml."""
     found = [
         f"{rel}:{i}: {line.strip()}"

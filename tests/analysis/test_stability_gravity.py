@@ -23,10 +23,10 @@ from armcli.analysis import pdloop
 from armcli.analysis import stability as stab
 from armcli.check.options import CheckOptions
 from armcli.check.run import check_urdf
-from armcli.sim.reference import build_reference
 from armcli.sim.simulate import SimConfig, simulate, simulated
-from armcli.sim.trajectory import loads_trajectory
 from armcli.spec.load import load_spec
+from armcli.trajectory.message import loads_trajectory
+from armcli.trajectory.reference import build_reference
 from armcli.urdf.read import read_urdf
 from tests.helpers import FIXTURES, load_robot
 

@@ -136,8 +136,8 @@ def _arm_state(mujoco, m, d) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def test_zmp_agrees_with_mujoco_along_a_fast_swing(
     course: tuple[RobotSpec, Urdf, Stance], tmp_path: Path
 ) -> None:
-    from armcli.sim.reference import build_reference
-    from armcli.sim.trajectory import load_trajectory
+    from armcli.trajectory.message import load_trajectory
+    from armcli.trajectory.reference import build_reference
 
     spec, urdf, stance = course
     mujoco, m = _mujoco_model(spec, urdf, tmp_path, (0.0, 0.0, -G))

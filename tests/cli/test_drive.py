@@ -151,7 +151,7 @@ def test_a_robot_without_a_diff_drive_is_exit_2(
 def test_a_robot_check_says_tips_is_refused_unless_ignored_then_tips(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    heavy = tmp_path / "heavy_hand.yaml"  # a 10 kg hand: tests/sim/test_drive.py
+    heavy = tmp_path / "heavy_hand.yaml"  # a 10 kg hand: tests/drive/test_job.py
     text = DEFAULT_SPEC.read_text()
     heavy.write_text(text.replace("      material: orange\n      mass: 0.3\n",
                                   "      material: orange\n      mass: 10.0\n"))  # fmt: skip

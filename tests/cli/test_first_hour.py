@@ -70,8 +70,8 @@ def test_a_base_without_an_arm_gets_no_arm_advice(capsys: pytest.CaptureFixture[
 
 def test_the_demo_trajectory_ends_off_the_joint_stops() -> None:
     """`make demo` simulates pick.yaml: ending on the stops gave stop hits on every run."""
-    from armcli.sim.trajectory import load_trajectory
     from armcli.spec.load import load_spec
+    from armcli.trajectory.message import load_trajectory
 
     spec = load_spec(DEFAULT_SPEC)
     limits = {

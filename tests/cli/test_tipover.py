@@ -7,7 +7,7 @@ the polygon toward the rear for 0.12 s (the largest acceleration that holds is 3
 tests/analysis/test_zmp.py checks the point against closed forms and MuJoCo): too briefly to
 rotate the robot over its wheels, so a lift-off warning. A 10 kg hand swung straight
 forward puts the centre of mass itself past the caster: that robot tips (as MuJoCo's
-contact simulation agrees, tests/sim/test_drive.py).
+contact simulation agrees, tests/drive/test_job.py).
 """
 
 from __future__ import annotations

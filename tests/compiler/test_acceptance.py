@@ -149,8 +149,8 @@ def test_simulate_refuses_commanding_a_follower_or_locking_its_leader(built: Pat
 def test_coupled_reference_adds_multiplier_and_offset() -> None:
     """q_f(t) = m q_l(t) + o, v_f = m v_l on every polynomial piece, chains leaders first."""
     from armcli.robot.mimic import Mimic
-    from armcli.sim.reference import build_reference, coupled
-    from armcli.sim.trajectory import loads_trajectory
+    from armcli.trajectory.message import loads_trajectory
+    from armcli.trajectory.reference import build_reference, coupled
 
     limits = {n: (-5.0, 5.0) for n in ("a", "b", "c")}
     msg = (

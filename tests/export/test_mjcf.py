@@ -18,10 +18,10 @@ from lxml import etree
 
 from armcli.export.mjcf_files import export_mjcf
 from armcli.robot.frames import rpy_matrix, rpy_quaternion
-from armcli.sim.reference import build_reference
 from armcli.sim.simulate import SimConfig, simulate, simulated
-from armcli.sim.trajectory import loads_trajectory
 from armcli.spec.load import load_spec
+from armcli.trajectory.message import loads_trajectory
+from armcli.trajectory.reference import build_reference
 from armcli.urdf.source import read_robot
 from tests.helpers import COURSE_GAINS, DEFAULT_SPEC, ROOT, course_gains_spec, load_robot
 

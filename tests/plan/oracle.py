@@ -3,7 +3,7 @@
 Nothing of armcli's planner, timing or certification is used. The written document is read
 with PyYAML; each segment's quintic is rebuilt from its two points' positions, velocities
 and accelerations by solving the 6 x 6 boundary conditions (numpy.linalg.solve, not the
-closed forms sim.reference uses) and sampled every millisecond with its analytic
+closed forms trajectory.reference uses) and sampled every millisecond with its analytic
 derivatives. Positions, velocities and accelerations are compared with the joint limits,
 torques (Pinocchio's RNEA on a model built directly from the URDF) with the effort limits,
 and every sample is checked for collisions with Pinocchio and coal on geometry loaded

@@ -13,7 +13,7 @@ from armcli.plan.certify import certify
 from armcli.plan.inputs import Loaded
 from armcli.plan.output import read_back, trajectory_yaml
 from armcli.plan.timing import Timed
-from armcli.sim.trajectory import load_trajectory
+from armcli.trajectory.message import load_trajectory
 
 DURATION_S = 60.0  # issue 36: "a 60 s plan certifies and writes"
 RATE_HZ = 100.0  # plan.timing.OUTPUT_RATE_HZ

@@ -15,7 +15,7 @@ import pytest
 
 from armcli.sim import native
 from armcli.sim import rollout as ro
-from armcli.sim.reference import Reference
+from armcli.trajectory.reference import Reference
 
 
 def has_compiler() -> bool:

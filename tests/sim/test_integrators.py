@@ -18,9 +18,9 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from armcli.robot.model import Robot
-from armcli.sim.reference import Reference, build_reference
 from armcli.sim.simulate import SimConfig, plant_of, simulate, simulated
-from armcli.sim.trajectory import loads_trajectory
+from armcli.trajectory.message import loads_trajectory
+from armcli.trajectory.reference import Reference, build_reference
 from tests.helpers import load_robot
 from tests.sim.engines import run_held
 from tests.sim.test_simulate import _arm, pendulum

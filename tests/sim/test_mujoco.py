@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 
 from armcli.robot.model import Robot
-from armcli.sim.reference import build_reference
 from armcli.sim.simulate import SimConfig, simulate, simulated
-from armcli.sim.trajectory import loads_trajectory
+from armcli.trajectory.message import loads_trajectory
+from armcli.trajectory.reference import build_reference
 from tests.helpers import load_robot
 
 mujoco = pytest.importorskip("mujoco")

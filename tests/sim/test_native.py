@@ -16,7 +16,6 @@ from armcli.robot.model import Robot
 from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim.options import Integrator
-from armcli.sim.reference import build_reference
 from armcli.sim.simulate import (
     SETTLE_TOL,
     Run,
@@ -26,7 +25,8 @@ from armcli.sim.simulate import (
     simulate_batch,
     simulated,
 )
-from armcli.sim.trajectory import loads_trajectory
+from armcli.trajectory.message import loads_trajectory
+from armcli.trajectory.reference import build_reference
 from tests.helpers import load_robot
 from tests.sim.engines import require_native, run_held
 from tests.sim.test_rollout import TILTED_URDF

@@ -11,10 +11,10 @@ import pytest
 
 from armcli.robot.model import Robot
 from armcli.sim import rollout as ro
-from armcli.sim.reference import Reference
 from armcli.sim.report import SETTLE_TOL, joint_metrics
 from armcli.sim.simulate import SimConfig, SimResult, plant_of, simulate
 from armcli.sim.states import sample_states, sample_steps, states_bytes
+from armcli.trajectory.reference import Reference
 from tests.sim.engines import hold, require_native
 
 DT = 1e-3

@@ -13,7 +13,6 @@ from armcli.errors import InputError, SimulationError, UnstableLoopError
 from armcli.robot.model import Robot
 from armcli.sim import rollout as ro
 from armcli.sim.options import Integrator
-from armcli.sim.reference import build_reference
 from armcli.sim.simulate import (
     SimConfig,
     check_limits,
@@ -22,7 +21,8 @@ from armcli.sim.simulate import (
     simulate,
     simulated,
 )
-from armcli.sim.trajectory import loads_trajectory
+from armcli.trajectory.message import loads_trajectory
+from armcli.trajectory.reference import build_reference
 from tests.helpers import load_robot
 from tests.sim.engines import run_held
 

@@ -15,9 +15,9 @@ from typing import Any
 import numpy as np
 import pytest
 
+from armcli.drive import job as drive
 from armcli.errors import InputError
 from armcli.io.scene import load_scene
-from armcli.sim import drive
 from armcli.sim.options import SimOptions
 from armcli.sim.world import FLAT_BACK, add_scene, overlaps
 from armcli.spec.load import load_spec

@@ -15,8 +15,8 @@ import pytest
 
 from armcli.analysis import pdloop
 from armcli.analysis import stability as stab
-from armcli.sim.reference import Reference
 from armcli.spec.load import load_spec
+from armcli.trajectory.reference import Reference
 from armcli.tune import evaluate, problem
 from armcli.tune import job as tjob
 from armcli.tune.objective import Weights

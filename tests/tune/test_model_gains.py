@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from armcli.robot.model import Robot
-from armcli.sim.reference import Reference
 from armcli.sim.simulate import SimConfig, SimResult, simulate, simulated
+from armcli.trajectory.reference import Reference
 from armcli.tune.model_gains import STABILITY_MARGIN, start_gains
 from armcli.tune.objective import overshoot
 from tests.helpers import FIXTURES, load_robot

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from armcli.sim.driving import drive_robot
+from armcli.drive.api import drive_robot
 from armcli.sim.options import SimOptions
 from armcli.sim.rosbag import load_replay
 from armcli.sim.sensors.messages import scan_points

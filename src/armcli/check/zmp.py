@@ -6,7 +6,7 @@ base also accelerating and braking at the diff-drive plugin's limit, is measured
 the support polygon (`check/tipover.py` builds the stance). One finding for the run's
 worst moment, naming the time, the case and the base acceleration that still holds. An
 error only when the point stays outside long enough to rotate the robot over the edge
-(sim.excursion, docs/check.md); a shorter excursion lifts a wheel: a warning.
+(analysis.excursion, docs/check.md); a shorter excursion lifts a wheel: a warning.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""`armcli simulate SPEC --cmd-vel drive.yaml`: the whole robot on its wheels (sim.drive).
+"""`armcli simulate SPEC --cmd-vel drive.yaml`: the whole robot on its wheels (drive.job).
 
 Called by the simulate command; here only what the command prints and writes: the
 files together (never a new CSV beside an old plot), the summary, the warnings, and
@@ -31,9 +31,9 @@ def run_drive(
 ) -> None:
     """Drive, write and report; raises TipOverError when the robot tips over."""
     from armcli.check.gate import refuse_check_errors
+    from armcli.drive.api import drive_robot
     from armcli.sim import job as simjob
     from armcli.sim import report as simreport
-    from armcli.sim.driving import drive_robot
 
     try:
         driven = drive_robot(spec, opts, cmd_vel, progress=progress, world=world,

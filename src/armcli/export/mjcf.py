@@ -22,7 +22,7 @@ goes v dt beyond it for a step (armcli stops it on the stop).
 Friction cones are `elliptic`, MuJoCo's recommendation for realistic friction: its
 default pyramidal cone degenerates on a frictionless contact (mu 0: the pyramid's edges
 coincide) and its solver then lets a robot held by its wheels on a mu-0 caster creep
-(9 cm in 3 s, sim.wheelmotor).
+(9 cm in 3 s, drive.wheelmotor).
 """
 
 from __future__ import annotations

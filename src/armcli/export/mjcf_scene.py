@@ -7,7 +7,7 @@ The floor has friction 0 (FLOOR_FRICTION): MuJoCo gives a contact the larger fri
 its two geoms, Gazebo's ODE the smaller (and Gazebo's ground plane has mu 100), so only a
 frictionless floor lets each robot geom's own coefficient count, as in Gazebo: a caster
 of mu 0.1 on MuJoCo's default floor of 1 would grip like a wheel. The drive
-(`simulate --cmd-vel`, sim.drivemodel) stands on the same floor, so the exported scene
+(`simulate --cmd-vel`, drive.model) stands on the same floor, so the exported scene
 drives as it does.
 """
 

@@ -181,7 +181,7 @@ def _build(
                 for _, v in node.value
             )
         ):
-            # `{0.5, 0.3}`: the course's brace form; its reader decides (armcli.sim.brace)
+            # `{0.5, 0.3}`: the course's brace form; its reader decides (armcli.trajectory.brace)
             keys = [
                 _build(k, loader, (*path, i), doc, flow_sets) for i, (k, _) in enumerate(node.value)
             ]

@@ -1,7 +1,7 @@
 """Certify a trajectory before it is written, independently of how it was planned.
 
-The points are read back as `simulate` reads them (sim.trajectory) and interpolated as
-it interpolates them (sim.reference: quintic segments); the reference is sampled at
+The points are read back as `simulate` reads them (trajectory.message) and interpolated as
+it interpolates them (trajectory.reference: quintic segments); the reference is sampled at
 CERTIFY_RATE_HZ and every sample is checked against the joint position, velocity,
 acceleration and effort limits (effort: inverse dynamics, RNEA, of the sampled motion) and
 for collisions with every enabled pair (robot, scene, ground). The first violation is
@@ -18,8 +18,8 @@ import numpy as np
 from armcli.plan.collision import CollisionChecker
 from armcli.plan.robot import PlanRobot
 from armcli.plan.timing import Timed, inverse_dynamics
-from armcli.sim.reference import build_reference
-from armcli.sim.trajectory import Trajectory
+from armcli.trajectory.message import Trajectory
+from armcli.trajectory.reference import build_reference
 
 CERTIFY_RATE_HZ = 1000.0  # [Hz] samples checked, whatever the output rate
 RELATIVE_TOL = 1e-9  # velocity, acceleration and effort may reach their limit, not pass it

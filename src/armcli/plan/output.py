@@ -13,7 +13,7 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 
 from armcli.plan.timing import Timed
-from armcli.sim.trajectory import Trajectory, loads_trajectory
+from armcli.trajectory.message import Trajectory, loads_trajectory
 
 
 def _floats(values: Iterable[float]) -> str:

@@ -20,7 +20,6 @@ from armcli.robot.mimic import Mimic
 from armcli.robot.model import Robot
 from armcli.sim.options import SimOptions
 from armcli.sim.plot import plot_steps
-from armcli.sim.reference import Reference, build_reference, coupled
 from armcli.sim.simulate import (
     MAX_STEPS,
     SimConfig,
@@ -31,8 +30,9 @@ from armcli.sim.simulate import (
     steps_of,
 )
 from armcli.sim.states import distinct, sample_steps
-from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
 from armcli.spec.types import time_step
+from armcli.trajectory.message import Trajectory, load_trajectory, loads_trajectory
+from armcli.trajectory.reference import Reference, build_reference, coupled
 from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_urdf
 from armcli.urdf.source import Trust, read_urdf_file, spec_urdfs

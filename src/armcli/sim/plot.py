@@ -36,7 +36,7 @@ def tracking_png(
     """PNG bytes of a rows = (position, velocity, torque), columns = joints figure.
 
     `extra_row` draws `rows` more rows, given their axes row after row (the zero-moment
-    point's, sim.tipping; a drive's path and wheel loads, sim.driveout).
+    point's, sim.tipping; a drive's path and wheel loads, drive.output).
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure

@@ -17,7 +17,7 @@ import numpy as np
 
 from armcli.sim import native
 from armcli.sim.options import Integrator
-from armcli.sim.reference import Reference
+from armcli.trajectory.reference import Reference
 
 Failure = Literal["", "nonfinite", "velocity", "energy"]  # why a run stopped early
 CHUNK_STEPS = 10_000  # steps per call into the engine, between progress reports

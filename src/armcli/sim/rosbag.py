@@ -32,10 +32,10 @@ import numpy as np
 
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
+from armcli.io.mcap_guard import check_chunks
 from armcli.io.userfile import open_regular
 from armcli.robot.frames import axis_quaternion, quaternion_product, rotate, rpy_quaternion
 from armcli.robot.joints import rest
-from armcli.sim.mcap_guard import check_chunks
 from armcli.sim.simulate import SimResult
 from armcli.sim.states import TIME, Replay, column, sample_states
 from armcli.spec.joint_types import position_bounds

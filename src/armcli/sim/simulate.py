@@ -39,8 +39,8 @@ from armcli.robot.model import LIMITS, Robot
 from armcli.sim import native
 from armcli.sim import rollout as ro
 from armcli.sim.options import INTEGRATORS, Integrator
-from armcli.sim.reference import Reference
 from armcli.spec.types import time_step
+from armcli.trajectory.reference import Reference
 
 VEL_ABORT_FACTOR = 10.0  # divergence when |v| exceeds this times the URDF velocity limit
 DEFAULT_VABORT = 1000.0  # [rad/s or m/s] when the URDF gives no velocity limit

@@ -16,11 +16,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from armcli.analysis import zmp as zmps
+from armcli.analysis.excursion import Excursion, excursions
 from armcli.analysis.ground import mesh_loader
 from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
 from armcli.errors import InputError, TipOverError
 from armcli.robot.tool import tool_point
-from armcli.sim.excursion import Excursion, excursions
 from armcli.sim.job import SimJob
 from armcli.sim.simulate import SimResult
 from armcli.sim.states import sample_steps

@@ -18,9 +18,9 @@ from armcli.defaults import PdLoop
 from armcli.errors import InputError
 from armcli.io.yaml import load_yaml
 from armcli.sim.job import ARM_URDF, SETTLE_EXTRA_S, start_state
-from armcli.sim.reference import Reference, build_reference
-from armcli.sim.trajectory import Trajectory, load_trajectory
 from armcli.spec.model import RobotSpec
+from armcli.trajectory.message import Trajectory, load_trajectory
+from armcli.trajectory.reference import Reference, build_reference
 from armcli.tune import gains as gain_vector
 from armcli.tune.model_gains import (
     LOOPS,

@@ -20,8 +20,8 @@ from armcli.analysis.pdloop import Linearised
 from armcli.defaults import PdLoop
 from armcli.robot.model import Robot
 from armcli.sim.options import Integrator
-from armcli.sim.reference import Reference
 from armcli.sim.simulate import simulated
+from armcli.trajectory.reference import Reference
 from armcli.tune.model_gains import linearised, sample_configurations
 from armcli.urdf.read import parse_urdf
 

@@ -16,9 +16,9 @@ from lxml import etree
 
 from armcli.defaults import MAX_ROBOT_DOF, MAX_ROBOT_LINKS
 from armcli.errors import InputError, XacroRefusedError
-from armcli.io.doctype import doctype_offset
 from armcli.io.oneline import one_line
 from armcli.io.userfile import read_regular
+from armcli.io.xml import parse_xml
 from armcli.spec.joint_types import total_dof
 from armcli.spec.xacro_names import xacro_use
 from armcli.urdf import extensions as ext
@@ -243,55 +243,11 @@ def _materials(num: _Numbers, root: etree._Element) -> tuple[Material, ...]:
     return tuple(out)
 
 
-def _check_depth(root: etree._Element, source: str) -> None:
-    stack = [(root, 1)]
-    while stack:
-        el, depth = stack.pop()
-        if depth > MAX_URDF_DEPTH:
-            raise InputError(
-                f"XML nested deeper than {MAX_URDF_DEPTH} levels", file=source, line=_ln(el)
-            )
-        stack.extend((c, depth + 1) for c in el)
-
-
-def _line_at(data: bytes, offset: int) -> int:
-    return data.count(b"\n", 0, offset) + 1
-
-
 def parse_root(data: bytes, source: str) -> etree._Element:
     """Parse XML bytes safely and return the <robot> element (InputError otherwise)."""
     if len(data) > MAX_URDF_BYTES:
         raise InputError(f"file is larger than {MAX_URDF_BYTES} bytes", file=source)
-    try:  # first: in UTF-16 the DOCTYPE test below would not see "<!DOCTYPE"
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise InputError(
-            "not UTF-8 text (URDF files are UTF-8)", file=source, line=_line_at(data, exc.start)
-        ) from None
-    at = doctype_offset(text)  # the prolog's: a comment that names one declares nothing
-    if at is not None:
-        raise InputError(
-            "DOCTYPE/entity declarations are not allowed in URDF input",
-            file=source,
-            line=text.count("\n", 0, at) + 1,
-        )
-    parser = etree.XMLParser(
-        resolve_entities=False,
-        no_network=True,
-        load_dtd=False,
-        huge_tree=False,
-        remove_comments=True,
-        remove_pis=True,
-    )
-    try:
-        root = etree.fromstring(data, parser)
-    except etree.XMLSyntaxError as exc:
-        if "Excessive depth" in str(exc.msg):  # libxml2's own cap (256) hit before ours
-            raise InputError(
-                f"XML nested deeper than {MAX_URDF_DEPTH} levels", file=source, line=exc.lineno
-            ) from None
-        raise InputError(f"not well-formed XML: {exc.msg}", file=source, line=exc.lineno) from None
-    _check_depth(root, source)
+    root = parse_xml(data, source, max_depth=MAX_URDF_DEPTH, kind="URDF")
     if root.tag != "robot":
         raise InputError(
             f"not a URDF: root element is <{root.tag}>, expected <robot>",

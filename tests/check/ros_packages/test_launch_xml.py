@@ -95,3 +95,19 @@ def test_doubling_lets_stay_bounded(tmp_path: Path) -> None:
     text = f'<launch>\n  <let name="a0" value="x"/>\n{lets}{node_xml}</launch>\n'
     (node,) = read(tmp_path, "big.launch.xml", text).nodes
     assert node.executable is None  # 2**40 characters: not a literal
+
+
+def test_a_comment_naming_a_doctype_is_read_a_prolog_doctype_is_refused(tmp_path: Path) -> None:
+    # Before io/xml.py the checker searched the bytes for "<!DOCTYPE" and refused this file,
+    # whose comment only names one; the URDF reader reads the prolog (issue 42): both agree now.
+    noted = "<launch>\n  <!-- no <!DOCTYPE here -->\n  <node pkg='a' exec='b'/>\n</launch>\n"
+    ok = read(tmp_path, "noted.launch.xml", noted)
+    assert not ok.problems
+    assert [n.package for n in ok.nodes] == ["a"]
+    late = read(tmp_path, "late.launch.xml", "<?xml version='1.0'?>\n\n<!DOCTYPE l>\n<launch/>\n")
+    (p,) = late.problems
+    assert p.line == 3 and "DOCTYPE" in p.message
+    latin = tmp_path / "latin.launch.xml"
+    latin.write_bytes("<launch>\n<!-- caf\xe9 -->\n</launch>\n".encode("latin-1"))
+    (q,) = read_xml_launch(Jail(tmp_path), latin, Shares({}), {}).problems
+    assert q.line == 2 and "UTF-8" in q.message

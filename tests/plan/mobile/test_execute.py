@@ -4,7 +4,7 @@ Obstacles on the floor and a low table carrying the target (tests/fixtures/plan/
 the cluttered room (from off the origin, turned), a corridor, a partition to drive around.
 Judged on MuJoCo's ground truth (the root body's pose, the arm's joint positions through
 the model's kinematics): the tool within EXECUTE_TOL of the target, no limit broken, no tip;
-the encoder odometry the follower integrates agrees with the plugin's (sim.diffdrive, from
+the encoder odometry the follower integrates agrees with the plugin's (drive.diffdrive, from
 the recorded wheel speeds) to ODOMETRY_TOL (they differ by which step's speed a step uses).
 """
 

@@ -17,13 +17,13 @@ import numpy as np
 import pytest
 import yaml
 
+from armcli.drive.cmdvel import load_cmd_vel
 from armcli.errors import PlanningError
 from armcli.plan.api import PlanOptions
 from armcli.plan.mobile.basefiles import cmd_vel_yaml
 from armcli.plan.mobile.virtual import MobileRobot, load_mobile
 from armcli.plan.mobile.whole import BaseGoal, Drive, WholePlan, files, plan_drive, plan_whole
-from armcli.sim.cmdvel import load_cmd_vel
-from armcli.sim.trajectory import load_trajectory
+from armcli.trajectory.message import load_trajectory
 from armcli.urdf.source import read_robot
 from tests.helpers import DEFAULT_SPEC
 from tests.plan.mobile.reference import INFEASIBLE, Reference, read_objects

@@ -7,7 +7,7 @@ from typing import Any
 
 import yaml
 
-from armcli.sim import drive
+from armcli.drive import job as drive
 from armcli.sim.options import SimOptions
 from armcli.spec.load import load_spec
 from tests.helpers import DEFAULT_SPEC

@@ -17,7 +17,10 @@ from typing import TYPE_CHECKING
 from armcli.errors import InputError
 from armcli.io.packages import inside
 from armcli.io.userfile import read_regular
+from armcli.io.xml import line_of, parse_xml
 from armcli.io.yaml import YamlDoc, loads_yaml
+
+__all__ = ["Jail", "Problem", "line_of"]
 
 if TYPE_CHECKING:
     from lxml import etree
@@ -80,40 +83,4 @@ class Jail:
 
     def xml(self, path: Path, what: str = "XML file") -> etree._Element:
         """An XML file inside DIR, parsed without DTDs, entities or network."""
-        return parse_xml(self.read(path, what), str(path))
-
-
-def parse_xml(data: bytes, source: str) -> etree._Element:
-    """XML bytes -> root element; InputError naming the line when malformed or refused."""
-    from lxml import etree
-
-    if b"<!DOCTYPE" in data or b"<!ENTITY" in data:
-        line = data[: data.find(b"<!")].count(b"\n") + 1
-        raise InputError("DOCTYPE/entity declarations are not allowed", file=source, line=line)
-    parser = etree.XMLParser(
-        resolve_entities=False,
-        no_network=True,
-        load_dtd=False,
-        huge_tree=False,
-        remove_comments=True,
-        remove_pis=True,
-    )
-    try:
-        root = etree.fromstring(data, parser)
-    except etree.XMLSyntaxError as exc:
-        raise InputError(f"not well-formed XML: {exc.msg}", file=source, line=exc.lineno) from None
-    if root is None:
-        raise InputError("empty XML document", file=source)
-    for el in root.iter():
-        depth = sum(1 for _ in el.iterancestors())
-        if depth > MAX_XML_DEPTH:
-            raise InputError(
-                f"XML nested deeper than {MAX_XML_DEPTH} levels", file=source, line=line_of(el)
-            )
-    return root
-
-
-def line_of(el: etree._Element) -> int | None:
-    """An element's 1-based source line."""
-    line = el.sourceline
-    return line if isinstance(line, int) else None
+        return parse_xml(self.read(path, what), str(path), max_depth=MAX_XML_DEPTH)

@@ -1,6 +1,6 @@
 """`plan --base --execute`: the whole plan on the MuJoCo drive, followed on the encoders, judged.
 
-The drive (`sim.drive`: the robot as `export mjcf` writes it, gazebo_ros_diff_drive's
+The drive (`drive.job`: the robot as `export mjcf` writes it, gazebo_ros_diff_drive's
 controller and wheel motor, the arm's PD loop with gravity compensation) runs among the
 scene's objects (`sim.world`, the scene moved into the frame the robot starts in: MuJoCo's
 origin), the base steered by the path follower (`plan.mobile.pursuit`) on the plugin's
@@ -18,15 +18,16 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from armcli.analysis.liftoff import TipVerdict
+from armcli.drive import job as drive
+from armcli.drive import output as driveout
+from armcli.drive.job import DriveRun
 from armcli.errors import InputError
 from armcli.io.scene import Scene, SceneObject
 from armcli.plan.mobile.pursuit import Pursuit, legs_in_odom
 from armcli.plan.mobile.wheels import to_base
 from armcli.plan.mobile.whole import WholePlan
 from armcli.robot.frames import quaternion_matrix
-from armcli.sim import drive, driveout
-from armcli.sim.drive import DriveRun
-from armcli.sim.liftoff import TipVerdict
 from armcli.sim.options import SimOptions
 from armcli.sim.simulate import SimResult, steps_of
 from armcli.urdf.source import RobotFile
@@ -182,7 +183,8 @@ def _judge(plan: WholePlan, run: DriveRun, arm: SimResult, verdict: TipVerdict,
 
 def run_files(plan: WholePlan, done: Executed, out_dir: Path) -> dict[Path, bytes]:
     """run.csv (the drive's states columns) and run.mcap (its topics and /plan)."""
-    from armcli.sim import drivebag, rosbag, states
+    from armcli.drive import bag as drivebag
+    from armcli.sim import rosbag, states
 
     rate = done.run.job.arm.rate
     cols = driveout.columns(done.run, done.arm, rate)

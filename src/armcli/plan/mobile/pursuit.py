@@ -7,7 +7,7 @@ pure pursuit (curvature 2 y / L² toward a point LOOKAHEAD ahead on the leg's li
 robot's frame, mirrored when reversing) at a speed regulated down to arrive at the leg's
 end (v ≤ sqrt(2 a d) with margin APPROACH). Each motion ends when the odometry says it
 is within POSITION_TOL / YAW_TOL of its end. The pose fed back is the plugin's own
-encoder odometry (sim.diffdrive), integrated here step by step from the wheel joints'
+encoder odometry (drive.diffdrive), integrated here step by step from the wheel joints'
 speeds: every tracking error is corrected, but not what the encoders cannot see. MuJoCo's
 drive turns 1.3-3 % less than its encoders say when it turns in place (the caster scrubs,
 the soft contacts creep: 20-50 mrad per quarter turn, tests/plan/mobile/test_pursuit.py),
@@ -16,7 +16,7 @@ that drift (Nav2 follows the path in `map`, AMCL correcting `map -> odom` a few 
 second); `localize` [Hz] stands for one: at that rate the odometry is corrected to the
 ground truth (the MCAP's `world -> odom`), in between it runs on the encoders alone.
 
-As a `sim.drive.Pilot` it also holds the arm's reference at the planned arrival until the
+As a `drive.job.Pilot` it also holds the arm's reference at the planned arrival until the
 base has actually arrived: the arm moves only once the base stands.
 """
 

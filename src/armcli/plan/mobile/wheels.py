@@ -1,6 +1,6 @@
 """The robot's differential drive as a base plan needs it: the plugin's numbers, the limits.
 
-A spec states it (`mobile_base.diff_drive`, `sim.diffdrive.DriveParams.of`); a URDF
+A spec states it (`mobile_base.diff_drive`, `drive.diffdrive.DriveParams.of`); a URDF
 carries it as a Gazebo plugin: gazebo_ros_diff_drive (`wheel_separation`,
 `wheel_diameter`, `max_wheel_torque`, `max_wheel_acceleration`, `update_rate`,
 `left_joint`, `right_joint`; ROS 1's camelCase names too: `wheelSeparation`, `leftJoint`,
@@ -17,11 +17,11 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from armcli.drive.diffdrive import DriveParams
 from armcli.errors import InputError
 from armcli.plan.mobile.basetime import DEFAULT_SPEED, TORQUE_SHARE, DriveLimits
 from armcli.plan.mobile.virtual import MobileRobot
 from armcli.robot.frames import joint_frame
-from armcli.sim.diffdrive import DriveParams
 from armcli.urdf.doc import Urdf
 
 NEEDS_DRIVE = (

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from armcli.drive.diffdrive import DriveParams
 from armcli.errors import PlanningError
 from armcli.plan.api import (
     PlanningContext,
@@ -38,7 +39,6 @@ from armcli.plan.mobile.place import TOLERANCE, Placement, place
 from armcli.plan.mobile.virtual import MobileRobot
 from armcli.plan.mobile.wheels import axle_offset, drive_limits, drive_params, to_axle, to_base
 from armcli.plan.timing import Timed
-from armcli.sim.diffdrive import DriveParams
 
 HOME = "home"
 RAMP_IN = 0.01  # [s] the arm's trajectory enters its first acceleration over this

@@ -5,7 +5,7 @@ frame: range times the ray's direction, the no-returns left out), every PointClo
 finite float32 x, y, z, each message at its header's time and frame; `/world`'s
 visualization_msgs/MarkerArray (boxes, spheres, cylinders, triangle lists in `world`)
 the objects to draw. The file is user input: its chunks are bounded before the reader
-sees them (sim.mcap_guard) and the points it may hold are bounded in all.
+sees them (io.mcap_guard) and the points it may hold are bounded in all.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ from typing import Any
 import numpy as np
 
 from armcli.errors import InputError
+from armcli.io.mcap_guard import check_chunks
 from armcli.io.userfile import open_regular
-from armcli.sim.mcap_guard import check_chunks
 from armcli.sim.rosbag import MAX_REPLAY_BYTES
 
 LASER_SCAN, POINT_CLOUD = "sensor_msgs/msg/LaserScan", "sensor_msgs/msg/PointCloud2"

@@ -8,8 +8,8 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from armcli.sim.drive import DriveRun
-from armcli.sim.liftoff import TipVerdict
+from armcli.analysis.liftoff import TipVerdict
+from armcli.drive.job import DriveRun
 from armcli.sim.simulate import SimResult
 
 LOAD_WINDOW_S = 0.01  # [s] the wheel loads are drawn as means over this (a single step chatters)
@@ -77,7 +77,7 @@ def _drive_rows(run: DriveRun, verdict_: TipVerdict) -> Callable[[Sequence[Any]]
 
 
 def _scan_row(ax: Any, run: DriveRun) -> None:
-    from armcli.sim.drive import start_data
+    from armcli.drive.job import start_data
     from armcli.sim.sensors.plot import draw_scan
 
     job = run.job

@@ -20,7 +20,7 @@ to ~0.01 % under load.
 (A velocity actuator on the wheel itself, the earlier stand-in, needs a gain, and no gain
 fits: the solver sees its force as explicit while the integrator damps it implicitly, so
 above ~70 N·m·s on the course robot the soft contacts push the base up to 17 % past its
-wheels' travel, and below it the wheels lag their load; tests/sim/test_drive_plugin.py.)
+wheels' travel, and below it the wheels lag their load; tests/drive/test_drive_plugin.py.)
 
 The wheel's effort is the clutch's torque: no MuJoCo sensor reports a friction-loss force,
 so the run reads it from the rotor's constraint force (`clutch_torque`).

@@ -15,9 +15,9 @@ from typing import Any
 
 import numpy as np
 
+from armcli.drive.job import DriveRun, start_data
 from armcli.robot.frames import matrix_quaternion, pose_matrix, yaw_quaternion
 from armcli.sim import rosbag
-from armcli.sim.drive import DriveRun, start_data
 from armcli.sim.sensors.messages import channels as sensor_channels
 from armcli.sim.states import TIME, sample_steps
 from armcli.sim.world import marker_array

@@ -15,8 +15,8 @@ from pathlib import Path
 import pytest
 
 from armcli.errors import InputError
+from armcli.io.mcap_guard import MAX_CHUNK_BYTES
 from armcli.sim import rosbag
-from armcli.sim.mcap_guard import MAX_CHUNK_BYTES
 from tests.sim.test_rosbag_bounds import JOINT, _mcap
 
 BOMB_BYTES = 2 * MAX_CHUNK_BYTES  # what the bombs inflate to: past the bound, cheap to build
@@ -184,7 +184,7 @@ def test_too_many_messages_are_refused_before_any_is_parsed(
     The bound is lowered for the test (a million messages take a minute to write); the count
     comes from the chunks' records, before the mcap reader parses or decodes anything.
     """
-    from armcli.sim import mcap_guard
+    from armcli.io import mcap_guard
 
     path = _mcap(tmp_path / "many.mcap", [0.1 * k for k in range(101)])
     monkeypatch.setattr(mcap_guard, "MAX_MESSAGES", 100)

@@ -15,7 +15,7 @@ are reported (`Rock`), as are lift-offs.
 
 A contact link (a wheel, the caster) has lifted off while it carries no normal force
 and stands more than LIFT_CLEARANCE above where it started: MuJoCo's soft contacts
-let a sliding sphere hop by ~10 µm for a few steps (sim.drivemodel), which is no
+let a sliding sphere hop by ~10 µm for a few steps (drive.model), which is no
 lift-off anybody would see. Each lift-off is a warning with its start and duration.
 """
 

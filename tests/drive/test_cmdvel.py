@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from armcli.drive.cmdvel import load_cmd_vel, loads_cmd_vel
 from armcli.errors import SpecError
-from armcli.sim.cmdvel import load_cmd_vel, loads_cmd_vel
 from tests.helpers import ROOT
 
 GOOD = """commands:

@@ -1,4 +1,4 @@
-"""Plan's layout read by sim.jointtext gives the YAML reader's data, float for float."""
+"""Plan's layout read by trajectory.jointtext gives the YAML reader's data, float for float."""
 
 from __future__ import annotations
 
@@ -15,8 +15,8 @@ from armcli.errors import SpecError
 from armcli.io.yaml import loads_yaml
 from armcli.plan.output import trajectory_yaml
 from armcli.plan.timing import Timed
-from armcli.sim.jointtext import canonical_doc
-from armcli.sim.trajectory import Trajectory, loads_trajectory, parse_trajectory
+from armcli.trajectory.jointtext import canonical_doc
+from armcli.trajectory.message import Trajectory, loads_trajectory, parse_trajectory
 
 NAMES = ("joint_a", "arm/b-2", "c.3")
 finite = st.floats(allow_nan=False, allow_infinity=False)
@@ -92,7 +92,7 @@ def outcome(read: Callable[..., Trajectory], *args: Any, **kwargs: Any) -> tuple
 
 @pytest.mark.parametrize("clamp", [False, True])
 def test_the_array_checks_give_the_yaml_readers_trajectory(clamp: bool) -> None:
-    # sim.trajectory checks plan's layout on arrays; the reference is parse_trajectory on
+    # trajectory.message checks plan's layout on arrays; the reference is parse_trajectory on
     # the YAML reader's data: every check it makes, passing or not, must come out the same
     rng = np.random.default_rng(5)
     limits = {n: (-1.0, 1.0) for n in NAMES}

@@ -12,7 +12,7 @@ collision geoms, the arm's `position` actuators (Kp, Kd, effort limit) and Gazeb
   robot's coefficient counts). A collision without
   Gazebo `mu1` keeps MuJoCo's default 1, which is Gazebo's default `mu` too. MuJoCo's
   friction is isotropic: a link whose `mu2` differs from `mu1` is noted, `mu1` is used;
-- the plugin's motor on each drive wheel (sim.wheelmotor): a rotor the run spins at the
+- the plugin's motor on each drive wheel (drive.wheelmotor): a rotor the run spins at the
   commanded speed and a clutch, a friction-loss constraint of max_wheel_torque holding
   the wheel at the rotor's speed, as ODE's `vel`/`fmax` motor;
 - sensors, so one copy of `sensordata` per step records the run: the arm and wheel
@@ -34,18 +34,18 @@ from typing import Any
 import numpy as np
 
 from armcli.analysis.stance import Stance
+from armcli.drive.diffdrive import DriveParams
+from armcli.drive.wheelmotor import add_wheel_motors, rotor_dofs
 from armcli.errors import InputError
 from armcli.export.mjcf import FREE_JOINT, build_mjcf
 from armcli.export.mjcf_scene import FLOOR_FRICTION
 from armcli.io.scene import Scene
-from armcli.sim.diffdrive import DriveParams
 from armcli.sim.sensors.model import add_sensors
-from armcli.sim.wheelmotor import add_wheel_motors, rotor_dofs
 from armcli.sim.world import WorldGeom, add_scene
 from armcli.urdf.doc import Urdf
 
 # [s] MuJoCo's contact time constant (solref, critically damped): its default, as the
-# exported scene has it. Measured on the course robot (tests/sim/test_drive.py): softer
+# exported scene has it. Measured on the course robot (tests/drive/test_job.py): softer
 # contacts (50 ms) stop the wheels' chatter but let the robot coast 2.5 % past its wheels'
 # travel after a stop.
 CONTACT_TIME = 0.02
@@ -79,7 +79,7 @@ class DriveModel:
     arm_act: np.ndarray  # (n,) int: the arm's position actuators; -1: a mimic joint follows
     wheel_qpos: np.ndarray  # (2,) int, left then right
     wheel_dof: np.ndarray  # (2,) int
-    wheel_rotor: np.ndarray  # (2,) int: the motors' rotor dofs (sim.wheelmotor.spin)
+    wheel_rotor: np.ndarray  # (2,) int: the motors' rotor dofs (drive.wheelmotor.spin)
     contacts: tuple[str, ...]  # ground-contact links
     layout: Layout
     base_z: float  # [m] the root body's height with the lowest contact on the floor

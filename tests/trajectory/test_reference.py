@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from armcli.sim.reference import build_reference, segment_coeffs
-from armcli.sim.trajectory import Trajectory
+from armcli.trajectory.message import Trajectory
+from armcli.trajectory.reference import build_reference, segment_coeffs
 
 
 def one_by_one(traj: Trajectory) -> np.ndarray:

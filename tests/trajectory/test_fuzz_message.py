@@ -18,8 +18,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from armcli.errors import ArmcliError
-from armcli.sim.reference import build_reference
-from armcli.sim.trajectory import Trajectory, load_trajectory, loads_trajectory
+from armcli.trajectory.message import Trajectory, load_trajectory, loads_trajectory
+from armcli.trajectory.reference import build_reference
 from tests.helpers import ROOT, mutated
 
 J1, J2 = "arm_base_forearm_joint", "forearm_hand_joint"

@@ -1,16 +1,16 @@
 """Drive the whole robot on its wheels in MuJoCo while the arm follows its trajectory.
 
 What `armcli simulate SPEC --cmd-vel drive.yaml` runs: the robot as `export mjcf` writes
-it (sim.drivemodel) standing on a floor under gravity; its base driven by
-gazebo_ros_diff_drive's controller (sim.diffdrive) from the /cmd_vel commands
-(sim.cmdvel); its arm under the PD law, gains, gravity compensation and reference of
+it (drive.model) standing on a floor under gravity; its base driven by
+gazebo_ros_diff_drive's controller (drive.diffdrive) from the /cmd_vel commands
+(drive.cmdvel); its arm under the PD law, gains, gravity compensation and reference of
 `simulate` (sim.job prepares them as for the fixed-base engine) through the export's
 position actuators: ctrl = q_ref + (Kd / Kp) v_ref (+ g(q) / Kp with gravity
 compensation, the fixed-base arm's g as the controller computes it), so the actuator
 force Kp (q_ref - q) + Kd (v_ref - v) + g is clipped at the effort limit as a whole.
 
 Every step's sensors are kept (one copy of `sensordata`); odometry, tipping and lift-off
-are computed from them after the run (sim.liftoff), the outputs by sim.driveout.
+are computed from them after the run (analysis.liftoff), the outputs by drive.output.
 """
 
 from __future__ import annotations
@@ -24,19 +24,19 @@ from typing import TYPE_CHECKING, Any, Protocol
 import numpy as np
 
 from armcli.analysis.stance import NoStance, Stance, stance_of
+from armcli.drive.cmdvel import CmdVel, load_cmd_vel
+from armcli.drive.diffdrive import DiffDriveController, DriveParams, Odometry, encoder_odometry
+from armcli.drive.model import DriveModel, build_drive_model
+from armcli.drive.wheelmotor import clutch_torque, spin
 from armcli.errors import InputError, SimulationError
 from armcli.io.scene import Scene
 from armcli.sim import job as simjob
-from armcli.sim.cmdvel import CmdVel, load_cmd_vel
-from armcli.sim.diffdrive import DiffDriveController, DriveParams, Odometry, encoder_odometry
-from armcli.sim.drivemodel import DriveModel, build_drive_model
 from armcli.sim.job import SimJob
 from armcli.sim.options import SimOptions
 from armcli.sim.sensors.reading import Reading
 from armcli.sim.sensors.rig import make_rig
 from armcli.sim.simulate import steps_of
 from armcli.sim.tipping import robot_urdf
-from armcli.sim.wheelmotor import clutch_torque, spin
 from armcli.sim.world import load_world, refuse_overlaps
 from armcli.urdf.doc import Urdf
 
@@ -253,7 +253,7 @@ def run(
             ctrl[arm_act] = ctrl_arm[j] + gravity(d.qpos[arm_qpos])[cols] * inv_kp
         mujoco.mj_step(m, d)
         rec[k] = d.sensordata
-        rec[k, wheel_force] = -d.qfrc_constraint[rotor]  # sim.wheelmotor.clutch_torque
+        rec[k, wheel_force] = -d.qfrc_constraint[rotor]  # drive.wheelmotor.clutch_torque
         if due[k]:
             sample(k, m, d)
         if progress is not None and k % PROGRESS_STEPS == 0 and k:

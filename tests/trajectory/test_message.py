@@ -12,8 +12,8 @@ from hypothesis import given
 from scipy.interpolate import BPoly, CubicHermiteSpline
 
 from armcli.errors import ArmcliError, SpecError
-from armcli.sim.reference import build_reference, segment_coeffs
-from armcli.sim.trajectory import DEFAULT_SEGMENT_S, load_trajectory, loads_trajectory
+from armcli.trajectory.message import DEFAULT_SEGMENT_S, load_trajectory, loads_trajectory
+from armcli.trajectory.reference import build_reference, segment_coeffs
 from tests.helpers import ROOT, mutated
 
 J1, J2 = "arm_base_forearm_joint", "forearm_hand_joint"
@@ -78,7 +78,7 @@ EXAMPLES = sorted((ROOT / "specs" / "trajectories").glob("*.yaml"))
 
 
 @pytest.mark.parametrize("path", [p for p in EXAMPLES if "\ncommands:" not in p.read_text()])
-def test_example_trajectories_load(path: Path) -> None:  # drive.yaml: tests/sim/test_cmdvel.py
+def test_example_trajectories_load(path: Path) -> None:  # drive.yaml: tests/drive/test_cmdvel.py
     tr = load_trajectory(path, LIMITS)
     assert tr.positions.shape[1] == 2
     assert np.all(np.diff(tr.times) > 0)

@@ -7,8 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from armcli.analysis.stance import Stance, stance_of
-from armcli.sim.liftoff import (
+from armcli.analysis.liftoff import (
     LIFT_CLEARANCE,
     edge_tilts,
     lifts,
@@ -16,6 +15,7 @@ from armcli.sim.liftoff import (
     tipping_angles,
     verdict,
 )
+from armcli.analysis.stance import Stance, stance_of
 from armcli.urdf.read import parse_urdf
 from tests.helpers import FIXTURES
 

@@ -9,7 +9,7 @@ which lets the other jump to its target mid-ramp); otherwise each wheel's
 instructed rim speed moves by `desired - current`, clipped to
 ±max_wheel_acceleration * (time since the last update). The joint motor holds the
 commanded speed with at most max_wheel_torque (ODE's `vel`/`fmax`; here a MuJoCo
-clutch, sim.wheelmotor). The plugin's quirks are kept: the instructed
+clutch, drive.wheelmotor). The plugin's quirks are kept: the instructed
 speed accumulates from its previous value rather than from the measured speed, and
 the comparison is >= on the left and > on the right.
 

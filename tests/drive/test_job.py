@@ -18,8 +18,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from armcli.drive import job as drive
+from armcli.drive import output as driveout
 from armcli.robot.frames import quaternion_rpy, tilt
-from armcli.sim import drive, driveout
 from armcli.sim import job as simjob
 from armcli.sim.options import SimOptions
 from armcli.spec.load import load_spec

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from armcli.robot.mimic import Mimic
-from armcli.sim.trajectory import Trajectory
+from armcli.trajectory.message import Trajectory
 
 
 @dataclass(frozen=True)

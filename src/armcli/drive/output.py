@@ -5,17 +5,17 @@ tracking plot rows and its joint-state columns are the same code. The states fil
 the base's ground truth (`base.x/y/z/roll/pitch/yaw`: the root link in the world), the
 plugin's odometry (`odom.x/y/yaw`), the wheel joints' position/velocity/effort and the
 normal force on each ground-contact link (`LINK.normal_force`, the mean over the output
-period: MuJoCo's contact force of a single step chatters, sim.drivemodel).
-The MCAP file: sim.drivebag; the plot: sim.driveplot.
+period: MuJoCo's contact force of a single step chatters, drive.model).
+The MCAP file: drive.bag; the plot: drive.plot.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from armcli.analysis.liftoff import TipVerdict, verdict
+from armcli.drive.job import DriveRun
 from armcli.robot.frames import quaternion_rpy
-from armcli.sim.drive import DriveRun
-from armcli.sim.liftoff import TipVerdict, verdict
 from armcli.sim.rollout import Stats
 from armcli.sim.simulate import SETTLE_TOL, SimResult
 from armcli.sim.states import column, distinct, sample_states, sample_steps
@@ -67,7 +67,7 @@ def arm_result(run: DriveRun, keep: np.ndarray) -> SimResult:
 
 
 def tip_verdict(run: DriveRun) -> TipVerdict:
-    """The run's tilt and lift-offs (sim.liftoff)."""
+    """The run's tilt and lift-offs (analysis.liftoff)."""
     job, L, s = run.job, run.job.model.layout, run.sensors
     z = s[:, L.contact_pos][:, 2::3]
     force = s[:, L.touch]

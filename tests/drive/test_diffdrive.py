@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
+from armcli.drive.diffdrive import DiffDriveController, DriveParams, encoder_odometry
 from armcli.errors import InputError
-from armcli.sim.diffdrive import DiffDriveController, DriveParams, encoder_odometry
 from armcli.spec.load import load_spec
 from tests.helpers import DEFAULT_SPEC
 

@@ -3,7 +3,7 @@
 The YAML mirrors the ROS message (`header.frame_id`, `joint_names`, `points` with
 `positions` and optional `velocities`, `accelerations`, `effort`, `time_from_start`), so
 the payload of `ros2 topic pub /set_joint_trajectory ...` reads as ROS reads it, including
-the brace form `{0.5, 0.3}` (see armcli.sim.brace).
+the brace form `{0.5, 0.3}` (see armcli.trajectory.brace).
 
 Interpolation follows ros2_control's joint_trajectory_controller: per segment, linear
 when the points give positions only, cubic when they give velocities, quintic when they
@@ -31,14 +31,14 @@ import numpy as np
 
 from armcli.errors import Problem, SpecError, one_per_kind
 from armcli.io.yaml import MAX_YAML_BYTES, FlowKeys, YamlDoc, dotted, loads_yaml, read_text
-from armcli.sim.brace import BraceNotes
-from armcli.sim.jointtext import MAX_PLAN_BYTES, canonical_arrays
+from armcli.trajectory.brace import BraceNotes
+from armcli.trajectory.jointtext import MAX_PLAN_BYTES, canonical_arrays
 
 DEFAULT_SEGMENT_S = 1.0  # [s] time given to a point without time_from_start
 MIN_SEGMENT_S = 1e-6  # [s] shorter segments make the interpolated reference overflow
 MAX_TIME_S = 1e6  # [s] ~11.6 days: far beyond any simulation worth running step by step
 LIMIT_TOL = 1e-9  # [rad] slack when comparing positions with joint limits
-_RULES = (LIMIT_TOL, MIN_SEGMENT_S, MAX_TIME_S)  # what sim.jointtext checks on arrays
+_RULES = (LIMIT_TOL, MIN_SEGMENT_S, MAX_TIME_S)  # what trajectory.jointtext checks
 CUTOFF = 0.6  # difflib similarity below which no "did you mean" is offered (spec.suggest's)
 _TOP_KEYS = {"header", "joint_names", "points"}
 _POINT_KEYS = {"positions", "velocities", "accelerations", "effort", "time_from_start"}
@@ -87,7 +87,7 @@ def loads_trajectory(
 ) -> Trajectory:
     """Validate a trajectory given as text, e.g. the `ros2 topic pub` payload.
 
-    Plan's own layout is read by sim.jointtext (same data, fast; problems are reported from
+    Plan's own layout is read by trajectory.jointtext (same data, fast; problems are reported from
     the YAML reader, which knows lines). `max_bytes`: None for armcli's own output.
     """
     fast = canonical_arrays(text)  # plan's layout, checked on arrays as parse_trajectory checks
@@ -293,7 +293,7 @@ def _time(
 ) -> float:
     """`time_from_start` of entry `k` of the list `key` [s] (seconds or {sec, nanosec}).
 
-    Missing: DEFAULT_SEGMENT_S after the previous entry. sim.cmdvel reads its times so too.
+    Missing: DEFAULT_SEGMENT_S after the previous entry. drive.cmdvel reads its times so too.
     """
     path: tuple[str | int, ...] = (key, k, "time_from_start")
     last = previous[-1] if previous else 0.0

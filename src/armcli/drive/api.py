@@ -1,6 +1,6 @@
 """A drive of the whole robot as one library call: what `simulate --cmd-vel` runs.
 
-`drive_robot` prepares (sim.drive: the exported MuJoCo model, the check gate a caller
+`drive_robot` prepares (drive.job: the exported MuJoCo model, the check gate a caller
 passes), runs, and turns the run into the arm's `SimResult` and the tip-over verdict;
 `Driven.files` gives the states file (.csv, .json, .mcap) and the plot as bytes, for the
 caller to write together.
@@ -13,11 +13,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from armcli.analysis.liftoff import TipVerdict
+from armcli.drive import job as drive
+from armcli.drive import output as driveout
+from armcli.drive.job import DriveJob, DriveRun
 from armcli.errors import InputError
 from armcli.io.scene import Scene
-from armcli.sim import drive, driveout
-from armcli.sim.drive import DriveJob, DriveRun
-from armcli.sim.liftoff import TipVerdict
 from armcli.sim.options import SimOptions
 from armcli.sim.simulate import SimResult
 from armcli.urdf.doc import Urdf
@@ -38,7 +39,8 @@ class Driven:
 
     def files(self, output: Path | None, plot: Path | None) -> dict[Path, bytes]:
         """The states file and the plot, as bytes by path."""
-        from armcli.sim import drivebag, rosbag, states
+        from armcli.drive import bag as drivebag
+        from armcli.sim import rosbag, states
 
         files: dict[Path, bytes] = {}
         rate = self.job.arm.rate
@@ -50,7 +52,7 @@ class Driven:
                 else states.states_bytes(cols, states.output_format(output))
             )
         if plot is not None:
-            from armcli.sim import driveplot  # matplotlib: only for a plot
+            from armcli.drive import plot as driveplot  # matplotlib: only for a plot
 
             files[plot] = driveplot.plot_png(self.run, self.arm, self.verdict)
         return files
@@ -66,7 +68,7 @@ def drive_robot(
     world: Path | Scene | None = None,
     sensors: bool = True,
 ) -> Driven:
-    """Drive the spec's whole robot by the /cmd_vel commands in `cmd_vel` (sim.drive).
+    """Drive the spec's whole robot by the /cmd_vel commands in `cmd_vel` (drive.job).
 
     `world`: a scene file (or Scene) of obstacles in the world frame (sim.world);
     `sensors`: simulate the spec's sensors (sim.sensors).

@@ -1,8 +1,8 @@
 """The drive against gazebo_ros_diff_drive (ROS 2) as an independent script would run it.
 
 The reference here is written from the plugin's source (gazebo_ros_pkgs, branch ros2,
-gazebo_plugins/src/gazebo_ros_diff_drive.cpp, `OnUpdate`), not from sim/diffdrive.py: it
-steps the same compiled MuJoCo model (the export's, sim.drivemodel) with its own loop, so
+gazebo_plugins/src/gazebo_ros_diff_drive.cpp, `OnUpdate`), not from drive/diffdrive.py: it
+steps the same compiled MuJoCo model (the export's, drive.model) with its own loop, so
 the only thing compared is the controller and its timing. Its rules, from the source:
 
 - Gazebo advances the sim time before `OnUpdate`, which acts once `update_period` has
@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 import pytest
 
+from armcli.drive import job as drive
 from armcli.robot.frames import quaternion_rpy
-from armcli.sim import drive
 from armcli.sim.options import SimOptions
 from armcli.spec.load import load_spec
 from tests.helpers import DEFAULT_SPEC
@@ -142,8 +142,8 @@ def _exported_scene(job: drive.DriveJob, spec: Path, tmp_path: Path) -> Any:
     """`export mjcf --whole-robot --base free`'s scene.xml, with the plugin's wheel motors."""
     import mujoco
 
+    from armcli.drive.wheelmotor import add_wheel_motors
     from armcli.export.mjcf_files import export_mjcf
-    from armcli.sim.wheelmotor import add_wheel_motors
 
     export_mjcf(spec, tmp_path / "out" / "robot.xml", base="free", whole_robot=True)
     ms = mujoco.MjSpec.from_file(str(tmp_path / "out" / "scene.xml"))
@@ -227,7 +227,7 @@ def test_the_motor_stand_in_parameters_do_not_matter(
     solref: float,
     solimp: tuple[float, float] | None,
 ) -> None:
-    from armcli.sim import wheelmotor
+    from armcli.drive import wheelmotor
 
     base = _fast(tmp_path)
     monkeypatch.setattr(wheelmotor, "ROTOR_ARMATURE", armature)

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from armcli.analysis import zmp as zmps
+from armcli.analysis.excursion import excursions
 from armcli.analysis.stance import Stance, stance_of
-from armcli.sim.excursion import excursions
 from armcli.urdf.read import parse_urdf
 from tests.helpers import FIXTURES
 

@@ -20,7 +20,7 @@ import numpy as np
 
 from armcli.errors import Problem, SpecError
 from armcli.io.yaml import YamlDoc, dotted, load_yaml, loads_yaml
-from armcli.sim.trajectory import _Collector, _finite, _short, _time
+from armcli.trajectory.message import _Collector, _finite, _short, _time
 
 _TOP_KEYS = {"commands"}
 _COMMAND_KEYS = {"linear", "angular", "time_from_start"}

@@ -8,9 +8,9 @@ only, is matched by one pattern and turned into arrays (`Canonical`) holding wha
 safe YAML reader builds from it: the same floats (YAML reads each of these number forms
 as `float(text)`), ints, strings and key order (`Canonical.doc`). Anything else (another
 layout, a name or number of another form) gives None and is read by the YAML reader.
-sim.trajectory checks the arrays as it checks the YAML reader's points, without a Python
+trajectory.message checks the arrays as it checks the YAML reader's points, without a Python
 step per point: reading a 60 s plan back takes milliseconds where the general reader takes
-a second; tests/sim/test_jointtext.py checks that both readers give the same data.
+a second; tests/trajectory/test_jointtext.py checks that both readers give the same data.
 """
 
 from __future__ import annotations
@@ -65,10 +65,10 @@ class Canonical:
         self, limits: Mapping[str, tuple[float, float]], others: Mapping[str, str],
         rules: tuple[float, float, float],
     ) -> np.ndarray | None:  # fmt: skip
-        """The times [s] when every check sim.trajectory makes passes, else None.
+        """The times [s] when every check trajectory.message makes passes, else None.
 
         `rules`: (position slack [rad], shortest segment [s], latest time [s]) as
-        sim.trajectory defines them. None: the YAML reader reads it again and says what fails.
+        trajectory.message defines them. None: the YAML reader reads it again and says what fails.
         """
         tol, shortest, latest = rules
         names = self.names
