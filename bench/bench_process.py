@@ -72,10 +72,11 @@ from pathlib import Path
 from armcli.sim import job as simjob
 from armcli.sim.options import SimOptions
 from armcli.sim.simulate import simulate
+from armcli.urdf.source import read_robot
 traj, urdf = Path(sys.argv[1]), Path(sys.argv[2])
 duration, dt = float(sys.argv[3]), float(sys.argv[4])
-opts = SimOptions(trajectory=traj, urdf=urdf, kp=(50.0,), kd=(5.0,), dt=dt, duration=duration)
-job = simjob.prepare(None, opts)
+opts = SimOptions(trajectory=traj, kp=(50.0,), kd=(5.0,), dt=dt, duration=duration)
+job = simjob.prepare(read_robot(urdf), opts)
 simulate(job.robot, job.reference, job.q0, job.duration, job.config)
 """
 

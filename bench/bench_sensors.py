@@ -39,7 +39,7 @@ sys.path.insert(0, str(ROOT / "src"))
 from armcli.drive import job as drive  # noqa: E402
 from armcli.sim.options import SimOptions  # noqa: E402
 from armcli.sim.sensors import raycast, scanners  # noqa: E402
-from armcli.spec.load import load_spec  # noqa: E402
+from armcli.urdf.source import read_robot  # noqa: E402
 
 SPEC = ROOT / "specs" / "rover.yaml"
 WORLD = ROOT / "specs" / "rover" / "world.yaml"
@@ -100,8 +100,10 @@ def floors(tmp: Path, reps: int) -> None:
     """One scan and one depth image: the samplers against a Python loop of mj_ray."""
     import mujoco
 
-    spec = load_spec(spec_with(tmp, ("base_scan", "front_depth")))
-    job = drive.prepare(spec, SimOptions(duration=1.0), DRIVE, world=WORLD)
+    file = read_robot(spec_with(tmp, ("base_scan", "front_depth")))
+    job = drive.prepare(file, SimOptions(duration=1.0), DRIVE, world=WORLD)
+    spec = file.spec
+    assert spec is not None
     m = job.model.model
     d = drive.start_data(job.model, job.arm.q0)
     for _ in range(500):
@@ -163,7 +165,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp_:
         tmp = Path(tmp_)
         specs = {k: spec_with(tmp, v) for k, v in VARIANTS.items()}
-        jobs = {k: drive.prepare(load_spec(p), SimOptions(duration=duration), DRIVE, world=WORLD)
+        jobs = {k: drive.prepare(read_robot(p), SimOptions(duration=duration), DRIVE, world=WORLD)
                 for k, p in specs.items()}  # fmt: skip
         report(
             "the run (drive.job.run)",

@@ -27,10 +27,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
 from armcli.sim import native  # noqa: E402
-from armcli.spec.load import load_spec  # noqa: E402
 from armcli.tune import job as tjob  # noqa: E402
 from armcli.tune.engine import DaskEngine, Engine, LocalEngine  # noqa: E402
 from armcli.tune.objective import Weights  # noqa: E402
+from armcli.urdf.source import read_robot  # noqa: E402
 
 SPEC = ROOT / "specs" / "my_robot.yaml"
 SEED = 0
@@ -100,7 +100,7 @@ def main() -> None:
     args = ap.parse_args()
     count, repeats = (8, 2) if args.quick else (32, 7)
     native.require()
-    job = tjob.prepare(load_spec(SPEC), SPEC, [], tjob.TuneSettings())
+    job = tjob.prepare(read_robot(SPEC), [], tjob.TuneSettings())
     batch = candidates(job, count)
     steps = sum(round(c.duration / job.problem.dt) for c in job.problem.cases)
     print(f"load average before the run: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")

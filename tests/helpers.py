@@ -22,6 +22,7 @@ from hypothesis import strategies as st
 
 if TYPE_CHECKING:
     from armcli.robot.model import Robot
+    from armcli.urdf.source import RobotFile
 
 ROOT = Path(__file__).resolve().parents[1]  # the repository checkout
 SPECS = ROOT / "specs"
@@ -48,6 +49,13 @@ def load_robot(path: Path, *, floating: bool = False, strict: bool = True) -> Ro
     from armcli.urdf.read import read_urdf
 
     return Robot.load(read_urdf(path), floating=floating, strict=strict)
+
+
+def spec_file(path: Path) -> RobotFile:
+    """A spec file's robot file, as a command reads it (the library's entry points take it)."""
+    from armcli.urdf.source import read_robot
+
+    return read_robot(path)
 
 
 def course_gains_spec(directory: Path, name: str = "my_robot.yaml") -> Path:

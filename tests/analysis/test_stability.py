@@ -13,11 +13,10 @@ from armcli.analysis import pdloop
 from armcli.analysis import stability as stab
 from armcli.analysis import verdict as verdicts
 from armcli.errors import UnstableLoopError
+from armcli.robot.file import robot_of
 from armcli.robot.model import Robot
-from armcli.sim.job import load_arm
 from armcli.sim.simulate import SimConfig, check_stability
-from armcli.spec.load import load_spec
-from tests.helpers import DEFAULT_SPEC, load_robot
+from tests.helpers import DEFAULT_SPEC, load_robot, spec_file
 
 # The course arm (specs/my_robot.yaml): two solid cylinders r = 0.02 m, l = 0.3 m,
 # m = 0.3 kg, hinged at one end, both joints about y; gains Kp = 50, Kd = 5, joint
@@ -132,7 +131,8 @@ def test_pinocchio_crba_matches_the_textbook_matrix(root) -> None:
 
 @pytest.fixture(scope="module")
 def seed_arm() -> Robot:
-    return load_arm(load_spec(DEFAULT_SPEC), None, None)
+    file = spec_file(DEFAULT_SPEC)
+    return robot_of(file, file.arm)
 
 
 def _sweep() -> list[tuple[float, float, float, float]]:

@@ -17,6 +17,7 @@ from armcli.sim import job as simjob
 from armcli.sim.options import SimOptions
 from armcli.sim.simulate import SimConfig
 from armcli.spec.load import load_spec
+from armcli.urdf.source import RobotFile
 from tests.helpers import DEFAULT_SPEC, ROOT
 
 LIBRARY = ROOT / "src" / "armcli"
@@ -39,10 +40,10 @@ def test_library_code_names_no_flags() -> None:
 def test_a_python_caller_is_told_the_option_it_passed() -> None:
     spec = load_spec(DEFAULT_SPEC)
     with pytest.raises(InputError) as err:
-        simjob.prepare(spec, SimOptions(message=MESSAGE, dt=0.5))
+        simjob.prepare(RobotFile.of_spec(spec), SimOptions(message=MESSAGE, dt=0.5))
     assert err.value.field == "SimOptions.dt" and "--" not in str(err.value)
     with pytest.raises(InputError) as err:
-        simjob.prepare(spec, SimOptions(message=MESSAGE, kp=(1.0, 2.0, 3.0)))
+        simjob.prepare(RobotFile.of_spec(spec), SimOptions(message=MESSAGE, kp=(1.0, 2.0, 3.0)))
     assert err.value.field == "SimOptions.kp"
 
 
@@ -103,7 +104,7 @@ def test_one_time_step_rule_names_each_entry(
     assert spec_err.value.problems[0].message == rule
     spec = load_spec(DEFAULT_SPEC)
     with pytest.raises(InputError) as opt_err:
-        simjob.prepare(spec, SimOptions(message=MESSAGE, dt=dt))
+        simjob.prepare(RobotFile.of_spec(spec), SimOptions(message=MESSAGE, dt=dt))
     assert (opt_err.value.field, opt_err.value.message) == ("SimOptions.dt", rule)
     with pytest.raises(InputError) as cfg_err:
         SimConfig(np.ones(1), np.ones(1), dt=dt)

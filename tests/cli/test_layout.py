@@ -14,7 +14,7 @@ from typing import Any
 
 import pytest
 
-from tests.helpers import ROOT, run_main
+from tests.helpers import ROOT, run_main, spec_file
 
 SPEC = ROOT / "specs" / "my_robot.yaml"
 PICK = ROOT / "specs" / "trajectories" / "pick.yaml"
@@ -70,11 +70,10 @@ def test_simulate_table_fits(
     from armcli.sim import job as simjob
     from armcli.sim.options import SimOptions
     from armcli.sim.report import joint_metrics
-    from armcli.spec.load import load_spec
 
     monkeypatch.setenv("COLUMNS", str(width))
     _, out = run(["simulate", str(SPEC), "-t", str(PICK)], capsys)
-    job = simjob.prepare(load_spec(SPEC), SimOptions(trajectory=PICK))
+    job = simjob.prepare(spec_file(SPEC), SimOptions(trajectory=PICK))
     res = simjob.run(job)  # the same deterministic run, through the library
     numbers = []
     for m in joint_metrics(res, job.trajectory.duration):

@@ -15,6 +15,7 @@ import pytest
 from lxml import etree
 
 from armcli.compiler.expand import build
+from armcli.urdf.source import RobotFile
 from tests.helpers import FIXTURES
 from tests.meshes import house_triangles, prism_triangles, write_stl
 
@@ -113,7 +114,7 @@ def _finger_job(built: Path, msg: str, joints: tuple[str, ...] = FINGERS) -> Any
 
     spec = load_spec(built.parent.parent / "armcli.yaml")
     opts = SimOptions(message=msg, joints=joints, kp=(200.0,), kd=(2.0,), duration=1.5)
-    return simjob.prepare(spec, opts)
+    return simjob.prepare(RobotFile.of_spec(spec), opts)
 
 
 def test_simulate_drives_the_mimic_finger_through_its_leader(built: Path) -> None:
@@ -175,5 +176,5 @@ def test_simulate_asks_for_the_leaders_gains_only(built: Path) -> None:
     spec = load_spec(built.parent.parent / "armcli.yaml")
     msg = "{joint_names: [left_finger_joint], points: [{positions: [0.02], time_from_start: 1}]}"
     with pytest.raises(InputError, match=r"no kp for left_finger_joint in the spec") as info:
-        simjob.prepare(spec, SimOptions(message=msg, joints=FINGERS))
+        simjob.prepare(RobotFile.of_spec(spec), SimOptions(message=msg, joints=FINGERS))
     assert "right_finger_joint" not in str(info.value)

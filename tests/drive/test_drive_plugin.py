@@ -24,8 +24,7 @@ import pytest
 from armcli.drive import job as drive
 from armcli.robot.frames import quaternion_rpy
 from armcli.sim.options import SimOptions
-from armcli.spec.load import load_spec
-from tests.helpers import DEFAULT_SPEC
+from tests.helpers import DEFAULT_SPEC, spec_file
 
 pytest.importorskip("mujoco")
 
@@ -100,7 +99,7 @@ def _pose(d: Any) -> tuple[float, float, float]:
 
 
 def _arc(spec: Path, tmp_path: Path) -> tuple[drive.DriveJob, drive.DriveRun]:
-    job = drive.prepare(load_spec(spec), SimOptions(duration=ARC_S + 1.0), _arc_file(tmp_path))
+    job = drive.prepare(spec_file(spec), SimOptions(duration=ARC_S + 1.0), _arc_file(tmp_path))
     return job, drive.run(job)
 
 
@@ -158,7 +157,7 @@ def test_the_exported_scene_drives_as_simulate_cmd_vel(tmp_path: Path) -> None:
     path = tmp_path / "straight.yaml"
     path.write_text("commands:\n  - {linear: {x: 0.3}, time_from_start: 0}\n"
                     "  - {time_from_start: 4.0}\n")  # fmt: skip
-    job = drive.prepare(load_spec(DEFAULT_SPEC), SimOptions(duration=5.0), path)
+    job = drive.prepare(spec_file(DEFAULT_SPEC), SimOptions(duration=5.0), path)
     x, y, yaw = _pose(_plugin_reference(job, straight))
     assert x == pytest.approx(1.2, rel=0.02)  # the commanded distance
     sx, sy, syaw = _pose(
@@ -178,7 +177,7 @@ STAND_IN = 2e-3
 def _fast(tmp_path: Path) -> drive.DriveRun:
     path = tmp_path / "fast.yaml"
     path.write_text(FAST)
-    return drive.run(drive.prepare(load_spec(DEFAULT_SPEC), SimOptions(duration=3.5), path))
+    return drive.run(drive.prepare(spec_file(DEFAULT_SPEC), SimOptions(duration=3.5), path))
 
 
 def test_the_wheels_hold_their_speed_and_carry_newtons_torque(tmp_path: Path) -> None:

@@ -23,8 +23,7 @@ from armcli.drive import output as driveout
 from armcli.robot.frames import quaternion_rpy, tilt
 from armcli.sim import job as simjob
 from armcli.sim.options import SimOptions
-from armcli.spec.load import load_spec
-from tests.helpers import DEFAULT_SPEC, ROOT, course_gains_spec
+from tests.helpers import DEFAULT_SPEC, ROOT, course_gains_spec, spec_file
 
 pytest.importorskip("mujoco")
 
@@ -54,7 +53,7 @@ def _cmd(tmp_path: Path, name: str, text: str) -> Path:
 
 
 def _run(spec_path: Path, opts: SimOptions, cmd: Path) -> drive.DriveRun:
-    return drive.run(drive.prepare(load_spec(spec_path), opts, cmd))
+    return drive.run(drive.prepare(spec_file(spec_path), opts, cmd))
 
 
 def _axle(run: drive.DriveRun) -> tuple[np.ndarray, np.ndarray]:
@@ -159,9 +158,9 @@ def test_a_jerk_lifts_a_wheel_in_both_models_and_tips_neither(tmp_path: Path) ->
             " - {positions: [0.3, 1.2], time_from_start: 0.0}\n"
             " - {positions: [0.3, 1.2], time_from_start: 1.0}\n")  # fmt: skip
     opts = SimOptions(message=jerk, duration=1.5)
-    spec = load_spec(course)
-    job = simjob.prepare(spec, opts)
-    tip = tipping.prepare(spec, job, TipOptions(), MeshSearch(), [])
+    file = spec_file(course)
+    job = simjob.prepare(file, opts)
+    tip = tipping.prepare(file, job, TipOptions(), MeshSearch(), [])
     assert tip is not None
     res = simjob.run(job, extra=lambda steps: tip.steps(job, steps))
     report = tipping.report(tip, tip.series(job, res))

@@ -35,6 +35,7 @@ def test_rpy_is_urdf_fixed_axis_xyz(rpy: tuple[float, float, float]) -> None:
     # scipy's lower-case "xyz" is exactly that extrinsic sequence.
     ref = Rotation.from_euler("xyz", rpy)
     np.testing.assert_allclose(frames.rpy_matrix(rpy), ref.as_matrix(), atol=EXACT)
+    np.testing.assert_allclose(frames.rpy_rotation(rpy), ref.as_matrix(), atol=EXACT)
     assert _same_rotation(frames.rpy_quaternion(rpy), ref.as_quat())
     T = frames.pose_matrix((0.1, -0.2, 0.3), rpy)
     np.testing.assert_allclose(T[:3, :3], ref.as_matrix(), atol=EXACT)
@@ -149,8 +150,8 @@ def test_simulate_two_joints_of_a_robot_with_shared_names(tmp_path: Path) -> Non
 
 
 def test_every_lookup_by_name_goes_through_robot_frames() -> None:
-    """Pinocchio's name lookups and its reduction live in robot/frames.py only."""
-    calls = ("getFrameId(", "existFrame(", "buildReducedModel(")
+    """Pinocchio's name lookups, its reduction and its rpy maths live in robot/frames.py only."""
+    calls = ("getFrameId(", "existFrame(", "buildReducedModel(", "rpy.rpyToMatrix(")
     found = [
         f"{path.relative_to(ROOT)}:{n}"
         for path in sorted((ROOT / "src" / "armcli").rglob("*.py"))

@@ -14,7 +14,7 @@ from armcli.sim import job as simjob
 from armcli.sim.options import SimOptions
 from armcli.spec.load import load_spec
 from armcli.urdf.read import parse_urdf, read_urdf
-from armcli.urdf.source import read_robot
+from armcli.urdf.source import RobotFile, read_robot
 from armcli.view.scene import load_robot
 from tests.helpers import DEFAULT_SPEC
 
@@ -74,9 +74,9 @@ def test_check_simulate_and_view_report_the_same_point(arm_file: Path) -> None:
     summary = check_urdf(read_urdf(arm_file), CheckOptions()).summary
     assert summary is not None and summary.end_effector == "l2"
     assert load_robot(arm_file).tool == ToolPoint("l2")
-    opts = SimOptions(urdf=arm_file, message="joint_names: [j1]\npoints: [{positions: [0.1]}]",
-                      kp=(50.0,), kd=(5.0,))  # fmt: skip
-    job = simjob.prepare(None, opts)
+    opts = SimOptions(message="joint_names: [j1]\npoints: [{positions: [0.1]}]", kp=(50.0,),
+                      kd=(5.0,))  # fmt: skip
+    job = simjob.prepare(read_robot(arm_file), opts)
     assert job.tool_label.startswith("l2 ")
 
 
@@ -91,7 +91,7 @@ def test_check_and_simulate_print_the_same_label() -> None:
     robot = read_robot(DEFAULT_SPEC)
     summary = check_urdf(robot.robot, CheckOptions(spec=spec)).summary
     message = f"joint_names: [{spec.movable_arm_joints()[0]}]\npoints: [{{positions: [0.1]}}]"
-    job = simjob.prepare(spec, SimOptions(message=message))
+    job = simjob.prepare(RobotFile.of_spec(spec), SimOptions(message=message))
     assert summary is not None and summary.end_effector
     assert job.tool_label.startswith(summary.end_effector + " in ")
 

@@ -10,34 +10,32 @@ import pytest
 
 from armcli.sim.armrun import ArmRun, run_balanced, simulate_arm, trajectory_zmp
 from armcli.sim.options import SimOptions
-from armcli.sim.tipping import TipOptions, robot_urdf
-from armcli.spec.load import load_spec
-from armcli.spec.model import RobotSpec
-from tests.helpers import DEFAULT_SPEC, ROOT
+from armcli.sim.tipping import TipOptions, whole_robot
+from armcli.urdf.source import RobotFile
+from tests.helpers import DEFAULT_SPEC, ROOT, spec_file
 
 PICK = ROOT / "src" / "armcli" / "examples" / "trajectories" / "pick.yaml"
 
 
 @pytest.fixture(scope="module")
-def course_run() -> tuple[RobotSpec, ArmRun]:
-    spec = load_spec(DEFAULT_SPEC)
-    return spec, simulate_arm(spec, SimOptions(trajectory=PICK), TipOptions(payload=0.2))
+def course_run() -> tuple[RobotFile, ArmRun]:
+    file = spec_file(DEFAULT_SPEC)
+    return file, simulate_arm(file, SimOptions(trajectory=PICK), TipOptions(payload=0.2))
 
 
 def test_simulate_and_check_report_the_same_zero_moment_point(
-    course_run: tuple[RobotSpec, ArmRun],
+    course_run: tuple[RobotFile, ArmRun],
 ) -> None:
-    spec, run = course_run
+    file, run = course_run
     assert run.tip is not None and run.balance is not None and run.series is not None
-    whole = robot_urdf(spec, run.job)
-    assert whole is not None
-    r = trajectory_zmp(spec, whole, run.tip.stance, PICK, run.tip.base_accel, run.tip.threshold)
+    whole = whole_robot(file)
+    r = trajectory_zmp(file, whole, run.tip.stance, PICK, run.tip.base_accel, run.tip.threshold)
     # the same run, the same numbers field by field; only the label of the given accel differs
     assert replace(r, accel_source=run.balance.accel_source) == run.balance
 
 
 def test_the_kept_steps_change_what_is_recorded_not_the_motion(
-    course_run: tuple[RobotSpec, ArmRun],
+    course_run: tuple[RobotFile, ArmRun],
 ) -> None:
     _, run = course_run
     dense = run_balanced(run.job, run.tip, every_step=True)
@@ -50,7 +48,7 @@ def test_the_kept_steps_change_what_is_recorded_not_the_motion(
 
 
 def test_the_states_file_carries_the_balance_columns(
-    course_run: tuple[RobotSpec, ArmRun], tmp_path: Path
+    course_run: tuple[RobotFile, ArmRun], tmp_path: Path
 ) -> None:
     _, run = course_run
     out = tmp_path / "run.csv"

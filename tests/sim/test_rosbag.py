@@ -17,8 +17,7 @@ from armcli.sim import job as simjob
 from armcli.sim import rosbag
 from armcli.sim.options import SimOptions
 from armcli.sim.states import FLOAT_FMT, load_replay, write_states
-from armcli.spec.load import load_spec
-from tests.helpers import DEFAULT_SPEC, ROOT
+from tests.helpers import DEFAULT_SPEC, ROOT, spec_file
 
 PICK = ROOT / "specs" / "trajectories" / "pick.yaml"
 FK_ATOL = 1e-12  # [m] /tf composed vs Pinocchio: round-off only
@@ -28,7 +27,7 @@ DURATION = 1.5  # [s] enough for 16 states at the spec's 10 Hz
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     """One simulation written as CSV and as MCAP, and the job behind it."""
-    job = simjob.prepare(load_spec(DEFAULT_SPEC), SimOptions(trajectory=PICK, duration=DURATION))
+    job = simjob.prepare(spec_file(DEFAULT_SPEC), SimOptions(trajectory=PICK, duration=DURATION))
     res = simjob.run(job)
     out = tmp_path_factory.mktemp("rosbag")
     rosbag.write_mcap(out / "run.mcap", res, job.rate, job.urdf)

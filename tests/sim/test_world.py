@@ -20,8 +20,7 @@ from armcli.errors import InputError
 from armcli.io.scene import load_scene
 from armcli.sim.options import SimOptions
 from armcli.sim.world import FLAT_BACK, add_scene, overlaps
-from armcli.spec.load import load_spec
-from tests.helpers import DEFAULT_SPEC
+from tests.helpers import DEFAULT_SPEC, spec_file
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -126,7 +125,7 @@ def test_driving_into_a_wall_stops_the_base_at_the_wall(tmp_path: Path) -> None:
     cmd = tmp_path / "cmd.yaml"
     cmd.write_text("commands:\n  - {linear: {x: 0.5}, time_from_start: 0.0}\n")
     opts = SimOptions(duration=3.5)  # 0.5 m/s for 3.5 s would carry it 1.7 m: the wall is at 1
-    job = drive.prepare(load_spec(DEFAULT_SPEC), opts, cmd, world=tmp_path / "world.yaml")
+    job = drive.prepare(spec_file(DEFAULT_SPEC), opts, cmd, world=tmp_path / "world.yaml")
     run = drive.run(job)
     x = run.sensors[:, job.model.layout.base_pos][:, 0]
     # the course base_link box is 0.6 m long, centred on base_footprint (the root): its front
@@ -140,7 +139,7 @@ def test_an_object_the_robot_stands_in_is_refused(tmp_path: Path) -> None:
     cmd = tmp_path / "cmd.yaml"
     cmd.write_text("commands:\n  - {linear: {x: 0.0}, time_from_start: 0.0}\n")
     with pytest.raises(InputError, match="object 'wall' overlaps the robot's base_link") as exc:
-        drive.prepare(load_spec(DEFAULT_SPEC), SimOptions(duration=0.1), cmd,
+        drive.prepare(spec_file(DEFAULT_SPEC), SimOptions(duration=0.1), cmd,
                       world=tmp_path / "world.yaml")  # fmt: skip
     assert exc.value.file == str(tmp_path / "world.yaml")
 

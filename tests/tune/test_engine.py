@@ -20,14 +20,13 @@ import pytest
 from armcli.cli import main
 from armcli.sim.report import joint_metrics
 from armcli.sim.simulate import SimConfig, simulate
-from armcli.spec.load import load_spec
 from armcli.tune import job as tjob
 from armcli.tune import session
 from armcli.tune.engine import DaskEngine, LocalEngine
 from armcli.tune.objective import INFEASIBLE_COST, RMS, Weights
 from armcli.tune.problem import nominal_robot
 from armcli.tune.search import SearchOptions, cost_of, nominal
-from tests.helpers import ROOT
+from tests.helpers import ROOT, spec_file
 
 SPEC = ROOT / "specs" / "my_robot.yaml"
 PICK = ROOT / "specs" / "trajectories" / "pick.yaml"
@@ -40,7 +39,7 @@ DASK = Path(sys.executable).with_name("dask")
 @pytest.fixture(scope="module")
 def job() -> tjob.TuneJob:
     settings = tjob.TuneSettings(settle=0.5, robust=2, seed=3)
-    return tjob.prepare(load_spec(SPEC), SPEC, [PICK], settings)
+    return tjob.prepare(spec_file(SPEC), [PICK], settings)
 
 
 @pytest.fixture(scope="module")

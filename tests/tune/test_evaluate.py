@@ -15,13 +15,12 @@ import pytest
 
 from armcli.analysis import pdloop
 from armcli.analysis import stability as stab
-from armcli.spec.load import load_spec
 from armcli.trajectory.reference import Reference
 from armcli.tune import evaluate, problem
 from armcli.tune import job as tjob
 from armcli.tune.objective import Weights
 from tests.analysis import stability_reference as ref
-from tests.helpers import ROOT
+from tests.helpers import ROOT, spec_file
 
 SPEC = ROOT / "specs" / "my_robot.yaml"
 PICK = ROOT / "specs" / "trajectories" / "pick.yaml"
@@ -32,7 +31,7 @@ CANDIDATES = 5
 @pytest.fixture(scope="module")
 def job() -> tjob.TuneJob:
     settings = tjob.TuneSettings(settle=0.3, robust=2, seed=1)
-    return tjob.prepare(load_spec(SPEC), SPEC, [PICK, WAVE], settings)
+    return tjob.prepare(spec_file(SPEC), [PICK, WAVE], settings)
 
 
 def _batch(job: tjob.TuneJob) -> list[np.ndarray]:

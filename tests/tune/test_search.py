@@ -20,7 +20,7 @@ from armcli.tune.model_gains import linearised, sample_configurations
 from armcli.tune.objective import INFEASIBLE_COST
 from armcli.tune.problem import nominal_robot
 from armcli.tune.search import SearchOptions, cost_of
-from tests.helpers import ROOT
+from tests.helpers import ROOT, spec_file
 
 SPEC = ROOT / "specs" / "my_robot.yaml"
 TRIALS = 16
@@ -34,7 +34,7 @@ ROBUST_TRIALS = 24
 
 @pytest.fixture(scope="module")
 def job() -> tjob.TuneJob:
-    return tjob.prepare(load_spec(SPEC), SPEC, [], tjob.TuneSettings(settle=SETTLE))
+    return tjob.prepare(spec_file(SPEC), [], tjob.TuneSettings(settle=SETTLE))
 
 
 @pytest.fixture(scope="module")
@@ -82,11 +82,11 @@ def test_robust_worst_case_no_worse_than_nominal_tuning(tmp_path: Path) -> None:
     shutil.copytree(SPEC.parent / "trajectories", tmp_path / "trajectories")
     spec_path = tmp_path / "robot.yaml"
     spec_path.write_text(SPEC.read_text(encoding="utf-8").replace("  dt: 0.001", "  dt: 0.005"))
-    spec = load_spec(spec_path)
+    file = spec_file(spec_path)
     base = tjob.TuneSettings(settle=SETTLE, loop="explicit")
     opts = SearchOptions(trials=ROBUST_TRIALS, batch=BATCH, robust="worst")
-    nominal = session.run(tjob.prepare(spec, spec_path, [], base), LocalEngine(1), opts)
-    robust_job = tjob.prepare(spec, spec_path, [], replace(base, robust=3, mass_scale=(0.6, 1.0),
+    nominal = session.run(tjob.prepare(file, [], base), LocalEngine(1), opts)
+    robust_job = tjob.prepare(file, [], replace(base, robust=3, mass_scale=(0.6, 1.0),
                                                             seed=1))  # fmt: skip
     robust = session.run(robust_job, LocalEngine(1), opts)
     engine = LocalEngine(1)

@@ -17,7 +17,6 @@ from armcli.urdf.source import (
     inside_roots,
     read_robot,
     read_urdf_file,
-    spec_urdfs,
 )
 from armcli.xacro.args import XacroInputs
 from armcli.xacro.jail import sandbox_problem
@@ -170,29 +169,6 @@ def test_trusted_xacro_unknown_package_and_refused_env(tmp_path: Path) -> None:
     env = XacroInputs(env={"LD_PRELOAD": "/tmp/x.so"})
     with pytest.raises(InputError, match="--env: LD_PRELOAD may not be set"):
         expand_xacro(top, trust_xacro="unsandboxed", inputs=env)
-
-
-def test_spec_urdfs_compiles_each_spec_once(monkeypatch: pytest.MonkeyPatch) -> None:
-    from armcli.compiler import expand
-    from armcli.spec.load import load_spec
-
-    calls: list[str] = []
-    real = expand.expand_urdfs
-
-    def counting(spec: object, *args: object) -> dict[str, bytes]:
-        calls.append(spec.name)  # type: ignore[attr-defined]
-        return real(spec, *args)  # type: ignore[arg-type]
-
-    monkeypatch.setattr(expand, "expand_urdfs", counting)
-    spec = load_spec(DEFAULT_SPEC)
-    first = spec_urdfs(spec)
-    first["my_robot.urdf"] = b"changed by a caller"  # a copy: the kept one is untouched
-    again = spec_urdfs(spec)
-    assert calls == ["my_robot"]
-    assert again == real(spec) and again["my_robot.urdf"] != b"changed by a caller"
-    renamed = spec.model_copy(update={"name": "other"})  # another spec: compiled on its own
-    assert set(spec_urdfs(renamed)) == {"other.urdf", "standalone_arm.urdf"}
-    assert calls == ["my_robot", "other"]
 
 
 def test_simulate_runs_xacro_once(

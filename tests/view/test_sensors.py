@@ -20,9 +20,8 @@ from armcli.sim.options import SimOptions
 from armcli.sim.rosbag import load_replay
 from armcli.sim.sensors.messages import scan_points
 from armcli.sim.sensors.replay import load_sensor_replay
-from armcli.spec.load import load_spec
 from armcli.view.browser import Viewer
-from tests.helpers import SPECS
+from tests.helpers import SPECS, spec_file
 from tests.view.test_browser import browser, colour_masks, save, wait_for  # noqa: F401
 
 pytest.importorskip("mujoco")
@@ -35,7 +34,7 @@ PAINT_TIMEOUT_S = 60.0
 @pytest.fixture(scope="module")
 def drove(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     out = tmp_path_factory.mktemp("replay") / "run.mcap"
-    driven = drive_robot(load_spec(ROVER), SimOptions(duration=1.5),
+    driven = drive_robot(spec_file(ROVER), SimOptions(duration=1.5),
                          SPECS / "trajectories" / "rover" / "drive.yaml",
                          world=SPECS / "rover" / "world.yaml")  # fmt: skip
     out.write_bytes(driven.files(out, None)[out])

@@ -10,7 +10,7 @@ of mass without moving a contact (not the wheels, not a caster's swivel).
 
 from __future__ import annotations
 
-from collections.abc import Collection, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -110,17 +110,20 @@ def stance_of(
     declared: Sequence[str] | None = None,
     mesh: MeshVertices | None = None,
     payload: Payload | None = None,
+    floating: Callable[[], Robot] | None = None,
 ) -> Stance | NoStance:
     """The robot standing on its ground contacts, or why it cannot be analysed.
 
     `candidates`: the links that may touch the ground (a spec's mobile base; None: all).
     `declared`: the contact links, named by the user. Without either, a robot none of
     whose wheels touches the ground has a fixed base (an arm bolted down): no polygon.
+    `floating`: gives the URDF's floating, non-strict `Robot` when the caller's robot file
+    holds it (`robot.file.robot_of`: built once for `check` and `simulate` alike).
     """
     names = {lk.name for lk in urdf.links}
     if declared is None and candidates is not None and not names & set(candidates):
         return NoStance(FIXED_BASE)  # e.g. a spec's standalone arm: none of its base's links
-    robot = Robot.load(urdf, floating=True, strict=False)
+    robot = floating() if floating is not None else Robot.load(urdf, floating=True, strict=False)
     if declared is not None:
         unknown = [n for n in declared if n not in names]
         if unknown:

@@ -24,7 +24,7 @@ from armcli.errors import EXIT_FAILED, EXIT_OK, EXIT_UNUSABLE, InputError
 from armcli.io.yaml import load_yaml, read_text
 from armcli.urdf.doc import Urdf
 from armcli.urdf.read import parse_urdf
-from armcli.urdf.source import Trust, read_robot, read_urdf_file
+from armcli.urdf.source import RobotFile, Trust, read_robot, read_urdf_file
 from armcli.xacro.args import XacroInputs
 
 if TYPE_CHECKING:
@@ -70,15 +70,15 @@ class CheckRun:
 
 def _documents(
     path: Path, trust_xacro: Trust, inputs: XacroInputs | None = None
-) -> tuple[list[tuple[Urdf, RobotSpec | None]], list[Unusable]]:
-    """The URDF documents a PATH stands for, each with its spec (or None); the unusable files."""
+) -> tuple[list[tuple[Urdf, RobotFile | None]], list[Unusable]]:
+    """The URDF documents a PATH stands for, each with its file (or None); the unusable files."""
     if not path.is_dir():
         robot = read_robot(path, trust_xacro=trust_xacro, inputs=inputs)
-        return [(urdf, robot.spec) for urdf in robot.urdfs], []
+        return [(urdf, robot) for urdf in robot.urdfs], []
     files = sorted(p for p in path.rglob(URDF_GLOB) if p.is_file())
     if not files:
         raise InputError(f"no {URDF_GLOB} files under this directory", file=path)
-    docs: list[tuple[Urdf, RobotSpec | None]] = []
+    docs: list[tuple[Urdf, RobotFile | None]] = []
     bad: list[Unusable] = []
     for p in files:
         try:
@@ -114,10 +114,12 @@ def run_check(
             unusable.append(Unusable(str(path), exc, named=True))
             continue
         unusable.extend(bad)
-        spec_doc = load_yaml(path) if any(spec is not None for _, spec in docs) else None
+        has_spec = any(f is not None and f.spec is not None for _, f in docs)
+        spec_doc = load_yaml(path) if has_spec else None
         keys = key_lines(read_text(path)) if spec_doc is not None else {}
-        for urdf, spec in docs:
-            opts = replace(base, spec=spec) if spec is not None else base
+        for urdf, file in docs:
+            spec = file.spec if file is not None else None
+            opts = replace(base, spec=spec, robot_file=file) if spec is not None else base
             result = check_urdf(urdf, opts)
             if spec_doc is not None and spec is not None:  # point at the spec, not its URDF
                 found = locate(result.findings, urdf.text, spec_doc, keys)

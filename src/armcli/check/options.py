@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from armcli.urdf.meshes import MeshSearch
-from armcli.urdf.source import lookup_for
+from armcli.urdf.source import RobotFile, lookup_for
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -36,6 +36,7 @@ class CheckOptions:
     search_paths: tuple[Path, ...] = ()
     tipover: TipoverOptions = field(default_factory=TipoverOptions)
     ros_distro: str | None = None  # `--distro` for ROS packages (default: from their plugins)
+    robot_file: RobotFile | None = None  # the documents' file: its Robots are built once
 
     def mesh_search(self) -> MeshSearch:
         """The mesh-resolver view of these options (shared with view and render)."""

@@ -18,6 +18,7 @@ from armcli.analysis.ground import mesh_loader
 from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
 from armcli.check.context import Context, poses
 from armcli.check.findings import Collector, Value
+from armcli.robot.file import floating_of
 from armcli.robot.tool import tool_point
 
 NEAR_NAMED = 1e-3  # [m] a range's worst within this of a named pose's is that pose's finding
@@ -36,7 +37,7 @@ def check(c: Context) -> None:
 
 def stance_for(c: Context) -> Stance | None:
     """The robot on its ground contacts with the payload, or None (and a note) when it has none."""
-    opts, spec = c.opts.tipover, c.opts.spec
+    opts, spec, file = c.opts.tipover, c.opts.spec, c.opts.robot_file
     candidates = None
     if spec is not None and opts.contact_links is None:
         base = spec.mounted_base()
@@ -55,6 +56,7 @@ def stance_for(c: Context) -> Stance | None:
         declared=opts.contact_links,
         mesh=mesh_loader(c.urdf, c.opts.mesh_search(), missing),
         payload=Payload(opts.payload, link, xyz),
+        floating=None if file is None else floating_of(file, c.urdf),
     )
     if missing:
         c.notes.append(f"ground contacts: meshes not found, left out: {', '.join(missing)}")

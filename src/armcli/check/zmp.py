@@ -29,9 +29,11 @@ def check(c: Context) -> None:
                        "to be simulated (give --spec)")  # fmt: skip
         return
     from armcli.sim import armrun  # the simulator's stack: only with --trajectory (~60 ms)
+    from armcli.urdf.source import RobotFile
 
+    file = c.opts.robot_file if c.opts.robot_file is not None else RobotFile.of_spec(spec)
     try:
-        r = armrun.trajectory_zmp(spec, c.urdf, c.stance, opts.trajectory,
+        r = armrun.trajectory_zmp(file, c.urdf, c.stance, opts.trajectory,
                                    opts.base_accel, opts.min_margin)  # fmt: skip
     except ArmcliError as exc:
         c.notes.append(f"zero-moment point skipped: {exc}")

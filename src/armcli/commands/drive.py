@@ -10,7 +10,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from armcli.errors import ModelRefusedError
 from armcli.io import terminal
@@ -18,9 +18,12 @@ from armcli.io.outdir import existing, wrote
 from armcli.io.together import write_files_together
 from armcli.sim.options import SimOptions
 
+if TYPE_CHECKING:
+    from armcli.urdf.source import RobotFile
+
 
 def run_drive(
-    spec: Any,
+    file: RobotFile,
     opts: SimOptions,
     cmd_vel: Path,
     ignore: tuple[str, ...],
@@ -31,13 +34,15 @@ def run_drive(
 ) -> None:
     """Drive, write and report; raises TipOverError when the robot tips over."""
     from armcli.check.gate import refuse_check_errors
+    from armcli.check.options import CheckOptions
     from armcli.drive.api import drive_robot
     from armcli.sim import job as simjob
     from armcli.sim import report as simreport
 
     try:
-        driven = drive_robot(spec, opts, cmd_vel, progress=progress, world=world,
-                             gate=lambda u: refuse_check_errors(u, ignore=ignore))  # fmt: skip
+        driven = drive_robot(file, opts, cmd_vel, progress=progress, world=world,
+                             gate=lambda u: refuse_check_errors(u, CheckOptions(robot_file=file),
+                                                                ignore=ignore))  # fmt: skip
     except ModelRefusedError as exc:
         flags = " ".join(f"--ignore {r}" for r in exc.rules())
         raise ModelRefusedError(

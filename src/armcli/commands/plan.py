@@ -21,7 +21,7 @@ from armcli.io.terminal import say, say_line
 if TYPE_CHECKING:
     from armcli.plan.api import PlanResult
     from armcli.plan.execute import Execution
-    from armcli.urdf.source import RobotInput
+    from armcli.urdf.source import RobotFile, RobotInput
 
 FORMATS = ("text", "json")
 FROM_HELP = "Start: a named pose (spec poses, SRDF group states) or q1,q2,... [rad]."
@@ -146,7 +146,7 @@ def plan_cmd(
         write_file_atomic(output, result.document)
     done = None
     if execute:
-        done = _execute(robot_file, urdf, robot, result)
+        done = _execute(robot_file, robot, result)
     if fmt == "json":
         _json(_summary(result, output, planner, seed, done))
     else:
@@ -156,15 +156,11 @@ def plan_cmd(
         raise typer.Exit(1)
 
 
-def _execute(
-    robot_file: Any, urdf: Path | None, robot: RobotInput, result: PlanResult
-) -> Execution:
+def _execute(robot_file: RobotFile, robot: RobotInput, result: PlanResult) -> Execution:
     from armcli.plan.execute import execute
     from armcli.sim.options import SimOptions
 
-    opts = SimOptions(message=result.document.decode("utf-8"), urdf=urdf, trust_xacro=robot.trust,
-                      xacro=robot.xacro)  # fmt: skip
-    return execute(robot_file.spec, opts, robot.packages)
+    return execute(robot_file, SimOptions(message=result.document.decode("utf-8")), robot.packages)
 
 
 def _summary(

@@ -22,7 +22,7 @@ from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 if TYPE_CHECKING:  # the simulator is imported when the command runs: `--help` stays light
     from armcli.sim.armrun import ArmRun
     from armcli.sim.tipping import TipOptions
-    from armcli.urdf.source import RobotInput
+    from armcli.urdf.source import RobotFile, RobotInput
 
 INTEGRATOR_HELP = "Semi-implicit Euler (default) or RK4."
 GRAVITY_HELP = "Add g(q) to the PD torque (default: the spec's control.gravity_compensation)."
@@ -129,16 +129,10 @@ def simulate_cmd(
         check_output_file(output, "--output", read)  # never over an input (issue 42)
     if plot is not None:
         check_png_file(plot, "--plot", read)
-    spec_path, spec_obj = None, None
-    if robot.path is not None or urdf is None:  # the spec layers are imported only for a spec
-        from armcli.spec.load import load_spec
-
-        spec_path = robot.file()
-        spec_obj = load_spec(spec_path)
+    file, spec_path = _robot_file(robot, urdf)
     opts = SimOptions(
         trajectory=trajectory,
         message=message,
-        urdf=urdf,
         joints=joints or None,
         kp=kp,
         kd=kd,
@@ -148,23 +142,36 @@ def simulate_cmd(
         duration=duration,
         clamp=clamp,
         rate=rate,
-        trust_xacro=robot.trust,
-        xacro=robot.xacro,
     )
     tip_opts = TipOptions(base_accel, payload, payload_link, contact_links)
     if cmd_vel is not None:
-        _drive(spec_obj, opts, cmd_vel, world, tuple(ignore), output, plot,
+        _drive(file, opts, cmd_vel, world, tuple(ignore), output, plot,
                tip_opts != TipOptions())  # fmt: skip
         return
     asked = tip_opts != TipOptions()  # an arm on a fixed base is news only when asked about
     with _LazyProgress(terminal.console(sys.stderr)) as progress:
-        run = _simulate(spec_obj, spec_path, opts, tip_opts, robot, tuple(ignore), progress,
+        run = _simulate(file, spec_path, opts, tip_opts, robot, tuple(ignore), progress,
                         plot is not None, world)  # fmt: skip
     _report(run, output, plot, asked)
 
 
+def _robot_file(robot: RobotInput, urdf: Path | None) -> tuple[RobotFile, Path | None]:
+    """The robot file, read once, and the spec's path (None without a spec).
+
+    The spec, or `--urdf`'s file run with the settings of a spec named beside it.
+    """
+    if urdf is None:
+        return robot.read(), robot.file()
+    file = robot.read(urdf)
+    if robot.path is None:
+        return file, None
+    from armcli.spec.load import load_spec  # the spec layers: only for a spec
+
+    return file.with_spec(load_spec(robot.path)), robot.path
+
+
 def _simulate(
-    spec: Any, spec_path: Path | None, opts: SimOptions, tip_opts: TipOptions,
+    file: RobotFile, spec_path: Path | None, opts: SimOptions, tip_opts: TipOptions,
     robot: RobotInput, ignore: tuple[str, ...], progress: _LazyProgress, plot: bool,
     world: Path | None,
 ) -> ArmRun:  # fmt: skip
@@ -173,14 +180,16 @@ def _simulate(
     A model `check` reports as an error is not simulated (same rule ids), unless ignored.
     """
     from armcli.check.gate import bears_on_balance, refuse_check_errors
+    from armcli.check.options import CheckOptions
     from armcli.sim.armrun import simulate_arm
 
     try:
         return simulate_arm(
-            spec, opts, tip_opts, robot.packages,
-            gate=lambda doc: refuse_check_errors(doc, ignore=ignore),
-            balance_gate=lambda doc: refuse_check_errors(doc, ignore=ignore,
-                                                         only=bears_on_balance),
+            file, opts, tip_opts, robot.packages,
+            gate=lambda doc: refuse_check_errors(doc, CheckOptions(robot_file=file),
+                                                 ignore=ignore),
+            balance_gate=lambda doc: refuse_check_errors(doc, CheckOptions(robot_file=file),
+                                                         ignore=ignore, only=bears_on_balance),
             progress=progress, plot=plot, world=world,
         )  # fmt: skip
     except ModelRefusedError as exc:
@@ -205,7 +214,7 @@ def _sources(spec_path: Path | None, opts: SimOptions) -> dict[str, Any]:
 
 
 def _drive(
-    spec: Any, opts: SimOptions, cmd_vel: Path, world: Path | None, ignore: tuple[str, ...],
+    file: RobotFile, opts: SimOptions, cmd_vel: Path, world: Path | None, ignore: tuple[str, ...],
     output: Path | None, plot: Path | None, tip_asked: bool,
 ) -> None:  # fmt: skip
     """The whole robot on its wheels (commands.drive); the base-at-rest options do not apply."""
@@ -218,7 +227,7 @@ def _drive(
             field="--cmd-vel",
         )
     with _LazyProgress(terminal.console(sys.stderr)) as progress:
-        run_drive(spec, opts, cmd_vel, ignore, output, plot, progress, world)
+        run_drive(file, opts, cmd_vel, ignore, output, plot, progress, world)
 
 
 def _report(run: ArmRun, output: Path | None, plot: Path | None, asked: bool) -> None:

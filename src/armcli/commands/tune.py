@@ -107,6 +107,7 @@ def tune_cmd(
     from armcli.tune.engine import make_engine
     from armcli.tune.search import SearchOptions, validate
     from armcli.tune.write import check_writable
+    from armcli.urdf.source import RobotFile
 
     with flag_errors(flags()):
         spec_path = robot.file()
@@ -132,7 +133,8 @@ def tune_cmd(
             (friction_scale[0], friction_scale[1]),
             seed,
         )
-        job = tjob.prepare(load_spec(spec_path), spec_path, trajectory or [], settings)
+        file = RobotFile.of_spec(load_spec(spec_path), spec_path)  # compiled once
+        job = tjob.prepare(file, trajectory or [], settings)
         engine = make_engine(
             jobs if jobs is not None else (os.cpu_count() or 1),
             scheduler,

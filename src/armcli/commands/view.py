@@ -142,18 +142,15 @@ def _session(
     robot: RobotInput,
 ) -> PlanningSession | None:
     """The planning panel's session; a robot that cannot be planned for gets none (a note)."""
-    from armcli.sim.options import SimOptions
     from armcli.view.planning import load_session
 
     scene, srdf, joints, group = planning
     if not save_dir.is_dir():
         raise InputError(f"{save_dir} is not a directory", field="--save-dir")
     assert src.file is not None
-    sim = SimOptions(urdf=None if src.file.spec else src.file.path, trust_xacro=robot.trust,
-                     xacro=robot.xacro)  # fmt: skip
     try:
         session = load_session(src.file, srdf=srdf, scene=scene, joints=joints, group=group,
-                               search=src.search, sim=sim, save_dir=save_dir)  # fmt: skip
+                               search=src.search, save_dir=save_dir)  # fmt: skip
     except InputError as exc:
         if any(given is not None for given in planning):  # asked for planning: refuse
             raise

@@ -11,20 +11,16 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from armcli.analysis.liftoff import TipVerdict
 from armcli.drive import job as drive
 from armcli.drive import output as driveout
 from armcli.drive.job import DriveJob, DriveRun
-from armcli.errors import InputError
 from armcli.io.scene import Scene
 from armcli.sim.options import SimOptions
 from armcli.sim.simulate import SimResult
 from armcli.urdf.doc import Urdf
-
-if TYPE_CHECKING:
-    from armcli.spec.model import RobotSpec
+from armcli.urdf.source import RobotFile
 
 
 @dataclass(frozen=True)
@@ -59,7 +55,7 @@ class Driven:
 
 
 def drive_robot(
-    spec: RobotSpec | None,
+    file: RobotFile,
     opts: SimOptions,
     cmd_vel: Path,
     *,
@@ -68,18 +64,12 @@ def drive_robot(
     world: Path | Scene | None = None,
     sensors: bool = True,
 ) -> Driven:
-    """Drive the spec's whole robot by the /cmd_vel commands in `cmd_vel` (drive.job).
+    """Drive a spec's whole robot (`file`) by the /cmd_vel commands in `cmd_vel` (drive.job).
 
     `world`: a scene file (or Scene) of obstacles in the world frame (sim.world);
     `sensors`: simulate the spec's sensors (sim.sensors).
     """
-    if spec is None or opts.urdf is not None:
-        raise InputError(
-            "drives a spec's robot (its mobile_base.diff_drive); give a spec instead of "
-            "`SimOptions.urdf`",
-            field="cmd_vel",
-        )
-    job = drive.prepare(spec, opts, cmd_vel, gate=gate, world=world, sensors=sensors)
+    job = drive.prepare(file, opts, cmd_vel, gate=gate, world=world, sensors=sensors)
     warnings = (*job.arm.trajectory.warnings, *job.cmd.warnings, *job.model.notes)
     run = drive.run(job, progress)
     warnings = (*warnings, *run.notes)

@@ -30,15 +30,17 @@ from armcli.drive.model import DriveModel, build_drive_model
 from armcli.drive.wheelmotor import clutch_torque, spin
 from armcli.errors import InputError, SimulationError
 from armcli.io.scene import Scene
+from armcli.robot.file import floating_of
 from armcli.sim import job as simjob
 from armcli.sim.job import SimJob
 from armcli.sim.options import SimOptions
 from armcli.sim.sensors.reading import Reading
 from armcli.sim.sensors.rig import make_rig
 from armcli.sim.simulate import steps_of
-from armcli.sim.tipping import robot_urdf
+from armcli.sim.tipping import whole_robot
 from armcli.sim.world import load_world, refuse_overlaps
 from armcli.urdf.doc import Urdf
+from armcli.urdf.source import RobotFile
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
@@ -69,7 +71,7 @@ class DriveJob:
 
 
 def prepare(
-    spec: RobotSpec,
+    file: RobotFile,
     opts: SimOptions,
     cmd_vel: Path,
     *,
@@ -80,6 +82,7 @@ def prepare(
 ) -> DriveJob:
     """Validate the inputs and build the model; InputError names what is wrong.
 
+    `file`: a spec's robot file (`RobotFile.of_spec`; the drive runs its whole robot).
     Without a trajectory the arm holds its start pose. `gate` sees the whole robot's URDF
     first and may refuse it (the command passes check.gate.refuse_check_errors). `world`:
     a scene file (or its Scene) whose objects the robot drives among (sim.world); one the
@@ -87,16 +90,13 @@ def prepare(
     `params`: the diff drive when the spec's `mobile_base.diff_drive` does not state it (a
     URDF's plugin kept verbatim by import).
     """
+    spec = _driven_spec(file)
     params = params if params is not None else DriveParams.of(spec)
     cmd = load_cmd_vel(cmd_vel)
     rate = opts.rate if opts.rate is not None else params.update_rate
-    if opts.trajectory is None and opts.message is None:
-        opts = replace(opts, message=_hold_message(spec, opts))
     hold = opts.duration if opts.duration is not None else 1.0  # 0 is refused, as elsewhere
-    job = simjob.prepare(spec, replace(opts, rate=rate, duration=hold))
-    robot = robot_urdf(spec, job)
-    if robot is None:
-        raise InputError("the spec has no whole robot to drive", field="mobile_base")
+    job = simjob.prepare(file, replace(opts, rate=rate, duration=hold), hold=True)
+    robot = whole_robot(file)
     if gate is not None:
         gate(robot)
     duration = opts.duration
@@ -109,7 +109,8 @@ def prepare(
             field="SimOptions.duration",
         )
     job = replace(job, duration=float(duration))
-    stance = stance_of(robot, candidates=set(spec.mobile_base.links) if spec.mobile_base else None)
+    links = set(spec.mobile_base.links) if spec.mobile_base else None
+    stance = stance_of(robot, candidates=links, floating=floating_of(file, robot))
     if isinstance(stance, NoStance):
         raise InputError(f"the robot cannot stand: {stance.reason}", field="mobile_base")
     n = len(job.robot.names)
@@ -138,14 +139,12 @@ def start_data(dm: DriveModel, q0: np.ndarray) -> Any:
     return d
 
 
-def _hold_message(spec: RobotSpec, opts: SimOptions) -> str:
-    """A one-point trajectory at the start pose: the arm holds still."""
-    import yaml
-
-    arm = simjob.load_arm(spec, None, opts.joints)
-    q0 = simjob.start_state(arm, spec)
-    point = {"positions": [float(x) for x in q0], "time_from_start": 0.0}
-    return str(yaml.safe_dump({"joint_names": list(arm.names), "points": [point]}))
+def _driven_spec(file: RobotFile) -> RobotSpec:
+    """The spec whose whole robot drives; InputError for a URDF (no diff drive to run)."""
+    if file.spec is None or not file.compiled:
+        raise InputError("drives a spec's robot (its mobile_base.diff_drive); give a spec "
+                         "instead of a URDF", field="cmd_vel")  # fmt: skip
+    return file.spec
 
 
 @dataclass(frozen=True)

@@ -31,6 +31,7 @@ from armcli.plan.ik import IkResult, solve_ik
 from armcli.plan.output import read_back, trajectory_yaml
 from armcli.plan.robot import PlanRobot
 from armcli.plan.timing import Timed, parameterise
+from armcli.robot.frames import rpy_rotation
 
 # TOPP-RA limit scales tried until the certification passes: the output spline overshoots
 # an acceleration jump by up to ~27 % (plan.timing); a stop at a corner of the path is a
@@ -217,8 +218,6 @@ def solve_goal(
     an arm of 6 or more joints keeps the start's tool orientation and a smaller arm solves
     for the position only. PlanningError("ik") says the closest distance reached.
     """
-    import pinocchio as pin
-
     robot = ctx.robot
     target = np.asarray(list(xyz), dtype=float)
     if target.shape != (3,) or not np.all(np.abs(target) <= MAX_COORDINATE_M):  # NaN too
@@ -230,7 +229,7 @@ def solve_goal(
         r = np.asarray(list(rpy), dtype=float)
         if r.shape != (3,) or not np.all(np.isfinite(r)):
             raise InputError("give r,p,y: three finite numbers [rad]", field="to-rpy")
-        rotation = np.asarray(pin.rpy.rpyToMatrix(*r))
+        rotation = rpy_rotation(r)
     elif len(robot.joints) >= 6 and x0 is not None:
         from armcli.plan.ik import tool_pose
 

@@ -28,6 +28,7 @@ import numpy as np
 from armcli.plan.api import PlanningContext
 from armcli.plan.collision import CollisionChecker
 from armcli.plan.ik import solve_ik, tool_pose
+from armcli.robot.frames import rpy_rotation
 
 GRID_MAX_JOINTS = 3
 GRID_CELLS = 4096  # the grid's size in all: 64 per joint for 2 joints, 16 for 3
@@ -169,12 +170,10 @@ def reached_in_collision(
     IK again, with the same target, orientation rule (plan.api.solve_goal) and seed but
     collisions allowed; None when even that does not reach the point (it is out of reach).
     """
-    import pinocchio as pin
-
     robot = ctx.robot
     rotation = None
     if rpy is not None:
-        rotation = np.asarray(pin.rpy.rpyToMatrix(*(float(a) for a in rpy)))
+        rotation = rpy_rotation(rpy)
     elif len(robot.joints) >= 6:
         rotation = tool_pose(robot, start)[1]
     res = solve_ik(robot, np.asarray(list(xyz), dtype=float), rotation, seed_x=start, seed=seed)

@@ -22,6 +22,7 @@ from armcli.sim.armrun import run_balanced
 from armcli.sim.options import SimOptions
 from armcli.sim.states import Replay
 from armcli.urdf.meshes import MeshSearch
+from armcli.urdf.source import RobotFile
 
 if TYPE_CHECKING:
     from armcli.sim.simulate import SimResult
@@ -63,13 +64,14 @@ def check_executable(spec: RobotSpec | None) -> None:
                          "-t PLAN`", field="execute")  # fmt: skip
 
 
-def execute(
-    spec: RobotSpec | None, opts: SimOptions, search: MeshSearch | None = None
-) -> Execution:
-    """Simulate `opts.message` (the plan's document) and judge it; see the module docstring."""
-    job = simjob.prepare(spec, opts)
+def execute(file: RobotFile, opts: SimOptions, search: MeshSearch | None = None) -> Execution:
+    """Simulate `opts.message` (the plan's document) and judge it; see the module docstring.
+
+    `file`: the robot file the plan was made for (its Robots are built once for both).
+    """
+    job = simjob.prepare(file, opts)
     notes: list[str] = []
-    tip = tipping.prepare(spec, job, tipping.TipOptions(), search or MeshSearch(), notes)
+    tip = tipping.prepare(file, job, tipping.TipOptions(), search or MeshSearch(), notes)
     run = run_balanced(job, tip, every_step=True)
     res = run.result
     metrics = tuple(simreport.joint_metrics(res, job.trajectory.duration))

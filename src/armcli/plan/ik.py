@@ -54,19 +54,14 @@ class _Solver:
 
     def error(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Task error and Jacobian (world-aligned, at the tool point) w.r.t. planned joints."""
-        pin, robot = self.pin, self.robot
-        q = robot.q(x)
-        J6 = pin.computeFrameJacobian(
-            robot.model, self.data, q, robot.tool_frame, pin.LOCAL_WORLD_ALIGNED
-        )
-        M = self.data.oMf[robot.tool_frame]
-        r = M.rotation @ robot.tool_offset
-        p = M.translation + r
-        Jv = J6[:3] + _cross_cols(J6[3:], r)  # v_point = v_frame + ω × r
+        robot = self.robot
+        p, r, J6 = robot.robot.frame_jacobian(robot.q(x))  # the tool point, its lever arm
+        Jv = J6[:3] + np.cross(J6[3:].T, r).T  # v_point = v_frame + ω × r
         e = self.xyz - p
         if self.rotation is None:
             return e, self.cols(Jv)
-        e_rot = pin.log3(self.rotation @ M.rotation.T)
+        R = self.data.oMf[robot.tool_frame].rotation  # placed by the Jacobian's kinematics
+        e_rot = self.pin.log3(self.rotation @ R.T)
         return np.concatenate([e, e_rot]), self.cols(np.vstack([Jv, J6[3:]]))
 
     def run(self, x0: np.ndarray) -> tuple[np.ndarray, float, float]:
@@ -85,11 +80,6 @@ class _Solver:
             x = np.clip(x + dx, lo, hi)
         e, _ = self.error(x)
         return x, float(np.linalg.norm(e[:3])), float(np.linalg.norm(e[3:]))
-
-
-def _cross_cols(Jw: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """ω × r for each column ω of Jw (3, nv): the tool point's extra linear velocity."""
-    return np.cross(Jw.T, r).T
 
 
 def _columns(robot: PlanRobot) -> Callable[[np.ndarray], np.ndarray]:

@@ -107,6 +107,17 @@ def rpy_matrix(rpy: Sequence[float]) -> Matrix:
     )
 
 
+def rpy_rotation(rpy: Sequence[float] | NDArray[np.float64]) -> Matrix:
+    """`rpy_matrix` as Pinocchio computes it (`pin.rpy.rpyToMatrix`), bit for bit.
+
+    The orientation goal of `plan --to-rpy`: Eigen's angle-axis product, which the plans
+    were made with (the closed form differs in the last bits, and so would the plans).
+    """
+    import pinocchio as pin
+
+    return np.asarray(pin.rpy.rpyToMatrix(*(float(a) for a in rpy)), dtype=float)
+
+
 def pose_matrix(xyz: Sequence[float], rpy: Sequence[float]) -> Matrix:
     """The 4x4 transform of a URDF origin (`xyz` [m], `rpy` [rad])."""
     T = np.eye(4)

@@ -91,8 +91,24 @@ class Kinematics:
 
         Default point: the tool point. Rows 0-2: the point's velocity, rows 3-5: the link's
         angular velocity, in the root frame's axes, per joint velocity of `columns` (default:
-        all nv). Pinocchio's LOCAL_WORLD_ALIGNED frame Jacobian moves the frame's origin;
-        the point adds the lever arm r = R xyz: v_point = v_origin + ω × r = v_origin - [r]× ω.
+        all nv). The point adds the lever arm r to the frame's (`frame_jacobian`):
+        v_point = v_origin + ω × r = v_origin - [r]× ω.
+        """
+        p, r, J = self.frame_jacobian(q, link, xyz)
+        if columns is not None:
+            J = J[:, list(columns)]
+        skew = np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
+        return p, np.vstack([J[:3] - skew @ J[3:], J[3:]])
+
+    def frame_jacobian(
+        self, q: ArrayLike, link: str | None = None, xyz: ArrayLike = (0.0, 0.0, 0.0)
+    ) -> tuple[Vector, Vector, NDArray[np.float64]]:
+        """(point [m], lever arm r = R xyz [m], the link frame's (6, nv) Jacobian) at q.
+
+        The point fixed at `xyz` in `link` (default: the tool point) and Pinocchio's
+        LOCAL_WORLD_ALIGNED frame Jacobian of its link's origin, for a caller that composes
+        the point's own (`jacobian`; plan's IK as v + ω × r). The link's pose is then in
+        `data.oMf`.
         """
         import pinocchio as pin
 
@@ -103,13 +119,9 @@ class Kinematics:
             fid = self.frame(link)
         J6 = pin.computeFrameJacobian(self.model, self.data, _q(q), fid, pin.LOCAL_WORLD_ALIGNED)
         J = np.asarray(J6, dtype=float).reshape(6, -1)  # nv = 1 comes back 1-D
-        if columns is not None:
-            J = J[:, list(columns)]
         T = self.data.oMf[fid]
         r = np.asarray(T.rotation, dtype=float) @ np.asarray(xyz, dtype=float)
-        p = np.asarray(T.translation, dtype=float) + r
-        skew = np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
-        return p, np.vstack([J[:3] - skew @ J[3:], J[3:]])
+        return np.asarray(T.translation, dtype=float) + r, r, J
 
     def mass_matrix(self, q: ArrayLike) -> NDArray[np.float64]:
         """M(q) [kg·m² or kg], the whole symmetric matrix (CRBA fills only the upper triangle)."""

@@ -29,12 +29,12 @@ from armcli.sim.simulate import SimResult
 from armcli.sim.world import load_world
 from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import MeshSearch
+from armcli.urdf.source import RobotFile
 
 if TYPE_CHECKING:
     from armcli.analysis.stance import Stance
     from armcli.analysis.zmp import ZmpSeries
     from armcli.sim.tipping import Tipping, ZmpReport
-    from armcli.spec.model import RobotSpec
     from armcli.spec.sensors import Sensor
 
 Gate = Callable[[Urdf], None]  # refuses a model (ModelRefusedError): check's error rules
@@ -102,7 +102,7 @@ def run_balanced(
 
 
 def trajectory_zmp(
-    spec: RobotSpec,
+    file: RobotFile,
     urdf: Urdf,
     stance: Stance,
     trajectory: Path,
@@ -114,7 +114,7 @@ def trajectory_zmp(
     What `simulate` reports, for `check --trajectory`. Raises what `sim.job.prepare` raises
     (bad trajectory, gains the integrator refuses) and SimulationError.
     """
-    job = simjob.prepare(spec, SimOptions(trajectory=trajectory))
+    job = simjob.prepare(file, SimOptions(trajectory=trajectory))
     accel, source = tipping.base_acceleration(tipping.TipOptions(base_accel=base_accel), urdf)
     run = run_balanced(job, tipping.Tipping(stance, accel, source, threshold))
     assert run.balance is not None  # a Tipping was given
@@ -122,7 +122,7 @@ def trajectory_zmp(
 
 
 def simulate_arm(
-    spec: RobotSpec | None,
+    file: RobotFile,
     opts: SimOptions,
     balance: tipping.TipOptions | None = None,
     search: MeshSearch | None = None,
@@ -133,7 +133,7 @@ def simulate_arm(
     plot: bool = False,
     world: Path | Scene | None = None,
 ) -> ArmRun:
-    """Prepare and run `opts` (the spec's arm, or `opts.urdf`) with its zero-moment point.
+    """Prepare and run `opts` (`file.arm`: the spec's arm or a URDF) with its zero-moment point.
 
     `gate` refuses the simulated model and, for a spec's arm on a base, the whole robot;
     `balance_gate` refuses the whole robot when only its balance is at stake (the base's
@@ -142,19 +142,19 @@ def simulate_arm(
     The spec's sensors on the arm's links are sampled from the run (sim.sensors.armsense),
     among `world`'s objects (seen, not touched).
     """
-    job = simjob.prepare(spec, opts, gate=gate)
-    whole = tipping.robot_urdf(spec, job)  # parsed once: the gate and the balance read it
-    if spec is not None and opts.urdf is None:  # a spec's whole robot, as `check` sees it
-        if whole is not None and whole is not job.urdf and balance_gate is not None:
+    job = simjob.prepare(file, opts, gate=gate)
+    whole = tipping.whole_robot(file)
+    if file.compiled:  # a spec's whole robot, as `check` sees it
+        if whole is not job.urdf and balance_gate is not None:
             balance_gate(whole)
-        elif whole is not None and gate is not None:
+        elif gate is not None:
             gate(whole)
     _refuse_too_fast(job, opts)
     notes: list[str] = []
-    tip = tipping.prepare(spec, job, balance or tipping.TipOptions(), search or MeshSearch(),
-                          notes, whole)  # fmt: skip
+    tip = tipping.prepare(file, job, balance or tipping.TipOptions(), search or MeshSearch(),
+                          notes)  # fmt: skip
     warnings = (*precheck.holding_problems(job), *job.trajectory.warnings)
-    sensors, scene = _arm_sensing(spec, opts, job, world)
+    sensors, scene = _arm_sensing(file, job, world)
     also = (lambda steps: sensor_steps(sensors, steps, job.config.dt)) if sensors else None
     run = run_balanced(job, tip, progress, plot=plot, also=also)
     readings: tuple[Reading, ...] = ()
@@ -166,10 +166,11 @@ def simulate_arm(
 
 
 def _arm_sensing(
-    spec: RobotSpec | None, opts: SimOptions, job: SimJob, world: Path | Scene | None
+    file: RobotFile, job: SimJob, world: Path | Scene | None
 ) -> tuple[dict[str, Sensor], Scene | None]:
     """The spec's sensors the simulated arm carries, and the world they see (read here)."""
-    if spec is None or opts.urdf is not None or job.urdf is None:
+    spec = file.spec
+    if spec is None or not file.compiled or job.urdf is None:
         return {}, None
     if isinstance(world, Path):
         world = load_world(world, [lk.name for lk in job.urdf.links])

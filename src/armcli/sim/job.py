@@ -8,13 +8,13 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from armcli.defaults import DEFAULT_DT, DEFAULT_STATE_RATE_HZ, STANDALONE_ARM_URDF
 from armcli.errors import InputError
+from armcli.robot.file import robot_of
 from armcli.robot.frames import pose_matrix
 from armcli.robot.mimic import Mimic
 from armcli.robot.model import Robot
@@ -34,15 +34,14 @@ from armcli.spec.types import time_step
 from armcli.trajectory.message import Trajectory, load_trajectory, loads_trajectory
 from armcli.trajectory.reference import Reference, build_reference, coupled
 from armcli.urdf.doc import Urdf
-from armcli.urdf.read import parse_urdf
-from armcli.urdf.source import Trust, read_urdf_file, spec_urdfs
-from armcli.xacro.args import XacroInputs
+from armcli.urdf.source import RobotFile
 
 if TYPE_CHECKING:
     from armcli.spec.model import RobotSpec
 
 SETTLE_EXTRA_S = 2.0  # [s] simulated after the last trajectory point by default
 ARM_URDF = STANDALONE_ARM_URDF
+HOLD = "<the start pose>"  # the source of the trajectory a held arm tracks (`prepare(hold=)`)
 RATE_SLACK = 1e-9  # relative: --rate 1000 with dt 0.001 is exactly one sample per step
 
 
@@ -61,41 +60,6 @@ class SimJob:
     T_frame_root: np.ndarray  # 4x4 pose of the arm's root link in the reporting frame
     notes: tuple[str, ...] = ()  # what reading a xacro --urdf reported (Urdf.notes)
     urdf: Urdf | None = None  # the simulated description (an MCAP's /robot_description, /tf)
-
-
-def arm_urdf(
-    spec: RobotSpec | None,
-    urdf: Path | None,
-    *,
-    trust_xacro: Trust = False,
-    inputs: XacroInputs | None = None,
-) -> Urdf:
-    """The URDF to simulate: a given file or the spec's standalone arm built in memory.
-
-    A given file goes through the strict reader (a xacro file in safe mode unless trusted,
-    with `inputs`' arguments).
-    """
-    if urdf is not None:
-        return read_urdf_file(urdf, trust_xacro=trust_xacro, inputs=inputs)
-    if spec is None:
-        raise InputError("give a spec or `SimOptions.urdf`", field="SimOptions.urdf")
-    return parse_urdf(spec_urdfs(spec)[ARM_URDF], ARM_URDF)
-
-
-def load_arm(
-    spec: RobotSpec | None,
-    urdf: Path | None,
-    joints: Sequence[str] | None,
-    *,
-    trust_xacro: Trust = False,
-) -> Robot:
-    """The simulated arm: the spec's standalone arm built in memory, or a given URDF.
-
-    A given URDF goes through the same strict reader as `check` (no DOCTYPE, finite
-    numbers, no foreign xacro without trust), since Pinocchio alone would simulate
-    mass="nan" as 0 kg.
-    """
-    return simulated(Robot.load(arm_urdf(spec, urdf, trust_xacro=trust_xacro), spec=spec), joints)
 
 
 def mimic_pairs(
@@ -206,6 +170,22 @@ def start_state(robot: Robot, spec: RobotSpec | None) -> np.ndarray:
     return np.asarray(np.clip(q, robot.lower, robot.upper), dtype=float)
 
 
+def _within(traj: Trajectory, limits: dict[str, tuple[float, float]]) -> Trajectory:
+    """A trajectory handed over as an object, refused (InputError) where a file would be.
+
+    Unknown joints and positions outside the limits; the caller built it from this robot.
+    """
+    for i, name in enumerate(traj.joint_names):
+        if name not in limits:
+            raise InputError(f"unknown joint {name!r}; valid: {', '.join(limits)}",
+                             file=traj.source, field="joint_names")  # fmt: skip
+        lo, hi = limits[name]
+        if not np.all((traj.positions[:, i] >= lo) & (traj.positions[:, i] <= hi)):
+            raise InputError(f"{name} leaves its range [{lo:g}, {hi:g}]", file=traj.source,
+                             field="positions")  # fmt: skip
+    return traj
+
+
 def _duration_and_rate(
     spec: RobotSpec | None, opts: SimOptions, t_last: float, dt: float
 ) -> tuple[float, float]:
@@ -248,38 +228,30 @@ def base_joints(spec: RobotSpec | None) -> dict[str, str]:
 
 
 def prepare(
-    spec: RobotSpec | None, opts: SimOptions, *, gate: Callable[[Urdf], None] | None = None
+    file: RobotFile,
+    opts: SimOptions,
+    *,
+    gate: Callable[[Urdf], None] | None = None,
+    hold: bool = False,
 ) -> SimJob:
     """Validate every input and assemble the run; raises InputError on bad input.
 
-    `gate` sees a given URDF (`--urdf`) before it is simulated and may refuse it
-    (the simulate command passes check.gate.refuse_check_errors).
+    What runs is `file.arm` (a spec's standalone arm, or a URDF file) with the file's
+    spec's settings (gains, dt, home). `gate` sees a URDF file (`--urdf`) before it is
+    simulated and may refuse it (the simulate command passes check.gate.refuse_check_errors).
+    `hold`: without a trajectory the arm holds its start pose (the drive's arm).
     """
-    trajectory, message, dt = opts.trajectory, opts.message, opts.dt
-    if (trajectory is None) == (message is None):
-        raise InputError(
-            "give exactly one of `SimOptions.trajectory` (a file) or `SimOptions.message`",
-            field="SimOptions.trajectory",
-        )
+    spec, dt = file.spec, opts.dt
+    if not (hold and opts.trajectory is None and opts.message is None):
+        _one_trajectory(opts)
     dt_field = "SimOptions.dt" if dt is not None else "control.dt"  # else the spec's, checked
     dt = dt if dt is not None else (spec.control.dt if spec is not None else DEFAULT_DT)
     dt = time_step(dt, dt_field)
-    doc = arm_urdf(spec, opts.urdf, trust_xacro=opts.trust_xacro, inputs=opts.xacro)
-    whole = Robot.load(doc, spec=spec, gate=gate if opts.urdf else None)
+    doc = file.arm
+    whole = robot_of(file, doc, gate=None if file.compiled else gate)
     robot = simulated(whole, opts.joints)
-    limits = {
-        n: (float(lo), float(hi))
-        for n, lo, hi in zip(robot.names, robot.lower, robot.upper, strict=True)
-    }
-    others = base_joints(spec)
-    if trajectory is not None:
-        traj = load_trajectory(trajectory, limits, clamp=opts.clamp, others=others)
-    else:
-        traj = loads_trajectory(
-            str(message), limits, source="SimOptions.message", clamp=opts.clamp, others=others
-        )
-    source = str(trajectory) if trajectory else "SimOptions.message"
-    pairs = mimic_pairs(whole.mimics, robot, traj, source)
+    traj = _trajectory(robot, spec, opts)
+    pairs = mimic_pairs(whole.mimics, robot, traj, traj.source)
     q0 = start_state(robot, spec)
     for f, lead, m in pairs:
         q0[f] = np.clip(m.position(q0[lead]), robot.lower[f], robot.upper[f])
@@ -301,6 +273,38 @@ def prepare(
     label, T_frame_root = _report_frame(robot, spec)
     return SimJob(robot, traj, ref, q0, total, cfg, label, float(rate), T_frame_root, doc.notes,
                   doc)  # fmt: skip
+
+
+def _one_trajectory(opts: SimOptions) -> None:
+    if (opts.trajectory is None) == (opts.message is None):
+        raise InputError(
+            "give exactly one of `SimOptions.trajectory` (a file) or `SimOptions.message`",
+            field="SimOptions.trajectory",
+        )
+
+
+def _trajectory(robot: Robot, spec: RobotSpec | None, opts: SimOptions) -> Trajectory:
+    """What the arm tracks: a file, a message, a `Trajectory` handed over, else its start.
+
+    The start pose held is built here as an object (the drive without a trajectory), not
+    written as YAML text and read back.
+    """
+    trajectory, message = opts.trajectory, opts.message
+    if trajectory is None and message is None:
+        q0 = start_state(robot, spec)
+        return Trajectory(robot.names, np.zeros(1), q0[None, :], None, None, source=HOLD)
+    limits = {
+        n: (float(lo), float(hi))
+        for n, lo, hi in zip(robot.names, robot.lower, robot.upper, strict=True)
+    }
+    if isinstance(trajectory, Trajectory):
+        return _within(trajectory, limits)
+    others = base_joints(spec)
+    if trajectory is not None:
+        return load_trajectory(trajectory, limits, clamp=opts.clamp, others=others)
+    return loads_trajectory(
+        str(message), limits, source="SimOptions.message", clamp=opts.clamp, others=others
+    )
 
 
 def tool_position(job: SimJob, q: np.ndarray) -> np.ndarray:

@@ -1,4 +1,7 @@
-"""What a simulate run is told besides the spec: built once (by the CLI or a caller), passed down.
+"""What a simulate run is told besides its robot file: built once (by the CLI or a caller).
+
+The robot (a spec's standalone arm or a URDF file, read once) is the `RobotFile` handed
+beside these options; they hold no file path to read it again.
 
 A frozen dataclass with `Literal` choices, so a typo in an integrator name is a type error
 for library callers and a listed choice in `armcli simulate --help`.
@@ -13,8 +16,7 @@ from typing import TYPE_CHECKING, Literal, get_args
 from armcli.errors import InputError
 
 if TYPE_CHECKING:
-    from armcli.urdf.source import Trust
-    from armcli.xacro.args import XacroInputs
+    from armcli.trajectory.message import Trajectory
 
 Integrator = Literal["euler", "rk4"]
 """euler: semi-implicit Euler, Kd and damping implicit (first order; symplectic only for a
@@ -28,9 +30,9 @@ class SimOptions:
     """Options of one simulate run; None means "take it from the spec" (or the default).
 
     Attributes:
-        trajectory: JointTrajectory YAML file (exactly one of trajectory / message).
+        trajectory: JointTrajectory YAML file, or a `Trajectory` a library call built
+            (exactly one of trajectory / message).
         message: JointTrajectory as YAML text.
-        urdf: simulate this URDF instead of the spec's standalone arm.
         joints: joints to move; the others are locked at their start value.
         kp: P gain(s) [N·m/rad or N/m]: one value for all joints or one per joint.
         kd: D gain(s) [N·m·s/rad or N·s/m], same shape rule as kp.
@@ -40,13 +42,10 @@ class SimOptions:
         duration: simulated time [s] (default: last point + settle time).
         clamp: clamp trajectory positions outside the limits instead of refusing.
         rate: joint-state output rate [Hz].
-        trust_xacro: expand a foreign xacro file given as `urdf` in the sandbox.
-        xacro: a xacro `urdf`'s NAME:=VALUE arguments, --env values and package lookup.
     """
 
-    trajectory: Path | None = None
+    trajectory: Path | Trajectory | None = None
     message: str | None = None
-    urdf: Path | None = None
     joints: tuple[str, ...] | None = None
     kp: tuple[float, ...] | None = None
     kd: tuple[float, ...] | None = None
@@ -56,8 +55,6 @@ class SimOptions:
     duration: float | None = None
     clamp: bool = False
     rate: float | None = None
-    trust_xacro: Trust = False
-    xacro: XacroInputs | None = None
 
     def __post_init__(self) -> None:
         if self.integrator not in INTEGRATORS:

@@ -20,17 +20,17 @@ from armcli.analysis.excursion import Excursion, excursions
 from armcli.analysis.ground import mesh_loader
 from armcli.analysis.stance import NoStance, Payload, Stance, stance_of
 from armcli.errors import InputError, TipOverError
+from armcli.robot.file import floating_of
 from armcli.robot.tool import tool_point
 from armcli.sim.job import SimJob
 from armcli.sim.simulate import SimResult
 from armcli.sim.states import sample_steps
 from armcli.urdf.doc import Urdf
 from armcli.urdf.meshes import MeshSearch
-from armcli.urdf.read import parse_urdf
-from armcli.urdf.source import lookup_for, spec_urdfs
+from armcli.urdf.source import RobotFile, lookup_for
 
 if TYPE_CHECKING:
-    from armcli.spec.model import RobotSpec
+    pass
 
 DEFAULT_MIN_MARGIN = 0.02  # [m] as `check`'s support-margin threshold
 COLUMNS = ("zmp.x", "zmp.y", "zmp.margin", "zmp.margin_base")
@@ -78,34 +78,30 @@ class Tipping:
                                zmps.impacts(res.stop_active, res.v))  # fmt: skip
 
 
-def robot_urdf(spec: RobotSpec | None, job: SimJob) -> Urdf | None:
-    """The whole robot: the spec's full URDF (arm on its base), or the simulated URDF."""
-    if (
-        spec is not None
-        and job.urdf is not None
-        and job.urdf.source.endswith(".urdf")
-        and (spec.mounted_base() is not None)
-    ):
-        name = f"{spec.name}.urdf"
-        return parse_urdf(spec_urdfs(spec)[name], name)
-    return job.urdf
+def whole_robot(file: RobotFile) -> Urdf:
+    """The robot whose balance a fixed-base run reports.
+
+    A spec's whole robot when it mounts the arm on a base (also for a URDF file run with
+    that spec's settings, `RobotFile.with_spec`), else what is simulated (`file.arm`).
+    """
+    spec = file.spec
+    if spec is None or spec.mounted_base() is None:
+        return file.arm
+    if file.compiled:
+        return file.robot
+    whole = file.document(f"{spec.name}.urdf") if file.arm.source.endswith(".urdf") else None
+    return whole if whole is not None else file.arm
 
 
 def prepare(
-    spec: RobotSpec | None,
-    job: SimJob,
-    opts: TipOptions,
-    search: MeshSearch,
-    notes: list[str],
-    whole: Urdf | None = None,
+    file: RobotFile, job: SimJob, opts: TipOptions, search: MeshSearch, notes: list[str]
 ) -> Tipping | None:
     """The run's balance set-up, or None (with a note) for a robot on a fixed base.
 
-    `whole`: the whole robot's `robot_urdf`, when the caller has parsed it already.
+    The robot stands on `whole_robot(file)`'s floating `Robot`, the one `check`'s
+    static balance stands on (`robot_of`: built once per file).
     """
-    urdf = whole if whole is not None else robot_urdf(spec, job)
-    if urdf is None:
-        return None
+    urdf, spec = whole_robot(file), file.spec
     base = spec.mounted_base() if spec is not None else None
     candidates = set(base.links) if base is not None and opts.contact_links is None else None
     point = tool_point(urdf, spec)
@@ -118,7 +114,8 @@ def prepare(
     missing: list[str] = []
     search = lookup_for(spec, search)  # the packages the spec records too
     found = stance_of(urdf, candidates=candidates, declared=opts.contact_links,
-                      mesh=mesh_loader(urdf, search, missing), payload=payload)  # fmt: skip
+                      mesh=mesh_loader(urdf, search, missing), payload=payload,
+                      floating=floating_of(file, urdf))  # fmt: skip
     if isinstance(found, NoStance):
         notes.append(f"no zero-moment point: {found.reason}")
         return None

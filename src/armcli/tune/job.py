@@ -30,7 +30,7 @@ from armcli.tune.model_gains import (
     start_gains,
 )
 from armcli.tune.problem import Case, TuneProblem, draw_variants, nominal_robot
-from armcli.urdf.source import spec_urdfs
+from armcli.urdf.source import RobotFile, urdf_text
 
 DEFAULT_ZETA = 1.0  # critically damped
 MAX_ROBUST = 1000  # perturbed models per candidate
@@ -131,12 +131,14 @@ def largest_steps(cases: Sequence[Case], n: int) -> np.ndarray:
     return out
 
 
-def prepare(
-    spec: RobotSpec, spec_path: Path, trajectories: Sequence[Path], s: TuneSettings
-) -> TuneJob:
-    """Validate every input and build the job; raises InputError/SpecError on bad input."""
+def prepare(file: RobotFile, trajectories: Sequence[Path], s: TuneSettings) -> TuneJob:
+    """Validate every input and build the job; raises InputError/SpecError on bad input.
+
+    `file`: a spec's robot file (`RobotFile.of_spec`); its standalone arm is tuned.
+    """
     loop = _validate(s)
-    xml = spec_urdfs(spec)[ARM_URDF].decode("utf-8")
+    spec, spec_path = _spec(file), file.path
+    xml = urdf_text(file.arm)
     base = TuneProblem(xml, ARM_URDF, tuple(s.joints or ()), spec.control.dt, "euler",
                        bool(spec.control.gravity_compensation), loop, 1.0, (), ())  # fmt: skip
     robot = nominal_robot(base)
@@ -166,6 +168,12 @@ def prepare(
     problem = TuneProblem(xml, ARM_URDF, joints, spec.control.dt, "euler", base.gravity_comp,
                           loop, STABILITY_MARGIN, tuple(cases), variants).with_key()  # fmt: skip
     return TuneJob(problem, start, _spec_gains(spec, joints))
+
+
+def _spec(file: RobotFile) -> RobotSpec:
+    if file.spec is None or not file.compiled:
+        raise InputError("tunes a spec's gains: give a spec, not a URDF", file=file.path)
+    return file.spec
 
 
 def _spec_gains(spec: RobotSpec, joints: Sequence[str]) -> np.ndarray | None:

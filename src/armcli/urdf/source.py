@@ -12,7 +12,6 @@ Mesh URIs may only resolve inside the allowed roots, so a hostile URDF cannot ma
 from __future__ import annotations
 
 import os
-import threading
 from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -33,28 +32,64 @@ if TYPE_CHECKING:
 SPEC_SUFFIXES = (".yaml", ".yml")
 XACRO_SUFFIX = ".xacro"
 TRUSTED_ENV_REFUSED = ("LD_", "PYTHON")  # --env names that would change how the child runs
-COMPILED_KEPT = 4  # specs whose compiled URDFs `spec_urdfs` keeps (a command reads one or two)
-_COMPILED: list[tuple[RobotSpec, dict[str, bytes]]] = []  # (spec, its URDFs), newest last
-_COMPILED_LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
 class RobotFile:
-    """What a robot file argument stands for: its URDF document(s) and, for a spec, the spec."""
+    """What a robot file argument stands for, read once and handed down.
+
+    Its URDF document(s) (a spec's compiled in memory, a xacro file's expanded), for a
+    spec the spec, and the `Robot`s built from them: `robots` is filled by
+    `armcli.robot.file.robot_of` (this layer sits below the robot handle), one per
+    document and loading mode, so every library call a command makes shares them.
+    """
 
     path: Path
     urdfs: tuple[Urdf, ...]  # a spec gives the whole robot and the standalone arm
-    spec: RobotSpec | None = None
+    spec: RobotSpec | None = None  # its control settings (gains, dt, poses) and tool point
+    compiled: bool = False  # the documents are the spec's own, not a URDF read beside it
+    robots: dict[tuple[str, bool, bool], object] = field(
+        default_factory=dict, compare=False, hash=False, repr=False
+    )
+
+    @classmethod
+    def of_spec(cls, spec: RobotSpec, path: Path | None = None) -> RobotFile:
+        """A loaded spec's robot file: its xacro set compiled and parsed, once."""
+        path = path if path is not None else Path(spec.source_file)
+        urdfs = spec_urdfs(spec)
+        docs = tuple(parse_urdf(urdfs[n], f"{path}#{n}") for n in sorted(urdfs))
+        return cls(path, docs, spec, compiled=True)
+
+    def with_spec(self, spec: RobotSpec) -> RobotFile:
+        """This URDF run with a spec's settings (`simulate SPEC --urdf FILE`), no robot built.
+
+        A spec that mounts the arm on a base adds its compiled documents after a URDF file's
+        (not a xacro file's): the whole robot a fixed-base run's balance stands on
+        (`sim.tipping.whole_robot`).
+        """
+        urdf = self.urdfs[0].source.endswith(".urdf")
+        extra = RobotFile.of_spec(spec).urdfs if urdf and spec.mounted_base() is not None else ()
+        return RobotFile(self.path, self.urdfs + extra, spec)
+
+    def document(self, name: str) -> Urdf | None:
+        """A spec's document by file name (`my_robot.urdf`), None when it has none so named."""
+        return next((u for u in self.urdfs if u.source.endswith(f"#{name}")), None)
 
     @property
     def robot(self) -> Urdf:
         """The whole robot: the spec's `<name>.urdf`, else the only document."""
-        if self.spec is not None:
+        if self.compiled and self.spec is not None:
             for name in (f"{self.spec.name}.urdf", STANDALONE_ARM_URDF):
-                found = next((u for u in self.urdfs if u.source.endswith(f"#{name}")), None)
+                found = self.document(name)
                 if found is not None:
                     return found
         return self.urdfs[0]
+
+    @property
+    def arm(self) -> Urdf:
+        """What a fixed-base run simulates: a spec's standalone arm, else the only document."""
+        found = self.document(STANDALONE_ARM_URDF) if self.compiled else None
+        return found if found is not None else self.urdfs[0]
 
 
 @dataclass(frozen=True)
@@ -110,29 +145,19 @@ def read_robot(
 
         spec = load_spec(path)
         lookup_for(spec, inputs.packages if inputs is not None else None)  # refuse a bad one now
-        urdfs = spec_urdfs(spec)
-        docs = tuple(parse_urdf(urdfs[n], f"{path}#{n}") for n in sorted(urdfs))
-        return RobotFile(path, docs, spec)
+        return RobotFile.of_spec(spec, path)
     return RobotFile(path, (read_urdf_file(path, trust_xacro=trust_xacro, inputs=inputs),))
 
 
 def spec_urdfs(spec: RobotSpec) -> dict[str, bytes]:
-    """URDF file name -> expanded bytes of the spec's xacro set, compiled once per spec.
+    """URDF file name -> expanded bytes of the spec's xacro set, compiled at each call.
 
-    A spec is frozen (pydantic, `frozen=True`), so its URDFs never change: the last
-    COMPILED_KEPT specs keep theirs, and every command asks here instead of compiling
-    again (`simulate` needs the standalone arm and the whole robot: one expansion).
+    For the commands that write or compare the bytes (build, import, ros-package); a
+    library call that reads the robot is handed its `RobotFile` instead (compiled once).
     """
-    with _COMPILED_LOCK:
-        hit = next((urdfs for s, urdfs in _COMPILED if s is spec), None)
-    if hit is None:
-        from armcli.compiler.expand import expand_urdfs  # the spec compiler: only for a spec
+    from armcli.compiler.expand import expand_urdfs  # the spec compiler: only for a spec
 
-        hit = expand_urdfs(spec)
-        with _COMPILED_LOCK:
-            _COMPILED.append((spec, hit))
-            del _COMPILED[:-COMPILED_KEPT]
-    return dict(hit)
+    return expand_urdfs(spec)
 
 
 def lookup_for(spec: RobotSpec | None, search: PackageLookup | None = None) -> PackageLookup:

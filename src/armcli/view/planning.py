@@ -74,9 +74,8 @@ class ObstacleMesh:
 class PlanningSession:
     """Start and goal of the planned joints, the last plan and its execution.
 
-    `sim` carries how `simulate` reads the robot (a URDF path, xacro inputs); its
-    `message` is filled with each plan's document. `save_dir`: the one directory Save
-    writes into.
+    Execute simulates each plan's document on `robot_file` (read once, not again).
+    `save_dir`: the one directory Save writes into.
     """
 
     def __init__(
@@ -85,14 +84,12 @@ class PlanningSession:
         robot_file: RobotFile,
         *,
         scene: Scene | None = None,
-        sim: SimOptions | None = None,
         search: MeshSearch | None = None,
         save_dir: Path = Path("."),
         options: PlanOptions | None = None,
     ) -> None:
         self.context, self.robot_file = context, robot_file
         self.scene = scene or Scene()
-        self._sim = sim or SimOptions(urdf=None if robot_file.spec else robot_file.path)
         self._search = search
         self.save_dir = Path(save_dir)
         self._written: dict[str, tuple[int, ...]] = {}  # path -> _identity of what Save wrote
@@ -202,14 +199,9 @@ class PlanningSession:
         """Simulate the last plan as `simulate --trajectory` runs it; its states replay."""
         if self.result is None:
             raise PlanningError("no-plan", "nothing planned yet: click Plan first")
-        opts = SimOptions(
-            message=self.result.document.decode("utf-8"),
-            urdf=self._sim.urdf,
-            trust_xacro=self._sim.trust_xacro,
-            xacro=self._sim.xacro,
-        )
+        opts = SimOptions(message=self.result.document.decode("utf-8"))
         try:
-            self.execution = execute(self.robot_file.spec, opts, self._search)
+            self.execution = execute(self.robot_file, opts, self._search)
         except InputError as exc:
             if exc.field not in ("SimOptions.kp", "SimOptions.kd"):
                 raise
@@ -326,7 +318,6 @@ def load_session(
     scene: Path | None = None,
     joints: Sequence[str] | None = None,
     search: MeshSearch | None = None,
-    sim: SimOptions | None = None,
     save_dir: Path = Path("."),
     group: str | None = None,
 ) -> PlanningSession:
@@ -336,5 +327,6 @@ def load_session(
     """
     loaded = load_context(robot_file, srdf=srdf, scene=scene, joints=joints, search=search,
                           group=group)  # fmt: skip
-    return PlanningSession(loaded.context, robot_file, scene=loaded.scene, sim=sim,
-                           search=search, save_dir=save_dir)  # fmt: skip
+    return PlanningSession(
+        loaded.context, robot_file, scene=loaded.scene, search=search, save_dir=save_dir
+    )

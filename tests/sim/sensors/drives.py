@@ -9,8 +9,7 @@ import yaml
 
 from armcli.drive import job as drive
 from armcli.sim.options import SimOptions
-from armcli.spec.load import load_spec
-from tests.helpers import DEFAULT_SPEC
+from tests.helpers import DEFAULT_SPEC, spec_file
 
 
 def course_with(tmp_path: Path, sensors: dict[str, Any], caster_mu: float | None = None) -> Path:
@@ -32,7 +31,7 @@ def run(spec: Path, commands: str, duration: float, world: str | None = None) ->
     if world is not None:
         scene = spec.parent / "world.yaml"
         scene.write_text(world)
-    job = drive.prepare(load_spec(spec), SimOptions(duration=duration), cmd, world=scene)
+    job = drive.prepare(spec_file(spec), SimOptions(duration=duration), cmd, world=scene)
     return drive.run(job)
 
 

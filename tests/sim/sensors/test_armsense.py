@@ -18,8 +18,7 @@ import yaml
 
 from armcli.sim.armrun import simulate_arm
 from armcli.sim.options import SimOptions
-from armcli.spec.load import load_spec
-from tests.helpers import DEFAULT_SPEC
+from tests.helpers import DEFAULT_SPEC, spec_file
 
 pytest.importorskip("mujoco")
 
@@ -43,10 +42,10 @@ def _spec(tmp_path: Path) -> Path:
 
 
 def test_an_imu_and_a_depth_camera_on_the_hand(tmp_path: Path) -> None:
-    spec = load_spec(_spec(tmp_path))
+    file = spec_file(_spec(tmp_path))
     hold = ("joint_names: [arm_base_forearm_joint, forearm_hand_joint]\npoints:\n"
             f" - {{positions: [{Q[0]}, {Q[1]}], time_from_start: 1.0}}\n")  # fmt: skip
-    run = simulate_arm(spec, SimOptions(message=hold, duration=3.0, gravity_comp=True))
+    run = simulate_arm(file, SimOptions(message=hold, duration=3.0, gravity_comp=True))
     imu = next(r for r in run.readings if r.name == "hand_imu")
     assert len(imu.time) == 151  # 50 Hz over 3 s
     late = imu.data["imu"][imu.time >= 2.5]

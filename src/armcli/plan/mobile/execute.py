@@ -109,11 +109,11 @@ def execute_whole(
     `localize` [Hz]: the localiser's rate (`plan.mobile.pursuit`); 0: encoders alone.
     """
     mobile = plan.mobile
-    spec = executable(mobile.robot_file)
+    executable(mobile.robot_file)
     start = plan.goal.start
     duration = SLACK * plan.timing.duration + SLACK_S + plan.arm.duration_s + SETTLE_S
     opts = SimOptions(message=arm_yaml.decode("utf-8"), gravity_comp=True, duration=duration)
-    job = drive.prepare(spec, opts, cmd_vel, world=start_frame(mobile.scene, start),
+    job = drive.prepare(mobile.robot_file, opts, cmd_vel, world=start_frame(mobile.scene, start),
                         params=plan.drive)  # fmt: skip
     pilot = Pursuit(legs_in_odom(plan.timing, plan.path.start), plan.timing.motions,
                     radius=job.params.radius, separation=job.params.separation, dt=job.dt,

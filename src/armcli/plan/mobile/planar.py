@@ -22,7 +22,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike
 
-from armcli.robot.model import Robot
+from armcli.plan.robot import PlanRobot
 
 PARALLEL_TOL = 1e-6  # |a1 x a2| and |a · z| below this: parallel axes, horizontal axis
 TWO_PI = 2.0 * math.pi
@@ -51,8 +51,17 @@ class PlanarArm:
     offset: float  # [m] the tool point's distance from the shoulder along the axis
     l1: np.ndarray  # (2,) in-plane (u, w) vector shoulder -> elbow at q = 0
     l2: np.ndarray  # (2,) elbow -> tool point at q = 0
-    lower: np.ndarray  # (2,) [rad]
-    upper: np.ndarray
+    planned: PlanRobot  # whose planning limits bound the joints (a continuous one: ±pi)
+
+    @cached_property
+    def lower(self) -> np.ndarray:
+        """(2,) [rad] the joints' lower limits, as the planner reads them (`PlanRobot.lower`)."""
+        return np.array([self.planned.lower[self.planned.joints.index(j)] for j in self.joints])
+
+    @cached_property
+    def upper(self) -> np.ndarray:
+        """(2,) [rad] the joints' upper limits (`PlanRobot.upper`)."""
+        return np.array([self.planned.upper[self.planned.joints.index(j)] for j in self.joints])
 
     def plane(self, q: ArrayLike) -> np.ndarray:
         """In-plane (u, w) [m] of the tool point from the shoulder at joint values `q`."""
@@ -228,16 +237,16 @@ class PlanarArm:
         return np.concatenate(qs), np.concatenate(us)
 
 
-def planar_arm(robot: Robot, joints: Sequence[str], lower: np.ndarray, upper: np.ndarray
-               ) -> PlanarArm | None:  # fmt: skip
+def planar_arm(planned: PlanRobot, joints: Sequence[str]) -> PlanarArm | None:
     """The closed form of `joints` (the arm, root to tool) if they make a planar-reach arm.
 
-    `robot`'s root frame is the base; evaluated with every joint at zero (the closed form's
+    `planned.robot`'s root frame is the base; evaluated with every joint at zero (the closed form's
     reference, not the rest pose). None unless there are exactly two revolute joints with
     parallel horizontal axes.
     """
     import pinocchio as pin
 
+    robot = planned.robot
     model = robot.model
     if len(joints) != 2 or not all(model.existJointName(j) for j in joints):
         return None
@@ -277,6 +286,5 @@ def planar_arm(robot: Robot, joints: Sequence[str], lower: np.ndarray, upper: np
         offset=float((P3 - S) @ a),
         l1=in_plane(P2 - S),
         l2=in_plane(P3 - P2),
-        lower=np.asarray(lower, dtype=float),
-        upper=np.asarray(upper, dtype=float),
+        planned=planned,
     )

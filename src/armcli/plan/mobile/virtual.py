@@ -26,6 +26,7 @@ from armcli.plan.collision import CollisionChecker
 from armcli.plan.mobile.planar import PlanarArm, planar_arm
 from armcli.plan.robot import MOVABLE, PlanRobot, load_plan_robot
 from armcli.plan.srdf import allowed_pairs
+from armcli.robot.file import floating_of
 from armcli.robot.tool import tool_point
 from armcli.urdf.doc import Joint, Urdf
 from armcli.urdf.meshes import MeshSearch
@@ -155,10 +156,9 @@ def load_mobile(
     disabled = allowed_pairs(robot_file, None, search)
     checker = CollisionChecker(robot, world, disabled)
     candidates = set(spec.mobile_base.links) if spec is not None and spec.mobile_base else None
-    standing = stance_of(urdf, candidates=candidates)
+    standing = stance_of(urdf, candidates=candidates, floating=floating_of(robot_file, urdf))
     stance = None if isinstance(standing, NoStance) else standing
-    n = len(BASE_JOINTS)
-    planar = planar_arm(robot.robot, arm, robot.lower[n:], robot.upper[n:])
+    planar = planar_arm(robot, arm)
     return MobileRobot(robot, arm, checker, objects, stance,
                        standing.reason if isinstance(standing, NoStance) else "", planar,
                        robot_file, world, tuple(disabled))  # fmt: skip
