@@ -70,16 +70,18 @@ test: install-dev sysdeps lint native-check
 # install stamp, which a C++ edit outdates: that would recreate the whole venv.
 native:
 	@test -x $(BIN)/python || $(MAKE) install-dev
-	@echo "native: recompiling the engine and the planner (armcli.sim._rollout, armcli.plan._planner)"
+	@echo "native: recompiling the engine, the drive steps and the planner (armcli.sim._rollout, armcli.sim._drivestep, armcli.plan._planner)"
 	$(BIN)/python -m pip install -q --no-build-isolation --no-deps -e .
 	$(BIN)/python -m armcli.sim.native
+	$(BIN)/python -m armcli.drive.step
 	$(BIN)/python -m armcli.plan.native
 
 # The compiled engine must be there wherever a C++ compiler exists: a failed build fails
 # `make test` instead of skipping its tests.
 native-check: install-dev
 	@if command -v c++ >/dev/null 2>&1 || command -v g++ >/dev/null 2>&1; then \
-	  $(BIN)/python -m armcli.sim.native && $(BIN)/python -m armcli.plan.native; \
+	  $(BIN)/python -m armcli.sim.native && $(BIN)/python -m armcli.drive.step && \
+	  $(BIN)/python -m armcli.plan.native; \
 	else echo "no C++ compiler: armcli installs without its simulator; simulator tests skip"; fi
 
 bench: install-dev native-check

@@ -46,7 +46,7 @@ from tests.plan.mobile.reference import (  # noqa: E402
 from armcli.errors import PlanningError  # noqa: E402
 from armcli.plan.api import PlanOptions  # noqa: E402
 from armcli.plan.mobile.driving import driving_cost  # noqa: E402
-from armcli.plan.mobile.execute import execute_whole  # noqa: E402
+from armcli.plan.mobile.execute import Executed, execute_whole  # noqa: E402
 from armcli.plan.mobile.place import place  # noqa: E402
 from armcli.plan.mobile.virtual import load_mobile  # noqa: E402
 from armcli.plan.mobile.whole import BaseGoal, files, plan_drive, plan_whole  # noqa: E402
@@ -59,6 +59,7 @@ TOLERANCE = 0.01  # [m] placement's default
 CELL, YAW_CELL = 0.01, math.radians(1.0)  # the brute-force grid
 TURN = 0.225  # [m] half the course robot's wheel separation: the driving cost's turn weight
 SEED = 0
+REPEATS = 3  # --execute runs per variant: the best is reported
 
 
 def med(xs: list[float]) -> float:
@@ -153,21 +154,63 @@ def bench_plan_base(n: int, g: int) -> None:
 
 
 def bench_execute() -> None:
+    """The whole execute (drive model, run, judgement) with the compiled steps and without.
+
+    Real time is the peer; MuJoCo's own step on the same model, alone, is the floor.
+    """
+    import mujoco  # noqa: F401  (imported once per process, not per run: start-up)
+
+    from armcli.drive import step as drivestep
+    from armcli.plan.mobile.basefiles import cmd_vel_of
+
     mobile = load_mobile(read_robot(SPEC), scene=SCENES["warehouse"])
     goal = BaseGoal((1.35, 0.5, 0.42), (-0.5, -1.6, 0.0))  # onto the east rack's low board
     plan = plan_whole(mobile, goal, PlanOptions(seed=SEED))
     out = ROOT / "out" / "bench_place"
     out.mkdir(parents=True, exist_ok=True)
     written = files(plan, out, "bench")
-    for path, data in written.items():
-        path.write_bytes(data)
-    cpu = time.process_time()
-    done = execute_whole(plan, out / "cmd_vel.yaml", written[out / "arm.yaml"])
-    cpu = time.process_time() - cpu
-    sim = float(done.run.t[-1])
-    print(f"--execute, course robot across the warehouse: {sim:.1f} s simulated in {cpu:.2f} CPU "
-          f"s ({done.run.wall_time:.2f} s in the step loop): {sim / cpu:.1f}x real time "
-          f"(target >= 50x); tool {done.tool_error * 1e3:.1f} mm from the target")  # fmt: skip
+    compiled = drivestep.load()
+    for name, module in (("compiled steps", compiled), ("Python steps", None)):
+        if name == "compiled steps" and module is None:
+            print("--execute: armcli.sim._drivestep not built, compiled steps skipped")
+            continue
+        drivestep._state["module"] = module
+        cpu = wall = math.inf
+        for _ in range(REPEATS):  # the first run also pays one-time costs (BLAS discovery)
+            c0, w0 = time.process_time(), time.perf_counter()
+            done = execute_whole(plan, cmd_vel_of(plan.timing), written[out / "arm.yaml"])
+            cpu = min(cpu, time.process_time() - c0)
+            wall = min(wall, time.perf_counter() - w0)
+        sim = float(done.run.t[-1])
+        print(
+            f"--execute ({name}), course robot across the warehouse: {sim:.1f} s simulated "
+            f"in {cpu:.2f} CPU s / {wall:.2f} s wall, best of {REPEATS}: {sim / cpu:.1f}x real "
+            f"time in CPU, {sim / wall:.1f}x wall "
+            f"(target >= 50x CPU); tool {done.tool_error * 1e3:.1f} mm from the target"
+        )
+    drivestep._state["module"] = compiled
+    _bare_steps(done)
+
+
+def _bare_steps(done: Executed) -> None:
+    """The floor: MuJoCo's mj_step alone, as many steps on the same model, nothing else."""
+    import mujoco
+
+    from armcli.drive.job import start_data
+
+    job = done.run.job
+    cpu = math.inf
+    for _ in range(REPEATS):
+        d = start_data(job.model, job.arm.q0)
+        c0 = time.process_time()
+        for _ in range(done.run.steps):
+            mujoco.mj_step(job.model.model, d)
+        cpu = min(cpu, time.process_time() - c0)
+    sim = done.run.steps * job.dt
+    print(
+        f"  (MuJoCo's mj_step alone, the same {done.run.steps} steps standing still: "
+        f"{sim / cpu:.1f}x real time in CPU)"
+    )
 
 
 def main() -> None:
@@ -175,14 +218,19 @@ def main() -> None:
     ap.add_argument("--targets", type=int, default=200, help="place targets per room")
     ap.add_argument("--grid", type=int, default=10, help="of which the grid also solves")
     ap.add_argument("--plans", type=int, default=30, help="plan --base targets per room")
+    ap.add_argument("--only", choices=("place", "plan", "execute"), help="one section")
     args = ap.parse_args()
     print(
         f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} CPUs (times are wall "
         "clock unless CPU is said: on a loaded machine wall time is several times CPU time)"
     )
-    bench_place(args.targets, args.grid)
-    bench_plan_base(args.plans, args.grid)
-    bench_execute()
+    if args.only in (None, "place"):
+        bench_place(args.targets, args.grid)
+    if args.only in (None, "plan"):
+        bench_plan_base(args.plans, args.grid)
+    if args.only in (None, "execute"):
+        bench_execute()
+    print(f"load average {os.getloadavg()[0]:.2f} at the end")
 
 
 if __name__ == "__main__":

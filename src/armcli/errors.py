@@ -137,8 +137,9 @@ def one_per_kind(problems: Sequence[Problem], extra: Sequence[int] = ()) -> list
     out = []
     for i in first.values():
         p = problems[i]
-        out.append(Problem(p.field, f"{p.message} (and {counts[i]} more)", p.line) if counts[i]
-                   else p)  # fmt: skip
+        out.append(
+            Problem(p.field, f"{p.message} (and {counts[i]} more)", p.line) if counts[i] else p
+        )
     return out
 
 
@@ -187,9 +188,15 @@ class UnstableLoopError(InputError):
     def located(self, *, file: str | Path | None, field: str | None) -> UnstableLoopError:
         """The same error, saying which file and field (or option) dt and gains came from."""
         return UnstableLoopError(
-            self.message, scheme=self.scheme, dt=self.dt, suggestion_dt=self.suggestion_dt,
-            kp=self.kp, kd=self.kd, file=file, field=field,
-        )  # fmt: skip
+            self.message,
+            scheme=self.scheme,
+            dt=self.dt,
+            suggestion_dt=self.suggestion_dt,
+            kp=self.kp,
+            kd=self.kd,
+            file=file,
+            field=field,
+        )
 
 
 class XacroRefusedError(InputError):

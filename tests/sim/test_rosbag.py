@@ -167,3 +167,17 @@ def test_view_replay_takes_an_mcap(tmp_path: Path, capsys: pytest.CaptureFixture
         main(["view", str(DEFAULT_SPEC), "--replay", str(bad), "--port", "0"])
     assert exc.value.code == 2
     assert f"{bad}: unreadable MCAP file" in capsys.readouterr().err
+
+
+def test_outputs_are_refused_by_field_before_a_run(tmp_path: Path) -> None:
+    spec = tmp_path / "robot.yaml"
+    spec.write_text("name: x\n")
+    rosbag.check_outputs(tmp_path / "run.mcap", tmp_path / "plot.png", [spec])  # all writable
+    for output, plot, field in (
+        (tmp_path / "run.txt", None, "output"),  # no writer for .txt
+        (spec, None, "output"),  # over an input (issue 42)
+        (None, tmp_path / "plot.jpg", "plot"),  # plots are PNG
+    ):
+        with pytest.raises(InputError) as err:
+            rosbag.check_outputs(output, plot, [spec])
+        assert err.value.field == field

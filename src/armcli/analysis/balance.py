@@ -187,13 +187,15 @@ class MarginAt:
         """`joints`: the names the values of each call are given for, in order."""
         self.ev = _Mass(stance)
         self.m = stance.payload.mass if stance.payload is not None else 0.0
-        searched = {j.name: (j, lo, hi) for j, (lo, hi) in zip(stance.joints, stance.box,
-                                                               strict=True)}  # fmt: skip
+        searched = {
+            j.name: (j, lo, hi) for j, (lo, hi) in zip(stance.joints, stance.box, strict=True)
+        }
         self.template = stance.q(_values(stance, {}))
         # (value index, q index, lower, upper) per given joint the search moves; a continuous
         # one is stored as (cos, sin): through Stance.q, the one place that writes it
-        self.slots = [(k, *searched[n][1:], searched[n][0]) for k, n in enumerate(joints)
-                      if n in searched]  # fmt: skip
+        self.slots = [
+            (k, *searched[n][1:], searched[n][0]) for k, n in enumerate(joints) if n in searched
+        ]
         self.fast = all(not j.continuous for *_, j in self.slots)
         self.polygon = stance.polygon
 
@@ -227,8 +229,10 @@ def _point_label(stance: Stance) -> str:
 
 def _values(stance: Stance, values: dict[str, float]) -> list[float]:
     """The searched joints' values of a pose, clamped into range; a joint it leaves out rests."""
-    return [float(np.clip(values.get(j.name, j.rest), lo, hi))
-            for j, (lo, hi) in zip(stance.joints, stance.box, strict=True)]  # fmt: skip
+    return [
+        float(np.clip(values.get(j.name, j.rest), lo, hi))
+        for j, (lo, hi) in zip(stance.joints, stance.box, strict=True)
+    ]
 
 
 def _at(
@@ -263,8 +267,11 @@ def _payload_max(ev: _Mass, c0: NDArray[Any], p: NDArray[Any], threshold: float)
     d0, dp = poly.edge_distances(c0), poly.edge_distances(p)
     if np.any(d0 < threshold - PAYLOAD_TOL):
         return None
-    limits = [ev.M * (a - threshold) / (threshold - b) for a, b in zip(d0, dp, strict=True)
-              if b < threshold]  # fmt: skip
+    limits = [
+        ev.M * (a - threshold) / (threshold - b)
+        for a, b in zip(d0, dp, strict=True)
+        if b < threshold
+    ]
     return max(0.0, min(limits)) if limits else math.inf
 
 

@@ -74,8 +74,11 @@ class Rock:
 
 
 @dataclass(frozen=True)
-class TipVerdict:
-    """The run's tilt toward each support edge against that edge's angle, and its lift-offs."""
+class TiltVerdict:
+    """The run's tilt toward each support edge against that edge's angle, and its lift-offs.
+
+    The drive's `TipVerdict` (analysis.tipverdict), as `ZmpReport` is the fixed-base run's.
+    """
 
     angles: tuple[float, ...]  # [rad] per edge: static tipping angle, at least MIN_BOUND_DEG
     directions: tuple[str, ...]  # per edge
@@ -185,7 +188,7 @@ def verdict(
     t: np.ndarray,
     quat: np.ndarray,
     contacts: Mapping[str, tuple[np.ndarray, np.ndarray]],
-) -> TipVerdict:
+) -> TiltVerdict:
     """The verdict of a run: base orientation per state, and per contact link (force, height)."""
     angles = np.maximum(tipping_angles(stance, start), math.radians(MIN_BOUND_DEG))
     toward = edge_tilts(quat, stance.polygon.normals)
@@ -194,18 +197,24 @@ def verdict(
     down = past.any(axis=1) | (angle > math.radians(TIP_CAP_DEG))
     last = intervals(down)[-1] if down[-1] else None
     rocks = [
-        Rock(stance.polygon.edges[i].direction, float(angles[i]), float(t[a]),
-             float(t[min(b, len(t) - 1)] - t[a]), float(np.max(toward[a:b, i])))
-        for i in range(len(angles)) for a, b in intervals(past[:, i])
+        Rock(
+            stance.polygon.edges[i].direction,
+            float(angles[i]),
+            float(t[a]),
+            float(t[min(b, len(t) - 1)] - t[a]),
+            float(np.max(toward[a:b, i])),
+        )
+        for i in range(len(angles))
+        for a, b in intervals(past[:, i])
         if last is None or a < last[0]
-    ]  # fmt: skip
+    ]
     ratio = toward / angles
     worst = int(np.argmax(ratio)) % ratio.shape[1]
     if last is not None:
         worst = int(np.argmax(toward[-1] - angles))
     found = [lift for link, (f, h) in contacts.items() for lift in lifts(link, t, f, h)]
     m = int(np.argmax(angle))
-    return TipVerdict(
+    return TiltVerdict(
         angles=tuple(float(a) for a in angles),
         directions=tuple(e.direction for e in stance.polygon.edges),
         max_tilt=float(angle[m]),

@@ -7,6 +7,7 @@ loop is stepped (`Scheme`); `analysis.stability` decides whether that is stable.
 from __future__ import annotations
 
 import contextlib
+import functools
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -64,13 +65,26 @@ def one_blas_thread() -> Iterator[None]:
     OpenBLAS's threads on a busy 2-core machine), and under `tune`'s threads it competes
     with the rollouts. Without threadpoolctl the block runs as is.
     """
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:  # pragma: no cover - optional speed-up
+    controller = _blas_controller()
+    if controller is None:  # pragma: no cover - optional speed-up
         yield
         return
-    with threadpool_limits(limits=1, user_api="blas"):
+    with controller.limit(limits=1, user_api="blas"):
         yield
+
+
+@functools.cache
+def _blas_controller() -> Any:
+    """The loaded BLAS libraries as threadpoolctl finds them, once per process.
+
+    Finding them walks every loaded shared object (~0.1 s CPU on a busy machine: a fifth
+    of `plan --base --execute`'s drive); numpy's BLAS is loaded before the first call.
+    """
+    try:
+        from threadpoolctl import ThreadpoolController
+    except ImportError:  # pragma: no cover - optional speed-up
+        return None
+    return ThreadpoolController()
 
 
 def linearise(robot: Robot, configurations: Sequence[Any], *, gravity: bool = True) -> Linearised:

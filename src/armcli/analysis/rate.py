@@ -57,9 +57,11 @@ class RateVerdict:
     @property
     def rate_min(self) -> float:
         """The least stable rate 1/hold_max [Hz] (0: any rate; inf: none)."""
-        return 0.0 if math.isinf(self.hold_max) else (
-            math.inf if self.hold_max <= 0 else 1.0 / self.hold_max
-        )  # fmt: skip
+        return (
+            0.0
+            if math.isinf(self.hold_max)
+            else (math.inf if self.hold_max <= 0 else 1.0 / self.hold_max)
+        )
 
 
 def rate_verdict(lin: Linearised, pid: Pid, rate: float) -> RateVerdict:
@@ -161,9 +163,13 @@ def remedy_text(
             text += f", {i_} x {r.factor**2:.3g}"
         if len(names) <= LIST_GAINS:
             each = zip(names, r.kp, r.kd, r.ki, strict=True)
-            text += " (" + ", ".join(
-                f"{n} {p_} {p:g} {d_} {d:g}" + (f" {i_} {i:g}" if i > 0 else "")
-                for n, p, d, i in each
-            ) + ")"  # fmt: skip
+            text += (
+                " ("
+                + ", ".join(
+                    f"{n} {p_} {p:g} {d_} {d:g}" + (f" {i_} {i:g}" if i > 0 else "")
+                    for n, p, d, i in each
+                )
+                + ")"
+            )
         parts.append(text)
     return "; or ".join(parts) if parts else "lower the gains"

@@ -20,8 +20,16 @@ from numpy.typing import ArrayLike, NDArray
 COLLINEAR_TOL = 1e-6  # [m²] a hull of smaller area is a line or a point: no polygon
 HULL_EPS = 1e-12  # [m²] cross products below this are collinear (rounding of the contact points)
 # The eight compass directions of the root frame (+x forward, +y left, ROS REP 103).
-_DIRECTIONS = ("front", "front-left", "left", "rear-left", "rear", "rear-right", "right",
-               "front-right")  # fmt: skip
+_DIRECTIONS = (
+    "front",
+    "front-left",
+    "left",
+    "rear-left",
+    "rear",
+    "rear-right",
+    "right",
+    "front-right",
+)
 
 
 def direction_name(angle: float) -> str:
@@ -82,9 +90,9 @@ class SupportPolygon:
         Inside a convex polygon the nearest boundary point is on the nearest edge line;
         outside, the distance to the nearest point of the polygon (an edge or a corner).
         """
-        d = self.edge_distances(xy)
-        if np.all(d >= 0.0):
-            return float(np.min(d))
+        nearest = float(self.edge_distances(xy).min())  # NaN (not finite): outside, below
+        if nearest >= 0.0:
+            return nearest
         p = np.asarray(xy, dtype=float)[:2]
         return -min(_segment_distance(p, e) for e in self.edges)
 
@@ -95,8 +103,11 @@ class SupportPolygon:
         a = np.array([e.a for e in self.edges], dtype=float)  # (k, 2)
         ab = np.array([e.b for e in self.edges], dtype=float) - a
         with np.errstate(invalid="ignore", divide="ignore"):
-            u = np.clip(np.einsum("mkj,kj->mk", p[:, None, :] - a[None], ab)
-                        / np.sum(ab * ab, axis=1), 0.0, 1.0)  # fmt: skip
+            u = np.clip(
+                np.einsum("mkj,kj->mk", p[:, None, :] - a[None], ab) / np.sum(ab * ab, axis=1),
+                0.0,
+                1.0,
+            )
         gap = np.linalg.norm(p[:, None, :] - (a[None] + u[..., None] * ab[None]), axis=2)
         out = np.where(np.all(d >= 0.0, axis=1), np.min(d, axis=1), -np.min(gap, axis=1))
         out[~np.all(np.isfinite(p), axis=1)] = -math.inf

@@ -115,10 +115,18 @@ def verdict(lin: Linearised, pd: PD, dt: float, scheme: Scheme) -> LoopVerdict:
         radius = stab.spectral_radius(step)
     kp, d = _largest(pd.kp), _largest(pd.kd + pd.damping)
     return LoopVerdict(
-        scheme, LOOP_NAMES[scheme], ok, kp * dt * dt * lam, d * dt * lam, radius, dt_max,
-        None if scale is None else scale.factor, None if scale is None else scale.label,
-        None if ok else suggest(dt_max, scale, pd), worst,
-    )  # fmt: skip
+        scheme,
+        LOOP_NAMES[scheme],
+        ok,
+        kp * dt * dt * lam,
+        d * dt * lam,
+        radius,
+        dt_max,
+        None if scale is None else scale.factor,
+        None if scale is None else scale.label,
+        None if ok else suggest(dt_max, scale, pd),
+        worst,
+    )
 
 
 def analyse(
@@ -172,8 +180,13 @@ def remedy(s: Suggestion, names: Sequence[str], dt: float) -> str:
     return text
 
 
-def message(v: LoopVerdict, names: Sequence[str], q: Sequence[float], dt: float,
-            numbers: tuple[float, float, float, float]) -> str:  # fmt: skip
+def message(
+    v: LoopVerdict,
+    names: Sequence[str],
+    q: Sequence[float],
+    dt: float,
+    numbers: tuple[float, float, float, float],
+) -> str:
     """The whole sentence for an unstable loop: which loop, why, where, the edge, a remedy.
 
     `numbers` = (largest Kp, largest Kd + damping, gravity's stiffness, lambda_max).
@@ -187,8 +200,14 @@ def message(v: LoopVerdict, names: Sequence[str], q: Sequence[float], dt: float,
     return text if v.suggestion is None else f"{text}; {remedy(v.suggestion, names, dt)}"
 
 
-def refuse_unstable(lin: Linearised, pd: PD, dt: float, scheme: Scheme,
-                    names: Sequence[str], qs: Sequence[Sequence[float]]) -> None:  # fmt: skip
+def refuse_unstable(
+    lin: Linearised,
+    pd: PD,
+    dt: float,
+    scheme: Scheme,
+    names: Sequence[str],
+    qs: Sequence[Sequence[float]],
+) -> None:
     """Raise UnstableLoopError, with the verdict's remedy, when the loop diverges at dt."""
     with pdloop.one_blas_thread():
         if stab.stable(lin, pd, dt, scheme):

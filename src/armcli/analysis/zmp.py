@@ -175,8 +175,17 @@ def zmp_series(
         qk = to_q.q(np.asarray(q[rows[i]], dtype=float))
         pin.ccrba(model, data, qk, np.zeros(model.nv))
         bodies[i] = (c[i].copy(), np.array(data.Ig.inertia, dtype=float))
-    return ZmpSeries(np.asarray(t)[rows], np.asarray(step)[rows], zmp, margin,
-                     float(base_accel), float(threshold), skipped, shift, bodies)  # fmt: skip
+    return ZmpSeries(
+        np.asarray(t)[rows],
+        np.asarray(step)[rows],
+        zmp,
+        margin,
+        float(base_accel),
+        float(threshold),
+        skipped,
+        shift,
+        bodies,
+    )
 
 
 def max_base_accel(series: ZmpSeries, polygon: SupportPolygon, threshold: float) -> float:

@@ -26,24 +26,28 @@ def balance_items(balance: StaticBalance | None, zmp: ZmpReport | None) -> list[
     if balance is not None:
         out.append(_table(balance))
     if zmp is not None:
-        from armcli.sim.tipping import summary_line  # loaded by the --trajectory run already
-
-        out.append(Text(summary_line(zmp), style="red" if zmp.tips else ""))
+        out.append(Text(zmp.line(), style="red" if zmp.tips else ""))
     return out
 
 
 def _table(b: StaticBalance) -> Any:
     heads = [f"{d}\n[mm | deg]" for d in b.directions]
-    cols = [Column("pose", False), Column("COM x\n[m]"), Column("COM z\n[m]"),
-            Column("margin\n[mm]"), *(Column(h) for h in heads)]  # fmt: skip
+    cols = [
+        Column("pose", False),
+        Column("COM x\n[m]"),
+        Column("COM z\n[m]"),
+        Column("margin\n[mm]"),
+        *(Column(h) for h in heads),
+    ]
     table = FitTable(cols, title=_title(b), caption=_caption(b))
     for p in b.poses:
         cells = [_cell(m, a) for m, a in zip(p.margins, p.tip_angles, strict=True)]
         table.add_row(p.name, f"{p.com[0]:.4f}", f"{p.com[2]:.4f}", f"{p.margin * 1e3:.1f}", *cells)
     w = b.worst_overall
     worst = [_cell(p.margins[e], b.worst_tip_angles[e]) for e, p in enumerate(b.worst)]
-    table.add_row("worst in range", f"{w.com[0]:.4f}", f"{w.com[2]:.4f}",
-                  f"{w.margin * 1e3:.1f}", *worst)  # fmt: skip
+    table.add_row(
+        "worst in range", f"{w.com[0]:.4f}", f"{w.com[2]:.4f}", f"{w.margin * 1e3:.1f}", *worst
+    )
     return table
 
 

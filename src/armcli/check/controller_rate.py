@@ -60,11 +60,16 @@ def check(c: Context) -> None:
     if v.stable:
         return
     at = c.samples[v.worst][0]
-    text = message(v, names, [at[n] for n in names], what="the ros2_control controller",
-                   rate_name=RATE_FIELD, gain_names=("kp", "kd", "ki"))  # fmt: skip
+    text = message(
+        v,
+        names,
+        [at[n] for n in names],
+        what="the ros2_control controller",
+        rate_name=RATE_FIELD,
+        gain_names=("kp", "kd", "ki"),
+    )
     line = next((j.line for j in c.urdf.joints if j.name == names[0]), None)
-    c.out.add(RULE, line, text, fix(v, "controller_update_rate", ("kp", "kd", "ki")),
-              **values(v))  # fmt: skip
+    c.out.add(RULE, line, text, fix(v, "controller_update_rate", ("kp", "kd", "ki")), **values(v))
 
 
 def fix(v: RateVerdict, rate_key: str, gain_keys: tuple[str, str, str]) -> dict[str, Value]:

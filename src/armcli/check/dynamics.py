@@ -137,8 +137,13 @@ def _report_stability(
     out: Collector,
 ) -> None:
     """One finding per unstable loop, saying which loop, why, where and its one remedy."""
-    common = dict(lambda_max=rep.lambda_max, dt=rep.dt, kp=rep.kp, kd_plus_damping=rep.d,
-                  gravity_stiffness=rep.gravity_stiffness)  # fmt: skip
+    common = dict(
+        lambda_max=rep.lambda_max,
+        dt=rep.dt,
+        kp=rep.kp,
+        kd_plus_damping=rep.d,
+        gravity_stiffness=rep.gravity_stiffness,
+    )
     numbers = (rep.kp, rep.d, rep.gravity_stiffness, rep.lambda_max)
     for rule, v in (("pd-unstable", rep.implicit), ("pd-explicit-unstable", rep.explicit)):
         if v.stable or v.suggestion is None:
@@ -149,8 +154,9 @@ def _report_stability(
         fix: dict[str, Value] = {"dt": v.suggestion.dt}
         if v.suggestion.kp is not None and v.suggestion.kd is not None:
             fix["kp"], fix["kd"] = list(v.suggestion.kp), list(v.suggestion.kd)
-        out.add(rule, line, text, fix, **common, a=v.a, b=v.b, dt_max=v.dt_max,
-                gain_scale=v.gain_scale)  # fmt: skip
+        out.add(
+            rule, line, text, fix, **common, a=v.a, b=v.b, dt_max=v.dt_max, gain_scale=v.gain_scale
+        )
 
 
 def self_collision(

@@ -85,6 +85,7 @@ class Collector:
     def __init__(self, file: str) -> None:
         self.file = file
         self.findings: list[Finding] = []
+        self.declared: frozenset[str] | None = None  # the running family's rules (check/run.py)
 
     def add(
         self,
@@ -101,6 +102,8 @@ class Collector:
         inertia that would pass); `fix` is positional-only so no value can shadow it.
         """
         r = RULES[rule]
+        if self.declared is not None and rule not in self.declared:  # the gate would miss it
+            raise RuntimeError(f"{rule!r} is not among the rules its check family declares")
         self.findings.append(
             Finding(rule, r.severity, self.file, line, message, values, r.hint, dict(fix or {}))
         )

@@ -12,18 +12,31 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 
 from armcli.check.options import CheckOptions
-from armcli.check.rules import ERROR, RULES
-from armcli.check.run import check_urdf
-from armcli.errors import ModelRefusedError, RuleViolation
+from armcli.check.rules import ERROR, RULES, unknown_rules
+from armcli.check.run import check_rules
+from armcli.errors import InputError, ModelRefusedError, RuleViolation
 from armcli.urdf.doc import Urdf
 
 # Errors about what the simulator never reads or what a run itself shows: meshes and colours
 # (the dynamics come from <inertial>), contact at named poses, the URDF's name, and a motor
 # too weak for gravity (the run reports the saturation).
 NOT_SIMULATED = frozenset(
-    {"mesh-missing", "self-collision", "material-undefined", "rgba-range", "robot-name",
-     "gravity-effort"}
-)  # fmt: skip
+    {
+        "mesh-missing",
+        "self-collision",
+        "material-undefined",
+        "rgba-range",
+        "robot-name",
+        "gravity-effort",
+    }
+)
+
+
+def require_known(ignore: Iterable[str]) -> None:
+    """Refuse an `ignore` naming no rule: a typo would silence nothing, silently."""
+    unknown = unknown_rules(ignore)
+    if unknown:
+        raise InputError(f"unknown rule(s) {', '.join(unknown)}", field="ignore")
 
 
 def bears_on_balance(rule: str) -> bool:
@@ -48,14 +61,19 @@ def refuse_check_errors(
 
     Rules in `ignore` do not refuse (as `check --ignore` silences them): the user has
     judged the finding, e.g. a true `inertia-exceeds-geometry` on an arm whose inertia is
-    right although its collision shape is smaller.
+    right although its collision shape is smaller. Only the rule families that can report
+    a refusing error run (check.run.check_rules): the gate asks only for what it refuses.
     """
     skip = NOT_SIMULATED | set(ignore)
-    result = check_urdf(urdf, options)
+
+    def refuses(rule: str) -> bool:
+        return rule not in skip and (only is None or only(rule))
+
+    found = check_rules(urdf, options, lambda r: RULES[r].severity == ERROR and refuses(r))
     errors = [
         RuleViolation(f.rule, f.file, f.line, f.message)
-        for f in result.findings
-        if f.severity == ERROR and f.rule not in skip and (only is None or only(f.rule))
+        for f in found
+        if f.severity == ERROR and refuses(f.rule)
     ]
     if errors:
         raise ModelRefusedError(urdf.source, errors)

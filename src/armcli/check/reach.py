@@ -20,8 +20,10 @@ def check(c: Context) -> None:
     if tool is None or link_frame(c.loaded().model, tool.link) is None:
         return
     if c.stance is not None and tool.link in c.stance.ground.links:
-        c.notes.append(f"workspace skipped: the tool point {tool.label} touches the ground "
-                       "(a base without an arm)")  # fmt: skip
+        c.notes.append(
+            f"workspace skipped: the tool point {tool.label} touches the ground "
+            "(a base without an arm)"
+        )
         return
     chain = Chain(c.loaded(), tool)
     if not chain.joints:

@@ -254,8 +254,10 @@ def _stability_text(st: Any, rate: Any) -> Any:
         t.append("stable" if v.stable else "UNSTABLE", "green" if v.stable else "red")
         t.append(_loop_bounds(v))
     if rate is not None:
-        t.append(f"\n  ros2_control controller at {rate.rate:g} Hz (effort held "
-                 f"{rate.hold * 1e3:.3g} ms): ")  # fmt: skip
+        t.append(
+            f"\n  ros2_control controller at {rate.rate:g} Hz (effort held "
+            f"{rate.hold * 1e3:.3g} ms): "
+        )
         t.append("stable" if rate.stable else "UNSTABLE", "green" if rate.stable else "red")
         edge = "any hold" if rate.hold_max == float("inf") else f"{rate.hold_max * 1e3:.3g} ms"
         t.append(f" (up to a hold of {edge}: update_rate >= {round_up(rate.rate_min, 3):g} Hz)")

@@ -23,17 +23,37 @@ _DYNAMICS = "dynamics"
 
 
 _SENSOR_RULES = [  # check/sensors.py; in _RULES before the ROS packages'
-    Rule("sensor-link", ERROR, "a sensor's <gazebo reference> is not a link of the robot",
-         "name one of the robot's links (Gazebo drops the sensor)"),
-    Rule("sensor-rate", ERROR, "a sensor updates faster than the physics steps",
-         "lower the sensor's rate to at most 1 / dt, or lower dt"),
-    Rule("sensor-fov", ERROR, "empty field of view (equal scan angles, camera fov not in (0, pi))",
-         "give min_angle < max_angle for several rays, a horizontal_fov in (0, pi)"),
-    Rule("sensor-range", ERROR, "range_min >= range_max or near >= far: the range is empty",
-         "give range_min < range_max (near < far)"),
-    Rule("sensor-sees-robot", WARNING, "a lidar's rays start in the robot's collision shapes",
-         "move the lidar clear of them (it sees itself) or raise range_min past them"),
-]  # fmt: skip
+    Rule(
+        "sensor-link",
+        ERROR,
+        "a sensor's <gazebo reference> is not a link of the robot",
+        "name one of the robot's links (Gazebo drops the sensor)",
+    ),
+    Rule(
+        "sensor-rate",
+        ERROR,
+        "a sensor updates faster than the physics steps",
+        "lower the sensor's rate to at most 1 / dt, or lower dt",
+    ),
+    Rule(
+        "sensor-fov",
+        ERROR,
+        "empty field of view (equal scan angles, camera fov not in (0, pi))",
+        "give min_angle < max_angle for several rays, a horizontal_fov in (0, pi)",
+    ),
+    Rule(
+        "sensor-range",
+        ERROR,
+        "range_min >= range_max or near >= far: the range is empty",
+        "give range_min < range_max (near < far)",
+    ),
+    Rule(
+        "sensor-sees-robot",
+        WARNING,
+        "a lidar's rays start in the robot's collision shapes",
+        "move the lidar clear of them (it sees itself) or raise range_min past them",
+    ),
+]
 _RULES = [
     # structure
     Rule(

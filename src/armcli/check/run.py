@@ -43,6 +43,7 @@ from armcli.check.context import (
 )
 from armcli.check.findings import Collector, Finding
 from armcli.check.options import CheckOptions
+from armcli.check.rules import RULES
 from armcli.check.summary import Summary
 from armcli.errors import ModelLoadError
 from armcli.robot import sampling
@@ -53,11 +54,18 @@ from armcli.urdf.doc import Urdf
 
 @dataclass(frozen=True)
 class Family:
-    """A group of rules run together: a name, the stage it needs, and the function."""
+    """A group of rules run together: a name, the stage it needs, the function, its rules.
+
+    `rules` lists every rule id the family can report (Collector refuses any other), so a
+    caller that wants a few rules runs only the families that can report them
+    (`check_rules`: the gate before a run); `uses`, the families whose results it reads.
+    """
 
     name: str
     needs: Stage
     run: Callable[[Context], None]
+    rules: frozenset[str] = frozenset()
+    uses: tuple[str, ...] = ()
 
 
 def _gravity(c: Context) -> None:
@@ -80,20 +88,44 @@ def _self_collision(c: Context) -> None:
         dyn.self_collision(c.urdf, c.opts, c.loaded(), poses(c), c.out, c.notes)
 
 
+def _rules(ids: str) -> frozenset[str]:
+    """A family's rule ids, space-separated (each in check/rules.py's registry)."""
+    return frozenset(ids.split())
+
+
+INERTIA_RULES = _rules(
+    "missing-inertial root-inertia mass-nonpositive inertia-not-pd inertia-triangle "
+    "inertia-geometry com-geometry inertia-exceeds-geometry inertia-exceeds-visual"
+)
+JOINT_RULES = _rules("axis axis-unit limit-order limit-degrees limit-effort-velocity spec-limits")
+SENSOR_RULES = _rules("sensor-link sensor-rate sensor-fov sensor-range sensor-sees-robot")
 FAMILIES: tuple[Family, ...] = (
-    Family("inertia", URDF, lambda c: inertia.check(c.urdf, c.tree, c.out)),
-    Family("bodies", URDF, lambda c: bodies.check(c.urdf, c.tree, c.out)),
-    Family("joints", URDF, lambda c: joints.check(c.urdf, c.opts.spec, c.out, c.notes)),
-    Family("meshes", URDF, lambda c: meshes.check(c.urdf, c.opts, c.out)),
-    Family("gravity", DYNAMICS, _gravity),
-    Family("servo", DYNAMICS, _servo),
-    Family("stability", DYNAMICS, _stability),
-    Family("controller rate", DYNAMICS, controller_rate.check),
-    Family("self-collision", MODEL, _self_collision),
-    Family("tipover", BALANCE, tipover.check),
-    Family("zmp", DYNAMICS, zmp_rules.check),
-    Family("reach", MODEL, reach.check),
-    Family("sensors", MODEL, sensors.check),
+    Family("inertia", URDF, lambda c: inertia.check(c.urdf, c.tree, c.out), INERTIA_RULES),
+    Family(
+        "bodies",
+        URDF,
+        lambda c: bodies.check(c.urdf, c.tree, c.out),
+        _rules("mass-nonpositive inertia-not-pd tiny-mass"),
+    ),
+    Family(
+        "joints", URDF, lambda c: joints.check(c.urdf, c.opts.spec, c.out, c.notes), JOINT_RULES
+    ),
+    Family("meshes", URDF, lambda c: meshes.check(c.urdf, c.opts, c.out), _rules("mesh-missing")),
+    Family("gravity", DYNAMICS, _gravity, _rules("gravity-effort")),
+    Family("servo", DYNAMICS, _servo, _rules("servo-unstable servo-oscillates")),
+    Family(
+        "stability", DYNAMICS, _stability, _rules("pd-unstable pd-explicit-unstable"), ("servo",)
+    ),
+    Family(
+        "controller rate", DYNAMICS, controller_rate.check, _rules(controller_rate.RULE), ("servo",)
+    ),
+    Family("self-collision", MODEL, _self_collision, _rules("self-collision")),
+    Family("tipover", BALANCE, tipover.check, _rules("com-outside-support support-margin")),
+    Family(
+        "zmp", DYNAMICS, zmp_rules.check, _rules("zmp-outside-support zmp-margin"), ("tipover",)
+    ),
+    Family("reach", MODEL, reach.check, _rules("reach-point"), ("tipover",)),
+    Family("sensors", MODEL, sensors.check, SENSOR_RULES),
 )
 
 
@@ -108,15 +140,57 @@ class CheckResult:
 
 def check_urdf(urdf: Urdf, options: CheckOptions | None = None) -> CheckResult:
     """Run every rule on one parsed URDF: the document's families, then the model's."""
+    ctx = _run(urdf, options, FAMILIES)
+    return CheckResult(urdf.source, _found(ctx), summary.summarise(ctx))
+
+
+def check_rules(
+    urdf: Urdf, options: CheckOptions | None, wanted: Callable[[str], bool]
+) -> tuple[Finding, ...]:
+    """The findings of only the families that can report a `wanted` rule (no summary).
+
+    What the gate before a run asks (check/gate.py): the errors that refuse it. The
+    families that cannot report one (a missing mesh, the gravity load, self-collision at
+    the named poses) are not run; nor is the summary. Their findings are the same as
+    `check_urdf`'s for every wanted rule (tests/check/test_gate.py).
+    """
+    return _found(_run(urdf, options, families_for(wanted)))
+
+
+def families_for(wanted: Callable[[str], bool]) -> tuple[Family, ...]:
+    """The families that can report a `wanted` rule, in registry order.
+
+    Also those that report a rule that `blocks` a stage (their errors decide whether the
+    later families run at all, as in a full check) and those whose results a chosen
+    family reads (`uses`).
+    """
+    by_name = {f.name: f for f in FAMILIES}
+    todo = [f.name for f in FAMILIES if any(wanted(r) or RULES[r].blocks for r in f.rules)]
+    chosen: set[str] = set()
+    while todo:
+        name = todo.pop()
+        if name not in chosen:
+            chosen.add(name)
+            todo += by_name[name].uses
+    return tuple(f for f in FAMILIES if f.name in chosen)
+
+
+def _run(urdf: Urdf, options: CheckOptions | None, families: tuple[Family, ...]) -> Context:
+    """Run `families` on one parsed URDF: the document's first, then the model's in order."""
     opts = options or CheckOptions()
     out = Collector(urdf.source)
     ctx = Context(urdf, opts, out, structure.check(urdf, out), rows=joint_rows(urdf))
-    for family in sorted(FAMILIES, key=lambda f: f.needs != URDF):  # the document's first
+    for family in sorted(families, key=lambda f: f.needs != URDF):  # the document's first
         if _ready(ctx, family.needs):
+            out.declared = family.rules
             family.run(ctx)
-    _ready(ctx, MODEL)  # the summary's poses need the model even without model rules
-    found = tuple(_at_origin(f, urdf) for f in out.findings)
-    return CheckResult(urdf.source, found, summary.summarise(ctx))
+            out.declared = None
+    _ready(ctx, MODEL)  # the model's own findings (model-load), the summary's poses
+    return ctx
+
+
+def _found(ctx: Context) -> tuple[Finding, ...]:
+    return tuple(_at_origin(f, ctx.urdf) for f in ctx.out.findings)
 
 
 def _at_origin(f: Finding, urdf: Urdf) -> Finding:

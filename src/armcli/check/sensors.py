@@ -43,9 +43,15 @@ def check(c: Context) -> None:
             c.out.add("sensor-link", s.line, message, sensor=s.name, link=str(s.link))
             continue
         if s.update_rate is not None and s.update_rate * dt > 1.0 + 1e-9:
-            c.out.add("sensor-rate", s.line, f"sensor {s.name!r} updates at {s.update_rate:g} "
-                      f"Hz, above the physics rate {1.0 / dt:g} Hz (dt = {dt:g} s)",
-                      sensor=s.name, rate=s.update_rate, physics_rate=1.0 / dt)  # fmt: skip
+            c.out.add(
+                "sensor-rate",
+                s.line,
+                f"sensor {s.name!r} updates at {s.update_rate:g} "
+                f"Hz, above the physics rate {1.0 / dt:g} Hz (dt = {dt:g} s)",
+                sensor=s.name,
+                rate=s.update_rate,
+                physics_rate=1.0 / dt,
+            )
         if not (_fov(c, s) | _range(c, s)) and s.is_lidar:
             seeing.append(s)
     if seeing:
@@ -60,9 +66,15 @@ def _fov(c: Context, s: GazeboSensor) -> bool:
         n, lo, hi = scan
         assert n is not None and lo is not None and hi is not None
         if n > 1 and hi <= lo:
-            c.out.add("sensor-fov", s.line, f"sensor {s.name!r}: {int(n)} {axis} rays between "
-                      f"{lo:g} and {hi:g} rad: an empty field of view", sensor=s.name,
-                      min_angle=lo, max_angle=hi)  # fmt: skip
+            c.out.add(
+                "sensor-fov",
+                s.line,
+                f"sensor {s.name!r}: {int(n)} {axis} rays between "
+                f"{lo:g} and {hi:g} rad: an empty field of view",
+                sensor=s.name,
+                min_angle=lo,
+                max_angle=hi,
+            )
             return True
     fov = s.horizontal_fov
     if fov is not None and not 0.0 < fov < math.pi:
@@ -77,9 +89,13 @@ def _range(c: Context, s: GazeboSensor) -> bool:
     for (lo, hi), what in ((s.range or (None, None), "range"), (s.clip or (None, None), "clip")):
         if lo is not None and hi is not None and lo >= hi:
             names = ("range_min", "range_max") if what == "range" else ("near", "far")
-            c.out.add("sensor-range", s.line, f"sensor {s.name!r}: {names[0]} {lo:g} m is not "
-                      f"below {names[1]} {hi:g} m", sensor=s.name,
-                      **{names[0]: lo, names[1]: hi})  # fmt: skip
+            c.out.add(
+                "sensor-range",
+                s.line,
+                f"sensor {s.name!r}: {names[0]} {lo:g} m is not below {names[1]} {hi:g} m",
+                sensor=s.name,
+                **{names[0]: lo, names[1]: hi},
+            )
             return True
     return False
 
@@ -93,10 +109,14 @@ def _sees_robot(c: Context, lidars: list[GazeboSensor]) -> None:
     for s in lidars:
         inside, total, links = _inside(model, data, s)
         if inside:
-            c.out.add("sensor-sees-robot", s.line,
-                      f"sensor {s.name!r}: {inside} of its {total} rays start inside the "
-                      f"collision shape of {', '.join(links)}: the lidar sees its own robot",
-                      sensor=s.name, rays=inside)  # fmt: skip
+            c.out.add(
+                "sensor-sees-robot",
+                s.line,
+                f"sensor {s.name!r}: {inside} of its {total} rays start inside the "
+                f"collision shape of {', '.join(links)}: the lidar sees its own robot",
+                sensor=s.name,
+                rays=inside,
+            )
 
 
 def _mujoco_model(c: Context, lidars: list[GazeboSensor]) -> tuple[Any, Any]:

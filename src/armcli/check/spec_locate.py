@@ -51,8 +51,9 @@ _PD_RULE_PREFIX = "pd-"
 _SENSOR_RULE_PREFIX = "sensor-"  # check/sensors.py: about the spec's sensor named
 _RATE_RULE = "ros-controller-unstable"  # check/controller_rate.py: the spec's controller rate
 # check/tipover.py and check/zmp.py: about a pose or the base's drive, not a URDF element
-_BALANCE_RULES = frozenset({"com-outside-support", "support-margin", "zmp-outside-support",
-                            "zmp-margin"})  # fmt: skip
+_BALANCE_RULES = frozenset(
+    {"com-outside-support", "support-margin", "zmp-outside-support", "zmp-margin"}
+)
 
 
 def _element_at(root: Any, line: int) -> Any:

@@ -72,8 +72,10 @@ def _without_wheel_payload(c: Context, stance: Stance) -> Stance:
     if p is None or c.opts.tipover.payload_link is not None or p.link not in stance.ground.links:
         return stance
     if p.mass > 0:
-        c.notes.append(f"payload left out: the tool point {p.link} touches the ground (no arm); "
-                       "name its link with --payload-link")  # fmt: skip
+        c.notes.append(
+            f"payload left out: the tool point {p.link} touches the ground (no arm); "
+            "name its link with --payload-link"
+        )
     return replace(stance, payload=None)
 
 
@@ -104,9 +106,13 @@ NO_ARM_HINT = (
 
 
 def _add(
-    b: StaticBalance, p: PoseBalance, where: str, out: Collector, line: int | None,
+    b: StaticBalance,
+    p: PoseBalance,
+    where: str,
+    out: Collector,
+    line: int | None,
     holds: float | None,
-) -> None:  # fmt: skip
+) -> None:
     e = p.edge
     direction = b.directions[e]
     load = f" with {b.payload}" if b.payload else ""
@@ -115,8 +121,10 @@ def _add(
         what = f"centre of mass {-p.margin * 1e3:.1f} mm outside the support polygon"
     else:
         rule = "support-margin"
-        what = (f"centre of mass only {p.margin * 1e3:.1f} mm inside the support polygon "
-                f"(threshold {b.threshold * 1e3:g} mm)")  # fmt: skip
+        what = (
+            f"centre of mass only {p.margin * 1e3:.1f} mm inside the support polygon "
+            f"(threshold {b.threshold * 1e3:g} mm)"
+        )
     text = f"{where}: {what}, toward {direction}{load}; "
     fix: dict[str, Value] = {}
     if not b.payload_point:  # no payload point: a base without an arm
@@ -128,8 +136,18 @@ def _add(
     else:
         text += f"up to {holds:.3g} kg at {b.payload_point} holds there"
         fix["payload"] = round_down(holds)
-    out.add(rule, line, text, fix, pose=p.name, margin=p.margin, direction=direction,
-            tip_angle_deg=math.degrees(p.tip_angles[e]), com=list(p.com),
-            q=[v for _, v in p.q], payload=b.payload)  # fmt: skip
+    out.add(
+        rule,
+        line,
+        text,
+        fix,
+        pose=p.name,
+        margin=p.margin,
+        direction=direction,
+        tip_angle_deg=math.degrees(p.tip_angles[e]),
+        com=list(p.com),
+        q=[v for _, v in p.q],
+        payload=b.payload,
+    )
     if not b.payload_point:  # the rule's hint speaks of an arm this robot does not have
         out.findings[-1] = replace(out.findings[-1], hint=NO_ARM_HINT)

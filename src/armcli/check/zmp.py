@@ -25,16 +25,19 @@ def check(c: Context) -> None:
     if opts.trajectory is None or c.stance is None:
         return
     if spec is None or not spec.control.gains:
-        c.notes.append("zero-moment point skipped: the trajectory needs a spec's PD gains "
-                       "to be simulated (give --spec)")  # fmt: skip
+        c.notes.append(
+            "zero-moment point skipped: the trajectory needs a spec's PD gains "
+            "to be simulated (give --spec)"
+        )
         return
     from armcli.sim import armrun  # the simulator's stack: only with --trajectory (~60 ms)
     from armcli.urdf.source import RobotFile
 
     file = c.opts.robot_file if c.opts.robot_file is not None else RobotFile.of_spec(spec)
     try:
-        r = armrun.trajectory_zmp(file, c.urdf, c.stance, opts.trajectory,
-                                   opts.base_accel, opts.min_margin)  # fmt: skip
+        r = armrun.trajectory_zmp(
+            file, c.urdf, c.stance, opts.trajectory, opts.base_accel, opts.min_margin
+        )
     except ArmcliError as exc:
         c.notes.append(f"zero-moment point skipped: {exc}")
         return
@@ -45,15 +48,21 @@ def check(c: Context) -> None:
         what = f"{-r.min_margin * 1e3:.1f} mm outside the support polygon: the robot tips"
     elif r.min_margin < 0:  # too briefly to rotate the robot over the edge (sim.tipping)
         lift = sum(e.duration for e in r.lifts)
-        what = (f"{-r.min_margin * 1e3:.1f} mm outside the support polygon for {lift:.3f} s: "
-                "a wheel lifts off, too briefly to tip the robot")  # fmt: skip
+        what = (
+            f"{-r.min_margin * 1e3:.1f} mm outside the support polygon for {lift:.3f} s: "
+            "a wheel lifts off, too briefly to tip the robot"
+        )
     else:
-        what = (f"only {r.min_margin * 1e3:.1f} mm inside the support polygon "
-                f"(threshold {opts.min_margin * 1e3:g} mm)")  # fmt: skip
+        what = (
+            f"only {r.min_margin * 1e3:.1f} mm inside the support polygon "
+            f"(threshold {opts.min_margin * 1e3:g} mm)"
+        )
     holds = r.max_base_accel if r.tips else r.max_base_accel_margin
     fix: dict[str, Value] = {}
-    text = (f"trajectory {opts.trajectory.name}: zero-moment point {what}, toward "
-            f"{r.direction} at t = {r.time:.3f} s ({r.when}); ")  # fmt: skip
+    text = (
+        f"trajectory {opts.trajectory.name}: zero-moment point {what}, toward "
+        f"{r.direction} at t = {r.time:.3f} s ({r.when}); "
+    )
     if holds > 0 and math.isfinite(holds):
         text += f"a base acceleration up to {holds:.3g} m/s² holds"
         # the spec's diff_drive field when the limit came from the plugin, else the option
@@ -64,6 +73,16 @@ def check(c: Context) -> None:
     else:
         text += "the arm motion alone is too fast: slow the trajectory down"
     rule = "zmp-outside-support" if r.tips else "zmp-margin"
-    c.out.add(rule, c.urdf.line, text, fix, time=r.time, margin=r.min_margin, case=r.case,
-              base_accel=r.base_accel, direction=r.direction, zmp=list(r.zmp),
-              trajectory=str(opts.trajectory))  # fmt: skip
+    c.out.add(
+        rule,
+        c.urdf.line,
+        text,
+        fix,
+        time=r.time,
+        margin=r.min_margin,
+        case=r.case,
+        base_accel=r.base_accel,
+        direction=r.direction,
+        zmp=list(r.zmp),
+        trajectory=str(opts.trajectory),
+    )

@@ -2,31 +2,24 @@
 
 from __future__ import annotations
 
-import math
 import sys
-from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import typer
 
+from armcli.commands.flags import flag_errors
 from armcli.commands.options import choice
 from armcli.commands.robot_input import robot_options, write_notes
 from armcli.commands.values import REACH_POINT_HELP, Names, Numbers, names, point
 from armcli.defaults import ROS_DISTROS
 from armcli.errors import (
-    EXIT_FAILED,
-    EXIT_UNUSABLE,
     EXPANDED_TAG,
-    FindingsError,
-    InputError,
-    UnusableInputsError,
 )
 from armcli.io import terminal
 
 if TYPE_CHECKING:  # the checker is imported when the command runs: `--help` stays light
     from armcli.check.inputs import CheckRun
-    from armcli.check.options import TipoverOptions
     from armcli.urdf.source import RobotInput
 
 FORMATS = ("table", "json", "github", "sarif")
@@ -43,33 +36,14 @@ BASE_ACCEL_HELP = (
 )
 
 
-def tipover_options(
-    payload: float,
-    payload_link: str | None,
-    contact_links: Names | None,
-    min_margin: float,
-    trajectory: Path | None,
-    base_accel: float | None,
-    reach_points: list[Numbers],
-) -> TipoverOptions:
-    """The balance and reach options, refused here when they are not usable numbers."""
-    from armcli.check.options import TipoverOptions
-
-    for flag, x in (("--payload", payload), ("--min-margin", min_margin),
-                    ("--base-accel", 0.0 if base_accel is None else base_accel)):  # fmt: skip
-        if not (math.isfinite(x) and x >= 0):
-            raise InputError(f"must be a finite number >= 0, got {x:g}", field=flag)
-    if trajectory is not None and not trajectory.is_file():
-        raise InputError("no such file", file=trajectory, field="--trajectory")
-    return TipoverOptions(
-        payload=payload,
-        payload_link=payload_link,
-        contact_links=contact_links,
-        min_margin=min_margin,
-        trajectory=trajectory,
-        base_accel=base_accel,
-        reach_points=tuple((p[0], p[1], p[2]) for p in reach_points),
-    )
+# The library's names for what these flags set (errors name them; commands.flags maps back).
+FLAGS = {
+    "ignore": "--ignore",
+    "TipoverOptions.payload": "--payload",
+    "TipoverOptions.min_margin": "--min-margin",
+    "TipoverOptions.base_accel": "--base-accel",
+    "TipoverOptions.trajectory": "--trajectory",
+}
 
 
 @robot_options("paths")
@@ -97,42 +71,30 @@ def check_cmd(
     distro: str = choice(None, ROS_DISTROS, "--distro", help=DISTRO_HELP),
 ) -> None:
     """Check robot descriptions for physical sanity; exit 1 on error findings."""
-    from armcli.check import report
-    from armcli.check.findings import apply_policy
-    from armcli.check.inputs import run_check
-    from armcli.check.options import CheckOptions
-    from armcli.check.report import counts
-    from armcli.check.rules import RULES, unknown_rules
+    from armcli.check.api import check
+    from armcli.check.options import CheckOptions, TipoverOptions
 
-    unknown = unknown_rules(ignore)
-    if unknown:
-        raise InputError(f"unknown rule(s) {unknown}; known: {', '.join(RULES)}", field="--ignore")
-    tip = tipover_options(
-        payload, payload_link, contact_links, min_margin, trajectory, base_accel, reach_point
+    reach = tuple((p[0], p[1], p[2]) for p in reach_point)
+    tip = TipoverOptions(
+        payload, payload_link, contact_links, min_margin, trajectory, base_accel, reach
     )
     base = CheckOptions(package_dirs=robot.packages.package_dirs, tipover=tip, ros_distro=distro)
-    if spec is not None:  # the spec layers (pydantic, ~0.4 s to import) only for a spec
-        from armcli.spec.load import load_spec
-
-        base = replace(base, spec=load_spec(spec))
-    run = run_check(robot.files(), base, trust_xacro=robot.trust, inputs=robot.xacro)
-    for file, note in run.notes:
-        write_notes([note], file.removesuffix(EXPANDED_TAG))
-    everything = [f for r in run.results for f in r.findings]
-    everything += [u.finding() for u in run.unusable]
-    findings = report.by_severity(apply_policy(everything, ignore=ignore, strict=strict))
-    code = run.exit_code(findings)
-    _print(run, findings, fmt, code)
-    if code == EXIT_UNUSABLE:
-        unusable = UnusableInputsError([u.error for u in run.unusable])
-        unusable.reported = True  # in the report just printed
-        raise unusable
-    if code == EXIT_FAILED:
-        n_err = counts(findings)["error"]
-        raise FindingsError(
-            f"{n_err} error finding(s) in {len(run.results) + len(run.unusable)} file(s)",
-            [u.error for u in run.unusable],
+    with flag_errors(FLAGS):
+        checked = check(
+            robot.files(),
+            base,
+            spec=spec,
+            ignore=ignore,
+            strict=strict,
+            trust_xacro=robot.trust,
+            inputs=robot.xacro,
         )
+    for file, note in checked.run.notes:
+        write_notes([note], file.removesuffix(EXPANDED_TAG))
+    _print(checked.run, checked.findings, fmt, checked.code)
+    error = checked.error()
+    if error is not None:
+        raise error
 
 
 def _print(run: CheckRun, findings: list[Any], fmt: str, code: int) -> None:

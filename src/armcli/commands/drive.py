@@ -40,9 +40,14 @@ def run_drive(
     from armcli.sim import report as simreport
 
     try:
-        driven = drive_robot(file, opts, cmd_vel, progress=progress, world=world,
-                             gate=lambda u: refuse_check_errors(u, CheckOptions(robot_file=file),
-                                                                ignore=ignore))  # fmt: skip
+        driven = drive_robot(
+            file,
+            opts,
+            cmd_vel,
+            progress=progress,
+            world=world,
+            gate=lambda u: refuse_check_errors(u, CheckOptions(robot_file=file), ignore=ignore),
+        )
     except ModelRefusedError as exc:
         flags = " ".join(f"--ignore {r}" for r in exc.rules())
         raise ModelRefusedError(
@@ -64,8 +69,11 @@ def run_drive(
     o = res_run.odometry
     L = job.model.layout
     end = res_run.sensors[-1, L.base_pos]
-    terminal.line(out, f"base: odometry ({o.x[-1]:.3f}, {o.y[-1]:.3f}) m, yaw {o.yaw[-1]:.3f} "
-                       f"rad; ground truth ({end[0]:.3f}, {end[1]:.3f}) m")  # fmt: skip
+    terminal.line(
+        out,
+        f"base: odometry ({o.x[-1]:.3f}, {o.y[-1]:.3f}) m, yaw {o.yaw[-1]:.3f} "
+        f"rad; ground truth ({end[0]:.3f}, {end[1]:.3f}) m",
+    )
     terminal.line(out, verdict.line(), "red" if verdict.tips else None)
     for path in (output, plot):
         if path is not None:

@@ -67,8 +67,8 @@ def mjcf_cmd(
     write_notes(res.notes)
     exp = res.export
     say_line(f"{wrote_line(out, len(res.export.meshes), bool(before))} from {res.robot}")
-    say(f"{len(exp.joints)} joints, {len(exp.actuators)} actuators, "
-        f"keyframes: {', '.join(exp.keyframes)}")  # fmt: skip
+    keyframes = ", ".join(exp.keyframes)
+    say(f"{len(exp.joints)} joints, {len(exp.actuators)} actuators, keyframes: {keyframes}")
     say(res.report)
     say(res.verdict.text)
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import sys
-from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -14,14 +13,13 @@ from armcli.commands.options import choice, option, seed_option
 from armcli.commands.robot_input import robot_options
 from armcli.commands.values import Names, Numbers, names, numbers, point
 from armcli.defaults import MAX_PLAN_TIMEOUT_S, PLANNERS
-from armcli.errors import PlanningError
 from armcli.io.outdir import existing, wrote
 from armcli.io.terminal import say, say_line
 
 if TYPE_CHECKING:
     from armcli.plan.api import PlanResult
     from armcli.plan.execute import Execution
-    from armcli.urdf.source import RobotFile, RobotInput
+    from armcli.urdf.source import RobotInput
 
 FORMATS = ("text", "json")
 FROM_HELP = "Start: a named pose (spec poses, SRDF group states) or q1,q2,... [rad]."
@@ -57,6 +55,7 @@ FLAGS = {
     "base": "--base",
     "base_start": "--base-start",
     "execute": "--execute",
+    "output": "--output",
 }
 
 
@@ -106,9 +105,9 @@ def plan_cmd(
     ),
 ) -> None:
     """Plan a collision-free motion, time it within the limits, certify it, write it."""
-    from armcli.io.outdir import check_output_file
     from armcli.plan.api import PlanOptions
-    from armcli.plan.request import PlanRequest, plan_request
+    from armcli.plan.request import PlanRequest
+    from armcli.plan.run import plan
 
     if base or base_start is not None:
         from armcli.commands.plan_base import plan_base
@@ -117,50 +116,28 @@ def plan_cmd(
                   fmt, execute, tolerance)  # fmt: skip
         return
     request = PlanRequest(start, goal, to_xyz, to_rpy, srdf, scene, joints or None, group)
-    if output is not None:  # never over a file it reads (issue 42; hard links too)
-        inputs = [p for p in (urdf or robot.file(), srdf, scene) if p is not None]
-        check_output_file(output, "--output", inputs)
-    robot_file = robot.read(urdf)
-    if execute:  # refused before planning: nothing written
-        from armcli.plan.execute import check_executable
-
-        check_executable(robot_file.spec)
-    what = request.describe()
-    opts = PlanOptions(planner=planner, timeout=timeout, seed=seed,
-                       comment=f"armcli plan {what}, {planner}, seed {seed}")  # fmt: skip
-    for line in request.warnings():
-        say_line(f"warning: {line}", sys.stderr)
-    try:
-        result = plan_request(robot_file, replace(request, options=opts), robot.packages)
-    except PlanningError as exc:
-        if exc.kind == "ik" and robot_file.spec is not None and robot_file.spec.mobile_base:
-            why = f"{exc.reason}: out of the arm's reach from where the base stands"
-            raise PlanningError(
-                "ik", f"{why}; --base plans where to park and the drive there"
-            ) from None
-        raise
     before = existing(output)
-    if output is not None:
-        from armcli.io.files import write_file_atomic
-
-        write_file_atomic(output, result.document)
-    done = None
-    if execute:
-        done = _execute(robot_file, robot, result)
+    planned = plan(
+        robot,
+        request,
+        PlanOptions(planner, timeout, seed),
+        urdf=urdf,
+        output=output,
+        run=execute,
+        warn=_warn,
+    )
+    result, done = planned.result, planned.executed
     if fmt == "json":
         _json(_summary(result, output, planner, seed, done))
     else:
-        _print(result, wrote(output, output in before) if output else None, what, planner,
-               seed, done)  # fmt: skip
+        written = wrote(output, output in before) if output else None
+        _print(result, written, planned.what, planner, seed, done)
     if done is not None and done.broken:
         raise typer.Exit(1)
 
 
-def _execute(robot_file: RobotFile, robot: RobotInput, result: PlanResult) -> Execution:
-    from armcli.plan.execute import execute
-    from armcli.sim.options import SimOptions
-
-    return execute(robot_file, SimOptions(message=result.document.decode("utf-8")), robot.packages)
+def _warn(line: str) -> None:
+    say_line(f"warning: {line}", sys.stderr)
 
 
 def _summary(
@@ -214,8 +191,9 @@ def _print(
     if done is not None:
         lines.append("  executed in simulation:")
         for m, tau, lim in zip(done.metrics, done.peak_effort, done.effort_limit, strict=True):
-            lines.append(f"    {m.name}: max error {m.max_error:.4f} rad, "
-                         f"peak effort {tau:.3g} of {lim:g}")  # fmt: skip
+            lines.append(
+                f"    {m.name}: max error {m.max_error:.4f} rad, peak effort {tau:.3g} of {lim:g}"
+            )
         if done.tip_margin is not None:
             lines.append(f"    tip-over margin {done.tip_margin * 1e3:.1f} mm")
         lines += [f"    broken: {p}" for p in done.problems]

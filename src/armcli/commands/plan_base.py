@@ -19,8 +19,13 @@ if TYPE_CHECKING:
     from armcli.plan.mobile.whole import WholePlan
     from armcli.urdf.source import RobotInput
 
-FLAGS = {"base": "--base", "start": "--from", "target": "--to-xyz", "tolerance": "--tolerance",
-         "execute": "--execute"}  # fmt: skip
+FLAGS = {
+    "base": "--base",
+    "start": "--from",
+    "target": "--to-xyz",
+    "tolerance": "--tolerance",
+    "execute": "--execute",
+}
 FILES = ("arm.yaml", "cmd_vel.yaml", "path.yaml")
 RUN_FILES = ("run.csv", "run.mcap")
 
@@ -50,8 +55,9 @@ def plan_base(
     if to_xyz is None:
         raise InputError("--base plans for a point: give --to-xyz X,Y,Z", field="--to-xyz")
     if execute and output is None:
-        raise InputError("--execute with --base writes run.csv and run.mcap: give -o DIR",
-                         field="--execute")  # fmt: skip
+        raise InputError(
+            "--execute with --base writes run.csv and run.mcap: give -o DIR", field="--execute"
+        )
     if output is not None:
         for name in FILES + (RUN_FILES if execute else ()):
             check_output_file(output / name, "--output", parents=True)
@@ -60,15 +66,20 @@ def plan_base(
     robot_file = robot.read(urdf)
     origin = tuple(base_start) if base_start is not None else (0.0, 0.0, 0.0)
     what = f"from {start or 'the start pose'} to xyz {','.join(f'{v:g}' for v in to_xyz)}"
-    opts = PlanOptions(planner=planner, timeout=timeout, seed=seed,
-                       comment=f"armcli plan --base {what}, {planner}, seed {seed}")  # fmt: skip
+    opts = PlanOptions(
+        planner=planner,
+        timeout=timeout,
+        seed=seed,
+        comment=f"armcli plan --base {what}, {planner}, seed {seed}",
+    )
     try:
         with flag_errors(FLAGS):
             mobile = load_mobile(robot_file, scene=scene, search=robot.packages)
             if execute:  # refused before planning (nothing written), after "needs a drive"
                 _executable(mobile)
-            goal = BaseGoal((to_xyz[0], to_xyz[1], to_xyz[2]), (origin[0], origin[1], origin[2]),
-                            start)  # fmt: skip
+            goal = BaseGoal(
+                (to_xyz[0], to_xyz[1], to_xyz[2]), (origin[0], origin[1], origin[2]), start
+            )
             whole = plan_whole(mobile, goal, opts)
     except PlanningError as exc:
         if fmt == "json":
@@ -103,12 +114,13 @@ def _executable(mobile: MobileRobot) -> None:
     executable(mobile.robot_file)
 
 
-def _execute(whole: WholePlan, out: Path, written: dict[Path, bytes], tolerance: float
-             ) -> Executed:  # fmt: skip
+def _execute(whole: WholePlan, out: Path, written: dict[Path, bytes], tolerance: float) -> Executed:
     from armcli.io.together import write_files_together
+    from armcli.plan.mobile.basefiles import cmd_vel_of
     from armcli.plan.mobile.execute import execute_whole, run_files
 
-    done = execute_whole(whole, out / "cmd_vel.yaml", written[out / "arm.yaml"], tolerance)
+    cmd_vel = cmd_vel_of(whole.timing, str(out / "cmd_vel.yaml"))  # as written, not re-read
+    done = execute_whole(whole, cmd_vel, written[out / "arm.yaml"], tolerance)
     write_files_together(run_files(whole, done, out), parents=True)
     return done
 
@@ -134,8 +146,10 @@ def _localised(done: Executed) -> list[str]:
     """Say how the base was followed: the ground-truth fixes stand in for a localiser."""
     if done.localize <= 0:
         return ["  followed on the encoder odometry alone"]
-    return [f"  followed on the encoder odometry with a {done.localize:g} Hz ground-truth fix "
-            "(a stand-in for a localiser such as AMCL)"]  # fmt: skip
+    return [
+        f"  followed on the encoder odometry with a {done.localize:g} Hz ground-truth fix "
+        "(a stand-in for a localiser such as AMCL)"
+    ]
 
 
 def executed_lines(done: Executed, out: Path) -> list[str]:

@@ -12,8 +12,7 @@ import typer
 from armcli.commands.flags import flag_errors
 from armcli.commands.robot_input import robot_options, write_notes
 from armcli.commands.values import REACH_POINT_HELP, Numbers, point, size
-from armcli.errors import InputError
-from armcli.io.outdir import check_output_file, existing, wrote
+from armcli.io.outdir import existing, wrote
 from armcli.io.terminal import say, say_line
 
 if TYPE_CHECKING:
@@ -25,7 +24,7 @@ REACH_HELP = (
 )
 
 
-@flag_errors({"pose": "--pose", "q": "--q"})
+@flag_errors({"pose": "--pose", "q": "--q", "out": "--out", "reach": "--reach"})
 @robot_options()
 def render_cmd(
     robot: RobotInput,
@@ -55,53 +54,34 @@ def render_cmd(
     ),
 ) -> None:
     """Draw the robot at a pose from two viewpoints into a PNG (headless, no GPU)."""
-    from armcli.analysis.workspace import describe, verdict  # on use: `--help` stays light
-    from armcli.view.png import MESH_HINT, load_urdf, render_png, snapped
-    from armcli.view.scene import load_robot, pose_q
+    from armcli.view.picture import render  # on use: `--help` stays light
 
-    check_output_file(out, "--out", robot.files())  # before any work; never over the robot
     before = existing(out)
-    src = load_robot(robot)
-    write_notes(src.notes)
-    values = pose_q(src, pose, q)
-    width, height = image_size
-    skipped: dict[str, str] = {}
-    said: dict[str, str] = {}  # what trimesh said about a mesh it drew (a missing texture)
-    urdf = load_urdf(src.xml, src.source, src.mesh_dir, src.search, skipped, said)
-    values, notes = snapped(urdf, values)
-    for note in notes:
+    pic = render(
+        robot,
+        out,
+        pose=pose,
+        q=q,
+        size=(image_size[0], image_size[1]),
+        reach=reach,
+        targets=reach_point,
+    )
+    write_notes(pic.notes)
+    for note in pic.snapped:
         say_line(f"note: {note}", sys.stderr)
-    field = "--pose" if pose else "--q"
-    lines: list[str] = []
-    if reach or reach_point:
-        if src.tool is None:
-            raise InputError("the robot has no links: no tool point to reach with", field="--reach")
-        from armcli.view.reach import render_reach_png  # Pinocchio: only for --reach
-
-        pic = render_reach_png(urdf, src.xml, src.source, values, out, tool=src.tool,
-                               name=src.name, size=(width, height), targets=list(reach_point),
-                               field=field)  # fmt: skip
-        res = pic.render
-        lines = [describe(pic.workspace), *(verdict(p) for p in pic.points)]
-    else:
-        res = render_png(urdf, values, out, tool=src.tool, name=src.name,
-                         size=(width, height), field=field)  # fmt: skip
+    for warning in pic.warnings:  # drawn without them: a picture of the rest beats none
+        say_line(f"warning: {warning}", sys.stderr)
+    res = pic.result
     tip = (
         ""
         if res.tool_position is None
         else " tool at ({:.3f}, {:.3f}, {:.3f}) m".format(*res.tool_position)
     )
-    for uri, why in skipped.items():  # drawn without them: a picture of the rest beats none
-        hint = f" ({MESH_HINT})" if why == "not found" else ""
-        say_line(f"warning: {src.source}: mesh {uri!r} {why}, not drawn{hint}", sys.stderr)
-    for uri, what in said.items():
-        say_line(f"warning: {src.source}: mesh {uri!r}: {what}; drawn without it", sys.stderr)
-    drawn = _drawn(src.poses, pose, q)
     say_line(
         f"{wrote(res.path, Path(res.path) in before)} ({res.width}x{res.height} px) at "
-        f"{drawn};{tip}"
+        f"{_drawn(pic.poses, pose, q)};{tip}"
     )
-    for line in lines:
+    for line in pic.lines:
         say(line)
 
 

@@ -77,12 +77,14 @@ def _parameters(
         name, required, default_help = _POSITIONAL[kind]
         metavar = name if required else f"[{name}]"
         text = help or default_help
-        first = typer.Argument(... if required else None, metavar=metavar, show_default=False,
-                               help=text)  # fmt: skip
+        first = typer.Argument(
+            ... if required else None, metavar=metavar, show_default=False, help=text
+        )
         positional = [param("robot_file", Path | None, first)]
         if xacro:
-            rest = typer.Argument(None, metavar="[NAME:=VALUE]...", show_default=False,
-                                  help=ARGS_HELP)  # fmt: skip
+            rest = typer.Argument(
+                None, metavar="[NAME:=VALUE]...", show_default=False, help=ARGS_HELP
+            )
             positional.append(param("xacro_args", list[str] | None, rest))
     pkg = typer.Option([], "--package-dir", metavar="NAME=PATH", help=PACKAGE_DIR_HELP)
     options = [param("package_dir", list[str], pkg)] if packages or xacro else []  # xacro: both
@@ -90,9 +92,12 @@ def _parameters(
         options += [
             param("env", list[str], typer.Option([], "--env", metavar="VAR=VALUE", help=ENV_HELP)),
             param("trust_xacro", bool, typer.Option(False, "--trust-xacro", help=TRUST_XACRO_HELP)),
-            param("unsandboxed", bool,
-                  typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP)),
-        ]  # fmt: skip
+            param(
+                "unsandboxed",
+                bool,
+                typer.Option(False, "--trust-xacro-unsandboxed", help=UNSANDBOXED_HELP),
+            ),
+        ]
     return positional, options
 
 
@@ -154,8 +159,7 @@ def parse(
     if kind == "paths":
         paths, args = _split_paths(robot_file if isinstance(robot_file, list) else [])
     else:
-        path, args = _split_robot(robot_file if isinstance(robot_file, Path) else None,
-                                  xacro_args)  # fmt: skip
+        path, args = _split_robot(robot_file if isinstance(robot_file, Path) else None, xacro_args)
         if path is None and kind == "file":
             raise InputError("give the file before its NAME:=VALUE arguments", field="FILE")
         paths = [] if path is None else [path]

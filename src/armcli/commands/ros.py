@@ -15,6 +15,7 @@ from armcli.defaults import COLLISION_SAMPLES, ROS_TARGETS
 from armcli.io.terminal import say
 
 if TYPE_CHECKING:
+    from armcli.ros.packages import RosPackages
     from armcli.urdf.source import RobotInput
 
 TARGET_HELP = (
@@ -62,9 +63,14 @@ def ros_package_cmd(
         force=force,
         packages=robot.packages,
     )
+    _print(pkgs, len(written), out)
+
+
+def _print(pkgs: RosPackages, written: int, out: Path) -> None:
+    """What was written, the collision matrix in numbers, and the poses MoveIt will refuse."""
     n, m = pkgs.names, pkgs.matrix
     counts = {r: sum(d.reason == r for d in m.disabled) for r in ("Adjacent", "Default", "Never")}
-    say(f"wrote {len(written)} files into {out}/: {n.description}, {n.bringup}, {n.moveit}")
+    say(f"wrote {written} files into {out}/: {n.description}, {n.bringup}, {n.moveit}")
     say(
         f"collision matrix ({m.samples} samples, seed {m.seed}): {len(m.links)} links, "
         f"disabled {counts['Adjacent']} Adjacent, {counts['Default']} Default, "

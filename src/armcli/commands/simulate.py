@@ -15,7 +15,7 @@ from armcli.commands.robot_input import robot_options, write_notes
 from armcli.commands.values import Names, Numbers, names, numbers
 from armcli.errors import InputError, ModelRefusedError, UnstableLoopError
 from armcli.io import terminal
-from armcli.io.outdir import check_output_file, check_png_file, existing, wrote
+from armcli.io.outdir import existing, wrote
 from armcli.io.together import write_files_together
 from armcli.sim.options import INTEGRATORS, Integrator, SimOptions
 
@@ -50,6 +50,8 @@ FLAGS = {
     "output": "--output",
     "cmd_vel": "--cmd-vel",
     "world": "--world",
+    "ignore": "--ignore",
+    "plot": "--plot",
 }
 
 
@@ -108,27 +110,20 @@ def simulate_cmd(
     world: Path = option(None, "--world", help=WORLD_HELP),
 ) -> None:
     """Simulate the arm tracking a trajectory (Pinocchio ABA under PD control)."""
-    from armcli.check.rules import unknown_rules
-    from armcli.sim import states
+    from armcli.check.gate import require_known
+    from armcli.sim.rosbag import check_outputs  # the writers: imported by runs that write
     from armcli.sim.tipping import TipOptions
 
-    unknown = unknown_rules(ignore)
-    if unknown:
-        raise InputError(f"unknown rule(s) {', '.join(unknown)}", field="--ignore")
+    require_known(ignore)
     read = [*robot.paths] or ([robot.file()] if urdf is None else [])  # the spec: found first
     if trajectory is None and message is None and cmd_vel is None:
-        raise InputError("nothing to simulate: give the arm a trajectory (--trajectory FILE or "
-                         "--message YAML), or drive the robot's base (--cmd-vel FILE)",
-                         field="--trajectory")  # fmt: skip
+        raise InputError(
+            "nothing to simulate: give the arm a trajectory (--trajectory FILE or "
+            "--message YAML), or drive the robot's base (--cmd-vel FILE)",
+            field="--trajectory",
+        )
     read += [p for p in (urdf, trajectory, cmd_vel, world) if p is not None]
-    if output is not None:
-        from armcli.sim import rosbag  # the MCAP writer: imported by runs that write a file
-
-        if not rosbag.is_mcap(output):
-            states.output_format(output)
-        check_output_file(output, "--output", read)  # never over an input (issue 42)
-    if plot is not None:
-        check_png_file(plot, "--plot", read)
+    check_outputs(output, plot, read)  # never over an input (issue 42)
     file, spec_path = _robot_file(robot, urdf)
     opts = SimOptions(
         trajectory=trajectory,
@@ -145,13 +140,13 @@ def simulate_cmd(
     )
     tip_opts = TipOptions(base_accel, payload, payload_link, contact_links)
     if cmd_vel is not None:
-        _drive(file, opts, cmd_vel, world, tuple(ignore), output, plot,
-               tip_opts != TipOptions())  # fmt: skip
+        _drive(file, opts, cmd_vel, world, tuple(ignore), output, plot, tip_opts != TipOptions())
         return
     asked = tip_opts != TipOptions()  # an arm on a fixed base is news only when asked about
     with _LazyProgress(terminal.console(sys.stderr)) as progress:
-        run = _simulate(file, spec_path, opts, tip_opts, robot, tuple(ignore), progress,
-                        plot is not None, world)  # fmt: skip
+        run = _simulate(
+            file, spec_path, opts, tip_opts, robot, tuple(ignore), progress, plot is not None, world
+        )
     _report(run, output, plot, asked)
 
 
@@ -171,10 +166,16 @@ def _robot_file(robot: RobotInput, urdf: Path | None) -> tuple[RobotFile, Path |
 
 
 def _simulate(
-    file: RobotFile, spec_path: Path | None, opts: SimOptions, tip_opts: TipOptions,
-    robot: RobotInput, ignore: tuple[str, ...], progress: _LazyProgress, plot: bool,
+    file: RobotFile,
+    spec_path: Path | None,
+    opts: SimOptions,
+    tip_opts: TipOptions,
+    robot: RobotInput,
+    ignore: tuple[str, ...],
+    progress: _LazyProgress,
+    plot: bool,
     world: Path | None,
-) -> ArmRun:  # fmt: skip
+) -> ArmRun:
     """The run, with library refusals told in the command's terms (options, spec fields).
 
     A model `check` reports as an error is not simulated (same rule ids), unless ignored.
@@ -185,13 +186,18 @@ def _simulate(
 
     try:
         return simulate_arm(
-            file, opts, tip_opts, robot.packages,
-            gate=lambda doc: refuse_check_errors(doc, CheckOptions(robot_file=file),
-                                                 ignore=ignore),
-            balance_gate=lambda doc: refuse_check_errors(doc, CheckOptions(robot_file=file),
-                                                         ignore=ignore, only=bears_on_balance),
-            progress=progress, plot=plot, world=world,
-        )  # fmt: skip
+            file,
+            opts,
+            tip_opts,
+            robot.packages,
+            gate=lambda doc: refuse_check_errors(doc, CheckOptions(robot_file=file), ignore=ignore),
+            balance_gate=lambda doc: refuse_check_errors(
+                doc, CheckOptions(robot_file=file), ignore=ignore, only=bears_on_balance
+            ),
+            progress=progress,
+            plot=plot,
+            world=world,
+        )
     except ModelRefusedError as exc:
         flags = " ".join(f"--ignore {r}" for r in exc.rules())
         raise ModelRefusedError(
@@ -214,9 +220,15 @@ def _sources(spec_path: Path | None, opts: SimOptions) -> dict[str, Any]:
 
 
 def _drive(
-    file: RobotFile, opts: SimOptions, cmd_vel: Path, world: Path | None, ignore: tuple[str, ...],
-    output: Path | None, plot: Path | None, tip_asked: bool,
-) -> None:  # fmt: skip
+    file: RobotFile,
+    opts: SimOptions,
+    cmd_vel: Path,
+    world: Path | None,
+    ignore: tuple[str, ...],
+    output: Path | None,
+    plot: Path | None,
+    tip_asked: bool,
+) -> None:
     """The whole robot on its wheels (commands.drive); the base-at-rest options do not apply."""
     from armcli.commands.drive import run_drive
 
@@ -238,7 +250,6 @@ def _report(run: ArmRun, output: Path | None, plot: Path | None, asked: bool) ->
     """
     from armcli.sim import job as simjob
     from armcli.sim import report as simreport
-    from armcli.sim import tipping
 
     err = terminal.console(sys.stderr)  # warnings whole in a log, wrapped at a terminal
     job, res, balance = run.job, run.result, run.balance
@@ -252,15 +263,14 @@ def _report(run: ArmRun, output: Path | None, plot: Path | None, asked: bool) ->
     out = terminal.console()
     out.print(simreport.summary_table(metrics, ee, job.tool_label, res), crop=False)
     if balance is not None:
-        for lift in balance.lifts:  # too short to tip the robot: a wheel unloads, a warning
-            terminal.line(err, f"warning: {lift.line()}")
-        line = tipping.summary_line(balance)
-        terminal.line(out, line, "red" if balance.tips else None)
+        for note in balance.notes():  # too short to tip the robot: a wheel unloads, a warning
+            terminal.line(err, f"warning: {note}")
+        terminal.line(out, balance.line(), "red" if balance.tips else None)
     for path in (output, plot):
         if path is not None:
             terminal.line(out, wrote(path, path in before))
     if balance is not None and balance.tips:
-        raise tipping.tip_error(balance)
+        raise balance.error()
 
 
 class _LazyProgress:

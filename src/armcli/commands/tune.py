@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -13,15 +12,12 @@ from armcli.commands.options import choice, option, seed_option
 from armcli.commands.robot_input import robot_options
 from armcli.commands.values import Names, Numbers, names, numbers
 from armcli.defaults import PD_LOOPS, ROBUST_MODES
-from armcli.errors import InputError
 from armcli.io import terminal
-from armcli.io.outdir import check_output_file, check_png_file
 
 if TYPE_CHECKING:  # the tuner is imported when the command runs: `--help` stays light
-    from armcli.tune import job as tjob
     from armcli.tune import session
-    from armcli.tune.engine import Engine
-    from armcli.tune.search import SearchOptions
+    from armcli.tune.api import Tuned
+    from armcli.tune.job import TuneJob
     from armcli.urdf.source import RobotInput
 
 
@@ -53,6 +49,8 @@ def flags() -> dict[str, str]:
         "scheduler": "--scheduler",
         "joints": "--joints",
         "trajectories": "--trajectory",
+        "output": "--output",
+        "plot": "--plot",
     }
 
 
@@ -102,97 +100,76 @@ def tune_cmd(
     write: bool = option(False, "--write", help="Update control.gains in the spec in place."),
 ) -> None:
     """Tune PD gains: model-based start, then a seeded search over simulated rollouts."""
-    from armcli.spec.load import load_spec  # on use: `--help` stays light
-    from armcli.tune import job as tjob
-    from armcli.tune.engine import make_engine
-    from armcli.tune.search import SearchOptions, validate
-    from armcli.tune.write import check_writable
-    from armcli.urdf.source import RobotFile
+    from armcli.tune.api import TuneRequest, tune  # on use: `--help` stays light
+    from armcli.tune.job import TuneSettings
+    from armcli.tune.search import SearchOptions
 
-    with flag_errors(flags()):
-        spec_path = robot.file()
-        opts = SearchOptions(trials, batch, seed, span, robust_mode, quantile)
-        validate(opts)
-        if output is not None and output.suffix.lower() != ".json":
-            raise InputError("the output file must end in .json", field="--output")
-        read = [spec_path, *(trajectory or [])]  # never written over (issue 42)
-        if output is not None:  # before the search: no partial outputs
-            check_output_file(output, "--output", read)
-        if plot is not None:
-            check_png_file(plot, "--plot", read)
-        if write:
-            check_writable(spec_path)
-        settings = tjob.TuneSettings(
-            joints or None,
-            loop,
-            zeta,
-            wn,
-            settle,
-            robust,
-            (mass_scale[0], mass_scale[1]),
-            (friction_scale[0], friction_scale[1]),
-            seed,
-        )
-        file = RobotFile.of_spec(load_spec(spec_path), spec_path)  # compiled once
-        job = tjob.prepare(file, trajectory or [], settings)
-        engine = make_engine(
-            jobs if jobs is not None else (os.cpu_count() or 1),
+    scales = (mass_scale[0], mass_scale[1]), (friction_scale[0], friction_scale[1])
+    settings = TuneSettings(joints or None, loop, zeta, wn, settle, robust, *scales, seed)
+    search = SearchOptions(trials, batch, seed, span, robust_mode, quantile)
+    bar = _Bar(terminal.console(), trials)
+    with flag_errors(flags()), bar:
+        req = TuneRequest(
+            robot.file(),
+            settings,
+            search,
+            tuple(trajectory or ()),
+            jobs,
             scheduler,
-            trust_scheduler=trust_scheduler,
+            trust_scheduler,
+            output,
+            plot,
+            write,
         )
-        try:
-            _run(job, engine, opts, output, plot, write, spec_path)
-        finally:
-            engine.close()
+        tuned = tune(req, started=bar.start, progress=bar)
+    _report(bar.out, tuned)
 
 
-def _run(
-    job: tjob.TuneJob,
-    engine: Engine,
-    opts: SearchOptions,
-    output: Path | None,
-    plot: Path | None,
-    write: bool,
-    spec_path: Path,
-) -> None:
-    from rich.console import Console
-    from rich.progress import Progress
+class _Bar:
+    """The start gains printed, then a progress bar on stderr while the search runs."""
 
+    def __init__(self, out: Any, trials: int) -> None:
+        self.out, self.trials = out, trials
+        self.bar: Any = None
+        self.task: Any = None
+
+    def start(self, job: TuneJob, engine: str) -> None:
+        from rich.console import Console
+        from rich.progress import Progress
+
+        from armcli.tune import report
+
+        self.out.print(report.reasoning_table(job.start), crop=False)
+        self.bar = Progress(console=Console(stderr=True), transient=True)
+        self.bar.start()
+        self.task = self.bar.add_task(f"tuning on {engine}", total=self.trials)
+
+    def __call__(self, done: int, total: int) -> None:
+        if self.bar is not None:
+            self.bar.update(self.task, completed=done)
+
+    def __enter__(self) -> _Bar:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self.bar is not None:
+            self.bar.stop()
+
+
+def _report(out: Any, tuned: Tuned) -> None:
+    """The comparison and the summary; the files written together (all new or as before)."""
     from armcli.io.outdir import existing, wrote
     from armcli.io.together import write_files_together
-    from armcli.tune import gains as gain_vector
-    from armcli.tune import report, session
-    from armcli.tune.plot import tune_png
-    from armcli.tune.problem import nominal_robot
-    from armcli.tune.write import edited_spec
+    from armcli.tune import report
 
-    out = terminal.console()
-    out.print(report.reasoning_table(job.start), crop=False)
-    arm_damping = nominal_robot(job.problem).damping
-    with Progress(console=Console(stderr=True), transient=True) as bar:
-        task = bar.add_task(f"tuning on {engine.name}", total=opts.trials)
-        outcome = session.run(job, engine, opts, lambda d, t: bar.update(task, completed=d))
-    out.print(
-        report.comparison_table(job.problem, job.start, outcome.rows, arm_damping), crop=False
-    )
-    _summary(out, outcome)
-    files: dict[Path, bytes] = {}  # written together: all new or all as before
-    if output is not None:
-        files[output] = report.to_json(
-            job.problem, job.start, outcome.rows, outcome.result, opts, engine.name, arm_damping
-        ).encode("utf-8")
-    if plot is not None:
-        case = session.showcase_case(job, outcome)
-        runs = session.tracking_runs(job, outcome, case)
-        files[plot] = tune_png(outcome.result.history, runs, job.problem.cases[case].label)
-    if write:
-        best = gain_vector.by_joint(outcome.result.best, job.problem.joints)
-        files[spec_path] = edited_spec(spec_path, best)
-    before = existing(*files)
-    write_files_together(files)
-    for path in (output, plot, spec_path if write else None):
-        if path is not None:
-            terminal.line(out, wrote(path, path in before))
+    rows = tuned.outcome.rows
+    table = report.comparison_table(tuned.job.problem, tuned.job.start, rows, tuned.damping)
+    out.print(table, crop=False)
+    _summary(out, tuned.outcome)
+    before = existing(*tuned.files)
+    write_files_together(tuned.files)
+    for path in tuned.files:
+        terminal.line(out, wrote(path, path in before))
 
 
 def _summary(out: Any, outcome: session.Outcome) -> None:

@@ -55,8 +55,9 @@ def point(flag: str) -> Callable[[str], Numbers]:
     def parse(text: str) -> Numbers:
         values = parse_numbers(text)
         if not all(abs(v) <= MAX_COORDINATE_M for v in values):
-            raise InputError(f"each coordinate must be within ±{MAX_COORDINATE_M:g} m, "
-                             f"got {text!r}", field=flag)  # fmt: skip
+            raise InputError(
+                f"each coordinate must be within ±{MAX_COORDINATE_M:g} m, got {text!r}", field=flag
+            )
         return values
 
     return parse

@@ -110,14 +110,21 @@ def view_cmd(
     panel = base_panel = None
     try:  # entered before the URL is printed, so an early Ctrl-C still stops cleanly
         if session is not None:
-            panel = PlanningPanel(viewer, session, src.xml, source=src.source,
-                                  mesh_dir=src.mesh_dir, search=src.search)  # fmt: skip
+            panel = PlanningPanel(
+                viewer,
+                session,
+                src.xml,
+                source=src.source,
+                mesh_dir=src.mesh_dir,
+                search=src.search,
+            )
         if base is not None:
             from armcli.view.basepanel import BasePanel, MobileViewer
 
             assert isinstance(viewer, MobileViewer)
-            base_panel = BasePanel(viewer, base, src.xml, source=src.source,
-                                   mesh_dir=src.mesh_dir, search=src.search)  # fmt: skip
+            base_panel = BasePanel(
+                viewer, base, src.xml, source=src.source, mesh_dir=src.mesh_dir, search=src.search
+            )
         if pose:
             viewer.apply_pose(pose)
         sys.stdout.write(
@@ -149,8 +156,15 @@ def _session(
         raise InputError(f"{save_dir} is not a directory", field="--save-dir")
     assert src.file is not None
     try:
-        session = load_session(src.file, srdf=srdf, scene=scene, joints=joints, group=group,
-                               search=src.search, save_dir=save_dir)  # fmt: skip
+        session = load_session(
+            src.file,
+            srdf=srdf,
+            scene=scene,
+            joints=joints,
+            group=group,
+            search=src.search,
+            save_dir=save_dir,
+        )
     except InputError as exc:
         if any(given is not None for given in planning):  # asked for planning: refuse
             raise

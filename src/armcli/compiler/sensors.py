@@ -76,16 +76,21 @@ def _rays(el: etree._Element, s: Sensor, tag: str) -> None:
     scan = sub(ray, "scan")
     h = sub(scan, "horizontal")
     horizontal = (
-        ("samples", str(li.samples)), ("resolution", "1"),
-        ("min_angle", fmt(li.min_angle)), ("max_angle", fmt(li.max_angle)),
-    )  # fmt: skip
+        ("samples", str(li.samples)),
+        ("resolution", "1"),
+        ("min_angle", fmt(li.min_angle)),
+        ("max_angle", fmt(li.max_angle)),
+    )
     for key, value in horizontal:
         _text(h, key, value)
     if li.is_3d:
         v = sub(scan, "vertical")
-        for key, value in (("samples", str(li.vertical_samples)), ("resolution", "1"),
-                           ("min_angle", fmt(li.vertical_min_angle)),
-                           ("max_angle", fmt(li.vertical_max_angle))):  # fmt: skip
+        for key, value in (
+            ("samples", str(li.vertical_samples)),
+            ("resolution", "1"),
+            ("min_angle", fmt(li.vertical_min_angle)),
+            ("max_angle", fmt(li.vertical_max_angle)),
+        ):
             _text(v, key, value)
     rng = sub(ray, "range")
     _text(rng, "min", fmt(li.range_min))

@@ -12,7 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from armcli.analysis.liftoff import TipVerdict
+from armcli.analysis.liftoff import TiltVerdict
 from armcli.drive import job as drive
 from armcli.drive import output as driveout
 from armcli.drive.job import DriveJob, DriveRun
@@ -30,7 +30,7 @@ class Driven:
     job: DriveJob
     run: DriveRun
     arm: SimResult  # at the output rate and the plot's steps
-    verdict: TipVerdict
+    verdict: TiltVerdict
     warnings: tuple[str, ...]  # the trajectory's, the commands', the model's
 
     def files(self, output: Path | None, plot: Path | None) -> dict[Path, bytes]:

@@ -64,8 +64,9 @@ def mcap_bytes(
     if job.model.world:
         data = start_data(job.model, job.arm.q0)
         world = marker_array(job.model.model, data, job.model.world)
-        chans.append(rosbag.Channel(WORLD_TOPIC, MARKER_ARRAY, rosbag.qos(1, True),
-                                    [(stamps[0], world)]))  # fmt: skip
+        chans.append(
+            rosbag.Channel(WORLD_TOPIC, MARKER_ARRAY, rosbag.qos(1, True), [(stamps[0], world)])
+        )
     return rosbag.mcap_bytes([*chans, *more])
 
 

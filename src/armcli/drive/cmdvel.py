@@ -66,9 +66,18 @@ def parse_cmd_vel(doc: YamlDoc) -> CmdVel:
     c = _Collector(doc)
     data = doc.data
     if not isinstance(data, dict):
-        raise SpecError(doc.source, [Problem("", "a cmd_vel file must be a YAML mapping with a "
-                                             "`commands:` list, e.g. commands: [{linear: {x: "
-                                             "0.2}, time_from_start: 1.0}]", 1)])  # fmt: skip
+        raise SpecError(
+            doc.source,
+            [
+                Problem(
+                    "",
+                    "a cmd_vel file must be a YAML mapping with a "
+                    "`commands:` list, e.g. commands: [{linear: {x: "
+                    "0.2}, time_from_start: 1.0}]",
+                    1,
+                )
+            ],
+        )
     c.unknown_keys(data, _TOP_KEYS, ())
     raw = data.get("commands")
     if not isinstance(raw, list) or not raw:

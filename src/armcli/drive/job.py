@@ -27,7 +27,8 @@ from armcli.analysis.stance import NoStance, Stance, stance_of
 from armcli.drive.cmdvel import CmdVel, load_cmd_vel
 from armcli.drive.diffdrive import DiffDriveController, DriveParams, Odometry, encoder_odometry
 from armcli.drive.model import DriveModel, build_drive_model
-from armcli.drive.wheelmotor import clutch_torque, spin
+from armcli.drive.step import SEEN, Steps
+from armcli.drive.wheelmotor import clutch_torque
 from armcli.errors import InputError, SimulationError
 from armcli.io.scene import Scene
 from armcli.robot.file import floating_of
@@ -73,7 +74,7 @@ class DriveJob:
 def prepare(
     file: RobotFile,
     opts: SimOptions,
-    cmd_vel: Path,
+    cmd_vel: Path | CmdVel,
     *,
     gate: Callable[[Urdf], None] | None = None,
     world: Path | Scene | None = None,
@@ -88,11 +89,11 @@ def prepare(
     a scene file (or its Scene) whose objects the robot drives among (sim.world); one the
     robot stands in at the start is refused. `sensors`: simulate the spec's sensors.
     `params`: the diff drive when the spec's `mobile_base.diff_drive` does not state it (a
-    URDF's plugin kept verbatim by import).
+    URDF's plugin kept verbatim by import). `cmd_vel`: a file, or commands already read.
     """
     spec = _driven_spec(file)
     params = params if params is not None else DriveParams.of(spec)
-    cmd = load_cmd_vel(cmd_vel)
+    cmd = cmd_vel if isinstance(cmd_vel, CmdVel) else load_cmd_vel(cmd_vel)
     rate = opts.rate if opts.rate is not None else params.update_rate
     hold = opts.duration if opts.duration is not None else 1.0  # 0 is refused, as elsewhere
     job = simjob.prepare(file, replace(opts, rate=rate, duration=hold), hold=True)
@@ -142,8 +143,10 @@ def start_data(dm: DriveModel, q0: np.ndarray) -> Any:
 def _driven_spec(file: RobotFile) -> RobotSpec:
     """The spec whose whole robot drives; InputError for a URDF (no diff drive to run)."""
     if file.spec is None or not file.compiled:
-        raise InputError("drives a spec's robot (its mobile_base.diff_drive); give a spec "
-                         "instead of a URDF", field="cmd_vel")  # fmt: skip
+        raise InputError(
+            "drives a spec's robot (its mobile_base.diff_drive); give a spec instead of a URDF",
+            field="cmd_vel",
+        )
     return file.spec
 
 
@@ -188,15 +191,20 @@ class Pilot(Protocol):
 
     A path follower (plan.mobile.pursuit) gives /cmd_vel at every plugin update from the
     state as it is, instead of the job's file, and may hold the arm's reference until the
-    base has arrived.
+    base has arrived. Between two updates the drive steps without it (`drive.step`) and
+    then shows it what each step started from (`observe`).
     """
 
     def command(self, t: float, data: Any) -> tuple[float, float]:
         """(linear.x [m/s], angular.z [rad/s]) at the plugin update at time t [s]."""
         ...
 
-    def arm_step(self, k: int, data: Any) -> int:
-        """Before step k: which step's arm reference to use (<= k: the arm waits)."""
+    def arm_steps(self, k0: int, k1: int) -> np.ndarray:
+        """For steps k0 .. k1 - 1: which step's arm reference to use (<= k: the arm waits)."""
+        ...
+
+    def observe(self, k0: int, seen: np.ndarray) -> None:
+        """The states steps k0 .. k0 + len(seen) - 1 started from (`drive.step.SEEN`)."""
         ...
 
 
@@ -215,48 +223,49 @@ def run(
     q_ref, v_ref = arm.reference.sample(t)
     kp, kd = np.asarray(arm.config.kp, dtype=float), np.asarray(arm.config.kd, dtype=float)
     ctrl_arm = q_ref + np.divide(kd, kp, out=np.zeros_like(kp), where=kp > 0) * v_ref
-    gravity = _gravity(arm) if arm.config.gravity_comp else None
     inv_kp = np.divide(1.0, kp, out=np.zeros_like(kp), where=kp > 0)  # Kp 0: no g through ctrl
     updates = update_steps(steps, job.dt, job.params.period)
     now = (updates + 1) * job.dt  # Gazebo's sim time at each update
     lin, ang = job.cmd.at(now)
     elapsed = np.diff(now, prepend=0.0)  # the plugin's seconds_since_last_update
-    is_update = np.zeros(steps + 1, dtype=bool)
-    is_update[updates] = True
     rec = np.empty((steps + 1, m.nsensordata))  # the Layout's, then the sensors' (IMU)
     wheel_cmd = np.zeros((steps + 1, 2))
     controller = DiffDriveController(job.params)
-    wheel_dof, rotor, wheel_force = dm.wheel_dof, dm.wheel_rotor, dm.layout.wheel_force
     cols = np.nonzero(dm.arm_act >= 0)[0]  # a mimic joint follows its leader: no actuator
-    ctrl_arm, inv_kp = ctrl_arm[:, cols], inv_kp[cols]
-    act = dm.arm_act[cols]
-    arm_act = slice(int(act[0]), int(act[-1]) + 1) if _contiguous(act) else act
-    arm_qpos = dm.arm_qpos
-    ctrl, u, command = d.ctrl, 0, np.zeros(2)
+    stepper = Steps(
+        m,
+        d,
+        dm,
+        np.ascontiguousarray(ctrl_arm[:, cols]),
+        inv_kp[cols],
+        cols,
+        arm.robot if arm.config.gravity_comp else None,
+        rec,
+        np.empty((steps + 1, SEEN)),
+    )
+    command = np.zeros(2)
     used = np.arange(steps + 1)  # the arm reference's step at each step (a pilot may hold it)
     rig = make_rig(job.sensors, m, steps, job.dt)
-    due, sample = rig.due.tolist(), rig.sample
+    ends = _chunk_ends(steps, updates, rig.due)
     start = time.perf_counter()
-    for k in range(steps):
-        if is_update[k]:
+    k0 = u = 0
+    for k1 in ends.tolist():
+        if u < len(updates) and updates[u] == k0:
             twist = (lin[u], ang[u]) if pilot is None else pilot.command(float(now[u]), d)
-            command = controller.update(twist[0], twist[1], d.qvel[wheel_dof], elapsed[u])
+            command = controller.update(twist[0], twist[1], d.qvel[dm.wheel_dof], elapsed[u])
             u += 1
-        wheel_cmd[k] = command
-        spin(d, rotor, command)  # the plugin's motor speed (its "vel")
-        j = k if pilot is None else pilot.arm_step(k, d)
-        used[k] = j
-        if gravity is None:
-            ctrl[arm_act] = ctrl_arm[j]
-        else:
-            ctrl[arm_act] = ctrl_arm[j] + gravity(d.qpos[arm_qpos])[cols] * inv_kp
-        mujoco.mj_step(m, d)
-        rec[k] = d.sensordata
-        rec[k, wheel_force] = -d.qfrc_constraint[rotor]  # drive.wheelmotor.clutch_torque
-        if due[k]:
-            sample(k, m, d)
-        if progress is not None and k % PROGRESS_STEPS == 0 and k:
-            progress(k, steps)
+        if pilot is not None:
+            used[k0:k1] = pilot.arm_steps(k0, k1)
+        wheel_cmd[k0:k1] = command
+        stepper.advance(k0, k1, used[k0:k1], command)
+        if pilot is not None:
+            pilot.observe(k0, stepper.seen[k0:k1])
+        if rig.due[k1 - 1]:
+            rig.sample(k1 - 1, m, d)
+        if progress is not None and k1 // PROGRESS_STEPS > k0 // PROGRESS_STEPS:
+            progress(k1 // PROGRESS_STEPS * PROGRESS_STEPS, steps)
+        k0 = k1
+    due, sample, rotor, wheel_force = rig.due, rig.sample, dm.wheel_rotor, dm.layout.wheel_force
     mujoco.mj_forward(m, d)
     rec[steps], wheel_cmd[steps] = d.sensordata, command
     rec[steps, wheel_force] = clutch_torque(d, rotor)
@@ -269,8 +278,9 @@ def run(
     _refuse_reset(d, rec, job.dt)
     wl = rec[:-1, dm.layout.wheel_vel]
     odom = encoder_odometry(wl[:, 0], wl[:, 1], job.dt, job.params.radius, job.params.separation)
-    return DriveRun(job, t, rec, q_ref, v_ref, wheel_cmd, odom, wall,
-                    rig.readings(job.dt, rec), rig.notes)  # fmt: skip
+    return DriveRun(
+        job, t, rec, q_ref, v_ref, wheel_cmd, odom, wall, rig.readings(job.dt, rec), rig.notes
+    )
 
 
 def _refuse_reset(d: Any, rec: np.ndarray, dt: float) -> None:
@@ -278,8 +288,9 @@ def _refuse_reset(d: Any, rec: np.ndarray, dt: float) -> None:
     import mujoco
 
     W = mujoco.mjtWarning
-    bad = [w for w in (W.mjWARN_BADQACC, W.mjWARN_BADQPOS, W.mjWARN_BADQVEL)
-           if d.warning[w].number > 0]  # fmt: skip
+    bad = [
+        w for w in (W.mjWARN_BADQACC, W.mjWARN_BADQPOS, W.mjWARN_BADQVEL) if d.warning[w].number > 0
+    ]
     if bad:
         rows = np.nonzero(~np.all(np.isfinite(rec), axis=1))[0]
         step = int(rows[0]) if rows.size else None
@@ -291,11 +302,7 @@ def _refuse_reset(d: Any, rec: np.ndarray, dt: float) -> None:
         )
 
 
-def _contiguous(ids: np.ndarray) -> bool:
-    return len(ids) > 0 and bool(np.all(np.diff(ids) == 1))
-
-
-def _gravity(arm: SimJob) -> Callable[[np.ndarray], np.ndarray]:
-    """g(q) [N·m] of the fixed-base arm, as `simulate`'s controller adds it."""
-    robot = arm.robot
-    return lambda q: robot.gravity(robot.q(q))
+def _chunk_ends(steps: int, updates: np.ndarray, due: np.ndarray) -> np.ndarray:
+    """Where the steps between two plugin updates end: at each update, after each sensor sample."""
+    ends = np.concatenate([updates, np.nonzero(due[:steps])[0] + 1, [steps]])
+    return np.unique(ends[ends > 0])

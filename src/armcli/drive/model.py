@@ -131,8 +131,9 @@ def build_drive_model(
     geoms = add_scene(ms, world) if world is not None else ()
     model = ms.compile()
     model.geom_solref[:] = (CONTACT_TIME, 1.0)
-    arm_act = np.array([model.actuator(driven[j]).id if j in driven else -1
-                        for j in arm_joints], dtype=int)  # fmt: skip
+    arm_act = np.array(
+        [model.actuator(driven[j]).id if j in driven else -1 for j in arm_joints], dtype=int
+    )
     return DriveModel(
         model=model,
         arm_joints=arm_joints,
@@ -174,8 +175,9 @@ def _arm_actuators(
         if pd is None:
             for a in acts:
                 a.gainprm[0], a.biasprm[:3] = 0.0, 0.0
-            pd = ms.add_actuator(name=f"{joint}_pd", target=joint,
-                                 trntype=mujoco.mjtTrn.mjTRN_JOINT)  # fmt: skip
+            pd = ms.add_actuator(
+                name=f"{joint}_pd", target=joint, trntype=mujoco.mjtTrn.mjTRN_JOINT
+            )
             if np.isfinite(effort[i]):
                 pd.forcelimited = 1
                 pd.forcerange = [-effort[i], effort[i]]

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from armcli.analysis.liftoff import TipVerdict, verdict
+from armcli.analysis.liftoff import TiltVerdict, verdict
 from armcli.drive.job import DriveRun
 from armcli.robot.frames import quaternion_rpy
 from armcli.sim.rollout import Stats
@@ -66,7 +66,7 @@ def arm_result(run: DriveRun, keep: np.ndarray) -> SimResult:
     )
 
 
-def tip_verdict(run: DriveRun) -> TipVerdict:
+def tip_verdict(run: DriveRun) -> TiltVerdict:
     """The run's tilt and lift-offs (analysis.liftoff)."""
     job, L, s = run.job, run.job.model.layout, run.sensors
     z = s[:, L.contact_pos][:, 2::3]

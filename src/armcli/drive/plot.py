@@ -8,14 +8,14 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from armcli.analysis.liftoff import TipVerdict
+from armcli.analysis.liftoff import TiltVerdict
 from armcli.drive.job import DriveRun
 from armcli.sim.simulate import SimResult
 
 LOAD_WINDOW_S = 0.01  # [s] the wheel loads are drawn as means over this (a single step chatters)
 
 
-def plot_png(run: DriveRun, res: SimResult, verdict_: TipVerdict) -> bytes:
+def plot_png(run: DriveRun, res: SimResult, verdict_: TiltVerdict) -> bytes:
     """The tracking plot with two more rows: the path seen from above, the wheel loads."""
     from armcli.sim.plot import tracking_png
 
@@ -30,7 +30,7 @@ def _has_scene(run: DriveRun) -> bool:
     return bool(run.job.model.world) or pick_scan(run.readings) is not None
 
 
-def _drive_rows(run: DriveRun, verdict_: TipVerdict) -> Callable[[Sequence[Any]], None]:
+def _drive_rows(run: DriveRun, verdict_: TiltVerdict) -> Callable[[Sequence[Any]], None]:
     job, L, s = run.job, run.job.model.layout, run.sensors
     step = max(1, run.steps // 4000)
     window = max(1, round(LOAD_WINDOW_S / job.dt))
@@ -50,8 +50,14 @@ def _drive_rows(run: DriveRun, verdict_: TipVerdict) -> Callable[[Sequence[Any]]
             _scan_row(wide(axes[2 * n :]), run)
         pos = s[::step, L.base_pos]
         ax.plot(pos[:, 0], pos[:, 1], color="C0", lw=1.5, label=f"truth ({job.params.base_frame})")
-        ax.plot(run.odometry.x[::step], run.odometry.y[::step], "--", color="C1", lw=1.2,
-                label="odometry (wheel encoders)")  # fmt: skip
+        ax.plot(
+            run.odometry.x[::step],
+            run.odometry.y[::step],
+            "--",
+            color="C1",
+            lw=1.2,
+            label="odometry (wheel encoders)",
+        )
         ax.plot(pos[0, 0], pos[0, 1], "o", color="k", ms=4, label="start")
         ax.set_aspect("equal", adjustable="datalim")
         ax.set_xlabel("x [m]")
@@ -68,8 +74,10 @@ def _drive_rows(run: DriveRun, verdict_: TipVerdict) -> Callable[[Sequence[Any]]
             load.axvspan(lift.start, lift.start + lift.duration, color="C3", alpha=0.25)
         load.set_xlabel("time [s]")
         load.set_ylabel("normal force [N]")
-        load.set_title(f"wheel and caster loads ({LOAD_WINDOW_S * 1e3:g} ms means; shaded: "
-                       "lift-off)", fontsize=11)  # fmt: skip
+        load.set_title(
+            f"wheel and caster loads ({LOAD_WINDOW_S * 1e3:g} ms means; shaded: lift-off)",
+            fontsize=11,
+        )
         load.legend(loc="best", fontsize=8)
         load.grid(True, alpha=0.3)
 

@@ -55,8 +55,13 @@ def add_wheel_motors(ms: Any, joints: tuple[str, str], max_torque: float, dt: fl
         rotor = body.parent.add_body(
             name=f"{joint}_rotor", pos=body.pos, quat=body.quat, mass=1e-6, inertia=[1e-9] * 3
         )
-        rotor.add_joint(name=rotor.name, type=mujoco.mjtJoint.mjJNT_HINGE, pos=wheel.pos,
-                        axis=wheel.axis, armature=ROTOR_ARMATURE)  # fmt: skip
+        rotor.add_joint(
+            name=rotor.name,
+            type=mujoco.mjtJoint.mjJNT_HINGE,
+            pos=wheel.pos,
+            axis=wheel.axis,
+            armature=ROTOR_ARMATURE,
+        )
         clutch = ms.add_tendon(name=f"{joint}_clutch")
         clutch.wrap_joint(joint, 1.0)
         clutch.wrap_joint(rotor.name, -1.0)

@@ -237,8 +237,12 @@ def _header(root: etree._Element, name: str, spec: RobotSpec | None, infer: bool
     etree.SubElement(root, "option", opt)
     top = etree.SubElement(etree.SubElement(root, "default"), "default", {"class": name})
     if spec is not None:  # stops as stiff as the time step allows (armcli's are hard)
-        etree.SubElement(top, "joint", solreflimit=vec((LIMIT_STEPS * spec.control.dt,
-                         LIMIT_DAMPRATIO)), solimplimit=vec(LIMIT_SOLIMP))  # fmt: skip
+        etree.SubElement(
+            top,
+            "joint",
+            solreflimit=vec((LIMIT_STEPS * spec.control.dt, LIMIT_DAMPRATIO)),
+            solimplimit=vec(LIMIT_SOLIMP),
+        )
     vis = etree.SubElement(top, "default", {"class": "visual"})
     visual = {"contype": "0", "conaffinity": "0", "group": "2"}
     if infer:  # as in MuJoCo's URDF import, visual geoms weigh nothing

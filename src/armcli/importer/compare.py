@@ -25,9 +25,16 @@ INERTIAL_RTOL = 1e-12  # the issue's tolerance: derived inertias are recomputed 
 TYPED_TOP = ("link", "joint", "material", "gazebo")
 LINK_TAGS = ("inertial", "visual", "collision")
 JOINT_TAGS = (
-    "parent", "child", "origin", "axis", "limit", "dynamics", "mimic", "safety_controller",
+    "parent",
+    "child",
+    "origin",
+    "axis",
+    "limit",
+    "dynamics",
+    "mimic",
+    "safety_controller",
     "calibration",
-)  # fmt: skip
+)
 
 
 def _other(el: etree._Element, known: tuple[str, ...]) -> list[str]:

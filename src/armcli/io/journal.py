@@ -137,13 +137,17 @@ def _dead(pid: int) -> bool:
 def _report(directory: Path, done: list[str], refused: list[str]) -> list[str]:
     lines = []
     if done:
-        lines.append(f"{directory}: completed the files a killed armcli run left half-written: "
-                     f"{', '.join(done)}")  # fmt: skip
+        lines.append(
+            f"{directory}: completed the files a killed armcli run left half-written: "
+            f"{', '.join(done)}"
+        )
     if refused:
         more = len(refused) - MAX_REPORTED
         shown = "; ".join(refused[:MAX_REPORTED]) + (f" (and {more} more)" if more > 0 else "")
-        lines.append(f"{directory}: left alone, not armcli's own recovery journal: {shown}; "
-                     "remove it if no armcli run is writing here")  # fmt: skip
+        lines.append(
+            f"{directory}: left alone, not armcli's own recovery journal: {shown}; "
+            "remove it if no armcli run is writing here"
+        )
     return lines
 
 
@@ -187,8 +191,11 @@ def _read(dfd: int, name: str) -> list[tuple[int, str]]:
     try:
         fd = os.open(name, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC, dir_fd=dfd)
     except OSError as exc:
-        raise UntrustedError("it is a symbolic link" if exc.errno == errno.ELOOP else
-                        f"it cannot be read: {exc.strerror}") from None  # fmt: skip
+        raise UntrustedError(
+            "it is a symbolic link"
+            if exc.errno == errno.ELOOP
+            else f"it cannot be read: {exc.strerror}"
+        ) from None
     try:
         st = os.fstat(fd)  # the file opened, not the one looked at: swapped meanwhile?
         _own_file(st, "it")

@@ -73,11 +73,15 @@ class _Messages:
     def add(self, length: int, at: int) -> None:
         self.count += 1
         if self.count > MAX_MESSAGES:
-            raise InputError(f"more than {MAX_MESSAGES:,} messages, armcli's bound on a replay",
-                             file=self.source)  # fmt: skip
+            raise InputError(
+                f"more than {MAX_MESSAGES:,} messages, armcli's bound on a replay", file=self.source
+            )
         if length > MAX_MESSAGE_BYTES:
-            raise InputError(f"a message at byte {at} is {length} bytes, more than the "
-                             f"{MAX_MESSAGE_BYTES} a replay reads", file=self.source)  # fmt: skip
+            raise InputError(
+                f"a message at byte {at} is {length} bytes, more than the "
+                f"{MAX_MESSAGE_BYTES} a replay reads",
+                file=self.source,
+            )
 
     def walk(self, data: bytes, at: int) -> None:
         """Count the message records of a chunk's inflated records (opcode, length, body)."""

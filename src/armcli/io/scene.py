@@ -41,14 +41,33 @@ WORLD_FRAMES = ("", "world")
 PRIMITIVES = {1: "box", 2: "sphere", 3: "cylinder", 4: "cone"}  # SolidPrimitive constants
 DIMENSIONS = {"box": 3, "sphere": 1, "cylinder": 2, "cone": 2}  # [x y z], [r], [h r], [h r]
 _SCENE_KEYS = {
-    "name", "world", "collision_objects", "robot_state", "robot_model_name", "is_diff",
-    "fixed_frame_transforms", "allowed_collision_matrix", "link_padding", "link_scale",
+    "name",
+    "world",
+    "collision_objects",
+    "robot_state",
+    "robot_model_name",
+    "is_diff",
+    "fixed_frame_transforms",
+    "allowed_collision_matrix",
+    "link_padding",
+    "link_scale",
     "object_colors",
-}  # fmt: skip
+}
 _OBJECT_KEYS = {
-    "id", "header", "pose", "primitives", "primitive_poses", "meshes", "mesh_poses",
-    "operation", "type", "subframe_names", "subframe_poses", "planes", "plane_poses",
-}  # fmt: skip
+    "id",
+    "header",
+    "pose",
+    "primitives",
+    "primitive_poses",
+    "meshes",
+    "mesh_poses",
+    "operation",
+    "type",
+    "subframe_names",
+    "subframe_poses",
+    "planes",
+    "plane_poses",
+}
 Path_ = tuple[str | int, ...]
 
 
@@ -104,15 +123,21 @@ class _Reader:
         """One more shape against the scene's budget; stop past it."""
         self.shapes_read += 1
         if self.shapes_read > MAX_SCENE_SHAPES:
-            raise self.stop(path, f"the scene holds more than {MAX_SCENE_SHAPES} primitives and "
-                            "meshes, armcli's bound on a scene")  # fmt: skip
+            raise self.stop(
+                path,
+                f"the scene holds more than {MAX_SCENE_SHAPES} primitives and "
+                "meshes, armcli's bound on a scene",
+            )
 
     def spend(self, path: Path_, triangles: int) -> None:
         """A mesh's triangles against the scene's budget; stop past it."""
         self.triangles += triangles
         if self.triangles > MAX_SCENE_TRIANGLES:
-            raise self.stop(path, f"the scene's meshes hold more than {MAX_SCENE_TRIANGLES} "
-                            "triangles, armcli's bound on a scene")  # fmt: skip
+            raise self.stop(
+                path,
+                f"the scene's meshes hold more than {MAX_SCENE_TRIANGLES} "
+                "triangles, armcli's bound on a scene",
+            )
 
     def bounded(self, values: np.ndarray, path: Path_, what: str) -> bool:
         """Whether every value is finite and within ±MAX_COORDINATE_M; a problem if not."""
@@ -203,15 +228,26 @@ class _Reader:
             return None
         self.spend((*path, "triangles"), len(tris))  # before any array is built
         v = np.array(
-            [[self.number(p.get(k) if isinstance(p, dict) else None, (*path, "vertices", i, k))
-              for k in "xyz"] for i, p in enumerate(verts)]
-        )  # fmt: skip
+            [
+                [
+                    self.number(
+                        p.get(k) if isinstance(p, dict) else None, (*path, "vertices", i, k)
+                    )
+                    for k in "xyz"
+                ]
+                for i, p in enumerate(verts)
+            ]
+        )
         f = []
         for i, t in enumerate(tris):
             idx = t.get("vertex_indices") if isinstance(t, dict) else None
-            if not (isinstance(idx, list) and len(idx) == 3 and all(
-                isinstance(k, int) and not isinstance(k, bool) and 0 <= k < len(v) for k in idx
-            )):  # fmt: skip
+            if not (
+                isinstance(idx, list)
+                and len(idx) == 3
+                and all(
+                    isinstance(k, int) and not isinstance(k, bool) and 0 <= k < len(v) for k in idx
+                )
+            ):
                 self.add((*path, "triangles", i), f"needs vertex_indices: 3 of 0..{len(v) - 1}")
                 return None
             f.append(idx)
@@ -244,8 +280,10 @@ class _Reader:
                 file, self.doc.source, MAX_SCENE_TRIANGLES - self.triangles
             )
         except OverBudgetError as exc:
-            raise self.stop((*path, "path"), f"{name!r} {exc} of the scene's "
-                            f"{MAX_SCENE_TRIANGLES}-triangle bound") from None  # fmt: skip
+            raise self.stop(
+                (*path, "path"),
+                f"{name!r} {exc} of the scene's {MAX_SCENE_TRIANGLES}-triangle bound",
+            ) from None
         except InputError as exc:
             self.add((*path, "path"), f"{name!r}: {exc.message}")
             return None
@@ -337,8 +375,11 @@ def parse_scene(doc: YamlDoc, links: Sequence[str]) -> Scene:
     objects: list[SceneObject | None] = []
     try:
         if len(raw) > MAX_SCENE_SHAPES:  # each object holds a shape at least
-            raise r.stop(prefix, f"{len(raw)} collision objects, more than the {MAX_SCENE_SHAPES}"
-                         " primitives and meshes armcli reads in a scene")  # fmt: skip
+            raise r.stop(
+                prefix,
+                f"{len(raw)} collision objects, more than the {MAX_SCENE_SHAPES}"
+                " primitives and meshes armcli reads in a scene",
+            )
         objects = [r.obj(o, (*prefix, i), seen) for i, o in enumerate(raw)]
     except _StopError:
         pass  # the problem is recorded

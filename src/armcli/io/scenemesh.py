@@ -56,8 +56,10 @@ def read_scene_mesh(file: Path, source: str, budget: int) -> tuple[np.ndarray, n
         raise OverBudgetError(f"declares {declared} triangles, more than the {budget} left")
     kind = real.suffix.lstrip(".").lower()
     if kind == "gltf" and (names := _external_buffers(data)):
-        raise InputError(f"a glTF whose data is in other files ({names[0]!r}) is not read; "
-                         "armcli reads no file a mesh names: use a .glb")  # fmt: skip
+        raise InputError(
+            f"a glTF whose data is in other files ({names[0]!r}) is not read; "
+            "armcli reads no file a mesh names: use a .glb"
+        )
     try:
         loaded = trimesh.load(io.BytesIO(data), file_type=kind, force="mesh", process=False)
     except Exception as exc:  # trimesh raises many kinds on a bad file

@@ -154,8 +154,9 @@ class FitTable:
         heads = [c.header_lines() for c in self.columns]
         depth = max(len(h) for h in heads)
         for k in range(depth):  # headers aligned at the bottom, units under names
-            cells = [_text((h[k - depth + len(h)] if k >= depth - len(h) else ""), "bold")
-                     for h in heads]  # fmt: skip
+            cells = [
+                _text((h[k - depth + len(h)] if k >= depth - len(h) else ""), "bold") for h in heads
+            ]
             yield self._join([[c] for c in cells], widths)
         rule = Text("─" * (sum(widths) + GAP * (len(widths) - 1)), style="dim")
         yield rule

@@ -67,8 +67,12 @@ def spans(plain: str, first: int, rest: int) -> list[tuple[int, int]]:
         line, room = lines[-1], first if len(lines) == 1 else rest
         if (b - line[0][0]) <= room or (b - a) > rest or plain.startswith("::", a):
             line.append((a, b))  # it fits; or it fits nowhere; or it must not start a line
-        elif (len(line) > 1 and GLUED.match(plain, a, b) and b - line[-1][0] <= rest
-              and not plain.startswith("::", line[-1][0])):  # fmt: skip
+        elif (
+            len(line) > 1
+            and GLUED.match(plain, a, b)
+            and b - line[-1][0] <= rest
+            and not plain.startswith("::", line[-1][0])
+        ):
             lines.append([line.pop(), (a, b)])  # the unit and its number, together
         else:
             lines.append([(a, b)])

@@ -80,8 +80,9 @@ def sample(robot: PlanRobot, timed: Timed, rate: float = CERTIFY_RATE_HZ) -> Sam
     return Samples(t, q, v, a)
 
 
-def _limit(s: Samples, values: np.ndarray, limit: np.ndarray, kind: str, joints: tuple[str, ...]
-           ) -> Violation | None:  # fmt: skip
+def _limit(
+    s: Samples, values: np.ndarray, limit: np.ndarray, kind: str, joints: tuple[str, ...]
+) -> Violation | None:
     excess = np.abs(values) - limit * (1.0 + RELATIVE_TOL)
     if not np.any(excess > 0):
         return None
@@ -102,8 +103,10 @@ def kinematic_violation(robot: PlanRobot, s: Samples, compiled: Any = None) -> V
             k, j = np.unravel_index(int(np.argmax(excess)), excess.shape)
             bound = robot.lower[j] if excess is below else robot.upper[j]
             return Violation("position", float(s.t[k]), names[j], float(s.q[k, j]), float(bound))
-    for values, limit, kind in ((s.v, robot.velocity, "velocity"),
-                                (s.a, robot.acceleration, "acceleration")):  # fmt: skip
+    for values, limit, kind in (
+        (s.v, robot.velocity, "velocity"),
+        (s.a, robot.acceleration, "acceleration"),
+    ):
         found = _limit(s, values, limit, kind, names)
         if found is not None:
             return found

@@ -121,8 +121,9 @@ class CollisionChecker:
         self.pairs = self._pairs(gmodel, {_key(a, b) for a, b in disabled})
         self.gmodel = gmodel
         # a pair whose two bodies move with the same joints keeps its relative pose
-        self.moving = [self.bodies[i].moves_with != self.bodies[j].moves_with
-                       for i, j in self.pairs]  # fmt: skip
+        self.moving = [
+            self.bodies[i].moves_with != self.bodies[j].moves_with for i, j in self.pairs
+        ]
         mod = load() if native else None
         names = [b.name for b in self.bodies]
         self.native = (

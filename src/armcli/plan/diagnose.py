@@ -46,15 +46,21 @@ class Connectivity:
     def explain(self, timeout: float) -> str:
         """The failure's message: the goal cut off, or a path that exists but was not found."""
         if self.connected is False:
-            return (f"no path: the goal is cut off from the start: {self.method} joins no "
-                    "free region around the start to the goal's (an obstacle separates "
-                    "them; a longer --timeout will not help)")  # fmt: skip
+            return (
+                f"no path: the goal is cut off from the start: {self.method} joins no "
+                "free region around the start to the goal's (an obstacle separates "
+                "them; a longer --timeout will not help)"
+            )
         if self.connected:
-            return (f"no collision-free path found within {timeout:g} s, but a path exists "
-                    f"({self.method} joins start and goal): try a longer --timeout or "
-                    "another --seed")  # fmt: skip
-        return (f"no collision-free path found within {timeout:g} s, and {self.method} did not "
-                "join start and goal either: the goal may be cut off from the start")  # fmt: skip
+            return (
+                f"no collision-free path found within {timeout:g} s, but a path exists "
+                f"({self.method} joins start and goal): try a longer --timeout or "
+                "another --seed"
+            )
+        return (
+            f"no collision-free path found within {timeout:g} s, and {self.method} did not "
+            "join start and goal either: the goal may be cut off from the start"
+        )
 
 
 def connectivity(

@@ -58,10 +58,13 @@ def check_executable(spec: RobotSpec | None) -> None:
     a failure after planning would leave the plan written and the command failed.
     """
     if spec is None or not spec.control.gains:
-        raise InputError("simulates with a spec's control.gains, and this robot has none: "
-                         "`armcli import` writes a spec with start gains from a URDF, or run "
-                         "the written plan with `armcli simulate --urdf FILE --kp ... --kd ... "
-                         "-t PLAN`", field="execute")  # fmt: skip
+        raise InputError(
+            "simulates with a spec's control.gains, and this robot has none: "
+            "`armcli import` writes a spec with start gains from a URDF, or run "
+            "the written plan with `armcli simulate --urdf FILE --kp ... --kd ... "
+            "-t PLAN`",
+            field="execute",
+        )
 
 
 def execute(file: RobotFile, opts: SimOptions, search: MeshSearch | None = None) -> Execution:
@@ -89,9 +92,18 @@ def execute(file: RobotFile, opts: SimOptions, search: MeshSearch | None = None)
     if run.balance is not None:
         margin = run.balance.min_margin
         if run.balance.tips:
-            problems.append(tipping.tip_error(run.balance).args[0])
-    return Execution(metrics, peak_tau, arm.effort, peak_v, vlim, arm.names, margin,
-                     tuple(problems), _states(res))  # fmt: skip
+            problems.append(run.balance.error().args[0])
+    return Execution(
+        metrics,
+        peak_tau,
+        arm.effort,
+        peak_v,
+        vlim,
+        arm.names,
+        margin,
+        tuple(problems),
+        _states(res),
+    )
 
 
 def _states(res: SimResult) -> Replay:

@@ -103,8 +103,10 @@ def configuration(
             field=field,
         ) from None
     full = {j: given.get(j, robot.robot.rest(j)) for j in robot.joints}
-    limits = {j: (float(lo), float(hi)) for j, lo, hi in zip(robot.joints, robot.lower,
-                                                            robot.upper, strict=True)}  # fmt: skip
+    limits = {
+        j: (float(lo), float(hi))
+        for j, lo, hi in zip(robot.joints, robot.lower, robot.upper, strict=True)
+    }
     snapped, moved = snap_to_limits(full, limits)
     if notes is not None:
         notes.extend(f"{field}: {line}" for line in moved)

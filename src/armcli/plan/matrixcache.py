@@ -42,8 +42,9 @@ def cache_dir() -> Path:
     return Path(base) / "acm"
 
 
-def matrix_key(text: str | bytes, poses: Mapping[str, Mapping[str, float]] | None, samples: int,
-               seed: int) -> str:  # fmt: skip
+def matrix_key(
+    text: str | bytes, poses: Mapping[str, Mapping[str, float]] | None, samples: int, seed: int
+) -> str:
     """SHA-256 over everything the matrix depends on (see the module docstring)."""
     import pinocchio
     from lxml import etree

@@ -27,8 +27,15 @@ if TYPE_CHECKING:
 
 NATIVE = Path(__file__).parent / "_native"
 # The sources in CMakeLists.txt's PLANNER_SOURCES order: their hashes make the build's hash.
-SOURCES = ("core.hpp", "checker.cpp", "certify.cpp", "rrt.cpp", "timing.hpp", "timing.cpp",
-           "module.cpp")  # fmt: skip
+SOURCES = (
+    "core.hpp",
+    "checker.cpp",
+    "certify.cpp",
+    "rrt.cpp",
+    "timing.hpp",
+    "timing.cpp",
+    "module.cpp",
+)
 _state: dict[str, Any] = {}
 
 
@@ -103,9 +110,13 @@ def joint_entries(robot: PlanRobot) -> list[tuple[int, int, int, bool, float, np
 
 
 def compiled_scene(
-    mod: ModuleType, robot: PlanRobot, gmodel: Any, pairs: Sequence[tuple[int, int]],
-    moving: Sequence[bool], bodies: Sequence[str],
-) -> _planner.Scene:  # fmt: skip
+    mod: ModuleType,
+    robot: PlanRobot,
+    gmodel: Any,
+    pairs: Sequence[tuple[int, int]],
+    moving: Sequence[bool],
+    bodies: Sequence[str],
+) -> _planner.Scene:
     """The extension's copy of the robot, its geometry (obstacles included) and the pairs.
 
     `bodies`: each geometry's owner (link, scene object), whose geometries are culled together.

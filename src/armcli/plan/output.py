@@ -44,7 +44,8 @@ def read_back(text: bytes, limits: dict[str, tuple[float, float]]) -> Timed:
 
     No size cap: the document is armcli's own, just written (a 60 s plan is ~2.6 MB).
     """
-    traj: Trajectory = loads_trajectory(text.decode("utf-8"), limits, source="<plan>",
-                                        max_bytes=None)  # fmt: skip
+    traj: Trajectory = loads_trajectory(
+        text.decode("utf-8"), limits, source="<plan>", max_bytes=None
+    )
     assert traj.velocities is not None and traj.accelerations is not None
     return Timed(traj.times, traj.positions, traj.velocities, traj.accelerations)

@@ -42,14 +42,18 @@ class PlanRequest:
 
     def __post_init__(self) -> None:
         if (self.goal is None) == (self.to_xyz is None):
-            raise InputError("give exactly one goal: `goal` (a named pose or joint values) "
-                             "or `to_xyz` (a point for the tool)", field="goal")  # fmt: skip
+            raise InputError(
+                "give exactly one goal: `goal` (a named pose or joint values) "
+                "or `to_xyz` (a point for the tool)",
+                field="goal",
+            )
         if self.to_rpy is not None and self.to_xyz is None:
             raise InputError("`to_rpy` needs `to_xyz`", field="to_rpy")
         timeout = self.options.timeout
         if not 0 < timeout <= MAX_PLAN_TIMEOUT_S:  # NaN fails too
-            raise InputError(f"must be in (0, {MAX_PLAN_TIMEOUT_S:g}] s, got {timeout:g}",
-                             field="timeout")  # fmt: skip
+            raise InputError(
+                f"must be in (0, {MAX_PLAN_TIMEOUT_S:g}] s, got {timeout:g}", field="timeout"
+            )
 
     def warnings(self) -> list[str]:
         """What looks wrong in the request but is not refused: `to_rpy` given in degrees."""
@@ -58,8 +62,10 @@ class PlanRequest:
             return []
         rad = ",".join(f"{math.radians(a):.4g}" for a in rpy)
         given = ",".join(f"{a:g}" for a in rpy)
-        return [f"roll, pitch, yaw {given} look like degrees (an angle beyond 2 pi): they are "
-                f"radians; {given} degrees are {rad} rad"]  # fmt: skip
+        return [
+            f"roll, pitch, yaw {given} look like degrees (an angle beyond 2 pi): they are "
+            f"radians; {given} degrees are {rad} rad"
+        ]
 
     def describe(self) -> str:
         """`from home to reach`, `from home to xyz 0.2,0,0.15`: the request in words."""
@@ -76,8 +82,14 @@ def plan_request(
 
     `search`: the package lookup for meshes (--package-dir, the environment).
     """
-    loaded = load_context(robot, srdf=request.srdf, scene=request.scene,
-                          joints=request.joints, search=search, group=request.group)  # fmt: skip
+    loaded = load_context(
+        robot,
+        srdf=request.srdf,
+        scene=request.scene,
+        joints=request.joints,
+        search=search,
+        group=request.group,
+    )
     ctx = loaded.context
     if request.start is None and HOME not in ctx.robot.poses:
         raise InputError(f"this robot has no `{HOME}` pose: give `start`", field="start")
@@ -94,8 +106,9 @@ def plan_request(
         if exc.kind != "no-path":
             raise
         pr, opts = ctx.robot, request.options
-        found = connectivity(ctx.checker, pr.lower, pr.upper, x_start, x_goal,
-                             step=opts.step, seed=opts.seed)  # fmt: skip
+        found = connectivity(
+            ctx.checker, pr.lower, pr.upper, x_start, x_goal, step=opts.step, seed=opts.seed
+        )
         raise PlanningError("no-path", found.explain(opts.timeout)) from None
     return replace(result, notes=(*result.notes, *notes))
 
@@ -104,13 +117,15 @@ def _ik_goal(ctx: PlanningContext, request: PlanRequest, x_start: np.ndarray) ->
     """The IK goal; a point the tool reaches only in collision names what collides."""
     assert request.to_xyz is not None
     try:
-        return solve_goal(ctx, request.to_xyz, request.to_rpy, start=x_start,
-                          seed=request.options.seed)  # fmt: skip
+        return solve_goal(
+            ctx, request.to_xyz, request.to_rpy, start=x_start, seed=request.options.seed
+        )
     except PlanningError as exc:
         if exc.kind != "ik":
             raise
-        pair = reached_in_collision(ctx, request.to_xyz, request.to_rpy, x_start,
-                                    request.options.seed)  # fmt: skip
+        pair = reached_in_collision(
+            ctx, request.to_xyz, request.to_rpy, x_start, request.options.seed
+        )
         if pair is None:
             raise
         raise PlanningError(

@@ -117,8 +117,11 @@ class PlanRobot:
     @cached_property
     def rest(self) -> dict[str, float]:
         """Every 1-DoF joint not planned: at its `held` value, else its rest (`Robot.rest`)."""
-        return {j.name: float(self.held.get(j.name, j.rest)) for j in self.robot.joints
-                if j.name not in self.joints}  # fmt: skip
+        return {
+            j.name: float(self.held.get(j.name, j.rest))
+            for j in self.robot.joints
+            if j.name not in self.joints
+        }
 
     @cached_property
     def _map(self) -> JointMap:
@@ -191,9 +194,16 @@ def load_plan_robot(
     poses: dict[str, Mapping[str, float]] = dict(group_states or {})
     if spec is not None:
         poses.update({name: spec.pose(name) for name in spec.poses})
-    return PlanRobot(loaded, geometry, chosen, acc, poses,
-                     mobile=spec is not None and spec.mobile_base is not None, spec=spec,
-                     acceleration_defaulted=defaulted)  # fmt: skip
+    return PlanRobot(
+        loaded,
+        geometry,
+        chosen,
+        acc,
+        poses,
+        mobile=spec is not None and spec.mobile_base is not None,
+        spec=spec,
+        acceleration_defaulted=defaulted,
+    )
 
 
 def _accelerations(

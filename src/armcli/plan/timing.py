@@ -155,8 +155,10 @@ def _compiled(robot: PlanRobot, waypoints: np.ndarray, margin: float, compiled: 
         step=step,
     )
     if isinstance(out, int):
-        raise PlanningError("timing", f"TOPP-RA found no motion within the limits along "
-                            f"segment {out + 1} of the path")  # fmt: skip
+        raise PlanningError(
+            "timing",
+            f"TOPP-RA found no motion within the limits along segment {out + 1} of the path",
+        )
     return Timed(*out)
 
 
@@ -172,8 +174,11 @@ def _constraints(robot: PlanRobot, margin: float) -> list[Any]:
         # effort is mostly gravity, which the spline does not change: half the margin
         lim = np.column_stack([-effort, effort]) * (0.5 + 0.5 * margin)
         tau = inverse_dynamics(robot)
-        cons.append(constraint.JointTorqueConstraint(tau, lim, np.zeros(len(effort)),
-                                                     discretization_scheme=1))  # fmt: skip
+        cons.append(
+            constraint.JointTorqueConstraint(
+                tau, lim, np.zeros(len(effort)), discretization_scheme=1
+            )
+        )
     return cons
 
 
@@ -200,8 +205,10 @@ def parameterise(
         solver = algo.TOPPRA(cons, path, gridpoints=grid, parametrizer="ParametrizeConstAccel")
         traj = solver.compute_trajectory(0.0, 0.0)
         if traj is None:
-            raise PlanningError("timing", f"TOPP-RA found no motion within the limits along "
-                                f"segment {k + 1} of the path")  # fmt: skip
+            raise PlanningError(
+                "timing",
+                f"TOPP-RA found no motion within the limits along segment {k + 1} of the path",
+            )
         pieces.append(traj)
         starts.append(starts[-1] + float(traj.duration))
     duration = starts[-1]

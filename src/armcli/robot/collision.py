@@ -48,8 +48,9 @@ def box_corners(robot: Robot, gmodel: Any, q: ArrayLike) -> list[tuple[str, NDAr
     for T, g, link in zip(placements(robot, gmodel, q), gmodel.geometryObjects, links, strict=True):
         g.geometry.computeLocalAABB()
         lo, hi = np.asarray(g.geometry.aabb_local.min_), np.asarray(g.geometry.aabb_local.max_)
-        box = np.array([[a, b, c] for a in (lo[0], hi[0]) for b in (lo[1], hi[1])
-                        for c in (lo[2], hi[2])])  # fmt: skip
+        box = np.array(
+            [[a, b, c] for a in (lo[0], hi[0]) for b in (lo[1], hi[1]) for c in (lo[2], hi[2])]
+        )
         out.append((link, box @ T[:3, :3].T + T[:3, 3]))
     return out
 

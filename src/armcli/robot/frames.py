@@ -155,12 +155,14 @@ def quaternion_product(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
     """Hamilton product a b of (x, y, z, w) quaternions: b's rotation first, then a's."""
     ax, ay, az, aw = np.asarray(a, dtype=float)
     bx, by, bz, bw = np.asarray(b, dtype=float)
-    return np.array([
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-        aw * bw - ax * bx - ay * by - az * bz,
-    ])  # fmt: skip
+    return np.array(
+        [
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+            aw * bw - ax * bx - ay * by - az * bz,
+        ]
+    )
 
 
 def rotate(quat: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:

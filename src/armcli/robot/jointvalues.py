@@ -28,8 +28,11 @@ def parse_joint_values(text: str, joints: Sequence[str], field: str) -> dict[str
     order = ", ".join(joints) or "(none)"
     named = bool(items) and all("=" in s for s in items)
     if not named and len(items) != len(joints):
-        raise InputError(f"expected {len(joints)} value(s), one for each of {order}, or "
-                         f"joint=value pairs; got {text!r}", field=field)  # fmt: skip
+        raise InputError(
+            f"expected {len(joints)} value(s), one for each of {order}, or "
+            f"joint=value pairs; got {text!r}",
+            field=field,
+        )
     pairs = [s.split("=", 1) for s in items] if named else list(zip(joints, items, strict=True))
     out: dict[str, float] = {}
     for name, value in pairs:
@@ -53,6 +56,8 @@ def snap_to_limits(
         for bound, side, beyond in ((lo, "lower", lo - value), (hi, "upper", value - hi)):
             if 0.0 < beyond <= SNAP:
                 out[name] = bound
-                notes.append(f"{name} = {value:g} is taken as its {side} limit {bound:.9g} "
-                             f"({beyond:.2g} beyond it, within {SNAP:g})")  # fmt: skip
+                notes.append(
+                    f"{name} = {value:g} is taken as its {side} limit {bound:.9g} "
+                    f"({beyond:.2g} beyond it, within {SNAP:g})"
+                )
     return out, notes

@@ -101,8 +101,9 @@ def collision_model(model: Any, xml: str, source: str = "<urdf>") -> Any:
             )
         )
     except (RuntimeError, ValueError) as exc:
-        raise ModelLoadError(f"Pinocchio cannot load the collision geometry: {exc}", file=source,
-                             parser_messages=[]) from None  # fmt: skip
+        raise ModelLoadError(
+            f"Pinocchio cannot load the collision geometry: {exc}", file=source, parser_messages=[]
+        ) from None
     return gmodel
 
 

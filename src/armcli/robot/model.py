@@ -108,14 +108,27 @@ class Robot(Kinematics):
             loaded = checked_model(urdf, gate=gate, floating=floating)
         else:
             loaded = load_model(urdf.source, xml=urdf_text(urdf), floating=floating)
-        return cls(loaded.model, mimics=mimics(urdf.joints), tool=tool_point(urdf, spec),
-                   source=urdf.source, xml=urdf_text(urdf), urdf=urdf,
-                   parser_messages=loaded.parser_messages)  # fmt: skip
+        return cls(
+            loaded.model,
+            mimics=mimics(urdf.joints),
+            tool=tool_point(urdf, spec),
+            source=urdf.source,
+            xml=urdf_text(urdf),
+            urdf=urdf,
+            parser_messages=loaded.parser_messages,
+        )
 
     def _like(self, model: Any) -> Robot:
         """This robot over another model (a reduced, scaled or loaded copy)."""
-        return Robot(model, mimics=self.mimics, tool=self.tool, source=self.source, xml=self.xml,
-                     urdf=self.urdf, parser_messages=self.parser_messages)  # fmt: skip
+        return Robot(
+            model,
+            mimics=self.mimics,
+            tool=self.tool,
+            source=self.source,
+            xml=self.xml,
+            urdf=self.urdf,
+            parser_messages=self.parser_messages,
+        )
 
     @property
     def data(self) -> Any:
@@ -221,9 +234,18 @@ class Robot(Kinematics):
 
         (lq, lx), (cq, cx) = indices(False), indices(True)
         by_name = self._by_name
-        followers = tuple((by_name[m.follower].idx_q, by_name[m.follower].continuous, m.follower,
-                           m.leader, m.multiplier, m.offset)
-                          for m in self.mimics if m.follower in by_name)  # fmt: skip
+        followers = tuple(
+            (
+                by_name[m.follower].idx_q,
+                by_name[m.follower].continuous,
+                m.follower,
+                m.leader,
+                m.multiplier,
+                m.offset,
+            )
+            for m in self.mimics
+            if m.follower in by_name
+        )
         return JointMap(template, (lq, lx), (cq, cq + 1, cx), followers, tuple(joints), rest)
 
     def reduced(self, joints: Sequence[str]) -> Robot:
@@ -234,8 +256,9 @@ class Robot(Kinematics):
         names = list(self.model.names)[1:]
         for name in joints:
             if name not in names:
-                raise InputError(f"unknown joint {name!r}; valid: {', '.join(names)}",
-                                 field="joints")  # fmt: skip
+                raise InputError(
+                    f"unknown joint {name!r}; valid: {', '.join(names)}", field="joints"
+                )
         if len(set(joints)) != len(joints):
             raise InputError("a joint is listed twice", field="joints")
         lock = [self.model.getJointId(nm) for nm in names if nm not in joints]

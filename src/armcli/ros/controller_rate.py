@@ -75,7 +75,13 @@ def jazzy_control(spec: RobotSpec, urdf_xml: bytes, source: str | None) -> Contr
     v, names, samples = judged
     if not v.stable:
         at = samples[v.worst][0]
-        text = message(v, names, [at[j] for j in names], what="the arm controller",
-                       rate_name=RATE_FIELD, gain_names=("kp", "kd", "ki"))  # fmt: skip
+        text = message(
+            v,
+            names,
+            [at[j] for j in names],
+            what="the arm controller",
+            rate_name=RATE_FIELD,
+            gain_names=("kp", "kd", "ki"),
+        )
         raise InputError(text, file=source, field=RATE_FIELD)
     return Control(holding, v)

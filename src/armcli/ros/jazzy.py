@@ -58,10 +58,21 @@ GZ_LAUNCH = "{name}_gz.launch.py"
 MOVE_GROUP_LAUNCH = "gz_move_group.launch.py"
 # Everything the Jazzy bringup launch starts or loads, for its package.xml.
 BRINGUP_DEPENDS = [
-    "ament_index_python", "control_msgs", "controller_manager", "gz_ros2_control",
-    "joint_state_broadcaster", "joint_trajectory_controller", "launch", "launch_ros",
-    "robot_state_publisher", "ros_gz_bridge", "ros_gz_sim", "rviz2", "trajectory_msgs", "xacro",
-]  # fmt: skip
+    "ament_index_python",
+    "control_msgs",
+    "controller_manager",
+    "gz_ros2_control",
+    "joint_state_broadcaster",
+    "joint_trajectory_controller",
+    "launch",
+    "launch_ros",
+    "robot_state_publisher",
+    "ros_gz_bridge",
+    "ros_gz_sim",
+    "rviz2",
+    "trajectory_msgs",
+    "xacro",
+]
 # control_msgs, trajectory_msgs: the README's send_goal / topic pub commands need them.
 MOVEIT_DEPENDS = ["launch", "launch_ros"]  # gz_move_group.launch.py imports them
 # What MoveIt waits for at the end of a trajectory (MoveIt's own defaults, written out).

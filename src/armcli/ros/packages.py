@@ -35,6 +35,7 @@ from armcli.ros.collision_matrix import (
 )
 from armcli.ros.controller_rate import Control, jazzy_control
 from armcli.ros.copying import mesh_files
+from armcli.ros.depends import BRINGUP_DEPENDS, DESCRIPTION_DEPENDS, MOVEIT_DEPENDS
 from armcli.ros.jazzy_readme import readme as jazzy_readme
 from armcli.ros.launch import render
 from armcli.ros.ros2_control import moveit_urdf_xacro, ros2_control_xacro
@@ -50,20 +51,6 @@ from armcli.urdf.source import lookup_for, spec_urdfs
 FORMAT3_SCHEMA = "http://download.ros.org/schema/package_format3.xsd"
 DISPLAY_RVIZ = "display.rviz"
 PACKAGE_NAME = re.compile(r"^[a-z][a-z0-9_]*$")  # REP 144
-DESCRIPTION_DEPENDS = [
-    "ament_index_python", "joint_state_publisher_gui", "launch", "launch_ros",
-    "robot_state_publisher", "rviz2", "urdf", "xacro",
-]  # fmt: skip
-BRINGUP_DEPENDS = [
-    "ament_index_python", "gazebo_plugins", "gazebo_ros", "launch", "launch_ros",
-    "robot_state_publisher", "rviz2", "xacro",
-]  # fmt: skip
-MOVEIT_DEPENDS = [
-    "controller_manager", "hardware_interface", "joint_state_broadcaster",
-    "joint_trajectory_controller", "moveit_configs_utils", "moveit_kinematics",
-    "moveit_planners", "moveit_ros_move_group", "moveit_ros_visualization",
-    "moveit_simple_controller_manager", "robot_state_publisher", "rviz2", "tf2_ros", "xacro",
-]  # fmt: skip
 TARGETS = ROS_TARGETS
 DEFAULT_TARGET = TARGETS[0]
 MOVEIT_LAUNCHES = {  # launch file -> (moveit_configs_utils generator, what it starts)

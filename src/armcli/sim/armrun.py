@@ -62,8 +62,9 @@ class ArmRun:
         files: dict[Path, bytes] = {}
         res, job = self.result, self.job
         if output is not None and rosbag.is_mcap(output):
-            files[output] = rosbag.run_mcap_bytes(res, job.rate, job.urdf,
-                                                  sensor_channels(self.readings))  # fmt: skip
+            files[output] = rosbag.run_mcap_bytes(
+                res, job.rate, job.urdf, sensor_channels(self.readings)
+            )
         elif output is not None:
             cols = states.sample_states(res, job.rate)
             if self.series is not None:
@@ -151,8 +152,7 @@ def simulate_arm(
             gate(whole)
     _refuse_too_fast(job, opts)
     notes: list[str] = []
-    tip = tipping.prepare(file, job, balance or tipping.TipOptions(), search or MeshSearch(),
-                          notes)  # fmt: skip
+    tip = tipping.prepare(file, job, balance or tipping.TipOptions(), search or MeshSearch(), notes)
     warnings = (*precheck.holding_problems(job), *job.trajectory.warnings)
     sensors, scene = _arm_sensing(file, job, world)
     also = (lambda steps: sensor_steps(sensors, steps, job.config.dt)) if sensors else None
@@ -161,8 +161,9 @@ def simulate_arm(
     if sensors and job.urdf is not None:
         readings, sensor_notes = arm_readings(job.urdf, run.result, sensors, scene)
         warnings = (*warnings, *sensor_notes)
-    return replace(run, notes=job.notes, balance_notes=tuple(notes), warnings=warnings,
-                   readings=readings)  # fmt: skip
+    return replace(
+        run, notes=job.notes, balance_notes=tuple(notes), warnings=warnings, readings=readings
+    )
 
 
 def _arm_sensing(

@@ -177,12 +177,16 @@ def _within(traj: Trajectory, limits: dict[str, tuple[float, float]]) -> Traject
     """
     for i, name in enumerate(traj.joint_names):
         if name not in limits:
-            raise InputError(f"unknown joint {name!r}; valid: {', '.join(limits)}",
-                             file=traj.source, field="joint_names")  # fmt: skip
+            raise InputError(
+                f"unknown joint {name!r}; valid: {', '.join(limits)}",
+                file=traj.source,
+                field="joint_names",
+            )
         lo, hi = limits[name]
         if not np.all((traj.positions[:, i] >= lo) & (traj.positions[:, i] <= hi)):
-            raise InputError(f"{name} leaves its range [{lo:g}, {hi:g}]", file=traj.source,
-                             field="positions")  # fmt: skip
+            raise InputError(
+                f"{name} leaves its range [{lo:g}, {hi:g}]", file=traj.source, field="positions"
+            )
     return traj
 
 
@@ -271,8 +275,9 @@ def prepare(
     check_stability(robot, cfg, configs)
     total, rate = _duration_and_rate(spec, opts, traj.duration, dt)
     label, T_frame_root = _report_frame(robot, spec)
-    return SimJob(robot, traj, ref, q0, total, cfg, label, float(rate), T_frame_root, doc.notes,
-                  doc)  # fmt: skip
+    return SimJob(
+        robot, traj, ref, q0, total, cfg, label, float(rate), T_frame_root, doc.notes, doc
+    )
 
 
 def _one_trajectory(opts: SimOptions) -> None:
@@ -334,5 +339,6 @@ def run(
     if extra is not None:
         keep = np.concatenate([keep, extra(steps)])
     keep = distinct(keep)
-    return simulate(job.robot, job.reference, job.q0, job.duration, job.config, progress,
-                    record=keep)  # fmt: skip
+    return simulate(
+        job.robot, job.reference, job.q0, job.duration, job.config, progress, record=keep
+    )

@@ -60,8 +60,16 @@ def tracking_png(
         if sat.any() and effort_limits is not None:
             for s in (-1, 1):
                 ax_t.axhline(s * effort_limits[i], color="C3", lw=0.8, ls=":", label=None)
-            ax_t.fill_between(t, 0, 1, where=sat, color="C3", alpha=0.15,
-                              transform=ax_t.get_xaxis_transform(), label="saturated")  # fmt: skip
+            ax_t.fill_between(
+                t,
+                0,
+                1,
+                where=sat,
+                color="C3",
+                alpha=0.15,
+                transform=ax_t.get_xaxis_transform(),
+                label="saturated",
+            )
         ax_q.set_title(name, fontsize=11)
         ax_q.set_ylabel("position [rad]")
         ax_v.set_ylabel("velocity [rad/s]")
@@ -77,8 +85,9 @@ def tracking_png(
     # title a fixed distance from the top, above the first row's titles at any height
     w, h = fig.get_size_inches()
     fig.suptitle(title, fontsize=12, y=1 - 0.1 / h, va="top")
-    fig.subplots_adjust(left=0.75 / w, right=1 - 0.2 / w, bottom=0.5 / h, top=1 - 0.8 / h,
-                        hspace=0.45, wspace=0.3)  # fmt: skip
+    fig.subplots_adjust(
+        left=0.75 / w, right=1 - 0.2 / w, bottom=0.5 / h, top=1 - 0.8 / h, hspace=0.45, wspace=0.3
+    )
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=100, metadata={"Software": None})
     return buf.getvalue()

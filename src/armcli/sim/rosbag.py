@@ -33,11 +33,12 @@ import numpy as np
 from armcli.errors import InputError
 from armcli.io.files import write_file_atomic
 from armcli.io.mcap_guard import check_chunks
+from armcli.io.outdir import check_output_file, check_png_file
 from armcli.io.userfile import open_regular
 from armcli.robot.frames import axis_quaternion, quaternion_product, rotate, rpy_quaternion
 from armcli.robot.joints import rest
 from armcli.sim.simulate import SimResult
-from armcli.sim.states import TIME, Replay, column, sample_states
+from armcli.sim.states import TIME, Replay, column, output_format, sample_states
 from armcli.spec.joint_types import position_bounds
 from armcli.urdf.doc import Joint, Urdf
 
@@ -60,11 +61,25 @@ def is_mcap(path: Path) -> bool:
     return path.suffix.lower() == MCAP_SUFFIX
 
 
+def check_outputs(output: Path | None, plot: Path | None, inputs: Sequence[Path]) -> None:
+    """Refuse a run's states file or plot before the run, naming the field.
+
+    A format it cannot write (.csv, .json, .mcap; a plot is PNG), or a path over one of the
+    `inputs` (issue 42).
+    """
+    if output is not None:
+        if not is_mcap(output):
+            output_format(output)
+        check_output_file(output, "output", inputs)
+    if plot is not None:
+        check_png_file(plot, "plot", inputs)
+
+
 # -- message definitions, as rosbag2 writes them ---------------------------------------------
 
 _DELIMITER = "=" * 80 + "\n"
-_PRIMITIVES = {"bool", "byte", "char", "float32", "float64", "int8", "uint8", "int16",
-               "uint16", "int32", "uint32", "int64", "uint64", "string"}  # fmt: skip
+_PRIMITIVE = re.compile(r"bool|byte|char|float(32|64)|u?int(8|16|32|64)|string")
+_STATE_FIELDS = ("position", "velocity", "effort")
 _FIELD_TYPE = re.compile(r"(?:^|\n)\s*([a-zA-Z0-9_/]+)(?:\[[^\]]*\])?\s+")  # rosbag2's regex
 _TYPENAME = re.compile(r"^([a-zA-Z0-9_]+)/(?:msg/)?([a-zA-Z0-9_]+)$")
 
@@ -84,7 +99,7 @@ def _dependencies(text: str, package: str) -> list[str]:
     deps = set()
     for m in _FIELD_TYPE.finditer(text):
         name = m.group(1)
-        if name not in _PRIMITIVES:
+        if not _PRIMITIVE.fullmatch(name):
             deps.add(name if "/" in name else f"{package}/{name}")
     return sorted(deps)
 
@@ -194,25 +209,27 @@ def channels(cols: Mapping[str, np.ndarray], names: Sequence[str], urdf: Urdf) -
     resting = {n: rest(*b) if b is not None else 0.0 for n, b in bounds.items()}  # not simulated
     for k, ns in enumerate(stamps):
         values = {n: float(cols[column(n, "position")][k]) for n in names}
-        state.append((ns, _joint_state(
-            ns, names, **{f: [cols[column(n, f)][k] for n in names]
-                          for f in ("position", "velocity", "effort")},
-        )))  # fmt: skip
-        ref.append((ns, _joint_state(ns, tracked, position=[cols[column(n, "reference")][k]
-                                                            for n in tracked])))  # fmt: skip
-        tf.append((ns, {"transforms": [_transform(j, values.get(j.name, resting[j.name]), ns)
-                                       for j in moving]}))  # fmt: skip
+        fields = {f: [cols[column(n, f)][k] for n in names] for f in _STATE_FIELDS}
+        state.append((ns, _joint_state(ns, names, **fields)))
+        reference = [cols[column(n, "reference")][k] for n in tracked]
+        ref.append((ns, _joint_state(ns, tracked, position=reference)))
+        moved = [_transform(j, values.get(j.name, resting[j.name]), ns) for j in moving]
+        tf.append((ns, {"transforms": moved}))
     fixed = [j for j in urdf.joints if j.type == "fixed"]
     start = stamps[0]
     text = urdf.text.decode("utf-8")
     return [
         Channel(DESCRIPTION, STRING, qos(1, True), [(start, {"data": text})]),
-        Channel(TF_STATIC, TF_MESSAGE, qos(1, True),
-                [(start, {"transforms": [_transform(j, 0.0, start) for j in fixed]})]),
+        Channel(
+            TF_STATIC,
+            TF_MESSAGE,
+            qos(1, True),
+            [(start, {"transforms": [_transform(j, 0.0, start) for j in fixed]})],
+        ),
         Channel(JOINT_STATES, JOINT_STATE, qos(10, False), state),
         Channel(REFERENCE, JOINT_STATE, qos(10, False), ref),
         Channel(TF, TF_MESSAGE, qos(100, False), tf),
-    ]  # fmt: skip
+    ]
 
 
 def mcap_bytes(chans: Sequence[Channel]) -> bytes:
@@ -298,8 +315,11 @@ def load_replay(path: str | Path, joints: Sequence[str]) -> Replay:
                 if channel.topic == TF:  # a drive's world -> odom -> base: where the robot is
                     count += len(msg.transforms)  # messages are bounded by check_chunks
                     if count > MAX_REPLAY_TRANSFORMS:
-                        raise InputError(f"more than {MAX_REPLAY_TRANSFORMS:,} /tf transforms, "
-                                         "armcli's bound on a replay", file=source)  # fmt: skip
+                        raise InputError(
+                            f"more than {MAX_REPLAY_TRANSFORMS:,} /tf transforms, "
+                            "armcli's bound on a replay",
+                            file=source,
+                        )
                     _collect_base(msg, bases)
                     continue
                 t = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
@@ -307,8 +327,9 @@ def load_replay(path: str | Path, joints: Sequence[str]) -> Replay:
                 mine = {n: v for n, v in known.items() if n in joints}
                 bad = [n for n, v in mine.items() if not math.isfinite(v)]
                 if bad:
-                    raise InputError(f"{channel.topic} at t = {t:g} s: {bad[0]} is not finite",
-                                     file=source)  # fmt: skip
+                    raise InputError(
+                        f"{channel.topic} at t = {t:g} s: {bad[0]} is not finite", file=source
+                    )
                 rows[channel.topic].append((t, mine))
     except InputError:
         raise

@@ -59,8 +59,10 @@ def _check_joint_value(joint: str, name: str, x: float) -> None:
     }[name]
     if not ok:
         need = {"effort": "> 0 (inf: none)", "damping": "finite, >= 0", "friction": "finite, >= 0"}
-        raise InputError(f"joint {joint!r}: {name} {x:g} is not a valid value"
-                         + (f" (must be {need[name]})" if name in need else ""))  # fmt: skip
+        raise InputError(
+            f"joint {joint!r}: {name} {x:g} is not a valid value"
+            + (f" (must be {need[name]})" if name in need else "")
+        )
 
 
 @dataclass(frozen=True)
@@ -243,9 +245,17 @@ def _run(r: Run, compiled: Any, progress: Callable[[int, int], None] | None) -> 
     plant = plant_of(r.robot, r.cfg)
     plant = replace(plant, energy_max=_energy_max(r.robot, r.q0, plant.vabort))
     start = time.perf_counter()
-    out = ro.run(plant, r.reference, np.asarray(r.q0, dtype=float), np.zeros(len(r.q0)), steps,
-                 record=r.record, settle_tol=SETTLE_TOL, compiled=compiled,
-                 progress=progress)  # fmt: skip
+    out = ro.run(
+        plant,
+        r.reference,
+        np.asarray(r.q0, dtype=float),
+        np.zeros(len(r.q0)),
+        steps,
+        record=r.record,
+        settle_tol=SETTLE_TOL,
+        compiled=compiled,
+        progress=progress,
+    )
     wall = time.perf_counter() - start
     if out.failure:
         _raise(r.robot, plant, out)

@@ -54,8 +54,9 @@ class TipOptions:
         if self.base_accel is not None and not (
             math.isfinite(self.base_accel) and self.base_accel >= 0
         ):
-            raise InputError(f"must be finite and >= 0, got {self.base_accel:g}",
-                             field="TipOptions.base_accel")  # fmt: skip
+            raise InputError(
+                f"must be finite and >= 0, got {self.base_accel:g}", field="TipOptions.base_accel"
+            )
 
 
 @dataclass(frozen=True)
@@ -73,9 +74,18 @@ class Tipping:
 
     def series(self, job: SimJob, res: SimResult) -> zmps.ZmpSeries:
         """The zero-moment point at every kept state of the run."""
-        return zmps.zmp_series(self.stance, res.joint_names, res.t, res.step, res.q, res.v,
-                               res.dt, self.base_accel, self.threshold,
-                               zmps.impacts(res.stop_active, res.v))  # fmt: skip
+        return zmps.zmp_series(
+            self.stance,
+            res.joint_names,
+            res.t,
+            res.step,
+            res.q,
+            res.v,
+            res.dt,
+            self.base_accel,
+            self.threshold,
+            zmps.impacts(res.stop_active, res.v),
+        )
 
 
 def whole_robot(file: RobotFile) -> Urdf:
@@ -113,9 +123,14 @@ def prepare(
         return None
     missing: list[str] = []
     search = lookup_for(spec, search)  # the packages the spec records too
-    found = stance_of(urdf, candidates=candidates, declared=opts.contact_links,
-                      mesh=mesh_loader(urdf, search, missing), payload=payload,
-                      floating=floating_of(file, urdf))  # fmt: skip
+    found = stance_of(
+        urdf,
+        candidates=candidates,
+        declared=opts.contact_links,
+        mesh=mesh_loader(urdf, search, missing),
+        payload=payload,
+        floating=floating_of(file, urdf),
+    )
     if isinstance(found, NoStance):
         notes.append(f"no zero-moment point: {found.reason}")
         return None
@@ -204,6 +219,49 @@ class ZmpReport:
         """The worst moment's case, with the base's acceleration when it counts."""
         return self.case + (f" at {self.base_accel:g} m/s²" if self.case != zmps.CASES[0] else "")
 
+    def line(self) -> str:
+        """The summary's line: where the point came closest to the edge, and whether it tips."""
+        load = f", {self.payload}" if self.payload else ""
+        head = (
+            f"zero-moment point (base held on its wheels{load}; base accel "
+            f"{self.base_accel:g} m/s² from {self.accel_source}): "
+        )
+        if self.tips:
+            what = (
+                f"TIPS: {-self.min_margin * 1e3:.1f} mm outside the support polygon "
+                f"toward {self.direction}"
+            )
+        elif self.min_margin < 0:
+            what = (
+                f"{-self.min_margin * 1e3:.1f} mm outside toward {self.direction} for "
+                f"{sum(e.duration for e in self.lifts):.3f} s: a wheel lifts off, no tip"
+            )
+        else:
+            what = f"least margin {self.min_margin * 1e3:.1f} mm toward {self.direction}"
+        left = f"; {self.impacts} joint-stop impact(s) left out" if self.impacts else ""
+        holds = "any" if math.isinf(self.max_base_accel) else f"{self.max_base_accel:.3g} m/s²"
+        return (
+            f"{head}{what} at t = {self.time:.3f} s ({self.when}); arm motion alone: "
+            f"{self.arm_margin * 1e3:.1f} mm; base acceleration that holds: {holds}{left}"
+        )
+
+    def notes(self) -> list[str]:
+        """The lift-off warnings: excursions too short to tip the robot, case by case."""
+        return [e.line() for e in self.lifts]
+
+    def error(self) -> TipOverError:
+        """The error a run that tips the robot over ends with (after its files are written)."""
+        e = next(e for e in self.excursions if e.tips)
+        accel = f" at {self.base_accel:g} m/s²" if e.case != zmps.CASES[0] else ""
+        return TipOverError(
+            f"the robot tips over: its zero-moment point is up to {e.depth * 1e3:.1f} mm "
+            f"outside the support polygon toward {e.direction} from t = {e.start:.3f} s for "
+            f"{e.duration:.3f} s ({e.case}{accel}), long enough to rotate it over that edge",
+            time=e.start,
+            margin=-e.depth,
+            case=e.case,
+        )
+
 
 def report(tip: Tipping, series: zmps.ZmpSeries) -> ZmpReport:
     """The numbers of a run's zero-moment point."""
@@ -230,42 +288,6 @@ def report(tip: Tipping, series: zmps.ZmpSeries) -> ZmpReport:
     )
 
 
-def summary_line(r: ZmpReport) -> str:
-    """The summary's line: where the point came closest to the edge, and whether it tips."""
-    load = f", {r.payload}" if r.payload else ""
-    head = (f"zero-moment point (base held on its wheels{load}; base accel {r.base_accel:g} "
-            f"m/s² from {r.accel_source}): ")  # fmt: skip
-    if r.tips:
-        what = (
-            f"TIPS: {-r.min_margin * 1e3:.1f} mm outside the support polygon toward {r.direction}"
-        )
-    elif r.min_margin < 0:
-        what = (f"{-r.min_margin * 1e3:.1f} mm outside toward {r.direction} for "
-                f"{sum(e.duration for e in r.lifts):.3f} s: a wheel lifts off, no tip")  # fmt: skip
-    else:
-        what = f"least margin {r.min_margin * 1e3:.1f} mm toward {r.direction}"
-    left = f"; {r.impacts} joint-stop impact(s) left out" if r.impacts else ""
-    holds = "any" if math.isinf(r.max_base_accel) else f"{r.max_base_accel:.3g} m/s²"
-    return (
-        f"{head}{what} at t = {r.time:.3f} s ({r.when}); arm motion alone: "
-        f"{r.arm_margin * 1e3:.1f} mm; base acceleration that holds: {holds}{left}"
-    )
-
-
-def tip_error(r: ZmpReport) -> TipOverError:
-    """The error a run that tips the robot over ends with (after its files are written)."""
-    e = next(e for e in r.excursions if e.tips)
-    accel = f" at {r.base_accel:g} m/s²" if e.case != zmps.CASES[0] else ""
-    return TipOverError(
-        f"the robot tips over: its zero-moment point is up to {e.depth * 1e3:.1f} mm outside "
-        f"the support polygon toward {e.direction} from t = {e.start:.3f} s for "
-        f"{e.duration:.3f} s ({e.case}{accel}), long enough to rotate it over that edge",
-        time=e.start,
-        margin=-e.depth,
-        case=e.case,
-    )
-
-
 def plot_row(series: zmps.ZmpSeries) -> Any:
     """A drawer of the tracking plot's fourth row: margins per case, and the point itself."""
 
@@ -282,8 +304,14 @@ def plot_row(series: zmps.ZmpSeries) -> Any:
         k = int(np.argmin(np.min(series.margin[:, :cases], axis=1)))  # the least moment
         low = float(np.min(series.margin[k, :cases])) * 1e3
         ax.plot(series.t[k], low, "o", color="C3", ms=5, zorder=5)
-        ax.annotate(f"least {low:.1f} mm at {series.t[k]:.3f} s", (series.t[k], low),
-                    xytext=(8, -4), textcoords="offset points", fontsize=8, color="C3")  # fmt: skip
+        ax.annotate(
+            f"least {low:.1f} mm at {series.t[k]:.3f} s",
+            (series.t[k], low),
+            xytext=(8, -4),
+            textcoords="offset points",
+            fontsize=8,
+            color="C3",
+        )
         top = float(np.max(series.margin[:, :cases])) * 1e3
         span = top - min(low, 0.0)
         ax.set_ylim(min(low, 0.0) - 0.15 * span, top + 0.6 * span)  # the legend goes on top

@@ -103,8 +103,11 @@ def _shape(ms: Any, geom: Any, shape: Shape, name: str, source: str) -> None:
         vertices, faces = _cone(d) if shape.kind == "cone" else _mesh(shape)
         if len(vertices) < MESH_VERTICES:
             oid = name[len(PREFIX) :].rsplit("/", 1)[0]
-            raise InputError(f"object {oid!r}: a mesh needs at least {MESH_VERTICES} vertices "
-                             "(MuJoCo's convex hull)", file=source)  # fmt: skip
+            raise InputError(
+                f"object {oid!r}: a mesh needs at least {MESH_VERTICES} vertices "
+                "(MuJoCo's convex hull)",
+                file=source,
+            )
         mesh = ms.add_mesh(name=name, uservert=vertices.ravel(), userface=faces.ravel())
         mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL  # a static body: no volume needed
         geom.type, geom.meshname = G.mjGEOM_MESH, name
@@ -204,14 +207,19 @@ def marker_array(model: Any, data: Any, geoms: Sequence[WorldGeom]) -> dict[str,
         r, gr, b, a = (float(c) for c in model.geom_rgba[gid])
         marker = {
             "header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": g.frame or "world"},
-            "ns": g.object_id, "id": i, "type": MARKERS.get(kind, 11), "action": 0,
-            "pose": {"position": dict(zip("xyz", map(float, pos), strict=True)),
-                     "orientation": dict(zip("wxyz", map(float, quat), strict=True))},
+            "ns": g.object_id,
+            "id": i,
+            "type": MARKERS.get(kind, 11),
+            "action": 0,
+            "pose": {
+                "position": dict(zip("xyz", map(float, pos), strict=True)),
+                "orientation": dict(zip("wxyz", map(float, quat), strict=True)),
+            },
             "scale": dict(zip("xyz", map(float, scale), strict=True)),
             "color": {"r": r, "g": gr, "b": b, "a": a},
             "frame_locked": bool(g.frame),
             "points": _triangles(model, gid) if kind == "mesh" else [],
-        }  # fmt: skip
+        }
         out.append(marker)
     return {"markers": out}
 

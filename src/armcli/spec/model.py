@@ -102,7 +102,7 @@ __all__ = [
     "Sphere",
     "Tolerances",
     "Tool",
-]  # fmt: skip
+]
 
 
 class DiffDrive(_Model):

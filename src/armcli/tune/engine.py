@@ -174,8 +174,9 @@ def check_scheduler_address(address: str, trusted: bool) -> None:
     """Refuse a plain-text scheduler on another host unless `trusted` (see the docstring)."""
     scheme, host, _ = _split(address)
     if scheme in PLAIN_SCHEMES and not is_loopback(host) and not trusted:
-        raise InputError(f"{address} is not encrypted and not on this machine: {TRUST_HINT}",
-                         field="scheduler")  # fmt: skip
+        raise InputError(
+            f"{address} is not encrypted and not on this machine: {TRUST_HINT}", field="scheduler"
+        )
 
 
 def _raw_probe(host: str, port: int, timeout: float) -> None:
@@ -227,8 +228,9 @@ def _probe(address: str, timeout: float) -> None:
         asyncio.run(once())
     except (_NotDaskError, MemoryError, OverflowError, struct.error) as exc:
         why = str(exc) or type(exc).__name__
-        raise InputError(f"{address} does not answer as a Dask scheduler ({why})",
-                         field="scheduler") from None  # fmt: skip
+        raise InputError(
+            f"{address} does not answer as a Dask scheduler ({why})", field="scheduler"
+        ) from None
 
 
 def make_engine(jobs: int, scheduler: str | None, *, trust_scheduler: bool = False) -> Engine:

@@ -116,8 +116,9 @@ def _pose_cases(
     return cases
 
 
-def _traj_case(traj: Trajectory, label: str, joints: Sequence[str], q0: np.ndarray,
-               settle: float) -> Case:  # fmt: skip
+def _traj_case(
+    traj: Trajectory, label: str, joints: Sequence[str], q0: np.ndarray, settle: float
+) -> Case:
     ref = build_reference(traj, joints, q0)
     return Case(label, ref, q0, traj.duration, traj.duration + settle)
 
@@ -139,12 +140,24 @@ def prepare(file: RobotFile, trajectories: Sequence[Path], s: TuneSettings) -> T
     loop = _validate(s)
     spec, spec_path = _spec(file), file.path
     xml = urdf_text(file.arm)
-    base = TuneProblem(xml, ARM_URDF, tuple(s.joints or ()), spec.control.dt, "euler",
-                       bool(spec.control.gravity_compensation), loop, 1.0, (), ())  # fmt: skip
+    base = TuneProblem(
+        xml,
+        ARM_URDF,
+        tuple(s.joints or ()),
+        spec.control.dt,
+        "euler",
+        bool(spec.control.gravity_compensation),
+        loop,
+        1.0,
+        (),
+        (),
+    )
     robot = nominal_robot(base)
     joints = robot.names
-    limits = {n: (float(lo), float(hi)) for n, lo, hi in zip(joints, robot.lower, robot.upper,
-                                                              strict=True)}  # fmt: skip
+    limits = {
+        n: (float(lo), float(hi))
+        for n, lo, hi in zip(joints, robot.lower, robot.upper, strict=True)
+    }
     q0 = start_state(robot, spec)
     paths = list(trajectories) or default_trajectories(spec_path, joints)
     cases = [_traj_case(load_trajectory(p, limits), p.stem, joints, q0, s.settle) for p in paths]
@@ -161,12 +174,28 @@ def prepare(file: RobotFile, trajectories: Sequence[Path], s: TuneSettings) -> T
         if s.wn is not None
         else 2 * math.pi * spec.control.controller_update_rate / TARGET_RATIO
     )
-    start = start_gains(robot, dt=spec.control.dt, loop=s.loop, zeta=s.zeta, wn_target=wn,
-                        steps=largest_steps(cases, len(joints)),
-                        gravity=not base.gravity_comp)  # fmt: skip
+    start = start_gains(
+        robot,
+        dt=spec.control.dt,
+        loop=s.loop,
+        zeta=s.zeta,
+        wn_target=wn,
+        steps=largest_steps(cases, len(joints)),
+        gravity=not base.gravity_comp,
+    )
     variants = draw_variants(robot, s.robust, s.mass_scale, s.friction_scale, s.seed)
-    problem = TuneProblem(xml, ARM_URDF, joints, spec.control.dt, "euler", base.gravity_comp,
-                          loop, STABILITY_MARGIN, tuple(cases), variants).with_key()  # fmt: skip
+    problem = TuneProblem(
+        xml,
+        ARM_URDF,
+        joints,
+        spec.control.dt,
+        "euler",
+        base.gravity_comp,
+        loop,
+        STABILITY_MARGIN,
+        tuple(cases),
+        variants,
+    ).with_key()
     return TuneJob(problem, start, _spec_gains(spec, joints))
 
 

@@ -169,10 +169,22 @@ def start_gains(
         kp_j, kd_j = m_max * wn * wn, 2.0 * zeta * wn * m_max
         rows.append(
             JointReasoning(
-                name, float(diag[:, j].min()), m_max, float(g[j]), float(steps[j]), float(lam_j[j]),
-                wn_target, wn_s, wn_e, wn, zeta, kp_j, kd_j, binding,
+                name,
+                float(diag[:, j].min()),
+                m_max,
+                float(g[j]),
+                float(steps[j]),
+                float(lam_j[j]),
+                wn_target,
+                wn_s,
+                wn_e,
+                wn,
+                zeta,
+                kp_j,
+                kd_j,
+                binding,
             )
-        )  # fmt: skip
+        )
     kp = np.array([r.kp for r in rows])
     kd = np.array([r.kd for r in rows])
     scale = _coupled_scale(robot, lin, kp, kd, loop, dt)

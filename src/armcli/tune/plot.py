@@ -16,8 +16,9 @@ from armcli.tune.objective import INFEASIBLE_COST
 from armcli.tune.search import TrialRecord
 
 
-def tune_png(history: Sequence[TrialRecord], runs: Sequence[tuple[str, SimResult]],
-             case_label: str) -> bytes:  # fmt: skip
+def tune_png(
+    history: Sequence[TrialRecord], runs: Sequence[tuple[str, SimResult]], case_label: str
+) -> bytes:
     """PNG bytes: the history on top, one tracking-error panel per joint below.
 
     Errors rather than positions: at this scale the position curves would overlap.

@@ -107,9 +107,12 @@ def scored_models(problem: TuneProblem) -> tuple[Scored, ...]:
 
 
 def draw_variants(
-    robot: Robot, count: int, mass_range: tuple[float, float], friction_range: tuple[float, float],
+    robot: Robot,
+    count: int,
+    mass_range: tuple[float, float],
+    friction_range: tuple[float, float],
     seed: int,
-) -> tuple[Variant, ...]:  # fmt: skip
+) -> tuple[Variant, ...]:
     """`count` perturbed models, scales uniform in the given ranges, from a seeded stream."""
     rng = np.random.default_rng(seed)
     bodies = robot.model.njoints - 1

@@ -193,8 +193,9 @@ def to_json(
     return json.dumps(doc, indent=2, allow_nan=False) + "\n"
 
 
-def _row_doc(problem: TuneProblem, start: StartGains, row: Row, damping: np.ndarray
-             ) -> dict[str, Any]:  # fmt: skip
+def _row_doc(
+    problem: TuneProblem, start: StartGains, row: Row, damping: np.ndarray
+) -> dict[str, Any]:
     return {
         "robust_cost": _num(row.robust_cost),
         "feasible": row.nominal.feasible,
@@ -206,8 +207,13 @@ def _row_doc(problem: TuneProblem, start: StartGains, row: Row, damping: np.ndar
 
 
 def _trial_doc(r: TrialRecord) -> dict[str, Any]:
-    return {"trial": r.number, "cost": _num(r.cost), "feasible": r.feasible,
-            "reason": r.reason, "gains": r.gains.tolist()}  # fmt: skip
+    return {
+        "trial": r.number,
+        "cost": _num(r.cost),
+        "feasible": r.feasible,
+        "reason": r.reason,
+        "gains": r.gains.tolist(),
+    }
 
 
 def _joint_doc(start: StartGains, row: Row, j: int, damping: float) -> dict[str, Any]:

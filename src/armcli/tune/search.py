@@ -121,8 +121,9 @@ def search(
         k = min(opts.batch, opts.trials - len(history))
         trials = [study.ask(dists) for _ in range(k)]
         batch = [np.array([t.params[nm] for nm in names]) for t in trials]
-        for t, g, ev in zip(trials, batch, engine.evaluate(problem, batch, opts.weights),
-                            strict=True):  # fmt: skip
+        for t, g, ev in zip(
+            trials, batch, engine.evaluate(problem, batch, opts.weights), strict=True
+        ):
             cost = cost_of(ev, opts)
             study.tell(t, cost)
             history.append(TrialRecord(t.number, g, cost, ev.feasible, ev.reason))

@@ -99,8 +99,10 @@ def updated_text(text: str, path: Path, gains: Mapping[str, tuple[float, float]]
         last = list(block.keys())[-1]
         last_line = _last_line(block, last, lines)
         indent = " " * block.lc.key(last)[1]
-        add = [f"{indent}{j}: {{kp: {fmt_gain(gains[j][0])}, kd: {fmt_gain(gains[j][1])}}}\n"
-               for j in missing]  # fmt: skip
+        add = [
+            f"{indent}{j}: {{kp: {fmt_gain(gains[j][0])}, kd: {fmt_gain(gains[j][1])}}}\n"
+            for j in missing
+        ]
         if not lines[last_line].endswith("\n"):
             lines[last_line] += "\n"
         lines[last_line + 1 : last_line + 1] = add
@@ -133,6 +135,7 @@ def edited_spec(path: Path, gains: Mapping[str, tuple[float, float]]) -> bytes:
         if got is None or (fmt_gain(got.kp), fmt_gain(got.kd)) != (fmt_gain(kp), fmt_gain(kd)):
             raise InputError(
                 f"the edited spec does not read back {joint}'s gains; nothing written",
-                file=path, field="control.gains",
-            )  # fmt: skip
+                file=path,
+                field="control.gains",
+            )
     return new.encode("utf-8")

@@ -99,13 +99,19 @@ def _sensor(gz: etree._Element, el: etree._Element) -> GazeboSensor:
     frame = el.findtext("gz_frame_id") or el.findtext("plugin/frame_name")
     rng = _pair(el, "ray/range", "min", "max") or _pair(el, "lidar/range", "min", "max")
     return GazeboSensor(
-        name=el.get("name", ""), type=el.get("type", ""), link=gz.get("reference"),
-        line=_ln(el), pose=pose, update_rate=_number(el, "update_rate"),
-        frame=frame.strip() if frame else None, rays=_scan(el, "horizontal"),
-        vertical=_scan(el, "vertical"), range=rng,
+        name=el.get("name", ""),
+        type=el.get("type", ""),
+        link=gz.get("reference"),
+        line=_ln(el),
+        pose=pose,
+        update_rate=_number(el, "update_rate"),
+        frame=frame.strip() if frame else None,
+        rays=_scan(el, "horizontal"),
+        vertical=_scan(el, "vertical"),
+        range=rng,
         horizontal_fov=_number(el, "camera/horizontal_fov"),
         clip=_pair(el, "camera/clip", "near", "far"),
-    )  # fmt: skip
+    )
 
 
 def sensors(root: etree._Element) -> tuple[GazeboSensor, ...]:

@@ -79,12 +79,20 @@ class MobileViewer(Viewer):
 class BasePanel:
     """Adds the Mobile base folder, the room target, the drawings and the replay."""
 
-    def __init__(self, viewer: MobileViewer, session: BaseSession, urdf_xml: str, *,
-                 source: str = "<urdf>", mesh_dir: str | Path | None = None,
-                 search: MeshSearch | None = None) -> None:  # fmt: skip
+    def __init__(
+        self,
+        viewer: MobileViewer,
+        session: BaseSession,
+        urdf_xml: str,
+        *,
+        source: str = "<urdf>",
+        mesh_dir: str | Path | None = None,
+        search: MeshSearch | None = None,
+    ) -> None:
         self.viewer, self.session = viewer, session
-        self._ghost_urdf = load_urdf(moving_parts(urdf_xml, session.arm, source), source,
-                                     mesh_dir, search)  # fmt: skip
+        self._ghost_urdf = load_urdf(
+            moving_parts(urdf_xml, session.arm, source), source, mesh_dir, search
+        )
         self._lock = threading.RLock()
         self._stop = threading.Event()
         self._replayer: threading.Thread | None = None
@@ -180,19 +188,29 @@ class BasePanel:
         if len(drawing.region):
             pts = np.column_stack([drawing.region, np.full(len(drawing.region), FLOOR_LIFT)])
             colours = np.tile(np.array(REGION_RGB, dtype=np.uint8), (len(pts), 1))
-            self._drawn.append(scene.add_point_cloud("/plan/region", pts.astype(np.float32),
-                                                     colours, point_size=REGION_POINT))  # fmt: skip
+            self._drawn.append(
+                scene.add_point_cloud(
+                    "/plan/region", pts.astype(np.float32), colours, point_size=REGION_POINT
+                )
+            )
         x, y, yaw = drawing.parked
         self._parked.position, self._parked.wxyz = (x, y, 0.0), _yaw_wxyz(yaw)
         self._parked.visible = True
         while len(self._ghosts) < len(drawing.ghosts):
-            self._ghosts.append(ViserUrdf(self.viewer.server, self._ghost_urdf,
-                                          root_node_name=f"/plan/parked/ghost{len(self._ghosts)}",
-                                          mesh_color_override=GHOST_RGBA))  # fmt: skip
+            self._ghosts.append(
+                ViserUrdf(
+                    self.viewer.server,
+                    self._ghost_urdf,
+                    root_node_name=f"/plan/parked/ghost{len(self._ghosts)}",
+                    mesh_color_override=GHOST_RGBA,
+                )
+            )
         names = self.viewer.joint_names
         for ghost, q in zip(self._ghosts, drawing.ghosts, strict=False):
-            values = {**self.viewer.configuration(), **dict(zip(self.session.arm, q.tolist(),
-                                                                strict=True))}  # fmt: skip
+            values = {
+                **self.viewer.configuration(),
+                **dict(zip(self.session.arm, q.tolist(), strict=True)),
+            }
             ghost.update_cfg(np.array([values.get(j, 0.0) for j in names]))
 
     def _start_replay(self) -> None:

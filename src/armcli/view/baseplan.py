@@ -79,8 +79,12 @@ class BaseSession:
         region = serving(judge, plan.goal.start, turn_radius(self.mobile))
         a = plan.arm.timed
         at = np.linspace(float(a.times[0]), float(a.times[-1]), GHOSTS)
-        ghosts = tuple(np.array([np.interp(tk, a.times, a.positions[:, i])
-                                 for i in range(a.positions.shape[1])]) for tk in at)  # fmt: skip
+        ghosts = tuple(
+            np.array(
+                [np.interp(tk, a.times, a.positions[:, i]) for i in range(a.positions.shape[1])]
+            )
+            for tk in at
+        )
         return BaseDrawing(path, region, plan.placement.verdict.base, ghosts)
 
     def execute(self) -> Executed:
@@ -101,8 +105,7 @@ class BaseSession:
             raise InputError("nothing executed yet: click Execute first", field="execute")
         run = done.run
         L, s = run.job.model.layout, run.sensors
-        names = [*run.job.arm.robot.names, run.job.params.left_joint,
-                 run.job.params.right_joint]  # fmt: skip
+        names = [*run.job.arm.robot.names, run.job.params.left_joint, run.job.params.right_joint]
         cols = np.column_stack([s[:, L.arm_pos], s[:, L.wheel_pos]])
         step = max(1, len(run.t) // 2000)
         position = {n: cols[::step, i].copy() for i, n in enumerate(names)}
@@ -114,9 +117,11 @@ class BaseSession:
         if self.plan is None:
             return f"no plan: {self.reason}" if self.reason else "drag the room target, then Plan"
         v, t = self.plan.placement.verdict, self.plan.timing
-        line = (f"parks at ({v.base[0]:.2f}, {v.base[1]:.2f}) m, {math.degrees(v.base[2]):.0f}°: "
-                f"{self.plan.path.length:.2f} m in {t.duration:.1f} s, then the arm "
-                f"{self.plan.arm.duration_s:.1f} s")  # fmt: skip
+        line = (
+            f"parks at ({v.base[0]:.2f}, {v.base[1]:.2f}) m, {math.degrees(v.base[2]):.0f}°: "
+            f"{self.plan.path.length:.2f} m in {t.duration:.1f} s, then the arm "
+            f"{self.plan.arm.duration_s:.1f} s"
+        )
         done = self.execution
         if done is not None:
             line += f"; executed: tool {done.tool_error * 1e3:.1f} mm from the target"

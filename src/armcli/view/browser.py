@@ -143,8 +143,11 @@ class Viewer:
                     mesh_color_override=GHOST_RGBA,
                 )
             self._build_scene()  # then the sensors: a world's camera replaces the robot's
-            self._sensors = SensorLayer(self.server, self._urdf, sensors, f"{root}/robot") if (
-                sensors is not None and replay is not None) else None  # fmt: skip
+            self._sensors = (
+                SensorLayer(self.server, self._urdf, sensors, f"{root}/robot")
+                if (sensors is not None and replay is not None)
+                else None
+            )
             self._build_gui(name)
             self._apply()
         except BaseException:

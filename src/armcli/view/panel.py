@@ -55,8 +55,9 @@ class PlanningPanel:
     ) -> None:
         self.viewer, self.session = viewer, session
         # one yourdfpy model for every ghost: each ghost poses it and reads it at once
-        self._ghost_urdf = load_urdf(moving_parts(urdf_xml, session.joints, source), source,
-                                     mesh_dir, search)  # fmt: skip
+        self._ghost_urdf = load_urdf(
+            moving_parts(urdf_xml, session.joints, source), source, mesh_dir, search
+        )
         self._lock = threading.RLock()
         self._quiet = False  # set while the panel moves its own widgets
         self._trail: list[Any] = []
@@ -72,8 +73,9 @@ class PlanningPanel:
         # frame); the mobile base panel's scene is the room, which stays (view.basepanel)
         scene = "/room" if viewer.MOBILE else f"{self._node}/scene"
         for k, ob in enumerate(session.obstacles()):
-            viewer.server.scene.add_mesh_simple(f"{scene}/{k}", ob.vertices, ob.faces,
-                                                color=OBSTACLE_RGB, opacity=0.6)  # fmt: skip
+            viewer.server.scene.add_mesh_simple(
+                f"{scene}/{k}", ob.vertices, ob.faces, color=OBSTACLE_RGB, opacity=0.6
+            )
         self._show_goal()
 
     # -- API the GUI and the tests share ---------------------------------------------------
@@ -198,8 +200,9 @@ class PlanningPanel:
     def _build_gui(self) -> None:
         gui, names = self.viewer.server.gui, self.session.pose_names
         with gui.add_folder("Planning"):
-            self._start_box: Any = gui.add_dropdown("Start", (CURRENT, *names),
-                                                    initial_value=CURRENT)  # fmt: skip
+            self._start_box: Any = gui.add_dropdown(
+                "Start", (CURRENT, *names), initial_value=CURRENT
+            )
             goal = next((n for n in names if n != "home"), DRAGGED)
             self._goal_box: Any = gui.add_dropdown("Goal", (*names, DRAGGED), initial_value=goal)
             self._plan_button: Any = gui.add_button("Plan")
@@ -294,8 +297,9 @@ class PlanningPanel:
     def _ghost(self, root: str, rgba: tuple[float, float, float, float]) -> Any:
         from viser.extras import ViserUrdf
 
-        return ViserUrdf(self.viewer.server, self._ghost_urdf, root_node_name=root,
-                         mesh_color_override=rgba)  # fmt: skip
+        return ViserUrdf(
+            self.viewer.server, self._ghost_urdf, root_node_name=root, mesh_color_override=rgba
+        )
 
     def _cfg(self, x: np.ndarray) -> np.ndarray:
         """A ghost's configuration: the viewer's joints, planned ones at `x`."""

@@ -123,8 +123,9 @@ class PlanningSession:
 
     def from_dict(self, q: Mapping[str, float]) -> np.ndarray:
         """Planned joint values from a configuration by name (missing: the start's)."""
-        return values(self.context, [q.get(j, s) for j, s in zip(self.joints, self.start,
-                                                              strict=True)], "q")  # fmt: skip
+        return values(
+            self.context, [q.get(j, s) for j, s in zip(self.joints, self.start, strict=True)], "q"
+        )
 
     def pose(self, name: str) -> np.ndarray:
         """Planned joint values of a named pose (InputError naming the valid ones)."""
@@ -187,8 +188,9 @@ class PlanningSession:
         timed = self.result.timed
 
         def at(t: float) -> np.ndarray:
-            return np.array([np.interp(t, timed.times, timed.positions[:, i])
-                             for i in range(len(self.joints))])  # fmt: skip
+            return np.array(
+                [np.interp(t, timed.times, timed.positions[:, i]) for i in range(len(self.joints))]
+            )
 
         t0, t1 = float(timed.times[0]), float(timed.times[-1])
         ghosts = tuple(at(t) for t in np.linspace(t0, t1, poses))
@@ -221,15 +223,17 @@ class PlanningSession:
         """
         name = name.strip()
         if any(ord(c) < 32 or ord(c) == 127 for c in name):
-            raise OutputRefusedError("a file name cannot hold control characters or NUL",
-                                     field="save")  # fmt: skip
+            raise OutputRefusedError(
+                "a file name cannot hold control characters or NUL", field="save"
+            )
         try:
             parts = [len(os.fsencode(p)) for p in PurePosixPath(name).parts]
         except UnicodeError:
             raise OutputRefusedError("the file name is not valid text", field="save") from None
         if sum(parts) > MAX_SAVE_NAME_BYTES or any(n > NAME_MAX for n in parts):
-            raise OutputRefusedError(f"the file name is too long ({len(name)} characters)",
-                                     field="save")  # fmt: skip
+            raise OutputRefusedError(
+                f"the file name is too long ({len(name)} characters)", field="save"
+            )
         rel = relative_inside(name)
         if Path(name).suffix not in SAVE_SUFFIXES:
             raise OutputRefusedError(
@@ -252,8 +256,11 @@ class PlanningSession:
             raise PlanningError("no-plan", "nothing planned yet: click Plan first")
         path = self.save_path(name)
         if os.path.lexists(path) and not overwrite and not self._wrote(path):
-            raise OutputRefusedError(f"{name.strip()!r} exists and this viewer did not write it; "
-                                     "tick Overwrite to replace it", field="save")  # fmt: skip
+            raise OutputRefusedError(
+                f"{name.strip()!r} exists and this viewer did not write it; "
+                "tick Overwrite to replace it",
+                field="save",
+            )
         try:
             written = write_file_atomic(path, self.result.document)
             st = os.stat(written)
@@ -325,8 +332,9 @@ def load_session(
 
     `joints` or `group` (a planning group of the SRDF) names the planned joints.
     """
-    loaded = load_context(robot_file, srdf=srdf, scene=scene, joints=joints, search=search,
-                          group=group)  # fmt: skip
+    loaded = load_context(
+        robot_file, srdf=srdf, scene=scene, joints=joints, search=search, group=group
+    )
     return PlanningSession(
         loaded.context, robot_file, scene=loaded.scene, search=search, save_dir=save_dir
     )

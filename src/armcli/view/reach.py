@@ -95,27 +95,42 @@ def render_reach_png(
     closest = np.array([chain.position([v for _, v in p.q]) for p in points]).reshape(-1, 3)
 
     def overlay(ax: Any) -> None:
-        ax.scatter(cloud[:, 0], cloud[:, 1], cloud[:, 2], c=cloud[:, 2], cmap="viridis",
-                   s=CLOUD_SIZE, alpha=CLOUD_ALPHA, depthshade=False, linewidths=0)  # fmt: skip
+        ax.scatter(
+            cloud[:, 0],
+            cloud[:, 1],
+            cloud[:, 2],
+            c=cloud[:, 2],
+            cmap="viridis",
+            s=CLOUD_SIZE,
+            alpha=CLOUD_ALPHA,
+            depthshade=False,
+            linewidths=0,
+        )
         for p, near in zip(points, closest, strict=True):
             if p.reachable:
-                ax.scatter(*p.target, s=60, facecolors="none", edgecolors="green",
-                           linewidths=1.5, depthshade=False)  # fmt: skip
+                ax.scatter(
+                    *p.target,
+                    s=60,
+                    facecolors="none",
+                    edgecolors="green",
+                    linewidths=1.5,
+                    depthshade=False,
+                )
             else:
                 ax.scatter(*p.target, s=60, color="red", marker="x", depthshade=False)
                 ax.plot(*zip(p.target, near, strict=True), "--", color="red", lw=1.0)
 
     extent = np.concatenate([cloud, marks])
-    fig = render_figure(urdf, full, tool=tool, name=name, size=size, overlay=overlay,
-                        extent=extent)  # fmt: skip
+    fig = render_figure(urdf, full, tool=tool, name=name, size=size, overlay=overlay, extent=extent)
     fig.subplots_adjust(bottom=CAPTION_SPACE)
     fig.text(0.5, 0.01, caption(ws, points), ha="center", va="bottom", fontsize=9)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=DPI, metadata={"Software": None})
     path = write_file_atomic(out, buf.getvalue())
     tip = chain.position([dict(full).get(j.name, 0.0) for j in chain.joints])
-    result = RenderResult(Path(path), int(size[0]), int(size[1]), full,
-                          (float(tip[0]), float(tip[1]), float(tip[2])))  # fmt: skip
+    result = RenderResult(
+        Path(path), int(size[0]), int(size[1]), full, (float(tip[0]), float(tip[1]), float(tip[2]))
+    )
     return ReachPicture(result, ws, points)
 
 

@@ -27,8 +27,11 @@ class SensorLayer:
         self.server, self.urdf, self.replay, self.root = server, urdf, replay, root
         links = set(urdf.link_map)
         self.tracks = [t for t in replay.tracks if t.frame in links]
-        self.notes = tuple(f"{t.topic}: frame {t.frame!r} is not a link of the robot; not drawn"
-                           for t in replay.tracks if t.frame not in links)  # fmt: skip
+        self.notes = tuple(
+            f"{t.topic}: frame {t.frame!r} is not a link of the robot; not drawn"
+            for t in replay.tracks
+            if t.frame not in links
+        )
         self.handles: dict[str, Any] = {}  # topic -> its point cloud node
         for i, shape in enumerate(replay.world):
             _add_shape(server, f"/world/{i}", shape)
@@ -72,6 +75,13 @@ def _add_shape(server: Any, name: str, s: WorldShape) -> None:
         vertices = s.triangles.reshape(-1, 3)
         mesh = trimesh.Trimesh(vertices, np.arange(len(vertices)).reshape(-1, 3), process=False)
     rgb = tuple(round(255 * c) for c in s.rgba[:3])
-    server.scene.add_mesh_simple(name, np.asarray(mesh.vertices), np.asarray(mesh.faces),
-                                 color=rgb, opacity=s.rgba[3] if s.rgba[3] < 1 else None,
-                                 position=s.pose[:3], wxyz=s.pose[3:], side="double")  # fmt: skip
+    server.scene.add_mesh_simple(
+        name,
+        np.asarray(mesh.vertices),
+        np.asarray(mesh.faces),
+        color=rgb,
+        opacity=s.rgba[3] if s.rgba[3] < 1 else None,
+        position=s.pose[:3],
+        wxyz=s.pose[3:],
+        side="double",
+    )

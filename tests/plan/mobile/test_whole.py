@@ -20,7 +20,7 @@ import yaml
 from armcli.drive.cmdvel import load_cmd_vel
 from armcli.errors import PlanningError
 from armcli.plan.api import PlanOptions
-from armcli.plan.mobile.basefiles import cmd_vel_yaml
+from armcli.plan.mobile.basefiles import cmd_vel_of, cmd_vel_yaml
 from armcli.plan.mobile.virtual import MobileRobot, load_mobile
 from armcli.plan.mobile.whole import BaseGoal, Drive, WholePlan, files, plan_drive, plan_whole
 from armcli.trajectory.message import load_trajectory
@@ -131,6 +131,22 @@ def test_the_files_are_what_simulate_reads(cluttered: MobileRobot, tmp_path: Pat
     last = path["poses"][-1]["pose"]["position"]
     assert math.hypot(last["x"] - w.placement.verdict.base[0],
                       last["y"] - w.placement.verdict.base[1]) < 1e-9  # fmt: skip
+
+
+def test_the_unparsed_commands_are_the_file_read_back(
+    cluttered: MobileRobot, tmp_path: Path
+) -> None:
+    """`--execute` runs cmd_vel_of(timing) instead of re-reading its own cmd_vel.yaml."""
+    for target, start in zip(TARGETS[:3], STARTS[:3], strict=True):
+        w = _plan(cluttered, target, start)
+        (tmp_path / "cmd_vel.yaml").write_bytes(cmd_vel_yaml(w.timing))
+        read = load_cmd_vel(tmp_path / "cmd_vel.yaml")  # the reference: the file's parser
+        given = cmd_vel_of(w.timing)
+        for field in ("times", "linear", "angular"):
+            a, b = getattr(read, field), getattr(given, field)
+            assert a.dtype == b.dtype and np.array_equal(a, b)  # value for value
+            assert np.array_equal(np.signbit(a), np.signbit(b))  # -0.0 written as 0.0
+        assert np.any(read.linear[:, 0] != 0.0) or np.any(read.angular[:, 2] != 0.0)
 
 
 def test_the_wheels_stay_within_their_limits(cluttered: MobileRobot) -> None:

@@ -55,5 +55,12 @@ def _controller(ctx: PackageContext, cf: ControllerFile, c: Controller, urdf: Ur
     text = message(v, names, [at[j] for j in names], what=c.name, rate_name="update_rate")
     if cf.update_rate is None:
         text += f" (update_rate not set: controller_manager's default {DEFAULT_RATE:g} Hz)"
-    ctx.add(RULE, cf.path, cf.manager_line, text, fix(v, "update_rate", ("p", "d", "i")),
-            controller=c.name, **values(v))  # fmt: skip
+    ctx.add(
+        RULE,
+        cf.path,
+        cf.manager_line,
+        text,
+        fix(v, "update_rate", ("p", "d", "i")),
+        controller=c.name,
+        **values(v),
+    )

@@ -34,19 +34,40 @@ MODULE_PACKAGES = {
 # brings what it lists, which a launch file then uses.
 METAPACKAGES = {
     "gazebo_ros_pkgs": ("gazebo_dev", "gazebo_msgs", "gazebo_plugins", "gazebo_ros"),
-    "ros2_control": ("controller_interface", "controller_manager", "hardware_interface",
-                     "joint_limits", "ros2controlcli", "transmission_interface"),
-    "ros2_controllers": ("admittance_controller", "diff_drive_controller",
-                         "effort_controllers", "force_torque_sensor_broadcaster",
-                         "forward_command_controller", "gripper_controllers",
-                         "imu_sensor_broadcaster", "joint_state_broadcaster",
-                         "joint_trajectory_controller", "position_controllers",
-                         "tricycle_controller", "velocity_controllers"),
+    "ros2_control": (
+        "controller_interface",
+        "controller_manager",
+        "hardware_interface",
+        "joint_limits",
+        "ros2controlcli",
+        "transmission_interface",
+    ),
+    "ros2_controllers": (
+        "admittance_controller",
+        "diff_drive_controller",
+        "effort_controllers",
+        "force_torque_sensor_broadcaster",
+        "forward_command_controller",
+        "gripper_controllers",
+        "imu_sensor_broadcaster",
+        "joint_state_broadcaster",
+        "joint_trajectory_controller",
+        "position_controllers",
+        "tricycle_controller",
+        "velocity_controllers",
+    ),
     "ros_gz": ("ros_gz_bridge", "ros_gz_image", "ros_gz_interfaces", "ros_gz_sim"),
-    "moveit": ("moveit_core", "moveit_planners", "moveit_plugins", "moveit_ros",
-               "moveit_setup_assistant", "moveit_ros_move_group",
-               "moveit_ros_visualization", "moveit_simple_controller_manager"),
-}  # fmt: skip
+    "moveit": (
+        "moveit_core",
+        "moveit_planners",
+        "moveit_plugins",
+        "moveit_ros",
+        "moveit_setup_assistant",
+        "moveit_ros_move_group",
+        "moveit_ros_visualization",
+        "moveit_simple_controller_manager",
+    ),
+}
 ALWAYS_THERE = frozenset(
     {"launch", "launch_ros", "launch_xml", "launch_yaml", "ament_index_python"}
 )

@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 
+from armcli.drive.cmdvel import CmdVel
 from armcli.plan.mobile.basetime import BaseTiming
 from armcli.plan.mobile.nav2 import FRAME
 from armcli.plan.mobile.wheels import to_base
@@ -30,17 +31,42 @@ def _stamp(t: float) -> str:
     return f"{{sec: {sec}, nanosec: {nanosec}}}"
 
 
+def _read_back(t: float) -> float:
+    """[s] the time `_stamp(t)` reads back as (trajectory.message's {sec, nanosec} rule)."""
+    sec, nanosec = divmod(round(t * 1e9), 1_000_000_000)
+    return float(sec) + nanosec * 1e-9
+
+
 def cmd_vel_yaml(timing: BaseTiming, comment: str = "") -> bytes:
     """The commands: one per plugin period (each held until the next), then a stop."""
     times, lin, ang = timing.commands()
     lines = [f"# {c}" for c in comment.splitlines() if c]
     lines.append("commands:")
     for t, v, w in zip(times, lin, ang, strict=True):
-        lines.append(f"  - {{linear: {{x: {_f(v)}}}, angular: {{z: {_f(w)}}}, "
-                     f"time_from_start: {_stamp(float(t))}}}")  # fmt: skip
-    lines.append(f"  - {{linear: {{x: 0.0}}, angular: {{z: 0.0}}, "
-                 f"time_from_start: {_stamp(timing.duration)}}}")  # fmt: skip
+        lines.append(
+            f"  - {{linear: {{x: {_f(v)}}}, angular: {{z: {_f(w)}}}, "
+            f"time_from_start: {_stamp(float(t))}}}"
+        )
+    lines.append(
+        f"  - {{linear: {{x: 0.0}}, angular: {{z: 0.0}}, "
+        f"time_from_start: {_stamp(timing.duration)}}}"
+    )
     return ("\n".join(lines) + "\n").encode("utf-8")
+
+
+def cmd_vel_of(timing: BaseTiming, source: str = "cmd_vel.yaml") -> CmdVel:
+    """The commands `cmd_vel_yaml` writes, as `drive.cmdvel.load_cmd_vel` reads them back.
+
+    Value for value (floats round-trip through their repr, times through {sec, nanosec}),
+    without writing and parsing the text: `plan --base --execute` runs its own plan.
+    """
+    times, lin, ang = timing.commands()
+    n = len(times)
+    linear, angular = np.zeros((n + 1, 3)), np.zeros((n + 1, 3))
+    linear[:n, 0] = [float(v) + 0.0 for v in lin]
+    angular[:n, 2] = [float(w) + 0.0 for w in ang]
+    t = [_read_back(float(x)) for x in times] + [_read_back(timing.duration)]
+    return CmdVel(np.array(t, dtype=float), linear, angular, source)
 
 
 def path_times(timing: BaseTiming) -> np.ndarray:

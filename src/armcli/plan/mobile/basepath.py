@@ -96,8 +96,7 @@ class FloorPlan:
     def drivable(self, leg: Leg) -> bool:
         """Whether the leg's swept area is clear of every object."""
         self.checks += 1
-        return not self.objects.meets(sweep(self.robot, np.array(leg.a), np.array(leg.b),
-                                            leg.yaw))  # fmt: skip
+        return not self.objects.meets(sweep(self.robot, np.array(leg.a), np.array(leg.b), leg.yaw))
 
     def spinnable(self, xy: tuple[float, float]) -> bool:
         """Whether the robot may turn any amount at xy (its circle about the base is clear)."""
@@ -109,8 +108,10 @@ class FloorPlan:
             return True
         n = max(1, math.ceil(abs(by) / TURN_STEP))
         self.checks += n + 1
-        return not any(self.turning.meets(placed(self.robot, xy[0], xy[1], yaw + by * k / n))
-                       for k in range(n + 1))  # fmt: skip
+        return not any(
+            self.turning.meets(placed(self.robot, xy[0], xy[1], yaw + by * k / n))
+            for k in range(n + 1)
+        )
 
     def free(self, pose: tuple[float, float, float]) -> bool:
         """Whether the robot at the pose is clear of every object."""
@@ -128,8 +129,9 @@ def _leg(a: tuple[float, float], b: tuple[float, float], yaw_before: float) -> L
     return Leg(a, b, float(wrap(np.asarray(heading + math.pi))), -1.0)
 
 
-def _connects(plan: FloorPlan, path: list[tuple[float, float]], start_yaw: float,
-              goal_yaw: float | None) -> tuple[Leg, ...] | None:  # fmt: skip
+def _connects(
+    plan: FloorPlan, path: list[tuple[float, float]], start_yaw: float, goal_yaw: float | None
+) -> tuple[Leg, ...] | None:
     """The legs along `path` if every leg and turn is clear (goal_yaw None: no final turn)."""
     legs, yaw = [], start_yaw
     for a, b in itertools.pairwise(path):
@@ -145,7 +147,7 @@ def _connects(plan: FloorPlan, path: list[tuple[float, float]], start_yaw: float
     if goal_yaw is not None and not plan.turnable(
         path[-1], yaw, float(wrap(np.asarray(goal_yaw - yaw)))
     ):
-        return None  # fmt: skip
+        return None
     return tuple(legs)
 
 
@@ -166,8 +168,9 @@ def _halton(n: int, base: int, skip: int) -> np.ndarray:
     return out
 
 
-def _roadmap(plan: FloorPlan, start: tuple[float, float, float],
-             goal: tuple[float, float, float], seed: int) -> np.ndarray:  # fmt: skip
+def _roadmap(
+    plan: FloorPlan, start: tuple[float, float, float], goal: tuple[float, float, float], seed: int
+) -> np.ndarray:
     """Start, goal, the lines through them along their yaws, then Halton points.
 
     The points on the start's and goal's heading lines let the robot leave and arrive
@@ -188,8 +191,9 @@ def _roadmap(plan: FloorPlan, start: tuple[float, float, float],
     return np.array([a, b, *free, *keep], dtype=float)
 
 
-def _search(plan: FloorPlan, nodes: np.ndarray, start_yaw: float, goal_yaw: float,
-            half_track: float) -> list[int] | None:  # fmt: skip
+def _search(
+    plan: FloorPlan, nodes: np.ndarray, start_yaw: float, goal_yaw: float, half_track: float
+) -> list[int] | None:
     """Lazy A* over the roadmap, each corner's turn in the cost.
 
     A node's arrival is checked (its leg and the turn before it) only when the node comes
@@ -234,8 +238,9 @@ def _search(plan: FloorPlan, nodes: np.ndarray, start_yaw: float, goal_yaw: floa
     return None
 
 
-def _shortcut(plan: FloorPlan, pts: list[tuple[float, float]], start_yaw: float,
-              goal_yaw: float) -> tuple[Leg, ...]:  # fmt: skip
+def _shortcut(
+    plan: FloorPlan, pts: list[tuple[float, float]], start_yaw: float, goal_yaw: float
+) -> tuple[Leg, ...]:
     """Greedy straight shortcuts: from each corner, the farthest later one reachable straight.
 
     The last leg is kept (it arrives heading the goal's way). The turns where the shortened

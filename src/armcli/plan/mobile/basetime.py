@@ -137,8 +137,9 @@ def time_path(path: BasePath, limits: DriveLimits) -> BaseTiming:
         duration, peak = profile(amount * scale, limits.speed, limits.accel, limits.period)
         if duration == 0.0:
             continue
-        motions.append(Motion(kind, (x, y, yaw), amount, t, duration, peak / scale,
-                              limits.accel / scale))  # fmt: skip
+        motions.append(
+            Motion(kind, (x, y, yaw), amount, t, duration, peak / scale, limits.accel / scale)
+        )
         t += duration
         if kind == "turn":
             yaw += amount

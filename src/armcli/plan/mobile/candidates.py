@@ -63,8 +63,14 @@ def planar_family(judge: Judge, samples: int) -> Family:
     arm = judge.mobile.planar
     assert arm is not None
     q, _ = arm.at_height(float(judge.target[2] - arm.shoulder[2]), samples)
-    return Family(q, arm.points(q), np.zeros(len(q)), arm.axis, np.ones(len(q), dtype=bool),
-                  _planar_heights(judge))  # fmt: skip
+    return Family(
+        q,
+        arm.points(q),
+        np.zeros(len(q)),
+        arm.axis,
+        np.ones(len(q), dtype=bool),
+        _planar_heights(judge),
+    )
 
 
 def boundary_family(judge: Judge) -> Family:
@@ -87,8 +93,9 @@ def boundary_family(judge: Judge) -> Family:
     miss = np.abs(arm.points(qb)[:, 2] - judge.target[2])
     keep = miss <= judge.tolerance
     q = qb[keep]
-    return Family(q, arm.points(q), miss[keep], arm.axis, np.zeros(len(q), dtype=bool),
-                  _planar_heights(judge))  # fmt: skip
+    return Family(
+        q, arm.points(q), miss[keep], arm.axis, np.zeros(len(q), dtype=bool), _planar_heights(judge)
+    )
 
 
 def _planar_heights(judge: Judge) -> tuple[float, float]:
@@ -157,8 +164,9 @@ def standing(judge: Judge, family: Family) -> Family:
     ok[judged] = _stands(judge, family.q[judged])
     keep = np.nonzero(ok)[0]
     nearest = None if family.nearest is None else family.nearest[keep]
-    return Family(family.q[keep], family.p[keep], family.miss[keep], family.lateral, nearest,
-                  family.heights)  # fmt: skip
+    return Family(
+        family.q[keep], family.p[keep], family.miss[keep], family.lateral, nearest, family.heights
+    )
 
 
 def _stands(judge: Judge, qs: np.ndarray) -> np.ndarray:
@@ -196,13 +204,32 @@ def ordered(
     A planar family's poses come in tiers, each cheapest driving first: at the target's
     height on the plane, then stood off sideways by OFF_PLANE shares of the tolerance (the
     tool misses by that much), then the reach boundary's near misses. Poses whose miss is
-    beyond the tolerance are left out. Another arm's come nearest in height first.
+    beyond the tolerance are left out. Another arm's come nearest in height first. The
+    stand-off tier's poses are costed only once the plane's are used up (most placements
+    stop in the first chunk): a tier never mixes with the next (TIER).
     """
-    yaw = np.arange(-math.pi, math.pi, step)
-    c, s = np.cos(yaw)[None, None, :], np.sin(yaw)[None, None, :]
     offsets = np.array([0.0])
     if family.lateral is not None:
         offsets = np.array([0.0, *(f * tolerance for f in OFF_PLANE)])
+    tiers = [offsets]
+    if family.nearest is not None and bool(np.all(family.nearest)) and len(offsets) > 1:
+        tiers = [offsets[:1], offsets[1:]]  # the plane's tier 0, the stand-offs' tier 1
+    for offs in tiers:
+        yield from _chunks(family, offs, target, start, turn_radius, step, tolerance)
+
+
+def _chunks(
+    family: Family,
+    offsets: np.ndarray,
+    target: np.ndarray,
+    start: ArrayLike,
+    turn_radius: float,
+    step: float,
+    tolerance: float,
+) -> Iterator[list[Candidate]]:
+    """`ordered`'s chunks over the given sideways offsets [m] (see there)."""
+    yaw = np.arange(-math.pi, math.pi, step)
+    c, s = np.cos(yaw)[None, None, :], np.sin(yaw)[None, None, :]
     px = family.p[None, :, 0:1] + offsets[:, None, None] * family.lateral_xy[0]
     py = family.p[None, :, 1:2] + offsets[:, None, None] * family.lateral_xy[1]
     bx = target[0] - (c * px - s * py)  # (offsets, configurations, yaws)
@@ -230,7 +257,13 @@ def ordered(
         for flat in idx:
             dq, j = divmod(int(flat), n_yaw)
             d, i = divmod(dq, n_q)
-            chunk.append(Candidate((float(bx.flat[flat]), float(by.flat[flat]), float(yaw[j])),
-                                   family.q[i], float(miss[d, i]), float(drive[flat]),
-                                   family.nearest is not None and bool(near[i])))  # fmt: skip
+            chunk.append(
+                Candidate(
+                    (float(bx.flat[flat]), float(by.flat[flat]), float(yaw[j])),
+                    family.q[i],
+                    float(miss[d, i]),
+                    float(drive[flat]),
+                    family.nearest is not None and bool(near[i]),
+                )
+            )
         yield chunk

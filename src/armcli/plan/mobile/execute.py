@@ -18,9 +18,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from armcli.analysis.liftoff import TipVerdict
+from armcli.analysis.liftoff import TiltVerdict
 from armcli.drive import job as drive
 from armcli.drive import output as driveout
+from armcli.drive.cmdvel import CmdVel
 from armcli.drive.job import DriveRun
 from armcli.errors import InputError
 from armcli.io.scene import Scene, SceneObject
@@ -49,7 +50,7 @@ class Executed:
 
     run: DriveRun
     arm: SimResult
-    verdict: TipVerdict
+    verdict: TiltVerdict
     tool_error: float  # [m] ground truth, at the end
     base_error: tuple[float, float]  # [m, rad] final pose against the plan (ground truth)
     arrived: float | None  # [s] when the follower had the base at its goal (odometry)
@@ -88,23 +89,31 @@ def executable(robot_file: RobotFile) -> RobotSpec:
     """
     spec = robot_file.spec
     if spec is None:
-        raise InputError("drives a spec's robot: `armcli import` writes one from the URDF "
-                         "(keeping its diff-drive plugin)", field="execute")  # fmt: skip
+        raise InputError(
+            "drives a spec's robot: `armcli import` writes one from the URDF "
+            "(keeping its diff-drive plugin)",
+            field="execute",
+        )
     if spec.mobile_base is None:
-        raise InputError(f"drives a spec's mobile_base apart from its arm: {robot_file.path} "
-                         "has no mobile_base (its arm holds the wheels)",
-                         field="execute")  # fmt: skip
+        raise InputError(
+            f"drives a spec's mobile_base apart from its arm: {robot_file.path} "
+            "has no mobile_base (its arm holds the wheels)",
+            field="execute",
+        )
     return spec
 
 
 def execute_whole(
     plan: WholePlan,
-    cmd_vel: Path,
+    cmd_vel: Path | CmdVel,
     arm_yaml: bytes,
     tolerance: float = TOLERANCE,
     localize: float = LOCALIZE,
 ) -> Executed:
     """Run the plan (its written cmd_vel.yaml and arm.yaml) on the drive and judge it.
+
+    `cmd_vel`: the file, or the same commands unparsed (`basefiles.cmd_vel_of`): the
+    follower steers the base, the file's commands go to the MCAP's /cmd_vel.
 
     `localize` [Hz]: the localiser's rate (`plan.mobile.pursuit`); 0: encoders alone.
     """
@@ -113,14 +122,23 @@ def execute_whole(
     start = plan.goal.start
     duration = SLACK * plan.timing.duration + SLACK_S + plan.arm.duration_s + SETTLE_S
     opts = SimOptions(message=arm_yaml.decode("utf-8"), gravity_comp=True, duration=duration)
-    job = drive.prepare(mobile.robot_file, opts, cmd_vel, world=start_frame(mobile.scene, start),
-                        params=plan.drive)  # fmt: skip
-    pilot = Pursuit(legs_in_odom(plan.timing, plan.path.start), plan.timing.motions,
-                    radius=job.params.radius, separation=job.params.separation, dt=job.dt,
-                    period=job.params.period, speed=plan.timing.limits.speed,
-                    accel=plan.timing.limits.accel, wheel_dof=job.model.wheel_dof,
-                    arrival_step=steps_of(plan.timing.duration, job.dt), axle=plan.axle,
-                    localize=localize)  # fmt: skip
+    job = drive.prepare(
+        mobile.robot_file, opts, cmd_vel, world=start_frame(mobile.scene, start), params=plan.drive
+    )
+    pilot = Pursuit(
+        legs_in_odom(plan.timing, plan.path.start),
+        plan.timing.motions,
+        radius=job.params.radius,
+        separation=job.params.separation,
+        dt=job.dt,
+        period=job.params.period,
+        speed=plan.timing.limits.speed,
+        accel=plan.timing.limits.accel,
+        wheel_dof=job.model.wheel_dof,
+        arrival_step=steps_of(plan.timing.duration, job.dt),
+        axle=plan.axle,
+        localize=localize,
+    )
     run = drive.run(job, pilot=pilot)
     arm = driveout.arm_result(run, driveout.plot_steps_of(run.steps, job.dt, job.arm.rate))
     verdict = driveout.tip_verdict(run)
@@ -139,21 +157,30 @@ def _truth(plan: WholePlan, run: DriveRun) -> tuple[np.ndarray, np.ndarray]:
     return np.array([p[0], p[1], yaw]), R @ np.asarray(tool_b) + p
 
 
-def _judge(plan: WholePlan, run: DriveRun, arm: SimResult, verdict: TipVerdict,
-           pilot: Pursuit, tolerance: float) -> Executed:  # fmt: skip
+def _judge(
+    plan: WholePlan,
+    run: DriveRun,
+    arm: SimResult,
+    verdict: TiltVerdict,
+    pilot: Pursuit,
+    tolerance: float,
+) -> Executed:
     start = plan.goal.start
     c, s = math.cos(start[2]), math.sin(start[2])
 
     def local(x: float, y: float) -> np.ndarray:
-        return np.array([c * (x - start[0]) + s * (y - start[1]),
-                         -s * (x - start[0]) + c * (y - start[1])])  # fmt: skip
+        return np.array(
+            [c * (x - start[0]) + s * (y - start[1]), -s * (x - start[0]) + c * (y - start[1])]
+        )
 
     goal = plan.placement.verdict.base
     aim = plan.goal.target
     target = np.array([*local(aim[0], aim[1]), aim[2]])
     base, tool = _truth(plan, run)
-    base_err = (float(np.hypot(*(base[:2] - local(goal[0], goal[1])))),
-                abs(math.remainder(base[2] - (goal[2] - start[2]), 2 * math.pi)))  # fmt: skip
+    base_err = (
+        float(np.hypot(*(base[:2] - local(goal[0], goal[1])))),
+        abs(math.remainder(base[2] - (goal[2] - start[2]), 2 * math.pi)),
+    )
     tool_err = float(np.linalg.norm(tool - target))
     job = run.job
     L, sens = job.model.layout, run.sensors
@@ -168,11 +195,12 @@ def _judge(plan: WholePlan, run: DriveRun, arm: SimResult, verdict: TipVerdict,
         q = sens[:, L.arm_pos][:, i]
         lo, hi = job.arm.robot.lower[i], job.arm.robot.upper[i]
         if np.any(q < lo - STOP_SLACK) or np.any(q > hi + STOP_SLACK):
-            problems.append(f"{name} leaves its range [{lo:g}, {hi:g}] by more than "
-                            f"{STOP_SLACK:g}")  # fmt: skip
+            problems.append(f"{name} leaves its range [{lo:g}, {hi:g}] by more than {STOP_SLACK:g}")
     if tool_err > tolerance:
-        problems.append(f"the tool ends {tool_err * 1e3:.1f} mm from the target (tolerance "
-                        f"{tolerance * 1e3:g} mm)")  # fmt: skip
+        problems.append(
+            f"the tool ends {tool_err * 1e3:.1f} mm from the target (tolerance "
+            f"{tolerance * 1e3:g} mm)"
+        )
     arrived = None if pilot.arrived is None else pilot.arrived * job.dt
     if arrived is None:
         problems.append("the base did not arrive at its goal in the time given")
@@ -188,8 +216,9 @@ def run_files(plan: WholePlan, done: Executed, out_dir: Path) -> dict[Path, byte
 
     rate = done.run.job.arm.rate
     cols = driveout.columns(done.run, done.arm, rate)
-    plan_topic = rosbag.Channel("/plan", "nav_msgs/msg/Path", rosbag.qos(1, True),
-                                [(0, plan_message(plan))])  # fmt: skip
+    plan_topic = rosbag.Channel(
+        "/plan", "nav_msgs/msg/Path", rosbag.qos(1, True), [(0, plan_message(plan))]
+    )
     return {
         out_dir / "run.csv": states.states_bytes(cols, "csv"),
         out_dir / "run.mcap": drivebag.mcap_bytes(done.run, cols, rate, [plan_topic]),
@@ -209,10 +238,18 @@ def plan_message(plan: WholePlan) -> dict[str, object]:
         dx, dy = x - start[0], y - start[1]
         rel = yaw - start[2]
         ns = round(float(tk) * 1e9)
-        poses.append({
-            "header": {"stamp": rosbag.stamp(ns), "frame_id": rosbag.WORLD},
-            "pose": {"position": {"x": c * dx + s * dy, "y": -s * dx + c * dy, "z": 0.0},
-                     "orientation": {"x": 0.0, "y": 0.0, "z": math.sin(rel / 2),
-                                     "w": math.cos(rel / 2)}},
-        })  # fmt: skip
+        poses.append(
+            {
+                "header": {"stamp": rosbag.stamp(ns), "frame_id": rosbag.WORLD},
+                "pose": {
+                    "position": {"x": c * dx + s * dy, "y": -s * dx + c * dy, "z": 0.0},
+                    "orientation": {
+                        "x": 0.0,
+                        "y": 0.0,
+                        "z": math.sin(rel / 2),
+                        "w": math.cos(rel / 2),
+                    },
+                },
+            }
+        )
     return {"header": {"stamp": rosbag.stamp(0), "frame_id": rosbag.WORLD}, "poses": poses}

@@ -80,8 +80,12 @@ def grown(shape: Outline, d: float) -> Outline:
     bis = n + prev
     scale = d / np.maximum(np.einsum("ij,ij->i", bis, n), 1e-9)
     pts = p + bis * scale[:, None]
-    return Outline(pts, shape.centre, shape.radius + float(np.max(np.linalg.norm(bis * scale[
-        :, None], axis=1))), shape.name)  # fmt: skip
+    return Outline(
+        pts,
+        shape.centre,
+        shape.radius + float(np.max(np.linalg.norm(bis * scale[:, None], axis=1))),
+        shape.name,
+    )
 
 
 class Outlines:
@@ -126,8 +130,11 @@ class Outlines:
         """The least distance [m] from a point to the outlines (0 inside one)."""
         if not self.shapes:
             return math.inf
-        t = np.clip(np.einsum("ij,ij->i", p - self.v, self.e)
-                    / np.einsum("ij,ij->i", self.e, self.e), 0.0, 1.0)  # fmt: skip
+        t = np.clip(
+            np.einsum("ij,ij->i", p - self.v, self.e) / np.einsum("ij,ij->i", self.e, self.e),
+            0.0,
+            1.0,
+        )
         d = np.linalg.norm(self.v + t[:, None] * self.e - p, axis=1)
         left = self.e[:, 0] * (p[1] - self.v[:, 1]) - self.e[:, 1] * (p[0] - self.v[:, 0]) >= 0
         if np.any(np.logical_and.reduceat(left, self.start)):

@@ -95,12 +95,14 @@ def place(
     t0 = time.perf_counter()
     goal, begin = _values("target", target, 3), _values("start", start, 3)
     if not (math.isfinite(tolerance) and tolerance > 0):
-        raise InputError(f"must be a positive number of metres, got {tolerance!r}",
-                         field="tolerance")  # fmt: skip
+        raise InputError(
+            f"must be a positive number of metres, got {tolerance!r}", field="tolerance"
+        )
     inside = containing(mobile.scene, goal, tolerance)
     if inside is not None:
-        raise PlacementError(f"the target is inside {inside}: no pose of the tool can reach it",
-                             blocking=inside)  # fmt: skip
+        raise PlacementError(
+            f"the target is inside {inside}: no pose of the tool can reach it", blocking=inside
+        )
     judge = Judge(mobile, goal, tolerance, park)
     best, tally = None, Counter[str]()
     for samples, step in PASSES:
@@ -118,9 +120,15 @@ def place(
         raise _blocked(mobile, tally)
     verdict, cost = best
     around = region(judge, verdict)
-    return Placement(verdict, mobile.arm, around, cost,
-                     "closed form" if mobile.planar is not None else "sampled", judge.checks,
-                     time.perf_counter() - t0)  # fmt: skip
+    return Placement(
+        verdict,
+        mobile.arm,
+        around,
+        cost,
+        "closed form" if mobile.planar is not None else "sampled",
+        judge.checks,
+        time.perf_counter() - t0,
+    )
 
 
 def _families(judge: Judge, samples: int, seed: int) -> Iterator[Family]:
@@ -144,10 +152,14 @@ def _refuse_out_of_reach(mobile: MobileRobot, judge: Judge, family: Family) -> N
         return
     about = "" if mobile.planar is not None else "about "
     if z > top:
-        raise PlacementError(f"the target z = {z:.3f} m is above the tool's reach: the highest "
-                             f"point it reaches is {about}z = {top:.3f} m")  # fmt: skip
-    raise PlacementError(f"the target z = {z:.3f} m is below the tool's reach: the lowest "
-                         f"point it reaches is {about}z = {bottom:.3f} m")  # fmt: skip
+        raise PlacementError(
+            f"the target z = {z:.3f} m is above the tool's reach: the highest "
+            f"point it reaches is {about}z = {top:.3f} m"
+        )
+    raise PlacementError(
+        f"the target z = {z:.3f} m is below the tool's reach: the lowest "
+        f"point it reaches is {about}z = {bottom:.3f} m"
+    )
 
 
 def _search(
@@ -210,15 +222,21 @@ def _blocked(mobile: MobileRobot, tally: Counter[str]) -> PlacementError:
     if what == "tip":
         return PlacementError(f"the robot would tip over at every pose that reaches ({share})")
     if what == "self":
-        return PlacementError(f"the arm collides with the robot at every pose that reaches "
-                              f"({share})")  # fmt: skip
+        return PlacementError(
+            f"the arm collides with the robot at every pose that reaches ({share})"
+        )
     if what == "reach":
         return PlacementError(f"the tool cannot come within reach of the target ({share})")
     if what == "park":
-        return PlacementError(f"the base cannot stand at any pose that reaches the target with "
-                              f"the arm in its travel configuration ({share})")  # fmt: skip
+        return PlacementError(
+            f"the base cannot stand at any pose that reaches the target with "
+            f"the arm in its travel configuration ({share})"
+        )
     if what == "path":
-        return PlacementError(f"no path for the base leads to a pose that reaches the target "
-                              f"({share})")  # fmt: skip
-    return PlacementError(f"{what} blocks every base pose that reaches the target ({share} "
-                          f"collide with it)", blocking=what)  # fmt: skip
+        return PlacementError(
+            f"no path for the base leads to a pose that reaches the target ({share})"
+        )
+    return PlacementError(
+        f"{what} blocks every base pose that reaches the target ({share} collide with it)",
+        blocking=what,
+    )

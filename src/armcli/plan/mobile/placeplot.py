@@ -35,13 +35,16 @@ MAX_SHADED = 6000  # candidate poses judged for the shading
 SAMPLED_EVERY = 15  # of another arm's candidates, one in this many is judged for the shading
 
 
-def robot_outlines(mobile: MobileRobot, base: Sequence[float], q: np.ndarray
-                   ) -> list[tuple[str, list[tuple[float, float]]]]:  # fmt: skip
+def robot_outlines(
+    mobile: MobileRobot, base: Sequence[float], q: np.ndarray
+) -> list[tuple[str, list[tuple[float, float]]]]:
     """Each collision shape's outline from above (its box's hull) at the pose: (link, points)."""
     robot = mobile.robot
     boxes = box_corners(robot.robot, robot.geometry, robot.q(mobile.x(base, q)))
-    return [(link, convex_hull([(float(x), float(y)) for x, y in world[:, :2]]))
-            for link, world in boxes]  # fmt: skip
+    return [
+        (link, convex_hull([(float(x), float(y)) for x, y in world[:, :2]]))
+        for link, world in boxes
+    ]
 
 
 def serving(judge: Judge, start: Sequence[float], radius: float) -> np.ndarray:
@@ -77,17 +80,29 @@ def _objects(ax: Any, mobile: MobileRobot, base_top: float) -> None:
     for obj in world_objects(mobile.scene):
         hull, bottom, _ = outline(obj)
         low = bottom < base_top
-        ax.add_patch(Polygon(hull, closed=True, facecolor="0.35" if low else "none",
-                             edgecolor="0.2", hatch=None if low else "//", alpha=0.8))  # fmt: skip
+        ax.add_patch(
+            Polygon(
+                hull,
+                closed=True,
+                facecolor="0.35" if low else "none",
+                edgecolor="0.2",
+                hatch=None if low else "//",
+                alpha=0.8,
+            )
+        )
         cx, cy = np.mean(np.array(hull), axis=0)
-        ax.annotate(obj.id, (cx, cy), ha="center", va="center", fontsize=7,
-                    color="white" if low else "0.1")  # fmt: skip
+        ax.annotate(
+            obj.id, (cx, cy), ha="center", va="center", fontsize=7, color="white" if low else "0.1"
+        )
 
 
 def place_png(
-    mobile: MobileRobot, placement: Placement, target: Sequence[float], start: Sequence[float],
+    mobile: MobileRobot,
+    placement: Placement,
+    target: Sequence[float],
+    start: Sequence[float],
     tolerance: float,
-) -> bytes:  # fmt: skip
+) -> bytes:
     """The PNG bytes of the plot (see the module docstring)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -102,26 +117,52 @@ def place_png(
     base_links = set(mobile.base_links)
     _objects(ax, mobile, _base_top(mobile, v.base, v.q, base_links))
     ok = serving(judge, start, turn_radius(mobile))
-    ax.scatter(ok[:, 0], ok[:, 1], s=4, color="C2", alpha=0.35, lw=0,
-               label="base positions that reach the target")  # fmt: skip
+    ax.scatter(
+        ok[:, 0],
+        ok[:, 1],
+        s=4,
+        color="C2",
+        alpha=0.35,
+        lw=0,
+        label="base positions that reach the target",
+    )
     for link, hull in shapes:
         is_base = link in base_links
-        ax.add_patch(Polygon(hull, closed=True, facecolor="C0" if is_base else "C1",
-                             alpha=0.45 if is_base else 0.6, edgecolor="C0"))  # fmt: skip
+        ax.add_patch(
+            Polygon(
+                hull,
+                closed=True,
+                facecolor="C0" if is_base else "C1",
+                alpha=0.45 if is_base else 0.6,
+                edgecolor="C0",
+            )
+        )
     x, y, yaw = v.base
     size = max(max(np.ptp(np.array(h), axis=0)) for _, h in shapes)  # the robot's extent
-    ax.arrow(x, y, 0.4 * size * math.cos(yaw), 0.4 * size * math.sin(yaw), width=0.02 * size,
-             color="C0")  # fmt: skip
-    ax.add_patch(Circle((x, y), max(placement.region.xy_tolerance, 1e-4), fill=False,
-                        color="C3", lw=1.0, label="Nav2 xy_goal_tolerance"))  # fmt: skip
+    ax.arrow(
+        x, y, 0.4 * size * math.cos(yaw), 0.4 * size * math.sin(yaw), width=0.02 * size, color="C0"
+    )
+    ax.add_patch(
+        Circle(
+            (x, y),
+            max(placement.region.xy_tolerance, 1e-4),
+            fill=False,
+            color="C3",
+            lw=1.0,
+            label="Nav2 xy_goal_tolerance",
+        )
+    )
     ax.plot([start[0]], [start[1]], "ko", ms=5, label="start")
     ax.plot([target[0]], [target[1]], "r*", ms=14, label=f"target (z = {target[2]:g} m)")
     ax.set_aspect("equal", adjustable="datalim")
     ax.autoscale_view()
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    ax.set_title(f"armcli place: base at ({x:.3f}, {y:.3f}) m, yaw {math.degrees(yaw):.1f}°; "
-                 f"{placement.cost:.2f} m of wheel travel", fontsize=10)  # fmt: skip
+    ax.set_title(
+        f"armcli place: base at ({x:.3f}, {y:.3f}) m, yaw {math.degrees(yaw):.1f}°; "
+        f"{placement.cost:.2f} m of wheel travel",
+        fontsize=10,
+    )
     # below the floor, not on it: a corner legend hid objects and serving poses
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2, fontsize=8)
     fig.subplots_adjust(bottom=0.2)
@@ -141,7 +182,13 @@ def _base_top(mobile: MobileRobot, base: Sequence[float], q: np.ndarray, links: 
         if link not in links:
             continue
         g.geometry.computeLocalAABB()
-        radius = float(np.linalg.norm(np.asarray(g.geometry.aabb_local.max_)
-                                      - np.asarray(g.geometry.aabb_local.min_))) / 2  # fmt: skip
+        radius = (
+            float(
+                np.linalg.norm(
+                    np.asarray(g.geometry.aabb_local.max_) - np.asarray(g.geometry.aabb_local.min_)
+                )
+            )
+            / 2
+        )
         top = max(top, float(T[2, 3]) + radius)
     return top

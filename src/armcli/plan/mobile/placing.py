@@ -76,8 +76,9 @@ class Placed:
         if plot is not None:
             from armcli.plan.mobile.placeplot import place_png  # matplotlib: only for a plot
 
-            files[plot] = place_png(self.mobile, self.placement, self.target, self.start,
-                                    self.tolerance)  # fmt: skip
+            files[plot] = place_png(
+                self.mobile, self.placement, self.target, self.start, self.tolerance
+            )
         return files
 
 

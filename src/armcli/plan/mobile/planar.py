@@ -153,9 +153,14 @@ class PlanarArm:
         """The arcs as arrays: start q (A, 2), moving joint, span, centre (A, 2), radius, angle."""
         arcs = self.arcs()
         circles = [self._circle(a) for a in arcs]
-        return (np.array([a[0] for a in arcs]), np.array([a[1] for a in arcs]),
-                np.array([a[2] for a in arcs]), np.array([c[0] for c in circles]),
-                np.array([c[1] for c in circles]), np.array([c[2] for c in circles]))  # fmt: skip
+        return (
+            np.array([a[0] for a in arcs]),
+            np.array([a[1] for a in arcs]),
+            np.array([a[2] for a in arcs]),
+            np.array([c[0] for c in circles]),
+            np.array([c[1] for c in circles]),
+            np.array([c[2] for c in circles]),
+        )
 
     def nearest_batch(self, u: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Per in-plane point (u, w) [m]: q (N, 2, 2) and in-plane misses (N, 2) [m], per branch.
@@ -176,8 +181,10 @@ class PlanarArm:
             past = t > span
             t = np.where(past & (TWO_PI - t < t - span), 0.0, np.where(past, span, t))
             a = start + t
-            gap = np.hypot(centre[:, 0] + radius * np.cos(a) - u[out, None],
-                           centre[:, 1] + radius * np.sin(a) - w[out, None])  # fmt: skip
+            gap = np.hypot(
+                centre[:, 0] + radius * np.cos(a) - u[out, None],
+                centre[:, 1] + radius * np.sin(a) - w[out, None],
+            )
             best = np.argmin(gap, axis=1)
             rows = np.arange(len(best))
             near = q0[best].copy()

@@ -76,10 +76,22 @@ def legs_in_odom(timing: BaseTiming, start: tuple[float, float, float]) -> list[
 class Pursuit:
     """The pilot: odometry, the motion being followed, the commands, the arm's hold."""
 
-    def __init__(self, legs: list[Leg], motions: tuple[Motion, ...], *, radius: float,
-                 separation: float, dt: float, period: float, speed: float, accel: float,
-                 wheel_dof: np.ndarray, arrival_step: int, axle: np.ndarray,
-                 localize: float = 0.0) -> None:  # fmt: skip
+    def __init__(
+        self,
+        legs: list[Leg],
+        motions: tuple[Motion, ...],
+        *,
+        radius: float,
+        separation: float,
+        dt: float,
+        period: float,
+        speed: float,
+        accel: float,
+        wheel_dof: np.ndarray,
+        arrival_step: int,
+        axle: np.ndarray,
+        localize: float = 0.0,
+    ) -> None:
         self.legs, self.motions = legs, motions
         self.r, self.b, self.dt, self.period = radius, separation, dt, period
         self.speed, self.accel = speed, accel
@@ -101,35 +113,59 @@ class Pursuit:
         """The pose followed: the odometry, corrected by the localiser's last fix."""
         x, y, yaw = self.pose
         c, s = math.cos(self.fix[2]), math.sin(self.fix[2])
-        return np.array([self.fix[0] + c * x - s * y, self.fix[1] + s * x + c * y,
-                         self.fix[2] + yaw])  # fmt: skip
+        return np.array(
+            [self.fix[0] + c * x - s * y, self.fix[1] + s * x + c * y, self.fix[2] + yaw]
+        )
 
-    def _localize(self, data: Any) -> None:
-        """The ground truth's wheels' midpoint, relative to where it started: a perfect fix."""
+    def _localize(self, qpos: np.ndarray) -> None:
+        """The ground truth's wheels' midpoint, relative to where it started: a perfect fix.
+
+        `qpos`: MuJoCo's free joint (x, y, z, qw, qx, qy, qz) at the time of the fix.
+        """
         from armcli.plan.mobile.wheels import to_axle
 
-        w, x, y, z = (float(v) for v in data.qpos[3:7])
+        w, x, y, z = (float(v) for v in qpos[3:7])
         yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
         yaw += 2 * math.pi * round((self.located[2] - yaw) / (2 * math.pi))  # unwrapped
-        ax, ay, _ = to_axle((float(data.qpos[0]), float(data.qpos[1]), yaw), self.axle)
+        ax, ay, _ = to_axle((float(qpos[0]), float(qpos[1]), yaw), self.axle)
         truth = np.array([ax - self.axle[0], ay - self.axle[1], yaw])  # the start's at 0
         ox, oy, oyaw = self.pose
         dyaw = truth[2] - oyaw
         c, s = math.cos(dyaw), math.sin(dyaw)
         self.fix = np.array([truth[0] - (c * ox - s * oy), truth[1] - (s * ox + c * oy), dyaw])
 
-    def arm_step(self, k: int, data: Any) -> int:
-        """Integrate the odometry over step k; the arm's reference step (held until arrival)."""
-        wl, wr = (float(x) * self.r * self.dt for x in data.qvel[self.wheel_dof])
-        dtheta = (wr - wl) / self.b
-        heading = self.pose[2] + dtheta / 2.0
-        self.pose += ((wl + wr) / 2 * math.cos(heading), (wl + wr) / 2 * math.sin(heading), dtheta)
-        self.k = k
-        if self.every and k % self.every == 0:
-            self._localize(data)
+    def arm_steps(self, k0: int, k1: int) -> np.ndarray:
+        """The arm's reference step at steps k0 .. k1 - 1 (held until the base has arrived).
+
+        Held at the planned arrival until the follower has the base standing at its goal,
+        then resumed from there.
+        """
+        k = np.arange(k0, k1)
         if self.arrived is None:
-            return min(k, self.arrival_step)
-        return min(self.arrival_step + (k - self.arrived), k)
+            return np.minimum(k, self.arrival_step)
+        return np.minimum(self.arrival_step + (k - self.arrived), k)
+
+    def observe(self, k0: int, seen: np.ndarray) -> None:
+        """Integrate the encoder odometry over steps k0 .. k0 + len(seen) - 1, with the fixes.
+
+        Step k's wheel speeds (seen[:, 7:9], the state it started from) move the pose by
+        one step, as the plugin's odometry does; a fix (every `every` steps) sees the pose
+        after its step. Plain floats: a plugin period is ~20 steps, too few for numpy.
+        """
+        r, dt, b = self.r, self.dt, self.b
+        x, y, yaw = (float(v) for v in self.pose)
+        for i, (vl, vr) in enumerate(seen[:, 7:9].tolist()):
+            wl, wr = vl * r * dt, vr * r * dt
+            dtheta = (wr - wl) / b
+            heading = yaw + dtheta / 2.0
+            x += (wl + wr) / 2 * math.cos(heading)
+            y += (wl + wr) / 2 * math.sin(heading)
+            yaw += dtheta
+            if self.every and (k0 + i) % self.every == 0:
+                self.pose = np.array([x, y, yaw])
+                self._localize(seen[i, :7])
+        self.pose = np.array([x, y, yaw])
+        self.k = k0 + len(seen) - 1
 
     def command(self, t: float, data: Any) -> tuple[float, float]:
         """The twist for the next plugin period.
@@ -150,7 +186,7 @@ class Pursuit:
                 return 0.0, 0.0  # wait until the wheels stand
             if self.every and self.fixes < FINAL_FIXES:
                 self.fixes += 1
-                self._localize(data)
+                self._localize(data.qpos)
                 if self._correct():
                     return self.command(t, data)
             self.arrived = self.k
@@ -173,8 +209,9 @@ class Pursuit:
             return False
         if abs(along) >= FINAL_TOL:
             b = here[:2] + along * heading
-            self.legs.append(Leg("drive", here[:2].copy(), b, float(here[2]),
-                                 math.copysign(1.0, along)))  # fmt: skip
+            self.legs.append(
+                Leg("drive", here[:2].copy(), b, float(here[2]), math.copysign(1.0, along))
+            )
         self.legs.append(Leg("turn", end.copy(), end.copy(), goal.yaw, 1.0))
         return True
 

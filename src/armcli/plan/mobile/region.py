@@ -28,6 +28,7 @@ SPANS = (1.0, 1.0, math.pi)  # [m, m, rad] an interval is not searched beyond th
 REFINE = 8  # poses judged between the last serving one and the first that does not
 HALVINGS = 8  # rounds of halving the Nav2 tolerances before giving up (0, 0)
 DIRECTIONS = 8  # around the xy tolerance circle
+BLOCK = 24  # poses per row whose reach is computed at a time (a planar arm; a band fits)
 
 
 @dataclass(frozen=True)
@@ -45,30 +46,44 @@ class Region:
 def _first_failing(judge: Judge, best: Verdict, rows: list[np.ndarray]) -> list[int]:
     """Per row of poses: the index of the first pose that does not serve (its length if none).
 
-    A planar arm's reach comes for every row at once; another arm's inverse kinematics
-    runs pose by pose, each seeded with the previous pose's configuration. Poses are
-    judged inside out and a row stops at its first failure.
+    A planar arm's reach comes for all rows at once, BLOCK poses of each at a time (a row
+    mostly fails within its first few: the rest are never computed); another arm's inverse
+    kinematics runs pose by pose, each seeded with the previous pose's configuration. Poses
+    are judged inside out and a row stops at its first failure.
     """
-    planar = judge.mobile.planar is not None
-    if planar and rows:
-        q, errors = judge.reach(np.concatenate(rows), best.q)
-    out, at = [], 0
-    for poses in rows:
-        seed, first = best.q, len(poses)
-        for i, pose in enumerate(poses):
-            if planar:
-                qi, ei = q[at + i], errors[at + i]
+    if judge.mobile.planar is None:
+        return [_first_failing_ik(judge, best, poses) for poses in rows]
+    out = [len(poses) for poses in rows]
+    open_rows = [r for r, poses in enumerate(rows) if len(poses)]
+    lo = 0
+    while open_rows:
+        hi = lo + BLOCK
+        blocks = [rows[r][lo:hi] for r in open_rows]
+        q, errors = judge.reach(np.concatenate(blocks), best.q)
+        at, still = 0, []
+        for r, poses in zip(open_rows, blocks, strict=True):
+            for i, pose in enumerate(poses):
+                if not judge.best(pose, q[at + i], errors[at + i]).ok:
+                    out[r] = lo + i
+                    break
             else:
-                qs, es = judge.reach(pose[None, :], seed)
-                qi, ei = qs[0], es[0]
-            v = judge.best(pose, qi, ei)
-            if not v.ok:
-                first = i
-                break
-            seed = v.q
-        out.append(first)
-        at += len(poses)
+                if hi < len(rows[r]):
+                    still.append(r)
+            at += len(poses)
+        open_rows, lo = still, hi
     return out
+
+
+def _first_failing_ik(judge: Judge, best: Verdict, poses: np.ndarray) -> int:
+    """`_first_failing` of one row for an arm without a closed form (seeded IK per pose)."""
+    seed = best.q
+    for i, pose in enumerate(poses):
+        qs, es = judge.reach(pose[None, :], seed)
+        v = judge.best(pose, qs[0], es[0])
+        if not v.ok:
+            return i
+        seed = v.q
+    return len(poses)
 
 
 def _extents(judge: Judge, best: Verdict) -> list[float]:
@@ -98,8 +113,7 @@ def _extents(judge: Judge, best: Verdict) -> list[float]:
     fine = _first_failing(
         judge, best, [row(k, s, b) for (k, s), b in zip(moves, betweens, strict=True)]
     )
-    return [float(b[k - 1]) if k > 0 else g for b, k, g in zip(betweens, fine, goods,
-                                                               strict=True)]  # fmt: skip
+    return [float(b[k - 1]) if k > 0 else g for b, k, g in zip(betweens, fine, goods, strict=True)]
 
 
 def _band(best: Verdict, r: float, theta: float) -> np.ndarray:

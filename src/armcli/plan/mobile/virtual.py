@@ -71,8 +71,11 @@ class MobileRobot:
     def base_links(self) -> tuple[str, ...]:
         """Links no arm joint moves: the base and whatever is fixed to it."""
         moved = _moved_links(self.robot.urdf, set(self.arm))
-        return tuple(lk.name for lk in self.robot.urdf.links
-                     if lk.name not in moved and lk.name not in _VIRTUAL_LINKS)  # fmt: skip
+        return tuple(
+            lk.name
+            for lk in self.robot.urdf.links
+            if lk.name not in moved and lk.name not in _VIRTUAL_LINKS
+        )
 
 
 def _moved_links(urdf: Urdf, joints: set[str]) -> set[str]:
@@ -95,8 +98,11 @@ def with_planar_base(urdf: Urdf) -> Urdf:
     taken = {lk.name for lk in urdf.links} | {j.name for j in urdf.joints}
     clash = sorted(taken & {*BASE_JOINTS, *_VIRTUAL_LINKS})
     if clash:
-        raise InputError(f"the robot already has a link or joint called {clash[0]!r}, a name "
-                         "armcli's virtual base joint uses", file=urdf.source)  # fmt: skip
+        raise InputError(
+            f"the robot already has a link or joint called {clash[0]!r}, a name "
+            "armcli's virtual base joint uses",
+            file=urdf.source,
+        )
     children = {j.child for j in urdf.joints}
     roots = [lk.name for lk in urdf.links if lk.name not in children]
     if len(roots) != 1:
@@ -112,8 +118,9 @@ def with_planar_base(urdf: Urdf) -> Urdf:
         etree.SubElement(joint, "child", link=chain[k + 1])
         etree.SubElement(joint, "axis", xyz=axis)
         if kind == "prismatic":
-            etree.SubElement(joint, "limit", lower=repr(-ROOM), upper=repr(ROOM), effort="0",
-                             velocity="0")  # fmt: skip
+            etree.SubElement(
+                joint, "limit", lower=repr(-ROOM), upper=repr(ROOM), effort="0", velocity="0"
+            )
     return parse_urdf(etree.tostring(root), urdf.source)
 
 
@@ -159,6 +166,15 @@ def load_mobile(
     standing = stance_of(urdf, candidates=candidates, floating=floating_of(robot_file, urdf))
     stance = None if isinstance(standing, NoStance) else standing
     planar = planar_arm(robot, arm)
-    return MobileRobot(robot, arm, checker, objects, stance,
-                       standing.reason if isinstance(standing, NoStance) else "", planar,
-                       robot_file, world, tuple(disabled))  # fmt: skip
+    return MobileRobot(
+        robot,
+        arm,
+        checker,
+        objects,
+        stance,
+        standing.reason if isinstance(standing, NoStance) else "",
+        planar,
+        robot_file,
+        world,
+        tuple(disabled),
+    )

@@ -64,14 +64,17 @@ def _plugin(urdf: Urdf) -> DriveParams | None:
         if separation is None or (diameter is None and radius is None) or not left or not right:
             continue
         return DriveParams(
-            left, right, separation, radius if radius is not None else 0.5 * float(diameter or 0),
+            left,
+            right,
+            separation,
+            radius if radius is not None else 0.5 * float(diameter or 0),
             _number(p, "max_wheel_torque", "wheelTorque") or DEFAULT_TORQUE,
-            _number(p, "max_wheel_acceleration", "max_linear_acceleration",
-                    "wheelAcceleration") or 0.0,
+            _number(p, "max_wheel_acceleration", "max_linear_acceleration", "wheelAcceleration")
+            or 0.0,
             _number(p, "update_rate", "updateRate") or DEFAULT_RATE,
             p.get("odometry_frame") or p.get("odometryFrame") or "odom",
             p.get("robot_base_frame") or p.get("robotBaseFrame") or "base_footprint",
-        )  # fmt: skip
+        )
     return None
 
 
@@ -104,18 +107,23 @@ def drive_limits(
             speeds.append(lim.velocity * params.radius)
     speed = min(speeds) if speeds else DEFAULT_SPEED
     if not speeds:
-        notes.append(f"the wheel joints give no velocity limit: the base drives at most "
-                     f"{DEFAULT_SPEED:g} m/s")  # fmt: skip
+        notes.append(
+            f"the wheel joints give no velocity limit: the base drives at most "
+            f"{DEFAULT_SPEED:g} m/s"
+        )
     accel = params.max_accel
     if accel <= 0:
         mass = mobile.stance.mass if mobile.stance is not None else 0.0
         if mass <= 0:
-            raise InputError("the robot has no mass to size the drive's acceleration by",
-                             field="base")  # fmt: skip
+            raise InputError(
+                "the robot has no mass to size the drive's acceleration by", field="base"
+            )
         accel = TORQUE_SHARE * 2 * params.max_torque / (params.radius * mass)
-        notes.append(f"max_wheel_acceleration is 0 (no limit): the base accelerates at "
-                     f"{accel:.3g} m/s² ({TORQUE_SHARE:g} of what the wheel torque "
-                     "gives)")  # fmt: skip
+        notes.append(
+            f"max_wheel_acceleration is 0 (no limit): the base accelerates at "
+            f"{accel:.3g} m/s² ({TORQUE_SHARE:g} of what the wheel torque "
+            "gives)"
+        )
     if travel is not None and mobile.stance is not None:
         from armcli.analysis.balance import MarginAt
 
@@ -123,11 +131,14 @@ def drive_limits(
         tip = GRAVITY * max(balance(travel), 0.0) / max(balance.height(travel), 1e-6)
         if TIP_SHARE * tip < accel:
             accel = TIP_SHARE * tip
-            notes.append(f"the base accelerates at most {accel:.3g} m/s²: {TIP_SHARE:g} of what "
-                         "would tip it with the arm stowed")  # fmt: skip
+            notes.append(
+                f"the base accelerates at most {accel:.3g} m/s²: {TIP_SHARE:g} of what "
+                "would tip it with the arm stowed"
+            )
     if accel <= 0:
-        raise InputError("the robot would tip over at any acceleration with its arm stowed",
-                         field="base")  # fmt: skip
+        raise InputError(
+            "the robot would tip over at any acceleration with its arm stowed", field="base"
+        )
     return DriveLimits(speed, accel, 0.5 * params.separation, params.period, tuple(notes))
 
 
@@ -143,8 +154,9 @@ def axle_offset(mobile: MobileRobot, params: DriveParams) -> np.ndarray:
     for joint in (params.left_joint, params.right_joint):
         frame = joint_frame(robot.model, joint)
         if frame is None:
-            raise InputError(f"the diff drive's joint {joint!r} is not a joint of the robot",
-                             field="base")  # fmt: skip
+            raise InputError(
+                f"the diff drive's joint {joint!r} is not a joint of the robot", field="base"
+            )
         wheels.append(frame)
     arm = mobile.arm_robot()
     rest = [arm.robot.rest(j) for j in arm.joints]
@@ -156,12 +168,17 @@ def axle_offset(mobile: MobileRobot, params: DriveParams) -> np.ndarray:
 def to_axle(pose: Sequence[float], c: np.ndarray) -> tuple[float, float, float]:
     """The wheels' midpoint pose of a base pose (x, y, yaw)."""
     co, si = math.cos(pose[2]), math.sin(pose[2])
-    return (float(pose[0] + co * c[0] - si * c[1]), float(pose[1] + si * c[0] + co * c[1]),
-            float(pose[2]))  # fmt: skip
+    return (
+        float(pose[0] + co * c[0] - si * c[1]),
+        float(pose[1] + si * c[0] + co * c[1]),
+        float(pose[2]),
+    )
 
 
 def to_base(poses: np.ndarray, c: np.ndarray) -> np.ndarray:
     """Base poses (N, 3) of the wheels' midpoint poses (N, 3)."""
     co, si = np.cos(poses[:, 2]), np.sin(poses[:, 2])
-    return np.stack([poses[:, 0] - co * c[0] + si * c[1], poses[:, 1] - si * c[0] - co * c[1],
-                     poses[:, 2]], axis=1)  # fmt: skip
+    return np.stack(
+        [poses[:, 0] - co * c[0] + si * c[1], poses[:, 1] - si * c[0] - co * c[1], poses[:, 2]],
+        axis=1,
+    )

@@ -110,8 +110,14 @@ def _travel(mobile: MobileRobot, arm_start: str | None) -> np.ndarray:
 class _Paths:
     """The placement's `accept`: a pose is taken when a base path to it is found (cached)."""
 
-    def __init__(self, plan: FloorPlan, start: tuple[float, float, float], half: float,
-                 seed: int, axle: np.ndarray) -> None:  # fmt: skip
+    def __init__(
+        self,
+        plan: FloorPlan,
+        start: tuple[float, float, float],
+        half: float,
+        seed: int,
+        axle: np.ndarray,
+    ) -> None:
         self.plan, self.half, self.seed, self.axle = plan, half, seed, axle
         self.start = to_axle(start, axle)
         self.found: dict[tuple[float, float, float], BasePath] = {}
@@ -124,13 +130,16 @@ class _Paths:
                 math.dist(f[:2], v.base[:2]) < near_xy
                 and abs(math.remainder(f[2] - v.base[2], 2 * math.pi)) < near_yaw
             ):
-                return False  # fmt: skip
+                return False
         if len(self.failed) >= MAX_PATHS:
-            raise PlanningError("base-path", f"no base path reaches any of the {MAX_PATHS} best "
-                                "poses that serve the target")  # fmt: skip
+            raise PlanningError(
+                "base-path",
+                f"no base path reaches any of the {MAX_PATHS} best poses that serve the target",
+            )
         try:
-            self.found[v.base] = plan_base_path(self.plan, self.start, to_axle(v.base, self.axle),
-                                                self.half, self.seed)  # fmt: skip
+            self.found[v.base] = plan_base_path(
+                self.plan, self.start, to_axle(v.base, self.axle), self.half, self.seed
+            )
         except PlanningError:
             self.failed.append(v.base)
             return False
@@ -152,8 +161,11 @@ def _certify(mobile: MobileRobot, timing: BaseTiming, travel: np.ndarray, axle: 
         xs = [mobile.x(p, travel) for p in poses]
         if any(not checker.motion_free(a, b, CERTIFY_STEP) for a, b in itertools.pairwise(xs)):
             where = ", ".join(f"{v:.3f}" for v in poses[0])
-            raise PlanningError("certify", f"the base path collides in its 3-D check ({m.kind} "
-                                f"from {where}): the floor plan missed an object")  # fmt: skip
+            raise PlanningError(
+                "certify",
+                f"the base path collides in its 3-D check ({m.kind} "
+                f"from {where}): the floor plan missed an object",
+            )
 
 
 @dataclass(frozen=True)
@@ -182,21 +194,39 @@ def plan_drive(mobile: MobileRobot, goal: BaseGoal, seed: int = 0) -> Drive:
     floor = FloorPlan(outline, obstacles(mobile, top))
     t0 = time.perf_counter()
     paths = _Paths(floor, goal.start, limits.half_track, seed, axle)
-    placement = place(mobile, goal.target, goal.start, tolerance=goal.tolerance, seed=seed,
-                      park=lambda pose: floor.free(to_axle(pose, axle)), accept=paths)  # fmt: skip
+    placement = place(
+        mobile,
+        goal.target,
+        goal.start,
+        tolerance=goal.tolerance,
+        seed=seed,
+        park=lambda pose: floor.free(to_axle(pose, axle)),
+        accept=paths,
+    )
     path = paths.found[placement.verdict.base]
     timing = time_path(path, limits)
     t1 = time.perf_counter()
     _certify(mobile, timing, travel, axle)
-    return Drive(params, placement, path, timing, travel, t1 - t0, time.perf_counter() - t1, goal,
-                 axle, floor)  # fmt: skip
+    return Drive(
+        params,
+        placement,
+        path,
+        timing,
+        travel,
+        t1 - t0,
+        time.perf_counter() - t1,
+        goal,
+        axle,
+        floor,
+    )
 
 
 def plan_whole(mobile: MobileRobot, goal: BaseGoal, options: PlanOptions) -> WholePlan:
     """Place, drive, reach (see the module docstring); PlanningError when any step fails."""
     d = plan_drive(mobile, goal, options.seed)
-    ctx = planning_context(mobile.arm_robot(d.placement.verdict.base), mobile.world,
-                           mobile.disabled)  # fmt: skip
+    ctx = planning_context(
+        mobile.arm_robot(d.placement.verdict.base), mobile.world, mobile.disabled
+    )
     try:
         arm = plan_motion(ctx, d.travel, d.placement.verdict.q, options)
     except PlanningError as exc:  # say which half failed: the base's plan stands
@@ -207,8 +237,20 @@ def plan_whole(mobile: MobileRobot, goal: BaseGoal, options: PlanOptions) -> Who
             f"{math.degrees(yaw):.1f} deg: {exc.reason}",
             pair=exc.pair,
         ) from exc
-    return WholePlan(mobile, d.params, d.placement, d.path, d.timing, d.travel, arm,
-                     d.planning_time_s, d.certify_time_s, goal, d.axle, d.floor)  # fmt: skip
+    return WholePlan(
+        mobile,
+        d.params,
+        d.placement,
+        d.path,
+        d.timing,
+        d.travel,
+        arm,
+        d.planning_time_s,
+        d.certify_time_s,
+        goal,
+        d.axle,
+        d.floor,
+    )
 
 
 def files(plan: WholePlan, out_dir: Path, comment: str) -> dict[Path, bytes]:

@@ -78,9 +78,14 @@ def arm_readings(
 
 
 def _imu(
-    name: str, s: Sensor, model: Any, data: Any, res: SimResult,
-    adr: tuple[np.ndarray, np.ndarray], row: dict[int, int],
-) -> Reading:  # fmt: skip
+    name: str,
+    s: Sensor,
+    model: Any,
+    data: Any,
+    res: SimResult,
+    adr: tuple[np.ndarray, np.ndarray],
+    row: dict[int, int],
+) -> Reading:
     import mujoco
 
     qpos, dofs = adr

@@ -64,8 +64,9 @@ class CameraSampler:
         import mujoco
 
         self.ctx.make_current()
-        mujoco.mjv_updateScene(model, data, self.opt, None, self.cam,
-                               mujoco.mjtCatBit.mjCAT_ALL, self.scene)  # fmt: skip
+        mujoco.mjv_updateScene(
+            model, data, self.opt, None, self.cam, mujoco.mjtCatBit.mjCAT_ALL, self.scene
+        )
         mujoco.mjr_render(self.rect, self.scene, self.mjr)
         mujoco.mjr_readPixels(self.rgb, None, self.rect, self.mjr)
         img = self.rgb[::-1].astype(np.float64) / 255.0  # OpenGL's rows start at the bottom

@@ -34,8 +34,14 @@ def channels(readings: tuple[Reading, ...]) -> list[rosbag.Channel]:
     for r in readings:
         stamps = [round(float(t) * 1e9) for t in r.time]
         for topic, datatype, messages in _topics(r, stamps):
-            out.append(rosbag.Channel(topic, datatype, rosbag.qos(SENSOR_QOS_DEPTH, False),
-                                      list(zip(stamps, messages, strict=True))))  # fmt: skip
+            out.append(
+                rosbag.Channel(
+                    topic,
+                    datatype,
+                    rosbag.qos(SENSOR_QOS_DEPTH, False),
+                    list(zip(stamps, messages, strict=True)),
+                )
+            )
     return out
 
 
@@ -48,24 +54,39 @@ def _topics(r: Reading, stamps: list[int]) -> list[tuple[str, str, list[bytes]]]
         return [(base, LASER_SCAN, _scans(r, stamps))]
     if s.type == "imu":
         var = variances(s)
-        return [(base, IMU, [cdr.imu(ns, frame, row, var)
-                             for ns, row in zip(stamps, r.data["imu"], strict=True)])]  # fmt: skip
+        return [
+            (
+                base,
+                IMU,
+                [
+                    cdr.imu(ns, frame, row, var)
+                    for ns, row in zip(stamps, r.data["imu"], strict=True)
+                ],
+            )
+        ]
     assert s.camera is not None
     pin = Pinhole.of(s.camera)
     size = (pin.width, pin.height)
     info = [cdr.camera_info(ns, frame, size, pin.K) for ns in stamps]
     if s.type == "camera":
         kind = encoding(s)
-        images = [cdr.image(ns, frame, kind, img if kind != "mono8" else img[..., 0])
-                  for ns, img in zip(stamps, r.data["image"], strict=True)]  # fmt: skip
+        images = [
+            cdr.image(ns, frame, kind, img if kind != "mono8" else img[..., 0])
+            for ns, img in zip(stamps, r.data["image"], strict=True)
+        ]
         return [(f"{base}/image_raw", IMAGE, images), (f"{base}/camera_info", CAMERA_INFO, info)]
     depth = r.data["depth"]
     rays = pin.optical_rays().reshape(pin.height, pin.width, 3)
     images = [cdr.image(ns, frame, "32FC1", d) for ns, d in zip(stamps, depth, strict=True)]
-    clouds = [cdr.point_cloud(ns, frame, _optical_points(rays, d), dense=False)
-              for ns, d in zip(stamps, depth, strict=True)]  # fmt: skip
-    return [(f"{base}/depth/image_raw", IMAGE, images), (f"{base}/points", POINT_CLOUD, clouds),
-            (f"{base}/camera_info", CAMERA_INFO, info)]  # fmt: skip
+    clouds = [
+        cdr.point_cloud(ns, frame, _optical_points(rays, d), dense=False)
+        for ns, d in zip(stamps, depth, strict=True)
+    ]
+    return [
+        (f"{base}/depth/image_raw", IMAGE, images),
+        (f"{base}/points", POINT_CLOUD, clouds),
+        (f"{base}/camera_info", CAMERA_INFO, info),
+    ]
 
 
 def _optical_points(rays: np.ndarray, depth: np.ndarray) -> np.ndarray:
@@ -77,11 +98,20 @@ def _optical_points(rays: np.ndarray, depth: np.ndarray) -> np.ndarray:
 def _scans(r: Reading, stamps: list[int]) -> list[bytes]:
     li = r.sensor.lidar
     assert li is not None
-    angles = (li.min_angle, li.max_angle, angle_increment(li), 0.0, 1.0 / r.sensor.rate,
-              li.range_min, li.range_max)  # fmt: skip
+    angles = (
+        li.min_angle,
+        li.max_angle,
+        angle_increment(li),
+        0.0,
+        1.0 / r.sensor.rate,
+        li.range_min,
+        li.range_max,
+    )
     frame = r.sensor.frame_id
-    return [cdr.laser_scan(ns, frame, angles, ranges[0])
-            for ns, ranges in zip(stamps, r.data["ranges"], strict=True)]  # fmt: skip
+    return [
+        cdr.laser_scan(ns, frame, angles, ranges[0])
+        for ns, ranges in zip(stamps, r.data["ranges"], strict=True)
+    ]
 
 
 def _lidar_clouds(r: Reading, stamps: list[int]) -> list[bytes]:

@@ -59,16 +59,19 @@ def add_sensors(ms: Any, sensors: Mapping[str, Sensor]) -> None:
     for name, s in sorted(sensors.items()):
         body = ms.body(s.link)
         if body is None:  # spec semantics checked the link; a world link has no body here
-            raise InputError(f"sensor {name!r}: link {s.link!r} has no body in the model",
-                             field=f"sensors.{name}.link")  # fmt: skip
+            raise InputError(
+                f"sensor {name!r}: link {s.link!r} has no body in the model",
+                field=f"sensors.{name}.link",
+            )
         q = quat(s.origin.rpy)
         body.add_site(name=site_name(name), pos=list(s.origin.xyz), quat=list(q), group=SITE_GROUP)
         if s.type == "imu":
             S, obj = mujoco.mjtSensor, mujoco.mjtObj.mjOBJ_SITE
             kinds = (S.mjSENS_GYRO, S.mjSENS_ACCELEROMETER, S.mjSENS_FRAMEQUAT)
             for part, kind in zip(IMU_PARTS, kinds, strict=True):
-                ms.add_sensor(name=imu_name(name, part), type=kind, objtype=obj,
-                              objname=site_name(name))  # fmt: skip
+                ms.add_sensor(
+                    name=imu_name(name, part), type=kind, objtype=obj, objname=site_name(name)
+                )
         elif s.type == "camera" and s.camera is not None:
             _camera(ms, body, name, s)
 
@@ -81,8 +84,12 @@ def _camera(ms: Any, body: Any, name: str, s: Sensor) -> None:
     import mujoco
 
     mujoco.mju_mat2Quat(q, (R_link_sensor @ R_SENSOR_MJCAMERA).ravel())
-    body.add_camera(name=site_name(name), pos=list(s.origin.xyz), quat=list(q),
-                    fovy=float(np.degrees(pin.vertical_fov)))  # fmt: skip
+    body.add_camera(
+        name=site_name(name),
+        pos=list(s.origin.xyz),
+        quat=list(q),
+        fovy=float(np.degrees(pin.vertical_fov)),
+    )
     glob = ms.visual.global_
     glob.offwidth = max(int(glob.offwidth), pin.width)
     glob.offheight = max(int(glob.offheight), pin.height)

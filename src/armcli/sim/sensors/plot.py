@@ -27,8 +27,14 @@ def pick_scan(readings: tuple[Reading, ...]) -> tuple[Reading, int] | None:
     return None
 
 
-def draw_scan(ax: Any, model: Any, data: Any, geoms: tuple[Any, ...], path: np.ndarray,
-              readings: tuple[Reading, ...]) -> None:  # fmt: skip
+def draw_scan(
+    ax: Any,
+    model: Any,
+    data: Any,
+    geoms: tuple[Any, ...],
+    path: np.ndarray,
+    readings: tuple[Reading, ...],
+) -> None:
     """Draw the world (`geoms` in `data`), the `path` (n, 2) and one scan on `ax`."""
     for g in geoms:
         if not g.frame:

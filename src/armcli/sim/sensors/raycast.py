@@ -54,11 +54,22 @@ def cast(
         return _multiray(model, data, origin, dirs, start, stop)
     n = len(dirs)
     dist, geom, other = np.empty(n), np.empty(n, dtype=np.int32), np.empty(n, dtype=np.uint8)
-    mod.cast_rays(np.ascontiguousarray(origin, dtype=np.float64),
-                  np.ascontiguousarray(dirs, dtype=np.float64), start, stop, geoms.types,
-                  geoms.sizes, np.ascontiguousarray(data.geom_xpos[geoms.ids]),
-                  np.ascontiguousarray(data.geom_xmat[geoms.ids]), geoms.aabb, geoms.rbound,
-                  geoms.ids, dist, geom, other)  # fmt: skip
+    mod.cast_rays(
+        np.ascontiguousarray(origin, dtype=np.float64),
+        np.ascontiguousarray(dirs, dtype=np.float64),
+        start,
+        stop,
+        geoms.types,
+        geoms.sizes,
+        np.ascontiguousarray(data.geom_xpos[geoms.ids]),
+        np.ascontiguousarray(data.geom_xmat[geoms.ids]),
+        geoms.aabb,
+        geoms.rbound,
+        geoms.ids,
+        dist,
+        geom,
+        other,
+    )
     for i in np.nonzero(other)[0]:
         dist[i] = _from_start(model, data, origin, dirs[i], start[i], stop[i])
     return dist
@@ -75,8 +86,9 @@ def _multiray(
     geom = np.empty(n, dtype=np.int32)
     vec = np.ascontiguousarray(dirs, dtype=np.float64).reshape(-1)
     pnt = np.ascontiguousarray(origin, dtype=np.float64)
-    mujoco.mj_multiRay(model, data, pnt, vec, SEEN_GROUPS, 1, -1, geom, dist, None, n,
-                       float(np.max(stop)))  # fmt: skip
+    mujoco.mj_multiRay(
+        model, data, pnt, vec, SEEN_GROUPS, 1, -1, geom, dist, None, n, float(np.max(stop))
+    )
     dist[(dist < 0.0) | (dist > stop)] = np.inf
     for i in np.nonzero(dist < start)[0]:  # the ray begins beyond this hit
         dist[i] = _from_start(model, data, pnt, dirs[i], start[i], stop[i])
@@ -139,8 +151,9 @@ class SeenGeoms:
         ids = np.nonzero(ok)[0].astype(np.int32)
         sizes = np.ascontiguousarray(model.geom_size[ids])
         aabb = np.ascontiguousarray(model.geom_aabb[ids])
-        return cls(ids, model.geom_type[ids].astype(np.int32), sizes, aabb,
-                   model.geom_rbound[ids].copy())  # fmt: skip
+        return cls(
+            ids, model.geom_type[ids].astype(np.int32), sizes, aabb, model.geom_rbound[ids].copy()
+        )
 
 
 def cast_pinhole(
@@ -149,11 +162,27 @@ def cast_pinhole(
     """(depth [m] per pixel, +inf for none; pixels MuJoCo must cast: meshes) from the caster."""
     n = cam.width * cam.height
     depth, geom, other = np.empty(n), np.empty(n, dtype=np.int32), np.empty(n, dtype=np.uint8)
-    mod.cast_pinhole(cam.origin, cam.R.ravel(), cam.fx, cam.fy, cam.cx, cam.cy, cam.width,
-                     cam.height, cam.near, cam.far, geoms.types, geoms.sizes,
-                     np.ascontiguousarray(data.geom_xpos[geoms.ids]),
-                     np.ascontiguousarray(data.geom_xmat[geoms.ids]), geoms.aabb, geoms.ids,
-                     depth, geom, other)  # fmt: skip
+    mod.cast_pinhole(
+        cam.origin,
+        cam.R.ravel(),
+        cam.fx,
+        cam.fy,
+        cam.cx,
+        cam.cy,
+        cam.width,
+        cam.height,
+        cam.near,
+        cam.far,
+        geoms.types,
+        geoms.sizes,
+        np.ascontiguousarray(data.geom_xpos[geoms.ids]),
+        np.ascontiguousarray(data.geom_xmat[geoms.ids]),
+        geoms.aabb,
+        geoms.ids,
+        depth,
+        geom,
+        other,
+    )
     return depth, other.astype(bool)
 
 

@@ -122,8 +122,9 @@ def _cloud_points(msg: Any) -> np.ndarray:
     if n == 0 or step < 12 or len(data) < n * step:
         return np.zeros((0, 3))
     raw = np.frombuffer(data, dtype=np.uint8, count=n * step).reshape(n, step)
-    xyz = np.column_stack([raw[:, fields[k].offset : fields[k].offset + 4].copy().view("<f4")[:, 0]
-                           for k in "xyz"])  # fmt: skip
+    xyz = np.column_stack(
+        [raw[:, fields[k].offset : fields[k].offset + 4].copy().view("<f4")[:, 0] for k in "xyz"]
+    )
     return np.asarray(xyz[np.all(np.isfinite(xyz), axis=1)], dtype=np.float64)
 
 

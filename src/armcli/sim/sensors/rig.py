@@ -69,8 +69,10 @@ def make_rig(sensors: Mapping[str, Sensor], model: Any, steps: int, dt: float) -
     for name, s in sorted(sensors.items()):
         k = sample_steps(steps, dt, s.rate)
         if s.type == "camera" and gl.backend() is None:
-            notes.append(f"camera {name!r} renders nothing: no OpenGL backend for MuJoCo's "
-                         f"offscreen renderer ({gl.why_none()}); {gl.INSTALL_HINT}")  # fmt: skip
+            notes.append(
+                f"camera {name!r} renders nothing: no OpenGL backend for MuJoCo's "
+                f"offscreen renderer ({gl.why_none()}); {gl.INSTALL_HINT}"
+            )
             continue
         samplers.append(_sampler(name, s, model, k))
     due = np.zeros(steps + 1, dtype=bool)

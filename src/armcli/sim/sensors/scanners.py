@@ -55,15 +55,23 @@ class LidarSampler:
         assert li is not None
         hit = np.isfinite(r)
         if noise is not None:
-            r[hit] = np.clip(r[hit] + gaussian(self.rng, noise.mean, noise.stddev, int(hit.sum())),
-                             li.range_min, li.range_max)  # fmt: skip
+            r[hit] = np.clip(
+                r[hit] + gaussian(self.rng, noise.mean, noise.stddev, int(hit.sum())),
+                li.range_min,
+                li.range_max,
+            )
         r[hit] = quantise(r[hit], li.resolution)
         self.ranges[j] = r.reshape(self.shape)
 
     def reading(self, dt: float, record: np.ndarray) -> Reading:
         """The scans and their times."""
-        return Reading(self.name, self.sensor, self.steps, self.steps * dt,
-                       {"ranges": self.ranges, "pose": self.poses})  # fmt: skip
+        return Reading(
+            self.name,
+            self.sensor,
+            self.steps,
+            self.steps * dt,
+            {"ranges": self.ranges, "pose": self.poses},
+        )
 
 
 class DepthSampler:
@@ -102,16 +110,32 @@ class DepthSampler:
         """The compiled caster's depths; the pixels a mesh may cover through mj_multiRay."""
         assert self.native is not None and self.sensor.camera is not None
         p, cam = self.pinhole, self.sensor.camera
-        frame = PinholeCast(origin, R @ R_SENSOR_OPTICAL, p.fx, p.fy, p.cx, p.cy, p.width,
-                            p.height, cam.near, cam.far)  # fmt: skip
+        frame = PinholeCast(
+            origin,
+            R @ R_SENSOR_OPTICAL,
+            p.fx,
+            p.fy,
+            p.cx,
+            p.cy,
+            p.width,
+            p.height,
+            cam.near,
+            cam.far,
+        )
         z, other = cast_pinhole(self.native, model, data, self.geoms, frame)
         if other.any():
-            dist = cast(model, data, origin, self.dirs[other] @ R.T, self.start[other],
-                        self.stop[other], self.geoms)  # fmt: skip
+            dist = cast(
+                model,
+                data,
+                origin,
+                self.dirs[other] @ R.T,
+                self.start[other],
+                self.stop[other],
+                self.geoms,
+            )
             z[other] = dist / self.norm[other]
         return z
 
     def reading(self, dt: float, record: np.ndarray) -> Reading:
         """The depth images and their times."""
-        return Reading(self.name, self.sensor, self.steps, self.steps * dt,
-                       {"depth": self.depth})  # fmt: skip
+        return Reading(self.name, self.sensor, self.steps, self.steps * dt, {"depth": self.depth})
