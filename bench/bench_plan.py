@@ -42,13 +42,16 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
 from plan_peers import (  # noqa: E402
-    ARM,
     ERD,
     KINDS,
     PANDA,
+    PANDA_ARM,
     SCENES,
     STEP,
     TIMEOUT_S,
+    UR5_ARM,
+    Arm,
+    Kind,
     Roboplan,
     floor_plan,
     panda_context,
@@ -67,6 +70,7 @@ SPEC = ROOT / "specs" / "my_robot.yaml"
 BOX = ROOT / "tests" / "fixtures" / "plan" / "box_in_the_way.yaml"
 SEED = 0
 COURSE_REPEATS = 30
+FREE_PROBES = 200  # random states tried before drawing another arm's queries
 
 
 def med(xs: list[float]) -> float:
@@ -115,69 +119,98 @@ def ik(count: int) -> None:
     )
 
 
-def oracle_for(scene: Path) -> Oracle:
-    """The independent checker of tests/plan/oracle.py on the Panda in `scene`."""
-    acc = {j: DEFAULT_JOINT_ACCELERATION for j in ARM}  # the Panda's URDF gives none
-    return Oracle(PANDA / "urdf" / "panda.urdf", PANDA / "srdf" / "panda.srdf",
-                  [str(ERD.parent)], scene, acc)  # fmt: skip
+def oracle_for(scene: Path, arm: Arm = PANDA_ARM) -> Oracle:
+    """The independent checker of tests/plan/oracle.py on the arm in `scene`."""
+    acc = {j: DEFAULT_JOINT_ACCELERATION for j in arm.joints}  # their URDFs give none
+    return Oracle(arm.urdf, arm.srdf, [str(ERD.parent)], scene, acc)
 
 
-def panda(count: int) -> dict[str, list[tuple[np.ndarray, np.ndarray]]]:
-    chosen = {}
-    print(f"Panda, {count} queries per scene kind, {TIMEOUT_S:g} s limit; times are planning "
-          "+ simplification [ms], median / p90 over the solved queries")  # fmt: skip
-    head = f"{'kind':15} {'planner':9} {'solved':>7} {'median':>8} {'p90':>8}"
-    print(head + "  ratio to roboplan, path length ratio, certification, 1 kHz check")
-    for kind in KINDS:
-        loaded = panda_context(SCENES / kind.scene)
-        ctx = loaded.context
-        rb = Roboplan(loaded.scene)
-        qs = queries(kind, ctx, rb, count, SEED)
-        chosen[kind.scene] = qs
-        oracle = oracle_for(SCENES / kind.scene)
-        t: dict[str, list[float]] = {"armcli": [], "roboplan": [], "floor": []}
-        ratios, cert, cert_cpu, straight, bad, checked = [], [], [], 0, 0, 0
-        both: list[tuple[float, float]] = []  # (armcli, roboplan) on the queries both solved
-        for k, (a, b) in enumerate(qs):
-            mine = None
-            try:
-                res = plan_motion(ctx, a, b, PlanOptions(seed=k, timeout=TIMEOUT_S, step=STEP))
-                if res.path_time_s <= TIMEOUT_S:
-                    t["armcli"].append(res.path_time_s)
-                    cert.append(res.certify_time_s)
-                    cert_cpu.append(res.certify_cpu_s)
-                    mine, straight = res.path, straight + (len(res.path) == 2)
-                    report = oracle.check(res.document)
-                    checked += report.samples
-                    bad += not report.ok
-                    if not report.ok:
-                        print(f"  query {k}: the independent check fails: {report.first}")
-            except PlanningError as exc:
-                print(f"  query {k}: armcli: {exc.kind}: {exc.reason}")
-            dt, path = rb.plan(a, b, k)
-            if path is not None and dt <= TIMEOUT_S:
-                t["roboplan"].append(dt)
-                if mine is not None:
-                    ratios.append(length(mine) / length(path))
-                    both.append((t["armcli"][-1], dt))
+HEAD = (f"{'kind':15} {'planner':9} {'solved':>7} {'median':>8} {'p90':>8} (CPU median / p90)  "
+        "ratio to roboplan, path length ratio, certification, motion, 1 kHz check")  # fmt: skip
+
+
+def panda(count: int, seed: int) -> dict[str, list[tuple[np.ndarray, np.ndarray]]]:
+    print(f"Panda, {count} queries per scene kind (seed {seed}), {TIMEOUT_S:g} s limit; times "
+          "are planning + simplification [ms], median / p90 over the solved queries")  # fmt: skip
+    print(HEAD)
+    return {kind.scene: compare(kind, PANDA_ARM, count, seed) for kind in KINDS}
+
+
+def other_arm(count: int, seed: int) -> None:
+    print(f"UR5 (example-robot-data, its SRDF; not tuned for) at the open table, {count} "
+          f"queries (seed {seed})")  # fmt: skip
+    kind = KINDS[0]  # its tool rarely reaches into the bin or beyond the wall at random
+    ck = panda_context(SCENES / kind.scene, UR5_ARM).context.checker
+    rng = np.random.default_rng(seed)
+    lo, hi = ck.robot.lower, ck.robot.upper
+    hits = [ck.first_collision(rng.uniform(lo, hi), every_pair=True) for _ in range(FREE_PROBES)]
+    if all(hits):  # no query can be drawn: say why instead of searching forever
+        print(f"  none of {FREE_PROBES} random states is free (first: {hits[0]}): its SRDF "
+              "leaves these link pairs enabled")  # fmt: skip
+        return
+    print(HEAD)
+    compare(kind, UR5_ARM, count, seed, floor=False)
+
+
+def compare(kind: Kind, arm: Arm, count: int, seed: int, floor: bool = True
+            ) -> list[tuple[np.ndarray, np.ndarray]]:  # fmt: skip
+    """armcli, roboplan and the floor on `count` queries of `kind`; prints one line each."""
+    loaded = panda_context(SCENES / kind.scene, arm)
+    ctx = loaded.context
+    rb = Roboplan(loaded.scene, arm)
+    qs = queries(kind, ctx, rb, count, seed)
+    oracle = oracle_for(SCENES / kind.scene, arm)
+    t: dict[str, list[float]] = {"armcli": [], "roboplan": [], "floor": []}
+    cpu: dict[str, list[float]] = {"armcli": [], "roboplan": []}  # path time, CPU
+    ratios, cert, cert_cpu, motion, straight, bad, checked = [], [], [], [], 0, 0, 0
+    both: list[tuple[float, float]] = []  # (armcli, roboplan) on the queries both solved
+    for k, (a, b) in enumerate(qs):
+        mine = None
+        try:
+            res = plan_motion(ctx, a, b, PlanOptions(seed=k, timeout=TIMEOUT_S, step=STEP))
+            if res.path_time_s <= TIMEOUT_S:
+                t["armcli"].append(res.path_time_s)
+                cpu["armcli"].append(res.path_cpu_s)
+                cert.append(res.certify_time_s)
+                cert_cpu.append(res.certify_cpu_s)
+                motion.append(res.duration_s)
+                mine, straight = res.path, straight + (len(res.path) == 2)
+                report = oracle.check(res.document)
+                checked += report.samples
+                bad += not report.ok
+                if not report.ok:
+                    print(f"  query {k}: the independent check fails: {report.first}")
+        except PlanningError as exc:
+            print(f"  query {k}: armcli: {exc.kind}: {exc.reason}")
+        c0 = time.process_time()
+        dt, path = rb.plan(a, b, k)
+        if path is not None and dt <= TIMEOUT_S:
+            t["roboplan"].append(dt)
+            cpu["roboplan"].append(time.process_time() - c0)
+            if mine is not None:
+                ratios.append(length(mine) / length(path))
+                both.append((t["armcli"][-1], dt))
+        if floor:
             dt, path = floor_plan(ctx, a, b, k)
             if path is not None and dt <= TIMEOUT_S:
                 t["floor"].append(dt)
-        ratio = med(t["armcli"]) / med(t["roboplan"])
-        paired = med([a for a, _ in both]) / med([b for _, b in both])
-        for who in ("armcli", "roboplan", "floor"):
-            xs = t[who]
-            line = f"{kind.name:15} {who:9} {len(xs):>3}/{count:<3} {med(xs) * 1e3:8.1f} "
-            line += f"{p90(xs) * 1e3:8.1f}"
-            if who == "armcli":
-                line += (f"  {ratio:.2f} ({paired:.2f} on the {len(both)} both solved), "
-                         f"{med(ratios):.2f}, "
-                         f"{med(cert) * 1e3:.0f} ms median ({p90(cert) * 1e3:.0f} p90; CPU "
-                         f"{med(cert_cpu) * 1e3:.0f} ms), "
-                         f"{bad} of {len(xs)} fail ({checked} samples); "
-                         f"straight: {straight}")  # fmt: skip
-            print(line, flush=True)
-    return chosen
+    ratio = med(t["armcli"]) / med(t["roboplan"])
+    paired = med([a for a, _ in both]) / med([b for _, b in both])
+    for who in ("armcli", "roboplan", "floor") if floor else ("armcli", "roboplan"):
+        xs = t[who]
+        line = f"{kind.name:15} {who:9} {len(xs):>3}/{count:<3} {med(xs) * 1e3:8.1f} "
+        line += f"{p90(xs) * 1e3:8.1f}"
+        if who in cpu:
+            line += f" (CPU {med(cpu[who]) * 1e3:.1f} / {p90(cpu[who]) * 1e3:.1f})"
+        if who == "armcli":
+            line += (f"  {ratio:.2f} ({paired:.2f} on the {len(both)} both solved), "
+                     f"{med(ratios):.2f}, "
+                     f"{med(cert) * 1e3:.0f} ms median ({p90(cert) * 1e3:.0f} p90; CPU "
+                     f"{med(cert_cpu) * 1e3:.0f} ms), motion {med(motion):.1f} s median, "
+                     f"{bad} of {len(xs)} fail ({checked} samples); "
+                     f"straight: {straight}")  # fmt: skip
+        print(line, flush=True)
+    return qs
 
 
 def cpu_of(cmd: list[str]) -> tuple[float, int]:
@@ -219,6 +252,9 @@ def main() -> None:
     ap.add_argument("--queries", type=int, default=30, help="start/goal pairs per scene kind")
     ap.add_argument("--ik", type=int, default=300, help="IK poses")
     ap.add_argument("--process", type=int, default=5, help="whole-process runs per scene kind")
+    ap.add_argument("--other", type=int, default=20, help="UR5 queries per scene kind")
+    ap.add_argument("--seed", type=int, default=SEED,
+                    help="query seed (0: the benchmark's; others: held-out sets)")  # fmt: skip
     args = ap.parse_args()
     print(f"load: {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f} "
           f"on {os.cpu_count()} CPUs")  # fmt: skip
@@ -227,8 +263,9 @@ def main() -> None:
         print("Panda: example-robot-data not installed, skipped")
         return
     ik(args.ik)
-    chosen = panda(args.queries)
+    chosen = panda(args.queries, args.seed)
     process(chosen, args.process)
+    other_arm(args.other, args.seed)
 
 
 if __name__ == "__main__":

@@ -39,6 +39,23 @@ SCENES = ROOT / "bench" / "scenes"
 ERD = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix" / "share" / "example-robot-data"
 PANDA = ERD / "robots" / "panda_description"
 ARM = [f"panda_joint{i}" for i in range(1, 8)]
+
+
+@dataclass(frozen=True)
+class Arm:
+    """A robot of example-robot-data: its URDF, SRDF and planned joints."""
+
+    urdf: Path
+    srdf: Path
+    joints: list[str]
+
+
+PANDA_ARM = Arm(PANDA / "urdf" / "panda.urdf", PANDA / "srdf" / "panda.srdf", ARM)
+UR = ERD / "robots" / "ur_description"
+# the sanity check on an arm nobody here tuned for (bench_plan.other_arm)
+UR5_ARM = Arm(UR / "urdf" / "ur5_joint_limited_robot.urdf", UR / "srdf" / "ur5.srdf",
+              ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint",
+               "wrist_2_joint", "wrist_3_joint"])  # fmt: skip
 TIMEOUT_S = 1.0
 STEP = 0.02  # [rad] collision-check step of every planner
 Point = Callable[[np.ndarray], bool]
@@ -83,13 +100,13 @@ KINDS = (
 )  # fmt: skip
 
 
-def panda_context(scene: Path | None) -> Loaded:
-    """The Panda with its SRDF, the seven arm joints planned, in `scene`."""
+def panda_context(scene: Path | None, arm: Arm = PANDA_ARM) -> Loaded:
+    """The Panda (or `arm`) with its SRDF, the arm joints planned, in `scene`."""
     return load_context(
-        read_robot(PANDA / "urdf" / "panda.urdf"),
-        srdf=PANDA / "srdf" / "panda.srdf",
+        read_robot(arm.urdf),
+        srdf=arm.srdf,
         scene=scene,
-        joints=ARM,
+        joints=arm.joints,
         search=PackageLookup({"example-robot-data": ERD}),
     )
 
@@ -120,7 +137,7 @@ def queries(kind: Kind, ctx: PlanningContext, rb: Roboplan, count: int, seed: in
 class Roboplan:
     """roboplan's scene with the same URDF, SRDF and obstacles, and its RRT-Connect."""
 
-    def __init__(self, obstacles: Scene) -> None:
+    def __init__(self, obstacles: Scene, arm: Arm = PANDA_ARM) -> None:
         from roboplan.core import (
             Box,
             Cylinder,
@@ -132,10 +149,11 @@ class Roboplan:
         from roboplan.core import Scene as RScene
         from roboplan.rrt import RRT, RRTOptions
 
-        desc = loadUrdfSceneDescription(str(PANDA / "urdf" / "panda.urdf"), [str(ERD.parent)])
-        self.scene = RScene("panda", desc)
-        self.scene.importSrdf((PANDA / "srdf" / "panda.srdf").read_text())
-        self.scene.addGroup("arm", ARM)
+        self.joints = arm.joints
+        desc = loadUrdfSceneDescription(str(arm.urdf), [str(ERD.parent)])
+        self.scene = RScene("robot", desc)
+        self.scene.importSrdf(arm.srdf.read_text())
+        self.scene.addGroup("arm", arm.joints)
         color = np.array([0.5, 0.5, 0.5, 1.0])
         shapes = {"box": lambda d: Box(*d), "sphere": lambda d: Sphere(d[0]),
                   "cylinder": lambda d: Cylinder(d[1], d[0])}  # fmt: skip
@@ -155,7 +173,7 @@ class Roboplan:
             self.scene, PathShortcuttingOptions(group_name="arm", max_step_size=STEP)
         )
         self.full = self.scene.getCurrentJointPositions()
-        self.idx = self.scene.getJointPositionIndices(ARM)
+        self.idx = self.scene.getJointPositionIndices(arm.joints)
 
     def has(self, x: np.ndarray) -> bool:
         q = self.full.copy()
@@ -169,7 +187,8 @@ class Roboplan:
         self.rrt.setRngSeed(seed)
         t0 = time.perf_counter()
         try:
-            path = self.rrt.plan(JointConfiguration(ARM, a), JointConfiguration(ARM, b))
+            path = self.rrt.plan(JointConfiguration(self.joints, a),
+                                 JointConfiguration(self.joints, b))  # fmt: skip
         except RuntimeError:  # roboplan 0.7.0 raises on its time limit
             path = None
         if path is None or not path.positions:

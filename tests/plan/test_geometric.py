@@ -72,3 +72,19 @@ def test_a_stalled_attempt_gives_way_to_the_next_seed(panda_bin: Loaded) -> None
         assert path is not None
         found.append(stats["attempt"])
     assert max(found) > 0  # one round per attempt: later seeds solved some
+
+
+@pytest.mark.parametrize("lazy_step", [0.5, 5.0])
+def test_lazy_edges_are_checked_at_the_step(panda_bin: Loaded, lazy_step: float) -> None:
+    # 5 rad: beyond the range, so tree edges are checked at their ends only and many a
+    # path the trees meet along has an edge through the clutter, cut off and searched again
+    native, python = panda_bin.context.checker.native, python_twin(panda_bin)
+    assert native is not None
+    for k, (a, b) in enumerate(blocked_pairs(panda_bin, 4, 6)):
+        for ck in (panda_bin.context.checker, python):
+            ck.pad(PADDING, (a, b))
+        path, _ = native.plan(a, b, seed=k, threads=1, attempt_nodes=20_000,
+                              lazy_step=lazy_step, **OPTIONS)  # fmt: skip
+        assert path is not None
+        assert np.array_equal(path[0], a) and np.array_equal(path[-1], b)
+        assert all(python.motion_free(p, q, STEP) for p, q in itertools.pairwise(path))

@@ -67,3 +67,30 @@ def test_spline_is_scipys_clamped_cubic() -> None:
         scale = np.max(np.abs(cs(t, 2))) + 1.0
         assert np.allclose(v, cs(t, 1), rtol=0, atol=1e-9 * scale)
         assert np.allclose(a, cs(t, 2), rtol=0, atol=1e-9 * scale)
+
+
+@needs_native
+def test_blended_corners_stay_free_and_shorten_the_motion(panda_bin: Loaded) -> None:
+    # planned paths with corners in the bin: rounded corners (plan.timing's blend) must keep
+    # every output sample inside the limits and free by the exact Python check (plan.collision
+    # without the extension), and the motion, no longer stopping at corners, is shorter
+    from armcli.plan.collision import PADDING
+    from armcli.plan.geometric import plan_path
+    from tests.plan.test_collision import python_twin
+    from tests.plan.test_geometric import blocked_pairs
+
+    robot, checker = panda_bin.context.robot, panda_bin.context.checker
+    python = python_twin(panda_bin)
+    faster = 0
+    for k, (a, b) in enumerate(blocked_pairs(panda_bin, 4, 9)):
+        checker.pad(PADDING, (a, b))
+        path = plan_path(checker, robot.lower, robot.upper, a, b, seed=k, timeout=30.0)
+        if len(path) < 3:
+            continue
+        stops = parameterise(robot, path, 0.6, checker.native)
+        blended = parameterise(robot, path, 0.6, checker.native, blend=0.45)
+        assert np.array_equal(blended.positions[[0, -1]], path[[0, -1]])
+        assert np.all(blended.positions >= robot.lower) and np.all(blended.positions <= robot.upper)
+        assert all(python.first_collision(x, every_pair=True) is None for x in blended.positions)
+        faster += blended.duration < stops.duration
+    assert faster >= 2

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pytest
@@ -14,7 +16,7 @@ from armcli.io.yaml import loads_yaml
 from armcli.plan.output import trajectory_yaml
 from armcli.plan.timing import Timed
 from armcli.trajectory.jointtext import canonical_doc
-from armcli.trajectory.message import loads_trajectory
+from armcli.trajectory.message import Trajectory, loads_trajectory, parse_trajectory
 
 NAMES = ("joint_a", "arm/b-2", "c.3")
 finite = st.floats(allow_nan=False, allow_infinity=False)
@@ -76,3 +78,44 @@ def test_a_problem_is_reported_with_its_line() -> None:
     with pytest.raises(SpecError) as info:
         loads_trajectory(text, limits, source="<t>")
     assert info.value.problems[0].line == 4  # `  - positions: [5.0, ...]`, the first point
+
+
+def outcome(read: Callable[..., Trajectory], *args: Any, **kwargs: Any) -> tuple[object, ...]:
+    """What a reader gives: the trajectory's fields (floats by bits) or the problems."""
+    try:
+        t = read(*args, **kwargs)
+    except SpecError as exc:
+        return ("error", exc.problems)
+    arrays = (t.times, t.positions, t.velocities, t.accelerations)
+    return (t.joint_names, t.frame_id, t.warnings, *(np.asarray(a).tobytes() for a in arrays))
+
+
+@pytest.mark.parametrize("clamp", [False, True])
+def test_the_array_checks_give_the_yaml_readers_trajectory(clamp: bool) -> None:
+    # trajectory.message checks plan's layout on arrays; the reference is parse_trajectory on
+    # the YAML reader's data: every check it makes, passing or not, must come out the same
+    rng = np.random.default_rng(5)
+    limits = {n: (-1.0, 1.0) for n in NAMES}
+    times = np.cumsum(rng.uniform(0.01, 0.5, 6))
+    short = np.insert(times[1:], 1, times[1] + 5e-7)  # 500 ns after the second point
+    cases = {
+        "fine": (rng.uniform(-1, 1, (6, 3)), times),
+        "at the limits": (np.clip(rng.uniform(-2, 2, (6, 3)), -1 - 1e-9, 1 + 1e-9), times),
+        "beyond a limit": (rng.uniform(-1.5, 1.5, (6, 3)), times),
+        "times repeat": (rng.uniform(-1, 1, (6, 3)), np.repeat(times[:3], 2)),
+        "too short a segment": (rng.uniform(-1, 1, (6, 3)), short),
+        "first point just after 0": (rng.uniform(-1, 1, (6, 3)), times - times[0] + 5e-7),
+        "first point at 0": (rng.uniform(-1, 1, (6, 3)), times - times[0]),
+        "too late": (rng.uniform(-1, 1, (6, 3)), times + 2e6),
+    }
+    for name, (values, t) in cases.items():
+        text = document(values, t).decode()
+        for others in ({}, {"c.3": "a wheel joint"}):
+            fast = outcome(loads_trajectory, text, limits, clamp=clamp, others=others)
+            doc = loads_yaml(text, "<message>", flow_sets=True)
+            ref = outcome(parse_trajectory, doc, limits, clamp=clamp, others=others)
+            assert fast == ref, name
+            passes = name in ("fine", "at the limits", "first point at 0") or (
+                clamp and name == "beyond a limit"
+            )
+            assert (fast[0] != "error") == (passes and not others), name

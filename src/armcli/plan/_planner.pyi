@@ -49,6 +49,7 @@ class Scene:
         attempt_nodes: int,
         bridge: float = 0.0,
         bridge_sigma: float = 0.3,
+        lazy_step: float = 0.0,
     ) -> tuple[_F64 | None, dict[str, Any]]: ...
     def shortcut(self, path: _F64, step: float, seed: int, tries: int, patience: int) -> _F64: ...
     def sweep(self, X: _F64) -> tuple[int, int, int, int]: ...
@@ -62,6 +63,8 @@ class Scene:
         iv: list[int],
         grid: int,
         rate: float,
+        blend: float = 0.0,
+        step: float = 0.02,
     ) -> int | tuple[_F64, _F64, _F64, _F64]: ...
 
 def scene(

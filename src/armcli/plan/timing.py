@@ -12,6 +12,13 @@ follows that spline exactly). The spline averages TOPP-RA's bang-bang accelerati
 sample interval and overshoots their jumps by up to ~27 % (the decay ratio 2 - √3 of
 cubic spline interpolation), so the limits given to TOPP-RA are scaled by `margin` < 1 and
 the result is certified afterwards (plan.certify).
+
+With the compiled planner, `blend` > 0 rounds the path's corners first (plan/_native/
+timing.cpp): each corner becomes a quadratic Bézier of radius `blend` times the shorter
+neighbouring segment, kept only where the planner's own state check finds it free every
+`step` (else halved, at last a stop), so the motion passes its corners without stopping and
+stays inside the joint-limit box. TOPP-RA then times each stretch between stops in one pass.
+The Python path (no extension) stops at every corner.
 """
 
 from __future__ import annotations
@@ -130,7 +137,8 @@ def _spline(times: np.ndarray, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     return np.asarray(spline(times, 1)), np.asarray(spline(times, 2))
 
 
-def _compiled(robot: PlanRobot, waypoints: np.ndarray, margin: float, compiled: Any) -> Timed:
+def _compiled(robot: PlanRobot, waypoints: np.ndarray, margin: float, compiled: Any,
+              blend: float, step: float) -> Timed:  # fmt: skip
     """`parameterise` in the compiled planner (plan/_native/timing.cpp)."""
     effort = np.zeros(0)
     if np.any(np.isfinite(robot.effort)):
@@ -143,6 +151,8 @@ def _compiled(robot: PlanRobot, waypoints: np.ndarray, margin: float, compiled: 
         robot.v_indices(),
         GRID_PER_SEGMENT,
         OUTPUT_RATE_HZ,
+        blend=blend,
+        step=step,
     )
     if isinstance(out, int):
         raise PlanningError(
@@ -173,15 +183,17 @@ def _constraints(robot: PlanRobot, margin: float) -> list[Any]:
 
 
 def parameterise(
-    robot: PlanRobot, waypoints: np.ndarray, margin: float, compiled: Any = None
-) -> Timed:
+    robot: PlanRobot, waypoints: np.ndarray, margin: float, compiled: Any = None,
+    *, blend: float = 0.0, step: float = 0.02,
+) -> Timed:  # fmt: skip
     """Time-optimal motion along the polyline, limits scaled by `margin`; rest at each waypoint.
 
     `compiled`: the compiled planner's scene (plan.native), whose TOPP-RA is the toppra C++
     library's; without it, TOPP-RA's Python package (the same algorithm and LP solver).
+    `blend` (compiled only): round the corners, checked every `step` (see the module).
     """
     if compiled is not None:
-        return _compiled(robot, waypoints, margin, compiled)
+        return _compiled(robot, waypoints, margin, compiled, blend, step)
     import toppra.algorithm as algo
 
     logging.getLogger("toppra").setLevel(logging.ERROR)  # library code never prints

@@ -32,12 +32,13 @@ import numpy as np
 from armcli.errors import Problem, SpecError, one_per_kind
 from armcli.io.yaml import MAX_YAML_BYTES, FlowKeys, YamlDoc, dotted, loads_yaml, read_text
 from armcli.trajectory.brace import BraceNotes
-from armcli.trajectory.jointtext import MAX_PLAN_BYTES, canonical_doc
+from armcli.trajectory.jointtext import MAX_PLAN_BYTES, canonical_arrays
 
 DEFAULT_SEGMENT_S = 1.0  # [s] time given to a point without time_from_start
 MIN_SEGMENT_S = 1e-6  # [s] shorter segments make the interpolated reference overflow
 MAX_TIME_S = 1e6  # [s] ~11.6 days: far beyond any simulation worth running step by step
 LIMIT_TOL = 1e-9  # [rad] slack when comparing positions with joint limits
+_RULES = (LIMIT_TOL, MIN_SEGMENT_S, MAX_TIME_S)  # what trajectory.jointtext checks
 CUTOFF = 0.6  # difflib similarity below which no "did you mean" is offered (spec.suggest's)
 _TOP_KEYS = {"header", "joint_names", "points"}
 _POINT_KEYS = {"positions", "velocities", "accelerations", "effort", "time_from_start"}
@@ -89,10 +90,13 @@ def loads_trajectory(
     Plan's own layout is read by trajectory.jointtext (same data, fast; problems are reported from
     the YAML reader, which knows lines). `max_bytes`: None for armcli's own output.
     """
-    fast = canonical_doc(text, source)
+    fast = canonical_arrays(text)  # plan's layout, checked on arrays as parse_trajectory checks
+    t = None if fast is None else fast.checked_times(limits, others, _RULES)
+    if fast is not None and t is not None:
+        return Trajectory(fast.names, t, *fast.rows(), frame_id=fast.frame_id, source=source)
     with contextlib.suppress(SpecError):  # reported below, from the YAML reader
-        if fast is not None:
-            return parse_trajectory(fast, limits, clamp=clamp, others=others)
+        if fast is not None:  # e.g. out of limits: clamped, or refused with the YAML's lines
+            return parse_trajectory(fast.doc(source), limits, clamp=clamp, others=others)
     doc = loads_yaml(text, source, flow_sets=True, max_bytes=max_bytes)
     return parse_trajectory(doc, limits, clamp=clamp, others=others)
 
@@ -136,12 +140,8 @@ class _Collector:
                 close = difflib.get_close_matches(str(key), sorted(allowed), n=1, cutoff=CUTOFF)
                 hint = f"did you mean {close[0]!r}? " if close else ""
                 meant.update(close)
-                self.once((*path, key), f"unknown key; {hint}{_listed(allowed)}")
+                self.once((*path, key), f"unknown key; {hint}valid: {', '.join(sorted(allowed))}")
         return meant
-
-
-def _listed(allowed: set[str]) -> str:
-    return f"valid: {', '.join(sorted(allowed))}"
 
 
 def parse_trajectory(

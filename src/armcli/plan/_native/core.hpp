@@ -149,6 +149,7 @@ struct PlanOptions {
   long attempt_nodes = 20000;  // nodes per attempt before the next seed takes over
   double bridge = 0.0;      // probability of a bridge-test target (narrow passages)
   double bridge_sigma = 0.3;  // [rad] spread of a bridge's second end
+  double lazy_step = 0.0;   // [rad] > step: edges grown at this step, the path's at `step`
 };
 
 struct PlanStats {

@@ -109,8 +109,9 @@ PyScene* make_scene(nb::bytes model, nb::bytes geometry, In<double> q_template,
 
 nb::tuple plan(PyScene& ps, In<double> start, In<double> goal, double range, double goal_bias,
                double step, double timeout, uint64_t seed, int threads, long attempt_nodes,
-               double bridge, double bridge_sigma) {
+               double bridge, double bridge_sigma, double lazy_step) {
   PlanOptions o;
+  o.lazy_step = lazy_step;
   o.bridge = bridge, o.bridge_sigma = bridge_sigma;
   o.range = range, o.goal_bias = goal_bias, o.step = step, o.timeout = timeout, o.seed = seed;
   o.threads = threads, o.attempt_nodes = attempt_nodes;
@@ -194,7 +195,7 @@ NB_MODULE(_planner, m) {
       .def("plan", &plan, nb::arg("start"), nb::arg("goal"), nb::kw_only(), nb::arg("range"),
            nb::arg("goal_bias"), nb::arg("step"), nb::arg("timeout"), nb::arg("seed"),
            nb::arg("threads"), nb::arg("attempt_nodes"), nb::arg("bridge") = 0.0,
-           nb::arg("bridge_sigma") = 0.3)
+           nb::arg("bridge_sigma") = 0.3, nb::arg("lazy_step") = 0.0)
       .def("shortcut", [](PyScene& s, In<double> path, double step, uint64_t seed, int tries,
                           int patience) {
             long count = 0;
@@ -240,12 +241,14 @@ NB_MODULE(_planner, m) {
           }, nb::arg("X"), nb::arg("XD"), nb::arg("XDD"), nb::arg("iv"))
       .def("time_polyline", [](PyScene& s, In<double> W, In<double> velocity,
                                In<double> acceleration, In<double> effort, std::vector<int> iv,
-                               int grid, double rate) -> nb::object {
+                               int grid, double rate, double blend, double step) -> nb::object {
             const int n = s.scene->n;
             long count = 0;
             const double* w = rows(W, n, "W", count);
             if (count < 2 || grid < 1 || !(rate > 0.0))
               throw std::invalid_argument("two waypoints, grid >= 1 and rate > 0 needed");
+            if (!(blend >= 0.0 && blend < 0.5) || !(step > 0.0))
+              throw std::invalid_argument("blend in [0, 0.5) and step > 0 needed");
             TimingLimits lim;
             lim.velocity = vec(velocity, n, "velocity");
             lim.acceleration = vec(acceleration, n, "acceleration");
@@ -257,13 +260,15 @@ NB_MODULE(_planner, m) {
             Timed t;
             {
               nb::gil_scoped_release release;
-              t = time_polyline(*s.scene, rmat(w, count, n), lim, grid, rate);
+              t = time_polyline(*s.scene, rmat(w, count, n), lim, grid, rate, s.work.get(), blend,
+                                step);
             }
             if (t.failed_segment >= 0) return nb::int_(t.failed_segment);
             return nb::make_tuple(vector1(t.times), matrix(t.positions), matrix(t.velocities),
                                   matrix(t.accelerations));
           }, nb::arg("W"), nb::arg("velocity"), nb::arg("acceleration"), nb::arg("effort"),
-           nb::arg("iv"), nb::arg("grid"), nb::arg("rate"))
+           nb::arg("iv"), nb::arg("grid"), nb::arg("rate"), nb::arg("blend") = 0.0,
+           nb::arg("step") = 0.02)
       .def_prop_ro("lever", [](const PyScene& s) {
             RMat l = s.scene->lever;
             return matrix(l);

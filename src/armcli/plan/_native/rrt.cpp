@@ -9,6 +9,12 @@
 // to solve). Attempts run on `threads` threads at once; the path returned is always the one
 // of the lowest-numbered attempt that succeeds, so a seed gives the same path whatever the
 // number of threads, whenever the search ends before the timeout.
+//
+// Lazy edges (lazy_step > step): the trees grow with edges checked every lazy_step only;
+// when they meet, each edge of the path not yet checked at `step` is checked then, and an
+// edge that fails takes its child's subtree out of its tree (as Lazy PRM drops an edge),
+// and the search goes on. The path returned has every edge checked at `step`, as without
+// laziness; most tree edges, which no path uses, are checked at the coarse step only.
 
 #include <algorithm>
 #include <atomic>
@@ -66,15 +72,19 @@ struct Tree {
   int n = 0;
   std::vector<double> x;  // node k at x[k * n]
   std::vector<int> parent;
+  std::vector<char> checked;  // the edge to the parent was checked at the fine step
+  std::vector<char> dead;     // cut off with a subtree whose root edge failed
   std::vector<std::vector<float>> axis;  // axis[i][k]: coordinate i of node k
   std::vector<float> dist;
 
   size_t size() const { return parent.size(); }
   const double* node(size_t k) const { return x.data() + k * n; }
 
-  void add(const double* q, int up) {
+  void add(const double* q, int up, bool fine) {
     x.insert(x.end(), q, q + n);
     parent.push_back(up);
+    checked.push_back(fine);
+    dead.push_back(0);
     axis.resize(n);
     for (int i = 0; i < n; ++i) axis[i].push_back(static_cast<float>(q[i]));
   }
@@ -90,6 +100,18 @@ struct Tree {
     }
     return static_cast<size_t>(std::min_element(dist.begin(), dist.end()) - dist.begin());
   }
+
+  // Node k and its descendants out of the search (children come after their parents).
+  void cut(size_t k) {
+    dead[k] = 1;
+    for (size_t j = k + 1; j < size(); ++j)
+      if (!dead[j] && dead[parent[j]]) dead[j] = 1;
+    for (size_t j = k; j < size(); ++j)
+      if (dead[j])
+        for (int i = 0; i < n; ++i) axis[i][j] = FAR;  // never the nearest again
+  }
+
+  static constexpr float FAR = 1e18f;  // its squared distance overflows to infinity
 };
 
 class Attempt {
@@ -102,8 +124,8 @@ class Attempt {
            long& nodes) {
     Tree t[2];
     t[0].n = t[1].n = n_;
-    t[0].add(start.data(), -1);
-    t[1].add(goal.data(), -1);
+    t[0].add(start.data(), -1, true);
+    t[1].add(goal.data(), -1, true);
     int a = 0;
     for (long round = 0;; ++round) {
       if ((round & 15) == 0 && (stop.load(std::memory_order_relaxed) || Clock::now() > end))
@@ -118,8 +140,11 @@ class Attempt {
         do g = grow(t[1 - a], x_new.data(), met);
         while (g == ADVANCED && !stop.load(std::memory_order_relaxed));
         if (g == REACHED) {
-          nodes += static_cast<long>(t[0].size() + t[1].size());
-          return a == 0 ? join(t[0], added, t[1], met) : join(t[0], met, t[1], added);
+          const size_t at0 = a == 0 ? added : met, at1 = a == 0 ? met : added;
+          if (verified(t[0], at0) && verified(t[1], at1)) {
+            nodes += static_cast<long>(t[0].size() + t[1].size());
+            return join(t[0], at0, t[1], at1);
+          }
         }
       }
       a = 1 - a;
@@ -158,6 +183,23 @@ class Attempt {
     return false;
   }
 
+  // Whether every edge from node k to the root is free at the fine step; the first that
+  // is not (from the root down) is cut with its subtree.
+  bool verified(Tree& t, size_t k) {
+    std::vector<size_t> chain;
+    for (int j = static_cast<int>(k); j > 0; j = t.parent[j]) chain.push_back(j);
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+      const size_t j = *it;
+      if (t.checked[j]) continue;
+      if (!w_.motion_free(t.node(t.parent[j]), t.node(j), o_.step)) {
+        t.cut(j);
+        return false;
+      }
+      t.checked[j] = 1;
+    }
+    return true;
+  }
+
   // Extend `t` toward `q` by at most `range`; `added`: the node reached or added.
   Grow grow(Tree& t, const double* q, size_t& added) {
     const size_t k = t.nearest(q);
@@ -172,8 +214,9 @@ class Attempt {
     const bool reach = d <= o_.range;
     const double u = reach ? 1.0 : o_.range / d;
     for (int i = 0; i < n_; ++i) grown_[i] = reach ? q[i] : from[i] + (q[i] - from[i]) * u;
-    if (!w_.motion_free(from, grown_.data(), o_.step)) return TRAPPED;
-    t.add(grown_.data(), static_cast<int>(k));
+    const bool lazy = o_.lazy_step > o_.step;
+    if (!w_.motion_free(from, grown_.data(), lazy ? o_.lazy_step : o_.step)) return TRAPPED;
+    t.add(grown_.data(), static_cast<int>(k), !lazy);
     added = t.size() - 1;
     return reach ? REACHED : ADVANCED;
   }

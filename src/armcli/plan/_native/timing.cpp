@@ -3,6 +3,16 @@
 // extension): each straight segment timed from rest to rest under joint velocity,
 // acceleration and (optionally) torque limits, sampled at the output rate; then the
 // velocities and accelerations of the clamped C² cubic spline through those samples.
+//
+// Corner blends (blend > 0): a rest at every corner makes a many-segment path slow. Each
+// corner P between segments of lengths L1, L2 (joint-space, Euclidean) is replaced by the
+// quadratic Bézier from A = P - r u1 to C = P + r u2 (u: the unit directions, r = blend *
+// min(L1, L2), blend < 0.5 so that neighbouring blends never overlap) when the curve is free
+// by the planner's own state check every `step` (max norm); otherwise r is halved, and
+// after BLEND_HALVINGS the motion stops at P as before. The curve lies in the triangle A P
+// C, inside the joint-limit box; with s the arc length on the lines and 2r along the curve,
+// dq/ds is continuous (unit length at the joins) and d²q/ds² = (u2 - u1) / (2r) is constant
+// on the curve: TOPP-RA times each stretch between stops in one pass, through its corners.
 
 #include <cmath>
 #include <memory>
@@ -23,6 +33,110 @@ namespace armcli_plan {
 namespace {
 
 constexpr double MAX_PATH_SPEED_SQ = 1e16;  // [1/s²] sdot² bound (toppra's default: 100)
+constexpr int BLEND_HALVINGS = 3;  // a blend that collides is tried with r / 2, r / 4, r / 8
+constexpr int BLEND_GRID_DIVISOR = 3;  // a blend gets grid / 3 TOPP-RA intervals
+
+// Lines joined by quadratic Bézier blends (a stretch of the path between two stops).
+struct Piece {
+  bool line = true;
+  Vec a, p, c;  // line: from a to c; blend: ends a and c, corner p
+  double s0 = 0.0, len = 0.0;  // where it starts on the path and its length in s
+};
+
+class Blended : public toppra::GeometricPath {
+ public:
+  explicit Blended(std::vector<Piece> pieces)
+      : toppra::GeometricPath(static_cast<int>(pieces.front().a.size())),
+        pieces_(std::move(pieces)) {}
+  toppra::Vector eval_single(toppra::value_type s, int order) const override {
+    size_t k = 0;
+    while (k + 1 < pieces_.size() && pieces_[k + 1].s0 <= s) ++k;
+    const Piece& P = pieces_[k];
+    const double u = std::min(std::max((s - P.s0) / P.len, 0.0), 1.0);
+    if (P.line) {
+      if (order == 0) return P.a + u * (P.c - P.a);
+      if (order == 1) return (P.c - P.a) / P.len;
+      return toppra::Vector::Zero(P.a.size());
+    }
+    if (order == 0) return (1 - u) * (1 - u) * P.a + 2 * (1 - u) * u * P.p + u * u * P.c;
+    if (order == 1) return (2 * (1 - u) * (P.p - P.a) + 2 * u * (P.c - P.p)) / P.len;
+    return 2 * (P.a - 2 * P.p + P.c) / (P.len * P.len);
+  }
+  toppra::Bound pathInterval() const override {
+    return toppra::Bound(0.0, pieces_.back().s0 + pieces_.back().len);
+  }
+  // TOPP-RA's grid: `grid` intervals per line, grid / 3 per blend, every join a gridpoint.
+  toppra::Vector gridpoints(int grid) const {
+    std::vector<double> g{0.0};
+    for (const Piece& P : pieces_) {
+      const int m = P.line ? grid : std::max(2, grid / BLEND_GRID_DIVISOR);
+      for (int i = 1; i <= m; ++i) g.push_back(P.s0 + P.len * i / m);
+    }
+    return Eigen::Map<toppra::Vector>(g.data(), static_cast<long>(g.size()));
+  }
+
+ private:
+  std::vector<Piece> pieces_;
+};
+
+// Whether the blend a -> (p) -> c is free by the planner's check every `step` (max norm).
+bool blend_free(Work& w, const Vec& a, const Vec& p, const Vec& c, double step) {
+  const double bound = (p - a).cwiseAbs().maxCoeff() + (c - p).cwiseAbs().maxCoeff();
+  const int m = std::max(2, static_cast<int>(std::ceil(bound / step)));
+  Vec x(a.size());
+  for (int k : bisection_order(m)) {
+    if (k == m) continue;  // the ends lie on the segments, checked by the planner
+    const double u = static_cast<double>(k) / m;
+    x = (1 - u) * (1 - u) * a + 2 * (1 - u) * u * p + u * u * c;
+    if (!w.free(x.data())) return false;
+  }
+  return true;
+}
+
+// Each corner's blend radius (0: the motion stops there), checked as blend_free says.
+std::vector<double> radii(Work& w, const RMat& W, double blend, double step) {
+  const long N = W.rows();
+  std::vector<double> r(N, 0.0);
+  for (long k = 1; k + 1 < N; ++k) {
+    const Vec P = W.row(k).transpose();
+    const Vec d1 = P - W.row(k - 1).transpose(), d2 = W.row(k + 1).transpose() - P;
+    const double L1 = d1.norm(), L2 = d2.norm();
+    if (!(L1 > 0.0) || !(L2 > 0.0)) continue;
+    double rk = blend * std::min(L1, L2);
+    for (int h = 0; h <= BLEND_HALVINGS; ++h, rk *= 0.5) {
+      if (blend_free(w, P - rk * d1 / L1, P, P + rk * d2 / L2, step)) {
+        r[k] = rk;
+        break;
+      }
+    }
+  }
+  return r;
+}
+
+// The stretch of W from stop i to stop j (rows), its inner corners blended by radius r.
+std::vector<Piece> stretch(const RMat& W, const std::vector<double>& r, long i, long j) {
+  std::vector<Piece> out;
+  double s = 0.0;
+  Vec from = W.row(i).transpose();
+  for (long k = i; k < j; ++k) {
+    const Vec P = W.row(k + 1).transpose();
+    const Vec d = P - W.row(k).transpose();
+    const double L = d.norm();
+    const Vec to = k + 1 < j ? Vec(P - r[k + 1] * d / L) : P;
+    Piece line;
+    line.a = from, line.c = to, line.s0 = s, line.len = (to - from).norm();
+    if (line.len > 0.0) out.push_back(line), s += line.len;
+    if (k + 1 == j) break;
+    const Vec d2 = W.row(k + 2).transpose() - P;
+    Piece curve;
+    curve.line = false;
+    curve.a = to, curve.p = P, curve.c = P + r[k + 1] * d2 / d2.norm();
+    curve.s0 = s, curve.len = 2.0 * r[k + 1];
+    out.push_back(curve), s += curve.len;
+    from = curve.c;
+  }
+  return out;
+}
 
 class Segment : public toppra::GeometricPath {
  public:
@@ -60,7 +174,7 @@ class Torque : public toppra::constraint::JointTorque {
 }  // namespace
 
 Timed time_polyline(const Scene& s, const RMat& W, const TimingLimits& lim, int grid,
-                    double rate) {
+                    double rate, Work* w, double blend, double step) {
   const int n = static_cast<int>(W.cols());
   toppra::LinearConstraintPtrs cons{
       std::make_shared<toppra::constraint::LinearJointVelocity>(-lim.velocity, lim.velocity),
@@ -69,14 +183,26 @@ Timed time_polyline(const Scene& s, const RMat& W, const TimingLimits& lim, int 
   if (lim.effort.size() == n) cons.push_back(std::make_shared<Torque>(s, lim.iv, lim.effort));
   for (auto& c : cons) c->discretizationType(toppra::Interpolation);
   const toppra::Vector gridpoints = toppra::Vector::LinSpaced(grid + 1, 0.0, 1.0);
+  std::vector<double> r(W.rows(), 0.0);
+  if (w != nullptr && blend > 0.0) r = radii(*w, W, blend, step);
   std::vector<std::shared_ptr<toppra::parametrizer::ConstAccel>> pieces;
   std::vector<double> starts{0.0};
   Timed out;
-  for (long k = 0; k + 1 < W.rows(); ++k) {
-    auto path = std::make_shared<Segment>(W.row(k).transpose(), W.row(k + 1).transpose());
+  for (long k = 0; k + 1 < W.rows();) {
+    long j = k + 1;  // the next stop: the end, or a corner not blended
+    while (j + 1 < W.rows() && r[j] > 0.0) ++j;
+    toppra::GeometricPathPtr path;
+    toppra::Vector grid_k = gridpoints;
+    if (j == k + 1) {
+      path = std::make_shared<Segment>(W.row(k).transpose(), W.row(k + 1).transpose());
+    } else {
+      auto blended = std::make_shared<Blended>(stretch(W, r, k, j));
+      grid_k = blended->gridpoints(grid);
+      path = blended;
+    }
     toppra::algorithm::TOPPRA algo(cons, path);
     algo.solver(std::make_shared<toppra::solver::Seidel>());
-    algo.setGridpoints(gridpoints);
+    algo.setGridpoints(grid_k);
     algo.setInitialXBounds(toppra::Bound(0.0, MAX_PATH_SPEED_SQ));
     if (algo.computePathParametrization(0.0, 0.0) != toppra::ReturnCode::OK) {
       out.failed_segment = static_cast<int>(k);
@@ -86,6 +212,7 @@ Timed time_polyline(const Scene& s, const RMat& W, const TimingLimits& lim, int 
     pieces.push_back(std::make_shared<toppra::parametrizer::ConstAccel>(
         path, data.gridpoints, data.parametrization));
     starts.push_back(starts.back() + pieces.back()->getTimes().tail(1)[0]);
+    k = j;
   }
   const double duration = starts.back();
   const long points = std::max<long>(2, static_cast<long>(std::ceil(duration * rate)) + 1);

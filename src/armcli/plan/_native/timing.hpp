@@ -21,9 +21,11 @@ struct Timed {
 };
 
 // Each segment of W (rows: waypoints) timed from rest to rest on a grid of `grid` intervals,
-// the whole motion sampled at `rate` [Hz].
+// the whole motion sampled at `rate` [Hz]. With `blend` > 0 and a Work `w`, each corner is
+// first rounded (see timing.cpp) where the rounding is free by w's planner check at `step`,
+// and the motion stops only at the corners that could not be rounded.
 Timed time_polyline(const Scene& s, const RMat& W, const TimingLimits& lim, int grid,
-                    double rate);
+                    double rate, Work* w = nullptr, double blend = 0.0, double step = 0.02);
 
 // Velocities and accelerations at the knots of the clamped (zero end slopes) C² cubic spline.
 void spline(const Vec& t, const RMat& y, RMat& v, RMat& a);
