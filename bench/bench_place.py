@@ -174,7 +174,7 @@ def bench_execute() -> None:
         if name == "compiled steps" and module is None:
             print("--execute: armcli.sim._drivestep not built, compiled steps skipped")
             continue
-        drivestep._state["module"] = module
+        drivestep.DRIVESTEP.use(module)
         cpu = wall = math.inf
         for _ in range(REPEATS):  # the first run also pays one-time costs (BLAS discovery)
             c0, w0 = time.process_time(), time.perf_counter()
@@ -188,7 +188,7 @@ def bench_execute() -> None:
             f"time in CPU, {sim / wall:.1f}x wall "
             f"(target >= 50x CPU); tool {done.tool_error * 1e3:.1f} mm from the target"
         )
-    drivestep._state["module"] = compiled
+    drivestep.DRIVESTEP.use(compiled)
     _bare_steps(done)
 
 

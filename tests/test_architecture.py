@@ -14,10 +14,10 @@ from tests.helpers import ROOT
 
 SRC = ROOT / "src" / "armcli"
 RANK = {  # layer of each top-level module or subpackage (docs/ARCHITECTURE.md)
-    "errors": 0, "defaults": 0, "io": 1, "spec": 2, "xacro": 3, "compiler": 4, "urdf": 5,
-    "robot": 6, "analysis": 7, "trajectory": 8, "export": 9, "importer": 9, "ros": 9, "sim": 10,
-    "drive": 11, "check": 12, "tune": 12, "plan": 12, "view": 13, "commands": 14, "cli": 15,
-    "__main__": 16,
+    "errors": 0, "defaults": 0, "compiled": 0, "io": 1, "spec": 2, "xacro": 3, "compiler": 4,
+    "urdf": 5, "robot": 6, "analysis": 7, "trajectory": 8, "export": 9, "importer": 9, "ros": 9,
+    "sim": 10, "drive": 11, "check": 12, "tune": 12, "plan": 12, "view": 13, "commands": 14,
+    "cli": 15, "__main__": 16,
 }  # fmt: skip
 
 

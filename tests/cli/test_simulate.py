@@ -173,7 +173,7 @@ def test_engine_is_reported_and_a_missing_one_is_one_error(
     code, out, _ = run(["--trajectory", str(TRAJ / "pick.yaml")], capsys)
     assert code == 0 and "compiled engine" in out
     monkeypatch.setenv("ARMCLI_NO_NATIVE", "1")
-    monkeypatch.setattr(native, "_state", {})
+    monkeypatch.setattr(native.ROLLOUT, "_loaded", None)  # asked again
     code, _, err = run(["--trajectory", str(TRAJ / "pick.yaml")], capsys)
     lines = [ln for ln in err.splitlines() if ln.strip()]
     assert code == 2 and len(lines) == 1 and "simulator is unavailable" in lines[0]

@@ -167,7 +167,7 @@ def test_missing_extension_is_an_error_saying_how_to_get_it(
     arm: Robot, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setenv("ARMCLI_NO_NATIVE", "1")
-    monkeypatch.setattr(native, "_state", {})
+    monkeypatch.setattr(native.ROLLOUT, "_loaded", None)  # asked again
     cfg = SimConfig(np.full(2, 50.0), np.full(2, 5.0), dt=1e-3)
     with pytest.raises(InputError, match=r"simulator is unavailable.*C\+\+ compiler") as exc:
         simulate(arm, _reference(arm), np.zeros(2), 0.2, cfg)
@@ -181,8 +181,8 @@ def test_an_extension_built_from_other_source_is_refused(
     require_native()
     edited = tmp_path / "rollout.cpp"
     edited.write_bytes(native.SOURCE.read_bytes() + b"// edited\n")
-    monkeypatch.setattr(native, "SOURCE", edited)
-    monkeypatch.setattr(native, "_state", {})
+    monkeypatch.setattr(native.ROLLOUT, "sources", (edited,))
+    monkeypatch.setattr(native.ROLLOUT, "_loaded", None)  # asked again
     assert native.load() is None and "built from another" in native.why_missing()
 
 

@@ -17,8 +17,6 @@ the steps instead of inside them (`drive.job.Pilot.observe`).
 from __future__ import annotations
 
 import ctypes
-import hashlib
-import os
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -26,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from armcli.compiled import Extension
 from armcli.drive.model import DriveModel
 
 if TYPE_CHECKING:
@@ -36,28 +35,8 @@ SEEN = 9  # seen[k]: qpos[0:7] (the free joint), then the two wheels' qvel
 _state: dict[str, Any] = {}
 
 
-def load() -> ModuleType | None:
-    """The compiled loop, or None (not built, built from another source, ARMCLI_NO_NATIVE)."""
-    if "module" not in _state:
-        _state["module"] = _import()
-    mod: ModuleType | None = _state["module"]
-    return mod
-
-
-def _import() -> ModuleType | None:
-    if os.environ.get("ARMCLI_NO_NATIVE"):
-        return None
-    import pinocchio  # noqa: F401  (loads libpinocchio_default before the extension)
-
-    try:
-        from armcli.sim import _drivestep
-    except ImportError:
-        return None
-    if SOURCE.is_file() and hashlib.sha256(SOURCE.read_bytes()).hexdigest() != getattr(
-        _drivestep, "SOURCE_SHA256", ""
-    ):
-        return None
-    return _drivestep
+DRIVESTEP = Extension("armcli.sim._drivestep", (SOURCE,))
+load = DRIVESTEP.load  # the compiled loop, or None (not built, stale, ARMCLI_NO_NATIVE)
 
 
 def mj_step_address() -> int | None:

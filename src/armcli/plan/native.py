@@ -12,14 +12,14 @@ native`) is not used either.
 
 from __future__ import annotations
 
-import hashlib
-import os
 from collections.abc import Sequence
 from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from armcli.compiled import Extension
 
 if TYPE_CHECKING:
     from armcli.plan import _planner
@@ -36,44 +36,10 @@ SOURCES = (
     "timing.cpp",
     "module.cpp",
 )
-_state: dict[str, Any] = {}
-
-
-def load() -> ModuleType | None:
-    """The extension module, or None when it is missing, stale or ARMCLI_NO_NATIVE is set."""
-    if "module" not in _state:
-        _state["module"], _state["why"] = _import()
-    mod: ModuleType | None = _state["module"]
-    return mod
-
-
-def why_missing() -> str:
-    """Why `load()` returned None."""
-    load()
-    why: str = _state["why"]
-    return why
-
-
-def source_hash() -> str:
-    """SHA-256 over the sources' SHA-256 lines, as CMakeLists.txt computes it."""
-    lines = "".join(
-        hashlib.sha256((NATIVE / name).read_bytes()).hexdigest() + "\n" for name in SOURCES
-    )
-    return hashlib.sha256(lines.encode()).hexdigest()
-
-
-def _import() -> tuple[ModuleType | None, str]:
-    if os.environ.get("ARMCLI_NO_NATIVE"):
-        return None, "ARMCLI_NO_NATIVE is set"
-    import pinocchio  # noqa: F401  (loads libpinocchio and libcoal before the extension)
-
-    try:
-        from armcli.plan import _planner
-    except ImportError as exc:
-        return None, f"the armcli.plan._planner extension is not installed ({exc})"
-    if all((NATIVE / n).is_file() for n in SOURCES) and source_hash() != _planner.SOURCE_SHA256:
-        return None, "armcli.plan._planner was built from other sources (run make native)"
-    return _planner, ""
+PLANNER = Extension("armcli.plan._planner", tuple(NATIVE / name for name in SOURCES))
+load = PLANNER.load  # the module, or None: missing, stale or ARMCLI_NO_NATIVE (the Python path)
+why_missing = PLANNER.why_missing
+source_hash = PLANNER.source_hash
 
 
 def _serialised(obj: Any) -> bytes:

@@ -10,27 +10,20 @@ stale physics.
 
 from __future__ import annotations
 
-import hashlib
-import os
 from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
+from armcli.compiled import Extension
 from armcli.errors import InputError
 
 if TYPE_CHECKING:
     from armcli.sim import _rollout
 
 SOURCE = Path(__file__).parent / "_native" / "rollout.cpp"
-_state: dict[str, Any] = {}
-
-
-def load() -> ModuleType | None:
-    """The extension module, or None when it is not installed (or ARMCLI_NO_NATIVE is set)."""
-    if "module" not in _state:
-        _state["module"], _state["why"] = _import()
-    mod: ModuleType | None = _state["module"]
-    return mod
+ROLLOUT = Extension("armcli.sim._rollout", (SOURCE,))
+load = ROLLOUT.load  # the module, or None: not installed, stale, or ARMCLI_NO_NATIVE set
+why_missing = ROLLOUT.why_missing
 
 
 def require() -> ModuleType:
@@ -46,31 +39,6 @@ def require() -> ModuleType:
             "installed: install a C++ compiler (e.g. apt-get install g++) and reinstall armcli"
         )
     return mod
-
-
-def _import() -> tuple[ModuleType | None, str]:
-    if os.environ.get("ARMCLI_NO_NATIVE"):
-        return None, "ARMCLI_NO_NATIVE is set"
-    import pinocchio  # noqa: F401  (loads libpinocchio_default before the extension)
-
-    try:
-        from armcli.sim import _rollout
-    except ImportError as exc:
-        return None, f"the armcli.sim._rollout extension is not installed ({exc})"
-    if SOURCE.is_file() and _sha256(SOURCE) != _rollout.SOURCE_SHA256:
-        return None, f"armcli.sim._rollout was built from another {SOURCE.name} (run make native)"
-    return _rollout, ""
-
-
-def _sha256(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
-
-
-def why_missing() -> str:
-    """Why `load()` returned None, for the one-line message."""
-    load()
-    why: str = _state["why"]
-    return why
 
 
 def compiled_model(mod: ModuleType, model: Any) -> _rollout.Model:

@@ -18,8 +18,6 @@ slower).
 
 from __future__ import annotations
 
-import hashlib
-import os
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -27,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from armcli.compiled import Extension
 from armcli.sim.world import GROUP as WORLD_GROUP
 
 FLOOR_GROUP, COLLISION_GROUP = 0, 3  # the drive's floor; the export's collision geoms
@@ -109,29 +108,8 @@ def _from_start(
 # -- the compiled pinhole caster (sim/_native/raycast.cpp) ----------------------------------
 
 SOURCE = Path(__file__).parents[1] / "_native" / "raycast.cpp"
-_state: dict[str, Any] = {}
-
-
-def native() -> ModuleType | None:
-    """armcli.sim._raycast, or None (not built, stale, or ARMCLI_NO_NATIVE set)."""
-    if "module" not in _state:
-        _state["module"] = _import()
-    mod: ModuleType | None = _state["module"]
-    return mod
-
-
-def _import() -> ModuleType | None:
-    if os.environ.get("ARMCLI_NO_NATIVE"):
-        return None
-    try:
-        from armcli.sim import _raycast
-    except ImportError:
-        return None
-    if SOURCE.is_file() and hashlib.sha256(SOURCE.read_bytes()).hexdigest() != getattr(
-        _raycast, "SOURCE_SHA256", ""
-    ):
-        return None  # built from another raycast.cpp: `make native`
-    return _raycast
+RAYCAST = Extension("armcli.sim._raycast", (SOURCE,), preload=None)
+native = RAYCAST.load  # armcli.sim._raycast, or None (not built, stale, or ARMCLI_NO_NATIVE)
 
 
 @dataclass(frozen=True)
