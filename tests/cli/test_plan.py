@@ -108,7 +108,15 @@ def test_plan_for_a_urdf(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> 
     out_file = tmp_path / "t.yaml"
     urdf = FIXTURES / "plan" / "two_link.urdf"  # no poses: --from is required
     code, _, err = run_main(["plan", "--urdf", urdf, "--to", "1,0"], capsys)
-    assert code == 2 and "--from" in err
+    assert code == 2 and "--from" in err and "named pose: none" in err
+    srdf = tmp_path / "two_link.srdf"  # a pose named otherwise (example-robot-data's Panda)
+    srdf.write_text(
+        '<robot name="two_link"><group name="arm"><joint name="shoulder"/><joint name="elbow"/>'
+        '</group><group_state name="ready" group="arm"><joint name="shoulder" value="0"/>'
+        '<joint name="elbow" value="0.5"/></group_state></robot>\n'
+    )
+    code, _, err = run_main(["plan", "--urdf", urdf, "--srdf", srdf, "--to", "1,0"], capsys)
+    assert code == 2 and "--from" in err and "named pose: ready" in err, err
     args = ["plan", "--urdf", urdf, "--from", "0,0", "--to", "1.0,-0.5", "-o", out_file]
     code, out, err = run_main(args, capsys)
     assert code == 0, err

@@ -92,7 +92,11 @@ def plan_request(
     )
     ctx = loaded.context
     if request.start is None and HOME not in ctx.robot.poses:
-        raise InputError(f"this robot has no `{HOME}` pose: give `start`", field="start")
+        named = ", ".join(sorted(ctx.robot.poses)) or "none"
+        raise InputError(
+            f"this robot has no `{HOME}` pose: give `start` (positions, or a named pose: {named})",
+            field="start",
+        )
     notes: list[str] = []
     x_start = configuration(ctx, request.start or HOME, "start", notes)
     if request.goal is not None:
