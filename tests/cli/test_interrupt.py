@@ -30,6 +30,15 @@ def _wait_for(stream: IO[str], marker: str) -> str:
     return seen
 
 
+def _as_at_a_terminal() -> None:
+    """Ctrl-C's default disposition in the child, as a terminal's shell gives it.
+
+    A runner started as a background job of a non-interactive shell ignores SIGINT, and an
+    ignored signal stays ignored across exec: armcli would never see the Ctrl-C under test.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _interrupt(args: list[str], marker: str, on_stderr: bool, cwd: Path) -> tuple[int, str]:
     proc = subprocess.Popen(
         [sys.executable, "-m", "armcli", *args],
@@ -37,6 +46,7 @@ def _interrupt(args: list[str], marker: str, on_stderr: bool, cwd: Path) -> tupl
         stderr=subprocess.PIPE,
         text=True,
         cwd=cwd,
+        preexec_fn=_as_at_a_terminal,
     )
     assert proc.stdout is not None and proc.stderr is not None
     try:
@@ -47,6 +57,7 @@ def _interrupt(args: list[str], marker: str, on_stderr: bool, cwd: Path) -> tupl
     finally:
         if proc.poll() is None:
             proc.kill()
+            proc.communicate()  # reaped and its pipes closed: nothing left for the next test
     return proc.returncode, err
 
 
